@@ -1,0 +1,21 @@
+# Warning and sanitizer flags shared by every msm target.
+add_library(msm_compile_options INTERFACE)
+target_compile_options(msm_compile_options INTERFACE -Wall -Wextra -Wno-unused-parameter
+  # The CPU build of the shared math must round like the GPU: no fused multiply-adds by surprise.
+  -ffp-contract=off)
+if(MSM_WERROR)
+  target_compile_options(msm_compile_options INTERFACE -Werror)
+endif()
+if(MSM_SANITIZE)
+  target_compile_options(msm_compile_options INTERFACE -fsanitize=${MSM_SANITIZE} -fno-omit-frame-pointer)
+  target_link_options(msm_compile_options INTERFACE -fsanitize=${MSM_SANITIZE})
+endif()
+install(TARGETS msm_compile_options EXPORT msmTargets)
+
+# msm_add_test(NAME SOURCES... LIBS ...): one GoogleTest executable, its tests registered with CTest.
+function(msm_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main msm_compile_options)
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 900)
+endfunction()

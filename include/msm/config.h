@@ -1,0 +1,58 @@
+// Constants of the techniques, each with the reason it has its value and where it comes from.
+// Shared by GLSL and C++ (see shared.h). Everything a technique takes as a parameter defaults to
+// the value here, and is overridable where the technique is configured.
+#ifndef MSM_CONFIG_H
+#define MSM_CONFIG_H
+#include "msm/shared.h"
+
+MSM_BEGIN
+
+// --- Moment biasing: b' = (1 - alpha) b + alpha b* (2015 §4.2, JCGT §2.5, §4.2, §5.4.3) ---
+// 2015: [0,1] depth, b* = E(½δ0 + ½δ1); alpha for float storage (JCGT Fig. 4d).
+const float MSM_ALPHA_UNIT_FLOAT = 2.0e-6f;
+// 2015: [0,1] depth, 16-bit storage after θ4 needs the stronger bias the paper states.
+const float MSM_ALPHA_UNIT_16BIT = 3.0e-5f;
+// JCGT: [-1,1] depth in float: worst-case b* = (1,0,0.375,0,0.375) and 3e-7 suffice.
+const float MSM_ALPHA_SIGNED_FLOAT = 3.0e-7f;
+// JCGT: [-1,1] depth, 16-bit Θ4*: b* = (1,0,0.628,0,0.628) (optimal after Θ4*) with 6e-5.
+const float MSM_ALPHA_SIGNED_16BIT = 6.0e-5f;
+// JCGT §4.2: 32-bit integer summed-area tables keep ~22.4 bits for 28² kernels: 6e-7.
+const float MSM_ALPHA_SAT_INT32 = 6.0e-7f;
+// JCGT §5.4.3: six moments in 10-bit (64 bits per texel), 16-bit (96) and float (192).
+const float MSM_ALPHA6_10BIT = 4.0e-3f;
+const float MSM_ALPHA6_16BIT = 8.0e-5f;
+const float MSM_ALPHA6_FLOAT = 5.0e-6f;
+
+// Biasing targets b* (without b0 = 1).
+const vec4 MSM_BSTAR_UNIT = vec4(0.5f, 0.5f, 0.5f, 0.5f);          // ½δ0 + ½δ1 on [0,1]
+const vec4 MSM_BSTAR_SIGNED_FLOAT = vec4(0.0f, 0.375f, 0.0f, 0.375f); // JCGT §2.5 worst case
+const vec4 MSM_BSTAR_SIGNED_16BIT = vec4(0.0f, 0.628f, 0.0f, 0.628f); // JCGT §2.5 after Θ4*
+// JCGT §5.4.3, six moments: (b1..b3) and (b4..b6).
+const vec3 MSM_BSTAR6_LO = vec3(0.0f, 0.5566f, 0.0f);
+const vec3 MSM_BSTAR6_HI = vec3(0.489f, 0.0f, 0.47869382f);
+
+// --- Non-linear quantization (HPG 2017 §3) ---
+// ξ4 is clamped below at 1.2e-7 so that Ψ4 = ln ln(ξ4·1e7) stays finite (HPG §3.3).
+const float MSM_NL_XI4_MIN = 1.2e-7f;
+// Upper limit of ξ4 for any depth distribution on [-1,1] (HPG supplementary).
+const float MSM_NL_XI4_MAX = 0.25f;
+// Clamping y1 = y2, v2 = 0 or 1 away by this tolerance, below 64-bit rounding (HPG §3.4).
+const float MSM_NL_TOLERANCE = 1.0e-6f;
+
+// --- Soft shadows ---
+// JCGT Eq. (4): weight of the fragment depth in the average blocker depth.
+const float MSM_BLOCKER_EPSILON = 1.0e-3f;
+
+// --- Shading ---
+// JCGT §2.6: shadow intensity divided by 98% and clamped hides leaking below 2%.
+const float MSM_OVERDARKEN_DEFAULT = 0.98f;
+
+// --- Baselines (JCGT Fig. 4, HPG §5.1) ---
+const float MSM_EVSM_C_64BIT = 5.54f;         // exponent that 16-bit channels can hold
+const float MSM_EVSM_C_POS_128BIT = 40.0f;    // c+ at 32-bit float channels
+const float MSM_EVSM_C_NEG_128BIT = 5.54f;    // c- at 32-bit float channels
+const float MSM_ESM_C_DEFAULT = 80.0f;        // ESM exponent for [0,1] depth in float
+
+MSM_END
+
+#endif // MSM_CONFIG_H
