@@ -27,9 +27,9 @@ const float MSM_ALPHA6_FLOAT = 5.0e-6f;
 const vec4 MSM_BSTAR_UNIT = vec4(0.5f, 0.5f, 0.5f, 0.5f);          // ½δ0 + ½δ1 on [0,1]
 const vec4 MSM_BSTAR_SIGNED_FLOAT = vec4(0.0f, 0.375f, 0.0f, 0.375f); // JCGT §2.5 worst case
 const vec4 MSM_BSTAR_SIGNED_16BIT = vec4(0.0f, 0.628f, 0.0f, 0.628f); // JCGT §2.5 after Θ4*
-// JCGT §5.4.3, six moments: (b1..b3) and (b4..b6).
-const vec3 MSM_BSTAR6_LO = vec3(0.0f, 0.5566f, 0.0f);
-const vec3 MSM_BSTAR6_HI = vec3(0.489f, 0.0f, 0.47869382f);
+// JCGT §5.4.3, six moments b* = (1, 0, 0.5566, 0, 0.489, 0, 0.47869382): the odd moments
+// (b1, b3, b5) of b* are zero, the even ones (b2, b4, b6) are these.
+const vec3 MSM_BSTAR6_EVEN = vec3(0.5566f, 0.489f, 0.47869382f);
 
 // --- Non-linear quantization (HPG 2017 §3) ---
 // ξ4 is clamped below at 1.2e-7 so that Ψ4 = ln ln(ξ4·1e7) stays finite (HPG §3.3).

@@ -3,4 +3,10 @@
 #define MSM_MSM_H
 #include "msm/shared.h"
 #include "msm/config.h"
+#include "msm/moments.h"
+#include "msm/quantize.h"
+#include "msm/bias.h"
+#include "msm/hamburger4.h"
+#include "msm/hausdorff4.h"
+#include "msm/three_moments.h"
 #endif

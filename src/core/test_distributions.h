@@ -1,0 +1,33 @@
+// Random depth distributions for the tests of the shared math, in double precision.
+// Continuous distributions are represented by a fine midpoint quadrature (512 atoms), which is
+// what a filter kernel over a sloped surface produces anyway.
+#pragma once
+#include <random>
+#include <vector>
+#include <glm/glm.hpp>
+
+namespace msm::test {
+
+struct Distribution {
+    std::vector<double> z; // depths
+    std::vector<double> w; // weights, sum 1
+};
+
+// 'count' Diracs with random depths in [lo, hi] and random weights (none below 1%).
+Distribution random_diracs(std::mt19937_64& rng, int count, double lo, double hi);
+// A mixture of 1-3 bumps (uniform or truncated Gaussian) inside [lo, hi], discretized.
+Distribution random_continuous(std::mt19937_64& rng, double lo, double hi);
+// Either of the above (half each), with 1 to 8 Diracs.
+Distribution random_distribution(std::mt19937_64& rng, double lo, double hi);
+
+double cdf_less(const Distribution& d, double zf);       // Z(z < zf)
+double cdf_less_equal(const Distribution& d, double zf); // Z(z <= zf)
+
+// (b0 = 1, b1, ..., bm) of d.
+std::vector<double> power_moments(const Distribution& d, int m);
+// (E sin 2πz, E cos 2πz, E sin 4πz, E cos 4πz) of a distribution on [0,1].
+std::vector<double> trig_moments(const Distribution& d);
+// b1..b4 rounded to float.
+glm::vec4 moments4f(const Distribution& d);
+
+} // namespace msm::test
