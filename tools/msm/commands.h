@@ -1,0 +1,16 @@
+// Subcommands of the msm tool. Each registers itself on the CLI11 app and runs from its callback.
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace msm::tool {
+
+void add_demo(CLI::App& app);
+void add_techniques(CLI::App& app);
+void add_reconstruct(CLI::App& app);
+
+// Thrown by commands for bad input: main prints the message and exits with status 2.
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+} // namespace msm::tool

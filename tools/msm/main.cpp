@@ -1,0 +1,24 @@
+// msm: the command-line front end of the moment shadow mapping toolkit.
+#include "commands.h"
+
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <exception>
+
+int main(int argc, char** argv) {
+    CLI::App app{"msm: moment shadow mapping toolkit (filtered, soft and volumetric shadows)"};
+    app.require_subcommand(1);
+    msm::tool::add_demo(app);
+    msm::tool::add_techniques(app);
+    msm::tool::add_reconstruct(app);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "msm: error: {}\n", e.what());
+        return 2;
+    }
+    return 0;
+}
