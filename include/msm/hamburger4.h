@@ -5,38 +5,51 @@
 #ifndef MSM_HAMBURGER4_H
 #define MSM_HAMBURGER4_H
 #include "msm/shared.h"
+#include "msm/roots.h"
 
 MSM_BEGIN
 
 // The canonical representation through zf: B c = (1, zf, zf²) solved by LDLᵀ (robust for
 // nearly singular B, 2015 §4.2); z2 <= z3 are the roots of c2 z² + c1 z + c0.
+//
+// Degenerate input. A kernel holding a single depth (a flat receiver: the most common kernel)
+// gives a B that is singular up to the bias, and in float D2 = b4 - b2² - L21² D1 cancels to
+// exactly 0. The bound still has a well-defined limit (B singular: at most two atoms, 2015
+// Prop. 4), which these steps reach without inf or NaN:
+//  - the pivots are floored at MSM_MIN_PIVOT1/2, orders of magnitude below what a biased vector
+//    has (D1 >= α Var(b*), D2 ~ α), so valid inputs are untouched;
+//  - c is scaled to max |c_i| = 1 (roots are scale-free) and the quadratic is solved without
+//    cancellation (t = -(c1 + sign(c1) √disc)/2; roots c0/t and t/c2);
+//  - a root escaping to infinity (c2 -> 0, 2015 Prop. 3) is clamped to ±MSM_ROOT_LIMIT, where the
+//    closed forms below take their limits to float precision.
 struct Hamburger4Roots {
     vec3 c;
     float z2;
     float z3;
 };
 
+const float MSM_MIN_PIVOT1 = 1.0e-10f;
+const float MSM_MIN_PIVOT2 = 1.0e-12f;
+
 MSM_FN Hamburger4Roots msm_hamburger4_roots(vec4 b, float zf) {
     float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];
     // B = L D Lᵀ with L = [[1,0,0],[b1,1,0],[b2,L21,1]], D = diag(1, D1, D2).
-    float D1 = b2 - b1 * b1;
-    float L21D1 = b3 - b1 * b2;
+    // The differences are formed with one rounding (msm_fma): they cancel to ~α.
+    float D1 = max(msm_fma(-b1, b1, b2), MSM_MIN_PIVOT1);
+    float L21D1 = msm_fma(-b1, b2, b3);
     float L21 = L21D1 / D1;
-    float D2 = b4 - b2 * b2 - L21 * L21D1;
+    float D2 = max(msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)), MSM_MIN_PIVOT2);
     // Forward substitution, scaling, back substitution.
     float y1 = zf - b1;
-    float y2 = zf * zf - b2 - L21 * y1;
+    float y2 = msm_fma(-L21, y1, msm_fma(zf, zf, -b2));
     y1 /= D1;
     y2 /= D2;
     vec3 c;
     c[2] = y2;
     c[1] = y1 - L21 * c[2];
     c[0] = 1.0f - b1 * c[1] - b2 * c[2];
-    // Quadratic formula on the monic polynomial; the discriminant is >= 0 in exact arithmetic.
-    float p = c[1] / c[2];
-    float q = c[0] / c[2];
-    float r = sqrt(max(0.25f * p * p - q, 0.0f));
-    return Hamburger4Roots(c, -0.5f * p - r, -0.5f * p + r);
+    vec2 z = msm_solve_quadratic(c);
+    return Hamburger4Roots(c, z.x, z.y);
 }
 
 // Weight of zf in the canonical representation: w0 = 1 / (pᵀ B⁻¹ p), p = (1, zf, zf²)

@@ -16,6 +16,7 @@
 #define MSM_SHARED_H
 
 #ifdef __cplusplus
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <glm/gtc/packing.hpp>
@@ -42,8 +43,18 @@ MSM_BEGIN
 
 const float MSM_PI = 3.14159265358979323846f;
 
-// clamp(x, 0, 1), the HLSL saturate that GLSL lacks.
-MSM_FN float msm_saturate(float x) { return clamp(x, 0.0f, 1.0f); }
+// a * b + c with one rounding: exact differences such as b2 - b1² in nearly singular Hankel
+// matrices. GLSL's fma is the GPU's fused multiply-add; GLM's fma is an unfused a * b + c, so the
+// C++ side calls std::fma (correctly rounded).
+#if MSM_CPP
+MSM_FN float msm_fma(float a, float b, float c) { return std::fma(a, b, c); }
+#else
+MSM_FN float msm_fma(float a, float b, float c) { return fma(a, b, c); }
+#endif
+
+// clamp(x, 0, 1), the HLSL saturate that GLSL lacks; NaN goes to 0 (GLSL's clamp leaves NaN
+// undefined and GLM's returns it), so a degenerate texel shows as lit, never as garbage.
+MSM_FN float msm_saturate(float x) { return x > 0.0f ? min(x, 1.0f) : 0.0f; }
 
 MSM_END
 

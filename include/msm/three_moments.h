@@ -5,6 +5,7 @@
 #ifndef MSM_THREE_MOMENTS_H
 #define MSM_THREE_MOMENTS_H
 #include "msm/shared.h"
+#include "msm/roots.h"
 
 MSM_BEGIN
 
@@ -17,17 +18,13 @@ struct TwoDepths {
 // depths. Zero or negative variance (a single depth, or rounding) returns δ(b1) as the paper says.
 MSM_FN TwoDepths msm_two_depths_from_three_moments(vec3 b) {
     float b1 = b[0], b2 = b[1], b3 = b[2];
-    float q2 = b2 - b1 * b1;
+    float q2 = msm_fma(-b1, b1, b2);
     if (!(q2 > 0.0f)) return TwoDepths(vec2(b1, b1), vec2(1.0f, 0.0f));
-    float q1 = b1 * b2 - b3;
-    float q0 = -b1 * q1 - b2 * q2;
-    float p = q1 / q2;
-    float q = q0 / q2;
-    float r = sqrt(max(0.25f * p * p - q, 0.0f));
-    float z1 = -0.5f * p - r;
-    float z2 = -0.5f * p + r;
-    float w2 = (b1 - z1) / (z2 - z1);
-    return TwoDepths(vec2(z1, z2), vec2(1.0f - w2, w2));
+    float q1 = msm_fma(b1, b2, -b3);
+    float q0 = msm_fma(-b1, q1, -b2 * q2);
+    vec2 z = msm_solve_quadratic(vec3(q0, q1, q2));
+    float w2 = (b1 - z.x) / (z.y - z.x);
+    return TwoDepths(z, vec2(1.0f - w2, w2));
 }
 
 MSM_END

@@ -1,0 +1,31 @@
+// Polynomial roots shared by the reconstructions, written to survive degenerate input: no
+// cancellation, no inf or NaN, roots escaping to infinity clamped to ±MSM_ROOT_LIMIT (depths
+// live in [-1,1], so the closed forms using the clamped root take their limits).
+#ifndef MSM_ROOTS_H
+#define MSM_ROOTS_H
+#include "msm/shared.h"
+
+MSM_BEGIN
+
+const float MSM_ROOT_LIMIT = 1.0e8f;
+
+// x clamped to [-MSM_ROOT_LIMIT, MSM_ROOT_LIMIT]; NaN goes to -MSM_ROOT_LIMIT.
+MSM_FN float msm_clamp_root(float x) {
+    return x > -MSM_ROOT_LIMIT ? (x < MSM_ROOT_LIMIT ? x : MSM_ROOT_LIMIT) : -MSM_ROOT_LIMIT;
+}
+
+// Both real roots of c2 z² + c1 z + c0 (ascending), for c not all zero; a negative discriminant
+// (rounding) counts as zero.
+MSM_FN vec2 msm_solve_quadratic(vec3 c) {
+    c /= max(max(abs(c[0]), abs(c[1])), abs(c[2]));
+    float s = sqrt(max(c[1] * c[1] - 4.0f * c[0] * c[2], 0.0f));
+    float t = -0.5f * (c[1] + (c[1] < 0.0f ? -s : s));
+    t = (t == 0.0f) ? 1.0e-30f : t;
+    float r1 = msm_clamp_root(c[0] / t);
+    float r2 = msm_clamp_root(t / c[2]);
+    return vec2(min(r1, r2), max(r1, r2));
+}
+
+MSM_END
+
+#endif // MSM_ROOTS_H

@@ -1,0 +1,142 @@
+// The Vulkan 1.3 instance, device and queue that everything else in msm::vk is created from.
+#pragma once
+
+#include "msm/vk/common.h"
+
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace msm::vk {
+
+struct ValidationMessage {
+  VkDebugUtilsMessageSeverityFlagBitsEXT severity; // WARNING or ERROR
+  std::string id;   // message id name, e.g. "VUID-VkBufferMemoryBarrier2-offset-01187"
+  std::string text; // the full message
+};
+
+// Every validation-layer (and loader) WARNING or ERROR a Context's messenger received; thread-safe.
+// A Context hands it out as a shared_ptr so that what vkDestroyDevice/vkDestroyInstance report
+// (leaked objects) can still be read once the Context is gone.
+class ValidationLog {
+public:
+  void add(ValidationMessage message);
+  std::size_t count() const;
+  std::vector<ValidationMessage> messages(std::size_t first = 0) const; // those from index `first` on
+  void clear();
+  // Print each message to stderr as it arrives (default on): a message appears next to the output
+  // of the code that caused it. Tests that provoke messages on purpose turn it off.
+  void setEcho(bool echo);
+  static std::string format(const std::vector<ValidationMessage>& messages);
+
+private:
+  mutable std::mutex mutex_;
+  std::vector<ValidationMessage> messages_;
+  bool echo_ = true;
+};
+
+struct ContextOptions {
+  // Which physical device: "cpu" (lavapipe), "gpu" (first discrete, else integrated GPU), a decimal
+  // index into vkEnumeratePhysicalDevices, or a case-insensitive substring of the device name.
+  // Empty: the environment variable MSM_DEVICE, same syntax; if that is unset too, the first
+  // discrete GPU, else the first integrated GPU, else any other suitable device (lavapipe).
+  // Suitable: Vulkan 1.3, a compute queue, VK_KHR_push_descriptor. No match throws, listing devices.
+  std::string device;
+  // VK_LAYER_KHRONOS_validation + a VK_EXT_debug_utils messenger that records into validation().
+  // Also turned on by MSM_VALIDATION=1 (or true/on/yes) for any program. A missing layer is not an
+  // error here: it is reported on stderr and validationEnabled() is false (tests check that).
+  bool validation = false;
+  bool synchronizationValidation = true; // with validation: the layer's hazard checks as well
+  bool echoValidation = true;            // see ValidationLog::setEcho
+  bool verbose = true;                   // one line on stderr naming the device picked
+  std::string applicationName = "msm";
+};
+
+struct DeviceInfo {
+  uint32_t index = 0; // in vkEnumeratePhysicalDevices order
+  std::string name;
+  VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
+  std::string driverName; // e.g. "llvmpipe", "NVIDIA"
+  std::string driverInfo; // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+  uint32_t apiVersion = 0;
+  std::string describe() const; // one line with all of the above
+};
+
+// The features the device was created with: each is on where the device supports it (the list is in
+// context.cpp). Vulkan 1.3 makes synchronization2, dynamicRendering and timelineSemaphore mandatory;
+// shaderInt64, 16-bit storage, shaderFloat16, hostQueryReset etc. may be off. pNext members are null.
+struct DeviceFeatures {
+  VkPhysicalDeviceFeatures core{};
+  VkPhysicalDeviceVulkan11Features v11{};
+  VkPhysicalDeviceVulkan12Features v12{};
+  VkPhysicalDeviceVulkan13Features v13{};
+};
+
+// Instance, physical device, device with one queue (graphics+compute where the device has such a
+// family, else compute) and a command pool for one-shot submissions (submitAndWait).
+// Not copyable or movable (the messenger holds its address). Externally synchronized: use it from
+// one thread at a time (the queue and the command pool are). Precondition for the destructor: every
+// object created from it (Buffer, Image, Program, GpuTimer, ...) has been destroyed; the destructor
+// waits for the device to be idle.
+class Context {
+public:
+  explicit Context(const ContextOptions& options = ContextOptions());
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  VkInstance instance() const noexcept { return instance_; }
+  VkPhysicalDevice physicalDevice() const noexcept { return physicalDevice_; }
+  VkDevice device() const noexcept { return device_; }
+  VkQueue queue() const noexcept { return queue_; }
+  uint32_t queueFamily() const noexcept { return queueFamily_; }
+  VkCommandPool commandPool() const noexcept { return commandPool_; }
+
+  const DeviceInfo& info() const noexcept { return info_; }
+  const DeviceFeatures& features() const noexcept { return features_; }
+  const VkPhysicalDeviceProperties& properties() const noexcept { return properties_; }
+  const VkPhysicalDeviceMemoryProperties& memoryProperties() const noexcept { return memory_; }
+  // Of the queue's family: 0 means no timestamps (GpuTimer then measures nothing).
+  uint32_t timestampValidBits() const noexcept { return timestampValidBits_; }
+
+  bool validationEnabled() const noexcept { return validation_; }
+  ValidationLog& validation() const noexcept { return *log_; }
+  std::shared_ptr<ValidationLog> validationLog() const noexcept { return log_; }
+
+  // VK_KHR_push_descriptor entry points (device-level, loaded at creation).
+  PFN_vkCmdPushDescriptorSetKHR cmdPushDescriptorSet() const noexcept { return pushDescriptorSet_; }
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR cmdPushDescriptorSetWithTemplate() const noexcept {
+    return pushDescriptorSetWithTemplate_;
+  }
+  // Names an object in validation messages and debuggers; a no-op without validation.
+  void setObjectName(VkObjectType type, uint64_t handle, const std::string& name) const;
+  template <class Handle> void setObjectName(VkObjectType type, Handle handle, const std::string& name) const {
+    setObjectName(type, (uint64_t)handle, name); // C cast: handles are pointers, or uint64_t on 32-bit
+  }
+
+private:
+  void destroy() noexcept;
+
+  std::shared_ptr<ValidationLog> log_ = std::make_shared<ValidationLog>();
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  VkCommandPool commandPool_ = VK_NULL_HANDLE;
+  uint32_t queueFamily_ = 0;
+  uint32_t timestampValidBits_ = 0;
+  bool validation_ = false;
+  DeviceInfo info_;
+  DeviceFeatures features_;
+  VkPhysicalDeviceProperties properties_{};
+  VkPhysicalDeviceMemoryProperties memory_{};
+  PFN_vkCmdPushDescriptorSetKHR pushDescriptorSet_ = nullptr;
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR pushDescriptorSetWithTemplate_ = nullptr;
+  PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;
+  PFN_vkDestroyDebugUtilsMessengerEXT destroyMessenger_ = nullptr;
+};
+
+} // namespace msm::vk

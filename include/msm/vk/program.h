@@ -1,0 +1,112 @@
+// Compute programs: a pipeline from embedded SPIR-V whose descriptors are pushed
+// (VK_KHR_push_descriptor, through a descriptor update template), and a one-call dispatch.
+//
+//   Program p = createProgram(ctx, "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(Push));
+//   dispatch(cmd, p, groupCount(n, 64), 1, 1, {input, output}, Push{n});
+#pragma once
+
+#include "msm/vk/common.h"
+#include "msm/vk/resources.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <span>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+namespace msm::vk {
+
+class Context;
+
+// The type of descriptor at binding i of set 0 is the i-th entry of a program's binding list.
+enum class Binding : uint8_t {
+  StorageBuffer, // layout(binding = i) buffer
+  UniformBuffer, // layout(binding = i) uniform
+  StorageImage,  // layout(binding = i, <format>) uniform image2D
+  SampledImage,  // layout(binding = i) uniform sampler2D (combined image + sampler)
+};
+
+// The value of one binding for dispatch(): a buffer range, or an image view in a layout (plus a
+// sampler for Binding::SampledImage). Implicit from Buffer and Image, so `{input, output}` works.
+struct Descriptor {
+  union {
+    VkDescriptorBufferInfo buffer;
+    VkDescriptorImageInfo image;
+  };
+  Descriptor(VkBuffer b, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE) : buffer{b, offset, range} {}
+  Descriptor(const Buffer& b, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE)
+      : buffer{b.handle(), offset, range} {}
+  Descriptor(VkImageView view, VkImageLayout layout, VkSampler sampler = VK_NULL_HANDLE) : image{sampler, view, layout} {}
+  // GENERAL: the layout of storage images. For a SampledImage pass the layout and the sampler.
+  Descriptor(const Image& i, VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL, VkSampler sampler = VK_NULL_HANDLE)
+      : image{sampler, i.view(), layout} {}
+};
+
+class Program {
+public:
+  VkPipeline pipeline() const noexcept { return pipeline_; }
+  VkPipelineLayout layout() const noexcept { return layout_; }
+  VkDescriptorSetLayout setLayout() const noexcept { return setLayout_; } // null without bindings
+  std::span<const Binding> bindings() const noexcept { return bindings_; }
+  uint32_t pushConstantSize() const noexcept { return pushConstantSize_; }
+  const std::string& name() const noexcept { return name_; }
+  explicit operator bool() const noexcept { return bool(pipeline_); }
+
+private:
+  friend Program createProgram(const Context&, std::span<const uint32_t>, std::string_view, std::span<const Binding>,
+                               uint32_t);
+  friend void dispatch(VkCommandBuffer, const Program&, uint32_t, uint32_t, uint32_t, std::span<const Descriptor>,
+                       std::span<const std::byte>);
+  std::string name_;
+  std::vector<Binding> bindings_;
+  uint32_t pushConstantSize_ = 0;
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR pushDescriptors_ = nullptr;
+  // Declaration order is creation order; destruction runs in reverse.
+  Unique<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout> setLayout_;
+  Unique<VkPipelineLayout, vkDestroyPipelineLayout> layout_;
+  Unique<VkDescriptorUpdateTemplate, vkDestroyDescriptorUpdateTemplate> template_;
+  Unique<VkPipeline, vkDestroyPipeline> pipeline_;
+};
+
+// A compute pipeline from SPIR-V with entry point "main". The push-constant range is
+// [0, pushConstantSize) for the compute stage (none if 0). Preconditions (std::invalid_argument
+// otherwise): SPIR-V words start with the magic number; pushConstantSize is a multiple of 4 and at
+// most maxPushConstantsSize; bindings.size() <= maxPushDescriptors. That the list matches the
+// shader's declarations is checked by the validation layer, not here.
+Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
+                      std::span<const Binding> bindings, uint32_t pushConstantSize = 0);
+// The same from an embedded shader (see shaders.h), looked up by name.
+Program createProgram(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
+                      uint32_t pushConstantSize = 0);
+
+// Binds the pipeline, pushes one descriptor per binding and the push constants, and dispatches
+// groupsX * groupsY * groupsZ workgroups. Preconditions (std::invalid_argument otherwise, nothing
+// recorded): one descriptor per binding, pushConstants.size() == program.pushConstantSize(). The
+// resources are in the layouts given and synchronized by the caller (the barrier helpers of
+// commands.h); cmd is recording, outside a render pass.
+void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ,
+              std::span<const Descriptor> bindings, std::span<const std::byte> pushConstants = {});
+
+inline void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY,
+                     uint32_t groupsZ, std::initializer_list<Descriptor> bindings = {},
+                     std::span<const std::byte> pushConstants = {}) {
+  dispatch(cmd, program, groupsX, groupsY, groupsZ, std::span<const Descriptor>(bindings.begin(), bindings.size()),
+           pushConstants);
+}
+
+// Push constants given as one struct (its bytes, padding included, must match the shader's block).
+template <class PushConstants>
+  requires(std::is_trivially_copyable_v<PushConstants> &&
+           !std::is_convertible_v<const PushConstants&, std::span<const std::byte>>)
+void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ,
+              std::initializer_list<Descriptor> bindings, const PushConstants& pushConstants) {
+  dispatch(cmd, program, groupsX, groupsY, groupsZ, bindings, std::as_bytes(std::span(&pushConstants, 1)));
+}
+
+// Workgroups needed for `threads` invocations with `localSize` per group: ceil(threads / localSize).
+constexpr uint32_t groupCount(uint32_t threads, uint32_t localSize) { return (threads + localSize - 1) / localSize; }
+
+} // namespace msm::vk

@@ -1,0 +1,436 @@
+#include "msm/vk/context.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <optional>
+
+namespace msm::vk {
+namespace {
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+std::string lower(std::string_view s) {
+  std::string out(s);
+  for (char& c : out) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+bool envFlag(const char* name) {
+  const char* value = std::getenv(name);
+  if (!value) return false;
+  std::string v = lower(value);
+  return v == "1" || v == "true" || v == "on" || v == "yes";
+}
+
+bool contains(const std::vector<VkExtensionProperties>& list, const char* name) {
+  return std::any_of(list.begin(), list.end(),
+                     [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
+}
+
+std::vector<VkExtensionProperties> instanceExtensions(const char* layer) {
+  uint32_t count = 0;
+  if (vkEnumerateInstanceExtensionProperties(layer, &count, nullptr) != VK_SUCCESS) return {};
+  std::vector<VkExtensionProperties> list(count);
+  if (vkEnumerateInstanceExtensionProperties(layer, &count, list.data()) < 0) return {};
+  list.resize(count);
+  return list;
+}
+
+bool hasLayer(const char* name) {
+  uint32_t count = 0;
+  MSM_VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
+  std::vector<VkLayerProperties> layers(count);
+  if (vkEnumerateInstanceLayerProperties(&count, layers.data()) < 0) return false;
+  layers.resize(count);
+  return std::any_of(layers.begin(), layers.end(),
+                     [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+const char* typeName(VkPhysicalDeviceType type) {
+  switch (type) {
+  case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+  case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
+  default: return "other";
+  }
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                         VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                         void* user) {
+  static_cast<ValidationLog*>(user)->add({severity, data->pMessageIdName ? data->pMessageIdName : "",
+                                          data->pMessage ? data->pMessage : ""});
+  return VK_FALSE; // the spec reserves VK_TRUE for layer development
+}
+
+struct Candidate {
+  VkPhysicalDevice device;
+  DeviceInfo info;
+  uint32_t queueFamily = 0;
+  uint32_t timestampValidBits = 0;
+  std::string unsuitable; // why it cannot be used; empty if it can
+};
+
+Candidate inspect(VkPhysicalDevice device, uint32_t index) {
+  Candidate c{.device = device};
+  VkPhysicalDeviceDriverProperties driver{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+  VkPhysicalDeviceProperties2 props{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &driver};
+  vkGetPhysicalDeviceProperties2(device, &props);
+  c.info = {index, props.properties.deviceName, props.properties.deviceType, driver.driverName, driver.driverInfo,
+            props.properties.apiVersion};
+
+  uint32_t familyCount = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, nullptr);
+  std::vector<VkQueueFamilyProperties> families(familyCount);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, families.data());
+  // Graphics+compute first: the renderer draws shadow maps and filters them on one queue.
+  int best = -1;
+  for (uint32_t i = 0; i < familyCount; ++i) {
+    VkQueueFlags flags = families[i].queueFlags;
+    if (!(flags & VK_QUEUE_COMPUTE_BIT)) continue;
+    if (best < 0 || ((flags & VK_QUEUE_GRAPHICS_BIT) && !(families[best].queueFlags & VK_QUEUE_GRAPHICS_BIT))) best = int(i);
+  }
+
+  uint32_t extCount = 0;
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, nullptr);
+  std::vector<VkExtensionProperties> extensions(extCount);
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, extensions.data());
+  extensions.resize(extCount);
+
+  if (props.properties.apiVersion < VK_API_VERSION_1_3)
+    c.unsuitable = "Vulkan 1.3 not supported";
+  else if (best < 0)
+    c.unsuitable = "no compute queue";
+  else if (!contains(extensions, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME))
+    c.unsuitable = "no " VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME;
+  else {
+    c.queueFamily = uint32_t(best);
+    c.timestampValidBits = families[best].timestampValidBits;
+  }
+  return c;
+}
+
+std::string listDevices(const std::vector<Candidate>& candidates) {
+  std::string out;
+  for (const Candidate& c : candidates)
+    out += fmt::format("\n  {}: {}{}", c.info.index, c.info.describe(),
+                       c.unsuitable.empty() ? "" : " [unsuitable: " + c.unsuitable + "]");
+  return out.empty() ? "\n  (none)" : out;
+}
+
+// Index into candidates of the device the selector names (see ContextOptions::device).
+size_t select(const std::vector<Candidate>& candidates, const std::string& selector, const char* source) {
+  auto fail = [&](const std::string& why) -> size_t {
+    throw std::runtime_error(fmt::format("msm::vk: {} (device selector '{}' from {}); devices:{}", why, selector,
+                                         source, listDevices(candidates)));
+  };
+  auto usable = [&](size_t i) { return candidates[i].unsuitable.empty(); };
+  auto firstOfType = [&](VkPhysicalDeviceType type) -> std::optional<size_t> {
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (usable(i) && candidates[i].info.type == type) return i;
+    return std::nullopt;
+  };
+
+  if (selector.empty()) {
+    for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
+      if (auto i = firstOfType(type)) return *i;
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (usable(i)) return i;
+    return fail("no suitable Vulkan device (Vulkan 1.3, a compute queue, VK_KHR_push_descriptor)");
+  }
+  std::string wanted = lower(selector);
+  if (wanted == "cpu") {
+    if (auto i = firstOfType(VK_PHYSICAL_DEVICE_TYPE_CPU)) return *i;
+    return fail("no suitable CPU device (install mesa-vulkan-drivers for lavapipe)");
+  }
+  if (wanted == "gpu") {
+    for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
+      if (auto i = firstOfType(type)) return *i;
+    return fail("no suitable discrete or integrated GPU");
+  }
+  size_t index = 0;
+  auto [end, err] = std::from_chars(wanted.data(), wanted.data() + wanted.size(), index);
+  if (err == std::errc() && end == wanted.data() + wanted.size()) {
+    if (index >= candidates.size()) return fail(fmt::format("no device with index {}", index));
+    if (!usable(index)) return fail(fmt::format("device {} is unsuitable: {}", index, candidates[index].unsuitable));
+    return index;
+  }
+  for (size_t i = 0; i < candidates.size(); ++i)
+    if (lower(candidates[i].info.name).find(wanted) != std::string::npos) {
+      if (!usable(i)) return fail(fmt::format("device {} is unsuitable: {}", i, candidates[i].unsuitable));
+      return i;
+    }
+  return fail("no device name contains it");
+}
+
+// Turns on every feature of this list that the device has. Why these: the shadow-map renderer and
+// the moment math use them where present (64-bit/16-bit arithmetic and storage for the quantized
+// moment formats, depth clamp for shadow casters behind the near plane, storage images without a
+// format qualifier for the filters, min/max samplers and host query reset for the timers).
+DeviceFeatures pickFeatures(VkPhysicalDevice device) {
+  DeviceFeatures s;
+  s.v13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+  s.v12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, .pNext = &s.v13};
+  s.v11 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES, .pNext = &s.v12};
+  VkPhysicalDeviceFeatures2 f2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &s.v11};
+  vkGetPhysicalDeviceFeatures2(device, &f2);
+  s.core = f2.features;
+
+  DeviceFeatures e;
+  e.v11.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_FEATURES;
+  e.v12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  e.v13.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES;
+#define MSM_ENABLE(group, name) e.group.name = s.group.name
+  MSM_ENABLE(core, shaderInt64);
+  MSM_ENABLE(core, shaderInt16);
+  MSM_ENABLE(core, shaderFloat64);
+  MSM_ENABLE(core, depthClamp);
+  MSM_ENABLE(core, depthBiasClamp);
+  MSM_ENABLE(core, samplerAnisotropy);
+  MSM_ENABLE(core, imageCubeArray);
+  MSM_ENABLE(core, independentBlend);
+  MSM_ENABLE(core, sampleRateShading);
+  MSM_ENABLE(core, fillModeNonSolid);
+  MSM_ENABLE(core, multiDrawIndirect);
+  MSM_ENABLE(core, drawIndirectFirstInstance);
+  MSM_ENABLE(core, fragmentStoresAndAtomics);
+  MSM_ENABLE(core, shaderImageGatherExtended);
+  MSM_ENABLE(core, shaderStorageImageExtendedFormats);
+  MSM_ENABLE(core, shaderStorageImageReadWithoutFormat);
+  MSM_ENABLE(core, shaderStorageImageWriteWithoutFormat);
+  MSM_ENABLE(v11, storageBuffer16BitAccess);
+  MSM_ENABLE(v11, uniformAndStorageBuffer16BitAccess);
+  MSM_ENABLE(v11, storagePushConstant16);
+  MSM_ENABLE(v11, shaderDrawParameters);
+  MSM_ENABLE(v12, storageBuffer8BitAccess);
+  MSM_ENABLE(v12, uniformAndStorageBuffer8BitAccess);
+  MSM_ENABLE(v12, shaderFloat16);
+  MSM_ENABLE(v12, shaderInt8);
+  MSM_ENABLE(v12, drawIndirectCount);
+  MSM_ENABLE(v12, samplerFilterMinmax);
+  MSM_ENABLE(v12, scalarBlockLayout);
+  MSM_ENABLE(v12, hostQueryReset);
+  MSM_ENABLE(v12, timelineSemaphore);
+  MSM_ENABLE(v13, synchronization2);
+  MSM_ENABLE(v13, dynamicRendering);
+  MSM_ENABLE(v13, maintenance4);
+#undef MSM_ENABLE
+  return e;
+}
+
+} // namespace
+
+void ValidationLog::add(ValidationMessage message) {
+  std::lock_guard lock(mutex_);
+  if (echo_)
+    std::fprintf(stderr, "msm::vk validation %s: %s\n",
+                 message.severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "ERROR" : "WARNING",
+                 message.text.c_str());
+  messages_.push_back(std::move(message));
+}
+
+std::size_t ValidationLog::count() const {
+  std::lock_guard lock(mutex_);
+  return messages_.size();
+}
+
+std::vector<ValidationMessage> ValidationLog::messages(std::size_t first) const {
+  std::lock_guard lock(mutex_);
+  if (first >= messages_.size()) return {};
+  return {messages_.begin() + std::ptrdiff_t(first), messages_.end()};
+}
+
+void ValidationLog::clear() {
+  std::lock_guard lock(mutex_);
+  messages_.clear();
+}
+
+void ValidationLog::setEcho(bool echo) {
+  std::lock_guard lock(mutex_);
+  echo_ = echo;
+}
+
+std::string ValidationLog::format(const std::vector<ValidationMessage>& messages) {
+  std::string out;
+  for (const ValidationMessage& m : messages)
+    out += fmt::format("[{}] {}\n", m.severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "ERROR" : "WARNING",
+                       m.text);
+  return out;
+}
+
+std::string DeviceInfo::describe() const {
+  return fmt::format("{} ({}, driver {} {}, Vulkan {}.{}.{})", name, typeName(type), driverName, driverInfo,
+                     VK_API_VERSION_MAJOR(apiVersion), VK_API_VERSION_MINOR(apiVersion),
+                     VK_API_VERSION_PATCH(apiVersion));
+}
+
+Context::Context(const ContextOptions& options) {
+  try {
+    uint32_t loaderVersion = 0;
+    MSM_VK_CHECK(vkEnumerateInstanceVersion(&loaderVersion));
+    if (loaderVersion < VK_API_VERSION_1_3)
+      throw std::runtime_error(fmt::format("msm::vk: the Vulkan loader supports {}.{}, 1.3 is needed",
+                                           VK_API_VERSION_MAJOR(loaderVersion), VK_API_VERSION_MINOR(loaderVersion)));
+
+    log_->setEcho(options.echoValidation);
+    bool wantValidation = options.validation || envFlag("MSM_VALIDATION");
+    std::vector<const char*> layers, extensions;
+    bool syncValidation = false;
+    if (wantValidation) {
+      std::vector<VkExtensionProperties> layerExtensions = instanceExtensions(kValidationLayer);
+      bool debugUtils = contains(instanceExtensions(nullptr), VK_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
+                        contains(layerExtensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+      if (!hasLayer(kValidationLayer)) {
+        std::fprintf(stderr, "msm::vk: validation requested but %s is not installed (Debian: apt install "
+                             "vulkan-validationlayers); running WITHOUT validation\n", kValidationLayer);
+      } else if (!debugUtils) {
+        std::fprintf(stderr, "msm::vk: validation requested but " VK_EXT_DEBUG_UTILS_EXTENSION_NAME
+                             " is missing; running WITHOUT validation\n");
+      } else {
+        validation_ = true;
+        layers.push_back(kValidationLayer);
+        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        syncValidation = options.synchronizationValidation &&
+                         contains(layerExtensions, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+        if (syncValidation) extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+      }
+    }
+
+    // The messenger is also chained into VkInstanceCreateInfo so that vkCreateInstance and
+    // vkDestroyInstance are covered; it keeps a pointer to *log_, which outlives the instance.
+    VkDebugUtilsMessengerCreateInfoEXT messengerInfo{
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+        .pfnUserCallback = onMessage,
+        .pUserData = log_.get()};
+    VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+    VkValidationFeaturesEXT validationFeatures{.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+                                               .pNext = &messengerInfo,
+                                               .enabledValidationFeatureCount = 1,
+                                               .pEnabledValidationFeatures = enables};
+    VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
+                          .pApplicationName = options.applicationName.c_str(),
+                          .pEngineName = "msm",
+                          .apiVersion = VK_API_VERSION_1_3};
+    VkInstanceCreateInfo instanceInfo{
+        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
+        .pNext = validation_ ? (syncValidation ? static_cast<const void*>(&validationFeatures) : &messengerInfo) : nullptr,
+        .pApplicationInfo = &app,
+        .enabledLayerCount = uint32_t(layers.size()),
+        .ppEnabledLayerNames = layers.data(),
+        .enabledExtensionCount = uint32_t(extensions.size()),
+        .ppEnabledExtensionNames = extensions.data()};
+    MSM_VK_CHECK(vkCreateInstance(&instanceInfo, nullptr, &instance_));
+
+    if (validation_) {
+      auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+      destroyMessenger_ = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+          vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+      setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+          vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
+      if (!create || !destroyMessenger_) throw std::runtime_error("msm::vk: VK_EXT_debug_utils entry points missing");
+      MSM_VK_CHECK(create(instance_, &messengerInfo, nullptr, &messenger_));
+    }
+
+    uint32_t count = 0;
+    MSM_VK_CHECK(vkEnumeratePhysicalDevices(instance_, &count, nullptr));
+    std::vector<VkPhysicalDevice> devices(count);
+    MSM_VK_CHECK(vkEnumeratePhysicalDevices(instance_, &count, devices.data()));
+    std::vector<Candidate> candidates;
+    for (uint32_t i = 0; i < count; ++i) candidates.push_back(inspect(devices[i], i));
+
+    const char* source = "the default policy";
+    std::string selector = options.device;
+    if (!selector.empty())
+      source = "ContextOptions::device";
+    else if (const char* env = std::getenv("MSM_DEVICE"); env && *env) {
+      selector = env;
+      source = "MSM_DEVICE";
+    }
+    const Candidate& chosen = candidates[select(candidates, selector, source)];
+    physicalDevice_ = chosen.device;
+    info_ = chosen.info;
+    queueFamily_ = chosen.queueFamily;
+    timestampValidBits_ = chosen.timestampValidBits;
+    vkGetPhysicalDeviceProperties(physicalDevice_, &properties_);
+    vkGetPhysicalDeviceMemoryProperties(physicalDevice_, &memory_);
+
+    features_ = pickFeatures(physicalDevice_);
+    DeviceFeatures chain = features_;
+    chain.v11.pNext = &chain.v12;
+    chain.v12.pNext = &chain.v13;
+    VkPhysicalDeviceFeatures2 features2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2,
+                                        .pNext = &chain.v11,
+                                        .features = chain.core};
+    float priority = 1.0f;
+    VkDeviceQueueCreateInfo queueInfo{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+                                      .queueFamilyIndex = queueFamily_,
+                                      .queueCount = 1,
+                                      .pQueuePriorities = &priority};
+    const char* deviceExtensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    VkDeviceCreateInfo deviceInfo{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+                                  .pNext = &features2,
+                                  .queueCreateInfoCount = 1,
+                                  .pQueueCreateInfos = &queueInfo,
+                                  .enabledExtensionCount = 1,
+                                  .ppEnabledExtensionNames = deviceExtensions};
+    MSM_VK_CHECK(vkCreateDevice(physicalDevice_, &deviceInfo, nullptr, &device_));
+    vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+
+    pushDescriptorSet_ =
+        reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
+    pushDescriptorSetWithTemplate_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetWithTemplateKHR>(
+        vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetWithTemplateKHR"));
+    if (!pushDescriptorSet_ || !pushDescriptorSetWithTemplate_)
+      throw std::runtime_error("msm::vk: VK_KHR_push_descriptor entry points missing");
+
+    VkCommandPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+                                     .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
+                                     .queueFamilyIndex = queueFamily_};
+    MSM_VK_CHECK(vkCreateCommandPool(device_, &poolInfo, nullptr, &commandPool_));
+
+    if (options.verbose)
+      std::fprintf(stderr, "msm::vk: device %u: %s; validation %s\n", info_.index, info_.describe().c_str(),
+                   validation_ ? (syncValidation ? "on (+synchronization)" : "on") : "off");
+  } catch (...) {
+    destroy();
+    throw;
+  }
+}
+
+Context::~Context() { destroy(); }
+
+void Context::destroy() noexcept {
+  if (device_) {
+    vkDeviceWaitIdle(device_); // nothing to do about a failure in a destructor; destruction goes on
+    if (commandPool_) vkDestroyCommandPool(device_, commandPool_, nullptr);
+    vkDestroyDevice(device_, nullptr); // the layer reports objects still alive here, into *log_
+  }
+  if (messenger_) destroyMessenger_(instance_, messenger_, nullptr);
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+  commandPool_ = VK_NULL_HANDLE;
+  device_ = VK_NULL_HANDLE;
+  messenger_ = VK_NULL_HANDLE;
+  instance_ = VK_NULL_HANDLE;
+}
+
+void Context::setObjectName(VkObjectType type, uint64_t handle, const std::string& name) const {
+  if (!setObjectName_ || !handle) return;
+  VkDebugUtilsObjectNameInfoEXT info{.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT,
+                                     .objectType = type,
+                                     .objectHandle = handle,
+                                     .pObjectName = name.c_str()};
+  MSM_VK_CHECK(setObjectName_(device_, &info));
+}
+
+} // namespace msm::vk

@@ -1,0 +1,121 @@
+#include "msm/vk/timer.h"
+
+#include "msm/vk/context.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace msm::vk {
+
+double TimerResults::total(std::string_view name) const {
+  double sum = 0;
+  for (const TimerScope& s : scopes)
+    if (s.name == name) sum += s.ms();
+  return sum;
+}
+
+std::size_t TimerResults::count(std::string_view name) const {
+  std::size_t n = 0;
+  for (const TimerScope& s : scopes) n += s.name == name;
+  return n;
+}
+
+std::vector<std::pair<std::string, double>> TimerResults::totals() const {
+  std::vector<std::pair<std::string, double>> out;
+  for (const TimerScope& s : scopes) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const auto& t) { return t.first == s.name; });
+    if (it == out.end())
+      out.emplace_back(s.name, s.ms());
+    else
+      it->second += s.ms();
+  }
+  return out;
+}
+
+GpuTimer::GpuTimer(const Context& ctx, uint32_t reserveScopes)
+    : device_(ctx.device()), supported_(ctx.timestampValidBits() > 0),
+      hostQueryReset_(ctx.features().v12.hostQueryReset),
+      msPerTick_(double(ctx.properties().limits.timestampPeriod) * 1e-6),
+      mask_(ctx.timestampValidBits() >= 64 ? ~0ull : (1ull << ctx.timestampValidBits()) - 1),
+      poolSize_(2 * std::max(reserveScopes, 1u)) {
+  if (supported_) addPool(VK_NULL_HANDLE); // reset by reset(cmd) before first use
+}
+
+void GpuTimer::addPool(VkCommandBuffer cmd) {
+  VkQueryPoolCreateInfo info{.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+                             .queryType = VK_QUERY_TYPE_TIMESTAMP,
+                             .queryCount = poolSize_};
+  VkQueryPool pool = VK_NULL_HANDLE;
+  MSM_VK_CHECK(vkCreateQueryPool(device_, &info, nullptr, &pool));
+  pools_.emplace_back(device_, pool);
+  // A pool added while recording must be reset before its first query; a fresh pool is not in use
+  // on the device, so a host reset (no render-pass restriction) is safe.
+  if (cmd == VK_NULL_HANDLE) return;
+  if (hostQueryReset_)
+    vkResetQueryPool(device_, pool, 0, poolSize_);
+  else
+    vkCmdResetQueryPool(cmd, pool, 0, poolSize_);
+}
+
+void GpuTimer::reset(VkCommandBuffer cmd) {
+  records_.clear();
+  open_.clear();
+  used_ = 0;
+  recording_ = true;
+  for (const auto& pool : pools_) vkCmdResetQueryPool(cmd, pool, 0, poolSize_);
+}
+
+uint32_t GpuTimer::nextQuery(VkCommandBuffer cmd) {
+  if (used_ == pools_.size() * poolSize_) addPool(cmd);
+  return used_++;
+}
+
+void GpuTimer::begin(VkCommandBuffer cmd, std::string_view name, VkPipelineStageFlags2 stage) {
+  if (!recording_) throw std::logic_error("msm::vk::GpuTimer::begin: call reset(cmd) first");
+  Record record{std::string(name), uint32_t(open_.size()), 0, 0};
+  if (supported_) {
+    record.beginQuery = nextQuery(cmd);
+    vkCmdWriteTimestamp2(cmd, stage, pools_[record.beginQuery / poolSize_], record.beginQuery % poolSize_);
+  }
+  open_.push_back(records_.size());
+  records_.push_back(std::move(record));
+}
+
+void GpuTimer::end(VkCommandBuffer cmd, VkPipelineStageFlags2 stage) {
+  if (open_.empty()) throw std::logic_error("msm::vk::GpuTimer::end: no scope is open");
+  Record& record = records_[open_.back()];
+  open_.pop_back();
+  if (supported_) {
+    record.endQuery = nextQuery(cmd);
+    vkCmdWriteTimestamp2(cmd, stage, pools_[record.endQuery / poolSize_], record.endQuery % poolSize_);
+  }
+}
+
+TimerResults GpuTimer::read() {
+  if (!open_.empty())
+    throw std::logic_error(fmt::format("msm::vk::GpuTimer::read: scope '{}' was not ended", records_[open_.back()].name));
+  recording_ = false; // the queries must be reset before they are written again
+  TimerResults results;
+  if (!supported_ || records_.empty()) return results;
+
+  std::vector<uint64_t> ticks(used_);
+  for (uint32_t first = 0; first < used_; first += poolSize_) {
+    uint32_t n = std::min(poolSize_, used_ - first);
+    // No WAIT_BIT: a command buffer that was never submitted would block forever.
+    VkResult r = vkGetQueryPoolResults(device_, pools_[first / poolSize_], 0, n, n * sizeof(uint64_t), &ticks[first],
+                                       sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
+    if (r == VK_NOT_READY)
+      throw std::runtime_error("msm::vk::GpuTimer::read: timestamps not available; submit the command buffer and "
+                               "wait for it first");
+    MSM_VK_CHECK(r);
+  }
+  // Differences modulo 2^timestampValidBits: the counter may wrap between two timestamps.
+  uint64_t origin = ticks[records_.front().beginQuery];
+  auto ms = [&](uint32_t query) { return double((ticks[query] - origin) & mask_) * msPerTick_; };
+  for (const Record& record : records_)
+    results.scopes.push_back({record.name, record.depth, ms(record.beginQuery), ms(record.endQuery)});
+  return results;
+}
+
+} // namespace msm::vk

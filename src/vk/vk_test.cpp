@@ -1,0 +1,441 @@
+// Tests of the msm::vk layer on the device MSM_DEVICE picks (lavapipe here), validation on.
+#include "msm/shared.h"
+#include "msm/vk/test_support.h"
+#include "msm/vk/vk.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace msm::vk {
+namespace {
+
+using test::VulkanTest;
+
+// Runs `body` with an environment variable set, restoring the old value.
+template <class F> void withEnv(const char* name, const char* value, F&& body) {
+  const char* old = std::getenv(name);
+  std::string saved = old ? old : "";
+  setenv(name, value, 1);
+  try {
+    body();
+  } catch (...) {
+    old ? setenv(name, saved.c_str(), 1) : unsetenv(name);
+    throw;
+  }
+  old ? setenv(name, saved.c_str(), 1) : unsetenv(name);
+}
+
+ContextOptions quietOptions(std::string device = "") {
+  ContextOptions options = test::testOptions();
+  options.device = std::move(device);
+  options.verbose = false;
+  return options;
+}
+
+TEST(ErrorTest, CheckThrowsWithResultNameAndCallSite) {
+  try {
+    MSM_VK_CHECK(VK_ERROR_DEVICE_LOST);
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.result(), VK_ERROR_DEVICE_LOST);
+    std::string what = e.what();
+    EXPECT_NE(what.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << what;
+    EXPECT_NE(what.find("vk_test.cpp"), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(MSM_VK_CHECK(VK_SUCCESS));
+  EXPECT_STREQ(resultName(VK_ERROR_OUT_OF_DEVICE_MEMORY), "VK_ERROR_OUT_OF_DEVICE_MEMORY");
+  EXPECT_STREQ(resultName(VkResult(-12345)), "VkResult(-12345)");
+}
+
+TEST(ShaderRegistryTest, FindsShadersByFileNameAndStem) {
+  std::span<const uint32_t> byStem = embedded_shader("selftest");
+  ASSERT_GT(byStem.size(), 5u);
+  EXPECT_EQ(byStem[0], 0x07230203u); // SPIR-V magic
+  EXPECT_EQ(embedded_shader("selftest.comp").data(), byStem.data());
+  EXPECT_NE(embedded_shader("selftest_image").data(), byStem.data());
+  std::vector<std::string> names = embedded_shader_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "selftest_image.comp"), names.end());
+}
+
+TEST(ShaderRegistryTest, UnknownNameThrowsAndListsEmbeddedShaders) {
+  try {
+    embedded_shader("no_such_shader");
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    std::string what = e.what();
+    EXPECT_NE(what.find("no_such_shader"), std::string::npos) << what;
+    EXPECT_NE(what.find("selftest"), std::string::npos) << what;
+  }
+}
+
+TEST(ContextTest, CreatesLavapipeDeviceWithValidation) {
+  std::shared_ptr<ValidationLog> log;
+  {
+    std::unique_ptr<Context> ctx;
+    try {
+      ctx = std::make_unique<Context>(quietOptions("cpu"));
+    } catch (const std::runtime_error& e) {
+      GTEST_SKIP() << "no lavapipe here: " << e.what();
+    }
+    ASSERT_TRUE(test::validationActive(*ctx));
+    log = ctx->validationLog();
+    EXPECT_EQ(ctx->info().type, VK_PHYSICAL_DEVICE_TYPE_CPU);
+    EXPECT_NE(ctx->info().name.find("llvmpipe"), std::string::npos) << ctx->info().describe();
+    EXPECT_GE(ctx->info().apiVersion, VK_API_VERSION_1_3);
+    EXPECT_NE(ctx->info().describe().find(ctx->info().driverName), std::string::npos);
+    EXPECT_TRUE(ctx->features().v13.synchronization2);
+    EXPECT_TRUE(ctx->features().v13.dynamicRendering);
+    EXPECT_TRUE(ctx->features().v12.timelineSemaphore);
+    EXPECT_NE(ctx->cmdPushDescriptorSetWithTemplate(), nullptr);
+    EXPECT_NE(ctx->queue(), VK_NULL_HANDLE);
+  }
+  // Destruction included: the layer reports leaked objects at vkDestroyDevice.
+  EXPECT_TRUE(test::noValidationMessages(*log));
+}
+
+TEST(ContextTest, SelectsDevicesByIndexNameAndEnvironment) {
+  Context byIndex(quietOptions("0"));
+  EXPECT_EQ(byIndex.info().index, 0u);
+  std::string name = byIndex.info().name;
+  // Case-insensitive substring of the name.
+  std::string upper = name.substr(0, 4);
+  std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+  EXPECT_EQ(Context(quietOptions(upper)).info().index, 0u);
+  withEnv("MSM_DEVICE", "0", [] { EXPECT_EQ(Context(quietOptions()).info().index, 0u); });
+  // An unknown selector fails, naming what it looked for and what exists.
+  withEnv("MSM_DEVICE", "no-such-device", [&] {
+    try {
+      Context ctx(quietOptions());
+      FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+      std::string what = e.what();
+      EXPECT_NE(what.find("no-such-device"), std::string::npos) << what;
+      EXPECT_NE(what.find("MSM_DEVICE"), std::string::npos) << what;
+      EXPECT_NE(what.find(name), std::string::npos) << what;
+    }
+  });
+  // "gpu" gives a GPU or an error, never lavapipe.
+  try {
+    Context gpu(quietOptions("gpu"));
+    EXPECT_TRUE(gpu.info().type == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ||
+                gpu.info().type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU);
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("GPU"), std::string::npos) << e.what();
+  }
+}
+
+// The checks of the other tests can fail: a deliberate misuse is reported.
+TEST(ValidationTest, ReportsAnOutOfRangeBufferBarrier) {
+  ContextOptions options = quietOptions();
+  options.echoValidation = false;
+  std::shared_ptr<ValidationLog> log;
+  {
+    Context ctx(options);
+    if (!ctx.validationEnabled()) {
+      ASSERT_TRUE(test::validationActive(ctx));
+      GTEST_SKIP() << "validation layer not installed";
+    }
+    log = ctx.validationLog();
+    Buffer buffer = createBuffer(ctx, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    ASSERT_EQ(log->count(), 0u) << ValidationLog::format(log->messages());
+    submitAndWait(ctx, [&](VkCommandBuffer cmd) {
+      // offset must be less than the buffer's size (VUID-VkBufferMemoryBarrier2-offset-01187).
+      pipelineBarrier(cmd, bufferBarrier(buffer.handle(), VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                         VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                         VK_ACCESS_2_SHADER_READ_BIT, 1024, 16));
+    });
+    std::vector<ValidationMessage> messages = log->messages();
+    ASSERT_FALSE(messages.empty());
+    EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const ValidationMessage& m) {
+      return m.severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT && m.id.find("offset-01187") != std::string::npos;
+    })) << ValidationLog::format(messages);
+    log->clear();
+  }
+  EXPECT_TRUE(test::noValidationMessages(*log)); // nothing else went wrong, destruction included
+}
+
+// ... and an object never destroyed is reported when the Context goes.
+TEST(ValidationTest, ReportsObjectsAliveAtDeviceDestruction) {
+  ContextOptions options = quietOptions();
+  options.echoValidation = false;
+  std::shared_ptr<ValidationLog> log;
+  {
+    Context ctx(options);
+    if (!ctx.validationEnabled()) {
+      ASSERT_TRUE(test::validationActive(ctx));
+      GTEST_SKIP() << "validation layer not installed";
+    }
+    log = ctx.validationLog();
+    VkSamplerCreateInfo info{.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .maxLod = 1.0f};
+    VkSampler leaked = VK_NULL_HANDLE;
+    MSM_VK_CHECK(vkCreateSampler(ctx.device(), &info, nullptr, &leaked));
+  }
+  std::vector<ValidationMessage> messages = log->messages();
+  EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const ValidationMessage& m) {
+    return m.text.find("VkSampler") != std::string::npos;
+  })) << ValidationLog::format(messages);
+}
+
+class VkLayerTest : public VulkanTest {};
+
+TEST_F(VkLayerTest, SaturateShaderMatchesCpu) {
+  constexpr uint32_t n = 100000;
+  std::vector<float> input(n);
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<float> dist(-2.0f, 3.0f);
+  for (float& x : input) x = dist(rng);
+  // Edges and extremes. No NaN (what msm_saturate does with it is the shared header's contract, not
+  // this layer's) and no subnormals (GPUs may flush them to zero, which is not what is tested here).
+  const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, std::nextafter(1.0f, 2.0f), std::nextafter(1.0f, 0.0f),
+                            FLT_MIN, -FLT_MIN, FLT_MAX, -FLT_MAX, INFINITY, -INFINITY, 1e-30f, 1e30f};
+  std::copy(std::begin(specials), std::end(specials), input.begin());
+
+  Buffer src = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Device);
+  Buffer dst = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
+  uploadBuffer(ctx(), src, std::as_bytes(std::span(input)));
+  Program program = createProgram(ctx(), "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(uint32_t));
+  submitAndWait(ctx(), [&](VkCommandBuffer cmd) { dispatch(cmd, program, groupCount(n, 64), 1, 1, {src, dst}, n); });
+
+  std::span<const float> out = dst.mapped<const float>();
+  ASSERT_EQ(out.size(), n);
+  int mismatches = 0;
+  for (uint32_t i = 0; i < n; ++i)
+    if (!(out[i] == msm::msm_saturate(input[i])) && ++mismatches <= 5)
+      ADD_FAILURE() << "i=" << i << " x=" << input[i] << " gpu=" << out[i] << " cpu=" << msm::msm_saturate(input[i]);
+  EXPECT_EQ(mismatches, 0);
+  // The Device buffer reads back what was uploaded (staging path both ways).
+  EXPECT_EQ(readbackBuffer<float>(ctx(), src, n), input);
+}
+
+TEST_F(VkLayerTest, PushConstantsAndEveryBindingType) {
+  constexpr uint32_t W = 37, H = 23; // not multiples of the 8x8 workgroup: the bounds check matters
+  struct Push {
+    int32_t size[2];
+    float scale;
+    float layer;
+  } push{{int32_t(W), int32_t(H)}, 2.0f, 3.0f};
+  const float offset[4] = {0.125f, 0.25f, 0.5f, 1.0f};
+  // Multiples of 1/8 with few bits: every product and sum is exact, fused or not.
+  std::vector<float> source(W * H * 4), table(W * H * 4);
+  for (uint32_t y = 0; y < H; ++y)
+    for (uint32_t x = 0; x < W; ++x) {
+      float* s = &source[(y * W + x) * 4];
+      float* t = &table[(y * W + x) * 4];
+      s[0] = float(x % 16) / 8.0f, s[1] = float(y % 16) / 8.0f, s[2] = float((x + y) % 7) * 0.25f, s[3] = -1.0f;
+      t[0] = 0.25f * float(x % 4), t[1] = -0.5f * float(y % 3), t[2] = 1.0f, t[3] = 2.0f;
+    }
+
+  VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;
+  Image sourceImage = createImage(ctx(), {W, H, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  Image tableImage = createImage(ctx(), {W, H, format, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  Image result = createImage(ctx(), {W, H, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+  Buffer params = createBuffer(ctx(), sizeof(offset), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, Memory::Host);
+  Sampler sampler = createSampler(ctx(), VK_FILTER_NEAREST);
+  uploadImage(ctx(), sourceImage, std::as_bytes(std::span(source)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+  uploadImage(ctx(), tableImage, std::as_bytes(std::span(table)), VK_IMAGE_LAYOUT_UNDEFINED,
+              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  uploadBuffer(ctx(), params, std::as_bytes(std::span(offset)));
+
+  Program program = createProgram(
+      ctx(), "selftest_image",
+      {Binding::StorageImage, Binding::StorageImage, Binding::SampledImage, Binding::UniformBuffer}, sizeof(Push));
+  submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+    pipelineBarrier(cmd, imageBarrier(result.handle(), result.aspect(), VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                                      VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL));
+    dispatch(cmd, program, groupCount(W, 8), groupCount(H, 8), 1,
+             {sourceImage, result, Descriptor(tableImage, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler), params},
+             push);
+  });
+
+  std::vector<std::byte> bytes = readbackImage(ctx(), result, VK_IMAGE_LAYOUT_GENERAL);
+  ASSERT_EQ(bytes.size(), source.size() * sizeof(float));
+  std::vector<float> out(source.size());
+  std::memcpy(out.data(), bytes.data(), bytes.size());
+  int mismatches = 0;
+  for (uint32_t y = 0; y < H; ++y)
+    for (uint32_t x = 0; x < W; ++x)
+      for (uint32_t c = 0; c < 4; ++c) {
+        uint32_t i = (y * W + x) * 4 + c;
+        float coordinate[4] = {float(x), float(y), push.layer, 0.0f};
+        float expected = source[i] * push.scale + table[i] + offset[c] + coordinate[c];
+        if (out[i] != expected && ++mismatches <= 5)
+          ADD_FAILURE() << "(" << x << "," << y << ")." << c << ": " << out[i] << " != " << expected;
+      }
+  EXPECT_EQ(mismatches, 0);
+}
+
+TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
+  GpuTimer timer(ctx(), 2); // 4 queries per pool: the scopes below need several pools
+  if (!timer.supported()) GTEST_SKIP() << "no timestamps on this queue";
+  constexpr uint32_t n = 1 << 16;
+  Buffer a = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  Buffer b = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  std::vector<float> zeros(n, 0.5f);
+  uploadBuffer(ctx(), a, std::as_bytes(std::span(zeros)));
+  Program program = createProgram(ctx(), "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(uint32_t));
+  auto computeToCompute = memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  const std::vector<std::string> tinyNames(12, "tiny");
+
+  for (int frame = 0; frame < 2; ++frame) { // the second frame reuses the grown pools
+    submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+      timer.reset(cmd);
+      timer.begin(cmd, "frame");
+      timer.begin(cmd, "shadow_depth");
+      dispatch(cmd, program, groupCount(n, 64), 1, 1, {a, b}, n);
+      timer.end(cmd);
+      pipelineBarrier(cmd, computeToCompute);
+      timer.begin(cmd, "filter");
+      dispatch(cmd, program, groupCount(n, 64), 1, 1, {b, a}, n);
+      timer.end(cmd);
+      pipelineBarrier(cmd, computeToCompute);
+      timer.begin(cmd, "shadow_depth");
+      dispatch(cmd, program, groupCount(n, 64), 1, 1, {a, b}, n);
+      timer.end(cmd);
+      pipelineBarrier(cmd, computeToCompute);
+      timer.end(cmd);
+      for (const std::string& name : tinyNames) {
+        timer.begin(cmd, name);
+        timer.end(cmd);
+      }
+    });
+    TimerResults r = timer.read();
+    ASSERT_EQ(r.scopes.size(), 4 + tinyNames.size());
+    std::vector<std::string> names;
+    for (const TimerScope& s : r.scopes) names.push_back(s.name);
+    std::vector<std::string> expected = {"frame", "shadow_depth", "filter", "shadow_depth"};
+    expected.insert(expected.end(), tinyNames.begin(), tinyNames.end());
+    EXPECT_EQ(names, expected);
+    EXPECT_EQ(r.scopes[0].depth, 0u);
+    EXPECT_EQ(r.scopes[1].depth, 1u);
+    EXPECT_EQ(r.scopes[4].depth, 0u);
+    EXPECT_EQ(r.scopes[0].startMs, 0.0);
+    for (const TimerScope& s : r.scopes) {
+      EXPECT_GE(s.startMs, 0.0) << s.name;
+      EXPECT_GE(s.ms(), 0.0) << s.name;
+    }
+    // Sequential scopes do not overlap; nested ones lie inside their parent.
+    for (size_t i = 1; i + 1 < r.scopes.size(); ++i)
+      if (i != 3) {
+        EXPECT_LE(r.scopes[i].endMs, r.scopes[i + 1].startMs) << i;
+      }
+    for (size_t i = 1; i <= 3; ++i) {
+      EXPECT_GE(r.scopes[i].startMs, r.scopes[0].startMs);
+      EXPECT_LE(r.scopes[i].endMs, r.scopes[0].endMs);
+    }
+    EXPECT_GT(r.scopes[0].ms(), 0.0); // three dispatches of 65536 invocations take some time
+    EXPECT_EQ(r.count("shadow_depth"), 2u);
+    EXPECT_DOUBLE_EQ(r.total("shadow_depth"), r.scopes[1].ms() + r.scopes[3].ms());
+    EXPECT_EQ(r.total("absent"), 0.0);
+    auto totals = r.totals();
+    ASSERT_EQ(totals.size(), 4u);
+    EXPECT_EQ(totals[1].first, "shadow_depth");
+    EXPECT_EQ(totals[3].first, "tiny");
+  }
+
+  // Misuse is an exception, not a validation error or a hang.
+  submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+    EXPECT_THROW(timer.begin(cmd, "no reset"), std::logic_error);
+    timer.reset(cmd);
+    EXPECT_THROW(timer.end(cmd), std::logic_error);
+    timer.begin(cmd, "open");
+    EXPECT_THROW(timer.read(), std::logic_error);
+    timer.end(cmd);
+  });
+  EXPECT_EQ(timer.read().scopes.size(), 1u);
+}
+
+TEST_F(VkLayerTest, ArgumentErrorsThrowBeforeAnythingIsRecorded) {
+  Buffer buffer = createBuffer(ctx(), 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  Program program = createProgram(ctx(), "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, 4);
+  EXPECT_EQ(program.name(), "selftest");
+  EXPECT_EQ(program.bindings().size(), 2u);
+  submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer}, 1u), std::invalid_argument);
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer, buffer}), std::invalid_argument);
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer, buffer}, uint64_t(1)), std::invalid_argument);
+  });
+  EXPECT_THROW(createProgram(ctx(), "selftest", {Binding::StorageBuffer}, 6), std::invalid_argument);
+  const uint32_t notSpirv[] = {1, 2, 3};
+  EXPECT_THROW(createProgram(ctx(), notSpirv, "junk", {}), std::invalid_argument);
+  EXPECT_THROW(createProgram(ctx(), "no_such_shader", {}), std::runtime_error);
+  // An exception while recording leaves nothing behind (the command buffer is freed, unsubmitted).
+  EXPECT_THROW(submitAndWait(ctx(), [](VkCommandBuffer) { throw std::runtime_error("recording failed"); }),
+               std::runtime_error);
+  std::byte bytes[16]{};
+  EXPECT_THROW(uploadBuffer(ctx(), buffer, bytes, 56), std::out_of_range);
+  EXPECT_THROW(readbackBuffer(ctx(), buffer, bytes, 64), std::out_of_range);
+}
+
+TEST_F(VkLayerTest, BuffersRoundTripAtOffsets) {
+  std::vector<uint32_t> words(256);
+  for (uint32_t i = 0; i < words.size(); ++i) words[i] = i * 2654435761u;
+  for (Memory memory : {Memory::Device, Memory::Host}) {
+    Buffer buffer = createBuffer(ctx(), 4096, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, memory);
+    EXPECT_EQ(buffer.memory(), memory);
+    EXPECT_EQ(buffer.data() != nullptr, memory == Memory::Host);
+    uploadBuffer(ctx(), buffer, std::as_bytes(std::span(words)), 1024);
+    EXPECT_EQ(readbackBuffer<uint32_t>(ctx(), buffer, words.size(), 1024), words);
+    Buffer moved = std::move(buffer); // move-only handles: the moved-from one owns nothing
+    EXPECT_FALSE(buffer);
+    EXPECT_EQ(readbackBuffer<uint32_t>(ctx(), moved, 4, 1024 + 8), std::vector<uint32_t>(words.begin() + 2, words.begin() + 6));
+  }
+}
+
+TEST_F(VkLayerTest, ImagesWithMipsLayersSamplesAndViews) {
+  // Layers round trip through upload/readback.
+  Image layered = createImage(ctx(), {.width = 16, .height = 8, .format = VK_FORMAT_R32_SFLOAT,
+                                      .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                               VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                                      .layers = 3});
+  std::vector<float> texels(16 * 8 * 3);
+  for (size_t i = 0; i < texels.size(); ++i) texels[i] = float(i) * 0.5f;
+  uploadImage(ctx(), layered, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED,
+              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  std::vector<std::byte> bytes = readbackImage(ctx(), layered, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  ASSERT_EQ(bytes.size(), texels.size() * sizeof(float));
+  EXPECT_EQ(std::memcmp(bytes.data(), texels.data(), bytes.size()), 0);
+
+  // A mip chain with one view per mip, as a reduction pass would use.
+  Image mips = createImage(ctx(), {.width = 64, .height = 64, .format = VK_FORMAT_R16G16B16A16_SFLOAT,
+                                   .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT,
+                                   .mipLevels = 7});
+  EXPECT_NE(mips.view(), VK_NULL_HANDLE);
+  std::vector<ImageView> mipViews;
+  for (uint32_t mip = 0; mip < 7; ++mip)
+    mipViews.push_back(createImageView(ctx(), mips.handle(), mips.format(), VK_IMAGE_ASPECT_COLOR_BIT,
+                                       VK_IMAGE_VIEW_TYPE_2D, mip, 1));
+
+  // A multisampled depth target and a comparison sampler for shadow lookups.
+  VkSampleCountFlags counts = ctx().properties().limits.framebufferDepthSampleCounts;
+  VkSampleCountFlagBits samples = (counts & VK_SAMPLE_COUNT_4_BIT) ? VK_SAMPLE_COUNT_4_BIT : VK_SAMPLE_COUNT_1_BIT;
+  Image depth = createImage(ctx(), {.width = 32, .height = 32, .format = VK_FORMAT_D32_SFLOAT,
+                                    .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                                    .samples = samples});
+  EXPECT_EQ(depth.aspect(), VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT));
+  Sampler shadowSampler = createSampler(ctx(), VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
+                                        VK_COMPARE_OP_LESS_OR_EQUAL);
+  EXPECT_TRUE(shadowSampler);
+
+  // Transfer-only images get no view; move assignment releases the old image first.
+  Image plain = createImage(ctx(), {.width = 4, .height = 4, .format = VK_FORMAT_R8G8B8A8_UNORM,
+                                    .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  EXPECT_EQ(plain.view(), VK_NULL_HANDLE);
+  plain = std::move(depth);
+  EXPECT_FALSE(depth);
+  EXPECT_EQ(plain.format(), VK_FORMAT_D32_SFLOAT);
+}
+
+} // namespace
+} // namespace msm::vk
