@@ -5,8 +5,11 @@
 #include "msm/config.h"
 #include "msm/moments.h"
 #include "msm/quantize.h"
+#include "msm/roots.h"
 #include "msm/bias.h"
 #include "msm/hamburger4.h"
 #include "msm/hausdorff4.h"
 #include "msm/three_moments.h"
+#include "msm/nonlinear.h"
+#include "msm/baselines.h"
 #endif
