@@ -9,6 +9,8 @@
 #include "msm/bias.h"
 #include "msm/hamburger4.h"
 #include "msm/hausdorff4.h"
+#include "msm/hamburger6.h"
+#include "msm/blocker.h"
 #include "msm/three_moments.h"
 #include "msm/nonlinear.h"
 #include "msm/baselines.h"

@@ -91,6 +91,20 @@ float csm4_shade(const Texel& t, float zf) {
     return msm_csm_resolve(sum, p);
 }
 
+// ---- Six moments (JCGT §5.4), [-1,1] depth, Θ6* for fixed-point storage ----
+Texel from(Moments6 m) { return {m.odd.x, m.odd.y, m.odd.z, m.even.x, m.even.y, m.even.z, 0, 0}; }
+Moments6 to_m6(const Texel& t) { return Moments6(vec3(t[0], t[1], t[2]), vec3(t[3], t[4], t[5])); }
+Texel m6_float(float d) { return from(msm_moments6(msm_signed_depth(d))); }
+Texel m6_theta(float d) { return from(msm_theta6_star(msm_moments6(msm_signed_depth(d)))); }
+Texel m6_unorm16(const Texel& t) { return from(msm_quantize_unorm16(to_m6(t))); }
+Texel m6_unorm10(const Texel& t) { return from(msm_quantize_unorm10(to_m6(t))); }
+float m6_shade(Moments6 b, int representation, float zf) {
+    return msm_hamburger6_lower(msm_apply_bias6(b, msm_moment_bias6(representation)), msm_signed_depth(zf));
+}
+float m6_float_shade(const Texel& t, float zf) { return m6_shade(to_m6(t), MSM_REP6_FLOAT, zf); }
+float m6_16_shade(const Texel& t, float zf) { return m6_shade(msm_theta6_star_inverse(to_m6(t)), MSM_REP6_UNORM16, zf); }
+float m6_10_shade(const Texel& t, float zf) { return m6_shade(msm_theta6_star_inverse(to_m6(t)), MSM_REP6_UNORM10, zf); }
+
 constexpr Technique kTechniques[] = {
     {"vsm-32", "VSM, 2 x 16-bit UNORM after θ2, depth in [0,1] (2015)", 32, 2, vsm_theta2, unorm16x2, vsm_theta2_shade},
     {"vsm-64", "VSM, 2 x float", 64, 2, vsm_float, identity, vsm_float_shade},
@@ -112,6 +126,9 @@ constexpr Technique kTechniques[] = {
      hausdorff_unit_float},
     {"msm-hausdorff-64-theta4", "Hausdorff 4MSM on [0,1], 4 x 16-bit UNORM after θ4 (2015)", 64, 4, theta4, unorm16,
      hausdorff_theta4},
+    {"msm6-192", "Hamburger 6MSM, 6 x float, depth in [-1,1] (JCGT §5.4)", 192, 6, m6_float, identity, m6_float_shade},
+    {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", 96, 6, m6_theta, m6_unorm16, m6_16_shade},
+    {"msm6-64", "Hamburger 6MSM, 6 x 10-bit UNORM after Θ6* (JCGT §5.4.3)", 64, 6, m6_theta, m6_unorm10, m6_10_shade},
     {"msm-nl64", "Non-linearly quantized 4MSM, 4 x 16-bit (y1, y2, v2, Ψ4(ξ4)) (HPG 2017)", 64, 4, moments_signed,
      nl64_store, nl_shade},
     {"msm-nl32", "Non-linearly quantized 4MSM, 32-bit packed (HPG 2017)", 32, 4, moments_signed, nl32_store, nl_shade},
