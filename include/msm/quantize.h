@@ -76,7 +76,9 @@ MSM_FN Moments6 msm_theta6_star_inverse(Moments6 q) {
                     MSM_THETA6_EVEN_INV * (q.even - MSM_THETA6_EVEN_OFFSET));
 }
 
-// ---- Fixed-point storage, rounding exactly as Vulkan's UNORM conversion does ----
+// ---- Fixed-point storage: round to nearest, as Vulkan's UNORM conversion does ----
+// At an exact tie (x * 65535 = k + 1/2) GLM rounds away from zero and a device may round to even:
+// the two builds can then differ by one step, which the GPU tests accept at ties only.
 // Four values in [0,1] as 16-bit UNORM (RGBA16_UNORM texel = two uints).
 MSM_FN uvec2 msm_pack_unorm16x4(vec4 v) {
     return uvec2(packUnorm2x16(vec2(v[0], v[1])), packUnorm2x16(vec2(v[2], v[3])));
