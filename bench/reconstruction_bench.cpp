@@ -18,6 +18,7 @@ struct Input {
     vec4 q16;         // Θ4*-transformed 16-bit storage value
     NonLinearMoments nl;
     Moments6 b6;      // biased six moments for [-1,1] depth
+    vec4 trig;        // biased trigonometric moments, [0,1] depth
     vec4 csm0, csm1;  // four Fourier terms of a convolution shadow map, [0,1] depth
     float zf;         // fragment depth in [-1,1]
 };
@@ -38,6 +39,7 @@ const std::vector<Input>& inputs() {
             Moments6 m6 = msm_moments6_mix(msm_moments6(z1), msm_moments6(z2), w);
             in.b6 = msm_apply_bias6(m6, msm_moment_bias6(MSM_REP6_FLOAT));
             float u1 = msm_unit_depth(z1), u2 = msm_unit_depth(z2);
+            in.trig = msm_trig_bias(mix(msm_trig_moments(u1), msm_trig_moments(u2), w));
             in.csm0 = mix(msm_csm_basis_texel(u1, 0), msm_csm_basis_texel(u2, 0), w);
             in.csm1 = mix(msm_csm_basis_texel(u1, 1), msm_csm_basis_texel(u2, 1), w);
             in.zf = 2.0f * u(rng) - 1.0f;
@@ -107,6 +109,9 @@ void Hamburger6Blend(benchmark::State& s) {
 }
 void Blocker4(benchmark::State& s) { run(s, [](const Input& x) { return msm_blocker4(x.b, x.zf).depth; }); }
 void Blocker6(benchmark::State& s) { run(s, [](const Input& x) { return msm_blocker6(x.b6, x.zf).depth; }); }
+void Trigonometric(benchmark::State& s) {
+    run(s, [](const Input& x) { return msm_trig_lower(x.trig, msm_unit_depth(x.zf)); });
+}
 void Theta4StarInverse(benchmark::State& s) { run(s, [](const Input& x) { return msm_theta4_star_inverse(x.q16); }); }
 void Theta4Inverse(benchmark::State& s) { run(s, [](const Input& x) { return msm_theta4_inverse(x.q16); }); }
 
@@ -120,6 +125,7 @@ BENCHMARK(Hamburger4Bounds);
 BENCHMARK(Hamburger4From16Bit);
 BENCHMARK(Hausdorff4Lower);
 BENCHMARK(Canonical4);
+BENCHMARK(Trigonometric);
 BENCHMARK(Hamburger6Lower);
 BENCHMARK(Hamburger6Blend);
 BENCHMARK(Blocker4);

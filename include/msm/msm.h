@@ -11,6 +11,7 @@
 #include "msm/hausdorff4.h"
 #include "msm/hamburger6.h"
 #include "msm/blocker.h"
+#include "msm/trigonometric.h"
 #include "msm/three_moments.h"
 #include "msm/nonlinear.h"
 #include "msm/baselines.h"

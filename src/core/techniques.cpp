@@ -105,6 +105,10 @@ float m6_float_shade(const Texel& t, float zf) { return m6_shade(to_m6(t), MSM_R
 float m6_16_shade(const Texel& t, float zf) { return m6_shade(msm_theta6_star_inverse(to_m6(t)), MSM_REP6_UNORM16, zf); }
 float m6_10_shade(const Texel& t, float zf) { return m6_shade(msm_theta6_star_inverse(to_m6(t)), MSM_REP6_UNORM10, zf); }
 
+// ---- Trigonometric MSM (2015), [0,1] depth, 4 x float ----
+Texel trig(float d) { return from(msm_trig_moments(d)); }
+float trig_shade(const Texel& t, float zf) { return msm_trig_lower(msm_trig_bias(to_vec4(t)), zf); }
+
 constexpr Technique kTechniques[] = {
     {"vsm-32", "VSM, 2 x 16-bit UNORM after θ2, depth in [0,1] (2015)", 32, 2, vsm_theta2, unorm16x2, vsm_theta2_shade},
     {"vsm-64", "VSM, 2 x float", 64, 2, vsm_float, identity, vsm_float_shade},
@@ -126,6 +130,7 @@ constexpr Technique kTechniques[] = {
      hausdorff_unit_float},
     {"msm-hausdorff-64-theta4", "Hausdorff 4MSM on [0,1], 4 x 16-bit UNORM after θ4 (2015)", 64, 4, theta4, unorm16,
      hausdorff_theta4},
+    {"tmsm-128", "Trigonometric MSM, 4 x float, depth in [0,1] (2015)", 128, 4, trig, identity, trig_shade},
     {"msm6-192", "Hamburger 6MSM, 6 x float, depth in [-1,1] (JCGT §5.4)", 192, 6, m6_float, identity, m6_float_shade},
     {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", 96, 6, m6_theta, m6_unorm16, m6_16_shade},
     {"msm6-64", "Hamburger 6MSM, 6 x 10-bit UNORM after Θ6* (JCGT §5.4.3)", 64, 6, m6_theta, m6_unorm10, m6_10_shade},
