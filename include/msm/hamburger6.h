@@ -152,14 +152,36 @@ MSM_FN float msm_hamburger6_w0(Hamburger6Roots r, float zf) {
 // order (JCGT §5.4.2): the interpolation polynomial u with u(z[l]) = v[l] in Newton form by
 // divided differences, converted to the monomial basis, dotted with (b0, b1, b2, b3) (=
 // Σ w[l] u(z[l]) since the canonical distribution has the moments b0..b3). The nodes are
-// pairwise distinct for positive definite B (the roots are simple and Σ q[j] zf^j = 1/w0 > 0).
+// pairwise distinct for positive definite B in exact arithmetic (the roots are simple and
+// Σ q[j] zf^j = 1/w0 > 0).
+//
+// Computed nodes do coincide for valid input, though: a single depth z0 (or two nearly equal
+// ones) under the bias α gives, for receivers zf on a curve in the (z0, zf) plane, a true pair of
+// roots around z0 only ~1e-3 apart (5.7e-4 at z0 = -0.92593, zf = 0.2227, long double). A pair that close
+// is ill-conditioned: its split moves by ~sqrt of the relative error of q, which the float LDLᵀ of
+// a B with condition number ~1/α leaves at ~1e-6. Rounding then sends the discriminant of the
+// cubic below 0, msm_cubic_roots_leading clamps it and returns an exact double root (once per
+// ~1e5-1e6 random inputs; the GPU's rounding may keep the pair apart). The divided differences
+// then formed 0/0 = NaN and msm_saturate turned the lower bound into 0 instead of ~1.
+// v is a function of the node (u interpolates values, not slopes), so equal nodes carry equal
+// values, and a pair only matters through its combined weight: msm_divided_difference makes
+// every difference of equal values exactly 0, whatever the divisor. For a double node this is
+// Hermite interpolation with slope 0 there, which the true pair z0 ± δ sees as u(z0 ± δ) =
+// v + O(δ²): the pair's combined weight comes out right (a double root is a merged atom, see
+// msm_hamburger6_canonical); close but distinct nodes with equal values get the same 0.
+MSM_FN float msm_divided_difference(float dv, float dz) {
+    // dz == 0 with dv != 0 needs coincident nodes with different values: impossible for v a
+    // function of z; the guard keeps invalid input finite.
+    return (dv == 0.0f || dz == 0.0f) ? 0.0f : dv / dz;
+}
+
 MSM_FN float msm_hamburger6_weighted_sum(Moments6 b, vec4 z, vec4 v) {
-    float f01 = (v[1] - v[0]) / (z[1] - z[0]);
-    float f12 = (v[2] - v[1]) / (z[2] - z[1]);
-    float f23 = (v[3] - v[2]) / (z[3] - z[2]);
-    float f012 = (f12 - f01) / (z[2] - z[0]);
-    float f123 = (f23 - f12) / (z[3] - z[1]);
-    float f0123 = (f123 - f012) / (z[3] - z[0]);
+    float f01 = msm_divided_difference(v[1] - v[0], z[1] - z[0]);
+    float f12 = msm_divided_difference(v[2] - v[1], z[2] - z[1]);
+    float f23 = msm_divided_difference(v[3] - v[2], z[3] - z[2]);
+    float f012 = msm_divided_difference(f12 - f01, z[2] - z[0]);
+    float f123 = msm_divided_difference(f23 - f12, z[3] - z[1]);
+    float f0123 = msm_divided_difference(f123 - f012, z[3] - z[0]);
     // u(z) = v0 + (z - z0) (f01 + (z - z1) (f012 + (z - z2) f0123)), expanded from the inside:
     // a(z) = f012 + (z - z2) f0123 = a0 + a1 z
     float a0 = f012 - z[2] * f0123;
@@ -229,17 +251,58 @@ MSM_FN float msm_hamburger6_lagrange_weight(Moments6 b, float zl, float za, floa
     float e2 = za * zb + za * zc + zb * zc;
     float e3 = za * zb * zc;
     float numerator = b.odd[1] - e1 * b.even[0] + e2 * b.odd[0] - e3;
-    // Distinct nodes for valid input; coincident ones (invalid input, e.g. unbiased moments of a
-    // single depth give a triple root) get weight 0 instead of inf or NaN.
+    // msm_hamburger6_canonical merges close pairs before calling this; coincident nodes left
+    // (invalid input, e.g. unbiased moments of a single depth give a triple root) get weight 0
+    // instead of inf or NaN.
     float denominator = (zl - za) * (zl - zb) * (zl - zc);
     return (denominator != 0.0f) ? numerator / denominator : 0.0f;
 }
 
+// Roots closer than this are one atom of the canonical distribution (see below).
+const float MSM_MERGE_ROOTS6 = 1.0e-2f;
+
+// Weight and position (w, z) of a pair of roots za <= zb merged into one atom; zc is the third
+// root. The weight is Σ_{za, zb} w[l], the position the pair's mean Σ w[l] z[l] / Σ w[l], both as
+// weighted sums (v = 1 resp. v = z on the pair, 0 at zf and zc), which stay well-conditioned
+// however close the pair is (msm_hamburger6_weighted_sum). The far root goes last as there.
+MSM_FN vec2 msm_hamburger6_merged_pair(Moments6 b, float zf, float za, float zb, float zc) {
+    bool far_first = abs(za) > abs(zc) || abs(zb) > abs(zc);
+    vec4 z = far_first ? vec4(zf, zc, za, zb) : vec4(zf, za, zb, zc);
+    vec4 ones = far_first ? vec4(0.0f, 0.0f, 1.0f, 1.0f) : vec4(0.0f, 1.0f, 1.0f, 0.0f);
+    vec4 depths = far_first ? vec4(0.0f, 0.0f, za, zb) : vec4(0.0f, za, zb, 0.0f);
+    float w = msm_hamburger6_weighted_sum(b, z, ones);
+    float s = msm_hamburger6_weighted_sum(b, z, depths);
+    float mid = 0.5f * (za + zb);
+    return vec2(w, (w > 0.0f) ? clamp(s / w, za, zb) : mid);
+}
+
+// A pair of roots closer than MSM_MERGE_ROOTS6 is returned as one atom: position and combined
+// weight from msm_hamburger6_merged_pair in the lower slot, weight 0 at the same position in the
+// upper slot. Why: such a pair is ill-conditioned (msm_hamburger6_weighted_sum: its split moves
+// by ~sqrt of the ~1e-6 relative error of q, i.e. by ~1e-3), and the Lagrange weights divide by
+// the split, so each weight of the pair alone may be off by O(1) or come out 0 for an exact
+// double root (the bug: both 0, blocker6 returned zf with shadow 0 behind a single occluder),
+// while the pair's combined weight and mean are accurate. Merging changes nothing that the
+// bounds and the blocker search use (they sum over the roots below zf) unless zf falls between
+// the two roots, which is itself ill-conditioned. If all three roots lie within the tolerance
+// (invalid input only) the lower pair is merged.
 MSM_FN Canonical6 msm_hamburger6_canonical(Moments6 b, float zf) {
     Hamburger6Roots r = msm_hamburger6_roots(b, zf);
     float z1 = r.z[0], z2 = r.z[1], z3 = r.z[2];
+    float w0 = msm_hamburger6_w0(r, zf);
+    // Merge only pairs on one side of zf: a pair around zf is what the bounds need split.
+    if (z2 - z1 <= MSM_MERGE_ROOTS6 && (z2 < zf) == (z1 < zf)) {
+        vec2 pair = msm_hamburger6_merged_pair(b, zf, z1, z2, z3);
+        return Canonical6(vec4(zf, pair[1], pair[1], z3),
+                          vec4(w0, pair[0], 0.0f, msm_hamburger6_lagrange_weight(b, z3, zf, z1, z2)));
+    }
+    if (z3 - z2 <= MSM_MERGE_ROOTS6 && (z3 < zf) == (z2 < zf)) {
+        vec2 pair = msm_hamburger6_merged_pair(b, zf, z2, z3, z1);
+        return Canonical6(vec4(zf, z1, pair[1], pair[1]),
+                          vec4(w0, msm_hamburger6_lagrange_weight(b, z1, zf, z2, z3), pair[0], 0.0f));
+    }
     return Canonical6(vec4(zf, z1, z2, z3),
-                      vec4(msm_hamburger6_w0(r, zf),
+                      vec4(w0,
                            msm_hamburger6_lagrange_weight(b, z1, zf, z2, z3),
                            msm_hamburger6_lagrange_weight(b, z2, zf, z1, z3),
                            msm_hamburger6_lagrange_weight(b, z3, zf, z1, z2)));

@@ -44,12 +44,78 @@ MSM_BEGIN
 const float MSM_PI = 3.14159265358979323846f;
 
 // a * b + c with one rounding: exact differences such as b2 - b1² in nearly singular Hankel
-// matrices. GLSL's fma is the GPU's fused multiply-add; GLM's fma is an unfused a * b + c, so the
-// C++ side calls std::fma (correctly rounded).
+// matrices. GLM's fma is an unfused a * b + c, so the C++ side calls std::fma (correctly rounded).
+// GLSL's fma() need not be fused either (GLSL 4.60 §8.3 and SPIR-V's GLSL.std.450 Fma promise no
+// single rounding, `precise` or not; Mesa's lavapipe computes a * b and then + c), so on the device
+// msm_fma is the native fma() only where msm::vk found it fused, and the exact emulation below
+// elsewhere: msm::vk::Context probes each device's fma() at creation (src/vk/shaders/fma_probe.comp)
+// and every pipeline it creates sets the specialization constant msm_fused_fma (id
+// MSM_SPEC_FUSED_FMA_ID) to the verdict; the driver then compiles only one of the two branches.
+// Pipelines built outside msm::vk::createProgram must set it too (msm::vk::SharedSpecialization);
+// left at its default (true), msm_fma is the native fma(), as before.
+//
+// MSM_SPEC_FUSED_FMA_ID: the constant_id, a fixed number that C++ (which sets it) and GLSL share.
+// Ids 2000-2047 are reserved for the shared headers (glslang accepts constant_id <= 2047); shaders
+// keep their own constant_ids below 2000.
+#define MSM_SPEC_FUSED_FMA_ID 2000
+
+// `precise` (SPIR-V NoContraction): no contraction into fma and no reassociation of the operation
+// whose result it qualifies. Nothing in C++, whose build has -ffp-contract=off instead.
+#if MSM_CPP
+#define MSM_PRECISE
+#else
+#define MSM_PRECISE precise
+#endif
+
+// a * b + c correctly rounded (to nearest, ties to even: what std::fma and a fused fma() give)
+// from float additions and multiplications, each rounded once: Boldo & Melquiond's emulated FMA
+// ("Emulation of FMA and correctly rounded sums: proved algorithms using rounding to odd", IEEE
+// Trans. Computers 57(4), 2008, Algorithm 5.1):
+//   p + e = a * b exactly (Dekker's TwoProduct, Veltkamp's split by 2^12 + 1 into 12 + 12 bits),
+//   s + t = c + p exactly (Knuth's TwoSum),
+//   v = t + e rounded to odd (TwoSum, then one step to the odd neighbor if inexact and even),
+//   result = s + v rounded to nearest, which is then a * b + c rounded to nearest.
+// 30 flops (split 8, product 9, two TwoSums 12, final sum 1) plus 5 integer/compare/select
+// operations, against one fma. Every intermediate is `precise`, so no compiler may contract or
+// reassociate it. Preconditions: no overflow or underflow in the intermediates: finite inputs with
+// |a|, |b| < 2^100 and |a * b|, |c| each 0 or >= 2^-100 (GPUs flush subnormals). Checked against
+// std::fma (gpu_math_test.cpp: EmulatedFmaIsCorrectlyRounded; vk_test.cpp: on the device).
+// Its C++ build is exact only without contraction (-ffp-contract=off): C++ code calls msm_fma.
+MSM_FN float msm_fma_emulated(float a, float b, float c) {
+    MSM_PRECISE float ta = 4097.0f * a;
+    MSM_PRECISE float tb = 4097.0f * b;
+    MSM_PRECISE float ah = ta - (ta - a);
+    MSM_PRECISE float bh = tb - (tb - b);
+    MSM_PRECISE float al = a - ah;
+    MSM_PRECISE float bl = b - bh;
+    MSM_PRECISE float p = a * b;
+    MSM_PRECISE float e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+    MSM_PRECISE float s = c + p;
+    MSM_PRECISE float sc = s - c;
+    MSM_PRECISE float t = (c - (s - sc)) + (p - sc);
+    MSM_PRECISE float v = t + e;
+    MSM_PRECISE float ve = v - t;
+    MSM_PRECISE float w = (t - (v - ve)) + (e - ve);
+    int bits = floatBitsToInt(v);
+    // Rounded to odd: an inexact v with an even last bit moves to its neighbor on w's side (v != 0
+    // here: t + e rounds to 0 only if it is 0). Sign-magnitude: +1 is away from zero.
+    if (w != 0.0f && (bits & 1) == 0) bits += (w > 0.0f) == (v > 0.0f) ? 1 : -1;
+    MSM_PRECISE float r = s + intBitsToFloat(bits);
+    return r;
+}
+
 #if MSM_CPP
 MSM_FN float msm_fma(float a, float b, float c) { return std::fma(a, b, c); }
 #else
-MSM_FN float msm_fma(float a, float b, float c) { return fma(a, b, c); }
+#ifdef VULKAN
+layout(constant_id = MSM_SPEC_FUSED_FMA_ID) const bool msm_fused_fma = true;
+#else
+const bool msm_fused_fma = true; // OpenGL: no specialization constants
+#endif
+MSM_FN float msm_fma(float a, float b, float c) {
+    if (msm_fused_fma) return fma(a, b, c);
+    return msm_fma_emulated(a, b, c);
+}
 #endif
 
 // clamp(x, 0, 1), the HLSL saturate that GLSL lacks; NaN goes to 0 (GLSL's clamp leaves NaN

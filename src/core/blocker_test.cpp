@@ -247,4 +247,61 @@ void check_against_oracle(int m) {
 TEST(Blocker, FourMomentsEqualEquation4OnTheOraclesDistribution) { check_against_oracle(4); }
 TEST(Blocker, SixMomentsEqualEquation4OnTheOraclesDistribution) { check_against_oracle(6); }
 
+// Regression: a single occluder at z0 (or two at nearly the same depth) whose canonical
+// distribution has a (nearly) double root at z0 (hamburger6_test: CoincidentRootsOfASingleDepth).
+// Before the fix both Lagrange weights of the pair were 0 and blocker6 returned zf with shadow 0
+// for the fully occluded receiver. Sweep: z0 at 1001 positions in [-1, 1], receivers 0.1 or more
+// in front of or behind it (241 in [-1.2, 1.2]), one depth and two 3e-4 apart, plus the
+// regression inputs. Occluded: depth within a fraction of zf - z0 of the occluders' mean, shadow
+// ~1; unoccluded: depth ~zf, shadow ~0, for both Eq. (4) and the upper variant. Measured (also
+// 9.6e6 inputs, 4001 × 1201, in brackets): occluded depth relative max 1.1e-3 (2.1e-3), upper
+// variant the same, |shadow - 1| max 7.2e-5 (8.7e-5); unoccluded |depth - zf| max 4.7e-3, shadow
+// max 3.9e-6 (before the fix: depth relative 1 and shadow 0 at the double roots). Tolerances: 0.01 relative and 1e-3;
+// unoccluded 0.015 and 1e-4 (as UnoccludedFragmentReturnsItsOwnDepth).
+TEST(Blocker, SixMomentsSingleAndCoincidentOccluders) {
+    const MomentBias6 bias = msm_moment_bias6(MSM_REP6_FLOAT);
+    ErrorStats depth_occ, shadow_occ, depth_up, depth_free, shadow_free;
+    int nan = 0;
+    auto check = [&](float z0, float z1, float zf) {
+        Moments6 b = msm_apply_bias6(msm_moments6_mix(msm_moments6(z0), msm_moments6(z1), 0.37f), bias);
+        float mean = 0.63f * z0 + 0.37f * z1;
+        BlockerResult r = msm_blocker6(b, zf);
+        BlockerResult u = msm_blocker6_upper(b, zf, MSM_BLOCKER_EPSILON, MSM_BLOCKER_EPSILON);
+        nan += (std::isfinite(r.depth) && std::isfinite(r.shadow) && std::isfinite(u.depth)) ? 0 : 1;
+        if (mean < zf) {
+            depth_occ.add((r.depth - mean) / (zf - mean));
+            depth_up.add((u.depth - mean) / (zf - mean));
+            shadow_occ.add(r.shadow - 1.0f);
+            EXPECT_NEAR(r.depth, mean, 0.01f * (zf - mean)) << "z0 " << z0 << " zf " << zf;
+            EXPECT_NEAR(r.shadow, 1.0f, 1e-3f) << "z0 " << z0 << " zf " << zf;
+        } else {
+            depth_free.add(r.depth - zf);
+            shadow_free.add(r.shadow);
+            EXPECT_NEAR(r.depth, zf, 0.015f) << "z0 " << z0 << " zf " << zf;
+            EXPECT_NEAR(r.shadow, 0.0f, 1e-4f) << "z0 " << z0 << " zf " << zf;
+        }
+    };
+    check(-0.924f, -0.924f, 0.22f);
+    check(-0.925930023f, -0.925930023f, 0.2227f);
+    check(-0.965425968f, -0.965425968f, 0.100011125f);
+    check(-0.917450666f, -0.917450666f, 0.157999992f);
+    check(-0.954925954f, -0.954625954f, 0.108007438f);
+    check(0.947024703f, 0.947324703f, -0.251999974f);
+    for (int i = 0; i <= 1000; ++i) {
+        float z0 = -1.0f + 2.0f * float(i) / 1000.0f + 1.234e-5f * float(i % 7);
+        for (int j = 0; j <= 240; ++j) {
+            float zf = -1.2f + 2.4f * float(j) / 240.0f + 3.7e-6f * float(i % 11);
+            if (std::abs(zf - z0) < 0.1f) continue;
+            check(z0, z0, zf);
+            check(z0, z0 + 3e-4f, zf);
+        }
+    }
+    std::printf("[blocker6, single/coincident occluders] occluded: depth relative max %.2e (upper variant, "
+                "delta = eps: %.2e), |shadow - 1| max %.2e; unoccluded: |depth - zf| max %.2e, shadow max %.2e; "
+                "NaN %d\n",
+                depth_occ.max(), depth_up.max(), shadow_occ.max(), depth_free.max(), shadow_free.max(), nan);
+    EXPECT_EQ(nan, 0);
+    EXPECT_LT(depth_up.max(), 0.01);
+}
+
 } // namespace

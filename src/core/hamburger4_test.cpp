@@ -167,7 +167,9 @@ void check_against_lp(const std::vector<double>& grid, bool hausdorff, int cases
     EXPECT_GT(err.errors.size(), size_t(cases * 8 / 10));
     EXPECT_LT(err.quantile(0.9), 1e-4);
     EXPECT_LT(err.max(), 5e-3);
-    if (hausdorff) EXPECT_GT(four_atom_cases, 4); // the branch that differs from Hamburger is exercised
+    if (hausdorff) {
+        EXPECT_GT(four_atom_cases, 4); // the branch that differs from Hamburger is exercised
+    }
 }
 
 TEST(Hamburger4, EqualsTheLinearProgramOnAWideGrid) {

@@ -13,6 +13,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <vector>
 
@@ -474,6 +475,117 @@ TEST(Hamburger6, AdaptiveOverestimationWeight) {
         EXPECT_NEAR(msm_adaptive_overestimation_beta(l, p), 0.5f * (1.0f + c), 1e-6f);
     }
     EXPECT_EQ(msm_adaptive_overestimation_beta(vec3(0, 0, 1.001f), vec3(0, 0, 1.001f)), 1.0f); // clamped
+}
+
+// Regression: coincident roots. Biased float moments of a single depth z0 give, for receivers zf
+// on a curve in the (z0, zf) plane, two true roots around z0 only ~1e-3 apart (5.7e-4 at
+// z0 = -0.92593, zf = 0.2227 in long double); the float q moves such a pair by ~1e-3, so
+// msm_cubic_roots may return an exact double root (it does for the listed inputs on x86-64 with
+// -ffp-contract=off; the GPU test found z0 = -0.924, zf = 0.22). The divided differences then
+// formed 0/0 and the lower bound came out 0 instead of ~1, both canonical weights of the pair 0.
+// Now a difference of equal values is 0 and the canonical distribution merges the pair: lower
+// and upper bound, and the weight of the roots below zf, must equal the true CDF (1 for z0 < zf,
+// 0 above) within the bias' effect. Tolerance 1e-4 (measured: <= 3.5e-6 on these inputs).
+TEST(Hamburger6, CoincidentRootsOfASingleDepth) {
+    struct Case {
+        float z0, z1, zf; // depths z0 and z1 with weights 0.63 and 0.37
+    };
+    const Case cases[] = {
+        {-0.924f, -0.924f, 0.22f},           {-0.925930023f, -0.925930023f, 0.2227f},
+        {-0.965425968f, -0.965425968f, 0.100011125f}, {-0.941438317f, -0.941438317f, 0.964025915f},
+        {-0.917450666f, -0.917450666f, 0.157999992f}, {-0.916000009f, -0.916000009f, 0.134011045f},
+        {-0.954925954f, -0.954625954f, 0.108007438f}, {0.947024703f, 0.947324703f, -0.251999974f},
+        {0.966574073f, 0.966874073f, -0.959977865f},
+    };
+    int double_roots = 0;
+    for (const Case& c : cases) {
+        Moments6 m = msm_moments6_mix(msm_moments6(c.z0), msm_moments6(c.z1), 0.37f);
+        Moments6 b = msm_apply_bias6(m, msm_moment_bias6(MSM_REP6_FLOAT));
+        float truth = (c.z0 < c.zf) ? 1.0f : 0.0f;
+        vec3 roots = msm_hamburger6_roots(b, c.zf).z;
+        double_roots += (roots[0] == roots[1] || roots[1] == roots[2]) ? 1 : 0;
+        EXPECT_NEAR(msm_hamburger6_lower(b, c.zf), truth, 1e-4) << "z0 " << c.z0 << " zf " << c.zf;
+        EXPECT_NEAR(msm_hamburger6_upper(b, c.zf), truth, 1e-4) << "z0 " << c.z0 << " zf " << c.zf;
+        EXPECT_NEAR(msm_hamburger6_blend(b, c.zf, 0.5f), truth, 1e-4) << "z0 " << c.z0 << " zf " << c.zf;
+        Canonical6 canonical = msm_hamburger6_canonical(b, c.zf);
+        float below = 0.0f, sum = 0.0f;
+        for (int l = 0; l < 4; ++l) {
+            EXPECT_TRUE(std::isfinite(canonical.z[l]) && std::isfinite(canonical.w[l]));
+            EXPECT_GE(canonical.w[l], -1e-4f) << "z0 " << c.z0 << " zf " << c.zf << " l " << l;
+            if (l > 0 && canonical.z[l] < c.zf) below += canonical.w[l];
+            sum += canonical.w[l];
+        }
+        EXPECT_NEAR(below, truth, 1e-4) << "z0 " << c.z0 << " zf " << c.zf;
+        EXPECT_NEAR(sum, 1.0f, 1e-4) << "z0 " << c.z0 << " zf " << c.zf;
+        // The merged atom sits at the depth (within the pair's split and the spread of the depths).
+        int heavy_l = 1;
+        for (int l = 2; l < 4; ++l)
+            if (canonical.w[l] > canonical.w[heavy_l]) heavy_l = l;
+        float heavy = canonical.z[heavy_l];
+        EXPECT_NEAR(heavy, 0.63f * c.z0 + 0.37f * c.z1, 2e-3) << "z0 " << c.z0 << " zf " << c.zf;
+    }
+    std::printf("[hamburger6 coincident roots] %d of %zu regression inputs give an exact double root here\n",
+                double_roots, std::size(cases));
+}
+
+// The sweep around it: single depths z0 at 2001 positions in [-1, 1] × 481 receivers in
+// [-1.2, 1.2], and two nearly coincident depths (z0, z0 + 3e-4, weights 0.63 / 0.37). Nothing is
+// NaN, 0 <= lower <= upper <= 1, and away from the depth both bounds equal the true CDF up to the
+// bias: the biased moments are those of (1 - α) δ(z0) + α b*, and the bound moves by up to
+// ~α·n²-ish terms that grow as zf nears z0 (ExactForUpToThreeDepths). Measured (9.6e6 inputs,
+// 4001 × 1201): |bound - CDF| max 7.1e-3 for |zf - z0| in [0.01, 0.03), 7.8e-4 in [0.03, 0.1),
+// 7.4e-5 in [0.1, 0.3), 1.1e-5 beyond 0.3 (before the fix: 1 beyond 0.3, 7 exact double roots).
+// Tolerances: 2e-3 at >= 0.03, 3e-4 at >= 0.1, 5e-5 at >= 0.3. The canonical distribution's
+// weight below zf equals the lower bound (measured max 1.0e-4, tolerance 3e-4). Weights: pairs
+// closer than MSM_MERGE_ROOTS6 are merged; pairs a little further apart (1e-2..2e-2, or around
+// zf) still split their weight inaccurately, measured min weight -5.4e-4 (19 below -1e-4),
+// tolerance -5e-3 (CanonicalDistributionEqualsTheOracles' max weight error).
+TEST(Hamburger6, SingleAndCoincidentDepthsSweep) {
+    const MomentBias6 bias = msm_moment_bias6(MSM_REP6_FLOAT);
+    ErrorStats near_err, mid_err, far_err, consistency;
+    int nan = 0, negative = 0;
+    float min_weight = 0.0f;
+    for (int i = 0; i <= 2000; ++i) {
+        float z0 = -1.0f + 2.0f * float(i) / 2000.0f + 1.234e-5f * float(i % 7);
+        for (int k = 0; k < 2; ++k) {
+            Moments6 m = (k == 0) ? msm_moments6(z0)
+                                  : msm_moments6_mix(msm_moments6(z0), msm_moments6(z0 + 3e-4f), 0.37f);
+            Moments6 b = msm_apply_bias6(m, bias);
+            for (int j = 0; j <= 480; ++j) {
+                float zf = -1.2f + 2.4f * float(j) / 480.0f + 3.7e-6f * float(i % 11);
+                vec2 bounds = msm_hamburger6_bounds(b, zf);
+                Canonical6 c = msm_hamburger6_canonical(b, zf);
+                bool finite = std::isfinite(bounds.x) && std::isfinite(bounds.y);
+                float below = 0.0f;
+                for (int l = 0; l < 4; ++l) {
+                    finite = finite && std::isfinite(c.z[l]) && std::isfinite(c.w[l]);
+                    negative += (c.w[l] < -1e-4f) ? 1 : 0;
+                    min_weight = std::min(min_weight, c.w[l]);
+                    if (l > 0 && c.z[l] < zf) below += c.w[l];
+                }
+                nan += finite ? 0 : 1;
+                EXPECT_LE(0.0f, bounds.x);
+                EXPECT_LE(bounds.x, bounds.y);
+                EXPECT_LE(bounds.y, 1.0f);
+                consistency.add(std::clamp(below, 0.0f, 1.0f) - bounds.x);
+                float gap = std::abs(zf - z0);
+                double truth = (z0 < zf) ? 1.0 : 0.0;
+                double error = std::max(std::abs(bounds.x - truth), std::abs(bounds.y - truth));
+                if (gap >= 0.3f) far_err.add(error);
+                else if (gap >= 0.1f) mid_err.add(error);
+                else if (gap >= 0.03f) near_err.add(error);
+            }
+        }
+    }
+    std::printf("[hamburger6 single/coincident depths sweep] |bound - CDF| max: |zf - z0| >= 0.03 %.2e, >= 0.1 "
+                "%.2e, >= 0.3 %.2e; canonical below zf vs lower max %.2e; NaN %d, weights < -1e-4 %d, min %.2e\n",
+                near_err.max(), mid_err.max(), far_err.max(), consistency.max(), nan, negative, min_weight);
+    EXPECT_EQ(nan, 0);
+    EXPECT_GT(min_weight, -5e-3f);
+    EXPECT_LT(near_err.max(), 2e-3);
+    EXPECT_LT(mid_err.max(), 3e-4);
+    EXPECT_LT(far_err.max(), 5e-5);
+    EXPECT_LT(consistency.max(), 3e-4);
 }
 
 } // namespace

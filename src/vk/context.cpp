@@ -1,10 +1,16 @@
 #include "msm/vk/context.h"
 
+#include "msm/vk/commands.h"
+#include "msm/vk/program.h"
+#include "msm/vk/resources.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -225,6 +231,33 @@ DeviceFeatures pickFeatures(VkPhysicalDevice device) {
   return e;
 }
 
+// Twice rounded: a * b to float, then + c (volatile: no contraction whatever the flags).
+float unfusedFma(float a, float b, float c) {
+  volatile float p = a * b;
+  return p + c;
+}
+
+// The cases of the fma probe: a * b + c where the result rounded once (std::fma) and rounded twice
+// (a * b to float, then + c) differ, and in some of them also a * b + c computed in double and then
+// rounded to float (checked in probeFusedFma, so a mistake here fails loudly). All results are
+// normal floats: no flush to zero.
+struct FmaCase {
+  float a, b, c;
+};
+std::vector<FmaCase> fmaCases() {
+  constexpr float p12 = 1.0f + 0x1p-12f, p20 = 1.0f + 0x1p-20f;
+  return {
+      {p12, p12, -1.0f},                            // 2^-11 + 2^-24; twice: 2^-11 (a tie, to even)
+      {0.1f, 0.1f, -unfusedFma(0.1f, 0.1f, 0.0f)},  // the error of 0.1f², as in b2 - b1²; twice: 0
+      {-p20, p20, 1.0f},                            // -(2^-19 + 2^-40); twice: -2^-19
+      {p12, p12, 0x1p-70f},  // just above a tie: 1 + 2^-11 + 2^-23; twice and via double: 1 + 2^-11
+      {-p12, p12, -0x1p-70f},                       // the same, negative
+      {0.7f, 1.3f, -unfusedFma(0.7f, 1.3f, 0.0f)},  // a product's rounding error
+      {3.0f, 0x1.555556p-2f, -1.0f},                // 3 RN(1/3) - 1 = 2^-25; twice: 0
+      {1.0e6f + 1.0f, 1.0e6f - 1.0f, -1.0e12f},     // 10^12 - 1 - RN(10^12) = 4095; twice: 0
+  };
+}
+
 } // namespace
 
 void ValidationLog::add(ValidationMessage message) {
@@ -399,9 +432,18 @@ Context::Context(const ContextOptions& options) {
                                      .queueFamilyIndex = queueFamily_};
     MSM_VK_CHECK(vkCreateCommandPool(device_, &poolInfo, nullptr, &commandPool_));
 
+    fusedFma_ = probeFusedFma();
+    ContextOptions::FmaMode fmaMode = options.fmaMode;
+    if (fmaMode == ContextOptions::FmaMode::Probe && envFlag("MSM_FORCE_EMULATED_FMA"))
+      fmaMode = ContextOptions::FmaMode::Emulated;
+    useNativeFma_ = fmaMode == ContextOptions::FmaMode::Native || (fmaMode == ContextOptions::FmaMode::Probe && fusedFma_);
+
     if (options.verbose)
-      std::fprintf(stderr, "msm::vk: device %u: %s; validation %s\n", info_.index, info_.describe().c_str(),
-                   validation_ ? (syncValidation ? "on (+synchronization)" : "on") : "off");
+      std::fprintf(stderr, "msm::vk: device %u: %s; validation %s; fma() %s, msm_fma %s\n", info_.index,
+                   info_.describe().c_str(), validation_ ? (syncValidation ? "on (+synchronization)" : "on") : "off",
+                   fusedFma_ ? "fused" : "NOT fused",
+                   useNativeFma_ ? (fusedFma_ ? "native" : "native (forced, NOT exact)")
+                                 : (fusedFma_ ? "emulated (forced)" : "emulated"));
   } catch (...) {
     destroy();
     throw;
@@ -422,6 +464,40 @@ void Context::destroy() noexcept {
   device_ = VK_NULL_HANDLE;
   messenger_ = VK_NULL_HANDLE;
   instance_ = VK_NULL_HANDLE;
+}
+
+// Runs fma_probe.comp over kFmaCases (see there): fused if every case, in both of the shader's
+// forms, comes back rounded once. Anything else (twice rounded, evaluated in double, mixed): not.
+bool Context::probeFusedFma() const {
+  const std::vector<FmaCase> cases = fmaCases();
+  const uint32_t n = uint32_t(cases.size());
+  std::vector<float> words(4 * 3 * n, 0.0f); // vec4 per case: (a, b, c, 0) twice, then the results
+  bool catchesDouble = false;
+  for (uint32_t i = 0; i < n; ++i) {
+    const FmaCase& k = cases[i];
+    float fused = std::fma(k.a, k.b, k.c);
+    if (fused == unfusedFma(k.a, k.b, k.c) || !std::isnormal(fused))
+      throw std::logic_error(fmt::format("msm::vk: fma probe case {} does not tell fused from unfused", i));
+    catchesDouble |= fused != float(double(k.a) * double(k.b) + double(k.c));
+    for (uint32_t copy = 0; copy < 2; ++copy) {
+      float* v = &words[4 * (copy * n + i)];
+      v[0] = k.a, v[1] = k.b, v[2] = k.c;
+    }
+  }
+  if (!catchesDouble) throw std::logic_error("msm::vk: no fma probe case tells fused from computed in double");
+  VkDeviceSize size = words.size() * sizeof(float);
+  Buffer buffer = createBuffer(*this, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
+  std::memcpy(buffer.data(), words.data(), size);
+  Program probe = createProgram(*this, "fma_probe", {Binding::StorageBuffer});
+  submitAndWait(*this, [&](VkCommandBuffer cmd) { dispatch(cmd, probe, groupCount(n, 64), 1, 1, {buffer}); });
+  std::memcpy(words.data(), buffer.data(), size);
+  for (uint32_t i = 0; i < n; ++i) {
+    float fused = std::fma(cases[i].a, cases[i].b, cases[i].c);
+    const float* out = &words[4 * (2 * n + i)];
+    for (int form = 0; form < 2; ++form)
+      if (std::bit_cast<uint32_t>(out[form]) != std::bit_cast<uint32_t>(fused)) return false;
+  }
+  return true;
 }
 
 void Context::setObjectName(VkObjectType type, uint64_t handle, const std::string& name) const {

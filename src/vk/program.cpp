@@ -1,5 +1,6 @@
 #include "msm/vk/program.h"
 
+#include "msm/shared.h" // MSM_SPEC_FUSED_FMA_ID
 #include "msm/vk/context.h"
 #include "msm/vk/shaders.h"
 
@@ -19,6 +20,11 @@ VkDescriptorType descriptorType(Binding binding) {
 }
 
 } // namespace
+
+SharedSpecialization::SharedSpecialization(const Context& ctx)
+    : fusedFma_(ctx.useNativeFma() ? VK_TRUE : VK_FALSE),
+      entry_{.constantID = MSM_SPEC_FUSED_FMA_ID, .offset = 0, .size = sizeof(VkBool32)},
+      info_{.mapEntryCount = 1, .pMapEntries = &entry_, .dataSize = sizeof(VkBool32), .pData = &fusedFma_} {}
 
 Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
                       std::span<const Binding> bindings, uint32_t pushConstantSize) {
@@ -92,12 +98,14 @@ Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::
   VkShaderModule rawModule = VK_NULL_HANDLE;
   MSM_VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &rawModule));
   ShaderModule module(device, rawModule); // only needed while the pipeline is created
+  SharedSpecialization specialization(ctx);
   VkComputePipelineCreateInfo pipelineInfo{
       .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
       .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
                 .stage = VK_SHADER_STAGE_COMPUTE_BIT,
                 .module = module,
-                .pName = "main"},
+                .pName = "main",
+                .pSpecializationInfo = specialization.info()},
       .layout = layout};
   VkPipeline pipeline = VK_NULL_HANDLE;
   MSM_VK_CHECK(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline));

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdio>
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
@@ -64,6 +66,8 @@ TEST(ShaderRegistryTest, FindsShadersByFileNameAndStem) {
   EXPECT_NE(embedded_shader("selftest_image").data(), byStem.data());
   std::vector<std::string> names = embedded_shader_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "selftest_image.comp"), names.end());
+  // msm_vk's own (the Context's fma probe), linked through the static library's anchor.
+  EXPECT_NE(std::find(names.begin(), names.end(), "fma_probe.comp"), names.end());
 }
 
 TEST(ShaderRegistryTest, UnknownNameThrowsAndListsEmbeddedShaders) {
@@ -214,6 +218,119 @@ TEST_F(VkLayerTest, SaturateShaderMatchesCpu) {
   EXPECT_EQ(mismatches, 0);
   // The Device buffer reads back what was uploaded (staging path both ways).
   EXPECT_EQ(readbackBuffer<float>(ctx(), src, n), input);
+}
+
+// Inputs a, b, c for msm_fma where rounding a * b first changes the result: the residuals of the
+// Hankel pivots (b2 - b1 b1, b3 - b1 b2 of moments of depths in [-1, 1]), random operands over
+// 2^±20 with c anywhere relative to a b, exact ties, near-ties and ties broken by a tiny c.
+std::vector<float> fmaInputs(uint32_t n) {
+  std::mt19937 rng(777);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_int_distribution<int> exponent(-20, 20), shift(-30, 30);
+  std::vector<float> v(4 * n, 0.0f);
+  for (uint32_t i = 0; i < n; ++i) {
+    float a = unit(rng), b = unit(rng), c = 0.0f;
+    switch (i % 6) {
+    case 0: { // moments of a depth z: b2 - b1 b1, b3 - b1 b2 (of a mixture: not exactly 0)
+      float z = unit(rng), w = unit(rng) * 0.5f + 0.5f;
+      float b1 = w * z + (1 - w) * a, b2 = w * z * z + (1 - w) * a * a;
+      a = -b1, b = i % 2 ? b1 : b2, c = i % 2 ? b2 : w * z * z * z + (1 - w) * a * a * a;
+      break;
+    }
+    case 1: c = -(a * b); break;
+    case 2:
+      a = std::ldexp(a, exponent(rng)), b = std::ldexp(b, exponent(rng));
+      c = std::ldexp(unit(rng), std::ilogb(a * b) + shift(rng));
+      break;
+    case 3: // few bits: ties of a b + c
+      a = float(int(rng() % 4096) + 1), b = float(int(rng() % 8192) + 1), c = float(int(rng() % (1 << 23)) - (1 << 22));
+      break;
+    case 4: c = std::ldexp(unit(rng), std::ilogb(a * b) - 24 - int(rng() % 30)); break; // near ties
+    default: // a b half-way between two floats, c far below: the emulation's rounding to odd decides
+      a = float(4097 + 2 * int(rng() % 4000)) * 0x1p-12f, b = float(4097 + 2 * int(rng() % 4000)) * 0x1p-12f;
+      c = std::ldexp(unit(rng), -20 - int(rng() % 50));
+      break;
+    }
+    v[4 * i] = a, v[4 * i + 1] = b, v[4 * i + 2] = c;
+  }
+  return v;
+}
+
+// msm_fma (shared.h) in a shader (selftest_fma.comp) on the Context `ctx`; the number of results
+// that differ from std::fma (bitwise; +0 and -0 alike), the first few reported as failures if `report`.
+int fmaMismatches(Context& ctx, const std::vector<float>& in, const char* setting, bool report = true) {
+  uint32_t n = uint32_t(in.size() / 4);
+  Buffer src = createBuffer(ctx, in.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
+  Buffer dst = createBuffer(ctx, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
+  std::memcpy(src.data(), in.data(), in.size() * sizeof(float));
+  Program program = createProgram(ctx, "selftest_fma", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(uint32_t));
+  submitAndWait(ctx, [&](VkCommandBuffer cmd) { dispatch(cmd, program, groupCount(n, 64), 1, 1, {src, dst}, n); });
+  std::span<const float> out = dst.mapped<const float>();
+  int mismatches = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    float a = in[4 * i], b = in[4 * i + 1], c = in[4 * i + 2], want = std::fma(a, b, c);
+    if (std::bit_cast<uint32_t>(out[i]) != std::bit_cast<uint32_t>(want) && !(out[i] == 0.0f && want == 0.0f) &&
+        ++mismatches <= 3 && report)
+      ADD_FAILURE() << setting << std::hexfloat << ": msm_fma(" << a << ", " << b << ", " << c << ") = " << out[i]
+                    << ", std::fma: " << want;
+  }
+  return mismatches;
+}
+
+// The Context probes fma() at creation (fma_probe.comp) and every pipeline gets msm_fused_fma
+// accordingly: msm_fma is then exact (std::fma bit for bit) with the native fma() where the device
+// fuses it (GPUs) and with the emulation where it does not (lavapipe), and with the emulation forced
+// (FmaMode::Emulated, MSM_FORCE_EMULATED_FMA) everywhere. FmaMode::Native on a device that does not
+// fuse shows what the probe protects from: msm_fma rounding twice.
+TEST_F(VkLayerTest, FmaProbeAndExactMsmFma) {
+  std::vector<float> in = fmaInputs(50000);
+  uint32_t n = uint32_t(in.size() / 4);
+  std::printf("[vk] %s: fma() %s; msm_fma %s\n", ctx().info().name.c_str(), ctx().fusedFma() ? "fused" : "NOT fused",
+              ctx().useNativeFma() ? "native" : "emulated");
+  bool forced = [] {
+    const char* v = std::getenv("MSM_FORCE_EMULATED_FMA");
+    return v && (std::string(v) == "1" || std::string(v) == "true" || std::string(v) == "on" || std::string(v) == "yes");
+  }();
+  EXPECT_EQ(ctx().useNativeFma(), ctx().fusedFma() && !forced);
+  if (ctx().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU && ctx().info().driverName.find("llvmpipe") != std::string::npos) {
+    EXPECT_FALSE(ctx().fusedFma()) << "lavapipe's fma() was measured unfused (a * b, then + c)";
+  }
+  // The shared Context, as the probe set it up.
+  EXPECT_EQ(fmaMismatches(ctx(), in, ctx().useNativeFma() ? "native (probed fused)" : "emulated"), 0);
+
+  // Each setting on a Context of its own (same device), validation on.
+  auto withMode = [&](ContextOptions::FmaMode mode, auto&& body) {
+    ContextOptions options = quietOptions();
+    options.fmaMode = mode;
+    std::shared_ptr<ValidationLog> log;
+    {
+      Context other(options);
+      log = other.validationLog();
+      EXPECT_EQ(other.fusedFma(), ctx().fusedFma()) << "the probe is deterministic";
+      body(other);
+    }
+    EXPECT_TRUE(test::noValidationMessages(*log));
+  };
+  withMode(ContextOptions::FmaMode::Emulated, [&](Context& c) {
+    EXPECT_FALSE(c.useNativeFma());
+    EXPECT_EQ(fmaMismatches(c, in, "forced emulation"), 0);
+  });
+  withMode(ContextOptions::FmaMode::Native, [&](Context& c) {
+    EXPECT_TRUE(c.useNativeFma());
+    if (c.fusedFma()) {
+      EXPECT_EQ(fmaMismatches(c, in, "native"), 0);
+    } else { // the native fma() rounds twice: many of these inputs come out wrong
+      int wrong = fmaMismatches(c, in, "native", false);
+      std::printf("[vk] native unfused fma(): %d of %u results differ from std::fma\n", wrong, n);
+      EXPECT_GT(wrong, int(n / 10));
+    }
+  });
+  // The environment variable forces the emulation, as FmaMode::Emulated does.
+  withEnv("MSM_FORCE_EMULATED_FMA", "1", [&] {
+    Context forcedCtx(quietOptions());
+    EXPECT_FALSE(forcedCtx.useNativeFma());
+    EXPECT_EQ(forcedCtx.fusedFma(), ctx().fusedFma());
+  });
 }
 
 TEST_F(VkLayerTest, PushConstantsAndEveryBindingType) {

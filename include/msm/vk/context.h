@@ -51,6 +51,13 @@ struct ContextOptions {
   bool synchronizationValidation = true; // with validation: the layer's hazard checks as well
   bool echoValidation = true;            // see ValidationLog::setEcho
   bool verbose = true;                   // one line on stderr naming the device picked
+  // How msm_fma (shared.h) computes in the pipelines of this Context (useNativeFma()):
+  //  Probe: the native fma() where the probe found it fused, else the exact emulation. With
+  //         MSM_FORCE_EMULATED_FMA=1 (or true/on/yes) in the environment: Emulated;
+  //  Emulated: the emulation even where fma() is fused (tests of the emulation on such devices);
+  //  Native: the native fma() even where it is NOT fused (tests measuring what that costs).
+  enum class FmaMode { Probe, Emulated, Native };
+  FmaMode fmaMode = FmaMode::Probe;
   std::string applicationName = "msm";
 };
 
@@ -101,6 +108,16 @@ public:
   // Of the queue's family: 0 means no timestamps (GpuTimer then measures nothing).
   uint32_t timestampValidBits() const noexcept { return timestampValidBits_; }
 
+  // Whether the device's GLSL fma() is the fused multiply-add (one rounding), as found at creation
+  // by the probe shader fma_probe.comp: on cases where one rounding, two roundings and a double
+  // evaluation all differ, fused only if every case is rounded once. NVIDIA and AMD GPUs: fused;
+  // lavapipe (llvmpipe): a * b, then + c.
+  bool fusedFma() const noexcept { return fusedFma_; }
+  // The value of the shared headers' specialization constant msm_fused_fma (shared.h,
+  // MSM_SPEC_FUSED_FMA_ID) in every pipeline created from this Context: fusedFma(), unless
+  // ContextOptions::fmaMode (or MSM_FORCE_EMULATED_FMA) says otherwise.
+  bool useNativeFma() const noexcept { return useNativeFma_; }
+
   bool validationEnabled() const noexcept { return validation_; }
   ValidationLog& validation() const noexcept { return *log_; }
   std::shared_ptr<ValidationLog> validationLog() const noexcept { return log_; }
@@ -118,6 +135,7 @@ public:
 
 private:
   void destroy() noexcept;
+  bool probeFusedFma() const;
 
   std::shared_ptr<ValidationLog> log_ = std::make_shared<ValidationLog>();
   VkInstance instance_ = VK_NULL_HANDLE;
@@ -129,6 +147,8 @@ private:
   uint32_t queueFamily_ = 0;
   uint32_t timestampValidBits_ = 0;
   bool validation_ = false;
+  bool fusedFma_ = true;
+  bool useNativeFma_ = true;
   DeviceInfo info_;
   DeviceFeatures features_;
   VkPhysicalDeviceProperties properties_{};

@@ -71,7 +71,26 @@ private:
   Unique<VkPipeline, vkDestroyPipeline> pipeline_;
 };
 
-// A compute pipeline from SPIR-V with entry point "main". The push-constant range is
+// The specialization constants of the shared headers (include/msm/shared.h) for one pipeline stage:
+// msm_fused_fma (id MSM_SPEC_FUSED_FMA_ID) = ctx.useNativeFma(). createProgram sets it on every
+// pipeline; a pipeline created elsewhere (graphics) passes info() as each stage's
+// pSpecializationInfo. Ids that a shader does not declare are ignored, so every stage can take it.
+// info() points into this object: keep it alive until the pipeline is created.
+class SharedSpecialization {
+public:
+  explicit SharedSpecialization(const Context& ctx);
+  SharedSpecialization(const SharedSpecialization&) = delete;
+  SharedSpecialization& operator=(const SharedSpecialization&) = delete;
+  const VkSpecializationInfo* info() const noexcept { return &info_; }
+  bool nativeFma() const noexcept { return fusedFma_ != VK_FALSE; }
+
+private:
+  VkBool32 fusedFma_ = VK_TRUE; // a bool specialization constant is a VkBool32
+  VkSpecializationMapEntry entry_{};
+  VkSpecializationInfo info_{};
+};
+
+// A compute pipeline from SPIR-V with entry point "main", specialized with SharedSpecialization. The push-constant range is
 // [0, pushConstantSize) for the compute stage (none if 0). Preconditions (std::invalid_argument
 // otherwise): SPIR-V words start with the magic number; pushConstantSize is a multiple of 4 and at
 // most maxPushConstantsSize; bindings.size() <= maxPushDescriptors. That the list matches the

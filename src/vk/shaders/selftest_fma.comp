@@ -1,0 +1,17 @@
+// dst[i] = msm_fma(a, b, c) for src[i] = (a, b, c, unused): shared.h's msm_fma on the device, with
+// the specialization constant msm_fused_fma that createProgram sets (the native fma() where the
+// Context found it fused, else the exact emulation), against std::fma (vk_test.cpp).
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "msm/shared.h"
+
+layout(local_size_x = 64) in;
+
+layout(std430, binding = 0) readonly buffer Source { vec4 src[]; };
+layout(std430, binding = 1) writeonly buffer Destination { float dst[]; };
+layout(push_constant) uniform Push { uint count; } pc;
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i < pc.count) dst[i] = msm_fma(src[i].x, src[i].y, src[i].z);
+}
