@@ -22,15 +22,7 @@ namespace {
 
 using namespace msm;
 
-struct ErrorStats {
-    std::vector<double> errors;
-    void add(double e) { errors.push_back(std::abs(e)); }
-    double quantile(double q) {
-        std::sort(errors.begin(), errors.end());
-        return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
-    }
-    double max() { return quantile(1.0); }
-};
+using test::ErrorStats;
 
 // E f(z) in double: the filtered texel before it is rounded to the storage format.
 double expect(const test::Distribution& d, const std::function<double(double)>& f) {

@@ -19,15 +19,7 @@ namespace {
 
 using namespace msm;
 
-struct ErrorStats {
-    std::vector<double> errors;
-    void add(double e) { errors.push_back(std::abs(e)); }
-    double quantile(double q) {
-        std::sort(errors.begin(), errors.end());
-        return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
-    }
-    double max() { return quantile(1.0); }
-};
+using test::ErrorStats;
 
 // Biased float moments as the blocker search gets them: four moments from a [-1,1] float map
 // (JCGT: α = 3e-7), six moments from a float map (JCGT §5.4.3: α = 5e-6).

@@ -16,15 +16,7 @@ namespace {
 
 using namespace msm;
 
-struct ErrorStats {
-    std::vector<double> errors;
-    void add(double e) { errors.push_back(std::abs(e)); }
-    double quantile(double q) {
-        std::sort(errors.begin(), errors.end());
-        return errors.empty() ? 0.0 : errors[size_t(q * (errors.size() - 1))];
-    }
-    double max() { return quantile(1.0); }
-};
+using test::ErrorStats;
 
 std::vector<double> as_double_moments(vec4 b) { return {1.0, b[0], b[1], b[2], b[3]}; }
 

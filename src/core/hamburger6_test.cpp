@@ -21,15 +21,7 @@ namespace {
 
 using namespace msm;
 
-struct ErrorStats {
-    std::vector<double> errors;
-    void add(double e) { errors.push_back(std::abs(e)); }
-    double quantile(double q) {
-        std::sort(errors.begin(), errors.end());
-        return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
-    }
-    double max() { return quantile(1.0); }
-};
+using test::ErrorStats;
 
 // b1..b6 of d, rounded to float, then biased in float as a 192-bit six-moment map would be
 // (JCGT §5.4.3: α = 5e-6, b* = (1, 0, 0.5566, 0, 0.489, 0, 0.47869382)).

@@ -2,6 +2,8 @@
 // Continuous distributions are represented by a fine midpoint quadrature (512 atoms), which is
 // what a filter kernel over a sloped surface produces anyway.
 #pragma once
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 #include <glm/glm.hpp>
@@ -29,5 +31,16 @@ std::vector<double> power_moments(const Distribution& d, int m);
 std::vector<double> trig_moments(const Distribution& d);
 // b1..b4 rounded to float.
 glm::vec4 moments4f(const Distribution& d);
+
+// Absolute errors collected over many cases, for quantiles and the maximum.
+struct ErrorStats {
+    std::vector<double> errors;
+    void add(double e) { errors.push_back(std::abs(e)); }
+    double quantile(double q) {
+        std::sort(errors.begin(), errors.end());
+        return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
+    }
+    double max() { return quantile(1.0); }
+};
 
 } // namespace msm::test

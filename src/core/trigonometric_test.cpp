@@ -16,15 +16,7 @@ namespace {
 
 using namespace msm;
 
-struct ErrorStats {
-    std::vector<double> errors;
-    void add(double e) { errors.push_back(std::abs(e)); }
-    double quantile(double q) {
-        std::sort(errors.begin(), errors.end());
-        return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
-    }
-    double max() { return quantile(1.0); }
-};
+using test::ErrorStats;
 
 vec4 trig_moments4f(const test::Distribution& d) {
     std::vector<double> b = test::trig_moments(d);
