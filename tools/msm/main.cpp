@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
     msm::tool::add_demo(app);
     msm::tool::add_techniques(app);
     msm::tool::add_reconstruct(app);
+    msm::tool::add_compare(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

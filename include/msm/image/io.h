@@ -1,0 +1,41 @@
+// Reading and writing images: PNG (8-bit sRGB, via stb) and EXR (32-bit float, OpenEXR).
+//
+// Every write is atomic: the file is encoded in memory, written to a temporary file in the
+// target's directory (".<name>.tmp.<pid>.<n>"), flushed to disk (fsync) and renamed over the
+// target only when complete; on any failure the temporary file is removed, an existing target is
+// left untouched, and ImageError (path + reason) is thrown. Reading a missing, unreadable,
+// malformed or truncated file, or one with a side of 0 or > max_side, throws ImageError.
+#pragma once
+
+#include "msm/image/image.h"
+
+#include <filesystem>
+
+namespace msm::image {
+
+// PNG with 1 (grey), 2 (grey + alpha), 3 (RGB) or 4 (RGBA) channels, 8 bits per channel: colour
+// channels sRGB-encoded from linear values clamped to [0,1] (see to_srgb8), alpha linear.
+// Channel names are not stored.
+void write_png(const std::filesystem::path& path, const Image& image);
+// Any 8- or 16-bit PNG; values decoded to linear (sRGB decode for colour channels, alpha / max),
+// default channel names for the channel count.
+Image read_png(const std::filesystem::path& path);
+
+// EXR, scanline, ZIP-compressed, every channel 32-bit float (lossless), named by
+// image.channel_names(). The channel order is kept in the attribute "msmChannelOrder" (EXR itself
+// sorts channels by name).
+void write_exr(const std::filesystem::path& path, const Image& image);
+// Any scanline or tiled EXR (half, float or uint channels, converted to float) with 1..4
+// channels. Order: "msmChannelOrder" when present; otherwise R,G,B,A / Y,A when the names are
+// exactly such a set; otherwise the file's (alphabetical) order.
+Image read_exr(const std::filesystem::path& path);
+
+// By content (PNG or EXR signature), whatever the extension.
+Image read_image(const std::filesystem::path& path);
+// By extension: ".png" or ".exr" (case-insensitive); anything else throws ImageError.
+void write_image(const std::filesystem::path& path, const Image& image);
+
+// The atomic write used by the above, for any bytes.
+void write_file_atomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
+
+} // namespace msm::image

@@ -1,0 +1,250 @@
+// msm::scene: the scene description shared by the Vulkan renderer and the CPU ray tracer.
+//
+// A scene is a JSON file (schema below, examples in scenes/*.json, same text in scenes/README.md).
+// Loading it yields world-space triangle soups, materials, a camera, one directional light and the
+// shadow-map framing. Four built-in scenes reproduce the papers' stress cases; builtin_scene(name)
+// is exactly what loading scenes/<name>.json gives (the files are embedded at build time).
+//
+// Conventions: right-handed, +Y up, lengths in scene units (metres in the built-ins).
+//
+// ---------------------------------------------------------------------------------------------
+// JSON schema (every key optional unless marked REQUIRED; unknown keys are errors, so typos are
+// reported; comments /* */ and // are accepted):
+//
+// {
+//   "msm_scene": 1,                        REQUIRED format version (only 1 exists)
+//   "name": "fence",                       informative
+//   "camera": {
+//     "position": [x,y,z], "target": [x,y,z], "up": [0,1,0],
+//     "fov_y_deg": 45,                     vertical field of view, in (0, 180)
+//     "near": 0.1, "far": 1000             0 < near < far
+//   },
+//   "light": {                             ONE directional light
+//     "towards_light": [x,y,z],            REQUIRED direction FROM the scene TOWARDS the light
+//                                          (normalized on load; the light travels along -this)
+//     "irradiance": [r,g,b],               >= 0, default [3,3,3]
+//     "angular_extent_deg": 0              angular diameter of the light, [0, 90); 0 = hard
+//   },
+//   "shadow_map": {
+//     "framing": "fit"                     default: orthographic light frustum fitted to the
+//                                          scene's vertices (near plane through the closest one)
+//     | "framing": "explicit",
+//       "center": [x,y,z],                 world-space centre of the light frustum
+//       "extent": [w,h],                   full width/height across the light direction, > 0
+//       "depth_range": [n,f]               signed distances from center along the direction of
+//                                          travel (-towards_light), n < f; depth 0 at n, 1 at f
+//   },
+//   "materials": { "name": <material>, ... },   named materials that objects may refer to
+//   "objects": [ <object>, ... ]           REQUIRED, at least one
+// }
+//
+// <material> = {
+//   "albedo": [r,g,b] in [0,1] (default [0.8,0.8,0.8]), "albedo_texture": "path.png",
+//   "opacity": 1 in [0,1], "opacity_texture": "alpha.png" (alpha channel, or the grey value),
+//   (a constant given together with a texture multiplies it)
+//   "double_sided": false
+// }
+// Texture paths are relative to the scene file; they must exist when the scene is loaded but are
+// only read by load_texture().
+//
+// <object> = {
+//   "name": "wall",                        default "object<i>"; used in error messages
+//   "mesh": "models/bunny.obj"             file relative to the scene file (glTF 2.0 .gltf/.glb,
+//                                          OBJ, PLY, OFF and whatever else Assimp reads); node
+//                                          transforms are applied, normals generated if missing
+//   | "primitive": { "type": ..., parameters },  exactly one of "mesh" / "primitive"
+//   "transform": {
+//     "translate": [x,y,z],
+//     "rotate": [rx,ry,rz]                 Euler angles in degrees, applied X first, then Y, then Z
+//             | {"axis": [x,y,z], "angle_deg": a},
+//     "scale": s | [sx,sy,sz]              > 0 (no mirroring)
+//   },                                     world = translate * rotate * scale * local
+//   "material": <material> | "name"        default: the default material
+// }
+//
+// Primitives (local frames; sizes > 0 and <= 1e6; segment counts capped, see kMax* below):
+//   plane       {"size": [w,d], "subdivisions": [nx,nz]=[1,1]}   in y = 0, normal +Y, centred
+//   box         {"size": [x,y,z]}                                centred, 6 faces x 2 triangles
+//   sphere      {"radius": r, "segments": 64, "rings": 32}       centred (UV sphere)
+//   cylinder    {"radius": r, "height": h, "segments": 64, "caps": true}  axis Y, centred
+//   fence       {"length": 4, "height": 1, "bars": 9, "bar_width": 0.05, "bar_depth": 0.05,
+//                "rails": 2, "rail_height": 0.05}                vertical bars along X, rails at
+//                                          the top (and evenly below); stands on y = 0, centred
+//                                          in x and z. A railing is a fence with thin bars.
+//   stair       {"steps": 5, "width": 2, "step_depth": 0.3, "step_height": 0.2}
+//                                          solid steps rising towards -Z; stands on y = 0, the
+//                                          first step's front face at z = 0, centred in x
+//   torus_knot  {"p": 2, "q": 3, "radius": 1, "tube_radius": 0.15, "segments": 256,
+//                "tube_segments": 16}      procedural "model" (centred)
+//
+// Errors: every problem throws SceneError naming the file, the JSON pointer (and the object's
+// name) and what is wrong: malformed JSON, unknown keys/primitive/scene names, missing or
+// unreadable meshes/textures, NaN/infinite positions, meshes with only degenerate triangles,
+// scale <= 0, fov outside (0,180), opacity outside [0,1], absurd sizes or segment counts.
+// Degenerate (zero-area) triangles in otherwise valid meshes are dropped silently.
+//
+// Clip-space conventions (camera and light matrices): Vulkan: x right, y DOWN in NDC (an image
+// rendered with these matrices is upright with row 0 at the top), depth z in [0,1] (0 = near),
+// right-handed view space looking down -Z. Not reversed-Z.
+// ---------------------------------------------------------------------------------------------
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace msm::scene {
+
+// Caps against absurd input (checked before anything is allocated).
+inline constexpr int kMaxSegments = 4096;              // any one segment/ring/step/bar count
+inline constexpr std::size_t kMaxPrimitiveTriangles = 4'000'000;
+inline constexpr float kMaxSize = 1e6f;                // any primitive dimension / |translate|
+
+class SceneError : public std::runtime_error {
+public:
+  // what() = "<file>: <where>: <problem>" (file or where omitted when empty).
+  SceneError(std::string file, std::string where, std::string problem);
+  const std::string& file() const noexcept { return file_; }
+  const std::string& where() const noexcept { return where_; }    // JSON pointer (+ object name)
+  const std::string& problem() const noexcept { return problem_; }
+
+private:
+  std::string file_, where_, problem_;
+};
+
+struct Bounds {
+  glm::vec3 min{1e30f};
+  glm::vec3 max{-1e30f};
+  bool empty() const { return min.x > max.x; }
+  void extend(const glm::vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
+  void extend(const Bounds& b) { if (!b.empty()) { extend(b.min); extend(b.max); } }
+  glm::vec3 center() const { return 0.5f * (min + max); }
+  glm::vec3 size() const { return max - min; }
+};
+
+// Indexed triangle soup; normals are unit length, uvs zero where the source has none.
+struct Mesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<std::uint32_t> indices;  // 3 per triangle, counter-clockwise seen from the front
+  std::size_t triangle_count() const { return indices.size() / 3; }
+  double area() const;                 // sum of triangle areas
+  Bounds bounds() const;
+};
+
+struct Material {
+  std::string name;                     // key in "materials", or empty for inline ones
+  glm::vec3 albedo{0.8f};
+  std::filesystem::path albedo_texture; // absolute or relative to the CWD; empty = none
+  float opacity = 1.0f;
+  std::filesystem::path opacity_texture;
+  bool double_sided = false;
+};
+
+struct Transform {
+  glm::vec3 translate{0.0f};
+  glm::mat3 rotate{1.0f};
+  glm::vec3 scale{1.0f};
+  glm::mat4 matrix() const;  // translate * rotate * scale
+};
+
+struct Object {
+  std::string name;
+  std::filesystem::path mesh_file;  // empty for primitives
+  std::string primitive;            // primitive type, empty for meshes
+  Transform transform;
+  std::uint32_t material = 0;       // index into Scene::materials
+  Mesh mesh;                        // world space
+  Bounds bounds;                    // world space
+};
+
+struct Camera {
+  glm::vec3 position{0.0f, 2.0f, 6.0f};
+  glm::vec3 target{0.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float fov_y_deg = 45.0f;
+  float near = 0.1f;
+  float far = 1000.0f;
+  glm::mat4 view() const;
+  glm::mat4 projection(float aspect) const;  // Vulkan clip conventions (see above)
+};
+
+struct DirectionalLight {
+  glm::vec3 towards_light{0.0f, 1.0f, 0.0f};  // unit, from the scene towards the light
+  glm::vec3 irradiance{3.0f};
+  float angular_extent_deg = 0.0f;             // 0 = hard shadows
+  glm::vec3 travel() const { return -towards_light; }
+};
+
+struct ShadowFraming {
+  enum class Mode { Fit, Explicit } mode = Mode::Fit;
+  glm::vec3 center{0.0f};
+  glm::vec2 extent{1.0f};
+  glm::vec2 depth_range{-1.0f, 1.0f};
+};
+
+struct Scene {
+  std::string name;
+  std::filesystem::path source;  // the scene file, or "builtin:<name>"
+  std::vector<Material> materials;
+  std::vector<Object> objects;
+  Camera camera;
+  DirectionalLight light;
+  ShadowFraming shadow;
+
+  Bounds bounds() const;
+  std::size_t triangle_count() const;
+  std::size_t vertex_count() const;
+  // Light view (right-handed, looking along travel()) and orthographic projection, with the
+  // shadow framing applied: for "fit", the orthographic box is fitted to the scene's vertices
+  // in light space (plus a 1e-5 relative margin): every vertex maps into x,y in [-1,1] and depth
+  // in [0,1], depth 0 at the vertex closest to the light, 1 at the farthest. O(vertices) per
+  // call: cache the result. Vulkan clip conventions.
+  glm::mat4 light_view() const;
+  glm::mat4 light_projection() const;
+  glm::mat4 light_view_projection() const { return light_projection() * light_view(); }
+  glm::mat4 camera_view_projection(float aspect) const { return camera.projection(aspect) * camera.view(); }
+};
+
+// Loading. Relative mesh/texture paths resolve against base_dir (the file's directory).
+Scene load_scene_file(const std::filesystem::path& file);
+Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir,
+                      const std::string& source_name);
+
+// Built-in scenes: "fence" (the default), "railing", "stair", "column".
+std::vector<std::string> builtin_scene_names();
+std::string_view default_scene_name();               // "fence"
+std::string_view builtin_scene_json(std::string_view name);  // throws SceneError if unknown
+Scene builtin_scene(std::string_view name);
+// A built-in name, or else a path to a scene file.
+Scene load_scene(std::string_view name_or_path);
+
+// Mesh import through Assimp (node transforms applied, triangulated, normals generated if
+// missing, degenerate triangles dropped). Object space. Throws SceneError.
+Mesh import_mesh(const std::filesystem::path& file);
+
+// Primitive generators (local frames as documented above). Arguments are validated.
+Mesh make_plane(glm::vec2 size, glm::ivec2 subdivisions = {1, 1});
+Mesh make_box(glm::vec3 size);
+Mesh make_sphere(float radius, int segments = 64, int rings = 32);
+Mesh make_cylinder(float radius, float height, int segments = 64, bool caps = true);
+Mesh make_fence(float length, float height, int bars, float bar_width, float bar_depth, int rails,
+                float rail_height);
+Mesh make_stair(int steps, float width, float step_depth, float step_height);
+Mesh make_torus_knot(int p, int q, float radius, float tube_radius, int segments, int tube_segments);
+
+// Minimal lazy texture loading (stb_image), always 4 channels RGBA8.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;
+};
+Image load_texture(const std::filesystem::path& file);
+
+}  // namespace msm::scene

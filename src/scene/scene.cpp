@@ -1,0 +1,493 @@
+// JSON scene loading, built-in scenes and the camera/light matrices.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <utility>
+
+#include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "internal.h"
+
+namespace msm::scene {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// Generated from scenes/*.json at configure time: {name, text} pairs.
+struct BuiltinScene {
+  std::string_view name, json;
+};
+constexpr BuiltinScene kBuiltinScenes[] = {
+#include "builtin_scenes.inc"
+};
+
+std::string compose(const std::string& file, const std::string& where, const std::string& problem) {
+  std::string s;
+  if (!file.empty()) s += file + ": ";
+  if (!where.empty()) s += where + ": ";
+  return s + problem;
+}
+
+// Vulkan clip space: y down in NDC.
+glm::mat4 flip_y(const glm::mat4& p) {
+  glm::mat4 f(1.0f);
+  f[1][1] = -1.0f;
+  return f * p;
+}
+
+class Parser {
+public:
+  Parser(std::string file, fs::path base) : file_(file.empty() ? "<json>" : std::move(file)), base_(std::move(base)) {}
+
+  Scene parse(std::string_view text) {
+    json root;
+    try {
+      root = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    } catch (const json::exception& e) {  // parse_error, out_of_range (number overflow), ...
+      fail("", fmt::format("malformed JSON: {}", e.what()));
+    }
+    keys(root, "", {"msm_scene", "name", "camera", "light", "shadow_map", "materials", "objects"});
+    const json* version = find(root, "msm_scene");
+    if (!version) fail("/msm_scene", "required key missing (the format version, 1)");
+    if (!version->is_number_integer() || version->get<long long>() != 1)
+      fail("/msm_scene", "unsupported format version (only 1 exists)");
+    Scene s;
+    s.source = file_;
+    if (const json* v = find(root, "name")) s.name = string(*v, "/name");
+    if (const json* v = find(root, "camera")) s.camera = camera(*v, "/camera");
+    const json* light_json = find(root, "light");
+    if (!light_json) fail("/light", "required key missing");
+    s.light = light(*light_json, "/light");
+    if (const json* v = find(root, "shadow_map")) s.shadow = framing(*v, "/shadow_map");
+
+    Material default_material;
+    default_material.name = "default";
+    s.materials.push_back(default_material);
+    if (const json* mats = find(root, "materials")) {
+      if (!mats->is_object()) fail("/materials", "must be an object mapping names to materials");
+      for (const auto& [name, m] : mats->items()) {
+        const std::string ptr = "/materials/" + escape(name);
+        named_[name] = static_cast<std::uint32_t>(s.materials.size());
+        s.materials.push_back(material(m, ptr));
+        s.materials.back().name = name;
+      }
+    }
+    const json* objs = find(root, "objects");
+    if (!objs) fail("/objects", "required key missing");
+    if (!objs->is_array() || objs->empty()) fail("/objects", "must be a non-empty array");
+    for (std::size_t i = 0; i < objs->size(); ++i) s.objects.push_back(object((*objs)[i], fmt::format("/objects/{}", i), i, s));
+    return s;
+  }
+
+private:
+  [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
+    throw SceneError(file_, where, problem);
+  }
+
+  static std::string escape(const std::string& key) {  // JSON pointer escaping
+    std::string r;
+    for (char c : key) r += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    return r;
+  }
+
+  static const json* find(const json& obj, const char* key) {
+    auto it = obj.find(key);
+    return it == obj.end() ? nullptr : &*it;
+  }
+
+  void keys(const json& obj, const std::string& ptr, std::initializer_list<std::string_view> allowed) const {
+    if (!obj.is_object()) fail(ptr.empty() ? "/" : ptr, fmt::format("must be a JSON object (got {})", obj.type_name()));
+    for (const auto& [key, value] : obj.items())
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        fail(ptr + "/" + escape(key), fmt::format("unknown key (allowed: {})", fmt::join(allowed, ", ")));
+  }
+
+  std::string string(const json& v, const std::string& ptr) const {
+    if (!v.is_string()) fail(ptr, fmt::format("must be a string (got {})", v.type_name()));
+    return v.get<std::string>();
+  }
+
+  bool boolean(const json& v, const std::string& ptr) const {
+    if (!v.is_boolean()) fail(ptr, fmt::format("must be true or false (got {})", v.type_name()));
+    return v.get<bool>();
+  }
+
+  float number(const json& v, const std::string& ptr) const {
+    if (!v.is_number()) fail(ptr, fmt::format("must be a number (got {})", v.type_name()));
+    const double d = v.get<double>();
+    if (!std::isfinite(d) || std::abs(d) > 3e38) fail(ptr, "must be a finite number");
+    return static_cast<float>(d);
+  }
+
+  float number_in(const json& v, const std::string& ptr, float lo, float hi, bool open_lo, bool open_hi) const {
+    const float x = number(v, ptr);
+    if ((open_lo ? x <= lo : x < lo) || (open_hi ? x >= hi : x > hi))
+      fail(ptr, fmt::format("must be in {}{:g}, {:g}{} (got {:g})", open_lo ? '(' : '[', lo, hi, open_hi ? ')' : ']', x));
+    return x;
+  }
+
+  int integer(const json& v, const std::string& ptr) const {
+    if (!v.is_number()) fail(ptr, fmt::format("must be an integer (got {})", v.type_name()));
+    const double d = v.get<double>();
+    if (!std::isfinite(d) || d != std::floor(d)) fail(ptr, "must be an integer");
+    if (d < -1e9 || d > 1e9) fail(ptr, fmt::format("absurd value {:g}", d));
+    return static_cast<int>(d);
+  }
+
+  template <int N>
+  glm::vec<N, float> vec(const json& v, const std::string& ptr) const {
+    if (!v.is_array() || v.size() != N) fail(ptr, fmt::format("must be an array of {} numbers", N));
+    glm::vec<N, float> r;
+    for (int i = 0; i < N; ++i) r[i] = number(v[i], fmt::format("{}/{}", ptr, i));
+    return r;
+  }
+
+  glm::vec3 direction(const json& v, const std::string& ptr) const {
+    const glm::vec3 d = vec<3>(v, ptr);
+    const float len = glm::length(d);
+    if (!(len > 1e-20f) || !std::isfinite(len)) fail(ptr, "must be a non-zero direction");
+    return d / len;
+  }
+
+  Camera camera(const json& j, const std::string& ptr) const {
+    keys(j, ptr, {"position", "target", "up", "fov_y_deg", "near", "far"});
+    Camera c;
+    if (const json* v = find(j, "position")) c.position = vec<3>(*v, ptr + "/position");
+    if (const json* v = find(j, "target")) c.target = vec<3>(*v, ptr + "/target");
+    if (const json* v = find(j, "up")) c.up = direction(*v, ptr + "/up");
+    if (const json* v = find(j, "fov_y_deg")) c.fov_y_deg = number_in(*v, ptr + "/fov_y_deg", 0.0f, 180.0f, true, true);
+    if (const json* v = find(j, "near")) c.near = number_in(*v, ptr + "/near", 0.0f, kMaxSize, true, false);
+    if (const json* v = find(j, "far")) c.far = number_in(*v, ptr + "/far", 0.0f, 1e30f, true, false);
+    if (!(c.far > c.near)) fail(ptr + "/far", "must be greater than near");
+    const glm::vec3 view = c.target - c.position;
+    if (!(glm::length(view) > 0.0f)) fail(ptr + "/target", "must differ from position");
+    if (!(glm::length(glm::cross(glm::normalize(view), c.up)) > 1e-4f)) fail(ptr + "/up", "must not be parallel to the view direction");
+    return c;
+  }
+
+  DirectionalLight light(const json& j, const std::string& ptr) const {
+    keys(j, ptr, {"towards_light", "irradiance", "angular_extent_deg"});
+    DirectionalLight l;
+    const json* d = find(j, "towards_light");
+    if (!d) fail(ptr + "/towards_light", "required key missing (direction from the scene towards the light)");
+    l.towards_light = direction(*d, ptr + "/towards_light");
+    if (const json* v = find(j, "irradiance")) {
+      l.irradiance = vec<3>(*v, ptr + "/irradiance");
+      if (glm::any(glm::lessThan(l.irradiance, glm::vec3(0.0f)))) fail(ptr + "/irradiance", "must be >= 0");
+    }
+    if (const json* v = find(j, "angular_extent_deg"))
+      l.angular_extent_deg = number_in(*v, ptr + "/angular_extent_deg", 0.0f, 90.0f, false, true);
+    return l;
+  }
+
+  ShadowFraming framing(const json& j, const std::string& ptr) const {
+    keys(j, ptr, {"framing", "center", "extent", "depth_range"});
+    ShadowFraming f;
+    const std::string mode = find(j, "framing") ? string(*find(j, "framing"), ptr + "/framing") : "fit";
+    if (mode == "fit") {
+      for (const char* k : {"center", "extent", "depth_range"})
+        if (find(j, k)) fail(ptr + "/" + k, "only allowed with \"framing\": \"explicit\"");
+      return f;
+    }
+    if (mode != "explicit") fail(ptr + "/framing", fmt::format("unknown framing '{}' (fit, explicit)", mode));
+    f.mode = ShadowFraming::Mode::Explicit;
+    for (const char* k : {"center", "extent", "depth_range"})
+      if (!find(j, k)) fail(ptr + "/" + k, "required with \"framing\": \"explicit\"");
+    f.center = vec<3>(*find(j, "center"), ptr + "/center");
+    f.extent = vec<2>(*find(j, "extent"), ptr + "/extent");
+    if (!(f.extent.x > 0.0f && f.extent.y > 0.0f)) fail(ptr + "/extent", "must be > 0");
+    f.depth_range = vec<2>(*find(j, "depth_range"), ptr + "/depth_range");
+    if (!(f.depth_range.y > f.depth_range.x)) fail(ptr + "/depth_range", "must be [near, far] with near < far");
+    return f;
+  }
+
+  fs::path existing_file(const std::string& rel, const std::string& ptr, const char* what) const {
+    if (rel.empty()) fail(ptr, "empty path");
+    const fs::path p = (base_ / fs::path(rel)).lexically_normal();
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) fail(ptr, fmt::format("{} file '{}' does not exist or is not a file", what, p.string()));
+    return p;
+  }
+
+  Material material(const json& j, const std::string& ptr) const {
+    keys(j, ptr, {"albedo", "albedo_texture", "opacity", "opacity_texture", "double_sided"});
+    Material m;
+    if (const json* v = find(j, "albedo")) {
+      m.albedo = vec<3>(*v, ptr + "/albedo");
+      if (glm::any(glm::lessThan(m.albedo, glm::vec3(0.0f))) || glm::any(glm::greaterThan(m.albedo, glm::vec3(1.0f))))
+        fail(ptr + "/albedo", "components must be in [0, 1]");
+    }
+    if (const json* v = find(j, "albedo_texture"))
+      m.albedo_texture = existing_file(string(*v, ptr + "/albedo_texture"), ptr + "/albedo_texture", "texture");
+    if (const json* v = find(j, "opacity")) m.opacity = number_in(*v, ptr + "/opacity", 0.0f, 1.0f, false, false);
+    if (const json* v = find(j, "opacity_texture"))
+      m.opacity_texture = existing_file(string(*v, ptr + "/opacity_texture"), ptr + "/opacity_texture", "texture");
+    if (const json* v = find(j, "double_sided")) m.double_sided = boolean(*v, ptr + "/double_sided");
+    return m;
+  }
+
+  Transform transform(const json& j, const std::string& ptr) const {
+    keys(j, ptr, {"translate", "rotate", "scale"});
+    Transform t;
+    if (const json* v = find(j, "translate")) {
+      t.translate = vec<3>(*v, ptr + "/translate");
+      if (glm::any(glm::greaterThan(glm::abs(t.translate), glm::vec3(kMaxSize))))
+        fail(ptr + "/translate", fmt::format("absurd translation (|component| > {:g})", kMaxSize));
+    }
+    if (const json* v = find(j, "rotate")) {
+      glm::mat4 r(1.0f);
+      if (v->is_array()) {
+        const glm::vec3 e = glm::radians(vec<3>(*v, ptr + "/rotate"));
+        r = glm::rotate(glm::mat4(1.0f), e.z, glm::vec3(0, 0, 1)) * glm::rotate(glm::mat4(1.0f), e.y, glm::vec3(0, 1, 0)) *
+            glm::rotate(glm::mat4(1.0f), e.x, glm::vec3(1, 0, 0));
+      } else if (v->is_object()) {
+        keys(*v, ptr + "/rotate", {"axis", "angle_deg"});
+        if (!find(*v, "axis") || !find(*v, "angle_deg")) fail(ptr + "/rotate", "axis-angle needs \"axis\" and \"angle_deg\"");
+        const glm::vec3 axis = direction(*find(*v, "axis"), ptr + "/rotate/axis");
+        r = glm::rotate(glm::mat4(1.0f), glm::radians(number(*find(*v, "angle_deg"), ptr + "/rotate/angle_deg")), axis);
+      } else {
+        fail(ptr + "/rotate", "must be Euler degrees [x,y,z] or {\"axis\": [x,y,z], \"angle_deg\": a}");
+      }
+      t.rotate = glm::mat3(r);
+    }
+    if (const json* v = find(j, "scale")) {
+      t.scale = v->is_array() ? vec<3>(*v, ptr + "/scale") : glm::vec3(number(*v, ptr + "/scale"));
+      for (int i = 0; i < 3; ++i)
+        if (!(t.scale[i] > 0.0f) || t.scale[i] > kMaxSize)
+          fail(ptr + "/scale", fmt::format("must be > 0 and <= {:g} (got {:g}); mirroring is not supported", kMaxSize, t.scale[i]));
+    }
+    return t;
+  }
+
+  Mesh primitive(const json& j, const std::string& ptr, std::string& type) const {
+    if (!j.is_object()) fail(ptr, "must be an object with a \"type\"");
+    const json* tj = find(j, "type");
+    if (!tj) fail(ptr + "/type", "required key missing (plane, box, sphere, cylinder, fence, stair, torus_knot)");
+    type = string(*tj, ptr + "/type");
+    auto num = [&](const char* k, float def) { const json* v = find(j, k); return v ? number(*v, ptr + "/" + k) : def; };
+    auto intg = [&](const char* k, int def) { const json* v = find(j, k); return v ? integer(*v, ptr + "/" + k) : def; };
+    try {
+      if (type == "plane") {
+        keys(j, ptr, {"type", "size", "subdivisions"});
+        const glm::vec2 size = find(j, "size") ? vec<2>(*find(j, "size"), ptr + "/size") : glm::vec2(10.0f);
+        glm::ivec2 sub(1);
+        if (const json* v = find(j, "subdivisions")) {
+          if (!v->is_array() || v->size() != 2) fail(ptr + "/subdivisions", "must be an array of 2 integers");
+          sub = {integer((*v)[0], ptr + "/subdivisions/0"), integer((*v)[1], ptr + "/subdivisions/1")};
+        }
+        return make_plane(size, sub);
+      }
+      if (type == "box") {
+        keys(j, ptr, {"type", "size"});
+        return make_box(find(j, "size") ? vec<3>(*find(j, "size"), ptr + "/size") : glm::vec3(1.0f));
+      }
+      if (type == "sphere") {
+        keys(j, ptr, {"type", "radius", "segments", "rings"});
+        return make_sphere(num("radius", 0.5f), intg("segments", 64), intg("rings", 32));
+      }
+      if (type == "cylinder") {
+        keys(j, ptr, {"type", "radius", "height", "segments", "caps"});
+        const bool caps = find(j, "caps") ? boolean(*find(j, "caps"), ptr + "/caps") : true;
+        return make_cylinder(num("radius", 0.5f), num("height", 1.0f), intg("segments", 64), caps);
+      }
+      if (type == "fence") {
+        keys(j, ptr, {"type", "length", "height", "bars", "bar_width", "bar_depth", "rails", "rail_height"});
+        return make_fence(num("length", 4.0f), num("height", 1.0f), intg("bars", 9), num("bar_width", 0.05f),
+                          num("bar_depth", 0.05f), intg("rails", 2), num("rail_height", 0.05f));
+      }
+      if (type == "stair") {
+        keys(j, ptr, {"type", "steps", "width", "step_depth", "step_height"});
+        return make_stair(intg("steps", 5), num("width", 2.0f), num("step_depth", 0.3f), num("step_height", 0.2f));
+      }
+      if (type == "torus_knot") {
+        keys(j, ptr, {"type", "p", "q", "radius", "tube_radius", "segments", "tube_segments"});
+        return make_torus_knot(intg("p", 2), intg("q", 3), num("radius", 1.0f), num("tube_radius", 0.15f),
+                               intg("segments", 256), intg("tube_segments", 16));
+      }
+    } catch (const SceneError& e) {
+      if (!e.file().empty()) throw;  // already complete (from this parser)
+      fail(e.where().empty() ? ptr : ptr + "/" + e.where(), e.problem());
+    }
+    fail(ptr + "/type", fmt::format("unknown primitive '{}' (plane, box, sphere, cylinder, fence, stair, torus_knot)", type));
+  }
+
+  Object object(const json& j, const std::string& ptr, std::size_t index, Scene& s) const {
+    Object o;
+    o.name = fmt::format("object{}", index);
+    if (j.is_object())
+      if (const json* v = find(j, "name")) o.name = string(*v, ptr + "/name");
+    try {
+      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material"});
+      const json* mesh = find(j, "mesh");
+      const json* prim = find(j, "primitive");
+      if (!mesh == !prim) fail(ptr, "needs exactly one of \"mesh\" (a file) and \"primitive\"");
+      if (const json* v = find(j, "transform")) o.transform = transform(*v, ptr + "/transform");
+      if (const json* v = find(j, "material")) {
+        if (v->is_string()) {
+          const auto it = named_.find(v->get<std::string>());
+          if (it == named_.end()) fail(ptr + "/material", fmt::format("unknown material '{}'", v->get<std::string>()));
+          o.material = it->second;
+        } else {
+          o.material = static_cast<std::uint32_t>(s.materials.size());
+          s.materials.push_back(material(*v, ptr + "/material"));
+        }
+      }
+      Mesh m;
+      if (mesh) {
+        o.mesh_file = existing_file(string(*mesh, ptr + "/mesh"), ptr + "/mesh", "mesh");
+        try {
+          m = import_mesh(o.mesh_file);
+        } catch (const SceneError& e) {
+          fail(ptr + "/mesh", fmt::format("{} ({})", e.problem(), o.mesh_file.string()));
+        }
+      } else {
+        m = primitive(*prim, ptr + "/primitive", o.primitive);
+      }
+      // To world space. Scale > 0, so the winding is kept; normals by the inverse transpose.
+      const glm::mat4 mm = o.transform.matrix();
+      for (std::size_t v = 0; v < m.positions.size(); ++v) {
+        m.positions[v] = glm::vec3(mm * glm::vec4(m.positions[v], 1.0f));
+        m.normals[v] = glm::normalize(o.transform.rotate * (m.normals[v] / o.transform.scale));
+      }
+      try {
+        detail::finalize_mesh(m, "");
+      } catch (const SceneError& e) {
+        fail(ptr, "after the transform: " + e.problem());
+      }
+      o.mesh = std::move(m);
+      o.bounds = o.mesh.bounds();
+    } catch (const SceneError& e) {
+      // Name the object in the location.
+      throw SceneError(e.file(), fmt::format("{} (object '{}')", e.where(), o.name), e.problem());
+    }
+    return o;
+  }
+
+  std::string file_;
+  fs::path base_;
+  std::map<std::string, std::uint32_t> named_;
+};
+
+}  // namespace
+
+SceneError::SceneError(std::string file, std::string where, std::string problem)
+    : std::runtime_error(compose(file, where, problem)), file_(std::move(file)), where_(std::move(where)),
+      problem_(std::move(problem)) {}
+
+glm::mat4 Transform::matrix() const {
+  return glm::translate(glm::mat4(1.0f), translate) * glm::mat4(rotate) * glm::scale(glm::mat4(1.0f), scale);
+}
+
+glm::mat4 Camera::view() const { return glm::lookAtRH(position, target, up); }
+
+glm::mat4 Camera::projection(float aspect) const {
+  if (!(aspect > 0.0f) || !std::isfinite(aspect)) throw SceneError("", "aspect", "must be finite and > 0");
+  return flip_y(glm::perspectiveRH_ZO(glm::radians(fov_y_deg), aspect, near, far));
+}
+
+Bounds Scene::bounds() const {
+  Bounds b;
+  for (const Object& o : objects) b.extend(o.bounds);
+  return b;
+}
+
+std::size_t Scene::triangle_count() const {
+  std::size_t n = 0;
+  for (const Object& o : objects) n += o.mesh.triangle_count();
+  return n;
+}
+
+std::size_t Scene::vertex_count() const {
+  std::size_t n = 0;
+  for (const Object& o : objects) n += o.mesh.positions.size();
+  return n;
+}
+
+glm::mat4 Scene::light_view() const {
+  const glm::vec3 d = light.travel();
+  const glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  const Bounds b = bounds();
+  const glm::vec3 c = shadow.mode == ShadowFraming::Mode::Explicit ? shadow.center : (b.empty() ? glm::vec3(0.0f) : b.center());
+  return glm::lookAtRH(c, c + d, up);
+}
+
+glm::mat4 Scene::light_projection() const {
+  if (shadow.mode == ShadowFraming::Mode::Explicit) {
+    const glm::vec2 h = 0.5f * shadow.extent;
+    return flip_y(glm::orthoRH_ZO(-h.x, h.x, -h.y, h.y, shadow.depth_range.x, shadow.depth_range.y));
+  }
+  const Bounds b = bounds();
+  if (b.empty()) return flip_y(glm::orthoRH_ZO(-1.0f, 1.0f, -1.0f, 1.0f, -1.0f, 1.0f));
+  // Fitted to the vertices (tighter than the bounds' corners): the near plane touches the
+  // vertex closest to the light and the far plane the farthest one.
+  const glm::mat4 v = light_view();
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const Object& o : objects)
+    for (const glm::vec3& q : o.mesh.positions) {
+      const glm::vec3 p(v * glm::vec4(q, 1.0f));
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+  // A tiny margin keeps rounding from pushing vertices out; depth 0 stays at the closest point.
+  const float margin = 1e-5f * glm::length(b.size()) + 1e-6f;
+  lo -= margin;
+  hi += margin;
+  // View space looks down -z: distance along the light's travel is -z.
+  return flip_y(glm::orthoRH_ZO(lo.x, hi.x, lo.y, hi.y, -hi.z, -lo.z));
+}
+
+Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir, const std::string& source_name) {
+  return Parser(source_name, base_dir).parse(json_text);
+}
+
+Scene load_scene_file(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) throw SceneError(file.string(), "", "scene file does not exist");
+  if (!std::filesystem::is_regular_file(file, ec)) throw SceneError(file.string(), "", "scene path is not a regular file");
+  const auto size = std::filesystem::file_size(file, ec);
+  if (ec || size > (64u << 20)) throw SceneError(file.string(), "", "scene file unreadable or larger than 64 MiB");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(file.string(), "", "cannot open the scene file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  Scene s = load_scene_json(text.str(), file.parent_path(), file.string());
+  s.source = file;
+  return s;
+}
+
+std::vector<std::string> builtin_scene_names() {
+  std::vector<std::string> names;
+  for (const BuiltinScene& b : kBuiltinScenes) names.emplace_back(b.name);
+  return names;
+}
+
+std::string_view default_scene_name() { return "fence"; }
+
+std::string_view builtin_scene_json(std::string_view name) {
+  for (const BuiltinScene& b : kBuiltinScenes)
+    if (b.name == name) return b.json;
+  throw SceneError("", "", fmt::format("unknown built-in scene '{}' (known: {})", name, fmt::join(builtin_scene_names(), ", ")));
+}
+
+Scene builtin_scene(std::string_view name) {
+  const std::string source = fmt::format("builtin:{}", name);
+  return load_scene_json(builtin_scene_json(name), std::filesystem::path("."), source);
+}
+
+Scene load_scene(std::string_view name_or_path) {
+  for (const BuiltinScene& b : kBuiltinScenes)
+    if (b.name == name_or_path) return builtin_scene(name_or_path);
+  const std::filesystem::path p{std::string(name_or_path)};
+  std::error_code ec;
+  if (!std::filesystem::exists(p, ec))
+    throw SceneError(std::string(name_or_path), "",
+                     fmt::format("neither a built-in scene ({}) nor an existing scene file", fmt::join(builtin_scene_names(), ", ")));
+  return load_scene_file(p);
+}
+
+}  // namespace msm::scene

@@ -1,0 +1,489 @@
+// Tests of msm::scene: built-in scenes and their JSON files, primitives, transforms, Assimp
+// import, matrices, and clear errors for bad input.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "msm/scene/scene.h"
+
+namespace fs = std::filesystem;
+using namespace msm::scene;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// A fresh temporary directory per test.
+class TempDir {
+public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() / ("msm_scene_test_" + std::to_string(rd()) + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path p = path_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+private:
+  fs::path path_;
+};
+
+double signed_volume(const Mesh& m) {
+  double v = 0.0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]), c(m.positions[m.indices[3 * t + 2]]);
+    v += glm::dot(a, glm::cross(b, c)) / 6.0;
+  }
+  return v;
+}
+
+// Normals unit length, and every triangle wound counter-clockwise around its vertex normals.
+void expect_consistent(const Mesh& m) {
+  ASSERT_EQ(m.positions.size(), m.normals.size());
+  ASSERT_EQ(m.positions.size(), m.uvs.size());
+  ASSERT_EQ(m.indices.size() % 3, 0u);
+  for (const glm::vec3& n : m.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-5f);
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const std::uint32_t* i = &m.indices[3 * t];
+    ASSERT_LT(std::max({i[0], i[1], i[2]}), m.positions.size());
+    const glm::vec3 e = glm::cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]);
+    ASSERT_GT(glm::dot(e, m.normals[i[0]] + m.normals[i[1]] + m.normals[i[2]]), 0.0f) << "triangle " << t;
+  }
+}
+
+std::string scene_with_object(const std::string& object_json, const std::string& extra = "") {
+  return R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, )" + extra + R"("objects": [)" + object_json + "]}";
+}
+
+// Expects a SceneError whose message contains every one of the given fragments.
+template <class F>
+void expect_error(F&& f, std::initializer_list<std::string> fragments) {
+  try {
+    f();
+    ADD_FAILURE() << "no SceneError thrown (expected one mentioning '" << *fragments.begin() << "')";
+  } catch (const SceneError& e) {
+    const std::string what = e.what();
+    for (const std::string& frag : fragments) EXPECT_NE(what.find(frag), std::string::npos) << "'" << frag << "' not in: " << what;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not a SceneError: " << e.what();
+  }
+}
+
+void expect_json_error(const std::string& json, std::initializer_list<std::string> fragments) {
+  expect_error([&] { load_scene_json(json, fs::current_path(), "test.json"); }, fragments);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Built-in scenes
+
+TEST(BuiltinScenes, NamesAndDefault) {
+  const auto names = builtin_scene_names();
+  EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column"}));
+  EXPECT_EQ(default_scene_name(), "fence");
+}
+
+TEST(BuiltinScenes, LoadWithSaneBoundsAndCounts) {
+  for (const std::string& name : builtin_scene_names()) {
+    SCOPED_TRACE(name);
+    const Scene s = builtin_scene(name);
+    EXPECT_EQ(s.name, name);
+    EXPECT_GE(s.objects.size(), 2u);
+    EXPECT_GT(s.triangle_count(), 20u);
+    EXPECT_LT(s.triangle_count(), 200000u);
+    const Bounds b = s.bounds();
+    ASSERT_FALSE(b.empty());
+    EXPECT_NEAR(b.min.y, 0.0f, 1e-5f);  // everything stands on the ground plane y = 0
+    EXPECT_GT(b.max.y, 0.5f);
+    EXPECT_LT(glm::length(b.size()), 100.0f);
+    for (const Object& o : s.objects) {
+      SCOPED_TRACE(o.name);
+      expect_consistent(o.mesh);
+      EXPECT_LT(o.material, s.materials.size());
+    }
+    EXPECT_NEAR(glm::length(s.light.towards_light), 1.0f, 1e-6f);
+    EXPECT_GT(s.light.towards_light.y, 0.0f);
+  }
+}
+
+TEST(BuiltinScenes, JsonFilesLoadToTheBuiltins) {
+  for (const std::string& name : builtin_scene_names()) {
+    SCOPED_TRACE(name);
+    const Scene a = builtin_scene(name);
+    const Scene b = load_scene_file(fs::path(MSM_SCENES_DIR) / (name + ".json"));
+    ASSERT_EQ(a.objects.size(), b.objects.size());
+    EXPECT_EQ(a.triangle_count(), b.triangle_count());
+    EXPECT_EQ(a.bounds().min, b.bounds().min);
+    EXPECT_EQ(a.bounds().max, b.bounds().max);
+    for (std::size_t i = 0; i < a.objects.size(); ++i) {
+      EXPECT_EQ(a.objects[i].name, b.objects[i].name);
+      EXPECT_EQ(a.objects[i].mesh.positions, b.objects[i].mesh.positions);
+      EXPECT_EQ(a.objects[i].mesh.indices, b.objects[i].mesh.indices);
+    }
+    EXPECT_EQ(a.camera.position, b.camera.position);
+    EXPECT_EQ(a.light.towards_light, b.light.towards_light);
+    EXPECT_EQ(load_scene(name).triangle_count(), a.triangle_count());  // by name
+  }
+}
+
+TEST(BuiltinScenes, StressCaseGeometry) {
+  // fence: the shadows of the sign, the fence and the wall overlap (one, two or three occluders
+  // in one filter kernel).
+  const Scene fence = builtin_scene("fence");
+  // Shadow footprints (light-space xy of each occluder's bounds) of wall, fence and sign overlap.
+  const glm::mat4 lvp = fence.light_view_projection();
+  auto footprint = [&](const std::string& name) {
+    Bounds b;
+    for (const Object& o : fence.objects)
+      if (o.name.rfind(name, 0) == 0)
+        for (const glm::vec3& p : o.mesh.positions) {
+          const glm::vec4 c = lvp * glm::vec4(p, 1.0f);
+          b.extend(glm::vec3(c.x, c.y, 0.0f));
+        }
+    return b;
+  };
+  const Bounds wall = footprint("wall"), fence_fp = footprint("fence"), sign = footprint("sign_board");
+  auto overlap = [](const Bounds& a, const Bounds& b) {
+    const glm::vec3 lo = glm::max(a.min, b.min), hi = glm::min(a.max, b.max);
+    return std::min(hi.x - lo.x, hi.y - lo.y);
+  };
+  EXPECT_GT(overlap(wall, fence_fp), 0.0f);
+  EXPECT_GT(overlap(fence_fp, sign), 0.0f);
+  EXPECT_GT(overlap(wall, sign), 0.0f);
+
+  // column: light at 80 degrees incidence.
+  const Scene column = builtin_scene("column");
+  EXPECT_NEAR(std::acos(column.light.towards_light.y) * 180.0 / kPi, 80.0, 1e-3);
+  // railing: the banner is a few centimetres behind the railing.
+  const Scene railing = builtin_scene("railing");
+  EXPECT_LT(railing.objects[1].bounds.min.z - railing.objects[2].bounds.max.z, 0.1f);
+  EXPECT_TRUE(railing.materials[railing.objects[2].material].double_sided);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Matrices
+
+TEST(Matrices, LightFrustumContainsAllVerticesWithDepthInUnitRange) {
+  for (const std::string& name : builtin_scene_names()) {
+    SCOPED_TRACE(name);
+    const Scene s = builtin_scene(name);
+    const glm::mat4 m = s.light_view_projection();
+    float zmin = 2.0f, zmax = -1.0f;
+    for (const Object& o : s.objects)
+      for (const glm::vec3& p : o.mesh.positions) {
+        const glm::vec4 c = m * glm::vec4(p, 1.0f);
+        ASSERT_FLOAT_EQ(c.w, 1.0f);
+        ASSERT_GE(c.x, -1.0f);
+        ASSERT_LE(c.x, 1.0f);
+        ASSERT_GE(c.y, -1.0f);
+        ASSERT_LE(c.y, 1.0f);
+        ASSERT_GE(c.z, 0.0f);
+        ASSERT_LE(c.z, 1.0f);
+        zmin = std::min(zmin, c.z);
+        zmax = std::max(zmax, c.z);
+      }
+    EXPECT_LT(zmin, 1e-4f);  // tight: near plane at the closest vertex
+    EXPECT_GT(zmax, 1.0f - 1e-4f);
+    // Points nearer to the light get smaller depths.
+    const glm::vec3 c = s.bounds().center();
+    const float d0 = (m * glm::vec4(c, 1.0f)).z, d1 = (m * glm::vec4(c + 0.1f * s.light.towards_light, 1.0f)).z;
+    EXPECT_LT(d1, d0);
+  }
+}
+
+TEST(Matrices, ExplicitShadowFraming) {
+  const Scene s = load_scene_json(scene_with_object(R"({"primitive": {"type": "box"}})",
+      R"("shadow_map": {"framing": "explicit", "center": [0, 0, 0], "extent": [4, 2], "depth_range": [-5, 5]},)"),
+      ".", "explicit.json");
+  const glm::mat4 m = s.light_view_projection();  // light straight down
+  const glm::vec4 c = m * glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+  EXPECT_NEAR(c.z, 0.5f, 1e-6f);
+  EXPECT_NEAR((m * glm::vec4(0.0f, 5.0f, 0.0f, 1.0f)).z, 0.0f, 1e-6f);  // towards the light: near
+  EXPECT_NEAR((m * glm::vec4(0.0f, -5.0f, 0.0f, 1.0f)).z, 1.0f, 1e-6f);
+  const glm::vec4 edge = m * glm::vec4(2.0f, 0.0f, 0.0f, 1.0f);
+  const glm::vec4 edge2 = m * glm::vec4(0.0f, 0.0f, 1.0f, 1.0f);
+  EXPECT_NEAR(std::max(std::abs(edge.x), std::abs(edge.y)) + std::max(std::abs(edge2.x), std::abs(edge2.y)), 2.0f, 1e-5f);
+}
+
+TEST(Matrices, CameraUsesVulkanClipConventions) {
+  const Scene s = builtin_scene("fence");
+  const glm::mat4 m = s.camera_view_projection(16.0f / 9.0f);
+  glm::vec4 t = m * glm::vec4(s.camera.target, 1.0f);
+  t /= t.w;
+  EXPECT_NEAR(t.x, 0.0f, 1e-5f);
+  EXPECT_NEAR(t.y, 0.0f, 1e-5f);
+  EXPECT_GT(t.z, 0.0f);
+  EXPECT_LT(t.z, 1.0f);
+  glm::vec4 above = m * glm::vec4(s.camera.target + 0.5f * s.camera.up, 1.0f);
+  EXPECT_LT(above.y / above.w, 0.0f);  // y down in NDC: up in the world is up in the image
+  const glm::vec3 dir = glm::normalize(s.camera.target - s.camera.position);
+  glm::vec4 n = m * glm::vec4(s.camera.position + s.camera.near * dir, 1.0f);
+  glm::vec4 f = m * glm::vec4(s.camera.position + s.camera.far * dir, 1.0f);
+  EXPECT_NEAR(n.z / n.w, 0.0f, 1e-5f);
+  EXPECT_NEAR(f.z / f.w, 1.0f, 1e-5f);
+  expect_error([&] { (void)s.camera.projection(0.0f); }, {"aspect"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Primitives
+
+TEST(Primitives, SphereAreaVolumeAndNormals) {
+  const float r = 1.5f;
+  const Mesh m = make_sphere(r, 64, 32);
+  expect_consistent(m);
+  EXPECT_NEAR(m.area() / (4.0 * kPi * r * r), 1.0, 0.01);
+  EXPECT_NEAR(signed_volume(m) / (4.0 / 3.0 * kPi * r * r * r), 1.0, 0.02);
+  for (std::size_t v = 0; v < m.positions.size(); ++v) {
+    EXPECT_NEAR(glm::length(m.positions[v]), r, 1e-5f);
+    EXPECT_GT(glm::dot(m.normals[v], m.positions[v]), 0.99f * r);  // outward
+  }
+}
+
+TEST(Primitives, Box) {
+  const Mesh m = make_box({1.0f, 2.0f, 3.0f});
+  expect_consistent(m);
+  EXPECT_EQ(m.triangle_count(), 12u);
+  EXPECT_NEAR(m.area(), 2.0 * (2 + 6 + 3), 1e-5);
+  EXPECT_NEAR(signed_volume(m), 6.0, 1e-5);
+  std::vector<glm::vec3> normals;
+  for (const glm::vec3& n : m.normals)
+    if (std::find(normals.begin(), normals.end(), n) == normals.end()) normals.push_back(n);
+  EXPECT_EQ(normals.size(), 6u);  // 6 faces
+  EXPECT_EQ(m.bounds().min, glm::vec3(-0.5f, -1.0f, -1.5f));
+  EXPECT_EQ(m.bounds().max, glm::vec3(0.5f, 1.0f, 1.5f));
+}
+
+TEST(Primitives, CylinderPlaneStairFenceKnot) {
+  const Mesh c = make_cylinder(0.5f, 2.0f, 128, true);
+  expect_consistent(c);
+  EXPECT_NEAR(c.area() / (2 * kPi * 0.5 * 2.0 + 2 * kPi * 0.25), 1.0, 0.01);
+  EXPECT_NEAR(signed_volume(c) / (kPi * 0.25 * 2.0), 1.0, 0.01);
+  EXPECT_EQ(make_cylinder(0.5f, 2.0f, 16, false).triangle_count(), 32u);
+
+  const Mesh p = make_plane({4.0f, 2.0f}, {3, 5});
+  expect_consistent(p);
+  EXPECT_EQ(p.triangle_count(), 30u);
+  EXPECT_NEAR(p.area(), 8.0, 1e-5);
+  for (const glm::vec3& n : p.normals) EXPECT_EQ(n, glm::vec3(0, 1, 0));
+
+  const Mesh s = make_stair(4, 2.0f, 0.3f, 0.2f);
+  expect_consistent(s);
+  EXPECT_EQ(s.triangle_count(), 4u * 12u);
+  EXPECT_NEAR(signed_volume(s), 2.0 * 0.3 * 0.2 * (1 + 2 + 3 + 4), 1e-5);
+  EXPECT_NEAR(s.bounds().max.y, 0.8f, 1e-6f);
+  EXPECT_NEAR(s.bounds().min.z, -1.2f, 1e-6f);
+  EXPECT_NEAR(s.bounds().max.z, 0.0f, 1e-6f);
+
+  const Mesh f = make_fence(4.0f, 1.0f, 9, 0.05f, 0.04f, 2, 0.06f);
+  expect_consistent(f);
+  EXPECT_EQ(f.triangle_count(), (9u + 2u) * 12u);
+  EXPECT_NEAR(signed_volume(f), 9 * 0.05 * 0.04 * 1.0 + 2 * 4.0 * 0.06 * 0.04, 1e-5);
+  EXPECT_NEAR(f.bounds().min.x, -2.0f, 1e-6f);
+  EXPECT_NEAR(f.bounds().max.x, 2.0f, 1e-6f);
+  EXPECT_NEAR(f.bounds().min.y, 0.0f, 1e-6f);
+
+  const Mesh k = make_torus_knot(2, 3, 1.0f, 0.1f, 256, 16);
+  expect_consistent(k);
+  EXPECT_GT(signed_volume(k), 0.0);  // closed, outward
+}
+
+TEST(Primitives, TransformsApply) {
+  const Scene s = load_scene_json(scene_with_object(
+      R"({"name": "b", "primitive": {"type": "box", "size": [1, 1, 1]},
+          "transform": {"translate": [10, 0, 0], "rotate": [0, 90, 0], "scale": [2, 1, 1]}},
+         {"name": "c", "primitive": {"type": "box", "size": [1, 1, 1]},
+          "transform": {"translate": [10, 0, 0], "rotate": {"axis": [0, 2, 0], "angle_deg": 90}, "scale": [2, 1, 1]}},
+         {"name": "d", "primitive": {"type": "sphere", "radius": 1}, "transform": {"scale": [1, 3, 1]}})"),
+      ".", "t.json");
+  const Bounds b = s.objects[0].bounds;
+  EXPECT_NEAR(b.min.x, 9.5f, 1e-5f);
+  EXPECT_NEAR(b.max.x, 10.5f, 1e-5f);
+  EXPECT_NEAR(b.min.z, -1.0f, 1e-5f);
+  EXPECT_NEAR(b.max.z, 1.0f, 1e-5f);
+  for (std::size_t v = 0; v < s.objects[0].mesh.positions.size(); ++v)
+    EXPECT_LT(glm::distance(s.objects[0].mesh.positions[v], s.objects[1].mesh.positions[v]), 1e-5f);
+  for (const Object& o : s.objects) expect_consistent(o.mesh);
+  // Non-uniform scale: normals by the inverse transpose (the ellipsoid's gradient).
+  const Mesh& e = s.objects[2].mesh;
+  EXPECT_NEAR(e.bounds().max.y, 3.0f, 1e-5f);
+  for (std::size_t v = 0; v < e.positions.size(); ++v) {
+    const glm::vec3 p = e.positions[v];
+    const glm::vec3 grad = glm::normalize(glm::vec3(p.x, p.y / 9.0f, p.z));
+    EXPECT_GT(glm::dot(grad, e.normals[v]), 0.9999f);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Assimp import
+
+TEST(Import, ObjPlyOffGltf) {
+  TempDir dir;
+  // OBJ: a quad (2 triangles) and a triangle, no normals.
+  const fs::path obj = dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\n"
+                                          "f 1 2 3 4\nf 5 6 7\n");
+  // PLY: a tetrahedron.
+  const fs::path ply = dir.write("m.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                                          "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                                          "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  // OFF: a cube of 6 quads.
+  const fs::path off = dir.write("m.off", "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
+                                          "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n");
+  // glTF 2.0: one triangle, the buffer embedded as base64 (3 float3 positions + 3 uint16 indices).
+  const std::string gltf =
+      R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+          "nodes": [{"mesh": 0, "translation": [5, 0, 0]}],
+          "meshes": [{"primitives": [{"attributes": {"POSITION": 1}, "indices": 0}]}],
+          "buffers": [{"uri": "data:application/octet-stream;base64,AAABAAIAAAAAAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAAAAAACAPwAAAAA=", "byteLength": 44}],
+          "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 6, "target": 34963},
+                          {"buffer": 0, "byteOffset": 8, "byteLength": 36, "target": 34962}],
+          "accessors": [{"bufferView": 0, "componentType": 5123, "count": 3, "type": "SCALAR"},
+                        {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3",
+                         "min": [0, 0, 0], "max": [1, 1, 0]}]})";
+  const fs::path gl = dir.write("m.gltf", gltf);
+
+  const Mesh mo = import_mesh(obj);
+  EXPECT_EQ(mo.triangle_count(), 3u);
+  expect_consistent(mo);
+  const Mesh mp = import_mesh(ply);
+  EXPECT_EQ(mp.triangle_count(), 4u);
+  EXPECT_EQ(import_mesh(off).triangle_count(), 12u);
+  EXPECT_NEAR(import_mesh(off).area(), 6.0, 1e-5);
+  const Mesh mg = import_mesh(gl);
+  EXPECT_EQ(mg.triangle_count(), 1u);
+  EXPECT_NEAR(mg.bounds().min.x, 5.0f, 1e-6f);  // the node transform is applied
+  EXPECT_NEAR(mg.area(), 0.5, 1e-6);
+
+  // Through a scene file: path relative to the scene file, then transformed.
+  fs::create_directories(dir.path() / "scenes");
+  const fs::path scene = dir.write("scenes/s.json", scene_with_object(
+      R"({"name": "m", "mesh": "../m.obj", "transform": {"translate": [0, 0, 7]}})"));
+  const Scene s = load_scene_file(scene);
+  EXPECT_EQ(s.triangle_count(), 3u);
+  EXPECT_NEAR(s.bounds().min.z, 7.0f, 1e-6f);
+  EXPECT_EQ(s.objects[0].mesh_file, (dir.path() / "m.obj").lexically_normal());
+}
+
+TEST(Import, RealModelIfInstalled) {
+  const fs::path candidates[] = {"/usr/share/assimp-testmodels/models/OBJ/spider.obj",
+                                 "/usr/share/assimp-testmodels/models/PLY/cube.ply",
+                                 "/usr/share/glmark2/models/horse.3ds", "/usr/share/glmark2/models/cat.3ds"};
+  for (const fs::path& p : candidates)
+    if (fs::exists(p)) {
+      const Mesh m = import_mesh(p);
+      EXPECT_GT(m.triangle_count(), 0u) << p;
+      expect_consistent(m);
+      return;
+    }
+  GTEST_SKIP() << "no real model found (install assimp-testmodels or glmark2-data to run this test)";
+}
+
+// ---------------------------------------------------------------------------------------------
+// Textures
+
+TEST(Textures, PathRecordedAndLoadedLazily) {
+  TempDir dir;
+  dir.write("t.ppm", std::string("P6\n2 1\n255\n") + std::string("\xff\x00\x00\x00\x80\xff", 6));
+  const Scene s = load_scene_json(scene_with_object(
+      R"({"primitive": {"type": "box"}, "material": {"albedo_texture": "t.ppm", "opacity": 0.5, "double_sided": true}})"),
+      dir.path(), "tex.json");
+  const Material& m = s.materials[s.objects[0].material];
+  EXPECT_EQ(m.albedo_texture, (dir.path() / "t.ppm").lexically_normal());
+  EXPECT_FLOAT_EQ(m.opacity, 0.5f);
+  EXPECT_TRUE(m.double_sided);
+  const Image img = load_texture(m.albedo_texture);
+  ASSERT_EQ(img.width, 2);
+  ASSERT_EQ(img.height, 1);
+  EXPECT_EQ(img.rgba, (std::vector<std::uint8_t>{255, 0, 0, 255, 0, 128, 255, 255}));
+  expect_error([&] { load_texture(dir.path() / "none.png"); }, {"none.png", "does not exist"});
+  dir.write("bad.png", "not an image");
+  expect_error([&] { load_texture(dir.path() / "bad.png"); }, {"bad.png", "cannot decode"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: a SceneError naming the file, the location and the problem.
+
+TEST(Errors, Files) {
+  TempDir dir;
+  expect_error([&] { load_scene_file(dir.path() / "missing.json"); }, {"missing.json", "does not exist"});
+  expect_error([&] { load_scene_file(dir.path()); }, {"not a regular file"});
+  const fs::path bad = dir.write("bad.json", R"({"msm_scene": 1, "objects": [ )");
+  expect_error([&] { load_scene_file(bad); }, {"bad.json", "malformed JSON"});
+  expect_error([&] { builtin_scene("nosuch"); }, {"unknown built-in scene 'nosuch'", "fence"});
+  expect_error([&] { load_scene("nosuch"); }, {"nosuch", "neither a built-in scene"});
+}
+
+TEST(Errors, Structure) {
+  expect_json_error("[1, 2]", {"test.json", "must be a JSON object"});
+  expect_json_error(R"({"light": {"towards_light": [0,1,0]}, "objects": []})", {"/msm_scene", "required"});
+  expect_json_error(R"({"msm_scene": 2, "light": {"towards_light": [0,1,0]}, "objects": []})", {"/msm_scene", "version"});
+  expect_json_error(R"({"msm_scene": 1, "objects": [{"primitive": {"type": "box"}}]})", {"/light", "required"});
+  expect_json_error(R"({"msm_scene": 1, "light": {"towards_light": [0,1,0]}, "objects": []})", {"/objects", "non-empty"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "colour": 1})"), {"/objects/0/colour", "unknown key"});
+  expect_json_error(scene_with_object(R"({"name": "p", "primitive": {"type": "pyramid"}})"),
+                    {"/objects/0/primitive/type", "object 'p'", "unknown primitive 'pyramid'"});
+  expect_json_error(scene_with_object(R"({"name": "x"})"), {"/objects/0", "exactly one of"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": "steel"})"), {"unknown material 'steel'"});
+  expect_json_error(R"({"msm_scene": 1, "light": {"towards_light": [0,0,0]}, "objects": [{"primitive": {"type": "box"}}]})",
+                    {"/light/towards_light", "non-zero"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box", "size": [1, "2", 1]}})"), {"/objects/0/primitive/size/1", "number"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}})", R"("shadow_map": {"framing": "tight"},)"),
+                    {"/shadow_map/framing", "unknown framing"});
+}
+
+TEST(Errors, Values) {
+  expect_json_error(scene_with_object(R"({"name": "s", "primitive": {"type": "box"}, "transform": {"scale": -1}})"),
+                    {"/objects/0/transform/scale", "object 's'", "> 0"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "transform": {"scale": [1, 0, 1]}})"), {"scale", "> 0"});
+  for (const char* fov : {"0", "180", "-5", "200"})
+    expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}})",
+                                        std::string(R"("camera": {"fov_y_deg": )") + fov + "},"),
+                      {"/camera/fov_y_deg", "(0, 180)"});
+  for (const char* opacity : {"1.5", "-0.1"})
+    expect_json_error(scene_with_object(std::string(R"({"primitive": {"type": "box"}, "material": {"opacity": )") + opacity + "}}"),
+                      {"/objects/0/material/opacity", "[0, 1]"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 1000000000}})"),
+                    {"/objects/0/primitive/segments", "4096"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 1e30}})"), {"segments", "absurd"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 4096, "rings": 4096}})"),
+                    {"/objects/0/primitive", "cap"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box", "size": [1e9, 1, 1]}})"), {"size", "<= 1e+06"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "fence", "bars": 0}})"), {"bars"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "plane", "size": [1e400, 1]}})"), {"test.json", "number overflow"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": {"albedo_texture": "nope.png"}})"),
+                    {"/objects/0/material/albedo_texture", "nope.png", "does not exist"});
+}
+
+TEST(Errors, Meshes) {
+  TempDir dir;
+  auto load = [&](const std::string& object_json) { load_scene_file(dir.write("s.json", scene_with_object(object_json))); };
+  expect_error([&] { load(R"({"name": "m", "mesh": "missing.obj"})"); }, {"s.json", "/objects/0/mesh", "object 'm'", "missing.obj", "does not exist"});
+  dir.write("garbage.ply", "ply\nthis is not a ply file\n\x01\x02\x03");
+  expect_error([&] { load(R"({"mesh": "garbage.ply"})"); }, {"/objects/0/mesh", "garbage.ply", "Assimp cannot read"});
+  dir.write("empty.obj", "# nothing\n");
+  expect_error([&] { load(R"({"mesh": "empty.obj"})"); }, {"/objects/0/mesh", "empty.obj"});
+  dir.write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 4\n");
+  expect_error([&] { load(R"({"mesh": "degenerate.obj"})"); }, {"/objects/0/mesh", "non-zero area"});
+  dir.write("nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  expect_error([&] { load(R"({"mesh": "nan.ply"})"); }, {"/objects/0/mesh", "nan.ply", "NaN or infinite"});
+  dir.write("inf.obj", "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expect_error([&] { load(R"({"mesh": "inf.obj"})"); }, {"/objects/0/mesh", "inf.obj", "NaN or infinite"});
+  // Degenerate triangles next to good ones are dropped.
+  dir.write("mixed.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
+  load_scene_file(dir.write("ok.json", scene_with_object(R"({"mesh": "mixed.obj"})")));
+  EXPECT_EQ(load_scene_file(dir.path() / "ok.json").triangle_count(), 1u);
+}
