@@ -377,18 +377,29 @@ TEST(Import, ObjPlyOffGltf) {
   EXPECT_EQ(s.objects[0].mesh_file, (dir.path() / "m.obj").lexically_normal());
 }
 
+// A real model from a Debian package: the Stanford bunny of glmark2-data (69666 triangles). Its
+// own vertex normals are smoothed, so a few sliver triangles at creases face slightly against
+// them (measured: 1 of 69666); the generated meshes' per-triangle winding check does not apply,
+// so this asserts the count, valid indices, unit normals and consistent winding on >= 99.9%.
 TEST(Import, RealModelIfInstalled) {
-  const fs::path candidates[] = {"/usr/share/assimp-testmodels/models/OBJ/spider.obj",
-                                 "/usr/share/assimp-testmodels/models/PLY/cube.ply",
-                                 "/usr/share/glmark2/models/horse.3ds", "/usr/share/glmark2/models/cat.3ds"};
-  for (const fs::path& p : candidates)
-    if (fs::exists(p)) {
-      const Mesh m = import_mesh(p);
-      EXPECT_GT(m.triangle_count(), 0u) << p;
-      expect_consistent(m);
-      return;
+  const fs::path bunny = "/usr/share/glmark2/models/bunny.obj";
+  if (fs::exists(bunny)) {
+    const Mesh m = import_mesh(bunny);
+    ASSERT_EQ(m.triangle_count(), 69666u);
+    ASSERT_EQ(m.positions.size(), m.normals.size());
+    std::size_t consistent = 0;
+    for (const glm::vec3& n : m.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-5f);
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const std::uint32_t* i = &m.indices[3 * t];
+      ASSERT_LT(std::max({i[0], i[1], i[2]}), m.positions.size());
+      const glm::vec3 e = glm::cross(m.positions[i[1]] - m.positions[i[0]], m.positions[i[2]] - m.positions[i[0]]);
+      consistent += glm::dot(e, m.normals[i[0]] + m.normals[i[1]] + m.normals[i[2]]) > 0.0f;
     }
-  GTEST_SKIP() << "no real model found (install assimp-testmodels or glmark2-data to run this test)";
+    EXPECT_GE(double(consistent), 0.999 * double(m.triangle_count()));
+    return;
+  }
+  // scripts/bootstrap.sh installs glmark2-data; a machine set up otherwise may lack it.
+  GTEST_SKIP() << "no real model found (install glmark2-data: scripts/bootstrap.sh does)";
 }
 
 // ---------------------------------------------------------------------------------------------
