@@ -247,15 +247,9 @@ struct Canonical6 {
 };
 
 MSM_FN float msm_hamburger6_lagrange_weight(Moments6 b, float zl, float za, float zb, float zc) {
-    float e1 = za + zb + zc;
-    float e2 = za * zb + za * zc + zb * zc;
-    float e3 = za * zb * zc;
-    float numerator = b.odd[1] - e1 * b.even[0] + e2 * b.odd[0] - e3;
     // msm_hamburger6_canonical merges close pairs before calling this; coincident nodes left
-    // (invalid input, e.g. unbiased moments of a single depth give a triple root) get weight 0
-    // instead of inf or NaN.
-    float denominator = (zl - za) * (zl - zb) * (zl - zc);
-    return (denominator != 0.0f) ? numerator / denominator : 0.0f;
+    // (invalid input, e.g. unbiased moments of a single depth give a triple root) get weight 0.
+    return msm_four_atom_weight(vec4(b.odd[0], b.even[0], b.odd[1], b.even[1]), zl, za, zb, zc);
 }
 
 // Roots closer than this are one atom of the canonical distribution (see below).

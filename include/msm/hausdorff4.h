@@ -14,17 +14,6 @@
 
 MSM_BEGIN
 
-// E[(z-u)(z-v)(z-t)] from the moments (b0 = 1).
-MSM_FN float msm_expect_cubic(vec4 b, float u, float v, float t) {
-    float e1 = u + v + t, e2 = u * v + u * t + v * t, e3 = u * v * t;
-    return b[2] - e1 * b[1] + e2 * b[0] - e3;
-}
-
-// Weight of atom x in the four-atom distribution {x, u, v, t} matching b0..b3.
-MSM_FN float msm_four_atom_weight(vec4 b, float x, float u, float v, float t) {
-    return msm_expect_cubic(b, u, v, t) / ((x - u) * (x - v) * (x - t));
-}
-
 MSM_FN float msm_hausdorff4_lower(vec4 b, float zf, float lo, float hi) {
     if (zf <= lo) return 0.0f;
     if (zf > hi) return 1.0f;
@@ -32,7 +21,7 @@ MSM_FN float msm_hausdorff4_lower(vec4 b, float zf, float lo, float hi) {
     if (r.z2 >= lo && r.z3 <= hi) return msm_hamburger4_lower_from_roots(b, zf, r);
     // zfree = E[z r(z)] / E[r(z)] with r(z) = (z-lo)(z-hi)(z-zf) = z³ - s1 z² + s2 z - s3.
     float s1 = lo + hi + zf, s2 = lo * hi + lo * zf + hi * zf, s3 = lo * hi * zf;
-    float er = b[2] - s1 * b[1] + s2 * b[0] - s3;
+    float er = msm_expect_cubic(b, lo, hi, zf);
     float ezr = b[3] - s1 * b[2] + s2 * b[1] - s3 * b[0];
     float zfree = ezr / er;
     float shadow = msm_four_atom_weight(b, lo, zf, zfree, hi);

@@ -1,6 +1,7 @@
-// Polynomial roots shared by the reconstructions, written to survive degenerate input: no
-// cancellation, no inf or NaN, roots escaping to infinity clamped to ±MSM_ROOT_LIMIT (depths
-// live in [-1,1], so the closed forms using the clamped root take their limits).
+// Polynomials shared by the reconstructions, written to survive degenerate input: roots without
+// cancellation, inf or NaN (roots escaping to infinity are clamped to ±MSM_ROOT_LIMIT; depths
+// live in [-1,1], so the closed forms using the clamped root take their limits), and the weights
+// of atoms in a distribution with known moments.
 #ifndef MSM_ROOTS_H
 #define MSM_ROOTS_H
 #include "msm/shared.h"
@@ -24,6 +25,20 @@ MSM_FN vec2 msm_solve_quadratic(vec3 c) {
     float r1 = msm_clamp_root(c[0] / t);
     float r2 = msm_clamp_root(t / c[2]);
     return vec2(min(r1, r2), max(r1, r2));
+}
+
+// E[(z-u)(z-v)(z-t)] from the moments b = (b1, b2, b3, .) (b0 = 1).
+MSM_FN float msm_expect_cubic(vec4 b, float u, float v, float t) {
+    float e1 = u + v + t, e2 = u * v + u * t + v * t, e3 = u * v * t;
+    return b[2] - e1 * b[1] + e2 * b[0] - e3;
+}
+
+// Weight of atom x in the distribution on the four atoms {x, u, v, t} that matches b0..b3:
+// Lagrange interpolation, E[(z-u)(z-v)(z-t)] / ((x-u)(x-v)(x-t)). An atom coinciding with
+// another (invalid input) gets weight 0 instead of inf or NaN.
+MSM_FN float msm_four_atom_weight(vec4 b, float x, float u, float v, float t) {
+    float denominator = (x - u) * (x - v) * (x - t);
+    return (denominator != 0.0f) ? msm_expect_cubic(b, u, v, t) / denominator : 0.0f;
 }
 
 MSM_END
