@@ -31,14 +31,31 @@ struct Hamburger4Roots {
 const float MSM_MIN_PIVOT1 = 1.0e-10f;
 const float MSM_MIN_PIVOT2 = 1.0e-12f;
 
-MSM_FN Hamburger4Roots msm_hamburger4_roots(vec4 b, float zf) {
+// B = [[1,b1,b2],[b1,b2,b3],[b2,b3,b4]] = L D Lᵀ with L = [[1,0,0],[b1,1,0],[b2,L21,1]] and
+// D = diag(1, D1, D2). D1 is the variance; D2 = det B / D1 is ξ4 of the non-linear
+// representation (HPG Eq. (3)). The differences cancel to ~α for biased moments, so each is formed
+// with one rounding (msm_fma). D1 is floored at MSM_MIN_PIVOT1 so that L21 stays finite; D2 is
+// returned as computed (callers floor or clamp it as they need).
+struct HankelLdl3 {
+    float D1;
+    float L21;
+    float L21D1;
+    float D2;
+};
+
+MSM_FN HankelLdl3 msm_hankel3_ldl(vec4 b) {
     float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];
-    // B = L D Lᵀ with L = [[1,0,0],[b1,1,0],[b2,L21,1]], D = diag(1, D1, D2).
-    // The differences are formed with one rounding (msm_fma): they cancel to ~α.
     float D1 = max(msm_fma(-b1, b1, b2), MSM_MIN_PIVOT1);
     float L21D1 = msm_fma(-b1, b2, b3);
     float L21 = L21D1 / D1;
-    float D2 = max(msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)), MSM_MIN_PIVOT2);
+    return HankelLdl3(D1, L21, L21D1, msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)));
+}
+
+MSM_FN Hamburger4Roots msm_hamburger4_roots(vec4 b, float zf) {
+    float b1 = b[0], b2 = b[1];
+    HankelLdl3 f = msm_hankel3_ldl(b);
+    float D1 = f.D1, L21 = f.L21;
+    float D2 = max(f.D2, MSM_MIN_PIVOT2);
     // Forward substitution, scaling, back substitution.
     float y1 = zf - b1;
     float y2 = msm_fma(-L21, y1, msm_fma(zf, zf, -b2));

@@ -31,6 +31,7 @@
 #include "msm/bias.h"
 #include "msm/quantize.h"
 #include "msm/three_moments.h"
+#include "msm/hamburger4.h"
 
 MSM_BEGIN
 
@@ -44,7 +45,7 @@ struct NonLinearMoments {
 // ---- Φ (HPG Algorithm 2) ----
 // Precondition: b biased (see above), so that σ² = b2 - b1² > 0. A non-positive σ² (a single
 // depth, or rounding) gives δ(b1) with v2 = 0, as msm_two_depths_from_three_moments does, and
-// ξ4 = b4 - b2².
+// ξ4 from the LDLᵀ with σ² floored at MSM_MIN_PIVOT1 (then ~0: clamped to >= 0).
 // In exact arithmetic y1, y2 lie in [-1,1] and ξ4 >= 0 (HPG §3.1, §3.2). In float they do not
 // quite: the float moment vector itself is off by rounding (ξ4 of the float moments, evaluated
 // in double, goes down to about -3e-8), the float evaluation adds ~4e-8, and when σ² ~ α the
@@ -52,18 +53,14 @@ struct NonLinearMoments {
 // (nonlinear_test measures these). So the result is clamped: y to [-1,1], ξ4 to >= 0. Both
 // clamps only touch values that rounding produced.
 MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
-    float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];
     // Steps 1-5: the two depths and the weight of the larger one.
-    TwoDepths two = msm_two_depths_from_three_moments(vec3(b1, b2, b3));
+    TwoDepths two = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
     // Steps 6-7: third diagonal entry of the LDLᵀ factorization of the Hankel matrix (Eq. (3)),
-    // ξ4 = b4 - b2² - L21² σ² with L21 σ² = b3 - b1 b2. The differences cancel down to ~α, so each
-    // is formed with one rounding (msm_fma): 6x less error in ξ4 than separate multiplies and
-    // subtractions (max 4e-8 instead of 2.3e-7 against double on the same float moments), which
-    // matters because ξ4 itself is ~1e-7 for the most common texel, a single surface.
-    float sigma2 = msm_fma(-b1, b1, b2);
-    float L21sigma2 = msm_fma(-b1, b2, b3);
-    float L21 = sigma2 > 0.0f ? L21sigma2 / sigma2 : 0.0f;
-    float xi4 = msm_fma(-L21, L21sigma2, msm_fma(-b2, b2, b4));
+    // ξ4 = b4 - b2² - L21² σ² with L21 σ² = b3 - b1 b2, shared with Hamburger 4MSM. Its
+    // differences are formed with one rounding (msm_fma): 6x less error in ξ4 than separate
+    // multiplies and subtractions (max 4e-8 instead of 2.3e-7 against double on the same float
+    // moments), which matters because ξ4 is ~1e-7 for the most common texel, a single surface.
+    float xi4 = msm_hankel3_ldl(b).D2;
     return NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, max(xi4, 0.0f));
 }
 
