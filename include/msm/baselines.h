@@ -39,8 +39,6 @@ MSM_BEGIN
 
 // ================================ Shading helpers ================================================
 
-// saturate((x - lo) / (hi - lo)); lo < hi.
-MSM_FN float msm_linstep(float lo, float hi, float x) { return msm_saturate((x - lo) / (hi - lo)); }
 
 // Over-darkening (Annen et al. 2007; JCGT §2.6): shadow intensities are divided by 'factor' and
 // clamped, so that light leaking below 1 - factor disappears: shadow >= factor gives 1, shadow = 0
@@ -91,15 +89,13 @@ MSM_FN float msm_vsm_shadow_theta2(vec2 q, float zf, float min_variance) {
 MSM_FN float msm_vsm_shadow_theta2(vec2 q, float zf) {
     return msm_vsm_shadow_theta2(q, zf, MSM_VSM_MIN_VARIANCE_UNORM16);
 }
-// Round-trip through RG16_UNORM storage (what a texture write then read does).
-MSM_FN vec2 msm_quantize_unorm16x2(vec2 q) { return unpackUnorm2x16(packUnorm2x16(q)); }
 
 // Light-bleeding reduction (Lauritzen, GPU Gems 3 ch. 8): the lit fraction 1 - shadow is
 // remapped by linstep(amount, 1, .), so that lit fractions below 'amount' become fully shadowed.
 // amount in [0, 1): 0 = off (the default), 0.2-0.3 is typical. Algebraically this equals
-// msm_overdarken(shadow, 1 - amount); it is no longer a lower bound.
+// msm_overdarken(shadow, 1 - amount), which computes it; it is no longer a lower bound.
 MSM_FN float msm_vsm_reduce_light_bleeding(float shadow, float amount) {
-    return 1.0f - msm_linstep(amount, 1.0f, 1.0f - shadow);
+    return msm_overdarken(shadow, 1.0f - amount);
 }
 
 // ================================ ESM (Salvi 2008; Annen et al. 2008) ============================

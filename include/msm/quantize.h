@@ -90,6 +90,7 @@ MSM_FN vec4 msm_unpack_unorm16x4(uvec2 p) {
 }
 // Round-trip through 16-bit UNORM storage (what a texture write then read does).
 MSM_FN vec4 msm_quantize_unorm16(vec4 v) { return msm_unpack_unorm16x4(msm_pack_unorm16x4(v)); }
+MSM_FN vec2 msm_quantize_unorm16x2(vec2 v) { return unpackUnorm2x16(packUnorm2x16(v)); }
 
 // Three values in [0,1] as 10-bit UNORM in the RGB channels of A2B10G10R10_UNORM (R lowest).
 MSM_FN uint msm_pack_unorm10x3(vec3 v) {
