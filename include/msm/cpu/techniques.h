@@ -20,6 +20,9 @@ struct Technique {
     std::string_view description;
     int bits_per_texel;
     int channels;
+    // The id in the shared technique table (include/msm/techniques.h, MSM_TECH_*), which the
+    // renderer uses too; -1 for the techniques only this CPU pipeline has.
+    int id;
     // Channels for one depth sample; depth is the shadow map's [0,1] depth.
     Texel (*generate)(float unit_depth);
     // What writing the filtered texel to its storage format and reading it back returns.

@@ -1,0 +1,154 @@
+// Every filtered-shadow technique as three per-texel steps, shared by the CPU pipeline
+// (src/core/techniques.cpp) and the renderer's shaders (src/render/shaders): generation of the
+// filterable channels for one depth sample, and the reconstruction of the shadow intensity from
+// the filtered, stored and reloaded channels. What lies between (MSAA resolve, blur, mips,
+// bilinear lookup, storage rounding) is linear filtering plus the texel format, which the GPU
+// does with images and the CPU emulates.
+//
+// A technique is an int id (MSM_TECH_*), a compile-time constant in shaders (a specialization
+// constant: the switch folds away), a runtime value on the CPU. Its parameters travel as one vec4
+// (msm_technique_default_params gives the papers' values):
+//   x: moment bias alpha (MSM, TMSM, 6MSM)          y: exponent c (ESM) or c+ (EVSM)
+//   z: exponent c- (EVSM4)                          w: minimum variance (VSM, EVSM)
+// Depth conventions: unit_depth and unit_zf are shadow-map depths in [0,1]; techniques on
+// [-1,1] map them with msm_signed_depth.
+//
+// Channel layout of a texel: a = channels 0..3, b = channels 4..7 (6MSM: a = (b1, b3, b5, b2),
+// b = (b4, b6, 0, 0), i.e. the odd then the even moments in channel order).
+#ifndef MSM_TECHNIQUES_H
+#define MSM_TECHNIQUES_H
+#include "msm/msm.h"
+MSM_BEGIN
+
+// Depth-based techniques (no filterable channels: they read the depth map itself).
+const int MSM_TECH_PLAIN = 0; // one depth comparison per fragment
+const int MSM_TECH_PCF = 1;   // Gaussian-weighted depth comparisons, the filtered reference
+// Baselines.
+const int MSM_TECH_VSM32 = 2;   // 2 x UNORM16 after θ2, [0,1]
+const int MSM_TECH_VSM64 = 3;   // 2 x float, [0,1]
+const int MSM_TECH_ESM32 = 4;   // 1 x float, exp(c z), [0,1]
+const int MSM_TECH_EVSM2_32 = 5;  // 2 x half, positive warp, [-1,1]
+const int MSM_TECH_EVSM2_64 = 6;  // 2 x float, positive warp c+ = 40
+const int MSM_TECH_EVSM4_64 = 7;  // 4 x half, both warps c = 5.54
+const int MSM_TECH_EVSM4_128 = 8; // 4 x float, c+ = 40, c- = 5.54
+// Four power moments.
+const int MSM_TECH_HAMBURGER_128_UNIT = 10;   // 4 x float, [0,1] (2015)
+const int MSM_TECH_HAMBURGER_128 = 11;        // 4 x float, [-1,1] (JCGT)
+const int MSM_TECH_HAMBURGER_64_THETA4 = 12;  // 4 x UNORM16 after θ4, [0,1] (2015)
+const int MSM_TECH_HAMBURGER_64 = 13;         // 4 x UNORM16 after Θ4*, [-1,1] (JCGT)
+const int MSM_TECH_HAUSDORFF_128_UNIT = 14;
+const int MSM_TECH_HAUSDORFF_128 = 15;
+const int MSM_TECH_HAUSDORFF_64_THETA4 = 16;
+const int MSM_TECH_HAUSDORFF_64 = 17;
+// Other bases.
+const int MSM_TECH_TMSM_128 = 18;  // trigonometric, 4 x float, [0,1]
+const int MSM_TECH_MSM6_192 = 19;  // six moments, 6 x float, [-1,1]
+const int MSM_TECH_MSM6_96 = 20;   // six moments, 6 x UNORM16 after Θ6*
+
+struct MsmTexel {
+    vec4 a;
+    vec4 b;
+};
+
+// True for the techniques that read the depth map instead of filterable channels.
+MSM_FN bool msm_technique_is_depth_based(int t) { return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF; }
+
+MSM_FN bool msm_technique_is_signed(int t) {
+    return t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64 || t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128 ||
+           t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_128 ||
+           t == MSM_TECH_HAUSDORFF_64 || t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96;
+}
+
+// The papers' parameters (config.h, baselines.h); see the vec4 layout above.
+MSM_FN vec4 msm_technique_default_params(int t) {
+    if (t == MSM_TECH_VSM32) return vec4(0.0f, 0.0f, 0.0f, MSM_VSM_MIN_VARIANCE_UNORM16);
+    if (t == MSM_TECH_VSM64) return vec4(0.0f, 0.0f, 0.0f, MSM_VSM_MIN_VARIANCE_FLOAT);
+    if (t == MSM_TECH_ESM32) return vec4(0.0f, MSM_ESM_C_DEFAULT, 0.0f, 0.0f);
+    if (t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM4_64)
+        return vec4(0.0f, MSM_EVSM_C_64BIT, MSM_EVSM_C_64BIT, MSM_EVSM_MIN_VARIANCE_HALF);
+    if (t == MSM_TECH_EVSM2_64 || t == MSM_TECH_EVSM4_128)
+        return vec4(0.0f, MSM_EVSM_C_POS_128BIT, MSM_EVSM_C_NEG_128BIT, MSM_EVSM_MIN_VARIANCE_FLOAT);
+    if (t == MSM_TECH_HAMBURGER_128_UNIT || t == MSM_TECH_HAUSDORFF_128_UNIT)
+        return vec4(MSM_ALPHA_UNIT_FLOAT, 0.0f, 0.0f, 0.0f);
+    if (t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAUSDORFF_128) return vec4(MSM_ALPHA_SIGNED_FLOAT, 0.0f, 0.0f, 0.0f);
+    if (t == MSM_TECH_HAMBURGER_64_THETA4 || t == MSM_TECH_HAUSDORFF_64_THETA4)
+        return vec4(MSM_ALPHA_UNIT_16BIT, 0.0f, 0.0f, 0.0f);
+    if (t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_64) return vec4(MSM_ALPHA_SIGNED_16BIT, 0.0f, 0.0f, 0.0f);
+    if (t == MSM_TECH_TMSM_128) return vec4(MSM_TRIG_ALPHA_DEFAULT, 0.0f, 0.0f, 0.0f);
+    if (t == MSM_TECH_MSM6_192) return vec4(MSM_ALPHA6_FLOAT, 0.0f, 0.0f, 0.0f);
+    if (t == MSM_TECH_MSM6_96) return vec4(MSM_ALPHA6_16BIT, 0.0f, 0.0f, 0.0f);
+    return vec4(0.0f);
+}
+
+// Filterable channels of one depth sample, already in the storage basis (θ2, θ4, Θ4*, Θ6*), so
+// that the UNORM16 formats hold them; every transform is affine and commutes with filtering.
+MSM_FN MsmTexel msm_technique_generate(int t, float unit_depth, vec4 params) {
+    float z = msm_signed_depth(unit_depth);
+    vec4 zero = vec4(0.0f);
+    if (t == MSM_TECH_VSM32) return MsmTexel(vec4(msm_vsm_moments_theta2(unit_depth), 0.0f, 0.0f), zero);
+    if (t == MSM_TECH_VSM64) return MsmTexel(vec4(msm_vsm_moments(unit_depth), 0.0f, 0.0f), zero);
+    if (t == MSM_TECH_ESM32) return MsmTexel(vec4(msm_esm_moment(unit_depth, params.y), 0.0f, 0.0f, 0.0f), zero);
+    if (t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64)
+        return MsmTexel(vec4(msm_evsm2_moments(z, params.y), 0.0f, 0.0f), zero);
+    if (t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128) return MsmTexel(msm_evsm4_moments(z, params.y, params.z), zero);
+    if (t == MSM_TECH_HAMBURGER_128_UNIT || t == MSM_TECH_HAUSDORFF_128_UNIT)
+        return MsmTexel(msm_moments4(unit_depth), zero);
+    if (t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAUSDORFF_128) return MsmTexel(msm_moments4(z), zero);
+    if (t == MSM_TECH_HAMBURGER_64_THETA4 || t == MSM_TECH_HAUSDORFF_64_THETA4)
+        return MsmTexel(msm_theta4(msm_moments4(unit_depth)), zero);
+    if (t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_64) return MsmTexel(msm_theta4_star(msm_moments4(z)), zero);
+    if (t == MSM_TECH_TMSM_128) return MsmTexel(msm_trig_moments(unit_depth), zero);
+    if (t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96) {
+        Moments6 m = msm_moments6(z);
+        if (t == MSM_TECH_MSM6_96) m = msm_theta6_star(m);
+        return MsmTexel(vec4(m.odd, m.even.x), vec4(m.even.y, m.even.z, 0.0f, 0.0f));
+    }
+    return MsmTexel(vec4(unit_depth, 0.0f, 0.0f, 0.0f), zero); // depth-based: the depth itself
+}
+
+MSM_FN float msm_technique_shadow_4moments(int t, vec4 stored, float unit_zf, float alpha) {
+    float zf = msm_signed_depth(unit_zf);
+    if (t == MSM_TECH_HAMBURGER_128_UNIT)
+        return msm_hamburger4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_UNIT), unit_zf);
+    if (t == MSM_TECH_HAMBURGER_128) return msm_hamburger4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_SIGNED_FLOAT), zf);
+    if (t == MSM_TECH_HAMBURGER_64_THETA4)
+        return msm_hamburger4_lower(msm_apply_bias(msm_theta4_inverse(stored), alpha, MSM_BSTAR_UNIT), unit_zf);
+    if (t == MSM_TECH_HAMBURGER_64)
+        return msm_hamburger4_lower(msm_apply_bias(msm_theta4_star_inverse(stored), alpha, MSM_BSTAR_SIGNED_16BIT), zf);
+    if (t == MSM_TECH_HAUSDORFF_128_UNIT)
+        return msm_hausdorff4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_UNIT), unit_zf, 0.0f, 1.0f);
+    if (t == MSM_TECH_HAUSDORFF_128)
+        return msm_hausdorff4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_SIGNED_FLOAT), zf, -1.0f, 1.0f);
+    if (t == MSM_TECH_HAUSDORFF_64_THETA4)
+        return msm_hausdorff4_lower(msm_apply_bias(msm_theta4_inverse(stored), alpha, MSM_BSTAR_UNIT), unit_zf, 0.0f, 1.0f);
+    // MSM_TECH_HAUSDORFF_64
+    return msm_hausdorff4_lower(msm_apply_bias(msm_theta4_star_inverse(stored), alpha, MSM_BSTAR_SIGNED_16BIT), zf, -1.0f,
+                                1.0f);
+}
+
+// Shadow intensity in [0,1] (1 = fully shadowed) at fragment depth unit_zf from the filtered
+// channels as the texture returns them. Not for the depth-based techniques (returns 0).
+MSM_FN float msm_technique_shadow(int t, MsmTexel stored, float unit_zf, vec4 params) {
+    float zf = msm_signed_depth(unit_zf);
+    vec2 a2 = vec2(stored.a.x, stored.a.y);
+    if (t == MSM_TECH_VSM32) return msm_vsm_shadow_theta2(a2, unit_zf, params.w);
+    if (t == MSM_TECH_VSM64) return msm_vsm_shadow(a2, unit_zf, params.w);
+    if (t == MSM_TECH_ESM32) return msm_esm_shadow(stored.a.x, unit_zf, params.y);
+    if (t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64) return msm_evsm2_shadow(a2, zf, params.y, params.w);
+    if (t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128)
+        return msm_evsm4_shadow(stored.a, zf, params.y, params.z, params.w);
+    if (t >= MSM_TECH_HAMBURGER_128_UNIT && t <= MSM_TECH_HAUSDORFF_64)
+        return msm_technique_shadow_4moments(t, stored.a, unit_zf, params.x);
+    if (t == MSM_TECH_TMSM_128) return msm_trig_lower(msm_trig_bias(stored.a, params.x), unit_zf);
+    if (t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96) {
+        Moments6 m = Moments6(vec3(stored.a.x, stored.a.y, stored.a.z), vec3(stored.a.w, stored.b.x, stored.b.y));
+        if (t == MSM_TECH_MSM6_96) m = msm_theta6_star_inverse(m);
+        MomentBias6 bias = msm_moment_bias6(t == MSM_TECH_MSM6_96 ? MSM_REP6_UNORM16 : MSM_REP6_FLOAT);
+        bias.alpha = params.x;
+        return msm_hamburger6_lower(msm_apply_bias6(m, bias), zf);
+    }
+    return 0.0f;
+}
+
+MSM_END
+#endif // MSM_TECHNIQUES_H
