@@ -21,24 +21,33 @@ VkDescriptorType descriptorType(Binding binding) {
 
 } // namespace
 
-SharedSpecialization::SharedSpecialization(const Context& ctx)
-    : fusedFma_(ctx.useNativeFma() ? VK_TRUE : VK_FALSE),
-      entry_{.constantID = MSM_SPEC_FUSED_FMA_ID, .offset = 0, .size = sizeof(VkBool32)},
-      info_{.mapEntryCount = 1, .pMapEntries = &entry_, .dataSize = sizeof(VkBool32), .pData = &fusedFma_} {}
+SharedSpecialization::SharedSpecialization(const Context& ctx, std::span<const SpecConstant> extra) {
+  values_.push_back(ctx.useNativeFma() ? VK_TRUE : VK_FALSE);
+  entries_.push_back({.constantID = MSM_SPEC_FUSED_FMA_ID, .offset = 0, .size = sizeof(uint32_t)});
+  for (const SpecConstant& c : extra) {
+    for (const VkSpecializationMapEntry& e : entries_)
+      if (e.constantID == c.id)
+        throw std::invalid_argument(fmt::format("msm::vk: specialization constant {} given twice", c.id));
+    entries_.push_back({.constantID = c.id, .offset = uint32_t(values_.size() * sizeof(uint32_t)), .size = sizeof(uint32_t)});
+    values_.push_back(c.value);
+  }
+  info_ = {.mapEntryCount = uint32_t(entries_.size()), .pMapEntries = entries_.data(),
+           .dataSize = values_.size() * sizeof(uint32_t), .pData = values_.data()};
+}
 
-Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
-                      std::span<const Binding> bindings, uint32_t pushConstantSize) {
-  if (spirv.empty() || spirv[0] != 0x07230203u)
-    throw std::invalid_argument(fmt::format("msm::vk::createProgram({}): not SPIR-V", name));
+// Everything of a Program but its pipeline: descriptor set layout (push descriptors), pipeline
+// layout and update template, for the given stages and bind point.
+Program createProgramLayout(const Context& ctx, std::string_view name, std::span<const Binding> bindings,
+                            uint32_t pushConstantSize, VkShaderStageFlags stages, VkPipelineBindPoint bindPoint) {
   if (pushConstantSize % 4 || pushConstantSize > ctx.properties().limits.maxPushConstantsSize)
-    throw std::invalid_argument(fmt::format("msm::vk::createProgram({}): push constant size {} (multiple of 4, at most {})",
+    throw std::invalid_argument(fmt::format("msm::vk: program {}: push constant size {} (multiple of 4, at most {})",
                                             name, pushConstantSize, ctx.properties().limits.maxPushConstantsSize));
   VkPhysicalDevicePushDescriptorPropertiesKHR pushProps{
       .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PUSH_DESCRIPTOR_PROPERTIES_KHR};
   VkPhysicalDeviceProperties2 props{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &pushProps};
   vkGetPhysicalDeviceProperties2(ctx.physicalDevice(), &props);
   if (bindings.size() > pushProps.maxPushDescriptors)
-    throw std::invalid_argument(fmt::format("msm::vk::createProgram({}): {} bindings, the device pushes at most {}",
+    throw std::invalid_argument(fmt::format("msm::vk: program {}: {} bindings, the device pushes at most {}",
                                             name, bindings.size(), pushProps.maxPushDescriptors));
 
   VkDevice device = ctx.device();
@@ -47,13 +56,15 @@ Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::
   p.bindings_.assign(bindings.begin(), bindings.end());
   p.pushConstantSize_ = pushConstantSize;
   p.pushDescriptors_ = ctx.cmdPushDescriptorSetWithTemplate();
+  p.stages_ = stages;
+  p.bindPoint_ = bindPoint;
 
   std::vector<VkDescriptorSetLayoutBinding> layoutBindings;
   std::vector<VkDescriptorUpdateTemplateEntry> entries;
   for (uint32_t i = 0; i < bindings.size(); ++i) {
     VkDescriptorType type = descriptorType(bindings[i]);
     layoutBindings.push_back({.binding = i, .descriptorType = type, .descriptorCount = 1,
-                              .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT});
+                              .stageFlags = stages});
     // dispatch() hands over Descriptor[]: entry i reads element i, whichever union member it is.
     entries.push_back({.dstBinding = i, .descriptorCount = 1, .descriptorType = type,
                        .offset = i * sizeof(Descriptor), .stride = sizeof(Descriptor)});
@@ -68,7 +79,7 @@ Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::
     p.setLayout_ = {device, setLayout};
   }
 
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantSize};
+  VkPushConstantRange range{stages, 0, pushConstantSize};
   VkDescriptorSetLayout setLayout = p.setLayout_;
   VkPipelineLayoutCreateInfo layoutInfo{.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
                                         .setLayoutCount = setLayout ? 1u : 0u,
@@ -84,7 +95,7 @@ Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::
                                               .descriptorUpdateEntryCount = uint32_t(entries.size()),
                                               .pDescriptorUpdateEntries = entries.data(),
                                               .templateType = VK_DESCRIPTOR_UPDATE_TEMPLATE_TYPE_PUSH_DESCRIPTORS_KHR,
-                                              .pipelineBindPoint = VK_PIPELINE_BIND_POINT_COMPUTE,
+                                              .pipelineBindPoint = bindPoint,
                                               .pipelineLayout = layout,
                                               .set = 0};
     VkDescriptorUpdateTemplate updateTemplate = VK_NULL_HANDLE;
@@ -92,13 +103,25 @@ Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::
     p.template_ = {device, updateTemplate};
   }
 
+  return p;
+}
+
+Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
+                      std::span<const Binding> bindings, uint32_t pushConstantSize,
+                      std::span<const SpecConstant> constants) {
+  if (spirv.empty() || spirv[0] != 0x07230203u)
+    throw std::invalid_argument(fmt::format("msm::vk::createProgram({}): not SPIR-V", name));
+  Program p = createProgramLayout(ctx, name, bindings, pushConstantSize, VK_SHADER_STAGE_COMPUTE_BIT,
+                                  VK_PIPELINE_BIND_POINT_COMPUTE);
+  VkDevice device = ctx.device();
+  VkPipelineLayout layout = p.layout_;
   VkShaderModuleCreateInfo moduleInfo{.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
                                       .codeSize = spirv.size_bytes(),
                                       .pCode = spirv.data()};
   VkShaderModule rawModule = VK_NULL_HANDLE;
   MSM_VK_CHECK(vkCreateShaderModule(device, &moduleInfo, nullptr, &rawModule));
   ShaderModule module(device, rawModule); // only needed while the pipeline is created
-  SharedSpecialization specialization(ctx);
+  SharedSpecialization specialization(ctx, constants);
   VkComputePipelineCreateInfo pipelineInfo{
       .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
       .stage = {.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
@@ -115,9 +138,9 @@ Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::
 }
 
 Program createProgram(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
-                      uint32_t pushConstantSize) {
+                      uint32_t pushConstantSize, std::initializer_list<SpecConstant> constants) {
   return createProgram(ctx, embedded_shader(shader), shader, std::span<const Binding>(bindings.begin(), bindings.size()),
-                       pushConstantSize);
+                       pushConstantSize, std::span<const SpecConstant>(constants.begin(), constants.size()));
 }
 
 void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ,
@@ -128,12 +151,24 @@ void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uin
   if (pushConstants.size() != program.pushConstantSize_)
     throw std::invalid_argument(fmt::format("msm::vk::dispatch({}): {} bytes of push constants given, the program "
                                             "takes {}", program.name_, pushConstants.size(), program.pushConstantSize_));
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, program.pipeline_);
+  if (program.bindPoint_ != VK_PIPELINE_BIND_POINT_COMPUTE)
+    throw std::invalid_argument(fmt::format("msm::vk::dispatch({}): not a compute program", program.name_));
+  bindProgram(cmd, program, bindings, pushConstants);
+  vkCmdDispatch(cmd, groupsX, groupsY, groupsZ);
+}
+
+void bindProgram(VkCommandBuffer cmd, const Program& program, std::span<const Descriptor> bindings,
+                 std::span<const std::byte> pushConstants) {
+  if (bindings.size() != program.bindings_.size())
+    throw std::invalid_argument(fmt::format("msm::vk::bindProgram({}): {} descriptors given, the program has {} "
+                                            "bindings", program.name_, bindings.size(), program.bindings_.size()));
+  if (pushConstants.size() != program.pushConstantSize_)
+    throw std::invalid_argument(fmt::format("msm::vk::bindProgram({}): {} bytes of push constants given, the program "
+                                            "takes {}", program.name_, pushConstants.size(), program.pushConstantSize_));
+  vkCmdBindPipeline(cmd, program.bindPoint_, program.pipeline_);
   if (!bindings.empty()) program.pushDescriptors_(cmd, program.template_, program.layout_, 0, bindings.data());
   if (!pushConstants.empty())
-    vkCmdPushConstants(cmd, program.layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, uint32_t(pushConstants.size()),
-                       pushConstants.data());
-  vkCmdDispatch(cmd, groupsX, groupsY, groupsZ);
+    vkCmdPushConstants(cmd, program.layout_, program.stages_, 0, uint32_t(pushConstants.size()), pushConstants.data());
 }
 
 } // namespace msm::vk

@@ -293,12 +293,12 @@ std::vector<std::byte> readbackImage(const Context& ctx, const Image& image, VkI
   submitAndWait(ctx, [&](VkCommandBuffer cmd) {
     pipelineBarrier(cmd, imageBarrier(image.handle(), image.aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
                                       VK_ACCESS_2_MEMORY_WRITE_BIT, layout, VK_PIPELINE_STAGE_2_COPY_BIT,
-                                      VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL));
+                                      VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 0, 1));
     vkCmdCopyImageToBuffer(cmd, image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(), 1, &region);
     pipelineBarrier(cmd, imageBarrier(image.handle(), image.aspect(), VK_PIPELINE_STAGE_2_COPY_BIT,
                                       VK_ACCESS_2_NONE, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                       VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                                      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, layout));
+                                      VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT, layout, 0, 1));
   });
   std::memcpy(bytes.data(), staging.data(), bytes.size());
   return bytes;

@@ -20,6 +20,7 @@
 namespace msm::vk {
 
 class Context;
+struct GraphicsDesc; // graphics.h
 
 // The type of descriptor at binding i of set 0 is the i-th entry of a program's binding list.
 enum class Binding : uint8_t {
@@ -45,10 +46,19 @@ struct Descriptor {
       : image{sampler, i.view(), layout} {}
 };
 
+// One 32-bit specialization constant (int, uint, float bits or a bool as VkBool32) of a pipeline.
+struct SpecConstant {
+  uint32_t id = 0;
+  uint32_t value = 0;
+};
+
+// A pipeline (compute, or graphics from graphics.h) with its push-descriptor layout.
 class Program {
 public:
   VkPipeline pipeline() const noexcept { return pipeline_; }
   VkPipelineLayout layout() const noexcept { return layout_; }
+  VkPipelineBindPoint bindPoint() const noexcept { return bindPoint_; }
+  VkShaderStageFlags stages() const noexcept { return stages_; } // of the descriptors and push constants
   VkDescriptorSetLayout setLayout() const noexcept { return setLayout_; } // null without bindings
   std::span<const Binding> bindings() const noexcept { return bindings_; }
   uint32_t pushConstantSize() const noexcept { return pushConstantSize_; }
@@ -57,13 +67,19 @@ public:
 
 private:
   friend Program createProgram(const Context&, std::span<const uint32_t>, std::string_view, std::span<const Binding>,
-                               uint32_t);
+                               uint32_t, std::span<const SpecConstant>);
+  friend Program createProgramLayout(const Context&, std::string_view, std::span<const Binding>, uint32_t,
+                                     VkShaderStageFlags, VkPipelineBindPoint);
+  friend void bindProgram(VkCommandBuffer, const Program&, std::span<const Descriptor>, std::span<const std::byte>);
   friend void dispatch(VkCommandBuffer, const Program&, uint32_t, uint32_t, uint32_t, std::span<const Descriptor>,
                        std::span<const std::byte>);
+  friend Program createGraphicsProgram(const Context&, const GraphicsDesc&);
   std::string name_;
   std::vector<Binding> bindings_;
   uint32_t pushConstantSize_ = 0;
   PFN_vkCmdPushDescriptorSetWithTemplateKHR pushDescriptors_ = nullptr;
+  VkShaderStageFlags stages_ = VK_SHADER_STAGE_COMPUTE_BIT;
+  VkPipelineBindPoint bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
   // Declaration order is creation order; destruction runs in reverse.
   Unique<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout> setLayout_;
   Unique<VkPipelineLayout, vkDestroyPipelineLayout> layout_;
@@ -71,22 +87,23 @@ private:
   Unique<VkPipeline, vkDestroyPipeline> pipeline_;
 };
 
-// The specialization constants of the shared headers (include/msm/shared.h) for one pipeline stage:
-// msm_fused_fma (id MSM_SPEC_FUSED_FMA_ID) = ctx.useNativeFma(). createProgram sets it on every
-// pipeline; a pipeline created elsewhere (graphics) passes info() as each stage's
-// pSpecializationInfo. Ids that a shader does not declare are ignored, so every stage can take it.
-// info() points into this object: keep it alive until the pipeline is created.
+// The specialization constants of one pipeline stage: those of the shared headers
+// (include/msm/shared.h) — msm_fused_fma (id MSM_SPEC_FUSED_FMA_ID) = ctx.useNativeFma() — plus
+// any given. createProgram sets them on every pipeline; a pipeline created elsewhere passes info()
+// as each stage's pSpecializationInfo. Ids that a shader does not declare are ignored, so every
+// stage can take it. info() points into this object: keep it alive until the pipeline is created.
+// Precondition: the extra ids are distinct and not MSM_SPEC_FUSED_FMA_ID.
 class SharedSpecialization {
 public:
-  explicit SharedSpecialization(const Context& ctx);
+  explicit SharedSpecialization(const Context& ctx, std::span<const SpecConstant> extra = {});
   SharedSpecialization(const SharedSpecialization&) = delete;
   SharedSpecialization& operator=(const SharedSpecialization&) = delete;
   const VkSpecializationInfo* info() const noexcept { return &info_; }
-  bool nativeFma() const noexcept { return fusedFma_ != VK_FALSE; }
+  bool nativeFma() const noexcept { return values_[0] != VK_FALSE; }
 
 private:
-  VkBool32 fusedFma_ = VK_TRUE; // a bool specialization constant is a VkBool32
-  VkSpecializationMapEntry entry_{};
+  std::vector<uint32_t> values_; // [0]: msm_fused_fma as a VkBool32
+  std::vector<VkSpecializationMapEntry> entries_;
   VkSpecializationInfo info_{};
 };
 
@@ -95,11 +112,35 @@ private:
 // otherwise): SPIR-V words start with the magic number; pushConstantSize is a multiple of 4 and at
 // most maxPushConstantsSize; bindings.size() <= maxPushDescriptors. That the list matches the
 // shader's declarations is checked by the validation layer, not here.
+// `constants` are further specialization constants (SharedSpecialization).
 Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
-                      std::span<const Binding> bindings, uint32_t pushConstantSize = 0);
+                      std::span<const Binding> bindings, uint32_t pushConstantSize = 0,
+                      std::span<const SpecConstant> constants = {});
 // The same from an embedded shader (see shaders.h), looked up by name.
 Program createProgram(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
-                      uint32_t pushConstantSize = 0);
+                      uint32_t pushConstantSize = 0, std::initializer_list<SpecConstant> constants = {});
+
+// The layout of a program without its pipeline (for pipeline kinds built elsewhere, graphics.h):
+// descriptors and push constants visible to `stages`. Preconditions as for createProgram.
+Program createProgramLayout(const Context& ctx, std::string_view name, std::span<const Binding> bindings,
+                            uint32_t pushConstantSize, VkShaderStageFlags stages, VkPipelineBindPoint bindPoint);
+
+// Binds the pipeline at its bind point, pushes one descriptor per binding and the push constants
+// (preconditions as for dispatch); draws or dispatches follow.
+void bindProgram(VkCommandBuffer cmd, const Program& program, std::span<const Descriptor> bindings,
+                 std::span<const std::byte> pushConstants = {});
+inline void bindProgram(VkCommandBuffer cmd, const Program& program, std::initializer_list<Descriptor> bindings,
+                        std::span<const std::byte> pushConstants = {}) {
+  bindProgram(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()), pushConstants);
+}
+template <class PushConstants>
+  requires(std::is_standard_layout_v<PushConstants> && std::is_trivially_destructible_v<PushConstants> &&
+           !std::is_convertible_v<const PushConstants&, std::span<const std::byte>>)
+void bindProgram(VkCommandBuffer cmd, const Program& program, std::initializer_list<Descriptor> bindings,
+                 const PushConstants& pushConstants) {
+  bindProgram(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()),
+              std::as_bytes(std::span(&pushConstants, 1)));
+}
 
 // Binds the pipeline, pushes one descriptor per binding and the push constants, and dispatches
 // groupsX * groupsY * groupsZ workgroups. Preconditions (std::invalid_argument otherwise, nothing
@@ -117,8 +158,10 @@ inline void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t group
 }
 
 // Push constants given as one struct (its bytes, padding included, must match the shader's block).
+// Standard layout rather than trivially copyable: GLM_FORCE_CTOR_INIT (msm::scene) gives glm types
+// user-provided copies, yet their bytes are all there is to them.
 template <class PushConstants>
-  requires(std::is_trivially_copyable_v<PushConstants> &&
+  requires(std::is_standard_layout_v<PushConstants> && std::is_trivially_destructible_v<PushConstants> &&
            !std::is_convertible_v<const PushConstants&, std::span<const std::byte>>)
 void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ,
               std::initializer_list<Descriptor> bindings, const PushConstants& pushConstants) {

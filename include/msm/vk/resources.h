@@ -129,9 +129,9 @@ Sampler createSampler(const Context& ctx, VkFilter filter = VK_FILTER_LINEAR,
 void uploadImage(const Context& ctx, const Image& image, std::span<const std::byte> bytes, VkImageLayout oldLayout,
                  VkImageLayout newLayout);
 
-// Mip 0 of every layer, tightly packed; the image is back in `layout` afterwards. Waits for every
-// earlier write. Precondition: TRANSFER_SRC usage, one sample, a color or depth-only format, in
-// `layout` (not UNDEFINED).
+// Mip 0 of every layer, tightly packed; mip 0 is back in `layout` afterwards (other mips are not
+// touched). Waits for every earlier write. Precondition: TRANSFER_SRC usage, one sample, a color or
+// depth-only format, mip 0 in `layout` (not UNDEFINED).
 std::vector<std::byte> readbackImage(const Context& ctx, const Image& image, VkImageLayout layout);
 
 // Bytes per texel of common uncompressed formats; throws std::invalid_argument for the others.

@@ -4,6 +4,7 @@
 #include "msm/vk/commands.h"
 #include "msm/vk/common.h"
 #include "msm/vk/context.h"
+#include "msm/vk/graphics.h"
 #include "msm/vk/program.h"
 #include "msm/vk/resources.h"
 #include "msm/vk/shaders.h"
