@@ -1,0 +1,43 @@
+// Parameters the renderer's host code hands to its shaders, declared once for both (the
+// Falcor HostDeviceShared idea on top of msm/shared.h). Only vec4, ivec4 and mat4 members, so
+// that std140 (GLSL) and the C++ layout agree without implicit padding; the host checks sizes
+// and offsets with static_asserts (src/render/frame_layout.cpp).
+#ifndef MSM_RENDER_FRAME_H
+#define MSM_RENDER_FRAME_H
+#include "msm/shared.h"
+MSM_BEGIN
+
+// Largest filter (odd number of taps per axis) of the blur and PCF: 63 taps fill 16 vec4s.
+const int MSM_MAX_FILTER_TAPS = 63;
+
+// The uniform block of every pass of one frame (binding 0 where a pass uses it).
+struct FrameUniforms {
+    mat4 camera_view_projection;
+    mat4 light_view_projection;      // world -> shadow-map clip space (orthographic)
+    mat4 light_normal_matrix;        // inverse transpose of its 3x3 part (normals -> clip space)
+    vec4 towards_light;              // xyz: unit direction from the scene towards the light
+    vec4 irradiance;                 // rgb: irradiance of the light; a: ambient factor
+    vec4 technique_params;           // see msm/techniques.h
+    vec4 shadow_map;                 // x: size in texels, y: 1 / size,
+                                     // z: normal offset in world units, w: depth bias in [0,1] depth
+    vec4 shading;                    // x: over-darkening factor (1 = off), y: exposure, zw: unused
+    vec4 background;                 // rgb: linear colour of pixels without a surface
+    ivec4 kernel;                    // x: taps per axis (odd), y: MSAA samples, z: radius, w: unused
+    vec4 filter_weights[16];         // normalized 1D Gaussian weights, tap k at [k / 4][k % 4]
+    vec4 sample_offsets[4];          // MSAA sample positions relative to the texel centre, in
+                                     // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
+};
+
+// Per draw of the shading pass (push constants).
+struct ObjectPush {
+    vec4 albedo_opacity;             // rgb: albedo (multiplies the texture), a: opacity
+    ivec4 flags;                     // x: 1 if the albedo texture is used, y: 1 if double-sided
+};
+
+// The compute passes on shadow-map images (push constants).
+struct ImagePassPush {
+    ivec4 size;                      // xy: image size in texels, z: pass-specific, w: unused
+};
+
+MSM_END
+#endif // MSM_RENDER_FRAME_H

@@ -1,0 +1,131 @@
+// msm::render: the headless Vulkan renderer of filtered hard shadows. One frame is four passes
+// (src/render/passes/, each with declared inputs, outputs and a GPU timer scope):
+//
+//   shadow_depth   scene -> 16-bit depth, 1x/4x/8x MSAA, orthographic light frustum
+//   moment_resolve depth samples -> the technique's channels per sample, averaged, in the
+//                  storage basis (compute); skipped by the depth-based techniques
+//   blur           separable Gaussian (taps x taps, sigma in texels) -> moment images; then mips
+//   shading        Lambert + ambient with the technique's shadow, over-darkening, tone mapping,
+//                  sRGB; plus the shadow buffer (visibility of the visible surface per pixel)
+//
+// A technique (msm/techniques.h for the per-texel math) picks its storage formats and its
+// shading shader; everything else is shared, so every technique sees the same depth samples and
+// the same filter kernel. PCF evaluates exactly that kernel (blur then bilinear lookup) on the
+// depth samples, with a receiver plane from the surface normal: it is the reference the filtered
+// techniques approximate.
+#pragma once
+
+#include "msm/image/image.h"
+#include "msm/scene/scene.h"
+
+#include <glm/glm.hpp>
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace msm::vk {
+class Context;
+}
+
+namespace msm::render {
+
+// Bad settings or an unknown technique: the message says what and which values are allowed.
+class RenderError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Technique {
+  std::string_view name;
+  std::string_view description;
+  int id;                          // MSM_TECH_* of msm/techniques.h
+  int bits_per_texel;              // of the filtered shadow map (depth-based: bits per depth sample)
+  std::array<int, 2> formats;      // VkFormat of the moment images (0: none)
+  std::string_view parameters;     // meaning of the technique_params components it uses
+};
+
+// Every technique of the renderer, in the order of the comparison tables.
+std::span<const Technique> techniques();
+// Throws RenderError listing the valid names.
+const Technique& find_technique(std::string_view name);
+// The papers' parameters of a technique (msm_technique_default_params).
+glm::vec4 default_params(const Technique& technique);
+
+// Limits against absurd input (checked by RenderSettings::validate before anything is allocated).
+inline constexpr int kMaxImageSide = 16384;
+inline constexpr long long kMaxImagePixels = 64ll << 20; // 64 Mpixels
+inline constexpr int kMaxShadowSize = 8192;
+inline constexpr int kMaxFilterTaps = 63;                // MSM_MAX_FILTER_TAPS
+
+struct RenderSettings {
+  std::string technique = "msm-hamburger-64";
+  int width = 1280, height = 720;
+  int shadow_size = 1024;          // texels per side of the square shadow map
+  int msaa = 4;                    // samples of the shadow depth pass: 1, 4 or 8
+  int filter_size = 9;             // Gaussian taps per axis (odd, 1..63; 1 = no blur)
+  float filter_sigma = 2.4f;       // in texels
+  bool mipmaps = true;             // mip chain of the moment images (trilinear lookups)
+  std::optional<glm::vec4> params; // technique parameters (msm/techniques.h); default: the papers'
+  float overdarken = 1.0f;         // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
+  float normal_offset = 0.0f;      // lookup offset along the normal, in shadow-map texels
+  std::optional<float> depth_bias; // subtracted from the fragment depth ([0,1] units); default:
+                                   // 2e-5 for the depth-based techniques (16-bit depth rounding),
+                                   // 0 for the others (moment biasing does their work)
+  float exposure = 1.0f;
+  // Throws RenderError naming the setting and the allowed range.
+  void validate() const;
+};
+
+// GPU time of one pass scope, in milliseconds.
+struct PassTime {
+  std::string name;
+  double ms = 0;
+};
+
+struct RenderResult {
+  image::Image color;  // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
+  image::Image shadow; // "visibility" (of the light at the visible surface, 0 where the surface
+                       // faces away from the light) and "background" (1 where no surface)
+  std::vector<PassTime> passes; // in execution order; empty where the queue has no timestamps
+  double total_ms = 0;          // sum of the passes
+};
+
+// What tests compare against the CPU: the depth samples and the resolved moment image (before
+// the blur), read back when requested.
+struct Intermediates {
+  std::vector<float> depth_samples; // shadow_size² x msaa, sample-major per texel, row-major
+  image::Image moments;             // resolve output of image 0 (as stored: UNORM/half/float)
+  image::Image moments1;            // of image 1 (6MSM), else empty
+  image::Image filtered;            // image 0 after blur (mip 0)
+};
+
+// Owns the scene's GPU buffers and textures and the pipelines it has built (cached per
+// technique, MSAA and filter configuration). Externally synchronized; the Context outlives it.
+class Renderer {
+public:
+  Renderer(const vk::Context& ctx, const scene::Scene& scene);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // One frame, submitted and waited for, images read back.
+  RenderResult render(const RenderSettings& settings, Intermediates* intermediates = nullptr);
+
+  // `frames` frames with the same settings, nothing read back: the per-pass times of each (for
+  // msm bench). Precondition: frames >= 1.
+  std::vector<std::vector<PassTime>> time_frames(const RenderSettings& settings, int frames);
+
+  const scene::Scene& scene() const noexcept;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace msm::render

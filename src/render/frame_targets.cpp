@@ -1,0 +1,74 @@
+#include "frame_targets.h"
+
+#include <bit>
+#include <fmt/format.h>
+
+namespace msm::render {
+namespace {
+
+void require(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags features, std::string_view why) {
+  VkFormatProperties props{};
+  vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), format, &props);
+  if ((props.optimalTilingFeatures & features) != features)
+    throw RenderError(fmt::format("{} does not support format {} for {}", ctx.info().name, int(format), why));
+}
+
+bool has(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags features) {
+  VkFormatProperties props{};
+  vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), format, &props);
+  return (props.optimalTilingFeatures & features) == features;
+}
+
+} // namespace
+
+int FrameConfig::moment_images() const {
+  if (!technique) return 0;
+  return (technique->formats[0] != 0) + (technique->formats[1] != 0);
+}
+
+VkExtent2D extent(const vk::Image& image) { return {image.width(), image.height()}; }
+
+FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : config(c) {
+  uint32_t shadow = uint32_t(c.shadow_size);
+  auto samples = VkSampleCountFlagBits(c.msaa);
+  if (!vk::supportsAttachment(ctx, VK_FORMAT_D16_UNORM, samples))
+    throw RenderError(fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name, c.msaa));
+  VkImageUsageFlags depthUsage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+  if (c.msaa == 1) depthUsage |= VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+  shadow_depth = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_D16_UNORM,
+                                       .usage = depthUsage, .samples = samples});
+
+  VkFormatFeatureFlags blit = VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT;
+  bool can_mip = c.mipmaps;
+  for (int i = 0; i < c.moment_images(); ++i) {
+    auto format = VkFormat(c.technique->formats[i]);
+    require(ctx, format, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT,
+            "moment images (storage, linear filtering)");
+    can_mip = can_mip && has(ctx, format, blit);
+  }
+  mip_levels = can_mip ? uint32_t(std::bit_width(shadow)) : 1u;
+  for (int i = 0; i < c.moment_images(); ++i) {
+    moments[size_t(i)] = vk::createImage(
+        ctx, {.width = shadow, .height = shadow, .format = VkFormat(c.technique->formats[i]),
+              .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                       VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+              .mipLevels = mip_levels});
+    moments_mip0[size_t(i)] = vk::createImageView(ctx, moments[size_t(i)].handle(), moments[size_t(i)].format(),
+                                                  VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);
+    if (c.taps > 1)
+      blur_temp[size_t(i)] = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                                   .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
+  }
+
+  uint32_t w = uint32_t(c.width), h = uint32_t(c.height);
+  color = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R8G8B8A8_SRGB,
+                                .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+  shadow_buffer = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R32G32_SFLOAT,
+                                        .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+  camera_depth = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_D32_SFLOAT,
+                                       .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT});
+  point_sampler = vk::createSampler(ctx, VK_FILTER_NEAREST);
+  moment_sampler = vk::createSampler(ctx, VK_FILTER_LINEAR);
+}
+
+} // namespace msm::render

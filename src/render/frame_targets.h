@@ -1,0 +1,38 @@
+// The images of one frame configuration (sizes, MSAA, technique formats), reused while the
+// configuration stays the same.
+#pragma once
+
+#include "msm/render/renderer.h"
+#include "msm/vk/vk.h"
+
+#include <array>
+
+namespace msm::render {
+
+struct FrameConfig {
+  const Technique* technique = nullptr;
+  int width = 0, height = 0, shadow_size = 0, msaa = 1, taps = 1;
+  bool mipmaps = true;
+  bool operator==(const FrameConfig&) const = default;
+  int moment_images() const; // 0 (depth-based), 1 or 2 (6MSM)
+};
+
+struct FrameTargets {
+  FrameConfig config;
+  vk::Image shadow_depth;              // D16, config.msaa samples
+  std::array<vk::Image, 2> moments;    // the technique's formats, mip_levels mips
+  std::array<vk::ImageView, 2> moments_mip0; // mip 0 alone: what resolve and blur write (GENERAL)
+  std::array<vk::Image, 2> blur_temp;  // RGBA32F, between the two blur directions
+  vk::Image color;                     // RGBA8 sRGB
+  vk::Image shadow_buffer;             // RG32F: visibility, coverage
+  vk::Image camera_depth;              // D32
+  uint32_t mip_levels = 1;
+  vk::Sampler point_sampler, moment_sampler;
+
+  // Throws RenderError where the device lacks a format feature the configuration needs.
+  FrameTargets(const vk::Context& ctx, const FrameConfig& config);
+};
+
+VkExtent2D extent(const vk::Image& image);
+
+} // namespace msm::render

@@ -1,0 +1,54 @@
+#include "gpu_scene.h"
+
+#include <map>
+
+namespace msm::render {
+namespace {
+
+vk::Image upload_rgba8(const vk::Context& ctx, int width, int height, std::span<const std::uint8_t> rgba) {
+  vk::Image image = vk::createImage(ctx, {.width = uint32_t(width), .height = uint32_t(height),
+                                          .format = VK_FORMAT_R8G8B8A8_SRGB,
+                                          .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  vk::uploadImage(ctx, image, std::as_bytes(rgba), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  return image;
+}
+
+} // namespace
+
+GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
+  std::vector<Vertex> vertex_data;
+  std::vector<uint32_t> index_data;
+  std::map<std::filesystem::path, int> texture_index;
+  for (const scene::Object& object : scene.objects) {
+    const scene::Mesh& mesh = object.mesh;
+    const scene::Material& material = scene.materials.at(object.material);
+    uint32_t base = uint32_t(vertex_data.size());
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+      vertex_data.push_back({mesh.positions[i], mesh.normals[i], i < mesh.uvs.size() ? mesh.uvs[i] : glm::vec2(0.0f)});
+    Draw draw;
+    draw.first_index = uint32_t(index_data.size());
+    for (uint32_t index : mesh.indices) index_data.push_back(base + index);
+    draw.index_count = uint32_t(mesh.indices.size());
+    if (!material.albedo_texture.empty()) {
+      auto [it, inserted] = texture_index.try_emplace(material.albedo_texture, int(textures.size()));
+      if (inserted) {
+        scene::Image texels = scene::load_texture(material.albedo_texture);
+        textures.push_back(upload_rgba8(ctx, texels.width, texels.height, texels.rgba));
+      }
+      draw.texture = it->second;
+    }
+    draw.double_sided = material.double_sided;
+    draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);
+    draw.push.flags = glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0, 0, 0);
+    if (draw.index_count) draws.push_back(draw);
+  }
+  vertices = vk::createBuffer(ctx, vertex_data.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vk::uploadBuffer(ctx, vertices, std::as_bytes(std::span(vertex_data)));
+  indices = vk::createBuffer(ctx, index_data.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  vk::uploadBuffer(ctx, indices, std::as_bytes(std::span(index_data)));
+  const std::uint8_t white_texel[4] = {255, 255, 255, 255};
+  white = upload_rgba8(ctx, 1, 1, white_texel);
+  texture_sampler = vk::createSampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
+}
+
+} // namespace msm::render

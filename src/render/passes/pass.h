@@ -1,0 +1,93 @@
+// The passes of a frame. Each declares what it reads and writes (PassDecl, apart from execute)
+// and records itself inside a GPU timer scope of its name; the renderer composes them. A pass
+// leaves its outputs in the layout and with the barrier its consumers need (stated per pass).
+#pragma once
+
+#include "../frame_targets.h"
+#include "../gpu_scene.h"
+
+#include <string_view>
+#include <vector>
+
+namespace msm::render {
+
+struct PassDecl {
+  std::string_view name; // also the GPU timer scope
+  std::vector<std::string_view> inputs, outputs;
+};
+
+// What execute() records with.
+struct FrameContext {
+  const vk::Context& ctx;
+  VkCommandBuffer cmd;
+  vk::GpuTimer& timer;
+  const FrameTargets& targets;
+  const GpuScene& scene;
+  const vk::Buffer& uniforms; // FrameUniforms
+};
+
+// Scene -> shadow_depth (D16, MSAA), left SHADER_READ_ONLY for compute and fragment reads.
+class ShadowDepthPass {
+public:
+  static const PassDecl& decl();
+  ShadowDepthPass(const vk::Context& ctx, int msaa);
+  void execute(FrameContext& f) const;
+
+private:
+  vk::Program program_;
+};
+
+// shadow_depth -> moments[0..1] mip 0 (GENERAL), visible to compute and fragment reads.
+class MomentResolvePass {
+public:
+  static const PassDecl& decl();
+  MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa);
+  void execute(FrameContext& f) const;
+
+private:
+  vk::Program program_;
+};
+
+// moments mip 0 -> blur_temp -> moments mip 0 (GENERAL), visible to transfer, compute, fragment.
+class BlurPass {
+public:
+  static const PassDecl& decl();
+  explicit BlurPass(const vk::Context& ctx);
+  void execute(FrameContext& f) const;
+
+private:
+  vk::Program program_;
+};
+
+// moments mip 0 -> mips 1.. by linear blits (GENERAL), visible to fragment reads.
+class MipmapPass {
+public:
+  static const PassDecl& decl();
+  void execute(FrameContext& f) const;
+};
+
+// Scene + shadow_depth or moments -> color (sRGB) and shadow_buffer, left TRANSFER_SRC.
+class ShadingPass {
+public:
+  static const PassDecl& decl();
+  ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa);
+  void execute(FrameContext& f) const;
+
+private:
+  vk::Program program_;
+  bool depth_based_;
+};
+
+// Scope guard for the timer scope of a pass.
+class PassScope {
+public:
+  PassScope(FrameContext& f, const PassDecl& decl) : f_(f) { f_.timer.begin(f_.cmd, decl.name); }
+  ~PassScope() { f_.timer.end(f_.cmd); }
+  PassScope(const PassScope&) = delete;
+  PassScope& operator=(const PassScope&) = delete;
+
+private:
+  FrameContext& f_;
+};
+
+} // namespace msm::render

@@ -1,0 +1,267 @@
+// The frame: uniforms, the passes in order, readback. Pipelines are built on first use of a
+// technique / MSAA combination and kept.
+#include "msm/render/renderer.h"
+
+#include "frame_targets.h"
+#include "gpu_scene.h"
+#include "msm/render/frame.h"
+#include "msm/techniques.h"
+#include "passes/pass.h"
+
+#include <fmt/format.h>
+#include <glm/gtc/packing.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+
+namespace msm::render {
+
+// std140 and the C++ struct agree (frame.h uses vec4/ivec4/mat4 members only).
+static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 4 * 16);
+static_assert(offsetof(FrameUniforms, kernel) == 3 * 64 + 6 * 16);
+static_assert(offsetof(FrameUniforms, filter_weights) == 3 * 64 + 7 * 16);
+static_assert(sizeof(ObjectPush) == 32 && sizeof(ImagePassPush) == 16);
+
+namespace {
+
+// Vulkan's standard sample locations (pixel-relative, y down), as offsets from the centre.
+std::vector<glm::vec2> standard_sample_offsets(int samples) {
+  static const float four[] = {0.375f, 0.125f, 0.875f, 0.375f, 0.125f, 0.625f, 0.625f, 0.875f};
+  static const float eight[] = {0.5625f, 0.3125f, 0.4375f, 0.6875f, 0.8125f, 0.5625f, 0.3125f, 0.1875f,
+                                0.1875f, 0.8125f, 0.0625f, 0.4375f, 0.6875f, 0.9375f, 0.9375f, 0.0625f};
+  const float* p = samples == 4 ? four : samples == 8 ? eight : nullptr;
+  std::vector<glm::vec2> out(size_t(samples), glm::vec2(0.0f));
+  if (p)
+    for (int i = 0; i < samples; ++i) out[size_t(i)] = glm::vec2(p[2 * i], p[2 * i + 1]) - 0.5f;
+  return out;
+}
+
+image::Image to_float_image(std::span<const std::byte> bytes, VkFormat format, int width, int height) {
+  int channels = 0;
+  enum { Unorm16, Half, Float } kind = Float;
+  switch (format) {
+  case VK_FORMAT_R16G16B16A16_UNORM: channels = 4; kind = Unorm16; break;
+  case VK_FORMAT_R16G16_UNORM: channels = 2; kind = Unorm16; break;
+  case VK_FORMAT_R16G16B16A16_SFLOAT: channels = 4; kind = Half; break;
+  case VK_FORMAT_R16G16_SFLOAT: channels = 2; kind = Half; break;
+  case VK_FORMAT_R32G32B32A32_SFLOAT: channels = 4; break;
+  case VK_FORMAT_R32G32_SFLOAT: channels = 2; break;
+  case VK_FORMAT_R32_SFLOAT: channels = 1; break;
+  default: throw RenderError("to_float_image: unexpected format");
+  }
+  image::Image out(width, height, channels);
+  std::span<float> px = out.pixels();
+  for (size_t i = 0; i < px.size(); ++i) {
+    if (kind == Unorm16) {
+      uint16_t v;
+      std::memcpy(&v, bytes.data() + 2 * i, 2);
+      px[i] = float(v) / 65535.0f;
+    } else if (kind == Half) {
+      uint16_t v;
+      std::memcpy(&v, bytes.data() + 2 * i, 2);
+      px[i] = glm::unpackHalf1x16(v);
+    } else {
+      std::memcpy(&px[i], bytes.data() + 4 * i, 4);
+    }
+  }
+  return out;
+}
+
+} // namespace
+
+struct Renderer::Impl {
+  const vk::Context& ctx;
+  scene::Scene scene;
+  GpuScene gpu;
+  glm::mat4 light_view_projection;
+  vk::Buffer uniforms;
+  vk::GpuTimer timer;
+  std::unique_ptr<FrameTargets> targets;
+  std::map<int, std::unique_ptr<ShadowDepthPass>> shadow_passes;
+  std::map<std::pair<int, int>, std::unique_ptr<MomentResolvePass>> resolve_passes;
+  std::map<std::pair<int, int>, std::unique_ptr<ShadingPass>> shading_passes;
+  std::unique_ptr<BlurPass> blur_pass;
+  std::unique_ptr<vk::Program> depth_copy;
+  MipmapPass mipmap_pass;
+
+  Impl(const vk::Context& c, const scene::Scene& s)
+      : ctx(c), scene(s), gpu(c, s), light_view_projection(s.light_view_projection()),
+        uniforms(vk::createBuffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::Host)),
+        timer(c, 16) {}
+
+  template <class Map, class Key, class Make> auto& cached(Map& map, const Key& key, Make make) {
+    auto it = map.find(key);
+    if (it == map.end()) it = map.emplace(key, make()).first;
+    return *it->second;
+  }
+
+  FrameUniforms frame_uniforms(const RenderSettings& s, const Technique& technique) const {
+    FrameUniforms u{};
+    u.camera_view_projection = scene.camera_view_projection(float(s.width) / float(s.height));
+    u.light_view_projection = light_view_projection;
+    u.light_normal_matrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(light_view_projection))));
+    u.towards_light = glm::vec4(scene.light.towards_light, 0.0f);
+    u.irradiance = glm::vec4(scene.light.irradiance, 0.03f); // ambient factor: as the reference
+    u.technique_params = s.params ? *s.params : default_params(technique);
+    // One shadow-map texel in world units: the light frustum's width over the map size.
+    glm::mat4 inverse = glm::inverse(light_view_projection);
+    float texel = glm::length(glm::vec3(inverse * glm::vec4(2.0f, 0.0f, 0.0f, 0.0f))) / float(s.shadow_size);
+    bool depth_based = msm_technique_is_depth_based(technique.id);
+    float depth_bias = s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f);
+    u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel, depth_bias);
+    u.shading = glm::vec4(s.overdarken, s.exposure, 0.0f, 0.0f);
+    u.background = glm::vec4(0.55f, 0.65f, 0.8f, 1.0f);
+    int radius = s.filter_size / 2;
+    u.kernel = glm::ivec4(s.filter_size, s.msaa, radius, 0);
+    double sum = 0;
+    std::vector<double> w(size_t(s.filter_size));
+    for (int k = 0; k < s.filter_size; ++k) {
+      double x = k - radius;
+      sum += w[size_t(k)] = std::exp(-x * x / (2.0 * double(s.filter_sigma) * s.filter_sigma));
+    }
+    for (int k = 0; k < s.filter_size; ++k) u.filter_weights[k / 4][k % 4] = float(w[size_t(k)] / sum);
+    std::vector<glm::vec2> offsets =
+        ctx.properties().limits.standardSampleLocations ? standard_sample_offsets(s.msaa) : std::vector<glm::vec2>(8);
+    for (size_t i = 0; i < offsets.size(); ++i) {
+      u.sample_offsets[i / 2][int(2 * (i % 2))] = offsets[i].x;
+      u.sample_offsets[i / 2][int(2 * (i % 2) + 1)] = offsets[i].y;
+    }
+    return u;
+  }
+
+  // Validates, builds what is missing, writes the uniforms.
+  const Technique& prepare(const RenderSettings& s) {
+    s.validate();
+    const Technique& technique = find_technique(s.technique);
+    VkSampleCountFlagBits samples = VkSampleCountFlagBits(s.msaa);
+    if (!vk::supportsAttachment(ctx, VK_FORMAT_D16_UNORM, samples))
+      throw RenderError(fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name,
+                                    s.msaa));
+    if (uint32_t(std::max(s.width, s.height)) > ctx.properties().limits.maxImageDimension2D ||
+        uint32_t(s.shadow_size) > ctx.properties().limits.maxImageDimension2D)
+      throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
+                                    ctx.properties().limits.maxImageDimension2D));
+    FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps};
+    if (!targets || !(targets->config == config)) {
+      targets.reset();
+      targets = std::make_unique<FrameTargets>(ctx, config);
+    }
+    cached(shadow_passes, s.msaa, [&] { return std::make_unique<ShadowDepthPass>(ctx, s.msaa); });
+    if (config.moment_images()) {
+      cached(resolve_passes, std::pair(technique.id, s.msaa),
+             [&] { return std::make_unique<MomentResolvePass>(ctx, technique, s.msaa); });
+      if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
+    }
+    cached(shading_passes, std::pair(technique.id, s.msaa),
+           [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa); });
+    FrameUniforms u = frame_uniforms(s, technique);
+    std::memcpy(uniforms.data(), &u, sizeof(u));
+    return technique;
+  }
+
+  // Records the passes; `until_resolve` stops after the moment resolve (intermediates).
+  void record(VkCommandBuffer cmd, const RenderSettings& s, const Technique& technique, bool until_resolve) {
+    timer.reset(cmd);
+    FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms};
+    shadow_passes.at(s.msaa)->execute(f);
+    if (targets->config.moment_images()) {
+      resolve_passes.at({technique.id, s.msaa})->execute(f);
+      if (until_resolve) return;
+      if (s.filter_size > 1) blur_pass->execute(f);
+      mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
+    }
+    if (until_resolve) return;
+    shading_passes.at({technique.id, s.msaa})->execute(f);
+  }
+
+  std::vector<PassTime> read_times() {
+    std::vector<PassTime> out;
+    for (auto& [name, ms] : timer.read().totals()) out.push_back({name, ms});
+    return out;
+  }
+
+  void read_intermediates(const RenderSettings& s, const Technique& technique, Intermediates& out) {
+    vk::submitAndWait(ctx, [&](VkCommandBuffer cmd) { record(cmd, s, technique, true); });
+    timer.read();
+    int size = s.shadow_size;
+    if (s.msaa == 1) {
+      std::vector<std::byte> bytes = vk::readbackImage(ctx, targets->shadow_depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      out.depth_samples.resize(size_t(size) * size);
+      for (size_t i = 0; i < out.depth_samples.size(); ++i) {
+        uint16_t v;
+        std::memcpy(&v, bytes.data() + 2 * i, 2);
+        out.depth_samples[i] = float(v) / 65535.0f;
+      }
+    } else {
+      if (!depth_copy)
+        depth_copy = std::make_unique<vk::Program>(vk::createProgram(
+            ctx, "depth_samples.comp", {vk::Binding::SampledImage, vk::Binding::StorageBuffer}, sizeof(ImagePassPush)));
+      size_t count = size_t(size) * size * size_t(s.msaa);
+      vk::Buffer buffer = vk::createBuffer(ctx, count * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::Host);
+      vk::submitAndWait(ctx, [&](VkCommandBuffer cmd) {
+        uint32_t groups = vk::groupCount(uint32_t(size), 8);
+        vk::dispatch(cmd, *depth_copy, groups, groups, 1,
+                     {vk::Descriptor(targets->shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                     targets->point_sampler),
+                      vk::Descriptor(buffer)},
+                     ImagePassPush{glm::ivec4(size, size, s.msaa, 0)});
+      });
+      std::span<const float> mapped = buffer.mapped<const float>();
+      out.depth_samples.assign(mapped.begin(), mapped.begin() + std::ptrdiff_t(count));
+    }
+    for (int i = 0; i < targets->config.moment_images(); ++i) {
+      std::vector<std::byte> bytes = vk::readbackImage(ctx, targets->moments[size_t(i)], VK_IMAGE_LAYOUT_GENERAL);
+      (i == 0 ? out.moments : out.moments1) = to_float_image(bytes, VkFormat(technique.formats[size_t(i)]), size, size);
+    }
+  }
+};
+
+Renderer::Renderer(const vk::Context& ctx, const scene::Scene& scene) : impl_(std::make_unique<Impl>(ctx, scene)) {}
+Renderer::~Renderer() = default;
+const scene::Scene& Renderer::scene() const noexcept { return impl_->scene; }
+
+RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermediates) {
+  Impl& m = *impl_;
+  const Technique& technique = m.prepare(s);
+  if (intermediates) m.read_intermediates(s, technique, *intermediates);
+  vk::submitAndWait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
+  RenderResult r;
+  r.passes = m.read_times();
+  for (const PassTime& p : r.passes) r.total_ms += p.ms;
+  if (intermediates && m.targets->config.moment_images())
+    intermediates->filtered = to_float_image(vk::readbackImage(m.ctx, m.targets->moments[0],
+                                                               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL),
+                                             VkFormat(technique.formats[0]), s.shadow_size, s.shadow_size);
+
+  std::vector<std::byte> color = vk::readbackImage(m.ctx, m.targets->color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  r.color = image::Image(s.width, s.height, 3);
+  std::span<float> c = r.color.pixels();
+  for (size_t i = 0; i < r.color.pixel_count(); ++i)
+    for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
+
+  std::vector<std::byte> shadow = vk::readbackImage(m.ctx, m.targets->shadow_buffer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  r.shadow = image::Image(s.width, s.height, {"visibility", "background"});
+  std::span<float> v = r.shadow.pixels();
+  for (size_t i = 0; i < r.shadow.pixel_count(); ++i) {
+    float px[2];
+    std::memcpy(px, shadow.data() + 8 * i, 8);
+    v[2 * i] = px[0];
+    v[2 * i + 1] = 1.0f - px[1];
+  }
+  return r;
+}
+
+std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {
+  if (frames < 1) throw RenderError("time_frames: at least one frame");
+  Impl& m = *impl_;
+  const Technique& technique = m.prepare(s);
+  std::vector<std::vector<PassTime>> out;
+  for (int i = 0; i < frames; ++i) {
+    vk::submitAndWait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
+    out.push_back(m.read_times());
+  }
+  return out;
+}
+
+} // namespace msm::render

@@ -1,0 +1,11 @@
+// Shared by the renderer's shaders: the frame's uniform block and the shading helpers.
+#include "msm/render/frame.h"
+
+layout(std140, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+
+// The technique (MSM_TECH_*, msm/techniques.h): a specialization constant, so that each pipeline
+// compiles one technique's path only.
+layout(constant_id = 0) const int kTechnique = 0;
+
+// Normalized 1D Gaussian weight of tap k in [0, taps).
+float kernel_weight(int k) { return frame.filter_weights[k / 4][k % 4]; }
