@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
     msm::tool::add_techniques(app);
     msm::tool::add_reconstruct(app);
     msm::tool::add_compare(app);
+    msm::tool::add_reference(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

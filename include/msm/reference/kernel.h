@@ -1,0 +1,50 @@
+// msm::reference: the continuous footprint of the renderer's shadow-map filter (PCF), in texels.
+//
+// The renderer filters a shadow map of shadow_size x shadow_size texels with a discrete Gaussian of
+// size x size taps (size odd, radius r = (size - 1) / 2) and samples the result bilinearly. The
+// 2D tap weights are w(i, j) = exp(-(i^2 + j^2) / (2 sigma^2)) normalized to sum 1 over
+// i, j in [-r, r]; they are the product w_i w_j of the normalized 1D weights
+// w_k = exp(-k^2 / (2 sigma^2)) / sum_j exp(-j^2 / (2 sigma^2)). Bilinear sampling spreads each tap
+// over a tent (hat) of half-width 1 texel per axis, so the continuous kernel of an offset
+// o = (ox, oy) in texels is
+//     K(o) = k(ox) k(oy),   k(s) = sum_k w_k tent(s - k),   tent(u) = max(0, 1 - |u|),
+// a density (it integrates to 1). Sampling: pick the tap k with probability w_k, then add a
+// triangular offset on [-1, 1] (the tent's density) - per axis, since K is separable.
+//
+// The offsets are in shadow-map texels of the light frustum of light_projection() * light_view():
+// one texel is the frustum's width / shadow_size along light-space x and its height / shadow_size
+// along light-space y (msm::reference::LightFrame).
+#pragma once
+
+#include <vector>
+
+namespace msm::reference {
+
+class FilterKernel {
+public:
+    // size odd in [1, kMaxSize], sigma finite and > 0 (in texels); else std::invalid_argument.
+    FilterKernel(int size = 9, double sigma = 2.4);
+    static constexpr int kMaxSize = 255;
+
+    int size() const noexcept { return size_; }
+    int radius() const noexcept { return (size_ - 1) / 2; }
+    double sigma() const noexcept { return sigma_; }
+    // Normalized 1D weights w_k for k = -radius..radius (index k + radius).
+    const std::vector<double>& weights() const noexcept { return weights_; }
+
+    // The 1D marginal k(s) and its cumulative distribution K1(s) = integral of k up to s.
+    double density(double s) const;
+    double cdf(double s) const;
+
+    // Inverse-transform-like map of u in [0, 1) to a 1D offset distributed with density k:
+    // the tap whose cumulative weight interval holds u, then the tent's inverse CDF of u rescaled
+    // within that interval. Measure-preserving, so stratified u give stratified offsets per tap.
+    double sample(double u) const;
+
+private:
+    int size_;
+    double sigma_;
+    std::vector<double> weights_, cumulative_;  // cumulative_[i] = sum of weights_[0..i)
+};
+
+}  // namespace msm::reference

@@ -1,0 +1,176 @@
+// msm::reference: ground truth for the renderer's shadows, by CPU ray tracing (Embree 3, TBB).
+//
+// render(scene, settings) traces one primary ray through the centre of every pixel and evaluates
+// one Effect at the closest surface it hits. Everything is defined per pixel, exactly; Monte Carlo
+// effects also report their sample count and standard error.
+//
+// Camera (identical to the rasterizer): an image of W x H pixels, pixel (x, y) with y = 0 the TOP
+// row. The primary ray of pixel (x, y) goes through NDC ((x + 0.5) / W * 2 - 1, (y + 0.5) / H * 2 - 1)
+// (Vulkan: y down, depth in [0, 1]): from the unprojection of NDC depth 0 to that of depth 1 with
+// inverse(scene.camera_view_projection(float(W) / H)), in double precision. The closest hit over
+// [near point, far point] is the visible surface. Back faces are surfaces too: the rasterizer
+// culls the back faces of single-sided materials, which shows the same surface as long as meshes
+// are closed (or seen from their front side); for an open single-sided surface seen from behind
+// the two differ, and the reference shows the surface. The hit point p is the intersection of the
+// (double precision) primary ray with the plane of the hit triangle; n is the triangle's
+// geometric normal (not the interpolated one).
+//
+// Effects (L = scene.light.towards_light, the exact direction towards the light; every shadow
+// ray starts at its point offset by eps along the geometric normal facing the light, with
+// eps = kOffsetScale * max(|p|_inf, largest |coordinate| of the hit triangle's vertices); every
+// surface blocks shadow rays, whatever its opacity, except in `translucent`):
+//
+//   hard        V(p) = 1 if the ray p -> L reaches infinity, else 0. One primary ray per pixel
+//               centre, no bias beyond eps, no antialiasing: the renderer's shadow buffer.
+//
+//   filtered    The antialiased hard shadow that a perfectly biased PCF approximates (the
+//               "receiver plane" reference): V(p) = integral of K(o) V_hard(p'(o)) do, with K the
+//               continuous filter kernel of msm/reference/kernel.h (offsets o in shadow-map
+//               texels) and p'(o) the point of the tangent plane of p whose light-space (x, y) is
+//               that of p moved by o: p' = p + o_world + t * travel, o_world = ox * texel_x *
+//               x_axis + oy * texel_y * y_axis (LightFrame), t chosen so that dot(n, p' - p) = 0 and
+//               clamped to |t| <= kMaxReceiverSlope * |o_world| on grazing planes. Estimated with
+//               `samples` stratified offsets.
+//
+//   soft        Visibility averaged over a directional area light: the fraction of the light
+//               that p sees. The light is a planar emitter at infinity: its directions are
+//               normalize(L + a * x_axis + b * y_axis) with (a, b) uniform over a disc of radius
+//               tan(extent / 2) (extent = angular DIAMETER; default the scene's
+//               angular_extent_deg) or over the rectangle [-tan(w/2), tan(w/2)] x
+//               [-tan(h/2), tan(h/2)] (angular width w along light-space x, height h along y).
+//               This is the light model of shadow-map soft shadows (penumbra width in light
+//               space = 2 tan(extent/2) x distance to the blocker); it differs from a disc that
+//               is uniform in solid angle by a density of cos^3 of the angle off L (relative
+//               1.5 tan^2(extent/2): 1.1e-4 at 1 degree, 1.1e-2 at 10 degrees). Light arriving
+//               from below the local horizon is blocked by the surface itself. Not weighted by the
+//               cosine: visibility, not irradiance. Extent 0 gives the hard shadow.
+//
+//   translucent T(p) = product over every surface crossed by the ray p -> L of (1 - opacity of
+//               its material); a closed mesh is crossed twice. Constant material opacity only
+//               (opacity textures are ignored). At most max_crossings surfaces are counted.
+//
+// Samplers (filtered, soft): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
+// for the first m^2 of the N samples per pixel and independent uniform points for the rest (so a
+// square N is fully stratified); the soft disc light maps the grid with Shirley and Chiu's
+// concentric map, the filter kernel with FilterKernel::sample per axis. `independent` uses N
+// independent uniform points (plain Monte Carlo, for checking the statistics). Every pixel draws
+// from its own generator seeded by (seed, x, y, effect): the image is the same for any thread
+// count. std_error = s / sqrt(N) with s^2 the unbiased sample variance: the standard error of the
+// mean of N independent samples; for the stratified sampler the actual error is smaller (the
+// variance of a stratified mean never exceeds that of independent sampling), so it is an upper
+// bound there. It is 0 where N = 1 or every sample agrees.
+//
+// Output images (W x H, row 0 at the top):
+//   visibility   channels "visibility", "background" and, for filtered and soft only,
+//                "sample_count", "std_error". background = 1 where the primary ray hits nothing
+//                (there visibility = 1, sample_count = std_error = 0), else 0.
+//   radiance     "R", "G", "B" (linear): shade() below at the visible surface, 0 on background.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string_view>
+
+#include <glm/glm.hpp>
+
+#include "msm/image/image.h"
+#include "msm/reference/kernel.h"
+#include "msm/scene/scene.h"
+
+namespace msm::reference {
+
+enum class Effect { hard, filtered, soft, translucent };
+inline constexpr std::array<Effect, 4> kEffects{Effect::hard, Effect::filtered, Effect::soft, Effect::translucent};
+std::string_view to_string(Effect effect);
+std::optional<Effect> parse_effect(std::string_view name);
+bool is_monte_carlo(Effect effect);  // filtered, soft
+
+enum class LightShape { disc, rectangle };
+std::string_view to_string(LightShape shape);
+std::optional<LightShape> parse_light_shape(std::string_view name);
+
+enum class Sampler { stratified, independent };
+std::string_view to_string(Sampler sampler);
+std::optional<Sampler> parse_sampler(std::string_view name);
+
+inline constexpr int kMaxSide = 16384;
+inline constexpr int kMaxSamples = 1'000'000;
+inline constexpr int kMaxShadowSize = 65536;
+inline constexpr int kMaxCrossings = 4096;
+inline constexpr int kMaxThreads = 1024;
+inline constexpr double kOffsetScale = 1e-5;       // shadow-ray origin offset, relative
+inline constexpr double kMaxReceiverSlope = 16.0;  // |t| / |o_world| on grazing receivers
+inline constexpr float kAmbient = 0.03f;           // ambient term, times the albedo
+
+// The radiance formula shared with the renderer: Lambert shading of the directional light plus a
+// constant ambient term,
+//   albedo * irradiance * max(0, n_dot_l) * visibility / pi + kAmbient * albedo,
+// with albedo the material's constant colour (albedo textures are ignored), n the interpolated
+// vertex normal turned towards the viewer, l = towards_light.
+glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, float visibility);
+
+// The shadow map's light-space frame, from the inverse of light_projection() * light_view():
+// x_axis / y_axis are the unit world directions of increasing clip x / y (along the map's texel
+// rows / columns; clip y points down the image), extent the frustum's width and height in world
+// units, so that one texel is extent.x / shadow_size along x_axis and extent.y / shadow_size along
+// y_axis. Both axes are orthogonal to towards_light.
+struct LightFrame {
+    glm::dvec3 towards_light{0.0, 1.0, 0.0};
+    glm::dvec3 x_axis{1.0, 0.0, 0.0}, y_axis{0.0, 0.0, 1.0};
+    glm::dvec2 extent{1.0, 1.0};
+    static LightFrame of(const scene::Scene& scene);
+};
+
+struct Progress {
+    std::size_t rows_done = 0, rows_total = 0;
+    double seconds = 0.0;  // since the start of the render (BVH build included)
+};
+
+struct Settings {
+    Effect effect = Effect::hard;
+    int width = 640, height = 360;        // 1..kMaxSide
+    int samples = 256;                    // per pixel (filtered, soft), 1..kMaxSamples
+    std::uint64_t seed = 1;
+    Sampler sampler = Sampler::stratified;
+    // filtered: the renderer's shadow map and filter.
+    int shadow_size = 1024;               // 1..kMaxShadowSize
+    int filter_size = 9;                  // odd, 1..FilterKernel::kMaxSize
+    double filter_sigma = 2.4;            // texels, > 0
+    // soft: light extent in degrees, in [0, 90). Unset: the scene's angular_extent_deg (the disc's
+    // diameter, and the rectangle's width and height unless given).
+    std::optional<double> light_extent_deg;
+    LightShape light_shape = LightShape::disc;
+    std::optional<double> light_width_deg, light_height_deg;  // rectangle only
+    // translucent
+    int max_crossings = 64;               // 1..kMaxCrossings
+    // Worker threads: 0 = TBB's default (all cores, or a tbb::global_control limit), else a
+    // task arena of that many (1..kMaxThreads). The image does not depend on it.
+    int threads = 0;
+    // Called from worker threads (one at a time) as rows complete, at most ~200 times.
+    std::function<void(const Progress&)> progress;
+};
+
+// Throws std::invalid_argument naming the setting and its allowed range.
+void validate(const Settings& settings);
+
+struct Result {
+    image::Image visibility;  // see above for the channels
+    image::Image radiance;    // R, G, B
+    int samples = 1;          // per covered pixel (1 for hard and translucent)
+    double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0;  // as used (soft)
+    double build_seconds = 0.0;   // Embree scene
+    double render_seconds = 0.0;  // tracing
+    std::uint64_t rays = 0;       // primary + shadow rays traced
+    std::size_t background_pixels = 0;
+    double mean_visibility = 0.0;  // over the covered (non-background) pixels; 1 if none
+    unsigned threads = 0;          // TBB concurrency used
+};
+
+// Throws std::invalid_argument for bad settings or a scene with non-finite vertices, and
+// std::runtime_error when Embree fails.
+Result render(const scene::Scene& scene, const Settings& settings);
+
+}  // namespace msm::reference
