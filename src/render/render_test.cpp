@@ -180,7 +180,9 @@ TEST_F(RenderTest, ResolvedMomentsEqualTheCpuComputationOnTheSameDepths) {
       // tie may round either way); float (moments in [-1,1]): 1e-6, a few ulps of 1 (the device
       // may convert D16 to float or contract a * b + c differently).
       EXPECT_LE(worst, unorm ? 1.0 : 1e-6);
-      if (msaa > 1) EXPECT_GT(distinct_depths, 100) << "edges give texels whose samples differ";
+      if (msaa > 1) {
+        EXPECT_GT(distinct_depths, 100) << "edges give texels whose samples differ";
+      }
     }
   }
 }
@@ -267,6 +269,28 @@ TEST_F(RenderTest, BlurNeverSpreadsNaN) {
             expected += double(w[size_t(i)] / sum) * (w[size_t(j)] / sum) * at(texels, x + i - radius, y + j - radius, c);
         EXPECT_NEAR(v, expected, 1e-5) << x << "," << y;
       }
+}
+
+// The parameters reach the shaders: over-darkening only darkens (it divides the shadow
+// intensity by the factor), a larger minimum variance only brightens VSM (Cantelli's bound
+// loosens), and both change something on the fence.
+TEST_F(RenderTest, ParametersReachTheShaders) {
+  Renderer renderer(ctx(), scene::builtin_scene("fence"));
+  image::Image base = visibility(renderer.render(small("vsm-32")));
+  RenderSettings dark = small("vsm-32");
+  dark.overdarken = 0.8f;
+  RenderSettings loose = small("vsm-32");
+  loose.params = default_params(find_technique("vsm-32")) + glm::vec4(0.0f, 0.0f, 0.0f, 0.01f);
+  image::Image darker = visibility(renderer.render(dark)), brighter = visibility(renderer.render(loose));
+  int darkened = 0, brightened = 0;
+  for (size_t i = 0; i < base.pixels().size(); ++i) {
+    EXPECT_LE(darker.pixels()[i], base.pixels()[i] + 1e-6f);
+    EXPECT_GE(brighter.pixels()[i], base.pixels()[i] - 1e-6f);
+    darkened += darker.pixels()[i] < base.pixels()[i] - 0.01f;
+    brightened += brighter.pixels()[i] > base.pixels()[i] + 0.01f;
+  }
+  EXPECT_GT(darkened, 50);
+  EXPECT_GT(brightened, 50);
 }
 
 TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {

@@ -5,10 +5,14 @@
 namespace msm::tool {
 
 void add_demo(CLI::App& app);
+void add_kernels(CLI::App& app);
+void add_bench(CLI::App& app);
 void add_techniques(CLI::App& app);
 void add_reconstruct(CLI::App& app);
 void add_compare(CLI::App& app);
 void add_reference(CLI::App& app);
+void add_render(CLI::App& app);
+void add_scenes(CLI::App& app);
 
 // Thrown by commands for bad input: main prints the message and exits with status 2.
 struct UsageError : std::runtime_error {

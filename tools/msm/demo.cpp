@@ -1,74 +1,121 @@
-// `msm demo`: every technique on the filter-kernel situations the papers use to show their
-// artifacts, against the exact answer (percentage-closer filtering of the same kernel).
-#include "commands.h"
-#include "msm/cpu/techniques.h"
+// `msm demo` (what `make demo` runs): the default scene with PCF, VSM, EVSM4, MSM 64 and MSM 128
+// side by side in one labelled image with magnified insets where they differ, and a table of the
+// error against the PCF reference and the GPU time per pass.
+#include "render_common.h"
+
+#include "msm/image/compose.h"
+#include "msm/image/io.h"
+#include "msm/image/metrics.h"
 
 #include <fmt/core.h>
 
 #include <algorithm>
-#include <cmath>
-#include <string>
-#include <vector>
+#include <cstdio>
+#include <unistd.h>
 
 namespace msm::tool {
-namespace {
-
-struct Example {
-    std::string name;
-    std::vector<float> depths, weights;
-    float zf; // just in front of the receiver, as a small depth bias would put it
-};
-
-// A sloped receiver: 64 depths evenly spread over [lo, hi].
-Example slope(std::string name, float lo, float hi, float zf) {
-    Example e{std::move(name), {}, {}, zf};
-    for (int i = 0; i < 64; ++i) {
-        e.depths.push_back(lo + (hi - lo) * (i + 0.5f) / 64.0f);
-        e.weights.push_back(1.0f);
-    }
-    return e;
-}
-
-std::vector<Example> paper_examples() {
-    return {
-        {"penumbra: occluder edge over ground (2 depths)", {0.30f, 0.60f}, {0.4f, 0.6f}, 0.598f},
-        {"short range: banner under railing (HPG Fig. 1)", {0.55f, 0.57f}, {0.5f, 0.5f}, 0.568f},
-        {"contact shadow: occluder touching receiver", {0.595f, 0.60f}, {0.5f, 0.5f}, 0.599f},
-        {"three occluders in one kernel (JCGT Fig. 4)", {0.20f, 0.35f, 0.50f}, {0.3f, 0.3f, 0.4f}, 0.80f},
-        {"two occluders + lit ground (JCGT Fig. 4 cyan)", {0.25f, 0.45f, 0.70f}, {0.35f, 0.35f, 0.3f}, 0.698f},
-        {"Dirac pair at far plane (HPG §3.2)", {0.9575f, 1.0f}, {0.5f, 0.5f}, 0.99f},
-        slope("sloped receiver, no occluder (acne test)", 0.50f, 0.52f, 0.52f - 0.005f),
-    };
-}
-
-} // namespace
 
 void add_demo(CLI::App& app) {
-    auto* cmd = app.add_subcommand("demo",
-        "Print every technique's reconstruction on the papers' example kernels against the exact answer");
-    cmd->callback([] {
-        std::vector<Example> examples = paper_examples();
-        fmt::print("Shadow intensity (0 = lit, 1 = shadowed) per filter kernel; exact = PCF of the same kernel.\n");
-        fmt::print("Light leaking shows as values below exact, wrong self-shadowing as values above.\n\n");
-        for (size_t i = 0; i < examples.size(); ++i)
-            fmt::print("  K{}: {} (zf = {})\n", i + 1, examples[i].name, examples[i].zf);
-        fmt::print("\n{:<26} {:>5}", "technique", "bits");
-        for (size_t i = 0; i < examples.size(); ++i) fmt::print(" {:>6}", fmt::format("K{}", i + 1));
-        fmt::print(" {:>8}\n", "max|err|");
-        fmt::print("{:<26} {:>5}", "exact (PCF)", "");
-        for (const Example& e : examples) fmt::print(" {:>6.3f}", cpu::percentage_closer(e.depths, e.weights, e.zf));
-        fmt::print("\n");
-        for (const cpu::Technique& t : cpu::techniques()) {
-            fmt::print("{:<26} {:>5}", t.name, t.bits_per_texel);
-            float worst = 0.0f;
-            for (const Example& e : examples) {
-                float s = cpu::filtered_shadow(t, e.depths, e.weights, e.zf);
-                worst = std::max(worst, std::abs(s - cpu::percentage_closer(e.depths, e.weights, e.zf)));
-                fmt::print(" {:>6.3f}", s);
-            }
-            fmt::print(" {:>8.3f}\n", worst);
-        }
-    });
+  struct Options {
+    FrameOptions frame;
+    std::string out = "msm-demo";
+    std::vector<std::string> techniques = {"pcf", "vsm-32", "evsm4-64", "msm-hamburger-64", "msm-hamburger-128"};
+  };
+  auto opt = std::make_shared<Options>();
+  opt->frame.settings.width = 960;
+  opt->frame.settings.height = 540;
+  opt->frame.scene = std::string(scene::default_scene_name());
+  auto* cmd = app.add_subcommand("demo", "Render the default scene with PCF, VSM, EVSM4, MSM 64 and MSM 128 into one "
+                                         "comparison image, and print the error against PCF and the time per pass");
+  cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
+  cmd->add_option("--techniques", opt->techniques, "Techniques to compare (the first is the reference)")
+      ->delimiter(',');
+  add_frame_options(cmd, opt->frame);
+  cmd->callback([opt] {
+    finish_frame_options(opt->frame);
+    if (opt->techniques.empty()) throw UsageError("--techniques: none given");
+    for (const std::string& name : opt->techniques) {
+      render::RenderSettings s = opt->frame.settings;
+      s.technique = name;
+      try {
+        s.validate();
+      } catch (const render::RenderError& e) {
+        throw UsageError(e.what());
+      }
+    }
+    scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    ensure_output_dir(opt->out);
+    std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
+    render::Renderer renderer(*ctx, scene);
+    fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
+               scene.name, opt->frame.settings.width, opt->frame.settings.height, opt->frame.settings.shadow_size,
+               opt->frame.settings.msaa, opt->frame.settings.filter_size, opt->frame.settings.filter_sigma,
+               ctx->info().name);
+
+    bool tty = isatty(fileno(stderr));
+    std::vector<render::RenderResult> results;
+    std::vector<image::Image> signals;
+    for (size_t i = 0; i < opt->techniques.size(); ++i) {
+      render::RenderSettings s = opt->frame.settings;
+      s.technique = opt->techniques[i];
+      if (tty) fmt::print(stderr, "\r[{}/{}] {:<26}", i + 1, opt->techniques.size(), s.technique);
+      results.push_back(renderer.render(s));
+      // The table shows the median of a few more frames: the first one pays for warming up.
+      std::vector<std::vector<render::PassTime>> frames = renderer.time_frames(s, 5);
+      for (render::PassTime& p : results.back().passes) {
+        std::vector<double> ms;
+        for (const auto& frame : frames)
+          for (const render::PassTime& q : frame)
+            if (q.name == p.name) ms.push_back(q.ms);
+        std::nth_element(ms.begin(), ms.begin() + std::ptrdiff_t(ms.size() / 2), ms.end());
+        p.ms = ms.empty() ? p.ms : ms[ms.size() / 2];
+      }
+      results.back().total_ms = 0;
+      for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
+      write_render(opt->out, s.technique, results.back(), render_json(s, scene, *ctx, results.back()));
+      signals.push_back(results.back().shadow.channel("visibility"));
+    }
+    if (tty) fmt::print(stderr, "\r{:<40}\r", "");
+
+    // Error against the first technique (PCF), background masked.
+    image::Image mask = results[0].shadow.channel("background");
+    int side = std::max(16, opt->frame.settings.width / 8);
+    std::vector<image::Rect> insets = image::find_difference_regions(signals, side, side, 3);
+    std::vector<image::Panel> panels;
+    std::vector<std::string> pass_names;
+    for (const render::PassTime& p : results[1 < results.size() ? 1 : 0].passes) pass_names.push_back(p.name);
+    std::string header = fmt::format("{:<20} {:>5} {:>8} {:>8} {:>7}", "technique", "bits", "MAE", "leaking", ">3%");
+    for (const std::string& p : pass_names) header += fmt::format(" {:>14}", p + " ms");
+    fmt::print("\n{} {:>10}\n", header, "total ms");
+    for (size_t i = 0; i < results.size(); ++i) {
+      const render::Technique& t = render::find_technique(opt->techniques[i]);
+      image::Metrics m = image::compute_metrics(signals[i], signals[0], {.mask = &mask});
+      std::string line = fmt::format("{:<20} {:>5} {:>8.5f} {:>8.5f} {:>6.2f}%", t.name, t.bits_per_texel, m.mae,
+                                     m.light_leaking, 100 * m.share_above_3pct);
+      for (const std::string& p : pass_names) {
+        double ms = -1;
+        for (const render::PassTime& q : results[i].passes)
+          if (q.name == p) ms = q.ms;
+        line += ms < 0 ? fmt::format(" {:>14}", "-") : fmt::format(" {:>14.3f}", ms);
+      }
+      fmt::print("{} {:>10.3f}\n", line, results[i].total_ms);
+      std::string caption = i == 0 ? std::string("reference") : fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking);
+      panels.push_back({std::string(t.name), results[i].color, caption});
+    }
+    image::ComposeOptions options;
+    options.insets = insets;
+    options.columns = int(std::min<size_t>(panels.size(), 3));
+    image::Image figure = image::compose_comparison(panels, options);
+    std::filesystem::path file = std::filesystem::path(opt->out) / "comparison.png";
+    try {
+      image::write_png(file, figure);
+    } catch (const image::ImageError& e) {
+      throw UsageError(e.what());
+    }
+    fmt::print("\nErrors are in visibility against {} (same kernel), background excluded; times are GPU "
+               "timestamps, median of 5 frames.\nWrote {} ({}x{}) and per technique PNG, shadow-buffer EXR and JSON in {}/\n",
+               opt->techniques[0], file.string(), figure.width(), figure.height(), opt->out);
+  });
 }
 
 } // namespace msm::tool

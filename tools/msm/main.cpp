@@ -9,10 +9,16 @@
 int main(int argc, char** argv) {
     CLI::App app{"msm: moment shadow mapping toolkit (filtered, soft and volumetric shadows)"};
     app.require_subcommand(1);
-    msm::tool::add_demo(app);
+    msm::tool::add_kernels(app);
     msm::tool::add_techniques(app);
     msm::tool::add_reconstruct(app);
     msm::tool::add_compare(app);
+#if MSM_TOOL_RENDER
+    msm::tool::add_demo(app);
+    msm::tool::add_bench(app);
+    msm::tool::add_render(app);
+    msm::tool::add_scenes(app);
+#endif
     msm::tool::add_reference(app);
     try {
         app.parse(argc, argv);

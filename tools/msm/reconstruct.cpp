@@ -2,6 +2,9 @@
 // on the command line.
 #include "commands.h"
 #include "msm/cpu/techniques.h"
+#if MSM_TOOL_RENDER
+#include "msm/render/renderer.h"
+#endif
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -11,10 +14,31 @@
 namespace msm::tool {
 
 void add_techniques(CLI::App& app) {
-    auto* cmd = app.add_subcommand("techniques", "List the shadow techniques with their storage cost");
+    auto* cmd = app.add_subcommand("techniques",
+        "List the shadow techniques: storage per texel, where they run (renderer, CPU pipeline), parameters");
     cmd->callback([] {
+        fmt::print("{:<26} {:>4}  {:<12} {}\n", "technique", "bits", "runs in", "description");
+#if MSM_TOOL_RENDER
+        for (const render::Technique& t : render::techniques()) {
+            bool cpu = false;
+            for (const cpu::Technique& c : cpu::techniques()) cpu = cpu || c.name == t.name;
+            fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, cpu ? "render, cpu" : "render",
+                       t.description);
+            if (!t.parameters.empty()) {
+                glm::vec4 p = render::default_params(t);
+                fmt::print("{:<26} {:>4}  {:<12} --param {},{},{},{} ({})\n", "", "", "", p.x, p.y, p.z, p.w,
+                           t.parameters);
+            }
+        }
+        for (const cpu::Technique& t : cpu::techniques()) {
+            bool rendered = false;
+            for (const render::Technique& r : render::techniques()) rendered = rendered || r.name == t.name;
+            if (!rendered) fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, "cpu", t.description);
+        }
+#else
         for (const cpu::Technique& t : cpu::techniques())
-            fmt::print("{:<26} {:>4} bits  {}\n", t.name, t.bits_per_texel, t.description);
+            fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, "cpu", t.description);
+#endif
     });
 }
 

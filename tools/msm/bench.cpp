@@ -1,0 +1,193 @@
+// `msm bench`: GPU time per pass over repeated frames (median and spread), and per technique the
+// cost relative to PCF with the same kernel: shading per pixel at the given resolutions, shadow
+// map (depth, resolve, blur, mips) per texel at the given sizes. JSON and a markdown table.
+#include "render_common.h"
+
+#include "msm/image/io.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <unistd.h>
+
+namespace msm::tool {
+namespace {
+
+struct Stats {
+  double median = 0, p10 = 0, p90 = 0;
+};
+
+Stats stats(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  auto at = [&](double q) { return v[size_t(q * double(v.size() - 1) + 0.5)]; };
+  return {at(0.5), at(0.1), at(0.9)};
+}
+
+// Sum of the named passes per frame, then statistics over the frames.
+Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const std::vector<std::string>& names) {
+  std::vector<double> sums;
+  for (const auto& frame : frames) {
+    double sum = 0;
+    for (const render::PassTime& p : frame)
+      if (std::find(names.begin(), names.end(), p.name) != names.end()) sum += p.ms;
+    sums.push_back(sum);
+  }
+  return stats(sums);
+}
+
+std::pair<int, int> parse_resolution(const std::string& text) {
+  int w = 0, h = 0;
+  if (std::sscanf(text.c_str(), "%dx%d", &w, &h) != 2) throw UsageError(fmt::format("resolution '{}': use WxH", text));
+  return {w, h};
+}
+
+} // namespace
+
+void add_bench(CLI::App& app) {
+  struct Options {
+    FrameOptions frame;
+    std::vector<std::string> techniques;
+    std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
+    std::vector<int> shadow_sizes = {1024, 2048};
+    int frames = 20, warmup = 2;
+    std::string json, markdown;
+  };
+  auto opt = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
+                                          "pixel, shadow map per texel)");
+  cmd->add_option("--techniques", opt->techniques, "Techniques (default: all)")->delimiter(',');
+  cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--shadow-sizes", opt->shadow_sizes, "Shadow map sizes for the shadow-map cost")->delimiter(',')
+      ->capture_default_str();
+  cmd->add_option("--frames", opt->frames, "Timed frames per configuration")->capture_default_str();
+  cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str();
+  cmd->add_option("--json", opt->json, "Write the results as JSON here");
+  cmd->add_option("--markdown", opt->markdown, "Write the results as a markdown table here");
+  add_frame_options(cmd, opt->frame);
+  cmd->callback([opt] {
+    finish_frame_options(opt->frame);
+    if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
+    if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
+    std::vector<std::string> names = opt->techniques;
+    if (names.empty())
+      for (const render::Technique& t : render::techniques()) names.emplace_back(t.name);
+    if (std::find(names.begin(), names.end(), "pcf") == names.end()) names.insert(names.begin(), "pcf");
+    std::vector<std::pair<int, int>> resolutions;
+    for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
+    // Validate every configuration before the first frame.
+    for (const std::string& name : names) {
+      render::RenderSettings s = opt->frame.settings;
+      s.technique = name;
+      try {
+        for (auto [w, h] : resolutions) { s.width = w; s.height = h; s.validate(); }
+        for (int size : opt->shadow_sizes) { s.shadow_size = size; s.validate(); }
+      } catch (const render::RenderError& e) {
+        throw UsageError(e.what());
+      }
+    }
+    scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
+    render::Renderer renderer(*ctx, scene);
+    const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve", "blur", "mipmaps"};
+
+    // A progress line: rewritten in place on a terminal, one line per step in a log.
+    bool tty = isatty(fileno(stderr));
+    auto progress = [&](const std::string& line) {
+      if (tty) fmt::print(stderr, "\r{:<70}", line);
+      else fmt::print(stderr, "{}\n", line);
+    };
+    auto run = [&](render::RenderSettings s) {
+      if (opt->warmup) renderer.time_frames(s, opt->warmup);
+      return renderer.time_frames(s, opt->frames);
+    };
+    nlohmann::json results = nlohmann::json::array();
+    std::map<std::string, std::map<std::string, double>> per_unit; // technique -> config -> ns per unit
+    size_t total = names.size() * (resolutions.size() + opt->shadow_sizes.size()), done = 0;
+    for (const std::string& name : names) {
+      nlohmann::json entry = {{"technique", name}, {"shading", nlohmann::json::object()},
+                              {"shadow_map", nlohmann::json::object()}, {"passes", nlohmann::json::object()}};
+      for (auto [w, h] : resolutions) {
+        render::RenderSettings s = opt->frame.settings;
+        s.technique = name;
+        s.width = w;
+        s.height = h;
+        progress(fmt::format("[{}/{}] {:<26} shading {}x{}", ++done, total, name, w, h));
+        auto frames = run(s);
+        Stats st = pass_sum(frames, {"shading"});
+        std::string key = fmt::format("{}x{}", w, h);
+        double ns = st.median * 1e6 / (double(w) * h);
+        per_unit[name]["shading " + key] = ns;
+        entry["shading"][key] = {{"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_pixel", ns}};
+        if (key == fmt::format("{}x{}", resolutions[0].first, resolutions[0].second))
+          for (const render::PassTime& p : frames[0]) {
+            Stats ps = pass_sum(frames, {p.name});
+            entry["passes"][p.name] = {{"median_ms", ps.median}, {"p10_ms", ps.p10}, {"p90_ms", ps.p90}};
+          }
+      }
+      for (int size : opt->shadow_sizes) {
+        render::RenderSettings s = opt->frame.settings;
+        s.technique = name;
+        s.width = 320; // the shadow-map passes do not depend on the image size
+        s.height = 180;
+        s.shadow_size = size;
+        progress(fmt::format("[{}/{}] {:<26} shadow map {}²", ++done, total, name, size));
+        Stats st = pass_sum(run(s), shadow_passes);
+        std::string key = std::to_string(size);
+        double ns = st.median * 1e6 / (double(size) * size);
+        per_unit[name]["shadow " + key] = ns;
+        entry["shadow_map"][key] = {{"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90},
+                                    {"ns_per_texel", ns}};
+      }
+      results.push_back(entry);
+    }
+    if (tty) fmt::print(stderr, "\r{:<70}\r", "");
+    // Ratios to PCF.
+    for (nlohmann::json& entry : results) {
+      const std::string name = entry["technique"];
+      for (auto& [key, value] : entry["shading"].items())
+        value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
+      for (auto& [key, value] : entry["shadow_map"].items())
+        value["ratio_to_pcf"] = per_unit[name]["shadow " + key] / per_unit["pcf"]["shadow " + key];
+    }
+
+    std::string md = fmt::format("Device: {}. Scene '{}', {} frames per configuration (median; p10–p90 in JSON), "
+                                 "{}x MSAA, {}² Gaussian.\n\n| technique |",
+                                 ctx->info().describe(), scene.name, opt->frames, opt->frame.settings.msaa,
+                                 opt->frame.settings.filter_size);
+    for (auto [w, h] : resolutions) md += fmt::format(" shading {}x{} ms (× PCF) |", w, h);
+    for (int size : opt->shadow_sizes) md += fmt::format(" shadow map {}² ms (× PCF) |", size);
+    md += "\n|---|";
+    for (size_t i = 0; i < resolutions.size() + opt->shadow_sizes.size(); ++i) md += "---:|";
+    md += "\n";
+    for (const nlohmann::json& entry : results) {
+      md += fmt::format("| {} |", entry["technique"].get<std::string>());
+      for (auto [w, h] : resolutions) {
+        const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
+        md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
+      }
+      for (int size : opt->shadow_sizes) {
+        const auto& v = entry["shadow_map"][std::to_string(size)];
+        md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
+      }
+      md += "\n";
+    }
+    fmt::print("{}", md);
+    nlohmann::json doc = {{"device", ctx->info().describe()}, {"scene", scene.name}, {"frames", opt->frames},
+                          {"warmup", opt->warmup}, {"msaa", opt->frame.settings.msaa},
+                          {"filter_size", opt->frame.settings.filter_size}, {"results", results}};
+    auto write = [](const std::string& path, const std::string& text) {
+      try {
+        image::write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+      } catch (const image::ImageError& e) {
+        throw UsageError(e.what());
+      }
+    };
+    if (!opt->json.empty()) write(opt->json, doc.dump(2) + "\n");
+    if (!opt->markdown.empty()) write(opt->markdown, md);
+  });
+}
+
+} // namespace msm::tool

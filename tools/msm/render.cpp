@@ -1,0 +1,89 @@
+// `msm render`: one or more techniques on one scene; `msm scenes`: the built-in scenes.
+#include "render_common.h"
+
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <unistd.h>
+
+namespace msm::tool {
+namespace {
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= list.size()) {
+    size_t end = list.find(',', start);
+    if (end == std::string::npos) end = list.size();
+    if (end > start) out.push_back(list.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
+} // namespace
+
+void add_render(CLI::App& app) {
+  struct Options {
+    FrameOptions frame;
+    std::string techniques = "msm-hamburger-64";
+    std::string out = "msm-render";
+  };
+  auto opt = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
+                                           "EXR and JSON per technique)");
+  cmd->add_option("--technique,-t", opt->techniques,
+                  "Technique, comma-separated list, or 'all' (msm techniques lists them)")->capture_default_str();
+  cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
+  add_frame_options(cmd, opt->frame);
+  cmd->callback([opt] {
+    finish_frame_options(opt->frame);
+    std::vector<std::string> names;
+    if (opt->techniques == "all")
+      for (const render::Technique& t : render::techniques()) names.emplace_back(t.name);
+    else
+      names = split(opt->techniques);
+    if (names.empty()) throw UsageError("--technique: no technique given");
+    for (const std::string& name : names) {
+      render::RenderSettings s = opt->frame.settings;
+      s.technique = name;
+      try {
+        s.validate();
+      } catch (const render::RenderError& e) {
+        throw UsageError(e.what());
+      }
+    }
+    scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    ensure_output_dir(opt->out);
+    std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
+    render::Renderer renderer(*ctx, scene);
+    bool tty = isatty(fileno(stderr));
+    for (size_t i = 0; i < names.size(); ++i) {
+      render::RenderSettings s = opt->frame.settings;
+      s.technique = names[i];
+      render::RenderResult result;
+      try {
+        result = renderer.render(s);
+      } catch (const render::RenderError& e) {
+        throw UsageError(e.what());
+      }
+      write_render(opt->out, names[i], result, render_json(s, scene, *ctx, result));
+      if (names.size() > 1 || tty)
+        fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU -> {}/{}.png\n", i + 1, names.size(), names[i],
+                   result.total_ms, opt->out, names[i]);
+    }
+  });
+}
+
+void add_scenes(CLI::App& app) {
+  auto* cmd = app.add_subcommand("scenes", "List the built-in scenes (each is also scenes/<name>.json)");
+  cmd->callback([] {
+    for (const std::string& name : scene::builtin_scene_names()) {
+      scene::Scene s = scene::builtin_scene(name);
+      fmt::print("{:<10} {:>8} triangles{}\n", name, s.triangle_count(),
+                 name == scene::default_scene_name() ? "  (default)" : "");
+    }
+  });
+}
+
+} // namespace msm::tool

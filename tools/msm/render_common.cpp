@@ -1,0 +1,111 @@
+#include "render_common.h"
+
+#include "msm/image/io.h"
+#include "msm/techniques.h"
+
+#include <fmt/format.h>
+
+#include <fstream>
+#include <unistd.h>
+
+namespace msm::tool {
+
+void add_frame_options(CLI::App* cmd, FrameOptions& o) {
+  render::RenderSettings& s = o.settings;
+  cmd->add_option("--scene", o.scene, "Built-in scene (msm scenes) or scene file")->capture_default_str();
+  cmd->add_option("--width", s.width, "Image width in pixels")->capture_default_str();
+  cmd->add_option("--height", s.height, "Image height in pixels")->capture_default_str();
+  cmd->add_option("--shadow-size", s.shadow_size, "Shadow map texels per side")->capture_default_str();
+  cmd->add_option("--msaa", s.msaa, "Shadow depth samples: 1, 4 or 8")->capture_default_str();
+  cmd->add_option("--filter", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
+  cmd->add_option("--sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
+  cmd->add_flag("--no-mipmaps", o.no_mipmaps, "No mip chain for the moment images");
+  cmd->add_option("--param", o.params, "Technique parameters x,y,z,w (see msm techniques)")->delimiter(',')->expected(4);
+  cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
+  cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
+  cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
+  cmd->add_option("--exposure", s.exposure, "Exposure before tone mapping")->capture_default_str();
+  cmd->add_option("--device", o.device, "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
+}
+
+void finish_frame_options(FrameOptions& o) {
+  if (!o.params.empty()) {
+    if (o.params.size() != 4) throw UsageError("--param takes four comma-separated values");
+    o.settings.params = glm::vec4(o.params[0], o.params[1], o.params[2], o.params[3]);
+  }
+  o.settings.mipmaps = !o.no_mipmaps;
+}
+
+std::unique_ptr<vk::Context> open_device(const std::string& device) {
+  vk::ContextOptions options;
+  options.device = device;
+  options.verbose = false;
+  try {
+    return std::make_unique<vk::Context>(options);
+  } catch (const std::exception& e) {
+    throw UsageError(fmt::format("no usable Vulkan device: {}", e.what()));
+  }
+}
+
+scene::Scene load_scene_or_fail(const std::string& name_or_path) {
+  try {
+    return scene::load_scene(name_or_path);
+  } catch (const scene::SceneError& e) {
+    throw UsageError(e.what());
+  }
+}
+
+void ensure_output_dir(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec || !std::filesystem::is_directory(dir))
+    throw UsageError(fmt::format("{}: cannot create the output directory: {}", dir.string(),
+                                 ec ? ec.message() : "not a directory"));
+  if (access(dir.c_str(), W_OK) != 0)
+    throw UsageError(fmt::format("{}: the output directory is not writable", dir.string()));
+}
+
+nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, const vk::Context& ctx,
+                           const render::RenderResult& result) {
+  const render::Technique& t = render::find_technique(s.technique);
+  glm::vec4 p = s.params ? *s.params : render::default_params(t);
+  bool depth_based = msm_technique_is_depth_based(t.id);
+  nlohmann::json passes = nlohmann::json::object();
+  for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
+  return {{"scene", scene.name},
+          {"scene_source", scene.source.string()},
+          {"technique", s.technique},
+          {"description", t.description},
+          {"bits_per_texel", t.bits_per_texel},
+          {"params", {p.x, p.y, p.z, p.w}},
+          {"params_meaning", t.parameters},
+          {"width", s.width},
+          {"height", s.height},
+          {"shadow_size", s.shadow_size},
+          {"msaa", s.msaa},
+          {"filter_size", s.filter_size},
+          {"filter_sigma", s.filter_sigma},
+          {"mipmaps", s.mipmaps},
+          {"overdarken", s.overdarken},
+          {"normal_offset_texels", s.normal_offset},
+          {"depth_bias", s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f)},
+          {"exposure", s.exposure},
+          {"device", ctx.info().describe()},
+          {"gpu_ms", passes},
+          {"gpu_ms_total", result.total_ms}};
+}
+
+void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
+                  const nlohmann::json& json) {
+  try {
+    image::write_png(dir / (stem + ".png"), result.color);
+    image::write_exr(dir / (stem + ".exr"), result.shadow);
+    std::string text = json.dump(2) + "\n";
+    image::write_file_atomic(dir / (stem + ".json"),
+                             std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  } catch (const image::ImageError& e) {
+    throw UsageError(e.what());
+  }
+}
+
+} // namespace msm::tool

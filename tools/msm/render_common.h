@@ -1,0 +1,49 @@
+// What the rendering subcommands (render, bench, demo) share: the options of a frame, the
+// device, the scene, and writing a render's outputs.
+#pragma once
+
+#include "commands.h"
+#include "msm/render/renderer.h"
+#include "msm/vk/context.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace msm::tool {
+
+struct FrameOptions {
+  render::RenderSettings settings;
+  std::string scene = "fence";   // built-in name or scene file
+  std::string device;             // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
+  std::vector<float> params;      // technique parameter override (4 values)
+  bool no_mipmaps = false;
+};
+
+// --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --param,
+// --overdarken, --normal-offset, --depth-bias, --exposure, --device.
+void add_frame_options(CLI::App* cmd, FrameOptions& options);
+// Applies the parsed options to options.settings; UsageError for bad values.
+void finish_frame_options(FrameOptions& options);
+
+// The Vulkan context (validation with MSM_VALIDATION=1); a failure is a UsageError naming devices.
+std::unique_ptr<vk::Context> open_device(const std::string& device);
+// A built-in scene or a scene file; SceneError becomes a UsageError with the loader's message.
+scene::Scene load_scene_or_fail(const std::string& name_or_path);
+
+// Creates the directory (UsageError if impossible or not writable).
+void ensure_output_dir(const std::filesystem::path& dir);
+
+// Every setting of a render (technique parameters included) and its pass times.
+nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, const vk::Context& ctx,
+                           const render::RenderResult& result);
+
+// <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>.json; each
+// written to a temporary name and renamed.
+void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
+                  const nlohmann::json& json);
+
+} // namespace msm::tool
