@@ -44,6 +44,9 @@ const int MSM_TECH_HAUSDORFF_64 = 17;
 const int MSM_TECH_TMSM_128 = 18;  // trigonometric, 4 x float, [0,1]
 const int MSM_TECH_MSM6_192 = 19;  // six moments, 6 x float, [-1,1]
 const int MSM_TECH_MSM6_96 = 20;   // six moments, 6 x UNORM16 after Θ6*
+// Non-linearly quantized four moments (HPG 2017), [-1,1]: filtered float moments -> Φ -> storage.
+const int MSM_TECH_NL64 = 21;      // RGBA16_UNORM: y1, y2, v2, Ψ4(ξ4)
+const int MSM_TECH_NL32 = 22;      // R32_UINT: folded 10-bit depths, √v2, Ψ4 (HPG §3.5)
 
 struct MsmTexel {
     vec4 a;
@@ -53,8 +56,12 @@ struct MsmTexel {
 // True for the techniques that read the depth map instead of filterable channels.
 MSM_FN bool msm_technique_is_depth_based(int t) { return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF; }
 
+// The non-linear techniques store Φ of the filtered moments: they filter before storage (the
+// one-pass filter) and decode before any interpolation.
+MSM_FN bool msm_technique_is_nonlinear(int t) { return t == MSM_TECH_NL64 || t == MSM_TECH_NL32; }
+
 MSM_FN bool msm_technique_is_signed(int t) {
-    return t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64 || t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128 ||
+    return msm_technique_is_nonlinear(t) || t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64 || t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128 ||
            t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_128 ||
            t == MSM_TECH_HAUSDORFF_64 || t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96;
 }
@@ -93,7 +100,8 @@ MSM_FN MsmTexel msm_technique_generate(int t, float unit_depth, vec4 params) {
     if (t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128) return MsmTexel(msm_evsm4_moments(z, params.y, params.z), zero);
     if (t == MSM_TECH_HAMBURGER_128_UNIT || t == MSM_TECH_HAUSDORFF_128_UNIT)
         return MsmTexel(msm_moments4(unit_depth), zero);
-    if (t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAUSDORFF_128) return MsmTexel(msm_moments4(z), zero);
+    if (t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAUSDORFF_128 || msm_technique_is_nonlinear(t))
+        return MsmTexel(msm_moments4(z), zero);
     if (t == MSM_TECH_HAMBURGER_64_THETA4 || t == MSM_TECH_HAUSDORFF_64_THETA4)
         return MsmTexel(msm_theta4(msm_moments4(unit_depth)), zero);
     if (t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_64) return MsmTexel(msm_theta4_star(msm_moments4(z)), zero);
@@ -105,6 +113,18 @@ MSM_FN MsmTexel msm_technique_generate(int t, float unit_depth, vec4 params) {
     }
     return MsmTexel(vec4(unit_depth, 0.0f, 0.0f, 0.0f), zero); // depth-based: the depth itself
 }
+
+// Non-linear storage of filtered (unbiased, float) moments, and its decoding. The 64-bit texel is
+// the four UNORM16 values of msm_nl_pack64 as floats (k / 65535: an RGBA16_UNORM write stores
+// exactly k).
+MSM_FN vec4 msm_nl64_encode(vec4 filtered) {
+    uvec2 p = msm_nl_pack64(msm_nl_from_filtered(filtered));
+    return vec4(unpackUnorm2x16(p.x), unpackUnorm2x16(p.y));
+}
+MSM_FN NonLinearMoments msm_nl64_decode(vec4 texel) {
+    return msm_nl_unpack64(uvec2(packUnorm2x16(vec2(texel.x, texel.y)), packUnorm2x16(vec2(texel.z, texel.w))));
+}
+MSM_FN uint msm_nl32_encode(vec4 filtered) { return msm_nl_pack32(msm_nl_from_filtered(filtered)); }
 
 MSM_FN float msm_technique_shadow_4moments(int t, vec4 stored, float unit_zf, float alpha) {
     float zf = msm_signed_depth(unit_zf);

@@ -91,9 +91,9 @@ constexpr Technique kTechniques[] = {
     {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", 96, 6, MSM_TECH_MSM6_96, generate<MSM_TECH_MSM6_96>, m6_unorm16,
      shade<MSM_TECH_MSM6_96>},
     {"msm6-64", "Hamburger 6MSM, 6 x 10-bit UNORM after Θ6* (JCGT §5.4.3)", 64, 6, -1, generate<MSM_TECH_MSM6_96>, m6_unorm10, m6_10_shade},
-    {"msm-nl64", "Non-linearly quantized 4MSM, 4 x 16-bit (y1, y2, v2, Ψ4(ξ4)) (HPG 2017)", 64, 4, -1,
+    {"msm-nl64", "Non-linearly quantized 4MSM, 4 x 16-bit (y1, y2, v2, Ψ4(ξ4)) (HPG 2017)", 64, 4, MSM_TECH_NL64,
      moments_signed, nl64_store, nl_shade},
-    {"msm-nl32", "Non-linearly quantized 4MSM, 32-bit packed (HPG 2017)", 32, 4, -1, moments_signed, nl32_store, nl_shade},
+    {"msm-nl32", "Non-linearly quantized 4MSM, 32-bit packed (HPG 2017)", 32, 4, MSM_TECH_NL32, moments_signed, nl32_store, nl_shade},
 };
 
 } // namespace

@@ -1,5 +1,7 @@
 #include "frame_targets.h"
 
+#include "msm/techniques.h"
+
 #include <bit>
 #include <fmt/format.h>
 
@@ -39,11 +41,15 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
                                        .usage = depthUsage, .samples = samples});
 
   VkFormatFeatureFlags blit = VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT;
-  bool can_mip = c.mipmaps;
+  // The non-linear maps are never interpolated by the hardware (and have no mips): they are
+  // decoded first.
+  bool nonlinear = msm_technique_is_nonlinear(c.technique ? c.technique->id : 0);
+  bool can_mip = c.mipmaps && !nonlinear;
   for (int i = 0; i < c.moment_images(); ++i) {
     auto format = VkFormat(c.technique->formats[i]);
-    require(ctx, format, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT,
-            "moment images (storage, linear filtering)");
+    VkFormatFeatureFlags need = VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
+    if (!nonlinear) need |= VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+    require(ctx, format, need, "moment images (storage, sampling)");
     can_mip = can_mip && has(ctx, format, blit);
   }
   mip_levels = can_mip ? uint32_t(std::bit_width(shadow)) : 1u;
@@ -55,7 +61,7 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
               .mipLevels = mip_levels});
     moments_mip0[size_t(i)] = vk::createImageView(ctx, moments[size_t(i)].handle(), moments[size_t(i)].format(),
                                                   VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);
-    if (c.taps > 1)
+    if (c.taps > 1 && !c.one_pass)
       blur_temp[size_t(i)] = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_R32G32B32A32_SFLOAT,
                                                    .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
   }

@@ -13,6 +13,7 @@ struct FrameConfig {
   const Technique* technique = nullptr;
   int width = 0, height = 0, shadow_size = 0, msaa = 1, taps = 1;
   bool mipmaps = true;
+  bool one_pass = false;   // one_pass_filter instead of moment_resolve + blur
   bool operator==(const FrameConfig&) const = default;
   int moment_images() const; // 0 (depth-based), 1 or 2 (6MSM)
 };

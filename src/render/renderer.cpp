@@ -4,6 +4,7 @@
 
 #include "frame_targets.h"
 #include "gpu_scene.h"
+#include "msm/render/blue_noise.h"
 #include "msm/render/frame.h"
 #include "msm/techniques.h"
 #include "passes/pass.h"
@@ -14,11 +15,12 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <tuple>
 
 namespace msm::render {
 
 // std140 and the C++ struct agree (frame.h uses vec4/ivec4/mat4 members only).
-static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 4 * 16);
+static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 16 + 4 * 16);
 static_assert(offsetof(FrameUniforms, kernel) == 3 * 64 + 6 * 16);
 static_assert(offsetof(FrameUniforms, filter_weights) == 3 * 64 + 7 * 16);
 static_assert(sizeof(ObjectPush) == 32 && sizeof(ImagePassPush) == 16);
@@ -81,6 +83,8 @@ struct Renderer::Impl {
   std::map<int, std::unique_ptr<ShadowDepthPass>> shadow_passes;
   std::map<std::pair<int, int>, std::unique_ptr<MomentResolvePass>> resolve_passes;
   std::map<std::pair<int, int>, std::unique_ptr<ShadingPass>> shading_passes;
+  std::map<std::tuple<int, int, int>, std::unique_ptr<OnePassFilterPass>> one_pass_passes;
+  vk::Image noise;
   std::unique_ptr<BlurPass> blur_pass;
   std::unique_ptr<vk::Program> depth_copy;
   MipmapPass mipmap_pass;
@@ -88,7 +92,18 @@ struct Renderer::Impl {
   Impl(const vk::Context& c, const scene::Scene& s)
       : ctx(c), scene(s), gpu(c, s), light_view_projection(s.light_view_projection()),
         uniforms(vk::createBuffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::Host)),
-        timer(c, 16) {}
+        timer(c, 16), noise(upload_blue_noise(c)) {}
+
+  static vk::Image upload_blue_noise(const vk::Context& ctx) {
+    const BlueNoise& n = blue_noise();
+    if (n.size != 64 || n.channels != 2) throw RenderError("blue noise: expected 64² textures with two channels");
+    vk::Image image = vk::createImage(ctx, {.width = 64, .height = 64, .format = VK_FORMAT_R8G8_UNORM,
+                                            .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                            .layers = uint32_t(n.count)});
+    vk::uploadImage(ctx, image, std::as_bytes(std::span(n.texels)), VK_IMAGE_LAYOUT_UNDEFINED,
+                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    return image;
+  }
 
   template <class Map, class Key, class Make> auto& cached(Map& map, const Key& key, Make make) {
     auto it = map.find(key);
@@ -123,6 +138,18 @@ struct Renderer::Impl {
     for (int k = 0; k < s.filter_size; ++k) u.filter_weights[k / 4][k % 4] = float(w[size_t(k)] / sum);
     std::vector<glm::vec2> offsets =
         ctx.properties().limits.standardSampleLocations ? standard_sample_offsets(s.msaa) : std::vector<glm::vec2>(8);
+    bool nonlinear = msm_technique_is_nonlinear(technique.id);
+    int lookup = s.lookup == RenderSettings::Lookup::nearest    ? MSM_LOOKUP_NEAREST
+                 : s.lookup == RenderSettings::Lookup::dither   ? MSM_LOOKUP_DITHER
+                 : s.lookup == RenderSettings::Lookup::bilinear ? MSM_LOOKUP_BILINEAR
+                 : nonlinear                                    ? MSM_LOOKUP_DITHER
+                                                                : MSM_LOOKUP_BILINEAR;
+    // A different blue-noise layer and offset each frame (a fixed hash of the frame number).
+    uint32_t h = uint32_t(s.frame) * 2654435761u + 0x9e3779b9u;
+    h ^= h >> 15;
+    h *= 2246822519u;
+    h ^= h >> 13;
+    u.lookup = glm::ivec4(lookup, int(h % uint32_t(blue_noise().count)), int((h >> 8) & 63u), int((h >> 16) & 63u));
     for (size_t i = 0; i < offsets.size(); ++i) {
       u.sample_offsets[i / 2][int(2 * (i % 2))] = offsets[i].x;
       u.sample_offsets[i / 2][int(2 * (i % 2) + 1)] = offsets[i].y;
@@ -142,13 +169,17 @@ struct Renderer::Impl {
         uint32_t(s.shadow_size) > ctx.properties().limits.maxImageDimension2D)
       throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
                                     ctx.properties().limits.maxImageDimension2D));
-    FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps};
+    bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(technique.id));
+    FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps, one_pass};
     if (!targets || !(targets->config == config)) {
       targets.reset();
       targets = std::make_unique<FrameTargets>(ctx, config);
     }
     cached(shadow_passes, s.msaa, [&] { return std::make_unique<ShadowDepthPass>(ctx, s.msaa); });
-    if (config.moment_images()) {
+    if (one_pass) {
+      cached(one_pass_passes, std::tuple(technique.id, s.msaa, s.filter_size),
+             [&] { return std::make_unique<OnePassFilterPass>(ctx, technique, s.msaa, s.filter_size); });
+    } else if (config.moment_images()) {
       cached(resolve_passes, std::pair(technique.id, s.msaa),
              [&] { return std::make_unique<MomentResolvePass>(ctx, technique, s.msaa); });
       if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
@@ -163,9 +194,13 @@ struct Renderer::Impl {
   // Records the passes; `until_resolve` stops after the moment resolve (intermediates).
   void record(VkCommandBuffer cmd, const RenderSettings& s, const Technique& technique, bool until_resolve) {
     timer.reset(cmd);
-    FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms};
+    FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms, noise};
     shadow_passes.at(s.msaa)->execute(f);
-    if (targets->config.moment_images()) {
+    if (targets->config.one_pass) {
+      one_pass_passes.at({technique.id, s.msaa, s.filter_size})->execute(f);
+      if (until_resolve) return;
+      mipmap_pass.execute(f);
+    } else if (targets->config.moment_images()) {
       resolve_passes.at({technique.id, s.msaa})->execute(f);
       if (until_resolve) return;
       if (s.filter_size > 1) blur_pass->execute(f);
@@ -212,6 +247,11 @@ struct Renderer::Impl {
     }
     for (int i = 0; i < targets->config.moment_images(); ++i) {
       std::vector<std::byte> bytes = vk::readbackImage(ctx, targets->moments[size_t(i)], VK_IMAGE_LAYOUT_GENERAL);
+      if (technique.formats[size_t(i)] == VK_FORMAT_R32_UINT) {
+        out.packed.resize(size_t(size) * size);
+        std::memcpy(out.packed.data(), bytes.data(), out.packed.size() * 4);
+        continue;
+      }
       (i == 0 ? out.moments : out.moments1) = to_float_image(bytes, VkFormat(technique.formats[size_t(i)]), size, size);
     }
   }
@@ -229,7 +269,7 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   RenderResult r;
   r.passes = m.read_times();
   for (const PassTime& p : r.passes) r.total_ms += p.ms;
-  if (intermediates && m.targets->config.moment_images())
+  if (intermediates && m.targets->config.moment_images() && technique.formats[0] != VK_FORMAT_R32_UINT)
     intermediates->filtered = to_float_image(vk::readbackImage(m.ctx, m.targets->moments[0],
                                                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL),
                                              VkFormat(technique.formats[0]), s.shadow_size, s.shadow_size);

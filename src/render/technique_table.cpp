@@ -56,6 +56,10 @@ constexpr Technique kTechniques[] = {
      {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kMoment},
     {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", MSM_TECH_MSM6_96, 96,
      {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM}, kMoment},
+    {"msm-nl64", "Non-linearly quantized 4MSM, RGBA16 UNORM (y1, y2, v2, Ψ4(ξ4)), one-pass filter, dithered lookup "
+                 "(HPG 2017)", MSM_TECH_NL64, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, ""},
+    {"msm-nl32", "Non-linearly quantized 4MSM, R32 UINT (folded 10-bit depths, √v2, Ψ4), one-pass filter, dithered "
+                 "lookup (HPG 2017)", MSM_TECH_NL32, 32, {VK_FORMAT_R32_UINT, kNone}, ""},
 };
 
 } // namespace
@@ -94,6 +98,17 @@ void RenderSettings::validate() const {
   finite("normal offset", normal_offset, 0.0f, 100.0f);
   finite("exposure", exposure, 1e-6f, 1e6f);
   if (depth_bias) finite("depth bias", *depth_bias, -1.0f, 1.0f);
+  const Technique& t = find_technique(technique);
+  bool nonlinear = msm_technique_is_nonlinear(t.id);
+  if (one_pass && !*one_pass && nonlinear)
+    throw RenderError(fmt::format("{} needs the one-pass filter (it stores Φ of the filtered moments)", technique));
+  bool uses_one_pass = one_pass.value_or(nonlinear);
+  if (uses_one_pass && (t.formats[0] == 0 || t.formats[1] != 0))
+    throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
+  if (uses_one_pass && filter_size > kMaxOnePassTaps)
+    throw RenderError(fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size,
+                                  kMaxOnePassTaps));
+  if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
   if (params)
     for (int i = 0; i < 4; ++i)
       if (!std::isfinite((*params)[i])) throw RenderError("technique parameters must be finite");

@@ -1,5 +1,5 @@
-// `msm demo` (what `make demo` runs): the default scene with PCF, VSM, EVSM4, MSM 64 and MSM 128
-// side by side in one labelled image with magnified insets where they differ, and a table of the
+// `msm demo` (what `make demo` runs): the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and
+// the non-linearly quantized MSM at 64 and 32 bits side by side in one labelled image with magnified insets where they differ, and a table of the
 // error against the PCF reference and the GPU time per pass.
 #include "render_common.h"
 
@@ -19,14 +19,15 @@ void add_demo(CLI::App& app) {
   struct Options {
     FrameOptions frame;
     std::string out = "msm-demo";
-    std::vector<std::string> techniques = {"pcf", "vsm-32", "evsm4-64", "msm-hamburger-64", "msm-hamburger-128"};
+    std::vector<std::string> techniques = {"pcf",          "vsm-32",   "evsm4-64", "msm-hamburger-64", "msm-hamburger-128",
+                                           "msm-nl64", "msm-nl32"};
   };
   auto opt = std::make_shared<Options>();
   opt->frame.settings.width = 960;
   opt->frame.settings.height = 540;
   opt->frame.scene = std::string(scene::default_scene_name());
-  auto* cmd = app.add_subcommand("demo", "Render the default scene with PCF, VSM, EVSM4, MSM 64 and MSM 128 into one "
-                                         "comparison image, and print the error against PCF and the time per pass");
+  auto* cmd = app.add_subcommand("demo", "Render the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the "
+                                         "non-linear MSM 64/32 into one comparison image, and print the error against PCF and the time per pass");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--techniques", opt->techniques, "Techniques to compare (the first is the reference)")
       ->delimiter(',');

@@ -25,6 +25,11 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
   cmd->add_option("--exposure", s.exposure, "Exposure before tone mapping")->capture_default_str();
+  cmd->add_option("--lookup", o.lookup, "Shadow-map lookup: auto (dither for msm-nl*, else bilinear), bilinear, "
+                                         "nearest, dither")->capture_default_str();
+  cmd->add_option("--filter-mode", o.filter_mode, "auto (one-pass for msm-nl*), one-pass (resolve + blur in shared "
+                                                  "memory), three-pass (resolve, blur H, blur V)")->capture_default_str();
+  cmd->add_option("--frame", s.frame, "Frame number (blue-noise layer and offset)")->capture_default_str();
   cmd->add_option("--device", o.device, "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
 }
 
@@ -34,6 +39,16 @@ void finish_frame_options(FrameOptions& o) {
     o.settings.params = glm::vec4(o.params[0], o.params[1], o.params[2], o.params[3]);
   }
   o.settings.mipmaps = !o.no_mipmaps;
+  using Lookup = render::RenderSettings::Lookup;
+  if (o.lookup == "auto") o.settings.lookup = Lookup::automatic;
+  else if (o.lookup == "bilinear") o.settings.lookup = Lookup::bilinear;
+  else if (o.lookup == "nearest") o.settings.lookup = Lookup::nearest;
+  else if (o.lookup == "dither") o.settings.lookup = Lookup::dither;
+  else throw UsageError(fmt::format("--lookup {}: use auto, bilinear, nearest or dither", o.lookup));
+  if (o.filter_mode == "one-pass") o.settings.one_pass = true;
+  else if (o.filter_mode == "three-pass") o.settings.one_pass = false;
+  else if (o.filter_mode != "auto")
+    throw UsageError(fmt::format("--filter-mode {}: use auto, one-pass or three-pass", o.filter_mode));
 }
 
 std::unique_ptr<vk::Context> open_device(const std::string& device) {
@@ -90,6 +105,13 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"normal_offset_texels", s.normal_offset},
           {"depth_bias", s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f)},
           {"exposure", s.exposure},
+          {"lookup", s.lookup == render::RenderSettings::Lookup::bilinear  ? "bilinear"
+                     : s.lookup == render::RenderSettings::Lookup::nearest ? "nearest"
+                     : s.lookup == render::RenderSettings::Lookup::dither  ? "dither"
+                     : msm_technique_is_nonlinear(t.id)                     ? "dither (auto)"
+                                                                            : "bilinear (auto)"},
+          {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
+          {"frame", s.frame},
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
           {"gpu_ms_total", result.total_ms}};

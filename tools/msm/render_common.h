@@ -21,6 +21,8 @@ struct FrameOptions {
   std::string device;             // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
   std::vector<float> params;      // technique parameter override (4 values)
   bool no_mipmaps = false;
+  std::string lookup = "auto";    // auto, bilinear, nearest, dither
+  std::string filter_mode = "auto"; // auto, one-pass, three-pass
 };
 
 // --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --param,

@@ -24,9 +24,16 @@ struct FrameUniforms {
     vec4 background;                 // rgb: linear colour of pixels without a surface
     ivec4 kernel;                    // x: taps per axis (odd), y: MSAA samples, z: radius, w: unused
     vec4 filter_weights[16];         // normalized 1D Gaussian weights, tap k at [k / 4][k % 4]
+    ivec4 lookup;                    // x: shadow-map lookup (MSM_LOOKUP_*), y: blue-noise layer,
+                                     // zw: blue-noise offset in pixels (per frame)
     vec4 sample_offsets[4];          // MSAA sample positions relative to the texel centre, in
                                      // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
 };
+
+// How the shading reads a filtered shadow map.
+const int MSM_LOOKUP_BILINEAR = 0; // hardware (tri)linear; for the non-linear maps: four decodes
+const int MSM_LOOKUP_NEAREST = 1;  // the texel under the fragment, mip 0
+const int MSM_LOOKUP_DITHER = 2;   // nearest after a blue-noise offset of up to half a texel (HPG)
 
 // Per draw of the shading pass (push constants).
 struct ObjectPush {

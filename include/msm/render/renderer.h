@@ -5,6 +5,7 @@
 //   moment_resolve depth samples -> the technique's channels per sample, averaged, in the
 //                  storage basis (compute); skipped by the depth-based techniques
 //   blur           separable Gaussian (taps x taps, sigma in texels) -> moment images; then mips
+//   (or one_pass_filter: resolve + blur in shared memory + storage in one dispatch; HPG 2017)
 //   shading        Lambert + ambient with the technique's shadow, over-darkening, tone mapping,
 //                  sRGB; plus the shadow buffer (visibility of the visible surface per pixel)
 //
@@ -21,6 +22,7 @@
 #include <glm/glm.hpp>
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
@@ -62,6 +64,7 @@ inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxImagePixels = 64ll << 20; // 64 Mpixels
 inline constexpr int kMaxShadowSize = 8192;
 inline constexpr int kMaxFilterTaps = 63;                // MSM_MAX_FILTER_TAPS
+inline constexpr int kMaxOnePassTaps = 17;               // radius 8 in one_pass_filter.glsl
 
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
@@ -78,6 +81,15 @@ struct RenderSettings {
                                    // 2e-5 for the depth-based techniques (16-bit depth rounding),
                                    // 0 for the others (moment biasing does their work)
   float exposure = 1.0f;
+  // How the shading reads a filtered map: automatic = dither for the non-linear techniques (HPG),
+  // bilinear for the others; nearest = the texel under the fragment (mip 0); bilinear for the
+  // non-linear maps = four decodes, moments interpolated, Φ again.
+  enum class Lookup { automatic, bilinear, nearest, dither } lookup = Lookup::automatic;
+  // The one-pass filter (resolve + blur in shared memory, then storage) instead of resolve, blur
+  // H, blur V through device memory. Default: on for the non-linear techniques (they need it),
+  // off for the others; not for 6MSM; at most 17 taps.
+  std::optional<bool> one_pass;
+  int frame = 0;                   // frame number: picks the blue-noise layer and offset
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;
 };
@@ -100,7 +112,9 @@ struct RenderResult {
 // the blur), read back when requested.
 struct Intermediates {
   std::vector<float> depth_samples; // shadow_size² x msaa, sample-major per texel, row-major
-  image::Image moments;             // resolve output of image 0 (as stored: UNORM/half/float)
+  image::Image moments;             // resolve output of image 0 (as stored: UNORM/half/float);
+                                    // with the one-pass filter: its (filtered, encoded) output
+  std::vector<std::uint32_t> packed; // R32_UINT maps (msm-nl32): the texels as stored
   image::Image moments1;            // of image 1 (6MSM), else empty
   image::Image filtered;            // image 0 after blur (mip 0)
 };

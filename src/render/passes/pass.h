@@ -24,6 +24,7 @@ struct FrameContext {
   const FrameTargets& targets;
   const GpuScene& scene;
   const vk::Buffer& uniforms; // FrameUniforms
+  const vk::Image& blue_noise; // 64 layers of 64² RG8 (blue_noise.h)
 };
 
 // Scene -> shadow_depth (D16, MSAA), left SHADER_READ_ONLY for compute and fragment reads.
@@ -42,6 +43,19 @@ class MomentResolvePass {
 public:
   static const PassDecl& decl();
   MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa);
+  void execute(FrameContext& f) const;
+
+private:
+  vk::Program program_;
+};
+
+// shadow_depth -> moments mip 0 (GENERAL) in one dispatch: resolve, Gaussian in shared memory,
+// encoding (HPG 2017 §4); visible to transfer, compute and fragment reads. One per technique,
+// MSAA and filter radius (specialization constants).
+class OnePassFilterPass {
+public:
+  static const PassDecl& decl();
+  OnePassFilterPass(const vk::Context& ctx, const Technique& technique, int msaa, int taps);
   void execute(FrameContext& f) const;
 
 private:
@@ -75,7 +89,7 @@ public:
 
 private:
   vk::Program program_;
-  bool depth_based_;
+  bool depth_based_, nonlinear_;
 };
 
 // Scope guard for the timer scope of a pass.

@@ -13,10 +13,13 @@ namespace {
 
 vk::GraphicsDesc shading_desc(const Technique& technique, int msaa) {
   bool depth_based = msm_technique_is_depth_based(technique.id);
+  std::string fragment = depth_based                        ? (msaa == 1 ? "shading_depth_1x.frag" : "shading_depth.frag")
+                         : technique.id == MSM_TECH_NL64 ? "shading_nl64.frag"
+                         : technique.id == MSM_TECH_NL32 ? "shading_nl32.frag"
+                                                         : "shading_moments.frag";
   vk::GraphicsDesc d{.name = std::string("shading ") + std::string(technique.name),
                      .vertexShader = "shading.vert",
-                     .fragmentShader = depth_based ? (msaa == 1 ? "shading_depth_1x.frag" : "shading_depth.frag")
-                                                   : "shading_moments.frag",
+                     .fragmentShader = fragment,
                      .bindings = {vk::Binding::UniformBuffer, vk::Binding::SampledImage, vk::Binding::SampledImage},
                      .pushConstantSize = sizeof(ObjectPush),
                      .vertexStride = sizeof(Vertex),
@@ -26,7 +29,10 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa) {
                      .colorFormats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32_SFLOAT},
                      .depthFormat = VK_FORMAT_D32_SFLOAT,
                      .constants = {{0, uint32_t(technique.id)}}};
-  if (!depth_based) d.bindings.push_back(vk::Binding::SampledImage);
+  if (!depth_based) { // second moment image, blue noise
+    d.bindings.push_back(vk::Binding::SampledImage);
+    d.bindings.push_back(vk::Binding::SampledImage);
+  }
   return d;
 }
 
@@ -34,7 +40,8 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa) {
 
 ShadingPass::ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa)
     : program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa))),
-      depth_based_(msm_technique_is_depth_based(technique.id)) {}
+      depth_based_(msm_technique_is_depth_based(technique.id)),
+      nonlinear_(msm_technique_is_nonlinear(technique.id)) {}
 
 void ShadingPass::execute(FrameContext& f) const {
   PassScope scope(f, decl());
@@ -67,8 +74,15 @@ void ShadingPass::execute(FrameContext& f) const {
   vk::Descriptor shadow0 = depth_based_
                                ? vk::Descriptor(t.shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                                 t.point_sampler)
-                               : vk::Descriptor(t.moments[0], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler);
-  const vk::Image& second = t.config.moment_images() > 1 ? t.moments[1] : t.moments[0];
+                               : vk::Descriptor(t.moments[0], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                                nonlinear_ ? t.point_sampler : t.moment_sampler);
+  // The second image of 6MSM; the others bind something valid of the declared type (float).
+  vk::Descriptor second = t.config.moment_images() > 1
+                              ? vk::Descriptor(t.moments[1], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler)
+                          : nonlinear_ ? vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                                        t.point_sampler)
+                                       : shadow0;
+  vk::Descriptor noise(f.blue_noise.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
   for (const Draw& d : f.scene.draws) {
     const vk::Image& texture = d.texture >= 0 ? f.scene.textures[size_t(d.texture)] : f.scene.white;
     vk::Descriptor albedo(texture.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler);
@@ -76,10 +90,7 @@ void ShadingPass::execute(FrameContext& f) const {
     if (depth_based_)
       vk::bindProgram(f.cmd, program_, {vk::Descriptor(f.uniforms), albedo, shadow0}, d.push);
     else
-      vk::bindProgram(f.cmd, program_,
-                      {vk::Descriptor(f.uniforms), albedo, shadow0,
-                       vk::Descriptor(second, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler)},
-                      d.push);
+      vk::bindProgram(f.cmd, program_, {vk::Descriptor(f.uniforms), albedo, shadow0, second, noise}, d.push);
     vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
   }
   vkCmdEndRendering(f.cmd);

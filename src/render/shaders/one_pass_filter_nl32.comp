@@ -1,0 +1,4 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define MSM_NL32 1
+#include "one_pass_filter.glsl"

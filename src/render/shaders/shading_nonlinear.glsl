@@ -1,0 +1,33 @@
+// Shading with the non-linearly quantized maps (HPG 2017): decode, then Algorithm 3. Their
+// texels cannot be interpolated as stored: nearest and dithered lookups decode one texel; the
+// true bilinear lookup decodes four, converts each back to moments (Eq. 4), interpolates those
+// and applies Φ again.
+#ifdef MSM_NL32
+layout(binding = 2) uniform usampler2D moments0;
+#else
+layout(binding = 2) uniform sampler2D moments0;
+#endif
+layout(binding = 3) uniform sampler2D unused_second_image; // the shading layout of every filtered technique
+#include "shading.glsl"
+#include "lookup.glsl"
+
+NonLinearMoments decode(ivec2 i) {
+#ifdef MSM_NL32
+  return msm_nl_unpack32(texelFetch(moments0, i, 0).x);
+#else
+  return msm_nl64_decode(texelFetch(moments0, i, 0));
+#endif
+}
+
+float shadow_intensity(ShadowLookup s) {
+  float zf = msm_signed_depth(s.z);
+  if (frame.lookup.x != MSM_LOOKUP_BILINEAR) {
+    ivec2 i = lookup_texel(s.t);
+    return msm_nl_shadow(decode(i), msm_signed_depth(receiver_depth_at(s, i)));
+  }
+  Bilinear b = bilinear_texels(s.t);
+  vec4 m00 = msm_nl_moments_from(decode(b.i0)), m10 = msm_nl_moments_from(decode(ivec2(b.i1.x, b.i0.y)));
+  vec4 m01 = msm_nl_moments_from(decode(ivec2(b.i0.x, b.i1.y))), m11 = msm_nl_moments_from(decode(b.i1));
+  vec4 m = mix(mix(m00, m10, b.f.x), mix(m01, m11, b.f.x), b.f.y);
+  return msm_nl_shadow(msm_nl_from_moments(m), zf);
+}
