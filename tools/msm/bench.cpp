@@ -79,8 +79,7 @@ void add_bench(CLI::App& app) {
     for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
     // Validate every configuration before the first frame.
     for (const std::string& name : names) {
-      render::RenderSettings s = opt->frame.settings;
-      s.technique = name;
+      render::RenderSettings s = settings_for(opt->frame, name);
       try {
         for (auto [w, h] : resolutions) { s.width = w; s.height = h; s.validate(); }
         for (int size : opt->shadow_sizes) { s.shadow_size = size; s.validate(); }
@@ -111,8 +110,7 @@ void add_bench(CLI::App& app) {
       nlohmann::json entry = {{"technique", name}, {"shading", nlohmann::json::object()},
                               {"shadow_map", nlohmann::json::object()}, {"passes", nlohmann::json::object()}};
       for (auto [w, h] : resolutions) {
-        render::RenderSettings s = opt->frame.settings;
-        s.technique = name;
+        render::RenderSettings s = settings_for(opt->frame, name);
         s.width = w;
         s.height = h;
         progress(fmt::format("[{}/{}] {:<26} shading {}x{}", ++done, total, name, w, h));
@@ -129,8 +127,7 @@ void add_bench(CLI::App& app) {
           }
       }
       for (int size : opt->shadow_sizes) {
-        render::RenderSettings s = opt->frame.settings;
-        s.technique = name;
+        render::RenderSettings s = settings_for(opt->frame, name);
         s.width = 320; // the shadow-map passes do not depend on the image size
         s.height = 180;
         s.shadow_size = size;

@@ -36,8 +36,7 @@ void add_demo(CLI::App& app) {
     finish_frame_options(opt->frame);
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
     for (const std::string& name : opt->techniques) {
-      render::RenderSettings s = opt->frame.settings;
-      s.technique = name;
+      render::RenderSettings s = settings_for(opt->frame, name);
       try {
         s.validate();
       } catch (const render::RenderError& e) {
@@ -57,8 +56,7 @@ void add_demo(CLI::App& app) {
     std::vector<render::RenderResult> results;
     std::vector<image::Image> signals;
     for (size_t i = 0; i < opt->techniques.size(); ++i) {
-      render::RenderSettings s = opt->frame.settings;
-      s.technique = opt->techniques[i];
+      render::RenderSettings s = settings_for(opt->frame, opt->techniques[i]);
       if (tty) fmt::print(stderr, "\r[{}/{}] {:<26}", i + 1, opt->techniques.size(), s.technique);
       results.push_back(renderer.render(s));
       // The table shows the median of a few more frames: the first one pays for warming up.

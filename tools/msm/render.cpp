@@ -45,8 +45,7 @@ void add_render(CLI::App& app) {
       names = split(opt->techniques);
     if (names.empty()) throw UsageError("--technique: no technique given");
     for (const std::string& name : names) {
-      render::RenderSettings s = opt->frame.settings;
-      s.technique = name;
+      render::RenderSettings s = settings_for(opt->frame, name);
       try {
         s.validate();
       } catch (const render::RenderError& e) {
@@ -59,8 +58,7 @@ void add_render(CLI::App& app) {
     render::Renderer renderer(*ctx, scene);
     bool tty = isatty(fileno(stderr));
     for (size_t i = 0; i < names.size(); ++i) {
-      render::RenderSettings s = opt->frame.settings;
-      s.technique = names[i];
+      render::RenderSettings s = settings_for(opt->frame, names[i]);
       render::RenderResult result;
       try {
         result = renderer.render(s);

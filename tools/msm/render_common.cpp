@@ -51,6 +51,18 @@ void finish_frame_options(FrameOptions& o) {
     throw UsageError(fmt::format("--filter-mode {}: use auto, one-pass or three-pass", o.filter_mode));
 }
 
+render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique) {
+  render::RenderSettings s = options.settings;
+  s.technique = technique;
+  try {
+    const render::Technique& t = render::find_technique(technique);
+    if (s.one_pass && *s.one_pass && (t.formats[0] == 0 || t.formats[1] != 0)) s.one_pass.reset();
+  } catch (const render::RenderError&) {
+    // validate() reports the unknown name
+  }
+  return s;
+}
+
 std::unique_ptr<vk::Context> open_device(const std::string& device) {
   vk::ContextOptions options;
   options.device = device;

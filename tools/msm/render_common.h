@@ -31,6 +31,10 @@ void add_frame_options(CLI::App* cmd, FrameOptions& options);
 // Applies the parsed options to options.settings; UsageError for bad values.
 void finish_frame_options(FrameOptions& options);
 
+// The frame settings for one technique: --filter-mode one-pass applies to the techniques with one
+// moment image (the depth-based ones and 6MSM keep their own pipeline).
+render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique);
+
 // The Vulkan context (validation with MSM_VALIDATION=1); a failure is a UsageError naming devices.
 std::unique_ptr<vk::Context> open_device(const std::string& device);
 // A built-in scene or a scene file; SceneError becomes a UsageError with the loader's message.
