@@ -203,7 +203,15 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
                 float* c = rad + (std::size_t(y) * W + x) * 3;
                 SurfaceHit hit;
                 ++row_rays;
-                if (!tracer.closest(near, dir, length, hit)) {
+                // The visible surface is the closest opaque one: translucent surfaces (opacity
+                // < 1) are looked through, as the renderer's shadow buffer does.
+                bool found = tracer.closest(near, dir, length, hit);
+                for (int crossed = 0; found && tracer.material(hit).opacity < 1.0f && crossed < kMaxCrossings; ++crossed) {
+                    const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
+                    found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
+                    ++row_rays;
+                }
+                if (!found) {
                     v[0] = 1.0f;
                     v[1] = 1.0f;
                     ++row_background[y];

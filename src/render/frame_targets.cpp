@@ -23,9 +23,33 @@ bool has(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags features)
 
 } // namespace
 
+namespace {
+VkFormat two_channels(VkFormat f) {
+  switch (f) {
+  case VK_FORMAT_R16G16B16A16_UNORM: return VK_FORMAT_R16G16_UNORM;
+  case VK_FORMAT_R16G16B16A16_SFLOAT: return VK_FORMAT_R16G16_SFLOAT;
+  case VK_FORMAT_R32G32B32A32_SFLOAT: return VK_FORMAT_R32G32_SFLOAT;
+  default: return VK_FORMAT_UNDEFINED;
+  }
+}
+} // namespace
+
+bool FrameConfig::split_rg() const {
+  return translucent && technique && two_channels(VkFormat(technique->formats[0])) != VK_FORMAT_UNDEFINED;
+}
+
+std::array<int, 2> FrameConfig::formats() const {
+  if (!technique) return {0, 0};
+  if (split_rg()) {
+    int f = two_channels(VkFormat(technique->formats[0]));
+    return {f, f};
+  }
+  return technique->formats;
+}
+
 int FrameConfig::moment_images() const {
-  if (!technique) return 0;
-  return (technique->formats[0] != 0) + (technique->formats[1] != 0);
+  std::array<int, 2> f = formats();
+  return (f[0] != 0) + (f[1] != 0);
 }
 
 VkExtent2D extent(const vk::Image& image) { return {image.width(), image.height()}; }
@@ -46,18 +70,20 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
   bool nonlinear = msm_technique_is_nonlinear(c.technique ? c.technique->id : 0);
   bool can_mip = c.mipmaps && !nonlinear;
   for (int i = 0; i < c.moment_images(); ++i) {
-    auto format = VkFormat(c.technique->formats[i]);
+    auto format = VkFormat(c.formats()[size_t(i)]);
     VkFormatFeatureFlags need = VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
     if (!nonlinear) need |= VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+    if (c.translucent) need |= VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT | VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT;
     require(ctx, format, need, "moment images (storage, sampling)");
     can_mip = can_mip && has(ctx, format, blit);
   }
   mip_levels = can_mip ? uint32_t(std::bit_width(shadow)) : 1u;
   for (int i = 0; i < c.moment_images(); ++i) {
     moments[size_t(i)] = vk::createImage(
-        ctx, {.width = shadow, .height = shadow, .format = VkFormat(c.technique->formats[i]),
+        ctx, {.width = shadow, .height = shadow, .format = VkFormat(c.formats()[size_t(i)]),
               .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                       VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                       VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                       (c.translucent ? VkImageUsageFlags(VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) : 0u),
               .mipLevels = mip_levels});
     moments_mip0[size_t(i)] = vk::createImageView(ctx, moments[size_t(i)].handle(), moments[size_t(i)].format(),
                                                   VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);

@@ -14,8 +14,13 @@ struct FrameConfig {
   int width = 0, height = 0, shadow_size = 0, msaa = 1, taps = 1;
   bool mipmaps = true;
   bool one_pass = false;   // one_pass_filter instead of moment_resolve + blur
+  // Translucent occluders are blended into the map (JCGT §3): a four-channel technique then
+  // stores its moments as two RG images, because the blend factor is the fragment's alpha.
+  bool translucent = false;
   bool operator==(const FrameConfig&) const = default;
-  int moment_images() const; // 0 (depth-based), 1 or 2 (6MSM)
+  bool split_rg() const;          // translucent and four channels in one image
+  std::array<int, 2> formats() const; // of the moment images as allocated
+  int moment_images() const; // 0 (depth-based), 1 or 2 (6MSM, split_rg)
 };
 
 struct FrameTargets {

@@ -1,5 +1,6 @@
 #include "gpu_scene.h"
 
+#include <algorithm>
 #include <map>
 
 namespace msm::render {
@@ -13,22 +14,44 @@ vk::Image upload_rgba8(const vk::Context& ctx, int width, int height, std::span<
   return image;
 }
 
+vk::Image upload_r8(const vk::Context& ctx, int width, int height, std::span<const std::uint8_t> texels) {
+  vk::Image image = vk::createImage(ctx, {.width = uint32_t(width), .height = uint32_t(height),
+                                          .format = VK_FORMAT_R8_UNORM,
+                                          .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  vk::uploadImage(ctx, image, std::as_bytes(texels), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  return image;
+}
+
 } // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
   std::vector<Vertex> vertex_data;
   std::vector<uint32_t> index_data;
-  std::map<std::filesystem::path, int> texture_index;
+  std::map<std::filesystem::path, int> texture_index, opacity_index;
+  glm::vec3 travel = scene.light.travel();
+  std::vector<std::pair<float, Draw>> translucent_by_depth;
   for (const scene::Object& object : scene.objects) {
     const scene::Mesh& mesh = object.mesh;
     const scene::Material& material = scene.materials.at(object.material);
+    bool is_translucent = material.opacity < 1.0f || !material.opacity_texture.empty();
     uint32_t base = uint32_t(vertex_data.size());
     for (std::size_t i = 0; i < mesh.positions.size(); ++i)
       vertex_data.push_back({mesh.positions[i], mesh.normals[i], i < mesh.uvs.size() ? mesh.uvs[i] : glm::vec2(0.0f)});
     Draw draw;
     draw.first_index = uint32_t(index_data.size());
-    for (uint32_t index : mesh.indices) index_data.push_back(base + index);
+    std::vector<uint32_t> triangles(mesh.triangle_count());
+    for (uint32_t t = 0; t < triangles.size(); ++t) triangles[t] = t;
+    if (is_translucent) { // far to near along the light
+      auto depth = [&](uint32_t t) {
+        const uint32_t* i = &mesh.indices[3 * t];
+        return glm::dot(mesh.positions[i[0]] + mesh.positions[i[1]] + mesh.positions[i[2]], travel);
+      };
+      std::stable_sort(triangles.begin(), triangles.end(), [&](uint32_t a, uint32_t b) { return depth(a) > depth(b); });
+    }
+    for (uint32_t t : triangles)
+      for (int k = 0; k < 3; ++k) index_data.push_back(base + mesh.indices[3 * t + uint32_t(k)]);
     draw.index_count = uint32_t(mesh.indices.size());
+    draw.center = object.bounds.center();
     if (!material.albedo_texture.empty()) {
       auto [it, inserted] = texture_index.try_emplace(material.albedo_texture, int(textures.size()));
       if (inserted) {
@@ -37,11 +60,29 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
       }
       draw.texture = it->second;
     }
+    if (!material.opacity_texture.empty()) {
+      auto [it, inserted] = opacity_index.try_emplace(material.opacity_texture, int(opacity_textures.size()));
+      if (inserted) {
+        scene::Image texels = scene::load_texture(material.opacity_texture);
+        bool opaque_alpha = true;
+        for (size_t i = 3; i < texels.rgba.size(); i += 4) opaque_alpha = opaque_alpha && texels.rgba[i] == 255;
+        std::vector<std::uint8_t> r8(texels.rgba.size() / 4);
+        for (size_t i = 0; i < r8.size(); ++i) r8[i] = texels.rgba[4 * i + (opaque_alpha ? 0 : 3)];
+        opacity_textures.push_back(upload_r8(ctx, texels.width, texels.height, r8));
+      }
+      draw.opacity_texture = it->second;
+    }
     draw.double_sided = material.double_sided;
     draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);
-    draw.push.flags = glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0, 0, 0);
-    if (draw.index_count) draws.push_back(draw);
+    draw.push.flags = glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0,
+                                 draw.opacity_texture >= 0 ? 1 : 0, 0);
+    if (!draw.index_count) continue;
+    if (is_translucent) translucent_by_depth.emplace_back(glm::dot(draw.center, travel), draw);
+    else draws.push_back(draw);
   }
+  std::stable_sort(translucent_by_depth.begin(), translucent_by_depth.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [depth, draw] : translucent_by_depth) translucent.push_back(draw);
   vertices = vk::createBuffer(ctx, vertex_data.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
   vk::uploadBuffer(ctx, vertices, std::as_bytes(std::span(vertex_data)));
   indices = vk::createBuffer(ctx, index_data.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);

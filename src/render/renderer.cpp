@@ -81,8 +81,9 @@ struct Renderer::Impl {
   vk::GpuTimer timer;
   std::unique_ptr<FrameTargets> targets;
   std::map<int, std::unique_ptr<ShadowDepthPass>> shadow_passes;
-  std::map<std::pair<int, int>, std::unique_ptr<MomentResolvePass>> resolve_passes;
-  std::map<std::pair<int, int>, std::unique_ptr<ShadingPass>> shading_passes;
+  std::map<std::tuple<int, int, bool>, std::unique_ptr<MomentResolvePass>> resolve_passes;
+  std::map<std::tuple<int, int, bool>, std::unique_ptr<ShadingPass>> shading_passes;
+  std::map<std::tuple<int, int, bool>, std::unique_ptr<TranslucentPass>> translucent_passes;
   std::map<std::tuple<int, int, int>, std::unique_ptr<OnePassFilterPass>> one_pass_passes;
   vk::Image noise;
   std::unique_ptr<BlurPass> blur_pass;
@@ -125,7 +126,7 @@ struct Renderer::Impl {
     bool depth_based = msm_technique_is_depth_based(technique.id);
     float depth_bias = s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f);
     u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel, depth_bias);
-    u.shading = glm::vec4(s.overdarken, s.exposure, 0.0f, 0.0f);
+    u.shading = glm::vec4(s.overdarken, s.exposure, s.translucent_alpha_threshold, 0.0f);
     u.background = glm::vec4(0.55f, 0.65f, 0.8f, 1.0f);
     int radius = s.filter_size / 2;
     u.kernel = glm::ivec4(s.filter_size, s.msaa, radius, 0);
@@ -170,7 +171,11 @@ struct Renderer::Impl {
       throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
                                     ctx.properties().limits.maxImageDimension2D));
     bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(technique.id));
-    FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps, one_pass};
+    bool translucent = s.translucent_occluders && !gpu.translucent.empty() && supports_translucency(technique) &&
+                       !one_pass;
+    FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps, one_pass,
+                       translucent};
+    bool split = config.split_rg();
     if (!targets || !(targets->config == config)) {
       targets.reset();
       targets = std::make_unique<FrameTargets>(ctx, config);
@@ -180,12 +185,16 @@ struct Renderer::Impl {
       cached(one_pass_passes, std::tuple(technique.id, s.msaa, s.filter_size),
              [&] { return std::make_unique<OnePassFilterPass>(ctx, technique, s.msaa, s.filter_size); });
     } else if (config.moment_images()) {
-      cached(resolve_passes, std::pair(technique.id, s.msaa),
-             [&] { return std::make_unique<MomentResolvePass>(ctx, technique, s.msaa); });
+      cached(resolve_passes, std::tuple(technique.id, s.msaa, split),
+             [&] { return std::make_unique<MomentResolvePass>(ctx, technique, s.msaa, split); });
+      if (translucent)
+        cached(translucent_passes, std::tuple(technique.id, s.msaa, split), [&] {
+          return std::make_unique<TranslucentPass>(ctx, technique, s.msaa, split, config.formats());
+        });
       if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
     }
-    cached(shading_passes, std::pair(technique.id, s.msaa),
-           [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa); });
+    cached(shading_passes, std::tuple(technique.id, s.msaa, split),
+           [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa, split); });
     FrameUniforms u = frame_uniforms(s, technique);
     std::memcpy(uniforms.data(), &u, sizeof(u));
     return technique;
@@ -194,20 +203,22 @@ struct Renderer::Impl {
   // Records the passes; `until_resolve` stops after the moment resolve (intermediates).
   void record(VkCommandBuffer cmd, const RenderSettings& s, const Technique& technique, bool until_resolve) {
     timer.reset(cmd);
-    FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms, noise};
+    FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms, noise, scene.camera.position};
+    bool split = targets->config.split_rg();
     shadow_passes.at(s.msaa)->execute(f);
     if (targets->config.one_pass) {
       one_pass_passes.at({technique.id, s.msaa, s.filter_size})->execute(f);
       if (until_resolve) return;
       mipmap_pass.execute(f);
     } else if (targets->config.moment_images()) {
-      resolve_passes.at({technique.id, s.msaa})->execute(f);
+      resolve_passes.at({technique.id, s.msaa, split})->execute(f);
       if (until_resolve) return;
+      if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
       if (s.filter_size > 1) blur_pass->execute(f);
       mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
     }
     if (until_resolve) return;
-    shading_passes.at({technique.id, s.msaa})->execute(f);
+    shading_passes.at({technique.id, s.msaa, split})->execute(f);
   }
 
   std::vector<PassTime> read_times() {
@@ -247,12 +258,13 @@ struct Renderer::Impl {
     }
     for (int i = 0; i < targets->config.moment_images(); ++i) {
       std::vector<std::byte> bytes = vk::readbackImage(ctx, targets->moments[size_t(i)], VK_IMAGE_LAYOUT_GENERAL);
-      if (technique.formats[size_t(i)] == VK_FORMAT_R32_UINT) {
+      VkFormat format = VkFormat(targets->config.formats()[size_t(i)]);
+      if (format == VK_FORMAT_R32_UINT) {
         out.packed.resize(size_t(size) * size);
         std::memcpy(out.packed.data(), bytes.data(), out.packed.size() * 4);
         continue;
       }
-      (i == 0 ? out.moments : out.moments1) = to_float_image(bytes, VkFormat(technique.formats[size_t(i)]), size, size);
+      (i == 0 ? out.moments : out.moments1) = to_float_image(bytes, format, size, size);
     }
   }
 };
@@ -269,10 +281,10 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   RenderResult r;
   r.passes = m.read_times();
   for (const PassTime& p : r.passes) r.total_ms += p.ms;
-  if (intermediates && m.targets->config.moment_images() && technique.formats[0] != VK_FORMAT_R32_UINT)
+  if (intermediates && m.targets->config.moment_images() && m.targets->config.formats()[0] != VK_FORMAT_R32_UINT)
     intermediates->filtered = to_float_image(vk::readbackImage(m.ctx, m.targets->moments[0],
                                                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL),
-                                             VkFormat(technique.formats[0]), s.shadow_size, s.shadow_size);
+                                             VkFormat(m.targets->config.formats()[0]), s.shadow_size, s.shadow_size);
 
   std::vector<std::byte> color = vk::readbackImage(m.ctx, m.targets->color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   r.color = image::Image(s.width, s.height, 3);

@@ -75,6 +75,10 @@ const Technique& find_technique(std::string_view name) {
   throw RenderError(fmt::format("unknown technique '{}'; valid: {}", name, valid));
 }
 
+bool supports_translucency(const Technique& t) {
+  return !msm_technique_is_depth_based(t.id) && !msm_technique_is_nonlinear(t.id) && t.formats[1] == 0;
+}
+
 glm::vec4 default_params(const Technique& technique) { return msm_technique_default_params(technique.id); }
 
 void RenderSettings::validate() const {
@@ -109,6 +113,7 @@ void RenderSettings::validate() const {
     throw RenderError(fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size,
                                   kMaxOnePassTaps));
   if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
+  finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
   if (params)
     for (int i = 0; i < 4; ++i)
       if (!std::isfinite((*params)[i])) throw RenderError("technique parameters must be finite");

@@ -93,9 +93,29 @@ Program createGraphicsProgram(const Context& ctx, const GraphicsDesc& desc) {
       .depthCompareOp = desc.depthCompare,
       .minDepthBounds = 0.0f,
       .maxDepthBounds = 1.0f};
-  std::vector<VkPipelineColorBlendAttachmentState> blend(
-      desc.colorFormats.size(), {.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
-                                                   VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT});
+  constexpr VkColorComponentFlags rgba = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                        VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  if (!desc.colorWriteMasks.empty() && desc.colorWriteMasks.size() != desc.colorFormats.size())
+    throw std::invalid_argument(fmt::format("msm::vk::createGraphicsProgram({}): one write mask per colour attachment",
+                                            desc.name));
+  std::vector<VkPipelineColorBlendAttachmentState> blend;
+  for (size_t i = 0; i < desc.colorFormats.size(); ++i) {
+    if (desc.alphaBlend) {
+      VkFormatProperties props{};
+      vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), desc.colorFormats[i], &props);
+      if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT))
+        throw std::invalid_argument(fmt::format("msm::vk::createGraphicsProgram({}): {} cannot blend format {}",
+                                                desc.name, ctx.info().name, int(desc.colorFormats[i])));
+    }
+    blend.push_back({.blendEnable = desc.alphaBlend ? VK_TRUE : VK_FALSE,
+                     .srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA,
+                     .dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
+                     .colorBlendOp = VK_BLEND_OP_ADD,
+                     .srcAlphaBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA,
+                     .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
+                     .alphaBlendOp = VK_BLEND_OP_ADD,
+                     .colorWriteMask = desc.colorWriteMasks.empty() ? rgba : desc.colorWriteMasks[i]});
+  }
   VkPipelineColorBlendStateCreateInfo colorBlend{.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
                                                  .attachmentCount = uint32_t(blend.size()),
                                                  .pAttachments = blend.data()};
@@ -134,19 +154,19 @@ void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, std::span<const Colo
   for (const ColorAttachment& c : colors)
     colorInfos.push_back({.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                           .imageView = c.view,
-                          .imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                          .imageLayout = c.layout,
                           .resolveMode = c.resolve ? VK_RESOLVE_MODE_AVERAGE_BIT : VK_RESOLVE_MODE_NONE,
                           .resolveImageView = c.resolve,
                           .resolveImageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                          .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                          .loadOp = c.load ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
                           .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
                           .clearValue = {.color = c.clear}});
   VkRenderingAttachmentInfo depthInfo{};
   if (depth)
     depthInfo = {.sType = VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO,
                  .imageView = depth->view,
-                 .imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                 .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                 .imageLayout = depth->layout,
+                 .loadOp = depth->load ? VK_ATTACHMENT_LOAD_OP_LOAD : VK_ATTACHMENT_LOAD_OP_CLEAR,
                  .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
                  .clearValue = {.depthStencil = {depth->clear, 0}}};
   VkRenderingInfo info{.sType = VK_STRUCTURE_TYPE_RENDERING_INFO,

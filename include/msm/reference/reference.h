@@ -8,7 +8,8 @@
 // row. The primary ray of pixel (x, y) goes through NDC ((x + 0.5) / W * 2 - 1, (y + 0.5) / H * 2 - 1)
 // (Vulkan: y down, depth in [0, 1]): from the unprojection of NDC depth 0 to that of depth 1 with
 // inverse(scene.camera_view_projection(float(W) / H)), in double precision. The closest hit over
-// [near point, far point] is the visible surface. Back faces are surfaces too: the rasterizer
+// [near point, far point] that is opaque (material opacity 1) is the visible surface: translucent
+// surfaces are looked through, as in the renderer's shadow buffer. Back faces are surfaces too: the rasterizer
 // culls the back faces of single-sided materials, which shows the same surface as long as meshes
 // are closed (or seen from their front side); for an open single-sided surface seen from behind
 // the two differ, and the reference shows the surface. The hit point p is the intersection of the

@@ -56,6 +56,8 @@ struct Technique {
 std::span<const Technique> techniques();
 // Throws RenderError listing the valid names.
 const Technique& find_technique(std::string_view name);
+// Whether a technique can blend translucent occluders into its map (see RenderSettings).
+bool supports_translucency(const Technique& technique);
 // The papers' parameters of a technique (msm_technique_default_params).
 glm::vec4 default_params(const Technique& technique);
 
@@ -90,6 +92,13 @@ struct RenderSettings {
   // off for the others; not for 6MSM; at most 17 taps.
   std::optional<bool> one_pass;
   int frame = 0;                   // frame number: picks the blue-noise layer and offset
+  // Translucent occluders (materials with opacity < 1 or an opacity texture): blended into the
+  // moment map back to front after the opaque resolve (JCGT §3), by the linear techniques with
+  // one moment image (four-channel ones then store two RG images) in the three-pass pipeline.
+  // The depth-based, non-linear and six-moment techniques (and a one-pass filter) draw them
+  // without a shadow. Fragments below the threshold opacity are discarded (JCGT: 1%).
+  bool translucent_occluders = true;
+  float translucent_alpha_threshold = 0.01f;
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;
 };

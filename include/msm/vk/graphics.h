@@ -42,6 +42,12 @@ struct GraphicsDesc {
   bool depthClamp = false;
   // Dynamic depth bias (vkCmdSetDepthBias) is enabled: set it before drawing.
   bool depthBias = false;
+  // "Over" blending on every colour attachment: rgb' = src.rgb * src.a + dst.rgb * (1 - src.a)
+  // (alpha' likewise); the factor is the fragment's output alpha, so attachments without an
+  // alpha channel (RG targets) blend too. Requires the formats' blend feature.
+  bool alphaBlend = false;
+  // Per colour attachment (empty: all channels of every attachment).
+  std::vector<VkColorComponentFlags> colorWriteMasks;
   std::vector<SpecConstant> constants; // extra specialization constants for both stages
 };
 
@@ -56,15 +62,19 @@ struct ColorAttachment {
   VkImageView view = VK_NULL_HANDLE;
   VkClearColorValue clear{};
   VkImageView resolve = VK_NULL_HANDLE; // single-sample image to average into, or null
+  bool load = false;                    // keep the contents instead of clearing
+  VkImageLayout layout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
 };
 
 struct DepthAttachment {
   VkImageView view = VK_NULL_HANDLE;
   float clear = 1.0f;
+  bool load = false;                    // keep the contents instead of clearing
+  VkImageLayout layout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
 };
 
-// vkCmdBeginRendering over the whole extent: every attachment cleared and stored. Images must be
-// in COLOR_ATTACHMENT_OPTIMAL / DEPTH_ATTACHMENT_OPTIMAL.
+// vkCmdBeginRendering over the whole extent: every attachment cleared (or loaded) and stored,
+// in the layout each attachment names (default COLOR_ / DEPTH_ATTACHMENT_OPTIMAL).
 void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, std::span<const ColorAttachment> colors,
                     std::optional<DepthAttachment> depth = std::nullopt);
 inline void beginRendering(VkCommandBuffer cmd, VkExtent2D extent, std::initializer_list<ColorAttachment> colors,

@@ -7,11 +7,11 @@ const PassDecl& MomentResolvePass::decl() {
   return d;
 }
 
-MomentResolvePass::MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa)
+MomentResolvePass::MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg)
     : program_(vk::createProgram(ctx, msaa == 1 ? "moment_resolve_1x.comp" : "moment_resolve.comp",
                                  {vk::Binding::UniformBuffer, vk::Binding::SampledImage, vk::Binding::StorageImage,
                                   vk::Binding::StorageImage},
-                                 sizeof(ImagePassPush), {{0, uint32_t(technique.id)}})) {}
+                                 sizeof(ImagePassPush), {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}})) {}
 
 void MomentResolvePass::execute(FrameContext& f) const {
   PassScope scope(f, decl());

@@ -25,6 +25,7 @@ struct FrameContext {
   const GpuScene& scene;
   const vk::Buffer& uniforms; // FrameUniforms
   const vk::Image& blue_noise; // 64 layers of 64² RG8 (blue_noise.h)
+  glm::vec3 camera_position;
 };
 
 // Scene -> shadow_depth (D16, MSAA), left SHADER_READ_ONLY for compute and fragment reads.
@@ -42,7 +43,7 @@ private:
 class MomentResolvePass {
 public:
   static const PassDecl& decl();
-  MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa);
+  MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg);
   void execute(FrameContext& f) const;
 
 private:
@@ -56,6 +57,19 @@ class OnePassFilterPass {
 public:
   static const PassDecl& decl();
   OnePassFilterPass(const vk::Context& ctx, const Technique& technique, int msaa, int taps);
+  void execute(FrameContext& f) const;
+
+private:
+  vk::Program program_;
+};
+
+// Translucent objects -> blended into moments mip 0 (GENERAL, as colour attachments), back to
+// front (JCGT §3); after the resolve, before the blur. Visible to compute and transfer.
+class TranslucentPass {
+public:
+  static const PassDecl& decl();
+  TranslucentPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg,
+                  const std::array<int, 2>& formats);
   void execute(FrameContext& f) const;
 
 private:
@@ -84,11 +98,11 @@ public:
 class ShadingPass {
 public:
   static const PassDecl& decl();
-  ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa);
+  ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg);
   void execute(FrameContext& f) const;
 
 private:
-  vk::Program program_;
+  vk::Program program_, translucent_program_; // opaque; translucent objects blended over it
   bool depth_based_, nonlinear_;
 };
 

@@ -2,6 +2,8 @@
 
 #include "msm/techniques.h"
 
+#include <algorithm>
+
 namespace msm::render {
 
 const PassDecl& ShadingPass::decl() {
@@ -11,7 +13,7 @@ const PassDecl& ShadingPass::decl() {
 
 namespace {
 
-vk::GraphicsDesc shading_desc(const Technique& technique, int msaa) {
+vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_rg, bool translucent) {
   bool depth_based = msm_technique_is_depth_based(technique.id);
   std::string fragment = depth_based                        ? (msaa == 1 ? "shading_depth_1x.frag" : "shading_depth.frag")
                          : technique.id == MSM_TECH_NL64 ? "shading_nl64.frag"
@@ -28,18 +30,24 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa) {
                                     {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
                      .colorFormats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32_SFLOAT},
                      .depthFormat = VK_FORMAT_D32_SFLOAT,
-                     .constants = {{0, uint32_t(technique.id)}}};
-  if (!depth_based) { // second moment image, blue noise
-    d.bindings.push_back(vk::Binding::SampledImage);
-    d.bindings.push_back(vk::Binding::SampledImage);
+                     .depthWrite = !translucent,
+                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}}};
+  // Second moment image, blue noise, opacity texture (the depth-based shaders use neither of
+  // the first two; the layout is the same for every technique).
+  for (int i = 0; i < 3; ++i) d.bindings.push_back(vk::Binding::SampledImage);
+  if (translucent) { // over the opaque image; the shadow buffer keeps the opaque surface's
+    d.name += " (translucent)";
+    d.alphaBlend = true;
+    d.colorWriteMasks = {VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT, 0};
   }
   return d;
 }
 
 } // namespace
 
-ShadingPass::ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa)
-    : program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa))),
+ShadingPass::ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg)
+    : program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, false))),
+      translucent_program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, true))),
       depth_based_(msm_technique_is_depth_based(technique.id)),
       nonlinear_(msm_technique_is_nonlinear(technique.id)) {}
 
@@ -83,16 +91,24 @@ void ShadingPass::execute(FrameContext& f) const {
                                                         t.point_sampler)
                                        : shadow0;
   vk::Descriptor noise(f.blue_noise.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
-  for (const Draw& d : f.scene.draws) {
+  if (depth_based_) second = vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
+  auto draw = [&](const vk::Program& program, const Draw& d) {
     const vk::Image& texture = d.texture >= 0 ? f.scene.textures[size_t(d.texture)] : f.scene.white;
+    const vk::Image& opacity = d.opacity_texture >= 0 ? f.scene.opacity_textures[size_t(d.opacity_texture)] : f.scene.white;
     vk::Descriptor albedo(texture.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler);
+    vk::Descriptor alpha(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler);
     vkCmdSetCullMode(f.cmd, d.double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
-    if (depth_based_)
-      vk::bindProgram(f.cmd, program_, {vk::Descriptor(f.uniforms), albedo, shadow0}, d.push);
-    else
-      vk::bindProgram(f.cmd, program_, {vk::Descriptor(f.uniforms), albedo, shadow0, second, noise}, d.push);
+    vk::bindProgram(f.cmd, program, {vk::Descriptor(f.uniforms), albedo, shadow0, second, noise, alpha}, d.push);
     vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
-  }
+  };
+  for (const Draw& d : f.scene.draws) draw(program_, d);
+  // Translucent surfaces over the opaque image, far to near from the camera (per object).
+  std::vector<const Draw*> order;
+  for (const Draw& d : f.scene.translucent) order.push_back(&d);
+  std::stable_sort(order.begin(), order.end(), [&](const Draw* a, const Draw* b) {
+    return glm::distance(a->center, f.camera_position) > glm::distance(b->center, f.camera_position);
+  });
+  for (const Draw* d : order) draw(translucent_program_, *d);
   vkCmdEndRendering(f.cmd);
   for (const vk::Image* image : {&t.color, &t.shadow_buffer})
     vk::pipelineBarrier(f.cmd, vk::imageBarrier(image->handle(), image->aspect(), color_stage,

@@ -35,6 +35,13 @@ void main() {
     b += t.b;
   }
   float inv = 1.0f / float(samples);
-  imageStore(moments0, p, a * inv);
-  if (kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96) imageStore(moments1, p, b * inv);
+  a *= inv;
+  b *= inv;
+  if (kSplitRG) {
+    imageStore(moments0, p, vec4(a.x, a.y, 0.0f, 0.0f));
+    imageStore(moments1, p, vec4(a.z, a.w, 0.0f, 0.0f));
+  } else {
+    imageStore(moments0, p, a);
+    if (kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96) imageStore(moments1, p, b);
+  }
 }

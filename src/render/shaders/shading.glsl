@@ -5,6 +5,7 @@
 #include "frame.glsl"
 
 layout(binding = 1) uniform sampler2D albedo_texture;
+layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
 layout(push_constant) uniform Push { ObjectPush object; };
 
 layout(location = 0) in vec3 world_position;
@@ -58,6 +59,9 @@ void main() {
   vec3 albedo = object.albedo_opacity.rgb;
   if (object.flags.x != 0) albedo *= texture(albedo_texture, texcoord).rgb;
   vec3 radiance = albedo * (frame.irradiance.rgb * (max(n_dot_l, 0.0f) * visibility / MSM_PI) + frame.irradiance.a);
-  out_color = vec4(tone_map(radiance * frame.shading.y), 1.0f);
+  // Alpha: the surface's opacity (translucent objects blend over the opaque image).
+  float opacity = object.albedo_opacity.a;
+  if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
+  out_color = vec4(tone_map(radiance * frame.shading.y), opacity);
   out_shadow = vec2(visibility, 1.0f);
 }

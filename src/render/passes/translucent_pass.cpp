@@ -1,0 +1,74 @@
+#include "pass.h"
+
+#include "msm/techniques.h"
+
+namespace msm::render {
+
+const PassDecl& TranslucentPass::decl() {
+  static const PassDecl d{"translucent", {"scene.translucent", "shadow_depth", "moments"}, {"moments"}};
+  return d;
+}
+
+namespace {
+
+vk::GraphicsDesc translucent_desc(const Technique& technique, int msaa, bool split_rg, const std::array<int, 2>& formats) {
+  std::string fragment = std::string(split_rg ? "translucent_moments2" : "translucent_moments") +
+                         (msaa == 1 ? "_1x.frag" : ".frag");
+  vk::GraphicsDesc d{.name = std::string("translucent ") + std::string(technique.name),
+                     .vertexShader = "translucent.vert",
+                     .fragmentShader = fragment,
+                     .bindings = {vk::Binding::UniformBuffer, vk::Binding::SampledImage, vk::Binding::SampledImage},
+                     .pushConstantSize = sizeof(ObjectPush),
+                     .vertexStride = sizeof(Vertex),
+                     .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                                    {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+                     .colorFormats = {VkFormat(formats[0])},
+                     .alphaBlend = true,
+                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}}};
+  if (split_rg) d.colorFormats.push_back(VkFormat(formats[1]));
+  return d;
+}
+
+} // namespace
+
+TranslucentPass::TranslucentPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg,
+                                 const std::array<int, 2>& formats)
+    : program_(vk::createGraphicsProgram(ctx, translucent_desc(technique, msaa, split_rg, formats))) {}
+
+void TranslucentPass::execute(FrameContext& f) const {
+  PassScope scope(f, decl());
+  const FrameTargets& t = f.targets;
+  constexpr VkPipelineStageFlags2 color = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
+  constexpr VkAccessFlags2 color_rw = VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
+  vk::pipelineBarrier(f.cmd, vk::memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                               VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, color, color_rw));
+  std::vector<vk::ColorAttachment> targets;
+  for (int i = 0; i < t.config.moment_images(); ++i)
+    targets.push_back({.view = t.moments_mip0[size_t(i)], .load = true, .layout = VK_IMAGE_LAYOUT_GENERAL});
+  VkExtent2D size{uint32_t(t.config.shadow_size), uint32_t(t.config.shadow_size)};
+  vk::beginRendering(f.cmd, size, targets);
+  vk::setViewportScissor(f.cmd, size);
+  vkCmdSetCullMode(f.cmd, VK_CULL_MODE_NONE);
+  VkDeviceSize offset = 0;
+  VkBuffer vertices = f.scene.vertices.handle();
+  vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
+  vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
+  vk::Descriptor depth(t.shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
+  for (const Draw& d : f.scene.translucent) {
+    const vk::Image& opacity = d.opacity_texture >= 0 ? f.scene.opacity_textures[size_t(d.opacity_texture)] : f.scene.white;
+    vk::bindProgram(f.cmd, program_,
+                    {vk::Descriptor(f.uniforms),
+                     vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler),
+                     depth},
+                    d.push);
+    vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
+  }
+  vkCmdEndRendering(f.cmd);
+  vk::pipelineBarrier(f.cmd, vk::memoryBarrier(color, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
+                                               VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
+                                                   VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                                                   VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                                               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT));
+}
+
+} // namespace msm::render

@@ -1,0 +1,45 @@
+// One translucent fragment blended into the moment shadow map with the over operator (JCGT §3):
+// moments' = alpha b(z) + (1 - alpha) moments, back to front (the draws and their triangles are
+// sorted). alpha is the material's opacity times the fraction of the texel's opaque depth samples
+// behind the fragment (a translucent surface behind an opaque one casts nothing there); below the
+// threshold (1% by default, frame.shading.z) the fragment is discarded: many nearly transparent
+// fragments would otherwise accumulate the rounding of every blend.
+#include "msm/techniques.h"
+#include "frame.glsl"
+
+layout(binding = 1) uniform sampler2D opacity_texture;
+#ifdef MSM_SINGLE_SAMPLE
+layout(binding = 2) uniform sampler2D depth_map;
+#else
+layout(binding = 2) uniform sampler2DMS depth_map;
+#endif
+layout(push_constant) uniform Push { ObjectPush object; };
+
+layout(location = 0) in vec2 texcoord;
+layout(location = 0) out vec4 out0;
+#ifdef MSM_TWO_TARGETS
+layout(location = 1) out vec4 out1;
+#endif
+
+void main() {
+  float alpha = object.albedo_opacity.a;
+  if (object.flags.z != 0) alpha *= texture(opacity_texture, texcoord).x;
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  float z = gl_FragCoord.z;
+  int samples = frame.kernel.y, behind = 0;
+  for (int s = 0; s < samples; ++s) {
+#ifdef MSM_SINGLE_SAMPLE
+    behind += texelFetch(depth_map, p, 0).x > z ? 1 : 0;
+#else
+    behind += texelFetch(depth_map, p, s).x > z ? 1 : 0;
+#endif
+  }
+  alpha *= float(behind) / float(samples);
+  if (alpha < frame.shading.z || alpha <= 0.0f) discard;
+  vec4 m = msm_technique_generate(kTechnique, z, frame.technique_params).a;
+  out0 = vec4(m.x, m.y, m.z, alpha);
+#ifdef MSM_TWO_TARGETS
+  out0 = vec4(m.x, m.y, 0.0f, alpha);
+  out1 = vec4(m.z, m.w, 0.0f, alpha);
+#endif
+}

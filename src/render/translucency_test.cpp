@@ -1,0 +1,113 @@
+// Translucent occluders blended into the moment shadow map (JCGT §3) against the ray-traced
+// transmittance: a stack of k parallel planes of opacity alpha over a ground plane transmits
+// (1 - alpha)^k.
+#include "msm/reference/reference.h"
+#include "msm/render/renderer.h"
+
+#include "msm/image/metrics.h"
+#include "msm/vk/test_support.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace msm::render {
+namespace {
+
+class TranslucencyTest : public vk::test::VulkanTest {};
+
+// Ground 4 x 4 at y = 0, k planes 2 x 2 at y = 0.6, 0.9, ..., light straight down, camera above.
+scene::Scene stack(int k, float alpha) {
+  std::string objects = R"({ "name": "ground", "primitive": { "type": "plane", "size": [4, 4] } })";
+  for (int i = 0; i < k; ++i)
+    objects += fmt::format(R"(, {{ "name": "layer{}", "primitive": {{ "type": "plane", "size": [2, 2] }},
+        "transform": {{ "translate": [0, {}, 0] }},
+        "material": {{ "albedo": [0.5, 0.5, 0.9], "opacity": {}, "double_sided": true }} }})",
+                           i, 0.6 + 0.3 * i, alpha);
+  std::string json = fmt::format(R"({{ "msm_scene": 1, "name": "stack",
+      "camera": {{ "position": [0, 6, 3], "target": [0, 0, 0], "fov_y_deg": 40 }},
+      "light": {{ "towards_light": [0, 1, 0] }},
+      "objects": [ {} ] }})", objects);
+  return scene::load_scene_json(json, ".", "stack");
+}
+
+RenderSettings settings(const std::string& technique) {
+  RenderSettings s;
+  s.technique = technique;
+  s.width = 96;
+  s.height = 72;
+  s.shadow_size = 256;
+  s.mipmaps = false;
+  return s;
+}
+
+// Mean visibility over the ground under the middle of the stack (the 16 x 12 central pixels).
+double centre_visibility(const image::Image& shadow) {
+  double sum = 0;
+  int n = 0;
+  for (int y = 30; y < 42; ++y)
+    for (int x = 40; x < 56; ++x, ++n) sum += shadow.at(x, y, 0);
+  return sum / n;
+}
+
+TEST_F(TranslucencyTest, StackOfPlanesTransmitsAsTheRayTracerSays) {
+  const float alpha = 0.3f;
+  for (int k = 1; k <= 3; ++k) {
+    scene::Scene scene = stack(k, alpha);
+    reference::Settings rs;
+    rs.effect = reference::Effect::translucent;
+    rs.width = 96;
+    rs.height = 72;
+    double truth = centre_visibility(reference::render(scene, rs).visibility);
+    EXPECT_NEAR(truth, std::pow(1.0 - alpha, k), 1e-5) << "the ray tracer, k = " << k;
+    Renderer renderer(ctx(), scene);
+    double msm_error = 0;
+    for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "msm-hausdorff-64", "evsm4-64", "vsm-32", "pcf"}) {
+      double v = centre_visibility(renderer.render(settings(t)).shadow);
+      fmt::print("k = {}: {:<18} visibility {:.4f}, ray traced {:.4f}\n", k, t, v, truth);
+      std::string name(t);
+      if (name == "pcf") {
+        EXPECT_EQ(v, 1.0) << "PCF: translucent objects cast no shadow";
+      } else if (name == "vsm-32") {
+        // Two moments cannot hold k + 1 depths: VSM leaks (measured 0.018 at k = 2, 0.037 at 3).
+        EXPECT_NEAR(v, truth, 0.05) << name << ", k = " << k;
+        if (k >= 2) {
+          EXPECT_GT(std::abs(v - truth), msm_error) << "VSM leaks more than MSM";
+        }
+      } else {
+        // Four moments: within 0.01 (measured <= 0.002 for MSM up to k = 3).
+        EXPECT_NEAR(v, truth, 0.01) << name << ", k = " << k;
+        msm_error = std::max(msm_error, std::abs(v - truth));
+      }
+    }
+  }
+}
+
+// JCGT §3: fragments of opacity below 1% are discarded, because blending many nearly transparent
+// fragments accumulates the rounding of every blend into the 16-bit moments. Forty layers of
+// opacity 0.8% (truth: 0.992^40 = 0.725): reported with and without the threshold.
+TEST_F(TranslucencyTest, AlphaThresholdAgainstManyFaintLayers) {
+  const int k = 40;
+  const float alpha = 0.008f;
+  scene::Scene scene = stack(k, alpha);
+  Renderer renderer(ctx(), scene);
+  double truth = std::pow(1.0 - alpha, k);
+  for (const char* t : {"msm-hamburger-64", "msm-hamburger-128"}) {
+    RenderSettings with = settings(t), without = settings(t);
+    without.translucent_alpha_threshold = 0.0f;
+    double v_with = centre_visibility(renderer.render(with).shadow);
+    double v_without = centre_visibility(renderer.render(without).shadow);
+    fmt::print("{:<18} {} layers of {}: visibility {:.4f} with the 1% threshold, {:.4f} without; truth {:.4f}\n", t, k,
+               alpha, v_with, v_without, truth);
+    // With the threshold every layer is discarded: the map is that of the ground alone (lit up
+    // to the moment bias). Without it the blends are kept and land near the truth: the failure
+    // the paper guards against (drift of 16-bit moments under many faint blends) did not show
+    // here, at 40 layers.
+    EXPECT_NEAR(v_with, 1.0, 0.01);
+    EXPECT_NEAR(v_without, truth, 0.05);
+  }
+}
+
+} // namespace
+} // namespace msm::render
