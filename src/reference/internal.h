@@ -106,17 +106,20 @@ public:
         std::uint64_t rays = 0;
     };
     // Product of (1 - opacity) over the surfaces crossed by origin + t dir, t >= 0, counting at
-    // most max_crossings of them; stops early at transmittance 0.
+    // most max_crossings of them; stops early at transmittance 0. Opacity = the material's
+    // constant times its opacity texture or noise (scene::opacity_image) at the hit's uv.
     Transmission transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const;
 
     // Interpolated vertex normal at a hit (unit).
     glm::dvec3 shading_normal(const SurfaceHit& hit) const;
     const scene::Material& material(const SurfaceHit& hit) const;
+    double opacity(const SurfaceHit& hit) const;
 
     struct Impl;  // Embree device and scene
 
 private:
     const scene::Scene& scene_;
+    std::vector<scene::OpacityImage> opacity_images_; // per material (width 0: none)
     std::unique_ptr<Impl> impl_;
 };
 

@@ -206,7 +206,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
                 // The visible surface is the closest opaque one: translucent surfaces (opacity
                 // < 1) are looked through, as the renderer's shadow buffer does.
                 bool found = tracer.closest(near, dir, length, hit);
-                for (int crossed = 0; found && tracer.material(hit).opacity < 1.0f && crossed < kMaxCrossings; ++crossed) {
+                for (int crossed = 0; found && tracer.material(hit).translucent() && crossed < kMaxCrossings; ++crossed) {
                     const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
                     found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
                     ++row_rays;

@@ -58,6 +58,7 @@ RTCRay make_ray(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) {
 }  // namespace
 
 Tracer::Tracer(const scene::Scene& scene) : scene_(scene), impl_(std::make_unique<Impl>()) {
+    for (const scene::Material& m : scene.materials) opacity_images_.push_back(scene::opacity_image(m));
     // Refuse non-finite vertices (possible in scenes not built by the loader).
     for (const scene::Object& o : scene.objects)
         for (std::size_t i = 0; i < o.mesh.positions.size(); ++i) {
@@ -160,7 +161,7 @@ Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::d
     while (result.crossings < max_crossings) {
         ++result.rays;
         if (!closest(o, dir, std::numeric_limits<double>::infinity(), hit)) break;
-        result.transmittance *= 1.0 - double(material(hit).opacity);
+        result.transmittance *= 1.0 - opacity(hit);
         ++result.crossings;
         if (result.transmittance <= 0.0) {
             result.transmittance = 0.0;
@@ -181,6 +182,22 @@ glm::dvec3 Tracer::shading_normal(const SurfaceHit& hit) const {
                          v * glm::dvec3(mesh.normals[tri[2]]);
     const double len = glm::length(n);
     return len > 1e-12 ? n / len : hit.normal;
+}
+
+double Tracer::opacity(const SurfaceHit& hit) const {
+    const scene::Material& m = material(hit);
+    double alpha = m.opacity;
+    const std::uint32_t index = scene_.objects[hit.object].material;
+    if (index < opacity_images_.size() && opacity_images_[index].width > 0) {
+        const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
+        if (mesh.uvs.size() == mesh.positions.size()) {
+            const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
+            const float u = hit.u, v = hit.v;
+            const glm::vec2 uv = (1.0f - u - v) * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
+            alpha *= double(opacity_images_[index].sample(uv));
+        }
+    }
+    return alpha;
 }
 
 const scene::Material& Tracer::material(const SurfaceHit& hit) const {

@@ -27,13 +27,13 @@ vk::Image upload_r8(const vk::Context& ctx, int width, int height, std::span<con
 GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
   std::vector<Vertex> vertex_data;
   std::vector<uint32_t> index_data;
-  std::map<std::filesystem::path, int> texture_index, opacity_index;
+  std::map<std::filesystem::path, int> texture_index;
   glm::vec3 travel = scene.light.travel();
   std::vector<std::pair<float, Draw>> translucent_by_depth;
   for (const scene::Object& object : scene.objects) {
     const scene::Mesh& mesh = object.mesh;
     const scene::Material& material = scene.materials.at(object.material);
-    bool is_translucent = material.opacity < 1.0f || !material.opacity_texture.empty();
+    bool is_translucent = material.translucent();
     uint32_t base = uint32_t(vertex_data.size());
     for (std::size_t i = 0; i < mesh.positions.size(); ++i)
       vertex_data.push_back({mesh.positions[i], mesh.normals[i], i < mesh.uvs.size() ? mesh.uvs[i] : glm::vec2(0.0f)});
@@ -60,17 +60,12 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
       }
       draw.texture = it->second;
     }
-    if (!material.opacity_texture.empty()) {
-      auto [it, inserted] = opacity_index.try_emplace(material.opacity_texture, int(opacity_textures.size()));
-      if (inserted) {
-        scene::Image texels = scene::load_texture(material.opacity_texture);
-        bool opaque_alpha = true;
-        for (size_t i = 3; i < texels.rgba.size(); i += 4) opaque_alpha = opaque_alpha && texels.rgba[i] == 255;
-        std::vector<std::uint8_t> r8(texels.rgba.size() / 4);
-        for (size_t i = 0; i < r8.size(); ++i) r8[i] = texels.rgba[4 * i + (opaque_alpha ? 0 : 3)];
-        opacity_textures.push_back(upload_r8(ctx, texels.width, texels.height, r8));
-      }
-      draw.opacity_texture = it->second;
+    if (!material.opacity_texture.empty() || material.opacity_noise) {
+      // One texture per material that has one (files and noise parameters may repeat; the
+      // textures are small).
+      scene::OpacityImage opacity = scene::opacity_image(material);
+      draw.opacity_texture = int(opacity_textures.size());
+      opacity_textures.push_back(upload_r8(ctx, opacity.width, opacity.height, opacity.values));
     }
     draw.double_sided = material.double_sided;
     draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 
 namespace msm::render {
 namespace {
@@ -107,6 +108,39 @@ TEST_F(TranslucencyTest, AlphaThresholdAgainstManyFaintLayers) {
     EXPECT_NEAR(v_with, 1.0, 0.01);
     EXPECT_NEAR(v_without, truth, 0.05);
   }
+}
+
+// JCGT Fig. 5: the smoke scene against the ray-traced transmittance (opacity noise sampled the
+// same way by both), on the opaque surfaces: every technique's error and leaking are printed
+// (docs/results.md). Asserted: MSM 64 leaks less than VSM and EVSM 64 (the paper's point), and
+// is closer to the truth than PCF, which ignores the smoke. Its total error is not below VSM's
+// here: the moment techniques over-darken the side wall lit at a grazing angle (self-shadowing of
+// sloped receivers without a depth bias; measured, docs/results.md).
+TEST_F(TranslucencyTest, SmokeScene) {
+  scene::Scene scene = scene::builtin_scene("smoke");
+  reference::Settings rs;
+  rs.effect = reference::Effect::translucent;
+  rs.width = 240;
+  rs.height = 135;
+  reference::Result truth = reference::render(scene, rs);
+  image::Image mask = truth.visibility.channel("background");
+  image::Image reference = truth.visibility.channel("visibility");
+  Renderer renderer(ctx(), scene);
+  std::map<std::string, image::Metrics> m;
+  for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "msm-hausdorff-64", "vsm-32", "vsm-64", "evsm4-64",
+                        "evsm4-128", "pcf"}) {
+    RenderSettings s;
+    s.technique = t;
+    s.width = 240;
+    s.height = 135;
+    s.shadow_size = 512;
+    m[t] = image::compute_metrics(renderer.render(s).shadow.channel("visibility"), reference, {.mask = &mask});
+    fmt::print("smoke {:<18} MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >10% {:.2f}%\n", t, m[t].mae,
+               m[t].light_leaking, m[t].over_darkening, 100 * m[t].share_above_10pct);
+  }
+  EXPECT_LT(m["msm-hamburger-64"].light_leaking, m["vsm-32"].light_leaking);
+  EXPECT_LT(m["msm-hamburger-64"].light_leaking, m["evsm4-64"].light_leaking);
+  EXPECT_LT(m["msm-hamburger-64"].mae, m["pcf"].mae) << "PCF ignores the smoke";
 }
 
 } // namespace

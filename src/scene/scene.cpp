@@ -215,7 +215,7 @@ private:
   }
 
   Material material(const json& j, const std::string& ptr) const {
-    keys(j, ptr, {"albedo", "albedo_texture", "opacity", "opacity_texture", "double_sided"});
+    keys(j, ptr, {"albedo", "albedo_texture", "opacity", "opacity_texture", "opacity_noise", "double_sided"});
     Material m;
     if (const json* v = find(j, "albedo")) {
       m.albedo = vec<3>(*v, ptr + "/albedo");
@@ -227,6 +227,18 @@ private:
     if (const json* v = find(j, "opacity")) m.opacity = number_in(*v, ptr + "/opacity", 0.0f, 1.0f, false, false);
     if (const json* v = find(j, "opacity_texture"))
       m.opacity_texture = existing_file(string(*v, ptr + "/opacity_texture"), ptr + "/opacity_texture", "texture");
+    if (const json* v = find(j, "opacity_noise")) {
+      const std::string q = ptr + "/opacity_noise";
+      if (!m.opacity_texture.empty()) fail(q, "give either opacity_texture or opacity_noise, not both");
+      keys(*v, q, {"seed", "scale", "octaves", "density", "softness"});
+      SmokeNoise n;
+      if (const json* x = find(*v, "seed")) n.seed = std::uint32_t(number_in(*x, q + "/seed", 0.0f, 1e9f, false, false));
+      if (const json* x = find(*v, "scale")) n.scale = number_in(*x, q + "/scale", 0.0f, 64.0f, true, false);
+      if (const json* x = find(*v, "octaves")) n.octaves = int(number_in(*x, q + "/octaves", 1.0f, 8.0f, false, false));
+      if (const json* x = find(*v, "density")) n.density = number_in(*x, q + "/density", 0.0f, 1.0f, false, false);
+      if (const json* x = find(*v, "softness")) n.softness = number_in(*x, q + "/softness", 0.0f, 1.0f, true, false);
+      m.opacity_noise = n;
+    }
     if (const json* v = find(j, "double_sided")) m.double_sided = boolean(*v, ptr + "/double_sided");
     return m;
   }

@@ -93,7 +93,7 @@ void expect_json_error(const std::string& json, std::initializer_list<std::strin
 
 TEST(BuiltinScenes, NamesAndDefault) {
   const auto names = builtin_scene_names();
-  EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke"}));
   EXPECT_EQ(default_scene_name(), "fence");
 }
 

@@ -8,8 +8,8 @@
 // row. The primary ray of pixel (x, y) goes through NDC ((x + 0.5) / W * 2 - 1, (y + 0.5) / H * 2 - 1)
 // (Vulkan: y down, depth in [0, 1]): from the unprojection of NDC depth 0 to that of depth 1 with
 // inverse(scene.camera_view_projection(float(W) / H)), in double precision. The closest hit over
-// [near point, far point] that is opaque (material opacity 1) is the visible surface: translucent
-// surfaces are looked through, as in the renderer's shadow buffer. Back faces are surfaces too: the rasterizer
+// [near point, far point] that is opaque (no opacity below 1, no opacity texture or noise) is the
+// visible surface: translucent surfaces are looked through, as in the renderer's shadow buffer. Back faces are surfaces too: the rasterizer
 // culls the back faces of single-sided materials, which shows the same surface as long as meshes
 // are closed (or seen from their front side); for an open single-sided surface seen from behind
 // the two differ, and the reference shows the surface. The hit point p is the intersection of the
@@ -47,8 +47,9 @@
 //               cosine: visibility, not irradiance. Extent 0 gives the hard shadow.
 //
 //   translucent T(p) = product over every surface crossed by the ray p -> L of (1 - opacity of
-//               its material); a closed mesh is crossed twice. Constant material opacity only
-//               (opacity textures are ignored). At most max_crossings surfaces are counted.
+//               its material: the constant times the opacity texture or
+//               procedural noise at the hit's uv, bilinear with repeat as the renderer samples
+//               it); a closed mesh is crossed twice. At most max_crossings surfaces are counted.
 //
 // Samplers (filtered, soft): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
 // for the first m^2 of the N samples per pixel and independent uniform points for the rest (so a

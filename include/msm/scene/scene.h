@@ -41,6 +41,9 @@
 // <material> = {
 //   "albedo": [r,g,b] in [0,1] (default [0.8,0.8,0.8]), "albedo_texture": "path.png",
 //   "opacity": 1 in [0,1], "opacity_texture": "alpha.png" (alpha channel, or the grey value),
+//   "opacity_noise": {"seed": 1, "scale": 4, "octaves": 4, "density": 0.5, "softness": 0.25}
+//                                          procedural puff of smoke instead of a texture file
+//                                          (see make_smoke_opacity); at most one of the two,
 //   (a constant given together with a texture multiplies it)
 //   "double_sided": false
 // }
@@ -92,6 +95,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -139,13 +143,25 @@ struct Mesh {
   Bounds bounds() const;
 };
 
+// A procedural opacity texture: a round puff of smoke (fractal value noise under a soft disc).
+struct SmokeNoise {
+  std::uint32_t seed = 1;
+  float scale = 4.0f;    // noise cells across the texture, (0, 64]
+  int octaves = 4;       // 1..8
+  float density = 0.5f;  // noise level at which the opacity is one half, [0, 1]
+  float softness = 0.25f; // width of the noise-to-opacity ramp, (0, 1]
+};
+
 struct Material {
   std::string name;                     // key in "materials", or empty for inline ones
   glm::vec3 albedo{0.8f};
   std::filesystem::path albedo_texture; // absolute or relative to the CWD; empty = none
   float opacity = 1.0f;
   std::filesystem::path opacity_texture;
+  std::optional<SmokeNoise> opacity_noise; // procedural opacity (instead of opacity_texture)
   bool double_sided = false;
+  // Opacity below 1 somewhere: a constant below 1, a texture or procedural noise.
+  bool translucent() const { return opacity < 1.0f || !opacity_texture.empty() || opacity_noise.has_value(); }
 };
 
 struct Transform {
@@ -246,5 +262,18 @@ struct Image {
   std::vector<std::uint8_t> rgba;
 };
 Image load_texture(const std::filesystem::path& file);
+
+// The opacity texture of a material (from its file or its procedural noise), as 8-bit values
+// (the alpha channel of the file, or its red channel where alpha is all 255); width 0 if none.
+// The renderer uploads it and the ray tracer samples it (bilinear, repeat), so both see the same
+// opacity.
+struct OpacityImage {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> values;
+  float sample(glm::vec2 uv) const; // bilinear with repeat, in [0, 1]; 1 if empty
+};
+OpacityImage opacity_image(const Material& material);
+// 128² procedural smoke: deterministic for its parameters.
+OpacityImage make_smoke_opacity(const SmokeNoise& noise);
 
 }  // namespace msm::scene
