@@ -90,7 +90,7 @@ void add_bench(CLI::App& app) {
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
-    const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve", "blur", "mipmaps",
+    const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve", "translucent", "blur", "mipmaps",
                                                     "one_pass_filter"};
 
     // A progress line: rewritten in place on a terminal, one line per step in a log.
