@@ -1,0 +1,191 @@
+// Moment soft shadow mapping, the per-pixel math (JCGT 2017 §4.3-4.5, App. D.4; Kneiphof et al.
+// 2017 §3.2, §4.2): blocker search region, average blocker depth, penumbra (filter) size, umbra
+// early-out, depth bias, final shadow intensity; for a directional area light and an
+// orthographic shadow map whose summed-area tables are built as in sat.h. Functions only: the
+// inputs are values the caller has already fetched, so the CPU and any shader call the same code.
+// Shared by GLSL and C++ (see shared.h).
+//
+// ---- Geometry: how far blockers reach (directional area light, orthographic shadow map) ----
+// The light is the set of directions ℓ + a X + b Y, with ℓ the unit vector towards the light, X
+// and Y the shadow map's axes and (a, b) in a disc of radius tan(θ/2) (θ the angular diameter) or
+// in the rectangle [-tan(θx/2), tan(θx/2)] × [-tan(θy/2), tan(θy/2)]: a planar emitter at infinity,
+// the model of msm::reference's soft effect. Depth grows away from the light. From a receiver p at
+// depth d_f (world units along ℓ), the ray towards light point (a, b), p + s (ℓ + a X + b Y),
+// reaches depth d_f - s at lateral offset s (a, b). So a blocker at depth d_b < d_f can occlude p
+// only within lateral distance (d_f - d_b) tan(θ/2) of p's shadow-map position, and for a planar
+// blocker at d_b the visible fraction of the light is exactly the unoccluded fraction of that
+// disc (or rectangle) on the blocker's plane. In texels, with w_d world units per unit of depth
+// (of the depth convention used: the frustum's depth range / 2 for [-1,1] depth) and w_t world
+// units per texel (frustum width / resolution, per axis):
+//     half-width in texels = spread · (zf - z_b),   spread = tan(θ/2) · w_d / w_t   (per axis).
+//  - blocker search (JCGT §4.3, PCSS [Fernando 2005]): blockers can lie anywhere from the near
+//    plane z_near (-1 in [-1,1] depth) to zf, the farthest reaching at z_near: half-width
+//    spread · (zf - z_near);
+//  - filter (penumbra estimation): all blockers assumed at the average blocker depth z_avg:
+//    half-width spread · (zf - z_avg). Kneiphof Eq. (5), sz_f = sz_L (d - z_avg) / d, is the
+//    same similar triangles for a light of size sz_L at distance d; at infinity sz_L / d becomes
+//    2 tan(θ/2) (full width = 2 × half-width).
+// The tables give box filters: exact for a rectangular light (JCGT §4.6.3); for a disc light a
+// box of the disc's radius covers the disc (pass tan(θ/2)·√π/2 instead for a box of equal area).
+//
+// ---- Kernel size limits ----
+// sat.h's queries are exact for rectangles of at most n_t texels. A region of width L texels
+// starting anywhere touches at most floor(L) + 2 texels, and at most L + 1 if L is an integer;
+// so half-widths are clamped to (W - 1) / 2 for a kernel of at most W texels per axis
+// (n_t = W², e.g. W = 27: JCGT's 27² search region): every query then touches <= W × W texels.
+// They are also at least 0.5 texel: a one-texel box with fractional borders is bilinear
+// interpolation of the moment map, the hard-shadow limit at contact points.
+#ifndef MSM_SOFT_H
+#define MSM_SOFT_H
+#include "msm/shared.h"
+#include "msm/config.h"
+#include "msm/moments.h"
+#include "msm/quantize.h"
+#include "msm/bias.h"
+#include "msm/hamburger4.h"
+#include "msm/hamburger6.h"
+#include "msm/blocker.h"
+#include "msm/baselines.h"
+#include "msm/sat.h"
+
+MSM_BEGIN
+
+// JCGT §4.5: a blocker search whose shadow intensity exceeds 1 - ε_u means the whole search
+// region occludes the fragment (umbra): it returns full shadow without filtering. To match, the
+// filtered intensities are over-darkened by 1 / (1 - ε_u) ("division of the shadow intensity by
+// 99% or less"), so that the filtered result reaches 1 where the early-out would start.
+const float MSM_SOFT_UMBRA_EPSILON = 0.01f;
+
+// Texels of lateral reach per unit of depth difference, per axis (see the top of the file).
+// tan_half_extent: tan(θ/2) of a disc light (both components), or of each half angle of a
+// rectangular light along the map's x and y; world_per_depth: world units per unit of depth
+// (frustum depth range / 2 for [-1,1] depth, / 1 for [0,1]); world_per_texel: frustum width and
+// height over the resolution.
+MSM_FN vec2 msm_soft_spread(vec2 tan_half_extent, float world_per_depth, vec2 world_per_texel) {
+    return tan_half_extent * world_per_depth / world_per_texel;
+}
+
+// spread · depth_distance, clamped to [0.5, (W - 1) / 2] texels with W = max_kernel_width >= 2
+// (the queries then touch at most W texels per axis: n_t = W²). Negative distances (a blocker
+// depth behind the receiver: not a blocker) give the minimum.
+MSM_FN vec2 msm_soft_kernel_half_width(vec2 spread, float depth_distance, int max_kernel_width) {
+    float largest = max(0.5f * float(max_kernel_width - 1), 0.5f);
+    vec2 h = spread * max(depth_distance, 0.0f);
+    return vec2(min(max(h.x, 0.5f), largest), min(max(h.y, 0.5f), largest));
+}
+
+// Blocker search half-width: blockers between the near plane (near_depth; -1 for [-1,1] depth)
+// and the fragment depth zf.
+MSM_FN vec2 msm_soft_search_half_width(vec2 spread, float zf, float near_depth, int max_kernel_width) {
+    return msm_soft_kernel_half_width(spread, zf - near_depth, max_kernel_width);
+}
+
+// Penumbra (filter) half-width for blockers at the average blocker depth.
+MSM_FN vec2 msm_soft_penumbra_half_width(vec2 spread, float zf, float blocker_depth, int max_kernel_width) {
+    return msm_soft_kernel_half_width(spread, zf - blocker_depth, max_kernel_width);
+}
+
+// A region [center - h, center + h] in texel units (texel i covers [i, i + 1); a shadow-map
+// coordinate uv in [0,1]² is at uv · size), clamped to the map [0, size]: near the edges only the
+// part inside is averaged. The center is clamped into the map first, so with h >= 0.5 the region
+// keeps a width of at least 0.5 and lo < hi (sat.h's precondition).
+struct SoftRegion {
+    vec2 lo;
+    vec2 hi;
+};
+MSM_FN SoftRegion msm_soft_region(vec2 center, vec2 half_width, ivec2 size) {
+    vec2 extent = vec2(size);
+    vec2 c = clamp(center, vec2(0.0f), extent);
+    return SoftRegion(max(c - half_width, vec2(0.0f)), min(c + half_width, extent));
+}
+
+// The grid-aligned blocker search rectangle (JCGT §4.5): one 4-lookup query (sat.h).
+MSM_FN SatRect msm_soft_search_rect(vec2 center, vec2 half_width, ivec2 size) {
+    SoftRegion r = msm_soft_region(center, half_width, size);
+    return msm_sat_grid_rect(r.lo, r.hi, size);
+}
+
+// ---- Moments from the tables ----
+// Averages from sat.h are Θ4* (Θ6*) moments in [0,1]; Θ is affine, so the inverse of the average
+// is the average of the moments. Biasing (bias.h): four moments with MSM_REP_SAT_INT32 (JCGT §4.2:
+// α = 6e-7 at ~22.4 bits). Six moments: no paper gives α for integer tables. Scaling the 16-bit
+// values by the precision gained predicts it: 4 moments 6e-5 · 2^-(22.4-16) = 7.1e-7 (JCGT's 6e-7),
+// 6 moments 8e-5 · 2^-6.4 = 9.5e-7, below float's 5e-6, whose own rounding then dominates: the
+// float bias MSM_REP6_FLOAT (soft_test checks it on single depths and flat receivers).
+MSM_FN vec4 msm_soft_moments4(vec4 q) {
+    return msm_apply_bias(msm_theta4_star_inverse(q), msm_moment_bias(MSM_REP_SAT_INT32));
+}
+MSM_FN Moments6 msm_soft_moments6(Moments6 q) {
+    return msm_apply_bias6(msm_theta6_star_inverse(q), msm_moment_bias6(MSM_REP6_FLOAT));
+}
+
+// ---- Average blocker depth (blocker.h: JCGT Eq. (4), Kneiphof Eq. (19)) ----
+// q: the search region's average Θ4* / Θ6* moments; zf: the UNBIASED fragment depth ([-1,1]).
+MSM_FN BlockerResult msm_soft_blocker4(vec4 q, float zf) {
+    return msm_blocker4(msm_soft_moments4(q), zf, MSM_BLOCKER_EPSILON);
+}
+MSM_FN BlockerResult msm_soft_blocker6(Moments6 q, float zf) {
+    return msm_blocker6(msm_soft_moments6(q), zf, MSM_BLOCKER_EPSILON);
+}
+// Kneiphof Eq. (19) with the mass at zf clamped to [delta1, delta2] (0 < delta1 <= delta2):
+// between Eq. (4) with ε = delta1 and Eq. (4) with ε = delta2 on the same reconstruction, so never
+// farther from the receiver than Eq. (4) with ε = delta1 (harder shadows when in doubt).
+MSM_FN BlockerResult msm_soft_blocker6_upper(Moments6 q, float zf, float delta1, float delta2) {
+    return msm_blocker6_upper(msm_soft_moments6(q), zf, delta1, delta2);
+}
+MSM_FN BlockerResult msm_soft_blocker4_upper(vec4 q, float zf, float delta1, float delta2) {
+    return msm_blocker4_upper(msm_soft_moments4(q), zf, delta1, delta2);
+}
+
+// Umbra early-out (JCGT §4.5): the search region's shadow intensity above 1 - ε_u.
+MSM_FN bool msm_soft_in_umbra(BlockerResult blocker, float umbra_epsilon) {
+    return blocker.shadow > 1.0f - umbra_epsilon;
+}
+
+// ---- Depth bias growing with the filter size (JCGT §4.4, Fig. 11) ----
+// A planar receiver whose depth changes by g.x, g.y per texel along the map's axes covers depths
+// zf ± (|g.x| h.x + |g.y| h.y) over a filter of half-widths h: up to half the filter region lies
+// in front of zf (closer to the light) and would shadow the receiver itself. The texels that the
+// region touches hold their own averages, whose centres lie up to h + 1/2 texel from the fragment.
+// Testing at
+//     zf - bias,   bias = constant_bias + |g.x| (h.x + 1/2) + |g.y| (h.y + 1/2)
+// (the fragment moved towards the light, as every depth bias in msm; the constant covers rounding
+// and the moment bias) avoids it: no texel of the receiver's own plane is below zf - bias.
+// JCGT's choice, proportional to the filter size and not adaptive, is a fixed g = the steepest
+// slope to tolerate (tan(angle of incidence) · w_t / w_d per texel; 80° needs 5.67 w_t / w_d);
+// passing the receiver plane's own gradient makes it adaptive (Dou et al. 2014). The blocker
+// search keeps the unbiased depth (blocker.h).
+MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float constant_bias) {
+    return constant_bias + abs(depth_per_texel.x) * (half_width.x + 0.5f) + abs(depth_per_texel.y) * (half_width.y + 0.5f);
+}
+
+// ---- Shadow intensity from the filtered moments ----
+// q: the filter region's average Θ4* (Θ6*) moments (msm_sat_filter_average); zf_biased: the
+// fragment depth minus msm_soft_depth_bias. Hamburger lower bound (JCGT App. D.4), over-darkened by
+// 1 / (1 - ε_u) to match the umbra early-out.
+MSM_FN float msm_soft_shadow4(vec4 q, float zf_biased, float umbra_epsilon) {
+    return msm_overdarken(msm_hamburger4_lower(msm_soft_moments4(q), zf_biased), 1.0f - umbra_epsilon);
+}
+MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon) {
+    return msm_overdarken(msm_hamburger6_lower(msm_soft_moments6(q), zf_biased), 1.0f - umbra_epsilon);
+}
+
+// The whole per-pixel flow, with S(x, y) a fetch from the table (0 where x or y is -1), size the
+// map's size, W the kernel width the table was built for (n_t = W²), scale = msm_sat_scale(W * W):
+//   vec2 spread = msm_soft_spread(tan_half_extent, world_per_depth, world_per_texel); // per light
+//   vec2 hs = msm_soft_search_half_width(spread, zf, -1.0f, W);
+//   SatRect r = msm_soft_search_rect(uv * vec2(size), hs, size);
+//   uvec4 sum = msm_sat_rect_sum(S(r.hi.x, r.hi.y), S(r.lo.x - 1, r.hi.y), S(r.hi.x, r.lo.y - 1),
+//                                S(r.lo.x - 1, r.lo.y - 1));
+//   BlockerResult blocker = msm_soft_blocker4(msm_sat_rect_average(sum, msm_sat_rect_texels(r), scale), zf);
+//   if (msm_soft_in_umbra(blocker, MSM_SOFT_UMBRA_EPSILON)) return 1.0f;
+//   vec2 hp = msm_soft_penumbra_half_width(spread, zf, blocker.depth, W);
+//   SoftRegion region = msm_soft_region(uv * vec2(size), hp, size);
+//   SatFilter f = msm_sat_filter(region.lo, region.hi);
+//   SatSamples16 t; for j, i in 0..3: t.s[4 * j + i] = S(f.x[i], f.y[j]);
+//   float zb = zf - msm_soft_depth_bias(hp, receiver_gradient, constant_bias);
+//   return msm_soft_shadow4(msm_sat_filter_average(t, f, scale), zb, MSM_SOFT_UMBRA_EPSILON);
+
+MSM_END
+
+#endif // MSM_SOFT_H

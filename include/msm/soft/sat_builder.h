@@ -1,0 +1,72 @@
+// Integer summed-area tables of moment shadow maps on the device (JCGT 2017 §4.2, Appendix C),
+// and the same tables on the CPU. The per-texel math (quantization, wrap-around, queries) is
+// include/msm/sat.h, shared with the shaders; the shaders are src/soft/shaders/sat_*.comp.
+//
+//   msm::soft::SatBuilder sat(ctx);
+//   sat.record(cmd, moments, table, 27 * 27, msm::soft::SatBuilder::Scheme::Blocks, &timer);
+//
+// Six moments (Θ6*, sat.h's msm_sat_split6): two moment images and two tables; record each pair
+// (or use the overload with two pairs, whose passes run side by side).
+#pragma once
+
+#include "msm/vk/context.h"
+#include "msm/vk/program.h"
+#include "msm/vk/resources.h"
+#include "msm/vk/timer.h"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace msm::soft {
+
+class SatBuilder {
+public:
+  enum class Scheme {
+    // Two passes, one thread per row, then one per column (Klehm et al. 2014; JCGT §4.2, App. D.4).
+    // Timer scopes "sat_rows" and "sat_columns".
+    RowsThenColumns,
+    // JCGT Appendix C: 8 × 8 workgroups walking 8 × 8 blocks, eight threads per row (then per
+    // column), each writing one prefix sum per block. Timer scope "sat_blocks" (both passes).
+    Blocks,
+  };
+
+  // Creates the four compute pipelines and a nearest sampler.
+  explicit SatBuilder(const vk::Context& ctx);
+
+  // Records the passes that fill `table` with the summed-area table of `moments` for kernels of
+  // at most max_kernel_texels texels (n_t; sat.h: quantization scale floor((2^32 - 1) / n_t)).
+  //  - moments: RGBA32_SFLOAT, RG32_SFLOAT, RGBA16_UNORM or RG16_UNORM (RG images count as
+  //    (r, g, 0, 0); UNORM codes are decoded as the C++ build decodes them, sat.h), SAMPLED usage, mip 0 is
+  //    read, in moments_layout (GENERAL or SHADER_READ_ONLY_OPTIMAL); the caller's barrier has
+  //    made its writes visible to compute-shader sampled reads.
+  //  - table: RGBA32_UINT, the same width and height, STORAGE usage, one mip. Its contents and
+  //    layout on entry do not matter (record() discards them: a barrier from UNDEFINED that waits
+  //    for earlier writes); on exit it is in GENERAL, written by the COMPUTE_SHADER stage
+  //    (SHADER_STORAGE_WRITE): the caller's barrier makes that visible to its readers.
+  //  - timer: if given, scopes as listed with the schemes (reset() is the caller's).
+  // Throws std::invalid_argument for other formats, mismatched sizes or max_kernel_texels < 1.
+  void record(VkCommandBuffer cmd, const vk::Image& moments, const vk::Image& table, int max_kernel_texels,
+              Scheme scheme, vk::GpuTimer* timer = nullptr,
+              VkImageLayout moments_layout = VK_IMAGE_LAYOUT_GENERAL) const;
+
+  // Several images (e.g. the two of six moments) at once: each pass is dispatched for every pair
+  // before the barrier that separates the passes. Preconditions as above, per pair.
+  void record(VkCommandBuffer cmd, std::span<const vk::Image* const> moments, std::span<const vk::Image* const> tables,
+              int max_kernel_texels, Scheme scheme, vk::GpuTimer* timer = nullptr,
+              VkImageLayout moments_layout = VK_IMAGE_LAYOUT_GENERAL) const;
+
+private:
+  vk::Program rows_, columns_, blockRows_, blockColumns_;
+  vk::Sampler sampler_;
+};
+
+// The table on the CPU, with sat.h's msm_sat_quantize: row-major, width × height texels of moments
+// (Θ4*, or half of Θ6*) in; the same layout of uvec4 out. A table built by SatBuilder from the same
+// values (a float image, or a UNORM16 image whose texels are given here as msm_unpack_unorm16x4
+// decodes them) is bitwise equal. Precondition: moments.size() == width * height.
+std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int width, int height, int max_kernel_texels);
+
+} // namespace msm::soft

@@ -1,0 +1,135 @@
+#include "msm/soft/sat_builder.h"
+
+#include "msm/sat.h"
+#include "msm/vk/commands.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace msm::soft {
+
+namespace {
+
+// The push constants of every sat_*.comp (shaders/sat_common.glsl).
+struct SatPush {
+  glm::ivec2 size;
+  uint32_t scale;
+  uint32_t flags; // 1: UNORM16 texels, 2: two channels (RG)
+};
+static_assert(sizeof(SatPush) == 16, "SatPush must match the shaders' push constant block");
+
+bool unorm16Format(VkFormat format) {
+  return format == VK_FORMAT_R16G16B16A16_UNORM || format == VK_FORMAT_R16G16_UNORM;
+}
+bool floatFormat(VkFormat format) {
+  return format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32_SFLOAT;
+}
+
+void check(const vk::Image& moments, const vk::Image& table, int maxKernelTexels) {
+  const char* where = "msm::soft::SatBuilder::record: ";
+  if (!moments || !table) throw std::invalid_argument(std::string(where) + "null image");
+  if (!unorm16Format(moments.format()) && !floatFormat(moments.format()))
+    throw std::invalid_argument(std::string(where) + "moments must be RGBA32_SFLOAT, RG32_SFLOAT, RGBA16_UNORM or RG16_UNORM");
+  if (!(moments.desc().usage & VK_IMAGE_USAGE_SAMPLED_BIT))
+    throw std::invalid_argument(std::string(where) + "moments need SAMPLED usage");
+  if (table.format() != VK_FORMAT_R32G32B32A32_UINT)
+    throw std::invalid_argument(std::string(where) + "the table must be RGBA32_UINT");
+  if (!(table.desc().usage & VK_IMAGE_USAGE_STORAGE_BIT) || table.desc().mipLevels != 1 || table.desc().layers != 1)
+    throw std::invalid_argument(std::string(where) + "the table needs STORAGE usage, one mip and one layer");
+  if (moments.width() != table.width() || moments.height() != table.height())
+    throw std::invalid_argument(std::string(where) + "moments and table differ in size");
+  if (maxKernelTexels < 1) throw std::invalid_argument(std::string(where) + "max_kernel_texels < 1");
+}
+
+} // namespace
+
+SatBuilder::SatBuilder(const vk::Context& ctx)
+    : rows_(vk::createProgram(ctx, "sat_rows.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
+                              sizeof(SatPush))),
+      columns_(vk::createProgram(ctx, "sat_columns.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
+      blockRows_(vk::createProgram(ctx, "sat_block_rows.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
+                                   sizeof(SatPush))),
+      blockColumns_(vk::createProgram(ctx, "sat_block_columns.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
+      sampler_(vk::createSampler(ctx, VK_FILTER_NEAREST)) {}
+
+void SatBuilder::record(VkCommandBuffer cmd, const vk::Image& moments, const vk::Image& table, int max_kernel_texels,
+                        Scheme scheme, vk::GpuTimer* timer, VkImageLayout moments_layout) const {
+  const vk::Image* m[] = {&moments};
+  const vk::Image* t[] = {&table};
+  record(cmd, m, t, max_kernel_texels, scheme, timer, moments_layout);
+}
+
+void SatBuilder::record(VkCommandBuffer cmd, std::span<const vk::Image* const> moments,
+                        std::span<const vk::Image* const> tables, int max_kernel_texels, Scheme scheme,
+                        vk::GpuTimer* timer, VkImageLayout moments_layout) const {
+  if (moments.size() != tables.size())
+    throw std::invalid_argument("msm::soft::SatBuilder::record: as many tables as moment images");
+  for (size_t i = 0; i < moments.size(); ++i) {
+    if (!moments[i] || !tables[i]) throw std::invalid_argument("msm::soft::SatBuilder::record: null image");
+    check(*moments[i], *tables[i], max_kernel_texels);
+  }
+  if (moments.empty()) return;
+  const uint32_t scale = msm_sat_scale(max_kernel_texels);
+  const VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
+  auto push = [&](size_t i) {
+    const vk::Image& m = *moments[i];
+    bool two = m.format() == VK_FORMAT_R32G32_SFLOAT || m.format() == VK_FORMAT_R16G16_UNORM;
+    return SatPush{glm::ivec2(int(m.width()), int(m.height())), scale, (unorm16Format(m.format()) ? 1u : 0u) | (two ? 2u : 0u)};
+  };
+
+  // Discard the tables' contents (UNDEFINED), after every earlier access to them.
+  for (const vk::Image* table : tables)
+    vk::pipelineBarrier(cmd, vk::imageBarrier(table->handle(), table->aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                              VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                              VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                              VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
+  // Pass 1 writes every texel; pass 2 reads and rewrites them in place.
+  const VkMemoryBarrier2 between =
+      vk::memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+
+  if (scheme == Scheme::RowsThenColumns) {
+    if (timer) timer->begin(cmd, "sat_rows");
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, rows_, vk::groupCount(moments[i]->height(), 64), 1, 1,
+                   {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)}, push(i));
+    if (timer) timer->end(cmd);
+    vk::pipelineBarrier(cmd, between);
+    if (timer) timer->begin(cmd, "sat_columns");
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, columns_, vk::groupCount(moments[i]->width(), 64), 1, 1, {vk::Descriptor(*tables[i], general)},
+                   push(i));
+    if (timer) timer->end(cmd);
+  } else {
+    if (timer) timer->begin(cmd, "sat_blocks");
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, blockRows_, vk::groupCount(moments[i]->height(), 8), 1, 1,
+                   {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)}, push(i));
+    vk::pipelineBarrier(cmd, between);
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, blockColumns_, vk::groupCount(moments[i]->width(), 8), 1, 1,
+                   {vk::Descriptor(*tables[i], general)}, push(i));
+    if (timer) timer->end(cmd);
+  }
+}
+
+std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int width, int height, int max_kernel_texels) {
+  if (width < 0 || height < 0 || moments.size() != size_t(width) * size_t(height))
+    throw std::invalid_argument("msm::soft::build_sat_cpu: moments.size() != width * height");
+  const uint32_t scale = msm_sat_scale(max_kernel_texels);
+  std::vector<glm::uvec4> table(moments.size());
+  for (int y = 0; y < height; ++y) {
+    glm::uvec4 sum(0u);
+    for (int x = 0; x < width; ++x) {
+      size_t i = size_t(y) * size_t(width) + size_t(x);
+      sum += msm_sat_quantize(moments[i], scale); // wraps modulo 2^32, as on the device
+      table[i] = sum;
+    }
+  }
+  for (int y = 1; y < height; ++y)
+    for (int x = 0; x < width; ++x) table[size_t(y) * size_t(width) + size_t(x)] += table[size_t(y - 1) * size_t(width) + size_t(x)];
+  return table;
+}
+
+} // namespace msm::soft
