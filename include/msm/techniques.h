@@ -47,6 +47,11 @@ const int MSM_TECH_MSM6_96 = 20;   // six moments, 6 x UNORM16 after Θ6*
 // Non-linearly quantized four moments (HPG 2017), [-1,1]: filtered float moments -> Φ -> storage.
 const int MSM_TECH_NL64 = 21;      // RGBA16_UNORM: y1, y2, v2, Ψ4(ξ4)
 const int MSM_TECH_NL32 = 22;      // R32_UINT: folded 10-bit depths, √v2, Ψ4 (HPG §3.5)
+// Moment soft shadows (JCGT §4): Θ4* moments in an integer summed-area table (sat.h, soft.h).
+const int MSM_TECH_MSSM4 = 23;
+
+// Soft shadows from a summed-area table instead of a filtered map.
+MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4; }
 
 struct MsmTexel {
     vec4 a;
@@ -104,7 +109,8 @@ MSM_FN MsmTexel msm_technique_generate(int t, float unit_depth, vec4 params) {
         return MsmTexel(msm_moments4(z), zero);
     if (t == MSM_TECH_HAMBURGER_64_THETA4 || t == MSM_TECH_HAUSDORFF_64_THETA4)
         return MsmTexel(msm_theta4(msm_moments4(unit_depth)), zero);
-    if (t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_64) return MsmTexel(msm_theta4_star(msm_moments4(z)), zero);
+    if (t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_64 || t == MSM_TECH_MSSM4)
+        return MsmTexel(msm_theta4_star(msm_moments4(z)), zero);
     if (t == MSM_TECH_TMSM_128) return MsmTexel(msm_trig_moments(unit_depth), zero);
     if (t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96) {
         Moments6 m = msm_moments6(z);

@@ -68,7 +68,8 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
   // The non-linear maps are never interpolated by the hardware (and have no mips): they are
   // decoded first.
   bool nonlinear = msm_technique_is_nonlinear(c.technique ? c.technique->id : 0);
-  bool can_mip = c.mipmaps && !nonlinear;
+  bool soft = msm_technique_is_soft(c.technique ? c.technique->id : 0);
+  bool can_mip = c.mipmaps && !nonlinear && !soft;
   for (int i = 0; i < c.moment_images(); ++i) {
     auto format = VkFormat(c.formats()[size_t(i)]);
     VkFormatFeatureFlags need = VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT | VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
@@ -87,11 +88,14 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
               .mipLevels = mip_levels});
     moments_mip0[size_t(i)] = vk::createImageView(ctx, moments[size_t(i)].handle(), moments[size_t(i)].format(),
                                                   VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);
-    if (c.taps > 1 && !c.one_pass)
+    if (c.taps > 1 && !c.one_pass && !soft)
       blur_temp[size_t(i)] = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_R32G32B32A32_SFLOAT,
                                                    .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
   }
 
+  if (soft)
+    sat_table = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_R32G32B32A32_UINT,
+                                      .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
   uint32_t w = uint32_t(c.width), h = uint32_t(c.height);
   color = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R8G8B8A8_SRGB,
                                 .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});

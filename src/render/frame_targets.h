@@ -32,6 +32,7 @@ struct FrameTargets {
   vk::Image color;                     // RGBA8 sRGB
   vk::Image shadow_buffer;             // RG32F: visibility, coverage
   vk::Image camera_depth;              // D32
+  vk::Image sat_table;                 // RGBA32_UINT summed-area table (soft shadows only)
   uint32_t mip_levels = 1;
   vk::Sampler point_sampler, moment_sampler;
 

@@ -6,6 +6,7 @@
 #include "gpu_scene.h"
 #include "msm/render/blue_noise.h"
 #include "msm/render/frame.h"
+#include "msm/soft.h"
 #include "msm/techniques.h"
 #include "passes/pass.h"
 
@@ -20,7 +21,7 @@
 namespace msm::render {
 
 // std140 and the C++ struct agree (frame.h uses vec4/ivec4/mat4 members only).
-static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 16 + 4 * 16);
+static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 3 * 16 + 4 * 16);
 static_assert(offsetof(FrameUniforms, kernel) == 3 * 64 + 6 * 16);
 static_assert(offsetof(FrameUniforms, filter_weights) == 3 * 64 + 7 * 16);
 static_assert(sizeof(ObjectPush) == 32 && sizeof(ImagePassPush) == 16);
@@ -87,6 +88,7 @@ struct Renderer::Impl {
   std::map<std::tuple<int, int, int>, std::unique_ptr<OnePassFilterPass>> one_pass_passes;
   vk::Image noise;
   std::unique_ptr<BlurPass> blur_pass;
+  std::unique_ptr<SatPass> sat_pass;
   std::unique_ptr<vk::Program> depth_copy;
   MipmapPass mipmap_pass;
 
@@ -124,8 +126,23 @@ struct Renderer::Impl {
     glm::mat4 inverse = glm::inverse(light_view_projection);
     float texel = glm::length(glm::vec3(inverse * glm::vec4(2.0f, 0.0f, 0.0f, 0.0f))) / float(s.shadow_size);
     bool depth_based = msm_technique_is_depth_based(technique.id);
-    float depth_bias = s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f);
-    u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel, depth_bias);
+    bool soft = msm_technique_is_soft(technique.id);
+    // Soft shadows: the constant part of msm_soft_depth_bias, in [-1,1] depth (the 32-bit table
+    // keeps ~22 bits of a 27² kernel's moments, plus the moment bias).
+    float depth_bias = s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : soft ? 1e-3f : 0.0f);
+    u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel,
+                             soft ? 0.0f : depth_bias);
+    if (soft) {
+      // soft.h: texels of reach per unit of [-1,1] depth = tan(θ/2) w_d / w_t.
+      float extent = s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg;
+      float tan_half = std::tan(glm::radians(extent) * 0.5f);
+      float world_per_depth = 0.5f * glm::length(glm::vec3(inverse * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f)));
+      float texel_y = glm::length(glm::vec3(inverse * glm::vec4(0.0f, 2.0f, 0.0f, 0.0f))) / float(s.shadow_size);
+      u.soft = glm::vec4(tan_half * world_per_depth / texel, tan_half * world_per_depth / texel_y, depth_bias,
+                         MSM_SOFT_UMBRA_EPSILON);
+      uint32_t scale = 0xFFFFFFFFu / uint32_t(s.soft_kernel * s.soft_kernel);
+      u.soft_kernel = glm::ivec4(s.soft_kernel, int(scale), 0, 0); // the uint's bits
+    }
     u.shading = glm::vec4(s.overdarken, s.exposure, s.translucent_alpha_threshold, 0.0f);
     u.background = glm::vec4(0.55f, 0.65f, 0.8f, 1.0f);
     int radius = s.filter_size / 2;
@@ -192,6 +209,7 @@ struct Renderer::Impl {
           return std::make_unique<TranslucentPass>(ctx, technique, s.msaa, split, config.formats());
         });
       if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
+      if (msm_technique_is_soft(technique.id) && !sat_pass) sat_pass = std::make_unique<SatPass>(ctx);
     }
     cached(shading_passes, std::tuple(technique.id, s.msaa, split),
            [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa, split); });
@@ -214,6 +232,11 @@ struct Renderer::Impl {
       resolve_passes.at({technique.id, s.msaa, split})->execute(f);
       if (until_resolve) return;
       if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
+      if (msm_technique_is_soft(technique.id)) {
+        sat_pass->execute(f, s.soft_kernel * s.soft_kernel);
+        shading_passes.at({technique.id, s.msaa, split})->execute(f);
+        return;
+      }
       if (s.filter_size > 1) blur_pass->execute(f);
       mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
     }

@@ -58,6 +58,9 @@ constexpr Technique kTechniques[] = {
      {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM}, kMoment},
     {"msm-nl64", "Non-linearly quantized 4MSM, RGBA16 UNORM (y1, y2, v2, Ψ4(ξ4)), one-pass filter, dithered lookup "
                  "(HPG 2017)", MSM_TECH_NL64, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, ""},
+    {"mssm4", "Moment soft shadow mapping (JCGT §4): Θ4* moments in a 32-bit integer summed-area table, blocker "
+              "search, nine-region filter over the penumbra of a directional area light (--light-extent)",
+     MSM_TECH_MSSM4, 128, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, ""},
     {"msm-nl32", "Non-linearly quantized 4MSM, R32 UINT (folded 10-bit depths, √v2, Ψ4), one-pass filter, dithered "
                  "lookup (HPG 2017)", MSM_TECH_NL32, 32, {VK_FORMAT_R32_UINT, kNone}, ""},
 };
@@ -76,7 +79,8 @@ const Technique& find_technique(std::string_view name) {
 }
 
 bool supports_translucency(const Technique& t) {
-  return !msm_technique_is_depth_based(t.id) && !msm_technique_is_nonlinear(t.id) && t.formats[1] == 0;
+  return !msm_technique_is_depth_based(t.id) && !msm_technique_is_nonlinear(t.id) && !msm_technique_is_soft(t.id) &&
+         t.formats[1] == 0;
 }
 
 glm::vec4 default_params(const Technique& technique) { return msm_technique_default_params(technique.id); }
@@ -107,6 +111,10 @@ void RenderSettings::validate() const {
   if (one_pass && !*one_pass && nonlinear)
     throw RenderError(fmt::format("{} needs the one-pass filter (it stores Φ of the filtered moments)", technique));
   bool uses_one_pass = one_pass.value_or(nonlinear);
+  if (uses_one_pass && msm_technique_is_soft(t.id))
+    throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
+  if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
+  range("soft kernel", soft_kernel, 3, 255);
   if (uses_one_pass && (t.formats[0] == 0 || t.formats[1] != 0))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
   if (uses_one_pass && filter_size > kMaxOnePassTaps)

@@ -29,6 +29,10 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
                                          "nearest, dither")->capture_default_str();
   cmd->add_option("--filter-mode", o.filter_mode, "auto (one-pass for msm-nl*), one-pass (resolve + blur in shared "
                                                   "memory), three-pass (resolve, blur H, blur V)")->capture_default_str();
+  cmd->add_option("--light-extent", s.light_extent_deg, "Angular diameter of the light in degrees, for soft "
+                                                      "shadows (default: the scene's)");
+  cmd->add_option("--soft-kernel", s.soft_kernel, "Largest soft-shadow kernel width in texels (n_t = W²)")
+      ->capture_default_str();
   cmd->add_option("--frame", s.frame, "Frame number (blue-noise layer and offset)")->capture_default_str();
   cmd->add_option("--device", o.device, "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
 }
@@ -124,6 +128,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                                                                             : "bilinear (auto)"},
           {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
           {"frame", s.frame},
+          {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg},
+          {"soft_kernel", s.soft_kernel},
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
           {"gpu_ms_total", result.total_ms}};

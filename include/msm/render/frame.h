@@ -26,6 +26,9 @@ struct FrameUniforms {
     vec4 filter_weights[16];         // normalized 1D Gaussian weights, tap k at [k / 4][k % 4]
     ivec4 lookup;                    // x: shadow-map lookup (MSM_LOOKUP_*), y: blue-noise layer,
                                      // zw: blue-noise offset in pixels (per frame)
+    vec4 soft;                       // soft shadows: xy: texels of reach per unit of [-1,1] depth
+                                     // (soft.h msm_soft_spread), z: constant depth bias, w: ε_u
+    ivec4 soft_kernel;               // x: kernel width W (n_t = W²), y: table scale (uint bits)
     vec4 sample_offsets[4];          // MSAA sample positions relative to the texel centre, in
                                      // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
 };

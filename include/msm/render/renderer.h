@@ -98,6 +98,10 @@ struct RenderSettings {
   // The depth-based, non-linear and six-moment techniques (and a one-pass filter) draw them
   // without a shadow. Fragments below the threshold opacity are discarded (JCGT: 1%).
   bool translucent_occluders = true;
+  // Soft shadows (mssm4): the directional light's angular diameter in degrees (default: the
+  // scene's angular_extent_deg) and the largest kernel width W in texels (n_t = W²; JCGT: 27).
+  std::optional<float> light_extent_deg;
+  int soft_kernel = 27;
   float translucent_alpha_threshold = 0.01f;
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;

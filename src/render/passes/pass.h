@@ -6,6 +6,9 @@
 #include "../frame_targets.h"
 #include "../gpu_scene.h"
 
+#include "msm/soft/sat_builder.h"
+
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -76,6 +79,18 @@ private:
   vk::Program program_;
 };
 
+// moments mip 0 (unfiltered Θ4*) -> sat_table (GENERAL): the 32-bit integer summed-area table of
+// moment soft shadows (JCGT §4.2, msm::soft::SatBuilder), visible to fragment reads.
+class SatPass {
+public:
+  static const PassDecl& decl();
+  explicit SatPass(const vk::Context& ctx);
+  void execute(FrameContext& f, int max_kernel_texels) const;
+
+private:
+  std::unique_ptr<soft::SatBuilder> builder_;
+};
+
 // moments mip 0 -> blur_temp -> moments mip 0 (GENERAL), visible to transfer, compute, fragment.
 class BlurPass {
 public:
@@ -103,7 +118,7 @@ public:
 
 private:
   vk::Program program_, translucent_program_; // opaque; translucent objects blended over it
-  bool depth_based_, nonlinear_;
+  bool depth_based_, nonlinear_, soft_;
 };
 
 // Scope guard for the timer scope of a pass.

@@ -18,6 +18,7 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_r
   std::string fragment = depth_based                        ? (msaa == 1 ? "shading_depth_1x.frag" : "shading_depth.frag")
                          : technique.id == MSM_TECH_NL64 ? "shading_nl64.frag"
                          : technique.id == MSM_TECH_NL32 ? "shading_nl32.frag"
+                         : msm_technique_is_soft(technique.id) ? "shading_soft.frag"
                                                          : "shading_moments.frag";
   vk::GraphicsDesc d{.name = std::string("shading ") + std::string(technique.name),
                      .vertexShader = "shading.vert",
@@ -49,7 +50,7 @@ ShadingPass::ShadingPass(const vk::Context& ctx, const Technique& technique, int
     : program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, false))),
       translucent_program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, true))),
       depth_based_(msm_technique_is_depth_based(technique.id)),
-      nonlinear_(msm_technique_is_nonlinear(technique.id)) {}
+      nonlinear_(msm_technique_is_nonlinear(technique.id)), soft_(msm_technique_is_soft(technique.id)) {}
 
 void ShadingPass::execute(FrameContext& f) const {
   PassScope scope(f, decl());
@@ -79,7 +80,8 @@ void ShadingPass::execute(FrameContext& f) const {
   vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
   vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
 
-  vk::Descriptor shadow0 = depth_based_
+  vk::Descriptor shadow0 = soft_ ? vk::Descriptor(t.sat_table, VK_IMAGE_LAYOUT_GENERAL, t.point_sampler)
+                          : depth_based_
                                ? vk::Descriptor(t.shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                                 t.point_sampler)
                                : vk::Descriptor(t.moments[0], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
@@ -87,7 +89,7 @@ void ShadingPass::execute(FrameContext& f) const {
   // The second image of 6MSM; the others bind something valid of the declared type (float).
   vk::Descriptor second = t.config.moment_images() > 1
                               ? vk::Descriptor(t.moments[1], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler)
-                          : nonlinear_ ? vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                          : nonlinear_ || soft_ ? vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                                         t.point_sampler)
                                        : shadow0;
   vk::Descriptor noise(f.blue_noise.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
