@@ -82,7 +82,14 @@ void add_demo(CLI::App& app) {
     std::vector<image::Rect> insets = image::find_difference_regions(signals, side, side, 3);
     std::vector<image::Panel> panels;
     std::vector<std::string> pass_names;
-    for (const render::PassTime& p : results[1 < results.size() ? 1 : 0].passes) pass_names.push_back(p.name);
+    // Every pass any technique ran, in the order of a frame.
+    for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur",
+                             "mipmaps", "shading"})
+      for (const render::RenderResult& r : results)
+        if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
+          pass_names.push_back(name);
+          break;
+        }
     std::string header = fmt::format("{:<20} {:>5} {:>8} {:>8} {:>7}", "technique", "bits", "MAE", "leaking", ">3%");
     for (const std::string& p : pass_names) header += fmt::format(" {:>14}", p + " ms");
     fmt::print("\n{} {:>10}\n", header, "total ms");
