@@ -35,14 +35,7 @@ void add_demo(CLI::App& app) {
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
-    for (const std::string& name : opt->techniques) {
-      render::RenderSettings s = settings_for(opt->frame, name);
-      try {
-        s.validate();
-      } catch (const render::RenderError& e) {
-        throw UsageError(e.what());
-      }
-    }
+    validate_techniques(opt->frame, opt->techniques);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);

@@ -44,14 +44,7 @@ void add_render(CLI::App& app) {
     else
       names = split(opt->techniques);
     if (names.empty()) throw UsageError("--technique: no technique given");
-    for (const std::string& name : names) {
-      render::RenderSettings s = settings_for(opt->frame, name);
-      try {
-        s.validate();
-      } catch (const render::RenderError& e) {
-        throw UsageError(e.what());
-      }
-    }
+    validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);

@@ -67,6 +67,16 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
   return s;
 }
 
+void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques) {
+  for (const std::string& name : techniques) {
+    try {
+      settings_for(options, name).validate();
+    } catch (const render::RenderError& e) {
+      throw UsageError(e.what());
+    }
+  }
+}
+
 std::unique_ptr<vk::Context> open_device(const std::string& device) {
   vk::ContextOptions options;
   options.device = device;

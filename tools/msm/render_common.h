@@ -35,6 +35,10 @@ void finish_frame_options(FrameOptions& options);
 // moment image (the depth-based ones and 6MSM keep their own pipeline).
 render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique);
 
+// Every technique's settings are valid, before anything is loaded or created (UsageError naming
+// the first problem otherwise).
+void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques);
+
 // The Vulkan context (validation with MSM_VALIDATION=1); a failure is a UsageError naming devices.
 std::unique_ptr<vk::Context> open_device(const std::string& device);
 // A built-in scene or a scene file; SceneError becomes a UsageError with the loader's message.
