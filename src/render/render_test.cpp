@@ -328,8 +328,8 @@ TEST_F(RenderTest, OnePassFilterEqualsTheThreePassFilter) {
 
 // The non-linear maps from the GPU against the CPU single-source pipeline on the same depth
 // samples. The CPU repeats the one-pass filter's float arithmetic in its order (sum of the
-// samples' moments over the count, then weight x value over the taps k = 0..2R, horizontally,
-// then vertically): the filtered float moments agree to 1e-6 (checked through the linear
+// samples' moments times the reciprocal of the count, then weight x value over the taps
+// k = 0..2R, horizontally, then vertically): the filtered float moments agree to 1e-6 (checked through the linear
 // technique on the same shader path). Φ, however, is ill-conditioned where a texel's depths
 // nearly coincide: its two-depth solve divides by a variance of ~1e-4 and ξ4 is a difference of
 // numbers near 1, so the device's division and square root (GLSL allows 2.5 ulp) move y1 or Ψ4
@@ -349,7 +349,7 @@ TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
     for (int i = 0; i < n * n; ++i) {
       glm::vec4 m(0.0f);
       for (int k = 0; k < msaa; ++k) m += msm_moments4(msm_signed_depth(in.depth_samples[size_t(i * msaa + k)]));
-      resolved[size_t(i)] = m / float(msaa);
+      resolved[size_t(i)] = m * (1.0f / float(msaa));
     }
     auto at = [&](const std::vector<glm::vec4>& v, int x, int y) {
       return v[size_t(std::clamp(y, 0, n - 1) * n + std::clamp(x, 0, n - 1))];

@@ -28,11 +28,8 @@ const int kTileH = kBlockH + 2 * kRadius;
 const int kMaxRadius = 8;                                    // checked by the host
 const int kHorizontalPerThread = (kBlockH + 2 * kMaxRadius) * kBlockW / kThreads; // 4
 
-#ifdef MSM_SINGLE_SAMPLE
-layout(binding = 1) uniform sampler2D depth_map;
-#else
-layout(binding = 1) uniform sampler2DMS depth_map;
-#endif
+#define MSM_DEPTH_BINDING 1
+#include "depth_map.glsl"
 #ifdef MSM_NL32
 layout(binding = 2) writeonly uniform uimage2D target;
 #else
@@ -54,20 +51,6 @@ void store_shared(int i, vec4 v) {
   s3[i] = v.w;
 }
 
-vec4 resolved_moments(ivec2 p) {
-  int samples = frame.kernel.y;
-  vec4 sum = vec4(0.0f);
-  for (int s = 0; s < samples; ++s) {
-#ifdef MSM_SINGLE_SAMPLE
-    float depth = texelFetch(depth_map, p, 0).x;
-#else
-    float depth = texelFetch(depth_map, p, s).x;
-#endif
-    sum += msm_technique_generate(kTechnique, msm_saturate(depth), frame.technique_params).a;
-  }
-  return sum / float(samples);
-}
-
 void main() {
   int index = int(gl_LocalInvocationIndex);
   ivec2 size = pc.size.xy;
@@ -76,7 +59,7 @@ void main() {
   // 1. Resolve the tile (block + apron), clamped to the edge as the three-pass blur is.
   for (int i = index; i < kTileW * kTileH; i += kThreads) {
     ivec2 p = clamp(origin - kRadius + ivec2(i % kTileW, i / kTileW), ivec2(0), size - 1);
-    store_shared(i, resolved_moments(p));
+    store_shared(i, resolved_texel(p).a);
   }
   barrier();
 

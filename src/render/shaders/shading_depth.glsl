@@ -2,20 +2,9 @@
 // kernel the moment techniques get from their pipeline (Gaussian blur, then a bilinear lookup):
 // the weight of depth texel i along an axis is (1 - f) g[i - i0 + R] + f g[i - i0 - 1 + R] for
 // t = i0 + f, over taps + 1 texels, and every MSAA sample counts 1 / samples.
-#ifdef MSM_SINGLE_SAMPLE
-layout(binding = 2) uniform sampler2D depth_map;
-#else
-layout(binding = 2) uniform sampler2DMS depth_map;
-#endif
 #include "shading.glsl"
-
-float depth_sample(ivec2 i, int s) {
-#ifdef MSM_SINGLE_SAMPLE
-  return texelFetch(depth_map, i, 0).x;
-#else
-  return texelFetch(depth_map, i, s).x;
-#endif
-}
+#define MSM_DEPTH_BINDING 2
+#include "depth_map.glsl"
 
 vec2 sample_offset(int k) {
   vec4 pair = frame.sample_offsets[k / 2];

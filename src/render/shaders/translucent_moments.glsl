@@ -8,11 +8,8 @@
 #include "frame.glsl"
 
 layout(binding = 1) uniform sampler2D opacity_texture;
-#ifdef MSM_SINGLE_SAMPLE
-layout(binding = 2) uniform sampler2D depth_map;
-#else
-layout(binding = 2) uniform sampler2DMS depth_map;
-#endif
+#define MSM_DEPTH_BINDING 2
+#include "depth_map.glsl"
 layout(push_constant) uniform Push { ObjectPush object; };
 
 layout(location = 0) in vec2 texcoord;
@@ -27,13 +24,7 @@ void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
   float z = gl_FragCoord.z;
   int samples = frame.kernel.y, behind = 0;
-  for (int s = 0; s < samples; ++s) {
-#ifdef MSM_SINGLE_SAMPLE
-    behind += texelFetch(depth_map, p, 0).x > z ? 1 : 0;
-#else
-    behind += texelFetch(depth_map, p, s).x > z ? 1 : 0;
-#endif
-  }
+  for (int s = 0; s < samples; ++s) behind += depth_sample(p, s) > z ? 1 : 0;
   alpha *= float(behind) / float(samples);
   if (alpha < frame.shading.z || alpha <= 0.0f) discard;
   vec4 m = msm_technique_generate(kTechnique, z, frame.technique_params).a;

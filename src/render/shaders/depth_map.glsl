@@ -1,0 +1,33 @@
+// The shadow pass's depth map as the compute and fragment shaders read it: multisampled, or
+// single-sampled where the including file defines MSM_SINGLE_SAMPLE (a sampler2DMS cannot take a
+// one-sample image). The including file defines MSM_DEPTH_BINDING.
+#ifdef MSM_SINGLE_SAMPLE
+layout(binding = MSM_DEPTH_BINDING) uniform sampler2D depth_map;
+#else
+layout(binding = MSM_DEPTH_BINDING) uniform sampler2DMS depth_map;
+#endif
+
+// Depth of sample s of texel p (sample 0 where single-sampled).
+float depth_sample(ivec2 p, int s) {
+#ifdef MSM_SINGLE_SAMPLE
+  return texelFetch(depth_map, p, 0).x;
+#else
+  return texelFetch(depth_map, p, s).x;
+#endif
+}
+
+#ifdef MSM_TECHNIQUES_H
+// The technique's channels of every sample of texel p, averaged: the MSAA resolve (a box filter,
+// linear like everything before storage). Depths are clamped: NaN never reaches the moments.
+MsmTexel resolved_texel(ivec2 p) {
+  int samples = frame.kernel.y;
+  MsmTexel sum = MsmTexel(vec4(0.0f), vec4(0.0f));
+  for (int s = 0; s < samples; ++s) {
+    MsmTexel t = msm_technique_generate(kTechnique, msm_saturate(depth_sample(p, s)), frame.technique_params);
+    sum.a += t.a;
+    sum.b += t.b;
+  }
+  float inv = 1.0f / float(samples);
+  return MsmTexel(sum.a * inv, sum.b * inv);
+}
+#endif
