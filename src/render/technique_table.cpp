@@ -1,11 +1,14 @@
 // The renderer's techniques: names, storage formats and the meaning of their parameters; the
 // per-texel math is msm/techniques.h. Settings validation lives here too (it needs the table).
 #include "msm/render/renderer.h"
+#include "msm/cpu/techniques.h"
 #include "msm/techniques.h"
 
 #include <vulkan/vulkan.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <vector>
 #include <fmt/format.h>
 
 namespace msm::render {
@@ -17,61 +20,76 @@ constexpr std::string_view kVsm = "w: minimum variance";
 constexpr std::string_view kEsm = "y: exponent c";
 constexpr std::string_view kEvsm = "y: c+, z: c- (EVSM4), w: minimum variance in depth units";
 
-constexpr Technique kTechniques[] = {
-    {"plain", "Shadow map, one depth comparison per fragment (receiver plane at the texel centre)", MSM_TECH_PLAIN,
-     16, {kNone, kNone}, ""},
-    {"pcf", "PCF with the Gaussian kernel of the blur (taps x taps, sigma), bilinear, every MSAA sample: the "
-            "reference for filtered hard shadows (2015)", MSM_TECH_PCF, 16, {kNone, kNone}, ""},
-    {"vsm-32", "VSM, 2 x 16-bit UNORM after θ2, depth in [0,1] (2015)", MSM_TECH_VSM32, 32,
-     {VK_FORMAT_R16G16_UNORM, kNone}, kVsm},
-    {"vsm-64", "VSM, 2 x float", MSM_TECH_VSM64, 64, {VK_FORMAT_R32G32_SFLOAT, kNone}, kVsm},
-    {"esm-32", "ESM, 1 x float, c = 80 on [0,1]", MSM_TECH_ESM32, 32, {VK_FORMAT_R32_SFLOAT, kNone}, kEsm},
-    {"evsm2-32", "EVSM, positive warp, 2 x half, c = 5.54 on [-1,1]", MSM_TECH_EVSM2_32, 32,
-     {VK_FORMAT_R16G16_SFLOAT, kNone}, kEvsm},
-    {"evsm2-64", "EVSM, positive warp, 2 x float, c+ = 40 on [-1,1]", MSM_TECH_EVSM2_64, 64,
-     {VK_FORMAT_R32G32_SFLOAT, kNone}, kEvsm},
-    {"evsm4-64", "EVSM, both warps, 4 x half, c = 5.54 (JCGT Fig. 4a)", MSM_TECH_EVSM4_64, 64,
-     {VK_FORMAT_R16G16B16A16_SFLOAT, kNone}, kEvsm},
-    {"evsm4-128", "EVSM, both warps, 4 x float, c+ = 40, c- = 5.54 (JCGT Fig. 4e)", MSM_TECH_EVSM4_128, 128,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kEvsm},
-    {"msm-hamburger-128-unit", "Hamburger 4MSM, 4 x float, depth in [0,1] (2015)", MSM_TECH_HAMBURGER_128_UNIT, 128,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
-    {"msm-hamburger-128", "Hamburger 4MSM, 4 x float, depth in [-1,1] (JCGT 2017)", MSM_TECH_HAMBURGER_128, 128,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
-    {"msm-hamburger-64-theta4", "Hamburger 4MSM, 4 x 16-bit UNORM after θ4, depth in [0,1] (2015)",
-     MSM_TECH_HAMBURGER_64_THETA4, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
-    {"msm-hamburger-64", "Hamburger 4MSM, 4 x 16-bit UNORM after Θ4*, depth in [-1,1] (JCGT 2017)",
-     MSM_TECH_HAMBURGER_64, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
-    {"msm-hausdorff-128-unit", "Hausdorff 4MSM on [0,1], 4 x float (2015)", MSM_TECH_HAUSDORFF_128_UNIT, 128,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
-    {"msm-hausdorff-128", "Hausdorff 4MSM on [-1,1], 4 x float (JCGT 2017 depth)", MSM_TECH_HAUSDORFF_128, 128,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
-    {"msm-hausdorff-64-theta4", "Hausdorff 4MSM on [0,1], 4 x 16-bit UNORM after θ4 (2015)",
-     MSM_TECH_HAUSDORFF_64_THETA4, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
-    {"msm-hausdorff-64", "Hausdorff 4MSM on [-1,1], 4 x 16-bit UNORM after Θ4* (JCGT 2017 storage)",
-     MSM_TECH_HAUSDORFF_64, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
-    {"tmsm-128", "Trigonometric MSM, 4 x float, depth in [0,1] (2015)", MSM_TECH_TMSM_128, 128,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
-    {"msm6-192", "Hamburger 6MSM, 6 x float, depth in [-1,1] (JCGT §5.4)", MSM_TECH_MSM6_192, 192,
-     {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kMoment},
-    {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", MSM_TECH_MSM6_96, 96,
-     {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM}, kMoment},
-    {"msm-nl64", "Non-linearly quantized 4MSM, RGBA16 UNORM (y1, y2, v2, Ψ4(ξ4)), one-pass filter, dithered lookup "
-                 "(HPG 2017)", MSM_TECH_NL64, 64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, ""},
-    {"mssm4", "Moment soft shadow mapping (JCGT §4): Θ4* moments in a 32-bit integer summed-area table, blocker "
-              "search, nine-region filter over the penumbra of a directional area light (--light-extent)",
-     MSM_TECH_MSSM4, 128, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, ""},
-    {"msm-nl32", "Non-linearly quantized 4MSM, R32 UINT (folded 10-bit depths, √v2, Ψ4), one-pass filter, dithered "
-                 "lookup (HPG 2017)", MSM_TECH_NL32, 32, {VK_FORMAT_R32_UINT, kNone}, ""},
+// The renderer's storage per technique. Name, description and bits per texel come from the CPU
+// pipeline's table (msm/cpu/techniques.h) for every technique it has, so they are written once;
+// the techniques only the renderer has (depth-based, soft) carry their own.
+struct Row {
+  int id;
+  std::array<int, 2> formats;
+  std::string_view parameters;
+  std::string_view name = {}, description = {};
+  int bits_per_texel = 0;
 };
+
+const Row kRows[] = {
+    {MSM_TECH_PLAIN, {kNone, kNone}, "", "plain",
+     "Shadow map, one depth comparison per fragment (receiver plane at the texel centre)", 16},
+    {MSM_TECH_PCF, {kNone, kNone}, "", "pcf",
+     "PCF with the Gaussian kernel of the blur (taps x taps, sigma), bilinear, every MSAA sample: the reference for "
+     "filtered hard shadows (2015)", 16},
+    {MSM_TECH_VSM32, {VK_FORMAT_R16G16_UNORM, kNone}, kVsm},
+    {MSM_TECH_VSM64, {VK_FORMAT_R32G32_SFLOAT, kNone}, kVsm},
+    {MSM_TECH_ESM32, {VK_FORMAT_R32_SFLOAT, kNone}, kEsm},
+    {MSM_TECH_EVSM2_32, {VK_FORMAT_R16G16_SFLOAT, kNone}, kEvsm},
+    {MSM_TECH_EVSM2_64, {VK_FORMAT_R32G32_SFLOAT, kNone}, kEvsm},
+    {MSM_TECH_EVSM4_64, {VK_FORMAT_R16G16B16A16_SFLOAT, kNone}, kEvsm},
+    {MSM_TECH_EVSM4_128, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kEvsm},
+    {MSM_TECH_HAMBURGER_128_UNIT, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
+    {MSM_TECH_HAMBURGER_128, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
+    {MSM_TECH_HAMBURGER_64_THETA4, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
+    {MSM_TECH_HAMBURGER_64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
+    {MSM_TECH_HAUSDORFF_128_UNIT, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
+    {MSM_TECH_HAUSDORFF_128, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
+    {MSM_TECH_HAUSDORFF_64_THETA4, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
+    {MSM_TECH_HAUSDORFF_64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, kMoment},
+    {MSM_TECH_TMSM_128, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kMoment},
+    {MSM_TECH_MSM6_192, {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kMoment},
+    {MSM_TECH_MSM6_96, {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM}, kMoment},
+    {MSM_TECH_NL64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, ""},
+    {MSM_TECH_MSSM4, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, "", "mssm4",
+     "Moment soft shadow mapping (JCGT §4): Θ4* moments in a 32-bit integer summed-area table, blocker search, "
+     "nine-region filter over the penumbra of a directional area light (--light-extent)", 128},
+    {MSM_TECH_NL32, {VK_FORMAT_R32_UINT, kNone}, ""},
+};
+
+std::vector<Technique> build_table() {
+  std::vector<Technique> out;
+  for (const Row& row : kRows) {
+    Technique t{row.name, row.description, row.id, row.bits_per_texel, row.formats, row.parameters};
+    for (const cpu::Technique& c : cpu::techniques())
+      if (c.id == row.id) {
+        t.name = c.name;
+        t.description = c.description;
+        t.bits_per_texel = c.bits_per_texel;
+      }
+    if (t.name.empty()) throw std::logic_error(fmt::format("technique id {} has no name", row.id));
+    out.push_back(t);
+  }
+  return out;
+}
+
+const std::vector<Technique>& table() {
+  static const std::vector<Technique> t = build_table();
+  return t;
+}
 
 } // namespace
 
-std::span<const Technique> techniques() { return kTechniques; }
+std::span<const Technique> techniques() { return table(); }
 
 const Technique& find_technique(std::string_view name) {
   std::string valid;
-  for (const Technique& t : kTechniques) {
+  for (const Technique& t : table()) {
     if (t.name == name) return t;
     valid += (valid.empty() ? "" : ", ") + std::string(t.name);
   }
