@@ -24,12 +24,7 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
         const glm::dvec3 origin = offset_origin(q, hit.normal, scale, ctx.towards_light);
         stats.add(ctx.tracer.occluded(origin, ctx.towards_light) ? 0.0 : 1.0);
     }
-    EffectResult r;
-    r.value = stats.mean;
-    r.std_error = stats.std_error();
-    r.samples = stats.n;
-    r.rays = std::uint64_t(stats.n);
-    return r;
+    return monte_carlo_result(stats);
 }
 
 }  // namespace msm::reference::detail

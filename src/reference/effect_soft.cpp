@@ -20,12 +20,7 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
         const glm::dvec3 dir = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
         stats.add(ctx.tracer.occluded(origin, dir) ? 0.0 : 1.0);
     }
-    EffectResult r;
-    r.value = stats.mean;
-    r.std_error = stats.std_error();
-    r.samples = stats.n;
-    r.rays = std::uint64_t(stats.n);
-    return r;
+    return monte_carlo_result(stats);
 }
 
 }  // namespace msm::reference::detail

@@ -147,6 +147,16 @@ struct EffectResult {
     std::uint64_t rays = 0;  // shadow rays traced
 };
 
+// The result of a Monte Carlo effect with one shadow ray per sample.
+inline EffectResult monte_carlo_result(const RunningStats& stats) {
+    EffectResult r;
+    r.value = stats.mean;
+    r.std_error = stats.std_error();
+    r.samples = stats.n;
+    r.rays = std::uint64_t(stats.n);
+    return r;
+}
+
 using EffectFunction = EffectResult (*)(const EffectContext&, const SurfaceHit&, Rng&);
 
 EffectResult effect_hard(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
