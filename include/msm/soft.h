@@ -137,6 +137,55 @@ MSM_FN BlockerResult msm_soft_blocker4_upper(vec4 q, float zf, float delta1, flo
     return msm_blocker4_upper(msm_soft_moments4(q), zf, delta1, delta2);
 }
 
+// The estimator chosen by the technique's parameters (techniques.h: x = δ1, y = δ2, z = 1 for
+// Kneiphof Eq. (19), 0 for JCGT Eq. (4) with ε = δ1).
+MSM_FN BlockerResult msm_soft_blocker4_select(vec4 q, float zf, vec4 params) {
+    return params.z > 0.5f ? msm_soft_blocker4_upper(q, zf, params.x, params.y)
+                           : msm_blocker4(msm_soft_moments4(q), zf, params.x);
+}
+MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params) {
+    return params.z > 0.5f ? msm_soft_blocker6_upper(q, zf, params.x, params.y)
+                           : msm_blocker6(msm_soft_moments6(q), zf, params.x);
+}
+
+// ---- Naive variance soft shadow mapping (Yang et al. 2010, the baseline of JCGT §4) ----
+// Two moments (z, z²) of [0,1] depth in the same integer table. Blocker search: Chebyshev's
+// one-sided bound σ² / (σ² + (zf - μ)²) is taken as the lit fraction N of the search region, whose
+// texels are assumed at zf; the rest, the blockers, then average (μ - N zf) / (1 - N). With
+// zf <= μ the bound says nothing and the fragment is taken as unoccluded. Returns the depth in
+// [-1,1] (as the moment estimators, for msm_soft_penumbra_half_width) and 1 - N as the shadow.
+// q: the region's average (z, z²); unit_zf: the unbiased fragment depth in [0,1].
+MSM_FN BlockerResult msm_soft_vssm_blocker(vec2 q, float unit_zf, float min_variance) {
+    float mean = q.x;
+    float d = unit_zf - mean;
+    if (d <= 0.0f) return BlockerResult(msm_signed_depth(unit_zf), 0.0f);
+    float variance = max(q.y - mean * mean, min_variance);
+    float lit = variance / (variance + d * d);
+    float blocked = 1.0f - lit;
+    float blocker = clamp((mean - lit * unit_zf) / max(blocked, 1e-6f), 0.0f, unit_zf);
+    return BlockerResult(msm_signed_depth(blocker), blocked);
+}
+// Chebyshev over the filter region, over-darkened like the moment techniques; zf_biased in [-1,1].
+MSM_FN float msm_soft_vssm_shadow(vec2 q, float zf_biased, float min_variance, float umbra_epsilon) {
+    return msm_overdarken(msm_vsm_shadow(q, 0.5f * zf_biased + 0.5f, min_variance), 1.0f - umbra_epsilon);
+}
+
+// ---- Percentage-closer soft shadows [Fernando 2005], the depth-map baseline ----
+// The same geometry, with the depth map itself: the blocker search averages the depths of every
+// texel (sample) of the grid-aligned search rectangle that lies in front of the receiver plane;
+// the filter averages the depth tests over the penumbra region, each texel weighted by its
+// overlap with the region (the box filter MSSM applies to moments, applied to test results).
+// Overlap of texel i ([i, i + 1)) with [lo, hi] along one axis.
+MSM_FN float msm_soft_texel_overlap(int i, float lo, float hi) {
+    return max(min(hi, float(i + 1)) - max(lo, float(i)), 0.0f);
+}
+// Average blocker depth from the sums over the search region: depth_sum and count of the
+// samples in front of the receiver, total samples. No blocker: the fragment depth, shadow 0.
+MSM_FN BlockerResult msm_soft_pcss_blocker(float depth_sum, float blockers, float samples, float zf) {
+    if (blockers <= 0.0f) return BlockerResult(zf, 0.0f);
+    return BlockerResult(depth_sum / blockers, blockers / samples);
+}
+
 // Umbra early-out (JCGT §4.5): the search region's shadow intensity above 1 - ε_u.
 MSM_FN bool msm_soft_in_umbra(BlockerResult blocker, float umbra_epsilon) {
     return blocker.shadow > 1.0f - umbra_epsilon;

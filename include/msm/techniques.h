@@ -47,11 +47,22 @@ const int MSM_TECH_MSM6_96 = 20;   // six moments, 6 x UNORM16 after Θ6*
 // Non-linearly quantized four moments (HPG 2017), [-1,1]: filtered float moments -> Φ -> storage.
 const int MSM_TECH_NL64 = 21;      // RGBA16_UNORM: y1, y2, v2, Ψ4(ξ4)
 const int MSM_TECH_NL32 = 22;      // R32_UINT: folded 10-bit depths, √v2, Ψ4 (HPG §3.5)
-// Moment soft shadows (JCGT §4): Θ4* moments in an integer summed-area table (sat.h, soft.h).
-const int MSM_TECH_MSSM4 = 23;
+// Soft shadows of a directional area light (soft.h). Moment soft shadows (JCGT §4): moments in
+// integer summed-area tables (sat.h); VSSM: the same pipeline with two moments; PCSS: the
+// depth map itself, every texel of the blocker search and of the filter region.
+const int MSM_TECH_MSSM4 = 23;  // Θ4*, [-1,1], one table
+const int MSM_TECH_MSSM6 = 24;  // Θ6*, [-1,1], two tables (Kneiphof §4.2), layout of MSM_TECH_MSM6_96
+const int MSM_TECH_VSSM = 25;   // (z, z²) of [0,1] depth, one table (naive variance soft shadows)
+const int MSM_TECH_PCSS = 26;   // percentage-closer soft shadows [Fernando 2005]: depth-based
 
-// Soft shadows from a summed-area table instead of a filtered map.
-MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4; }
+// Soft shadows from summed-area tables instead of a filtered map.
+MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
+// Six moments: the texel's b half (techniques.h layout) goes to a second image.
+MSM_FN bool msm_technique_is_six_moments(int t) {
+    return t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96 || t == MSM_TECH_MSSM6;
+}
+// Every technique whose penumbra follows the light's extent (the others filter with a fixed kernel).
+MSM_FN bool msm_technique_is_area_light(int t) { return msm_technique_is_soft(t) || t == MSM_TECH_PCSS; }
 
 struct MsmTexel {
     vec4 a;
@@ -59,7 +70,7 @@ struct MsmTexel {
 };
 
 // True for the techniques that read the depth map instead of filterable channels.
-MSM_FN bool msm_technique_is_depth_based(int t) { return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF; }
+MSM_FN bool msm_technique_is_depth_based(int t) { return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS; }
 
 // The non-linear techniques store Φ of the filtered moments: they filter before storage (the
 // one-pass filter) and decode before any interpolation.
@@ -68,7 +79,8 @@ MSM_FN bool msm_technique_is_nonlinear(int t) { return t == MSM_TECH_NL64 || t =
 MSM_FN bool msm_technique_is_signed(int t) {
     return msm_technique_is_nonlinear(t) || t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64 || t == MSM_TECH_EVSM4_64 || t == MSM_TECH_EVSM4_128 ||
            t == MSM_TECH_HAMBURGER_128 || t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_128 ||
-           t == MSM_TECH_HAUSDORFF_64 || t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96;
+           t == MSM_TECH_HAUSDORFF_64 || t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96 || t == MSM_TECH_MSSM4 ||
+           t == MSM_TECH_MSSM6;
 }
 
 // The papers' parameters (config.h, baselines.h); see the vec4 layout above.
@@ -89,6 +101,11 @@ MSM_FN vec4 msm_technique_default_params(int t) {
     if (t == MSM_TECH_TMSM_128) return vec4(MSM_TRIG_ALPHA_DEFAULT, 0.0f, 0.0f, 0.0f);
     if (t == MSM_TECH_MSM6_192) return vec4(MSM_ALPHA6_FLOAT, 0.0f, 0.0f, 0.0f);
     if (t == MSM_TECH_MSM6_96) return vec4(MSM_ALPHA6_16BIT, 0.0f, 0.0f, 0.0f);
+    // Moment soft shadows: x = δ1 (ε of Eq. 4), y = δ2, z = 1 for Kneiphof's upper-bound blocker
+    // depth (Eq. 19, the mass at zf clamped to [δ1, δ2]), 0 for JCGT Eq. (4).
+    if (t == MSM_TECH_MSSM4) return vec4(MSM_BLOCKER_EPSILON, MSM_BLOCKER_EPSILON, 0.0f, 0.0f);
+    if (t == MSM_TECH_MSSM6) return vec4(MSM_BLOCKER_EPSILON, MSM_SOFT6_DELTA2, 1.0f, 0.0f);
+    if (t == MSM_TECH_VSSM) return vec4(0.0f, 0.0f, 0.0f, MSM_VSSM_MIN_VARIANCE);
     return vec4(0.0f);
 }
 
@@ -98,7 +115,7 @@ MSM_FN MsmTexel msm_technique_generate(int t, float unit_depth, vec4 params) {
     float z = msm_signed_depth(unit_depth);
     vec4 zero = vec4(0.0f);
     if (t == MSM_TECH_VSM32) return MsmTexel(vec4(msm_vsm_moments_theta2(unit_depth), 0.0f, 0.0f), zero);
-    if (t == MSM_TECH_VSM64) return MsmTexel(vec4(msm_vsm_moments(unit_depth), 0.0f, 0.0f), zero);
+    if (t == MSM_TECH_VSM64 || t == MSM_TECH_VSSM) return MsmTexel(vec4(msm_vsm_moments(unit_depth), 0.0f, 0.0f), zero);
     if (t == MSM_TECH_ESM32) return MsmTexel(vec4(msm_esm_moment(unit_depth, params.y), 0.0f, 0.0f, 0.0f), zero);
     if (t == MSM_TECH_EVSM2_32 || t == MSM_TECH_EVSM2_64)
         return MsmTexel(vec4(msm_evsm2_moments(z, params.y), 0.0f, 0.0f), zero);
@@ -112,9 +129,9 @@ MSM_FN MsmTexel msm_technique_generate(int t, float unit_depth, vec4 params) {
     if (t == MSM_TECH_HAMBURGER_64 || t == MSM_TECH_HAUSDORFF_64 || t == MSM_TECH_MSSM4)
         return MsmTexel(msm_theta4_star(msm_moments4(z)), zero);
     if (t == MSM_TECH_TMSM_128) return MsmTexel(msm_trig_moments(unit_depth), zero);
-    if (t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96) {
+    if (t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96 || t == MSM_TECH_MSSM6) {
         Moments6 m = msm_moments6(z);
-        if (t == MSM_TECH_MSM6_96) m = msm_theta6_star(m);
+        if (t != MSM_TECH_MSM6_192) m = msm_theta6_star(m);
         return MsmTexel(vec4(m.odd, m.even.x), vec4(m.even.y, m.even.z, 0.0f, 0.0f));
     }
     return MsmTexel(vec4(unit_depth, 0.0f, 0.0f, 0.0f), zero); // depth-based: the depth itself

@@ -32,7 +32,8 @@ struct FrameTargets {
   vk::Image color;                     // RGBA8 sRGB
   vk::Image shadow_buffer;             // RG32F: visibility, coverage
   vk::Image camera_depth;              // D32
-  vk::Image sat_table;                 // RGBA32_UINT summed-area table (soft shadows only)
+  // RGBA32_UINT summed-area tables of the moment images (soft shadows only; two for mssm6).
+  std::array<vk::Image, 2> sat_tables;
   uint32_t mip_levels = 1;
   vk::Sampler point_sampler, moment_sampler;
 

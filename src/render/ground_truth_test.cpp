@@ -102,7 +102,7 @@ TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
     image::Image mask = truth.visibility.channel("background");
     image::Image reference = truth.visibility.channel("visibility");
     for (const Technique& t : techniques()) {
-      if (msm_technique_is_soft(t.id)) continue; // against the area light: soft_shadow_test.cpp
+      if (msm_technique_is_area_light(t.id)) continue; // against the area light: soft_shadow_test.cpp
       image::Metrics m = image::compute_metrics(renderer.render(settings(std::string(t.name))).shadow.channel("visibility"),
                                                 reference, {.mask = &mask});
       EXPECT_LT(m.mae, t.name == "plain" ? 0.12 : 0.07) << name << ", " << t.name;
@@ -116,7 +116,7 @@ TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
   for (size_t i = 0; i < kHardShadowScenes.size(); ++i) out += "---:|";
   out += "\n";
   for (const Technique& t : techniques()) {
-    if (msm_technique_is_soft(t.id)) continue;
+    if (msm_technique_is_area_light(t.id)) continue;
     out += fmt::format("| {} |", t.name);
     for (const std::string& name : kHardShadowScenes) {
       const image::Metrics& m = table[std::string(t.name)][name];

@@ -80,7 +80,7 @@ const std::map<std::string, SceneRenders>& renders(const vk::Context& ctx) {
     r.pcf = visibility(pcf);
     r.mask = background(pcf);
     for (const Technique& t : techniques()) // soft shadows are checked in soft_shadow_test.cpp
-      if (t.id != MSM_TECH_PCF && !msm_technique_is_soft(t.id))
+      if (t.id != MSM_TECH_PCF && !msm_technique_is_area_light(t.id))
         r.visibility[std::string(t.name)] = visibility(renderer.render(small(std::string(t.name))));
   }
   return all;
@@ -96,7 +96,7 @@ TEST_F(RenderTest, EveryTechniqueIsWithinItsBoundOfPcfOnEveryScene) {
   for (const auto& [scene, r] : renders(ctx())) table += fmt::format(" | {:^24}", scene);
   fmt::print("{}\n", table);
   for (const Technique& t : techniques()) {
-    if (t.id == MSM_TECH_PCF || msm_technique_is_soft(t.id)) continue;
+    if (t.id == MSM_TECH_PCF || msm_technique_is_area_light(t.id)) continue;
     std::string name(t.name);
     ASSERT_TRUE(kBounds.count(name)) << name << " has no bound";
     const Bound& bound = kBounds.at(name);

@@ -132,7 +132,7 @@ struct Renderer::Impl {
     float depth_bias = s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : soft ? 1e-3f : 0.0f);
     u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel,
                              soft ? 0.0f : depth_bias);
-    if (soft) {
+    if (msm_technique_is_area_light(technique.id)) {
       // soft.h: texels of reach per unit of [-1,1] depth = tan(θ/2) w_d / w_t.
       float extent = s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg;
       float tan_half = std::tan(glm::radians(extent) * 0.5f);
@@ -140,8 +140,9 @@ struct Renderer::Impl {
       float texel_y = glm::length(glm::vec3(inverse * glm::vec4(0.0f, 2.0f, 0.0f, 0.0f))) / float(s.shadow_size);
       u.soft = glm::vec4(tan_half * world_per_depth / texel, tan_half * world_per_depth / texel_y, depth_bias,
                          MSM_SOFT_UMBRA_EPSILON);
-      uint32_t scale = 0xFFFFFFFFu / uint32_t(s.soft_kernel * s.soft_kernel);
-      u.soft_kernel = glm::ivec4(s.soft_kernel, int(scale), 0, 0); // the uint's bits
+      int kernel = s.resolved_soft_kernel();
+      uint32_t scale = 0xFFFFFFFFu / uint32_t(kernel * kernel);
+      u.soft_kernel = glm::ivec4(kernel, int(scale), 0, 0); // the uint's bits
     }
     u.shading = glm::vec4(s.overdarken, s.exposure, s.translucent_alpha_threshold, 0.0f);
     u.background = glm::vec4(0.55f, 0.65f, 0.8f, 1.0f);
@@ -233,7 +234,7 @@ struct Renderer::Impl {
       if (until_resolve) return;
       if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
       if (msm_technique_is_soft(technique.id)) {
-        sat_pass->execute(f, s.soft_kernel * s.soft_kernel);
+        sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());
         shading_passes.at({technique.id, s.msaa, split})->execute(f);
         return;
       }

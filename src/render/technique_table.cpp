@@ -19,6 +19,9 @@ constexpr std::string_view kMoment = "x: moment bias alpha";
 constexpr std::string_view kVsm = "w: minimum variance";
 constexpr std::string_view kEsm = "y: exponent c";
 constexpr std::string_view kEvsm = "y: c+, z: c- (EVSM4), w: minimum variance in depth units";
+constexpr std::string_view kSoftMoments =
+    "x: δ1 (ε of JCGT Eq. 4), y: δ2, z: 1 = Kneiphof's upper-bound blocker depth (Eq. 19) with the mass at zf "
+    "clamped to [δ1, δ2], 0 = JCGT Eq. 4";
 
 // The renderer's storage per technique. Name, description and bits per texel come from the CPU
 // pipeline's table (msm/cpu/techniques.h) for every technique it has, so they are written once;
@@ -56,10 +59,19 @@ const Row kRows[] = {
     {MSM_TECH_MSM6_192, {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kMoment},
     {MSM_TECH_MSM6_96, {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM}, kMoment},
     {MSM_TECH_NL64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, ""},
-    {MSM_TECH_MSSM4, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, "", "mssm4",
+    {MSM_TECH_MSSM4, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kSoftMoments, "mssm4",
      "Moment soft shadow mapping (JCGT §4): Θ4* moments in a 32-bit integer summed-area table, blocker search, "
      "nine-region filter over the penumbra of a directional area light (--light-extent)", 128},
     {MSM_TECH_NL32, {VK_FORMAT_R32_UINT, kNone}, ""},
+    {MSM_TECH_MSSM6, {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kSoftMoments, "mssm6",
+     "Moment soft shadows with six moments (Kneiphof §4.2): Θ6* in two 32-bit integer summed-area tables, "
+     "upper-bound blocker depth (Eq. 19, clamp [δ1, δ2]), nine-region filter", 192},
+    {MSM_TECH_VSSM, {VK_FORMAT_R32G32_SFLOAT, kNone}, "w: minimum variance", "vssm",
+     "Naive variance soft shadow mapping (Yang et al. 2010): the mssm4 pipeline with two moments (z, z²), "
+     "Chebyshev blocker estimate and filter (the baseline of JCGT §4)", 64},
+    {MSM_TECH_PCSS, {kNone, kNone}, "", "pcss",
+     "Percentage-closer soft shadows (Fernando 2005): every texel of a search region up to 15², then PCF over "
+     "the penumbra, every MSAA sample against the receiver plane (the baseline of JCGT §4)", 16},
 };
 
 std::vector<Technique> build_table() {
@@ -103,6 +115,11 @@ bool supports_translucency(const Technique& t) {
 
 glm::vec4 default_params(const Technique& technique) { return msm_technique_default_params(technique.id); }
 
+int RenderSettings::resolved_soft_kernel() const {
+  if (soft_kernel != 0) return soft_kernel;
+  return find_technique(technique).id == MSM_TECH_PCSS ? kDefaultPcssKernel : kDefaultSatKernel;
+}
+
 void RenderSettings::validate() const {
   find_technique(technique);
   auto range = [](std::string_view what, long long v, long long lo, long long hi) {
@@ -132,7 +149,10 @@ void RenderSettings::validate() const {
   if (uses_one_pass && msm_technique_is_soft(t.id))
     throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
   if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
-  range("soft kernel", soft_kernel, 3, 255);
+  if (soft_kernel != 0) {
+    if (t.id == MSM_TECH_PCSS) range("soft kernel", soft_kernel, 3, kMaxPcssKernel);
+    else range("soft kernel", soft_kernel, 3, 255);
+  }
   if (uses_one_pass && (t.formats[0] == 0 || t.formats[1] != 0))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
   if (uses_one_pass && filter_size > kMaxOnePassTaps)

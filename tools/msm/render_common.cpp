@@ -24,6 +24,8 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
+  cmd->add_flag_callback("--no-receiver-plane-bias", [&s] { s.receiver_plane_bias = false; },
+                         "No receiver-plane (slope-scaled) bias for the filtered techniques");
   cmd->add_option("--exposure", s.exposure, "Exposure before tone mapping")->capture_default_str();
   cmd->add_option("--lookup", o.lookup, "Shadow-map lookup: auto (dither for msm-nl*, else bilinear), bilinear, "
                                          "nearest, dither")->capture_default_str();
@@ -31,8 +33,8 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
                                                   "memory), three-pass (resolve, blur H, blur V)")->capture_default_str();
   cmd->add_option("--light-extent", s.light_extent_deg, "Angular diameter of the light in degrees, for soft "
                                                       "shadows (default: the scene's)");
-  cmd->add_option("--soft-kernel", s.soft_kernel, "Largest soft-shadow kernel width in texels (n_t = W²)")
-      ->capture_default_str();
+  cmd->add_option("--soft-kernel", s.soft_kernel,
+                  "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15");
   cmd->add_option("--frame", s.frame, "Frame number (blue-noise layer and offset)")->capture_default_str();
   cmd->add_option("--device", o.device, "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
 }
@@ -130,6 +132,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"overdarken", s.overdarken},
           {"normal_offset_texels", s.normal_offset},
           {"depth_bias", s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f)},
+          {"receiver_plane_bias", s.receiver_plane_bias},
           {"exposure", s.exposure},
           {"lookup", s.lookup == render::RenderSettings::Lookup::bilinear  ? "bilinear"
                      : s.lookup == render::RenderSettings::Lookup::nearest ? "nearest"
@@ -139,7 +142,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
           {"frame", s.frame},
           {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg},
-          {"soft_kernel", s.soft_kernel},
+          {"soft_kernel", s.resolved_soft_kernel()},
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
           {"gpu_ms_total", result.total_ms}};

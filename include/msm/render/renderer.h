@@ -67,6 +67,9 @@ inline constexpr long long kMaxImagePixels = 64ll << 20; // 64 Mpixels
 inline constexpr int kMaxShadowSize = 8192;
 inline constexpr int kMaxFilterTaps = 63;                // MSM_MAX_FILTER_TAPS
 inline constexpr int kMaxOnePassTaps = 17;               // radius 8 in one_pass_filter.glsl
+inline constexpr int kDefaultSatKernel = 27;             // JCGT §4.5: a 27² search region
+inline constexpr int kDefaultPcssKernel = 15;            // the PCSS baseline's 15² search
+inline constexpr int kMaxPcssKernel = 63;                // 63² taps per pixel and loop
 
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
@@ -98,10 +101,14 @@ struct RenderSettings {
   // The depth-based, non-linear and six-moment techniques (and a one-pass filter) draw them
   // without a shadow. Fragments below the threshold opacity are discarded (JCGT: 1%).
   bool translucent_occluders = true;
-  // Soft shadows (mssm4): the directional light's angular diameter in degrees (default: the
-  // scene's angular_extent_deg) and the largest kernel width W in texels (n_t = W²; JCGT: 27).
+  // Soft shadows (mssm4, mssm6, vssm, pcss): the directional light's angular diameter in degrees
+  // (default: the scene's angular_extent_deg) and the largest kernel width W in texels of the
+  // blocker search and the filter (summed-area tables: n_t = W²). 0 = the technique's default:
+  // 27 for the tables (JCGT's 27² search region), 15 for PCSS (its 15² search: 225 taps, and up to
+  // 256 more for the filter). Tables take 3..255, PCSS 3..kMaxPcssKernel.
   std::optional<float> light_extent_deg;
-  int soft_kernel = 27;
+  int soft_kernel = 0;
+  int resolved_soft_kernel() const; // soft_kernel or the technique's default
   float translucent_alpha_threshold = 0.01f;
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;

@@ -79,8 +79,9 @@ private:
   vk::Program program_;
 };
 
-// moments mip 0 (unfiltered Θ4*) -> sat_table (GENERAL): the 32-bit integer summed-area table of
-// moment soft shadows (JCGT §4.2, msm::soft::SatBuilder), visible to fragment reads.
+// moments mip 0 (unfiltered Θ4*, Θ6* or (z, z²)) -> sat_tables (GENERAL): the 32-bit integer
+// summed-area tables of the soft shadows (JCGT §4.2, msm::soft::SatBuilder), one per moment
+// image, visible to fragment reads.
 class SatPass {
 public:
   static const PassDecl& decl();

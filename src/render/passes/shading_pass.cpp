@@ -80,16 +80,18 @@ void ShadingPass::execute(FrameContext& f) const {
   vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
   vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
 
-  vk::Descriptor shadow0 = soft_ ? vk::Descriptor(t.sat_table, VK_IMAGE_LAYOUT_GENERAL, t.point_sampler)
+  vk::Descriptor shadow0 = soft_ ? vk::Descriptor(t.sat_tables[0], VK_IMAGE_LAYOUT_GENERAL, t.point_sampler)
                           : depth_based_
                                ? vk::Descriptor(t.shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                                 t.point_sampler)
                                : vk::Descriptor(t.moments[0], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                                 nonlinear_ ? t.point_sampler : t.moment_sampler);
-  // The second image of 6MSM; the others bind something valid of the declared type (float).
-  vk::Descriptor second = t.config.moment_images() > 1
-                              ? vk::Descriptor(t.moments[1], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler)
-                          : nonlinear_ || soft_ ? vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+  // The second image of 6MSM (the second table of mssm6); the others bind something valid of the
+  // declared type (float; unsigned for the tables).
+  bool two = t.config.moment_images() > 1;
+  vk::Descriptor second = soft_ ? vk::Descriptor(t.sat_tables[two ? 1 : 0], VK_IMAGE_LAYOUT_GENERAL, t.point_sampler)
+                          : two ? vk::Descriptor(t.moments[1], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler)
+                          : nonlinear_ ? vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                                         t.point_sampler)
                                        : shadow0;
   vk::Descriptor noise(f.blue_noise.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);

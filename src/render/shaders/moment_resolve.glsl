@@ -24,6 +24,6 @@ void main() {
     imageStore(moments1, p, vec4(a.z, a.w, 0.0f, 0.0f));
   } else {
     imageStore(moments0, p, a);
-    if (kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96) imageStore(moments1, p, b);
+    if (msm_technique_is_six_moments(kTechnique)) imageStore(moments1, p, b);
   }
 }

@@ -1,7 +1,8 @@
-// Shading with the depth-based techniques: the plain shadow map and PCF. PCF uses exactly the
+// Shading with the depth-based techniques: the plain shadow map, PCF and PCSS. PCF uses exactly the
 // kernel the moment techniques get from their pipeline (Gaussian blur, then a bilinear lookup):
 // the weight of depth texel i along an axis is (1 - f) g[i - i0 + R] + f g[i - i0 - 1 + R] for
 // t = i0 + f, over taps + 1 texels, and every MSAA sample counts 1 / samples.
+#include "msm/soft.h"
 #include "shading.glsl"
 #define MSM_DEPTH_BINDING 2
 #include "depth_map.glsl"
@@ -23,7 +24,49 @@ float texel_occlusion(ivec2 i, ShadowLookup s) {
   return occluded / float(samples);
 }
 
+// Percentage-closer soft shadows (soft.h): every sample of the grid-aligned search rectangle is
+// tested against the receiver plane, those in front average to the blocker depth; the penumbra
+// region of soft.h is then filtered with texel_occlusion, each texel weighted by its overlap. The
+// search and filter sizes follow soft.h exactly as for the moment soft shadows (kernel width
+// frame.soft_kernel.x, 15 by default), so the two differ only in what they read.
+float pcss_shadow(ShadowLookup s) {
+  ivec2 map = ivec2(int(frame.shadow_map.x));
+  int width = frame.soft_kernel.x, samples = frame.kernel.y;
+  vec2 spread = vec2(frame.soft.x, frame.soft.y);
+  float zf = msm_signed_depth(s.z);
+  vec2 position = s.t + 0.5f; // texel i covers [i, i + 1) in soft.h
+  SatRect r = msm_soft_search_rect(position, msm_soft_search_half_width(spread, zf, -1.0f, width), map);
+  float depth_sum = 0.0f, blockers = 0.0f;
+  for (int y = r.lo.y; y <= r.hi.y; ++y)
+    for (int x = r.lo.x; x <= r.hi.x; ++x) {
+      float plane = s.z + dot(s.depth_per_texel, vec2(x, y) - s.t);
+      for (int k = 0; k < samples; ++k) {
+        float d = depth_sample(ivec2(x, y), k);
+        if (d < plane + dot(s.depth_per_texel, sample_offset(k))) {
+          depth_sum += d;
+          blockers += 1.0f;
+        }
+      }
+    }
+  BlockerResult blocker = msm_soft_pcss_blocker(depth_sum, blockers, float(msm_sat_rect_texels(r) * samples), s.z);
+  if (blocker.shadow <= 0.0f) return 0.0f;
+  // Every sample of the search region blocks: so does every one of the smaller filter region.
+  if (blocker.shadow >= 1.0f) return 1.0f;
+  vec2 hp = msm_soft_penumbra_half_width(spread, zf, msm_signed_depth(blocker.depth), width);
+  SoftRegion region = msm_soft_region(position, hp, map);
+  ivec2 lo = ivec2(floor(region.lo)), hi = min(ivec2(ceil(region.hi)), map) - 1;
+  float shadow = 0.0f;
+  for (int y = lo.y; y <= hi.y; ++y) {
+    float wy = msm_soft_texel_overlap(y, region.lo.y, region.hi.y);
+    for (int x = lo.x; x <= hi.x; ++x)
+      shadow += wy * msm_soft_texel_overlap(x, region.lo.x, region.hi.x) * texel_occlusion(ivec2(x, y), s);
+  }
+  vec2 extent = region.hi - region.lo;
+  return shadow / (extent.x * extent.y);
+}
+
 float shadow_intensity(ShadowLookup s) {
+  if (kTechnique == MSM_TECH_PCSS) return pcss_shadow(s);
   if (kTechnique == MSM_TECH_PLAIN) return texel_occlusion(ivec2(floor(s.t + 0.5f)), s);
   int taps = frame.kernel.x, radius = frame.kernel.z;
   ivec2 i0 = ivec2(floor(s.t));
