@@ -1,4 +1,4 @@
-// Built-in primitives: plane, box, sphere, cylinder, fence/railing, stair, torus knot.
+// Built-in primitives: plane, box, sphere, cylinder, fence/railing, stair, torus knot, brick wall.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -269,6 +269,44 @@ Mesh make_torus_knot(int p, int q, float radius, float tube_radius, int segments
     uv = {float(i) / tube_segments, float(j) / segments};
   });
   detail::finalize_mesh(m, "torus_knot");
+  return m;
+}
+
+Mesh make_brick_wall(int rows, int columns, float brick_length, float brick_height, float mortar, float relief,
+                     float thickness) {
+  check_count("rows", rows, 1);
+  check_count("columns", columns, 1);
+  check_size("brick_length", brick_length);
+  check_size("brick_height", brick_height);
+  check_size("mortar", mortar);
+  check_size("relief", relief);
+  check_size("thickness", thickness);
+  // Half bricks at the ends of the offset rows are (brick_length - mortar) / 2 long: they must exist.
+  if (mortar >= brick_length) throw SceneError("", "mortar", "must be smaller than brick_length");
+  if (mortar >= brick_height) throw SceneError("", "mortar", "must be smaller than brick_height");
+  const double length = double(columns) * (brick_length + mortar) + mortar;
+  const double height = double(rows) * (brick_height + mortar) + mortar;
+  if (length > kMaxSize || height > kMaxSize)
+    throw SceneError("", "", fmt::format("the wall would be {:g} x {:g}, more than {:g}", length, height, kMaxSize));
+  check_triangles(12ull * (std::size_t(rows) * (columns + 1) + 1));
+  Mesh m;
+  const float half = 0.5f * float(length), cell = brick_length + mortar;
+  // The mortar: the wall's core, its front face at z = 0.
+  add_box(m, {-half, 0.0f, -thickness}, {half, float(height), 0.0f});
+  // The bricks reach half-way into the core, so that no brick face is coplanar with a core face
+  // (coplanar faces would fight in depth buffers and confuse shadow rays).
+  for (int r = 0; r < rows; ++r) {
+    const float y0 = mortar + r * (brick_height + mortar);
+    // Running bond: odd rows shifted by half a brick, cut to the wall at both ends.
+    const float shift = (r % 2 == 1) ? 0.5f * cell : 0.0f;
+    const int bricks = (r % 2 == 1) ? columns + 1 : columns;
+    for (int i = 0; i < bricks; ++i) {
+      const float x0 = std::max(-half + mortar + i * cell - shift, -half + mortar);
+      const float x1 = std::min(-half + mortar + i * cell - shift + brick_length, half - mortar);
+      add_box(m, {x0, y0, -0.5f * thickness}, {x1, y0 + brick_height, relief});
+    }
+  }
+  detail::finalize_mesh(m, "brick_wall");
   return m;
 }
 

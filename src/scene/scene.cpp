@@ -279,7 +279,7 @@ private:
   Mesh primitive(const json& j, const std::string& ptr, std::string& type) const {
     if (!j.is_object()) fail(ptr, "must be an object with a \"type\"");
     const json* tj = find(j, "type");
-    if (!tj) fail(ptr + "/type", "required key missing (plane, box, sphere, cylinder, fence, stair, torus_knot)");
+    if (!tj) fail(ptr + "/type", "required key missing (plane, box, sphere, cylinder, fence, stair, torus_knot, brick_wall)");
     type = string(*tj, ptr + "/type");
     auto num = [&](const char* k, float def) { const json* v = find(j, k); return v ? number(*v, ptr + "/" + k) : def; };
     auto intg = [&](const char* k, int def) { const json* v = find(j, k); return v ? integer(*v, ptr + "/" + k) : def; };
@@ -321,11 +321,17 @@ private:
         return make_torus_knot(intg("p", 2), intg("q", 3), num("radius", 1.0f), num("tube_radius", 0.15f),
                                intg("segments", 256), intg("tube_segments", 16));
       }
+      if (type == "brick_wall") {
+        keys(j, ptr, {"type", "rows", "columns", "brick_length", "brick_height", "mortar", "relief", "thickness"});
+        return make_brick_wall(intg("rows", 12), intg("columns", 8), num("brick_length", 0.24f),
+                               num("brick_height", 0.07f), num("mortar", 0.012f), num("relief", 0.02f),
+                               num("thickness", 0.2f));
+      }
     } catch (const SceneError& e) {
       if (!e.file().empty()) throw;  // already complete (from this parser)
       fail(e.where().empty() ? ptr : ptr + "/" + e.where(), e.problem());
     }
-    fail(ptr + "/type", fmt::format("unknown primitive '{}' (plane, box, sphere, cylinder, fence, stair, torus_knot)", type));
+    fail(ptr + "/type", fmt::format("unknown primitive '{}' (plane, box, sphere, cylinder, fence, stair, torus_knot, brick_wall)", type));
   }
 
   Object object(const json& j, const std::string& ptr, std::size_t index, Scene& s) const {

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -93,7 +94,8 @@ void expect_json_error(const std::string& json, std::initializer_list<std::strin
 
 TEST(BuiltinScenes, NamesAndDefault) {
   const auto names = builtin_scene_names();
-  EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke", "models", "pillar_wall",
+                                             "disc"}));
   EXPECT_EQ(default_scene_name(), "fence");
 }
 
@@ -172,6 +174,80 @@ TEST(BuiltinScenes, StressCaseGeometry) {
   const Scene railing = builtin_scene("railing");
   EXPECT_LT(railing.objects[1].bounds.min.z - railing.objects[2].bounds.max.z, 0.1f);
   EXPECT_TRUE(railing.materials[railing.objects[2].material].double_sided);
+}
+
+// The soft-shadow scenes (JCGT 2017, Figs. 8, 10, 11, and the analytic disc): each has the objects
+// its figure needs, placed so that the effect it stresses happens, and a light with an extent
+// (column keeps extent 0: the hard-shadow tests use it; soft techniques give it one on the
+// command line).
+const Object& object_named(const Scene& s, const std::string& name) {
+  for (const Object& o : s.objects)
+    if (o.name == name) return o;
+  throw std::runtime_error("no object " + name + " in " + s.name);
+}
+
+TEST(BuiltinScenes, SoftShadowScenes) {
+  // models: two knots, one high above the ground (a wide penumbra) and one nearly touching it
+  // (contact hardening), 5-degree light.
+  const Scene models = builtin_scene("models");
+  ASSERT_EQ(models.objects.size(), 3u);
+  const Object& high = object_named(models, "high_knot");
+  const Object& low = object_named(models, "low_knot");
+  EXPECT_EQ(high.primitive, "torus_knot");
+  EXPECT_EQ(low.primitive, "torus_knot");
+  EXPECT_GT(high.bounds.min.y, 1.0f);
+  EXPECT_GT(low.bounds.min.y, 0.01f);  // hovering, not intersecting the ground
+  EXPECT_LT(low.bounds.min.y, 0.1f);
+  EXPECT_LT(low.bounds.max.y, high.bounds.min.y);
+  EXPECT_EQ(models.light.angular_extent_deg, 5.0f);
+  // The shadows fall apart: the knots' footprints along the light onto y = 0 do not overlap.
+  const auto footprint = [&](const Object& o) {
+    Bounds b;
+    const glm::vec3 l = models.light.towards_light;
+    for (const glm::vec3& p : o.mesh.positions) b.extend(p - (p.y / l.y) * l);
+    return b;
+  };
+  const Bounds fh = footprint(high), fl = footprint(low);
+  EXPECT_TRUE(fh.max.x < fl.min.x || fl.max.x < fh.min.x || fh.max.z < fl.min.z || fl.max.z < fh.min.z);
+
+  // pillar_wall: a pillar on the ground in front of a brick wall; the light, from the front, casts
+  // the pillar's shadow onto the wall's bricks.
+  const Scene pw = builtin_scene("pillar_wall");
+  ASSERT_EQ(pw.objects.size(), 3u);
+  const Object& wall = object_named(pw, "wall");
+  const Object& pillar = object_named(pw, "pillar");
+  EXPECT_EQ(wall.primitive, "brick_wall");
+  EXPECT_NEAR(pillar.bounds.min.y, 0.0f, 1e-6f);
+  EXPECT_NEAR(wall.bounds.min.y, 0.0f, 1e-6f);
+  const float gap = pillar.bounds.min.z - wall.bounds.max.z;
+  EXPECT_GT(gap, 0.05f);
+  EXPECT_LT(gap, 0.5f);
+  EXPECT_GT(pw.light.angular_extent_deg, 0.0f);
+  EXPECT_GT(pw.light.towards_light.z, 0.0f);  // the wall's front faces the light
+  // The pillar's top front corners, moved along the light onto the bricks' front plane, land on
+  // the wall: the shadow crosses the bricks.
+  const glm::vec3 travel = pw.light.travel();
+  for (float x : {pillar.bounds.min.x, pillar.bounds.max.x}) {
+    const glm::vec3 corner(x, pillar.bounds.max.y, pillar.bounds.max.z);
+    const glm::vec3 hit = corner + ((wall.bounds.max.z - corner.z) / travel.z) * travel;
+    EXPECT_GT(hit.x, wall.bounds.min.x);
+    EXPECT_LT(hit.x, wall.bounds.max.x);
+    EXPECT_GT(hit.y, 0.5f);
+    EXPECT_LT(hit.y, wall.bounds.max.y);
+  }
+
+  // column (Fig. 11): unchanged, hard by default.
+  EXPECT_EQ(builtin_scene("column").light.angular_extent_deg, 0.0f);
+
+  // disc: a thin disc straight above the origin, the light straight down; the exact geometry is
+  // checked against msm::reference::DiscOccluder in reference_test.
+  const Scene disc = builtin_scene("disc");
+  EXPECT_EQ(disc.light.towards_light, glm::vec3(0, 1, 0));
+  EXPECT_EQ(disc.light.angular_extent_deg, 10.0f);
+  const Object& occluder = object_named(disc, "disc");
+  EXPECT_EQ(occluder.primitive, "cylinder");
+  EXPECT_LT(occluder.bounds.size().y, 2e-4f);
+  EXPECT_NEAR(occluder.bounds.size().x, 0.5f, 1e-6f);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -299,6 +375,44 @@ TEST(Primitives, CylinderPlaneStairFenceKnot) {
   const Mesh k = make_torus_knot(2, 3, 1.0f, 0.1f, 256, 16);
   expect_consistent(k);
   EXPECT_GT(signed_volume(k), 0.0);  // closed, outward
+}
+
+// A 3-row, 4-column wall: a mortar core and 4 + 5 + 4 bricks (the middle row shifted by half a
+// brick, with half bricks at its ends), each face where it belongs.
+TEST(Primitives, BrickWall) {
+  const float length = 0.24f, height = 0.07f, mortar = 0.01f, relief = 0.02f, thickness = 0.2f;
+  const Mesh w = make_brick_wall(3, 4, length, height, mortar, relief, thickness);
+  expect_consistent(w);
+  EXPECT_EQ(w.triangle_count(), (1u + 4u + 5u + 4u) * 12u);
+  const Bounds b = w.bounds();
+  EXPECT_NEAR(b.min.x, -0.505f, 1e-6f);
+  EXPECT_NEAR(b.max.x, 0.505f, 1e-6f);
+  EXPECT_NEAR(b.min.y, 0.0f, 1e-6f);
+  EXPECT_NEAR(b.max.y, 3 * 0.08f + 0.01f, 1e-6f);
+  EXPECT_NEAR(b.min.z, -thickness, 1e-6f);
+  EXPECT_NEAR(b.max.z, relief, 1e-6f);
+  // Total brick length: 4 + 3 + 4 whole bricks and two halves of (length - mortar) / 2.
+  const double bricks_length = 11 * length + (length - mortar);
+  // Closed boxes: the volume is the core's plus the bricks' (which reach half-way into the core).
+  EXPECT_NEAR(signed_volume(w), 1.01 * 0.25 * thickness + bricks_length * height * (relief + 0.5 * thickness), 1e-5);
+  // The brick faces facing +Z lie at z = relief, and their area is the bricks' front area: no brick
+  // is lost or overlaps another; the core's front (z = 0) is covered by bricks except the mortar.
+  double front = 0.0, core_front = 0.0;
+  for (std::size_t t = 0; t < w.triangle_count(); ++t) {
+    const glm::vec3 p0 = w.positions[w.indices[3 * t]], p1 = w.positions[w.indices[3 * t + 1]], p2 = w.positions[w.indices[3 * t + 2]];
+    const double area = 0.5 * glm::length(glm::cross(glm::dvec3(p1 - p0), glm::dvec3(p2 - p0)));
+    // Corners are centre +- half size in float: within 1e-6 of the intended planes.
+    const auto on = [&](float z) { return std::abs(p0.z - z) < 1e-6f && std::abs(p1.z - z) < 1e-6f && std::abs(p2.z - z) < 1e-6f; };
+    if (on(relief)) front += area;
+    if (on(0.0f)) core_front += area;
+  }
+  EXPECT_NEAR(front, bricks_length * height, 1e-5);
+  EXPECT_NEAR(core_front, 1.01 * 0.25, 1e-5);
+  // Brick rows are separated by mortar: no vertex lies in a bed joint.
+  for (const glm::vec3& p : w.positions) {
+    if (p.z <= 0.0f) continue;
+    for (int r = 0; r <= 3; ++r) EXPECT_FALSE(p.y > r * 0.08f + 1e-6f && p.y < r * 0.08f + mortar - 1e-6f) << p.y;
+  }
 }
 
 TEST(Primitives, TransformsApply) {
@@ -473,6 +587,20 @@ TEST(Errors, Values) {
                     {"/objects/0/primitive", "cap"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "box", "size": [1e9, 1, 1]}})"), {"size", "<= 1e+06"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "fence", "bars": 0}})"), {"bars"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "rows": 0}})"),
+                    {"/objects/0/primitive/rows", "[1, 4096]"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "rows": 4096, "columns": 4096}})"),
+                    {"/objects/0/primitive", "cap"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "mortar": 0.3}})"),
+                    {"/objects/0/primitive/mortar", "smaller than brick_length"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "mortar": 0.08}})"),
+                    {"/objects/0/primitive/mortar", "smaller than brick_height"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "relief": 0}})"), {"relief", "> 0"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "brick_length": 1e9}})"),
+                    {"brick_length", "<= 1e+06"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "columns": 4000, "brick_length": 900}})"),
+                    {"/objects/0/primitive", "more than 1e+06"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "bricks": 3}})"), {"bricks"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "plane", "size": [1e400, 1]}})"), {"test.json", "number overflow"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": {"albedo_texture": "nope.png"}})"),
                     {"/objects/0/material/albedo_texture", "nope.png", "does not exist"});

@@ -2,7 +2,7 @@
 //
 // A scene is a JSON file (schema below, examples in scenes/*.json, same text in scenes/README.md).
 // Loading it yields world-space triangle soups, materials, a camera, one directional light and the
-// shadow-map framing. Four built-in scenes reproduce the papers' stress cases; builtin_scene(name)
+// shadow-map framing. The built-in scenes reproduce the papers' stress cases; builtin_scene(name)
 // is exactly what loading scenes/<name>.json gives (the files are embedded at build time).
 //
 // Conventions: right-handed, +Y up, lengths in scene units (metres in the built-ins).
@@ -79,6 +79,13 @@
 //                                          first step's front face at z = 0, centred in x
 //   torus_knot  {"p": 2, "q": 3, "radius": 1, "tube_radius": 0.15, "segments": 256,
 //                "tube_segments": 16}      procedural "model" (centred)
+//   brick_wall  {"rows": 12, "columns": 8, "brick_length": 0.24, "brick_height": 0.07,
+//                "mortar": 0.012, "relief": 0.02, "thickness": 0.2}
+//                                          a mortar core (x centred, on y = 0, front face z = 0,
+//                                          back face z = -thickness) with bricks in running bond
+//                                          protruding from its front by relief (odd rows shifted
+//                                          by half a brick, cut at the ends); mortar joints and
+//                                          borders `mortar` wide; mortar < brick_length, brick_height
 //
 // Errors: every problem throws SceneError naming the file, the JSON pointer (and the object's
 // name) and what is wrong: malformed JSON, unknown keys/primitive/scene names, missing or
@@ -234,7 +241,8 @@ Scene load_scene_file(const std::filesystem::path& file);
 Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir,
                       const std::string& source_name);
 
-// Built-in scenes: "fence" (the default), "railing", "stair", "column".
+// Built-in scenes (scenes/README.md): "fence" (the default), "railing", "stair", "column", "smoke",
+// "models", "pillar_wall", "disc".
 std::vector<std::string> builtin_scene_names();
 std::string_view default_scene_name();               // "fence"
 std::string_view builtin_scene_json(std::string_view name);  // throws SceneError if unknown
@@ -255,6 +263,8 @@ Mesh make_fence(float length, float height, int bars, float bar_width, float bar
                 float rail_height);
 Mesh make_stair(int steps, float width, float step_depth, float step_height);
 Mesh make_torus_knot(int p, int q, float radius, float tube_radius, int segments, int tube_segments);
+Mesh make_brick_wall(int rows, int columns, float brick_length, float brick_height, float mortar, float relief,
+                     float thickness);
 
 // Minimal lazy texture loading (stb_image), always 4 channels RGBA8.
 struct Image {
