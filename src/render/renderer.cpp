@@ -125,11 +125,8 @@ struct Renderer::Impl {
     // One shadow-map texel in world units: the light frustum's width over the map size.
     glm::mat4 inverse = glm::inverse(light_view_projection);
     float texel = glm::length(glm::vec3(inverse * glm::vec4(2.0f, 0.0f, 0.0f, 0.0f))) / float(s.shadow_size);
-    bool depth_based = msm_technique_is_depth_based(technique.id);
     bool soft = msm_technique_is_soft(technique.id);
-    // Soft shadows: the constant part of msm_soft_depth_bias, in [-1,1] depth (the 32-bit table
-    // keeps ~22 bits of a 27² kernel's moments, plus the moment bias).
-    float depth_bias = s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : soft ? 1e-3f : 0.0f);
+    float depth_bias = s.resolved_depth_bias();
     u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel,
                              soft ? 0.0f : depth_bias);
     if (msm_technique_is_area_light(technique.id)) {
@@ -138,7 +135,8 @@ struct Renderer::Impl {
       float tan_half = std::tan(glm::radians(extent) * 0.5f);
       float world_per_depth = 0.5f * glm::length(glm::vec3(inverse * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f)));
       float texel_y = glm::length(glm::vec3(inverse * glm::vec4(0.0f, 2.0f, 0.0f, 0.0f))) / float(s.shadow_size);
-      u.soft = glm::vec4(tan_half * world_per_depth / texel, tan_half * world_per_depth / texel_y, depth_bias,
+      // The constant part of msm_soft_depth_bias, in [-1,1] depth.
+      u.soft = glm::vec4(tan_half * world_per_depth / texel, tan_half * world_per_depth / texel_y, 2.0f * depth_bias,
                          MSM_SOFT_UMBRA_EPSILON);
       int kernel = s.resolved_soft_kernel();
       uint32_t scale = 0xFFFFFFFFu / uint32_t(kernel * kernel);

@@ -4,6 +4,7 @@
 #include "render_common.h"
 
 #include "msm/image/io.h"
+#include "msm/techniques.h"
 
 #include <fmt/core.h>
 
@@ -91,7 +92,7 @@ void add_bench(CLI::App& app) {
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
     const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve", "translucent", "blur", "mipmaps",
-                                                    "one_pass_filter"};
+                                                    "one_pass_filter", "sat"};
 
     // A progress line: rewritten in place on a terminal, one line per step in a log.
     bool tty = isatty(fileno(stderr));
@@ -142,11 +143,16 @@ void add_bench(CLI::App& app) {
       results.push_back(entry);
     }
     if (tty) fmt::print(stderr, "\r{:<70}\r", "");
-    // Ratios to PCF.
+    // Ratios to PCF; the soft techniques' shading also to PCSS where it ran (JCGT §4: two table
+    // queries against hundreds of taps).
+    bool with_pcss = per_unit.count("pcss") > 0;
     for (nlohmann::json& entry : results) {
       const std::string name = entry["technique"];
-      for (auto& [key, value] : entry["shading"].items())
+      for (auto& [key, value] : entry["shading"].items()) {
         value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
+        if (with_pcss && msm_technique_is_area_light(render::find_technique(name).id))
+          value["ratio_to_pcss"] = per_unit[name]["shading " + key] / per_unit["pcss"]["shading " + key];
+      }
       for (auto& [key, value] : entry["shadow_map"].items())
         value["ratio_to_pcf"] = per_unit[name]["shadow " + key] / per_unit["pcf"]["shadow " + key];
     }
@@ -170,6 +176,19 @@ void add_bench(CLI::App& app) {
         const auto& v = entry["shadow_map"][std::to_string(size)];
         md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
       }
+      md += "\n";
+    }
+    if (with_pcss) {
+      md += fmt::format("\nSoft shadows, shading time relative to pcss ({}² search):", opt->frame.settings.soft_kernel
+                                                                                         ? opt->frame.settings.soft_kernel
+                                                                                         : render::kDefaultPcssKernel);
+      for (const nlohmann::json& entry : results)
+        for (auto [w, h] : resolutions) {
+          const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
+          if (v.contains("ratio_to_pcss") && entry["technique"] != "pcss")
+            md += fmt::format(" {} {}x{}: {:.3f};", entry["technique"].get<std::string>(), w, h,
+                              v["ratio_to_pcss"].get<double>());
+        }
       md += "\n";
     }
     fmt::print("{}", md);

@@ -1,19 +1,114 @@
-// `msm demo` (what `make demo` runs): the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and
-// the non-linearly quantized MSM at 64 and 32 bits side by side in one labelled image with magnified insets where they differ, and a table of the
-// error against the PCF reference and the GPU time per pass.
+// `msm demo` (what `make demo` runs), in two parts:
+//  1. filtered hard shadows: the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the
+//     non-linearly quantized MSM at 64 and 32 bits side by side, errors against PCF (same kernel);
+//  2. soft shadows: the `models` scene (JCGT Fig. 8) with moment soft shadows (four and six
+//     moments) and their baselines VSSM and PCSS, errors against the ray-traced area light.
+// Each part writes one labelled image with magnified insets where the techniques differ, and
+// prints a table of the errors and the GPU time per pass.
 #include "render_common.h"
 
 #include "msm/image/compose.h"
 #include "msm/image/io.h"
 #include "msm/image/metrics.h"
+#include "msm/reference/reference.h"
 
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
+#include <optional>
 #include <unistd.h>
 
 namespace msm::tool {
+namespace {
+
+// One comparison: every technique rendered (per technique PNG, EXR, JSON in `out`), a table of
+// the errors against `truth` (the ray-traced visibility and its background) or, without it,
+// against the first technique, and the GPU time per pass (median of 5 frames); the figure in
+// out/figure_name. `truth_rgb` is the first panel where given.
+void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, const FrameOptions& frame,
+                        const std::vector<std::string>& techniques, const image::Image* truth,
+                        const image::Image* truth_rgb, const std::string& out, const std::string& figure_name) {
+  const scene::Scene& scene = renderer.scene();
+  bool tty = isatty(fileno(stderr));
+  std::vector<render::RenderResult> results;
+  std::vector<image::Image> signals;
+  for (size_t i = 0; i < techniques.size(); ++i) {
+    render::RenderSettings s = settings_for(frame, techniques[i]);
+    if (tty) fmt::print(stderr, "\r[{}/{}] {:<26}", i + 1, techniques.size(), s.technique);
+    results.push_back(renderer.render(s));
+    // The table shows the median of a few more frames: the first one pays for warming up.
+    std::vector<std::vector<render::PassTime>> frames = renderer.time_frames(s, 5);
+    for (render::PassTime& p : results.back().passes) {
+      std::vector<double> ms;
+      for (const auto& f : frames)
+        for (const render::PassTime& q : f)
+          if (q.name == p.name) ms.push_back(q.ms);
+      std::nth_element(ms.begin(), ms.begin() + std::ptrdiff_t(ms.size() / 2), ms.end());
+      p.ms = ms.empty() ? p.ms : ms[ms.size() / 2];
+    }
+    results.back().total_ms = 0;
+    for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
+    write_render(out, s.technique, results.back(), render_json(s, scene, ctx, results.back()));
+    signals.push_back(results.back().shadow.channel("visibility"));
+  }
+  if (tty) fmt::print(stderr, "\r{:<40}\r", "");
+
+  image::Image mask = truth ? truth->channel("background") : results[0].shadow.channel("background");
+  image::Image reference = truth ? truth->channel("visibility") : signals[0];
+  int side = std::max(16, frame.settings.width / 8);
+  std::vector<image::Image> candidates = signals;
+  if (truth) candidates.insert(candidates.begin(), reference);
+  std::vector<image::Rect> insets = image::find_difference_regions(candidates, side, side, 3);
+  std::vector<image::Panel> panels;
+  if (truth_rgb) panels.push_back({"ray traced", *truth_rgb, "reference"});
+  std::vector<std::string> pass_names;
+  // Every pass any technique ran, in the order of a frame.
+  for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur",
+                           "mipmaps", "shading"})
+    for (const render::RenderResult& r : results)
+      if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
+        pass_names.push_back(name);
+        break;
+      }
+  std::string header = fmt::format("{:<20} {:>5} {:>8} {:>8} {:>7}", "technique", "bits", "MAE", "leaking", ">3%");
+  for (const std::string& p : pass_names) header += fmt::format(" {:>14}", p + " ms");
+  fmt::print("\n{} {:>10}\n", header, "total ms");
+  for (size_t i = 0; i < results.size(); ++i) {
+    const render::Technique& t = render::find_technique(techniques[i]);
+    image::Metrics m = image::compute_metrics(signals[i], reference, {.mask = &mask});
+    std::string line = fmt::format("{:<20} {:>5} {:>8.5f} {:>8.5f} {:>6.2f}%", t.name, t.bits_per_texel, m.mae,
+                                   m.light_leaking, 100 * m.share_above_3pct);
+    for (const std::string& p : pass_names) {
+      double ms = -1;
+      for (const render::PassTime& q : results[i].passes)
+        if (q.name == p) ms = q.ms;
+      line += ms < 0 ? fmt::format(" {:>14}", "-") : fmt::format(" {:>14.3f}", ms);
+    }
+    fmt::print("{} {:>10.3f}\n", line, results[i].total_ms);
+    std::string caption = i == 0 && !truth ? std::string("reference")
+                                           : fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking);
+    panels.push_back({std::string(t.name), results[i].color, caption});
+  }
+  image::ComposeOptions options;
+  options.insets = insets;
+  options.columns = int(std::min<size_t>(panels.size(), 3));
+  image::Image figure = image::compose_comparison(panels, options);
+  std::filesystem::path file = std::filesystem::path(out) / figure_name;
+  try {
+    image::write_png(file, figure);
+  } catch (const image::ImageError& e) {
+    throw UsageError(e.what());
+  }
+  fmt::print("\nErrors are in visibility against {}, background excluded; times are GPU timestamps, median of 5 "
+             "frames.\nWrote {} ({}x{}) and per technique PNG, shadow-buffer EXR and JSON in {}/\n",
+             truth ? "the ray-traced area light" : techniques[0] + " (same kernel)", file.string(), figure.width(),
+             figure.height(), out);
+}
+
+} // namespace
 
 void add_demo(CLI::App& app) {
   struct Options {
@@ -21,99 +116,69 @@ void add_demo(CLI::App& app) {
     std::string out = "msm-demo";
     std::vector<std::string> techniques = {"pcf",          "vsm-32",   "evsm4-64", "msm-hamburger-64", "msm-hamburger-128",
                                            "msm-nl64", "msm-nl32"};
+    std::string soft_scene = "models";
+    std::vector<std::string> soft_techniques = {"mssm4", "mssm6", "vssm", "pcss"};
+    int soft_samples = 64;
   };
   auto opt = std::make_shared<Options>();
   opt->frame.settings.width = 960;
   opt->frame.settings.height = 540;
   opt->frame.scene = std::string(scene::default_scene_name());
   auto* cmd = app.add_subcommand("demo", "Render the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the "
-                                         "non-linear MSM 64/32 into one comparison image, and print the error against PCF and the time per pass");
+                                         "non-linear MSM 64/32 into one comparison image, then soft shadows (mssm4, "
+                                         "mssm6, vssm, pcss) against the ray-traced area light; print the errors and "
+                                         "the time per pass");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--techniques", opt->techniques, "Techniques to compare (the first is the reference)")
       ->delimiter(',');
+  cmd->add_option("--soft-scene", opt->soft_scene, "Scene of the soft-shadow part")->capture_default_str();
+  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques (empty: skip the soft part)")
+      ->delimiter(',');
+  cmd->add_option("--soft-samples", opt->soft_samples, "Ray-traced samples per pixel of the area-light reference")
+      ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
+    if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
     validate_techniques(opt->frame, opt->techniques);
+    FrameOptions soft = opt->frame;
+    soft.scene = opt->soft_scene;
+    if (!opt->soft_techniques.empty()) validate_techniques(soft, opt->soft_techniques);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    std::optional<scene::Scene> soft_scene;
+    if (!opt->soft_techniques.empty()) soft_scene = load_scene_or_fail(soft.scene);
     ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
-    render::Renderer renderer(*ctx, scene);
-    fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
-               scene.name, opt->frame.settings.width, opt->frame.settings.height, opt->frame.settings.shadow_size,
-               opt->frame.settings.msaa, opt->frame.settings.filter_size, opt->frame.settings.filter_sigma,
-               ctx->info().name);
-
-    bool tty = isatty(fileno(stderr));
-    std::vector<render::RenderResult> results;
-    std::vector<image::Image> signals;
-    for (size_t i = 0; i < opt->techniques.size(); ++i) {
-      render::RenderSettings s = settings_for(opt->frame, opt->techniques[i]);
-      if (tty) fmt::print(stderr, "\r[{}/{}] {:<26}", i + 1, opt->techniques.size(), s.technique);
-      results.push_back(renderer.render(s));
-      // The table shows the median of a few more frames: the first one pays for warming up.
-      std::vector<std::vector<render::PassTime>> frames = renderer.time_frames(s, 5);
-      for (render::PassTime& p : results.back().passes) {
-        std::vector<double> ms;
-        for (const auto& frame : frames)
-          for (const render::PassTime& q : frame)
-            if (q.name == p.name) ms.push_back(q.ms);
-        std::nth_element(ms.begin(), ms.begin() + std::ptrdiff_t(ms.size() / 2), ms.end());
-        p.ms = ms.empty() ? p.ms : ms[ms.size() / 2];
-      }
-      results.back().total_ms = 0;
-      for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
-      write_render(opt->out, s.technique, results.back(), render_json(s, scene, *ctx, results.back()));
-      signals.push_back(results.back().shadow.channel("visibility"));
+    const render::RenderSettings& fs = opt->frame.settings;
+    {
+      render::Renderer renderer(*ctx, scene);
+      fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
+                 scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
+                 ctx->info().name);
+      compare_techniques(renderer, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
     }
-    if (tty) fmt::print(stderr, "\r{:<40}\r", "");
-
-    // Error against the first technique (PCF), background masked.
-    image::Image mask = results[0].shadow.channel("background");
-    int side = std::max(16, opt->frame.settings.width / 8);
-    std::vector<image::Rect> insets = image::find_difference_regions(signals, side, side, 3);
-    std::vector<image::Panel> panels;
-    std::vector<std::string> pass_names;
-    // Every pass any technique ran, in the order of a frame.
-    for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur",
-                             "mipmaps", "shading"})
-      for (const render::RenderResult& r : results)
-        if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
-          pass_names.push_back(name);
-          break;
-        }
-    std::string header = fmt::format("{:<20} {:>5} {:>8} {:>8} {:>7}", "technique", "bits", "MAE", "leaking", ">3%");
-    for (const std::string& p : pass_names) header += fmt::format(" {:>14}", p + " ms");
-    fmt::print("\n{} {:>10}\n", header, "total ms");
-    for (size_t i = 0; i < results.size(); ++i) {
-      const render::Technique& t = render::find_technique(opt->techniques[i]);
-      image::Metrics m = image::compute_metrics(signals[i], signals[0], {.mask = &mask});
-      std::string line = fmt::format("{:<20} {:>5} {:>8.5f} {:>8.5f} {:>6.2f}%", t.name, t.bits_per_texel, m.mae,
-                                     m.light_leaking, 100 * m.share_above_3pct);
-      for (const std::string& p : pass_names) {
-        double ms = -1;
-        for (const render::PassTime& q : results[i].passes)
-          if (q.name == p) ms = q.ms;
-        line += ms < 0 ? fmt::format(" {:>14}", "-") : fmt::format(" {:>14.3f}", ms);
-      }
-      fmt::print("{} {:>10.3f}\n", line, results[i].total_ms);
-      std::string caption = i == 0 ? std::string("reference") : fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking);
-      panels.push_back({std::string(t.name), results[i].color, caption});
-    }
-    image::ComposeOptions options;
-    options.insets = insets;
-    options.columns = int(std::min<size_t>(panels.size(), 3));
-    image::Image figure = image::compose_comparison(panels, options);
-    std::filesystem::path file = std::filesystem::path(opt->out) / "comparison.png";
-    try {
-      image::write_png(file, figure);
-    } catch (const image::ImageError& e) {
-      throw UsageError(e.what());
-    }
-    fmt::print("\nErrors are in visibility against {} (same kernel), background excluded; times are GPU "
-               "timestamps, median of 5 frames.\nWrote {} ({}x{}) and per technique PNG, shadow-buffer EXR and JSON in {}/\n",
-               opt->techniques[0], file.string(), figure.width(), figure.height(), opt->out);
+    if (!soft_scene) return;
+    float extent = fs.light_extent_deg ? *fs.light_extent_deg : soft_scene->light.angular_extent_deg;
+    fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
+               "samples per pixel\n",
+               soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, opt->soft_samples);
+    reference::Settings rs;
+    rs.effect = reference::Effect::soft;
+    rs.width = fs.width;
+    rs.height = fs.height;
+    rs.samples = opt->soft_samples;
+    rs.light_extent_deg = extent;
+    reference::Result truth = reference::render(*soft_scene, rs);
+    // The renderer's look: ACES after the exposure, its sky colour where no surface is.
+    image::Image truth_rgb = image::tone_map(truth.radiance, {std::log2(fs.exposure), image::ToneCurve::aces});
+    for (int y = 0; y < truth_rgb.height(); ++y)
+      for (int x = 0; x < truth_rgb.width(); ++x)
+        if (truth.visibility.at(x, y, 1) > 0.5f)
+          for (int c = 0; c < 3; ++c) truth_rgb.at(x, y, c) = std::array{0.55f, 0.65f, 0.8f}[size_t(c)];
+    render::Renderer renderer(*ctx, *soft_scene);
+    compare_techniques(renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
+                       "soft-comparison.png");
   });
 }
 

@@ -112,7 +112,6 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                            const render::RenderResult& result) {
   const render::Technique& t = render::find_technique(s.technique);
   glm::vec4 p = s.params ? *s.params : render::default_params(t);
-  bool depth_based = msm_technique_is_depth_based(t.id);
   nlohmann::json passes = nlohmann::json::object();
   for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
   return {{"scene", scene.name},
@@ -131,7 +130,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"mipmaps", s.mipmaps},
           {"overdarken", s.overdarken},
           {"normal_offset_texels", s.normal_offset},
-          {"depth_bias", s.depth_bias ? *s.depth_bias : (depth_based ? 2e-5f : 0.0f)},
+          {"depth_bias", s.resolved_depth_bias()},
           {"receiver_plane_bias", s.receiver_plane_bias},
           {"exposure", s.exposure},
           {"lookup", s.lookup == render::RenderSettings::Lookup::bilinear  ? "bilinear"

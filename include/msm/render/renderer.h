@@ -84,7 +84,9 @@ struct RenderSettings {
   float normal_offset = 0.0f;      // lookup offset along the normal, in shadow-map texels
   std::optional<float> depth_bias; // subtracted from the fragment depth ([0,1] units); default:
                                    // 2e-5 for the depth-based techniques (16-bit depth rounding),
+                                   // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
                                    // 0 for the others (moment biasing does their work)
+  float resolved_depth_bias() const; // depth_bias or the technique's default
   float exposure = 1.0f;
   // How the shading reads a filtered map: automatic = dither for the non-linear techniques (HPG),
   // bilinear for the others; nearest = the texel under the fragment (mip 0); bilinear for the
