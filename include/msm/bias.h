@@ -46,6 +46,38 @@ MSM_FN MomentBias6 msm_moment_bias6(int representation) {
     return MomentBias6(MSM_ALPHA6_FLOAT, bstar);
 }
 
+// Receiver-plane depth bias of filtered shadow maps (subtracted from the fragment depth zf).
+// On a planar receiver whose depth changes by g per texel, the filter kernel around a fragment
+// holds the receiver's own depths zf + g·o, o distributed like the kernel (Gaussian taps, the
+// lookup's bilinear/trilinear footprint and the MSAA sample positions: independent per axis, each
+// symmetric about 0 with variance v texels²). That distribution is symmetric about zf with
+// standard deviation σ = |g| √v; half of it lies in front of zf, and how much of that half a
+// technique reports as shadow depends on its bound, so the bias is σ times a factor per bound:
+// - four moments (Hamburger or Hausdorff 4MSM): the lower bound of Z(z < zb) is 0 iff a
+//   distribution on [zb, ∞) has the moments, iff the localizing matrix
+//   [[b1 − zb b0, b2 − zb b1], [b2 − zb b1, b3 − zb b2]] is positive semidefinite; for moments
+//   centred on zf with b1 = b3 = 0, b2 = σ² (any symmetric distribution) that is (zf − zb)² ≥ σ²:
+//   a bias of exactly σ, whatever the shape of the kernel. Without it a Gaussian kernel on a slope
+//   reads a shadow of 1/6 (atoms at zf ± √3σ of weight 1/6); the moment bias then adds at most α;
+// - six moments: the 3x3 localizing matrix; it needs √3 σ for Gaussian depths (the limit of sums
+//   of independent offsets), 1.52-1.64 σ for the renderer's 9-tap σ = 2.4 kernel at any slope
+//   direction (computed), so √3 is the bias that holds for any such kernel;
+// - two moments (Cantelli, VSM), ESM (Markov on e^{cz}, Jensen) and the positive warp of EVSM:
+//   no shadow at the mean depth, so no bias;
+// - the negative warp −e^{−c z} of EVSM4: Cantelli reports shadow unless the warped zb is below
+//   the warped mean, i.e. e^{−c zb} ≥ E[e^{−c z}] = e^{−c zf + c²σ²/2} for Gaussian depths:
+//   zf − zb ≥ c σ²/2 (depths and σ in the warp's [-1,1] units).
+const float MSM_RECEIVER_SIGMAS4 = 1.0f;        // four moments: exact, for any symmetric kernel
+const float MSM_RECEIVER_SIGMAS6 = 1.7320508f;  // six moments: √3, the Gaussian limit
+
+// σ of the receiver's depth over the kernel: depth_per_texel = (dz/dx, dz/dy) per texel,
+// kernel_variance = the kernel's variance per axis in texels² (the same along x and y).
+MSM_FN float msm_receiver_depth_sigma(vec2 depth_per_texel, float kernel_variance) {
+    return sqrt(max(kernel_variance, 0.0f)) * length(depth_per_texel);
+}
+// The bias a negative exponential warp −e^{−c z} needs (see above), for σ in [-1,1] depth.
+MSM_FN float msm_receiver_plane_bias_negative_warp(float sigma, float c) { return 0.5f * c * sigma * sigma; }
+
 MSM_FN vec4 msm_apply_bias(vec4 b, float alpha, vec4 bstar) { return mix(b, bstar, alpha); }
 MSM_FN vec4 msm_apply_bias(vec4 b, MomentBias4 bias) { return mix(b, bias.bstar, bias.alpha); }
 MSM_FN Moments6 msm_apply_bias6(Moments6 b, MomentBias6 bias) {

@@ -21,9 +21,10 @@
 namespace msm::render {
 
 // std140 and the C++ struct agree (frame.h uses vec4/ivec4/mat4 members only).
-static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 3 * 16 + 4 * 16);
+static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 16);
 static_assert(offsetof(FrameUniforms, kernel) == 3 * 64 + 6 * 16);
 static_assert(offsetof(FrameUniforms, filter_weights) == 3 * 64 + 7 * 16);
+static_assert(offsetof(FrameUniforms, receiver_bias) == sizeof(FrameUniforms) - 16);
 static_assert(sizeof(ObjectPush) == 32 && sizeof(ImagePassPush) == 16);
 
 namespace {
@@ -171,6 +172,13 @@ struct Renderer::Impl {
       u.sample_offsets[i / 2][int(2 * (i % 2))] = offsets[i].x;
       u.sample_offsets[i / 2][int(2 * (i % 2) + 1)] = offsets[i].y;
     }
+    // Receiver-plane bias of the filtered techniques (lookup.glsl, msm/bias.h): the kernel's
+    // variance per axis in texels², of the normalized Gaussian taps plus the MSAA sample positions
+    // (the resolve averages depths taken there; mean of x and y); the lookup adds its own.
+    double kernel_variance = 0;
+    for (int k = 0; k < s.filter_size; ++k) kernel_variance += w[size_t(k)] / sum * double((k - radius) * (k - radius));
+    for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
+    u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
     return u;
   }
 

@@ -24,8 +24,11 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
-  cmd->add_flag_callback("--no-receiver-plane-bias", [&s] { s.receiver_plane_bias = false; },
-                         "No receiver-plane (slope-scaled) bias for the filtered techniques");
+  cmd->add_option("--receiver-plane-bias", s.receiver_plane_bias,
+                  "Receiver-plane (slope-scaled) bias of the filtered techniques, as a fraction of what "
+                  "their bound needs on a plane (0 = off)")
+      ->check(CLI::Range(0.0f, 4.0f))
+      ->capture_default_str();
   cmd->add_option("--exposure", s.exposure, "Exposure before tone mapping")->capture_default_str();
   cmd->add_option("--lookup", o.lookup, "Shadow-map lookup: auto (dither for msm-nl*, else bilinear), bilinear, "
                                          "nearest, dither")->capture_default_str();

@@ -20,7 +20,8 @@ struct FrameUniforms {
     vec4 technique_params;           // see msm/techniques.h
     vec4 shadow_map;                 // x: size in texels, y: 1 / size,
                                      // z: normal offset in world units, w: depth bias in [0,1] depth
-    vec4 shading;                    // x: over-darkening factor (1 = off), y: exposure, zw: unused
+    vec4 shading;                    // x: over-darkening factor (1 = off), y: exposure,
+                                     // z: translucent alpha threshold, w: unused
     vec4 background;                 // rgb: linear colour of pixels without a surface
     ivec4 kernel;                    // x: taps per axis (odd), y: MSAA samples, z: radius, w: unused
     vec4 filter_weights[16];         // normalized 1D Gaussian weights, tap k at [k / 4][k % 4]
@@ -31,6 +32,9 @@ struct FrameUniforms {
     ivec4 soft_kernel;               // x: kernel width W (n_t = W²), y: table scale (uint bits)
     vec4 sample_offsets[4];          // MSAA sample positions relative to the texel centre, in
                                      // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
+    vec4 receiver_bias;              // receiver-plane bias of the filtered techniques (lookup.glsl):
+                                     // x: the kernel's variance per axis in texels² (blur + MSAA),
+                                     // y: multiplier of the bias each bound needs (0 = off), zw: unused
 };
 
 // How the shading reads a filtered shadow map.

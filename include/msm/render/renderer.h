@@ -87,6 +87,14 @@ struct RenderSettings {
                                    // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
                                    // 0 for the others (moment biasing does their work)
   float resolved_depth_bias() const; // depth_bias or the technique's default
+  // Receiver-plane bias of the filtered techniques (msm/bias.h): the fragment depth moves towards
+  // the light by the spread of the receiver's own depth over the kernel (σ = slope x the kernel's
+  // standard deviation, mips included) times what the technique's bound needs on a plane (4MSM: 1,
+  // 6MSM: √3, EVSM4: c⁻σ²/2, VSM/ESM: 0), times this factor, on top of depth_bias. 1 removes the
+  // self-shadowing of sloped receivers (grazing light, coarse mips); it also loses short-range
+  // shadows of occluders closer than the bias (the railing: leaking x1.6-2), hence off (0) by
+  // default: at mip 0 the 16-bit maps' moment bias already absorbs most of it (docs/results.md).
+  float receiver_plane_bias = 0.0f;
   float exposure = 1.0f;
   // How the shading reads a filtered map: automatic = dither for the non-linear techniques (HPG),
   // bilinear for the others; nearest = the texel under the fragment (mip 0); bilinear for the

@@ -32,3 +32,31 @@ Bilinear bilinear_texels(vec2 t) {
   b.i1 = clamp(ivec2(base) + 1, ivec2(0), ivec2(last));
   return b;
 }
+
+// Receiver-plane bias of the filtered techniques (msm/bias.h), in [0,1] depth, to subtract from
+// the fragment depth: the filter kernel spans several texels of a sloped receiver, and the half
+// of them in front of the fragment would shadow it (self-shadowing, worst at grazing light).
+// frame.receiver_bias.x: the kernel's variance per axis in texels² from the blur and the MSAA
+// sample positions (host), .y: a multiplier (RenderSettings::receiver_plane_bias; 0 = off), applied
+// to σ (so the negative warp's σ² bias scales by its square). The lookup adds its own
+// footprint: bilinear at mip λ reads texels that average 2^λ x 2^λ mip-0 texels (variance
+// (4^λ − 1)/12 per axis) with tent weights over 2^λ texels (4^λ f(1 − f), 4^λ/6 on average over
+// the fractional position f): 4^λ/4 − 1/12 in all, 1/6 at mip 0; trilinear blends two levels,
+// which λ's fraction approximates. A nearest or dithered lookup compares at the receiver plane's
+// depth at the texel it reads (receiver_depth_at): its kernel is the blur's.
+float receiver_plane_bias(ShadowLookup s, float lod) {
+  float variance = frame.receiver_bias.x;
+  if (!(frame.receiver_bias.y > 0.0f)) return 0.0f; // off (or NaN)
+  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) variance += exp2(2.0f * lod) * 0.25f - 1.0f / 12.0f;
+  float sigma = frame.receiver_bias.y * msm_receiver_depth_sigma(s.depth_per_texel, variance); // [0,1] depth
+  if (kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96) return MSM_RECEIVER_SIGMAS6 * sigma;
+  if (kTechnique == MSM_TECH_EVSM4_64 || kTechnique == MSM_TECH_EVSM4_128)
+    return 0.5f * msm_receiver_plane_bias_negative_warp(2.0f * sigma, frame.technique_params.z); // [-1,1] warp
+  // Cantelli (VSM, EVSM2's positive warp) and Markov (ESM): nothing in front at the mean depth.
+  if (kTechnique == MSM_TECH_VSM32 || kTechnique == MSM_TECH_VSM64 || kTechnique == MSM_TECH_ESM32 ||
+      kTechnique == MSM_TECH_EVSM2_32 || kTechnique == MSM_TECH_EVSM2_64)
+    return 0.0f;
+  // Four moments: Hamburger, Hausdorff, trigonometric (power moments of the circle's angle to
+  // second order for the narrow spread of a kernel) and the non-linear maps (Hamburger 4MSM).
+  return MSM_RECEIVER_SIGMAS4 * sigma;
+}

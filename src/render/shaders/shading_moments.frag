@@ -12,6 +12,12 @@ float shadow_intensity(ShadowLookup s) {
   bool six = kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96;
   bool second = six || kSplitRG;
   MsmTexel texel = MsmTexel(vec4(0.0f), vec4(0.0f));
+  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
+    vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
+    s.z -= receiver_plane_bias(s, textureQueryLod(moments0, uv).x);
+  } else {
+    s.z -= receiver_plane_bias(s, 0.0f);
+  }
   float zf = s.z;
   if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
     vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;

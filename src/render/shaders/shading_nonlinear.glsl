@@ -20,6 +20,7 @@ NonLinearMoments decode(ivec2 i) {
 }
 
 float shadow_intensity(ShadowLookup s) {
+  s.z -= receiver_plane_bias(s, 0.0f); // the maps have no mips
   float zf = msm_signed_depth(s.z);
   if (frame.lookup.x != MSM_LOOKUP_BILINEAR) {
     ivec2 i = lookup_texel(s.t);
