@@ -128,7 +128,15 @@ float RenderSettings::resolved_depth_bias() const {
   // receiver planes are exact for planar receivers only, and across a 15-texel kernel curved ones
   // (the models scene's knots) would shadow themselves (MAE 0.018 at 2e-5, 0.006 at 5e-4).
   if (msm_technique_is_area_light(id)) return 5e-4f;
-  return msm_technique_is_depth_based(id) ? 2e-5f : 0.0f;
+  // Depth-based: 16-bit depth rounding (a step is 1.5e-5). Filtered: the moments come from the
+  // rounded D16 depths, the fragment's depth is a float: a receiver lit straight down is compared
+  // against its own texels up to half a step (7.6e-6) too far, which the float techniques' tiny
+  // moment bias (3e-7) does not absorb (msm-hamburger-128 read bare ground as shadowed).
+  // Non-linear maps: HPG §5 uses a constant 1e-3 in [-1,1] depth for all results; it is half a
+  // bin of msm-nl32's 10-bit depths (1/1023), which otherwise shadow a flat receiver facing the
+  // light wherever its depth rounds towards the light.
+  if (msm_technique_is_nonlinear(id)) return 5e-4f;
+  return msm_technique_is_depth_based(id) ? 2e-5f : 1e-5f;
 }
 
 void RenderSettings::validate() const {

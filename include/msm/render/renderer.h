@@ -85,7 +85,9 @@ struct RenderSettings {
   std::optional<float> depth_bias; // subtracted from the fragment depth ([0,1] units); default:
                                    // 2e-5 for the depth-based techniques (16-bit depth rounding),
                                    // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
-                                   // 0 for the others (moment biasing does their work)
+                                   // 1e-5 for the filtered ones (the D16 rounding that their
+                                   // moment bias does not cover), 5e-4 for the non-linear ones
+                                   // (HPG §5: 1e-3 in [-1,1] depth)
   float resolved_depth_bias() const; // depth_bias or the technique's default
   // Receiver-plane bias of the filtered techniques (msm/bias.h): the fragment depth moves towards
   // the light by the spread of the receiver's own depth over the kernel (σ = slope x the kernel's
