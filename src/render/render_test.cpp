@@ -506,6 +506,12 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
   rejects([&] { auto q = s; q.technique = "msm-nl64"; q.one_pass = false; return q; }(), "needs the one-pass filter");
   rejects([&] { auto q = s; q.technique = "msm6-96"; q.one_pass = true; return q; }(), "one moment image");
   rejects([&] { auto q = s; q.one_pass = true; q.filter_size = 19; return q; }(), "at most 17 taps");
+  rejects([&] { auto q = s; q.technique = "mssm4"; q.params = glm::vec4(0.0f); return q; }(), "0 < δ1 <= δ2 <= 1");
+  rejects([&] { auto q = s; q.technique = "mssm6"; q.params = glm::vec4(0.1f, 0.01f, 1, 0); return q; }(), "δ1 <= δ2");
+  rejects([&] { auto q = s; q.technique = "vssm"; q.params = glm::vec4(0.0f); return q; }(), "minimum variance");
+  rejects([&] { auto q = s; q.technique = "pcss"; q.soft_kernel = 64; return q; }(), "soft kernel = 64");
+  rejects([&] { auto q = s; q.technique = "mssm4"; q.soft_kernel = 256; return q; }(), "soft kernel = 256");
+  rejects([&] { auto q = s; q.technique = "mssm4"; q.one_pass = true; return q; }(), "summed-area table");
   if (!vk::supportsAttachment(ctx(), VK_FORMAT_D16_UNORM, VK_SAMPLE_COUNT_8_BIT))
     rejects([&] { auto q = s; q.msaa = 8; return q; }(), "8x MSAA");
   // The renderer still works afterwards.

@@ -179,9 +179,17 @@ void RenderSettings::validate() const {
                                   kMaxOnePassTaps));
   if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
   finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
-  if (params)
+  if (params) {
     for (int i = 0; i < 4; ++i)
       if (!std::isfinite((*params)[i])) throw RenderError("technique parameters must be finite");
+    const glm::vec4& p = *params;
+    // The blocker estimators divide by δ1 + (blocker mass) and VSSM by the variance.
+    if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
+      throw RenderError(fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique,
+                                    p.x, p.y));
+    if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
+      throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
+  }
 }
 
 } // namespace msm::render
