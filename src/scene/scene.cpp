@@ -215,7 +215,8 @@ private:
   }
 
   Material material(const json& j, const std::string& ptr) const {
-    keys(j, ptr, {"albedo", "albedo_texture", "opacity", "opacity_texture", "opacity_noise", "double_sided"});
+    keys(j, ptr, {"albedo", "albedo_texture", "opacity", "opacity_texture", "opacity_noise", "transmission_color",
+                  "double_sided"});
     Material m;
     if (const json* v = find(j, "albedo")) {
       m.albedo = vec<3>(*v, ptr + "/albedo");
@@ -238,6 +239,11 @@ private:
       if (const json* x = find(*v, "density")) n.density = number_in(*x, q + "/density", 0.0f, 1.0f, false, false);
       if (const json* x = find(*v, "softness")) n.softness = number_in(*x, q + "/softness", 0.0f, 1.0f, true, false);
       m.opacity_noise = n;
+    }
+    if (const json* v = find(j, "transmission_color")) {
+      const std::string q = ptr + "/transmission_color";
+      if (!v->is_array() || v->size() != 3) fail(q, "must be an array of 3 numbers (r, g, b)");
+      for (int c = 0; c < 3; ++c) m.transmission_color[c] = number_in((*v)[c], fmt::format("{}/{}", q, c), 0.0f, 1.0f, false, false);
     }
     if (const json* v = find(j, "double_sided")) m.double_sided = boolean(*v, ptr + "/double_sided");
     return m;

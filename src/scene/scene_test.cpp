@@ -538,6 +538,56 @@ TEST(Textures, PathRecordedAndLoadedLazily) {
   expect_error([&] { load_texture(dir.path() / "bad.png"); }, {"bad.png", "cannot decode"});
 }
 
+TEST(Materials, TransmissionColor) {
+  // Default: no transmission colour, per-channel opacity = alpha in every channel (grey shadows).
+  const Scene d = load_scene_json(scene_with_object(R"({"primitive": {"type": "box"}, "material": {"opacity": 0.5}})"),
+                                  fs::current_path(), "t.json");
+  const Material& dm = d.materials[d.objects[0].material];
+  EXPECT_EQ(dm.transmission_color, glm::vec3(0.0f));
+  EXPECT_EQ(dm.channel_opacity(0.5f), glm::vec3(0.5f));
+  EXPECT_EQ(dm.channel_opacity(1.0f), glm::vec3(1.0f));
+  EXPECT_TRUE(dm.translucent());
+  EXPECT_FALSE(Material{}.translucent());
+
+  // Parsed, named and inline; opacity 1 with a transmission colour is still translucent.
+  const Scene s = load_scene_json(
+      scene_with_object(R"({"primitive": {"type": "box"}, "material": "glass"}, {"primitive": {"type": "box"}, "material": {"transmission_color": [0, 0.5, 1]}})",
+                        R"("materials": {"glass": {"opacity": 0.6, "transmission_color": [1, 0.25, 0]}},)"),
+      fs::current_path(), "t.json");
+  const Material& glass = s.materials[s.objects[0].material];
+  EXPECT_EQ(glass.name, "glass");
+  EXPECT_EQ(glass.transmission_color, glm::vec3(1.0f, 0.25f, 0.0f));
+  const glm::vec3 a = glass.channel_opacity(0.6f);
+  EXPECT_FLOAT_EQ(a.r, 0.0f);
+  EXPECT_FLOAT_EQ(a.g, 0.45f);
+  EXPECT_FLOAT_EQ(a.b, 0.6f);
+  const Material& stained = s.materials[s.objects[1].material];
+  EXPECT_FLOAT_EQ(stained.opacity, 1.0f);
+  EXPECT_EQ(stained.transmission_color, glm::vec3(0.0f, 0.5f, 1.0f));
+  EXPECT_TRUE(stained.translucent());
+  Material only_blue;
+  only_blue.transmission_color = {0.0f, 0.0f, 0.1f};
+  EXPECT_TRUE(only_blue.translucent());
+  EXPECT_EQ(only_blue.channel_opacity(0.0f), glm::vec3(0.0f));
+
+  // Validation: each component in [0, 1], a number, exactly three of them.
+  const auto with = [](const std::string& tc) {
+    return scene_with_object(R"({"primitive": {"type": "box"}, "material": {"transmission_color": )" + tc + "}}");
+  };
+  expect_json_error(with("[0, 1.5, 0]"), {"test.json", "/objects/0/material/transmission_color/1", "[0, 1]", "1.5"});
+  expect_json_error(with("[-0.1, 0, 0]"), {"/objects/0/material/transmission_color/0", "[0, 1]"});
+  expect_json_error(with(R"([0, 0, "NaN"])"), {"/objects/0/material/transmission_color/2", "number"});
+  expect_json_error(with("[0, 0, null]"), {"/objects/0/material/transmission_color/2", "number"});
+  expect_json_error(with("[1, 1]"), {"/objects/0/material/transmission_color", "3 numbers"});
+  expect_json_error(with("[1, 1, 1, 1]"), {"/objects/0/material/transmission_color", "3 numbers"});
+  expect_json_error(with("0.5"), {"/objects/0/material/transmission_color", "3 numbers"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": "g"})",
+                                      R"("materials": {"g": {"transmission_color": [2, 0, 0]}},)"),
+                    {"/materials/g/transmission_color/0", "[0, 1]"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": {"transmission_colour": [1, 0, 0]}})"),
+                    {"/objects/0/material/transmission_colour", "unknown key", "transmission_color"});
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input: a SceneError naming the file, the location and the problem.
 

@@ -45,6 +45,10 @@
 //                                          procedural puff of smoke instead of a texture file
 //                                          (see make_smoke_opacity); at most one of the two,
 //   (a constant given together with a texture multiplies it)
+//   "transmission_color": [r,g,b] in [0,1] (default [0,0,0]): of the light meeting the covered
+//                                          fraction (opacity alpha) the fraction that passes, per
+//                                          channel; per-channel opacity alpha*(1 - transmission_color)
+//                                          (coloured shadows; see Material::channel_opacity)
 //   "double_sided": false
 // }
 // Texture paths are relative to the scene file; they must exist when the scene is loaded but are
@@ -90,7 +94,8 @@
 // Errors: every problem throws SceneError naming the file, the JSON pointer (and the object's
 // name) and what is wrong: malformed JSON, unknown keys/primitive/scene names, missing or
 // unreadable meshes/textures, NaN/infinite positions, meshes with only degenerate triangles,
-// scale <= 0, fov outside (0,180), opacity outside [0,1], absurd sizes or segment counts.
+// scale <= 0, fov outside (0,180), opacity, albedo or transmission_color outside [0,1], absurd
+// sizes or segment counts.
 // Degenerate (zero-area) triangles in otherwise valid meshes are dropped silently.
 //
 // Clip-space conventions (camera and light matrices): Vulkan: x right, y DOWN in NDC (an image
@@ -167,8 +172,19 @@ struct Material {
   std::filesystem::path opacity_texture;
   std::optional<SmokeNoise> opacity_noise; // procedural opacity (instead of opacity_texture)
   bool double_sided = false;
-  // Opacity below 1 somewhere: a constant below 1, a texture or procedural noise.
-  bool translucent() const { return opacity < 1.0f || !opacity_texture.empty() || opacity_noise.has_value(); }
+  // Coloured transmission (JCGT 2017, Sec. 3): of the light that meets the covered fraction (the
+  // opacity alpha) of this surface, the fraction that passes, per RGB channel, each in [0, 1].
+  // Default 0: the covered fraction blocks all channels alike (grey shadows, as without it).
+  glm::vec3 transmission_color{0.0f};
+  // Per-channel opacity at a point of opacity alpha (the constant times texture/noise there):
+  // alpha * (1 - transmission_color). Equals vec3(alpha) for the default transmission colour.
+  glm::vec3 channel_opacity(float alpha) const { return alpha * (glm::vec3(1.0f) - transmission_color); }
+  // Lets light through somewhere: an opacity constant below 1, an opacity texture, procedural
+  // noise, or any transmission_color component > 0 (stained glass of opacity 1 still transmits).
+  bool translucent() const {
+    return opacity < 1.0f || !opacity_texture.empty() || opacity_noise.has_value() ||
+           glm::any(glm::greaterThan(transmission_color, glm::vec3(0.0f)));
+  }
 };
 
 struct Transform {
