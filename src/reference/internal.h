@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -101,13 +102,16 @@ public:
     bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
 
     struct Transmission {
-        double transmittance = 1.0;
+        glm::dvec3 channels{1.0};   // per RGB channel
+        double transmittance = 1.0; // the mean of the three channels (exactly channels.r when all equal)
         int crossings = 0;
         std::uint64_t rays = 0;
     };
-    // Product of (1 - opacity) over the surfaces crossed by origin + t dir, t >= 0, counting at
-    // most max_crossings of them; stops early at transmittance 0. Opacity = the material's
-    // constant times its opacity texture or noise (scene::opacity_image) at the hit's uv.
+    // Per channel c, the product of (1 - alpha * (1 - transmission_color_c)) (the material's
+    // channel_opacity, in double precision) over the surfaces crossed by origin + t dir, t >= 0,
+    // counting at most max_crossings of them; stops early when every channel is 0. alpha = the
+    // material's constant times its opacity texture or noise (scene::opacity_image) at the hit's
+    // uv. Without transmission colours every channel is the product of (1 - alpha).
     Transmission transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const;
 
     // Interpolated vertex normal at a hit (unit).
@@ -141,7 +145,8 @@ struct EffectContext {
 };
 
 struct EffectResult {
-    double value = 1.0;      // visibility or transmittance
+    double value = 1.0;      // visibility or transmittance (translucent: the mean of rgb)
+    std::optional<glm::dvec3> rgb;  // translucent only: transmittance per RGB channel
     double std_error = 0.0;
     int samples = 1;
     std::uint64_t rays = 0;  // shadow rays traced

@@ -88,6 +88,11 @@ glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, float vis
     return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>) + kAmbient * albedo;
 }
 
+glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, glm::vec3 visibility) {
+    // Channel by channel exactly the scalar formula (same operations in the same order).
+    return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>) + kAmbient * albedo;
+}
+
 LightFrame LightFrame::of(const scene::Scene& scene) {
     const glm::dmat4 inv = glm::inverse(glm::dmat4(scene.light_view_projection()));
     LightFrame f;
@@ -168,6 +173,10 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     std::vector<std::string> names{"visibility", "background"};
     if (mc) names.insert(names.end(), {"sample_count", "std_error"});
     result.visibility = image::Image(W, H, names);
+    // translucent: the transmittance per RGB channel (coloured shadows; "visibility" is their
+    // mean), in an image of its own (an image has at most 4 channels).
+    const bool coloured = settings.effect == Effect::translucent;
+    if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
     result.radiance = image::Image(W, H, 3);
     result.samples = mc ? settings.samples : 1;
 
@@ -189,6 +198,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     const int channels = result.visibility.channels();
     float* vis = result.visibility.pixels().data();
     float* rad = result.radiance.pixels().data();
+    float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
     const auto trace_start = std::chrono::steady_clock::now();
 
     tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& range) {
@@ -225,12 +235,22 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
                     v[2] = float(e.samples);
                     v[3] = float(e.std_error);
                 }
+                const glm::vec3 rgb = e.rgb ? glm::vec3(*e.rgb) : glm::vec3(float(e.value));
+                if (vis_rgb) {
+                    float* t = vis_rgb + (std::size_t(y) * W + x) * 3;
+                    t[0] = rgb.r;
+                    t[1] = rgb.g;
+                    t[2] = rgb.b;
+                }
                 row_sum[y] += e.value;
-                // Shading: interpolated normal turned towards the viewer.
+                // Shading: interpolated normal turned towards the viewer; per channel where the
+                // effect gives a visibility per channel (translucent).
                 glm::dvec3 n = tracer.shading_normal(hit);
                 if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-                const glm::vec3 colour = shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                               float(glm::dot(n, ctx.towards_light)), float(e.value));
+                const glm::vec3 colour = e.rgb ? shade(tracer.material(hit).albedo, glm::vec3(irradiance),
+                                                       float(glm::dot(n, ctx.towards_light)), rgb)
+                                               : shade(tracer.material(hit).albedo, glm::vec3(irradiance),
+                                                       float(glm::dot(n, ctx.towards_light)), float(e.value));
                 c[0] = colour.r;
                 c[1] = colour.g;
                 c[2] = colour.b;

@@ -8,7 +8,8 @@
 //                  (exact for the planar light model, see reference.h), itself checked against a
 //                  numeric integral over the light; a rectangle light over the half-plane (a
 //                  linear ramp); error convergence with the sample count;
-//   - translucent: k parallel planes of opacity a give (1 - a)^k;
+//   - translucent: k parallel planes of opacity a give (1 - a)^k in every channel; planes with
+//                  transmission colours give the product per channel, their mean as visibility;
 //   - determinism across thread counts, and bad input.
 // The analytic side uses its own camera model (look-at basis and tan(fov / 2)), not the library's
 // matrices, so that the conventions themselves are checked.
@@ -589,8 +590,12 @@ TEST(reference_translucent, StackOfPlanesGivesPowerOfOneMinusOpacity) {
             for (int x = 0; x < s.width; ++x) {
                 ASSERT_NEAR(channel(r.visibility, "visibility", x, y), expected, 1e-6) << "k " << k << " pixel " << x << "," << y;
                 worst = std::max(worst, std::abs(channel(r.visibility, "visibility", x, y) - expected));
+                // Grey materials: three equal channels, exactly the scalar visibility.
+                for (const char* c : {"visibility_r", "visibility_g", "visibility_b"})
+                    ASSERT_EQ(channel(r.visibility_rgb, c, x, y), channel(r.visibility, "visibility", x, y)) << c;
                 const double radiance = 0.5 * 2.0 * towards.y / kPi * expected + 0.03 * 0.5;
-                ASSERT_NEAR(r.radiance.at(x, y, 1), radiance, 1e-6);
+                for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.radiance.at(x, y, c), radiance, 1e-6);
+                ASSERT_EQ(r.radiance.at(x, y, 0), r.radiance.at(x, y, 2));
             }
         RecordProperty("max_error_k" + std::to_string(k), num(worst));
         if (k == 4) {  // the crossing cap counts the first max_crossings surfaces only
@@ -599,6 +604,56 @@ TEST(reference_translucent, StackOfPlanesGivesPowerOfOneMinusOpacity) {
             EXPECT_NEAR(channel(capped.visibility, "visibility", 5, 5), (1.0 - alpha) * (1.0 - alpha), 1e-6);
         }
     }
+}
+
+// Coloured transmission (JCGT 2017, Sec. 3): under plane 1 (alpha 0.6, transmission colour
+// (1, 0, 0)) and plane 2 (alpha 0.5, (0, 0, 1)), lit straight down, T = (1 * 0.5, 0.4 * 0.5,
+// 0.4 * 1) = (0.5, 0.2, 0.4) and visibility = their mean; radiance per channel. A stained glass of
+// opacity 1 lets its colour through and is looked through by the primary rays.
+TEST(reference_translucent, TransmissionColourPerChannel) {
+    const glm::dvec3 towards(0, 1, 0);
+    const std::string ground = R"({"primitive": {"type": "plane", "size": [10, 10]}, "material": {"albedo": [0.5, 0.5, 0.5]}})";
+    const auto plane = [](double height, double alpha, const std::string& colour) {
+        return R"(, {"primitive": {"type": "plane", "size": [20, 20]}, "transform": {"translate": [0, )" + num(height) +
+               R"(, 0]}, "material": {"opacity": )" + num(alpha) + R"(, "transmission_color": )" + colour + "}}";
+    };
+    const auto check = [&](const Result& r, int W, int H, glm::dvec3 expected, const std::string& what) {
+        SCOPED_TRACE(what);
+        ASSERT_EQ(r.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
+        ASSERT_EQ(r.visibility_rgb.channel_names(), (std::vector<std::string>{"visibility_r", "visibility_g", "visibility_b"}));
+        ASSERT_EQ(r.background_pixels, 0u);
+        const double mean = (expected.r + expected.g + expected.b) / 3.0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                ASSERT_NEAR(channel(r.visibility_rgb, "visibility_r", x, y), expected.r, 1e-5) << x << "," << y;
+                ASSERT_NEAR(channel(r.visibility_rgb, "visibility_g", x, y), expected.g, 1e-5) << x << "," << y;
+                ASSERT_NEAR(channel(r.visibility_rgb, "visibility_b", x, y), expected.b, 1e-5) << x << "," << y;
+                ASSERT_NEAR(channel(r.visibility, "visibility", x, y), mean, 1e-5) << x << "," << y;
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_NEAR(r.radiance.at(x, y, c), 0.5 * 2.0 / kPi * expected[c] + 0.03 * 0.5, 1e-5) << x << "," << y;
+            }
+        EXPECT_NEAR(r.mean_visibility, mean, 1e-5);
+    };
+    Settings s;
+    s.effect = Effect::translucent;
+    s.width = s.height = 12;
+    // Camera below the planes, looking straight down at the ground.
+    const CameraSpec below{{0.0, 0.5, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+    const std::string stack = ground + plane(1.0, 0.6, "[1, 0, 0]") + plane(2.0, 0.5, "[0, 0, 1]");
+    check(render(make_scene(below, light_json(towards), stack), s), s.width, s.height, {0.5, 0.2, 0.4}, "stack");
+
+    // Opacity 1, transmission colour (0.2, 0.5, 0.8): T = the colour; the camera above it sees the
+    // ground through it.
+    const CameraSpec above{{0.0, 3.0, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+    const std::string glass = ground + plane(1.0, 1.0, "[0.2, 0.5, 0.8]");
+    check(render(make_scene(above, light_json(towards), glass), s), s.width, s.height, {0.2, 0.5, 0.8}, "stained glass");
+
+    // The other effects keep their channels; for them every surface blocks.
+    s.effect = Effect::hard;
+    const Result hard = render(make_scene(below, light_json(towards), stack), s);
+    EXPECT_EQ(hard.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
+    EXPECT_TRUE(hard.visibility_rgb.empty());
+    EXPECT_EQ(channel(hard.visibility, "visibility", 5, 5), 0.0f);
 }
 
 // A closed box is crossed twice; an opaque plane stops the light; hard ignores opacity.

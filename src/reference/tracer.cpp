@@ -161,15 +161,21 @@ Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::d
     while (result.crossings < max_crossings) {
         ++result.rays;
         if (!closest(o, dir, std::numeric_limits<double>::infinity(), hit)) break;
-        result.transmittance *= 1.0 - opacity(hit);
-        ++result.crossings;
-        if (result.transmittance <= 0.0) {
-            result.transmittance = 0.0;
-            break;
+        const double alpha = opacity(hit);
+        const glm::vec3 colour = material(hit).transmission_color;
+        for (int c = 0; c < 3; ++c) {
+            // 1 - channel_opacity(alpha)_c, in double; exactly 1 - alpha for colour 0.
+            result.channels[c] *= 1.0 - alpha * (1.0 - double(colour[c]));
+            if (result.channels[c] <= 0.0) result.channels[c] = 0.0;
         }
+        ++result.crossings;
+        if (result.channels.r == 0.0 && result.channels.g == 0.0 && result.channels.b == 0.0) break;
         // Continue from just beyond the crossed surface.
         o = offset_origin(hit.p, hit.normal, hit.scale, dir);
     }
+    // The mean, written so that three equal channels give exactly that value.
+    const glm::dvec3& t = result.channels;
+    result.transmittance = t.r + ((t.g - t.r) + (t.b - t.r)) / 3.0;
     return result;
 }
 

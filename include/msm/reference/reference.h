@@ -8,8 +8,9 @@
 // row. The primary ray of pixel (x, y) goes through NDC ((x + 0.5) / W * 2 - 1, (y + 0.5) / H * 2 - 1)
 // (Vulkan: y down, depth in [0, 1]): from the unprojection of NDC depth 0 to that of depth 1 with
 // inverse(scene.camera_view_projection(float(W) / H)), in double precision. The closest hit over
-// [near point, far point] that is opaque (no opacity below 1, no opacity texture or noise) is the
-// visible surface: translucent surfaces are looked through, as in the renderer's shadow buffer. Back faces are surfaces too: the rasterizer
+// [near point, far point] that is opaque (not scene::Material::translucent(): no opacity below 1,
+// no opacity texture or noise, no transmission colour) is the visible surface: translucent
+// surfaces are looked through, as in the renderer's shadow buffer. Back faces are surfaces too: the rasterizer
 // culls the back faces of single-sided materials, which shows the same surface as long as meshes
 // are closed (or seen from their front side); for an open single-sided surface seen from behind
 // the two differ, and the reference shows the surface. The hit point p is the intersection of the
@@ -46,10 +47,15 @@
 //               from below the local horizon is blocked by the surface itself. Not weighted by the
 //               cosine: visibility, not irradiance. Extent 0 gives the hard shadow.
 //
-//   translucent T(p) = product over every surface crossed by the ray p -> L of (1 - opacity of
-//               its material: the constant times the opacity texture or
-//               procedural noise at the hit's uv, bilinear with repeat as the renderer samples
-//               it); a closed mesh is crossed twice. At most max_crossings surfaces are counted.
+//   translucent Coloured transmittance (JCGT 2017, Sec. 3), per RGB channel c:
+//               T_c(p) = product over every surface i crossed by the ray p -> L of
+//               (1 - channel_opacity(alpha_i)_c) = (1 - alpha_i * (1 - transmission_color_i,c)),
+//               alpha_i the opacity of its material at the hit (the constant times the opacity
+//               texture or procedural noise at the hit's uv, bilinear with repeat as the renderer
+//               samples it), transmission_color_i its material's (scene::Material; default 0,
+//               where every channel is the product of (1 - alpha_i)). The scalar visibility is
+//               the mean (T_r + T_g + T_b) / 3, exactly T_r when the channels agree. A closed mesh
+//               is crossed twice. At most max_crossings surfaces are counted.
 //
 // Samplers (filtered, soft): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
 // for the first m^2 of the N samples per pixel and independent uniform points for the rest (so a
@@ -65,8 +71,14 @@
 // Output images (W x H, row 0 at the top):
 //   visibility   channels "visibility", "background" and, for filtered and soft only,
 //                "sample_count", "std_error". background = 1 where the primary ray hits nothing
-//                (there visibility = 1, sample_count = std_error = 0), else 0.
-//   radiance     "R", "G", "B" (linear): shade() below at the visible surface, 0 on background.
+//                (there visibility = 1, sample_count = std_error = 0), else 0. For translucent,
+//                "visibility" is the mean of the three channel transmittances.
+//   visibility_rgb  translucent only (empty for the other effects; an image holds at most 4
+//                channels, so not in `visibility`): "visibility_r", "visibility_g",
+//                "visibility_b" = T_r, T_g, T_b; 1 on background.
+//   radiance     "R", "G", "B" (linear): shade() below at the visible surface, 0 on background;
+//                for translucent with the visibility of each channel (T_r, T_g, T_b) in its
+//                channel. Result::mean_visibility averages "visibility".
 #pragma once
 
 #include <array>
@@ -113,6 +125,9 @@ inline constexpr float kAmbient = 0.03f;           // ambient term, times the al
 // with albedo the material's constant colour (albedo textures are ignored), n the interpolated
 // vertex normal turned towards the viewer, l = towards_light.
 glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, float visibility);
+// The same formula with a visibility per RGB channel (coloured translucent shadows); for equal
+// channels v it is exactly shade(albedo, irradiance, n_dot_l, v).
+glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, glm::vec3 visibility);
 
 // The shadow map's light-space frame, from the inverse of light_projection() * light_view():
 // x_axis / y_axis are the unit world directions of increasing clip x / y (along the map's texel
@@ -160,6 +175,7 @@ void validate(const Settings& settings);
 
 struct Result {
     image::Image visibility;  // see above for the channels
+    image::Image visibility_rgb;  // translucent: T_r, T_g, T_b ("visibility_r/_g/_b"); else empty
     image::Image radiance;    // R, G, B
     int samples = 1;          // per covered pixel (1 for hard and translucent)
     double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0;  // as used (soft)
