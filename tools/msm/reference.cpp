@@ -144,6 +144,14 @@ void add_reference(CLI::App& app) {
         try {
             msm::image::write_exr(out / "visibility.exr", result.visibility);
             msm::image::write_exr(out / "radiance.exr", result.radiance);
+            // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
+            // from an earlier run into the same folder for the other effects.
+            if (!result.visibility_rgb.empty()) {
+                msm::image::write_exr(out / "visibility_rgb.exr", result.visibility_rgb);
+            } else {
+                std::error_code ec;
+                fs::remove(out / "visibility_rgb.exr", ec);
+            }
         } catch (const msm::image::ImageError& e) {
             throw UsageError(e.what());
         }
@@ -168,6 +176,10 @@ void add_reference(CLI::App& app) {
         j["mean_visibility"] = result.mean_visibility;
         j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}};
         j["channels"] = {{"visibility", result.visibility.channel_names()}, {"radiance", result.radiance.channel_names()}};
+        if (!result.visibility_rgb.empty()) {
+            j["files"]["visibility_rgb"] = "visibility_rgb.exr";
+            j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();
+        }
         j["seconds"] = {{"load", load_seconds},
                         {"build", result.build_seconds},
                         {"render", result.render_seconds},
