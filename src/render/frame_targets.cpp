@@ -79,15 +79,23 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
     can_mip = can_mip && has(ctx, format, blit);
   }
   mip_levels = can_mip ? uint32_t(std::bit_width(shadow)) : 1u;
+  const VkImageUsageFlags moment_usage =
+      VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+      VK_IMAGE_USAGE_TRANSFER_DST_BIT | (c.translucent ? VkImageUsageFlags(VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) : 0u);
+  const int c_channels = c.channels();
   for (int i = 0; i < c.moment_images(); ++i) {
-    moments[size_t(i)] = vk::createImage(
-        ctx, {.width = shadow, .height = shadow, .format = VkFormat(c.formats()[size_t(i)]),
-              .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                       VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                       (c.translucent ? VkImageUsageFlags(VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT) : 0u),
-              .mipLevels = mip_levels});
+    moments[size_t(i)] = vk::createImage(ctx, {.width = shadow, .height = shadow,
+                                               .format = VkFormat(c.formats()[size_t(i)]), .usage = moment_usage,
+                                               .mipLevels = mip_levels});
     moments_mip0[size_t(i)] = vk::createImageView(ctx, moments[size_t(i)].handle(), moments[size_t(i)].format(),
                                                   VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);
+    for (int c = 1; c < c_channels; ++c) {
+      vk::Image& image = colour_moments[size_t(c - 1)][size_t(i)];
+      image = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = moments[size_t(i)].format(),
+                                    .usage = moment_usage, .mipLevels = mip_levels});
+      colour_moments_mip0[size_t(c - 1)][size_t(i)] = vk::createImageView(
+          ctx, image.handle(), image.format(), VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_VIEW_TYPE_2D, 0, 1);
+    }
     if (c.taps > 1 && !c.one_pass && !soft)
       blur_temp[size_t(i)] = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_R32G32B32A32_SFLOAT,
                                                    .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
@@ -100,7 +108,7 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
   uint32_t w = uint32_t(c.width), h = uint32_t(c.height);
   color = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R8G8B8A8_SRGB,
                                 .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
-  shadow_buffer = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R32G32_SFLOAT,
+  shadow_buffer = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R32G32B32A32_SFLOAT,
                                         .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
   camera_depth = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_D32_SFLOAT,
                                        .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT});

@@ -70,7 +70,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
     draw.double_sided = material.double_sided;
     draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);
     draw.push.flags = glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0,
-                                 draw.opacity_texture >= 0 ? 1 : 0, 0);
+                                 draw.opacity_texture >= 0 ? 1 : 0, -1);
+    draw.push.transmission = glm::vec4(material.transmission_color, 0.0f);
     if (!draw.index_count) continue;
     if (is_translucent) translucent_by_depth.emplace_back(glm::dot(draw.center, travel), draw);
     else draws.push_back(draw);

@@ -25,7 +25,7 @@ static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 3 * 16 + 4 * 
 static_assert(offsetof(FrameUniforms, kernel) == 3 * 64 + 6 * 16);
 static_assert(offsetof(FrameUniforms, filter_weights) == 3 * 64 + 7 * 16);
 static_assert(offsetof(FrameUniforms, receiver_bias) == sizeof(FrameUniforms) - 16);
-static_assert(sizeof(ObjectPush) == 32 && sizeof(ImagePassPush) == 16);
+static_assert(sizeof(ObjectPush) == 48 && sizeof(ImagePassPush) == 16);
 
 namespace {
 
@@ -84,7 +84,7 @@ struct Renderer::Impl {
   std::unique_ptr<FrameTargets> targets;
   std::map<int, std::unique_ptr<ShadowDepthPass>> shadow_passes;
   std::map<std::tuple<int, int, bool>, std::unique_ptr<MomentResolvePass>> resolve_passes;
-  std::map<std::tuple<int, int, bool>, std::unique_ptr<ShadingPass>> shading_passes;
+  std::map<std::tuple<int, int, bool, bool>, std::unique_ptr<ShadingPass>> shading_passes;
   std::map<std::tuple<int, int, bool>, std::unique_ptr<TranslucentPass>> translucent_passes;
   std::map<std::tuple<int, int, int>, std::unique_ptr<OnePassFilterPass>> one_pass_passes;
   vk::Image noise;
@@ -96,7 +96,7 @@ struct Renderer::Impl {
   Impl(const vk::Context& c, const scene::Scene& s)
       : ctx(c), scene(s), gpu(c, s), light_view_projection(s.light_view_projection()),
         uniforms(vk::createBuffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::Host)),
-        timer(c, 16), noise(upload_blue_noise(c)) {}
+        timer(c, 32), noise(upload_blue_noise(c)) {}
 
   static vk::Image upload_blue_noise(const vk::Context& ctx) {
     const BlueNoise& n = blue_noise();
@@ -198,7 +198,7 @@ struct Renderer::Impl {
     bool translucent = s.translucent_occluders && !gpu.translucent.empty() && supports_translucency(technique) &&
                        !one_pass;
     FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps, one_pass,
-                       translucent};
+                       translucent, translucent && s.coloured_translucency};
     bool split = config.split_rg();
     if (!targets || !(targets->config == config)) {
       targets.reset();
@@ -218,8 +218,8 @@ struct Renderer::Impl {
       if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
       if (msm_technique_is_soft(technique.id) && !sat_pass) sat_pass = std::make_unique<SatPass>(ctx);
     }
-    cached(shading_passes, std::tuple(technique.id, s.msaa, split),
-           [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa, split); });
+    cached(shading_passes, std::tuple(technique.id, s.msaa, split, config.coloured),
+           [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa, split, config.coloured); });
     FrameUniforms u = frame_uniforms(s, technique);
     std::memcpy(uniforms.data(), &u, sizeof(u));
     return technique;
@@ -230,25 +230,31 @@ struct Renderer::Impl {
     timer.reset(cmd);
     FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms, noise, scene.camera.position};
     bool split = targets->config.split_rg();
+    const ShadingPass& shading = *shading_passes.at({technique.id, s.msaa, split, targets->config.coloured});
     shadow_passes.at(s.msaa)->execute(f);
     if (targets->config.one_pass) {
       one_pass_passes.at({technique.id, s.msaa, s.filter_size})->execute(f);
       if (until_resolve) return;
       mipmap_pass.execute(f);
     } else if (targets->config.moment_images()) {
-      resolve_passes.at({technique.id, s.msaa, split})->execute(f);
-      if (until_resolve) return;
-      if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
-      if (msm_technique_is_soft(technique.id)) {
-        sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());
-        shading_passes.at({technique.id, s.msaa, split})->execute(f);
-        return;
+      // One set of moment images per colour channel with coloured translucency: the opaque
+      // resolve is the same for each, the translucent blend uses the channel's opacity.
+      for (f.channel = 0; f.channel < targets->config.channels(); ++f.channel) {
+        resolve_passes.at({technique.id, s.msaa, split})->execute(f);
+        if (until_resolve) return;
+        if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
+        if (msm_technique_is_soft(technique.id)) {
+          sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());
+          shading.execute(f);
+          return;
+        }
+        if (s.filter_size > 1) blur_pass->execute(f);
+        mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
       }
-      if (s.filter_size > 1) blur_pass->execute(f);
-      mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
+      f.channel = 0;
     }
     if (until_resolve) return;
-    shading_passes.at({technique.id, s.msaa, split})->execute(f);
+    shading.execute(f);
   }
 
   std::vector<PassTime> read_times() {
@@ -323,13 +329,19 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
     for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
 
   std::vector<std::byte> shadow = vk::readbackImage(m.ctx, m.targets->shadow_buffer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  // RGBA32F: visibility per colour channel, coverage. With coloured translucency "visibility" is
+  // the mean of the channels (as the ray tracer's), and the channels come along.
+  bool coloured = m.targets->config.coloured;
   r.shadow = image::Image(s.width, s.height, {"visibility", "background"});
+  if (coloured) r.shadow_rgb = image::Image(s.width, s.height, {"visibility_r", "visibility_g", "visibility_b"});
   std::span<float> v = r.shadow.pixels();
   for (size_t i = 0; i < r.shadow.pixel_count(); ++i) {
-    float px[2];
-    std::memcpy(px, shadow.data() + 8 * i, 8);
-    v[2 * i] = px[0];
-    v[2 * i + 1] = 1.0f - px[1];
+    float px[4];
+    std::memcpy(px, shadow.data() + 16 * i, 16);
+    v[2 * i] = coloured ? (px[0] + px[1] + px[2]) / 3.0f : px[0];
+    v[2 * i + 1] = 1.0f - px[3];
+    if (coloured)
+      for (size_t c = 0; c < 3; ++c) r.shadow_rgb.pixels()[3 * i + c] = px[c];
   }
   return r;
 }

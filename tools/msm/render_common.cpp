@@ -24,6 +24,13 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
+  cmd->add_flag_callback("--no-translucent-occluders", [&s] { s.translucent_occluders = false; },
+                         "Translucent objects cast no shadow (not blended into the moment map)");
+  cmd->add_option("--alpha-threshold", s.translucent_alpha_threshold,
+                  "Translucent fragments below this opacity are not blended (JCGT: 1%)")
+      ->capture_default_str();
+  cmd->add_flag("--coloured-translucency", s.coloured_translucency,
+                "Coloured translucent shadows: one moment map per colour channel (materials' transmission_color)");
   cmd->add_option("--receiver-plane-bias", s.receiver_plane_bias,
                   "Receiver-plane (slope-scaled) bias of the filtered techniques, as a fraction of what "
                   "their bound needs on a plane (0 = off)")
@@ -145,6 +152,9 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"frame", s.frame},
           {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg},
           {"soft_kernel", s.resolved_soft_kernel()},
+          {"translucent_occluders", s.translucent_occluders},
+          {"translucent_alpha_threshold", s.translucent_alpha_threshold},
+          {"coloured_translucency", s.coloured_translucency},
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
           {"gpu_ms_total", result.total_ms}};
@@ -155,6 +165,7 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
   try {
     image::write_png(dir / (stem + ".png"), result.color);
     image::write_exr(dir / (stem + ".exr"), result.shadow);
+    if (!result.shadow_rgb.empty()) image::write_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
     std::string text = json.dump(2) + "\n";
     image::write_file_atomic(dir / (stem + ".json"),
                              std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));

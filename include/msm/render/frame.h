@@ -45,7 +45,11 @@ const int MSM_LOOKUP_DITHER = 2;   // nearest after a blue-noise offset of up to
 // Per draw of the shading pass (push constants).
 struct ObjectPush {
     vec4 albedo_opacity;             // rgb: albedo (multiplies the texture), a: opacity
-    ivec4 flags;                     // x: 1 if the albedo texture is used, y: 1 if double-sided
+    ivec4 flags;                     // x: 1 if the albedo texture is used, y: 1 if double-sided,
+                                     // z: 1 if the opacity texture is used, w: the colour channel
+                                     // the translucent pass blends (-1: grey, the opacity itself)
+    vec4 transmission;               // rgb: transmission colour (the channel's opacity is
+                                     // opacity (1 - transmission)), a: unused
 };
 
 // The compute passes on shadow-map images (push constants).

@@ -113,6 +113,11 @@ struct RenderSettings {
   // The depth-based, non-linear and six-moment techniques (and a one-pass filter) draw them
   // without a shadow. Fragments below the threshold opacity are discarded (JCGT: 1%).
   bool translucent_occluders = true;
+  // Coloured translucent shadows (JCGT §3): one moment map per colour channel, each blended with
+  // the channel's opacity α (1 − the material's transmission_color). Three times the moment
+  // images, resolve, blend, blur and mips, three lookups per fragment; off: grey shadows (the
+  // opacity itself). Only where translucent occluders are blended (see above).
+  bool coloured_translucency = false;
   // Soft shadows (mssm4, mssm6, vssm, pcss): the directional light's angular diameter in degrees
   // (default: the scene's angular_extent_deg) and the largest kernel width W in texels of the
   // blocker search and the filter (summed-area tables: n_t = W²). 0 = the technique's default:
@@ -136,6 +141,8 @@ struct RenderResult {
   image::Image color;  // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
   image::Image shadow; // "visibility" (of the light at the visible surface, 0 where the surface
                        // faces away from the light) and "background" (1 where no surface)
+  image::Image shadow_rgb; // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
+                           // "visibility" is then their mean, as the ray tracer's); else empty
   std::vector<PassTime> passes; // in execution order; empty where the queue has no timestamps
   double total_ms = 0;          // sum of the passes
 };

@@ -19,7 +19,7 @@ void BlurPass::execute(FrameContext& f) const {
   uint32_t groups = vk::groupCount(uint32_t(size), 8);
   VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
   for (int i = 0; i < t.config.moment_images(); ++i) {
-    VkImageView moments = t.moments_mip0[size_t(i)];
+    VkImageView moments = t.moment_mip0(f.channel, i);
     const vk::Image& temp = t.blur_temp[size_t(i)];
     vk::pipelineBarrier(f.cmd, vk::imageBarrier(temp.handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
                                                 VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,

@@ -19,7 +19,7 @@ void MipmapPass::execute(FrameContext& f) const {
   constexpr VkPipelineStageFlags2 transfer = VK_PIPELINE_STAGE_2_TRANSFER_BIT;
   constexpr VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   for (int i = 0; i < t.config.moment_images(); ++i) {
-    VkImage image = t.moments[size_t(i)].handle();
+    VkImage image = t.moment_image(f.channel, i).handle();
     int32_t size = t.config.shadow_size;
     uint32_t levels = t.mip_levels;
     if (levels == 1) {

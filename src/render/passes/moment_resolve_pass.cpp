@@ -18,12 +18,12 @@ void MomentResolvePass::execute(FrameContext& f) const {
   const FrameTargets& t = f.targets;
   int images = t.config.moment_images();
   for (int i = 0; i < images; ++i)
-    vk::pipelineBarrier(f.cmd, vk::imageBarrier(t.moments[size_t(i)].handle(), VK_IMAGE_ASPECT_COLOR_BIT,
+    vk::pipelineBarrier(f.cmd, vk::imageBarrier(t.moment_image(f.channel, i).handle(), VK_IMAGE_ASPECT_COLOR_BIT,
                                                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED,
                                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                                                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL, 0, 1));
   // The shader writes image 1 only for 6MSM; the others get image 0 twice (a valid descriptor).
-  VkImageView first = t.moments_mip0[0], second = images > 1 ? t.moments_mip0[1] : first;
+  VkImageView first = t.moment_mip0(f.channel, 0), second = images > 1 ? t.moment_mip0(f.channel, 1) : first;
   ImagePassPush push{glm::ivec4(t.config.shadow_size, t.config.shadow_size, 0, 0)};
   uint32_t groups = vk::groupCount(uint32_t(t.config.shadow_size), 8);
   vk::dispatch(f.cmd, program_, groups, groups, 1,

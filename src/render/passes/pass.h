@@ -29,6 +29,9 @@ struct FrameContext {
   const vk::Buffer& uniforms; // FrameUniforms
   const vk::Image& blue_noise; // 64 layers of 64² RG8 (blue_noise.h)
   glm::vec3 camera_position;
+  // The colour channel whose moment images resolve, translucent, blur and mips work on
+  // (FrameTargets::moment_image; always 0 unless the frame has coloured translucency).
+  int channel = 0;
 };
 
 // Scene -> shadow_depth (D16, MSAA), left SHADER_READ_ONLY for compute and fragment reads.
@@ -114,7 +117,7 @@ public:
 class ShadingPass {
 public:
   static const PassDecl& decl();
-  ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg);
+  ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg, bool coloured);
   void execute(FrameContext& f) const;
 
 private:

@@ -13,7 +13,7 @@ const PassDecl& ShadingPass::decl() {
 
 namespace {
 
-vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_rg, bool translucent) {
+vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_rg, bool coloured, bool translucent) {
   bool depth_based = msm_technique_is_depth_based(technique.id);
   std::string fragment = depth_based                        ? (msaa == 1 ? "shading_depth_1x.frag" : "shading_depth.frag")
                          : technique.id == MSM_TECH_NL64 ? "shading_nl64.frag"
@@ -29,13 +29,14 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_r
                      .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
                                     {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
                                     {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
-                     .colorFormats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32_SFLOAT},
+                     .colorFormats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
                      .depthFormat = VK_FORMAT_D32_SFLOAT,
                      .depthWrite = !translucent,
-                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}}};
-  // Second moment image, blue noise, opacity texture (the depth-based shaders use neither of
-  // the first two; the layout is the same for every technique).
-  for (int i = 0; i < 3; ++i) d.bindings.push_back(vk::Binding::SampledImage);
+                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}, {4, coloured ? 1u : 0u}}};
+  // Second moment image, blue noise, opacity texture, then the green and blue channels' moment
+  // images (coloured translucency); the depth-based shaders use neither the second image nor the
+  // noise; the layout is the same for every technique.
+  for (int i = 0; i < 7; ++i) d.bindings.push_back(vk::Binding::SampledImage);
   if (translucent) { // over the opaque image; the shadow buffer keeps the opaque surface's
     d.name += " (translucent)";
     d.alphaBlend = true;
@@ -46,9 +47,9 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_r
 
 } // namespace
 
-ShadingPass::ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg)
-    : program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, false))),
-      translucent_program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, true))),
+ShadingPass::ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg, bool coloured)
+    : program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, coloured, false))),
+      translucent_program_(vk::createGraphicsProgram(ctx, shading_desc(technique, msaa, split_rg, coloured, true))),
       depth_based_(msm_technique_is_depth_based(technique.id)),
       nonlinear_(msm_technique_is_nonlinear(technique.id)), soft_(msm_technique_is_soft(technique.id)) {}
 
@@ -71,7 +72,7 @@ void ShadingPass::execute(FrameContext& f) const {
 
   VkExtent2D size = extent(t.color);
   // The background: visibility 1 (nothing to shadow), coverage 0. The sky colour is linear.
-  VkClearColorValue sky{{0.55f, 0.65f, 0.8f, 1.0f}}, lit{{1.0f, 0.0f, 0.0f, 0.0f}};
+  VkClearColorValue sky{{0.55f, 0.65f, 0.8f, 1.0f}}, lit{{1.0f, 1.0f, 1.0f, 0.0f}};
   vk::beginRendering(f.cmd, size, {{t.color.view(), sky}, {t.shadow_buffer.view(), lit}},
                      vk::DepthAttachment{t.camera_depth.view(), 1.0f});
   vk::setViewportScissor(f.cmd, size);
@@ -96,13 +97,25 @@ void ShadingPass::execute(FrameContext& f) const {
                                        : shadow0;
   vk::Descriptor noise(f.blue_noise.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
   if (depth_based_) second = vk::Descriptor(f.scene.white.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
+  // The green and blue channels' moment images where the frame has them, else the first set.
+  std::array<vk::Descriptor, 4> colour{shadow0, second, shadow0, second};
+  if (t.config.coloured)
+    for (int c = 1; c < 3; ++c)
+      for (int i = 0; i < 2; ++i) {
+        int image = std::min(i, t.config.moment_images() - 1);
+        colour[size_t(2 * (c - 1) + i)] = vk::Descriptor(t.moment_image(c, image),
+                                                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.moment_sampler);
+      }
   auto draw = [&](const vk::Program& program, const Draw& d) {
     const vk::Image& texture = d.texture >= 0 ? f.scene.textures[size_t(d.texture)] : f.scene.white;
     const vk::Image& opacity = d.opacity_texture >= 0 ? f.scene.opacity_textures[size_t(d.opacity_texture)] : f.scene.white;
     vk::Descriptor albedo(texture.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler);
     vk::Descriptor alpha(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler);
     vkCmdSetCullMode(f.cmd, d.double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
-    vk::bindProgram(f.cmd, program, {vk::Descriptor(f.uniforms), albedo, shadow0, second, noise, alpha}, d.push);
+    vk::bindProgram(f.cmd, program,
+                    {vk::Descriptor(f.uniforms), albedo, shadow0, second, noise, alpha, colour[0], colour[1], colour[2],
+                     colour[3]},
+                    d.push);
     vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
   };
   for (const Draw& d : f.scene.draws) draw(program_, d);

@@ -44,7 +44,7 @@ void TranslucentPass::execute(FrameContext& f) const {
                                                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, color, color_rw));
   std::vector<vk::ColorAttachment> targets;
   for (int i = 0; i < t.config.moment_images(); ++i)
-    targets.push_back({.view = t.moments_mip0[size_t(i)], .load = true, .layout = VK_IMAGE_LAYOUT_GENERAL});
+    targets.push_back({.view = t.moment_mip0(f.channel, i), .load = true, .layout = VK_IMAGE_LAYOUT_GENERAL});
   VkExtent2D size{uint32_t(t.config.shadow_size), uint32_t(t.config.shadow_size)};
   vk::beginRendering(f.cmd, size, targets);
   vk::setViewportScissor(f.cmd, size);
@@ -55,12 +55,14 @@ void TranslucentPass::execute(FrameContext& f) const {
   vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
   vk::Descriptor depth(t.shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
   for (const Draw& d : f.scene.translucent) {
+    ObjectPush push = d.push;
+    push.flags.w = t.config.coloured ? f.channel : -1; // the channel whose opacity to blend
     const vk::Image& opacity = d.opacity_texture >= 0 ? f.scene.opacity_textures[size_t(d.opacity_texture)] : f.scene.white;
     vk::bindProgram(f.cmd, program_,
                     {vk::Descriptor(f.uniforms),
                      vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler),
                      depth},
-                    d.push);
+                    push);
     vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
   }
   vkCmdEndRendering(f.cmd);

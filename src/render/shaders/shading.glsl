@@ -13,7 +13,7 @@ layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec2 texcoord;
 
 layout(location = 0) out vec4 out_color;  // tone mapped; the attachment is sRGB
-layout(location = 1) out vec2 out_shadow; // x: light visibility, y: 1 (a surface is here)
+layout(location = 1) out vec4 out_shadow; // rgb: light visibility per colour channel, a: 1 (a surface)
 
 // Where a fragment looks up the shadow map: t in texel-centre coordinates (texel i covers
 // [i - 0.5, i + 0.5)), z its depth in [0,1], and the receiver plane's depth per texel along x and
@@ -25,6 +25,10 @@ struct ShadowLookup {
 };
 
 float shadow_intensity(ShadowLookup s);
+#ifdef MSM_COLOURED_SHADOWS
+// Per colour channel, where kColoured (the including shader defines it with the macro).
+vec3 shadow_intensity_rgb(ShadowLookup s);
+#endif
 
 // Narkowicz's fit of the ACES filmic curve (as msm::image::ToneCurve::aces).
 vec3 tone_map(vec3 x) { return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f); }
@@ -35,7 +39,7 @@ void main() {
   vec3 l = frame.towards_light.xyz;
   float n_dot_l = dot(n, l);
 
-  float visibility = 0.0f; // surfaces turned away from the light are in their own shadow
+  vec3 visibility = vec3(0.0f); // surfaces turned away from the light are in their own shadow
   if (n_dot_l > 0.0f) {
     // Normal offset: more at grazing light, where depth varies fastest across a texel.
     vec3 p = world_position + n * (frame.shadow_map.z * (1.0f - n_dot_l));
@@ -51,8 +55,14 @@ void main() {
                             : vec2(0.0f);
     bool inside = all(greaterThanEqual(clip.xy, vec2(-1.0f))) && all(lessThanEqual(clip.xy, vec2(1.0f))) &&
                   clip.z <= 1.0f;
-    float shadow = inside ? shadow_intensity(s) : 0.0f;
-    if (frame.shading.x < 1.0f) shadow = msm_overdarken(shadow, frame.shading.x);
+#ifdef MSM_COLOURED_SHADOWS
+    vec3 shadow = !inside ? vec3(0.0f) : kColoured ? shadow_intensity_rgb(s) : vec3(shadow_intensity(s));
+#else
+    vec3 shadow = vec3(inside ? shadow_intensity(s) : 0.0f);
+#endif
+    if (frame.shading.x < 1.0f)
+      shadow = vec3(msm_overdarken(shadow.x, frame.shading.x), msm_overdarken(shadow.y, frame.shading.x),
+                    msm_overdarken(shadow.z, frame.shading.x));
     visibility = 1.0f - shadow;
   }
 
@@ -63,5 +73,5 @@ void main() {
   float opacity = object.albedo_opacity.a;
   if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
   out_color = vec4(tone_map(radiance * frame.shading.y), opacity);
-  out_shadow = vec2(visibility, 1.0f);
+  out_shadow = vec4(visibility, 1.0f);
 }

@@ -21,6 +21,8 @@ layout(location = 1) out vec4 out1;
 void main() {
   float alpha = object.albedo_opacity.a;
   if (object.flags.z != 0) alpha *= texture(opacity_texture, texcoord).x;
+  // Coloured translucency: this pass blends one colour channel's map, with that channel's opacity.
+  if (object.flags.w >= 0) alpha *= 1.0f - object.transmission[object.flags.w];
   ivec2 p = ivec2(gl_FragCoord.xy);
   float z = gl_FragCoord.z;
   int samples = frame.kernel.y, behind = 0;
