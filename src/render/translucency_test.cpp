@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <map>
 
@@ -127,6 +128,49 @@ TEST_F(TranslucencyTest, ColouredGlassCastsColouredShadows) {
     EXPECT_NEAR(grey, 0.2, tolerance) << t << ": grey without the option";
     EXPECT_NEAR(centre_visibility(r.shadow), (got.r + got.g + got.b) / 3.0, 1e-5) << "visibility is the mean";
   }
+}
+
+// The built-in glass scene (four stained-glass panes and a smoked sheet): per colour channel
+// against the ray-traced transmittance on the opaque surfaces, with one moment map per channel
+// and with the grey map (whose one shadow serves all three channels), 240x135, 512², with the
+// receiver-plane bias. Measured MAE: coloured 0.017-0.020 (what is left is mostly the 9² filter
+// against the ray tracer's unfiltered edges), grey 0.031-0.046. Asserted: coloured closer than
+// grey in every channel, below 0.025, and MSM 64 closer than VSM 32 in every channel.
+TEST_F(TranslucencyTest, GlassSceneColouredAgainstTheRayTracer) {
+  scene::Scene scene = scene::builtin_scene("glass");
+  reference::Settings rs;
+  rs.effect = reference::Effect::translucent;
+  rs.width = 240;
+  rs.height = 135;
+  reference::Result truth = reference::render(scene, rs);
+  image::Image mask = truth.visibility.channel("background");
+  Renderer renderer(ctx(), scene);
+  std::map<std::string, std::array<double, 3>> mae;
+  for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "evsm4-64", "vsm-32"}) {
+    RenderSettings s;
+    s.technique = t;
+    s.width = 240;
+    s.height = 135;
+    s.shadow_size = 512;
+    s.receiver_plane_bias = 1.0f; // the floor is lit at 53° from its normal (see SmokeScene)
+    s.coloured_translucency = true;
+    RenderResult coloured = renderer.render(s);
+    s.coloured_translucency = false;
+    image::Image grey = renderer.render(s).shadow.channel("visibility");
+    std::string line = fmt::format("glass {:<18} MAE per channel, coloured / grey:", t);
+    for (int k = 0; k < 3; ++k) {
+      std::string c = std::string("visibility_") + "rgb"[k];
+      image::Image reference = truth.visibility_rgb.channel(c);
+      image::Metrics mc = image::compute_metrics(coloured.shadow_rgb.channel(c), reference, {.mask = &mask});
+      image::Metrics mg = image::compute_metrics(grey, reference, {.mask = &mask});
+      line += fmt::format(" {:.4f} / {:.4f};", mc.mae, mg.mae);
+      EXPECT_LT(mc.mae, mg.mae) << t << ", " << c;
+      EXPECT_LT(mc.mae, 0.025) << t << ", " << c;
+      mae[t][size_t(k)] = mc.mae;
+    }
+    fmt::print("{}\n", line);
+  }
+  for (size_t k = 0; k < 3; ++k) EXPECT_LT(mae["msm-hamburger-64"][k], mae["vsm-32"][k]) << "channel " << k;
 }
 
 // JCGT §3: fragments of opacity below 1% are discarded, because blending many nearly transparent

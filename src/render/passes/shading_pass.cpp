@@ -19,7 +19,8 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_r
                          : technique.id == MSM_TECH_NL64 ? "shading_nl64.frag"
                          : technique.id == MSM_TECH_NL32 ? "shading_nl32.frag"
                          : msm_technique_is_soft(technique.id) ? "shading_soft.frag"
-                                                         : "shading_moments.frag";
+                         : coloured                             ? "shading_moments_rgb.frag"
+                                                                : "shading_moments.frag";
   vk::GraphicsDesc d{.name = std::string("shading ") + std::string(technique.name),
                      .vertexShader = "shading.vert",
                      .fragmentShader = fragment,
@@ -32,7 +33,7 @@ vk::GraphicsDesc shading_desc(const Technique& technique, int msaa, bool split_r
                      .colorFormats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
                      .depthFormat = VK_FORMAT_D32_SFLOAT,
                      .depthWrite = !translucent,
-                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}, {4, coloured ? 1u : 0u}}};
+                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}}};
   // Second moment image, blue noise, opacity texture, then the green and blue channels' moment
   // images (coloured translucency); the depth-based shaders use neither the second image nor the
   // noise; the layout is the same for every technique.

@@ -9,8 +9,6 @@ layout(constant_id = 0) const int kTechnique = 0;
 // Four moments stored as two RG images (translucent occluders blend into the map: JCGT §3):
 // channels 0, 1 in image 0 and 2, 3 in image 1.
 layout(constant_id = 3) const bool kSplitRG = false;
-// Coloured translucent shadows: the shading reads one set of moment images per colour channel.
-layout(constant_id = 4) const bool kColoured = false;
 
 // Normalized 1D Gaussian weight of tap k in [0, taps).
 float kernel_weight(int k) { return frame.filter_weights[k / 4][k % 4]; }

@@ -26,7 +26,7 @@ struct ShadowLookup {
 
 float shadow_intensity(ShadowLookup s);
 #ifdef MSM_COLOURED_SHADOWS
-// Per colour channel, where kColoured (the including shader defines it with the macro).
+// Per colour channel (coloured translucency: the including shader defines it with the macro).
 vec3 shadow_intensity_rgb(ShadowLookup s);
 #endif
 
@@ -56,7 +56,7 @@ void main() {
     bool inside = all(greaterThanEqual(clip.xy, vec2(-1.0f))) && all(lessThanEqual(clip.xy, vec2(1.0f))) &&
                   clip.z <= 1.0f;
 #ifdef MSM_COLOURED_SHADOWS
-    vec3 shadow = !inside ? vec3(0.0f) : kColoured ? shadow_intensity_rgb(s) : vec3(shadow_intensity(s));
+    vec3 shadow = inside ? shadow_intensity_rgb(s) : vec3(0.0f);
 #else
     vec3 shadow = vec3(inside ? shadow_intensity(s) : 0.0f);
 #endif

@@ -1,0 +1,51 @@
+// Shading with the linear filtered techniques: the blurred (and mip-mapped) moment images, read
+// with hardware bilinear/trilinear filtering, at the nearest texel or dithered, then
+// reconstructed by the shared technique code; with coloured translucency (shading_moments_rgb.frag
+// defines MSM_COLOURED_SHADOWS) once per colour channel. A separate shader, not a specialization
+// constant: lavapipe compiled the three reconstructions even where the constant disabled them,
+// tripling the pipeline build time of every linear technique.
+layout(binding = 2) uniform sampler2D moments0;
+layout(binding = 3) uniform sampler2D moments1; // second half of 6MSM; else moments0 again
+// Coloured translucency: the green and blue channels' moment images (bound to moments0/1 where the
+// frame has none; only shading_moments_rgb.frag reads them).
+layout(binding = 6) uniform sampler2D moments0_g;
+layout(binding = 7) uniform sampler2D moments1_g;
+layout(binding = 8) uniform sampler2D moments0_b;
+layout(binding = 9) uniform sampler2D moments1_b;
+#include "shading.glsl"
+#include "lookup.glsl"
+
+// The shadow intensity from one set of moment images (one colour channel's, or the only one).
+float shadow_from(sampler2D first, sampler2D second_image, ShadowLookup s) {
+  bool six = kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96;
+  bool second = six || kSplitRG;
+  MsmTexel texel = MsmTexel(vec4(0.0f), vec4(0.0f));
+  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
+    vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
+    s.z -= receiver_plane_bias(s, textureQueryLod(first, uv).x);
+  } else {
+    s.z -= receiver_plane_bias(s, 0.0f);
+  }
+  float zf = s.z;
+  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
+    vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
+    texel.a = texture(first, uv);
+    if (second) texel.b = texture(second_image, uv);
+  } else {
+    ivec2 i = lookup_texel(s.t);
+    texel.a = texelFetch(first, i, 0);
+    if (second) texel.b = texelFetch(second_image, i, 0);
+    zf = receiver_depth_at(s, i);
+  }
+  if (kSplitRG) texel = MsmTexel(vec4(texel.a.x, texel.a.y, texel.b.x, texel.b.y), vec4(0.0f));
+  return msm_technique_shadow(kTechnique, texel, zf, frame.technique_params);
+}
+
+float shadow_intensity(ShadowLookup s) { return shadow_from(moments0, moments1, s); }
+
+#ifdef MSM_COLOURED_SHADOWS
+vec3 shadow_intensity_rgb(ShadowLookup s) {
+  return vec3(shadow_from(moments0, moments1, s), shadow_from(moments0_g, moments1_g, s),
+              shadow_from(moments0_b, moments1_b, s));
+}
+#endif
