@@ -44,6 +44,15 @@ RenderSettings settings(const std::string& technique) {
   return s;
 }
 
+// The ray-traced transmittance of the light at every pixel's visible surface.
+reference::Result transmittance(const scene::Scene& scene, int width, int height) {
+  reference::Settings rs;
+  rs.effect = reference::Effect::translucent;
+  rs.width = width;
+  rs.height = height;
+  return reference::render(scene, rs);
+}
+
 // Mean visibility over the ground under the middle of the stack (the 16 x 12 central pixels).
 double centre_visibility(const image::Image& shadow) {
   double sum = 0;
@@ -138,11 +147,7 @@ TEST_F(TranslucencyTest, ColouredGlassCastsColouredShadows) {
 // grey in every channel, below 0.025, and MSM 64 closer than VSM 32 in every channel.
 TEST_F(TranslucencyTest, GlassSceneColouredAgainstTheRayTracer) {
   scene::Scene scene = scene::builtin_scene("glass");
-  reference::Settings rs;
-  rs.effect = reference::Effect::translucent;
-  rs.width = 240;
-  rs.height = 135;
-  reference::Result truth = reference::render(scene, rs);
+  reference::Result truth = transmittance(scene, 240, 135);
   image::Image mask = truth.visibility.channel("background");
   Renderer renderer(ctx(), scene);
   std::map<std::string, std::array<double, 3>> mae;
@@ -212,11 +217,7 @@ TEST_F(TranslucencyTest, AlphaThresholdAgainstManyFaintLayers) {
 // for VSM (Cantelli needs none).
 TEST_F(TranslucencyTest, SmokeScene) {
   scene::Scene scene = scene::builtin_scene("smoke");
-  reference::Settings rs;
-  rs.effect = reference::Effect::translucent;
-  rs.width = 240;
-  rs.height = 135;
-  reference::Result truth = reference::render(scene, rs);
+  reference::Result truth = transmittance(scene, 240, 135);
   image::Image mask = truth.visibility.channel("background");
   image::Image reference = truth.visibility.channel("visibility");
   Renderer renderer(ctx(), scene);
