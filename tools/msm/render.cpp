@@ -59,9 +59,10 @@ void add_render(CLI::App& app) {
         throw UsageError(e.what());
       }
       write_render(opt->out, names[i], result, render_json(s, scene, *ctx, result));
-      if (names.size() > 1 || tty)
-        fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU -> {}/{}.png\n", i + 1, names.size(), names[i],
-                   result.total_ms, opt->out, names[i]);
+      if (names.size() > 1 || tty || !result.shadow_rgb.empty())
+        fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU -> {}/{}.png{}\n", i + 1, names.size(), names[i],
+                   result.total_ms, opt->out, names[i],
+                   result.shadow_rgb.empty() ? "" : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]));
     }
   });
 }
