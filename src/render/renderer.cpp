@@ -237,11 +237,12 @@ struct Renderer::Impl {
       if (until_resolve) return;
       mipmap_pass.execute(f);
     } else if (targets->config.moment_images()) {
-      // One set of moment images per colour channel with coloured translucency: the opaque
-      // resolve is the same for each, the translucent blend uses the channel's opacity.
+      // One set of moment images per colour channel with coloured translucency: the resolve
+      // writes channel 0 and copies it to the others; the translucent blend uses each channel's
+      // opacity.
+      resolve_passes.at({technique.id, s.msaa, split})->execute(f);
+      if (until_resolve) return;
       for (f.channel = 0; f.channel < targets->config.channels(); ++f.channel) {
-        resolve_passes.at({technique.id, s.msaa, split})->execute(f);
-        if (until_resolve) return;
         if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
         if (msm_technique_is_soft(technique.id)) {
           sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());

@@ -1,5 +1,7 @@
 #include "pass.h"
 
+#include <vector>
+
 namespace msm::render {
 
 const PassDecl& MomentResolvePass::decl() {
@@ -37,6 +39,49 @@ void MomentResolvePass::execute(FrameContext& f) const {
                                                    VK_PIPELINE_STAGE_2_TRANSFER_BIT,
                                                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT |
                                                    VK_ACCESS_2_TRANSFER_WRITE_BIT));
+  // Coloured translucency: the other channels start from the same opaque moments (transfer
+  // layouts for the copy; everything back in GENERAL, as the resolve leaves channel 0).
+  if (t.config.channels() == 1) return;
+  constexpr VkImageAspectFlags color = VK_IMAGE_ASPECT_COLOR_BIT;
+  constexpr VkPipelineStageFlags2 transfer = VK_PIPELINE_STAGE_2_TRANSFER_BIT;
+  std::vector<VkImageMemoryBarrier2> to_transfer, to_general;
+  for (int i = 0; i < images; ++i) {
+    VkImage src = t.moment_image(0, i).handle();
+    to_transfer.push_back(vk::imageBarrier(src, color, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL, transfer,
+                                           VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 0, 1));
+    to_general.push_back(vk::imageBarrier(src, color, transfer, VK_ACCESS_2_TRANSFER_READ_BIT,
+                                          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                          VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                          VK_IMAGE_LAYOUT_GENERAL, 0, 1));
+    for (int c = 1; c < t.config.channels(); ++c) {
+      VkImage dst = t.moment_image(c, i).handle();
+      to_transfer.push_back(vk::imageBarrier(dst, color, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
+                                             VK_IMAGE_LAYOUT_UNDEFINED, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                             VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, 1));
+      to_general.push_back(vk::imageBarrier(dst, color, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                            VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                            VK_IMAGE_LAYOUT_GENERAL, 0, 1));
+    }
+  }
+  vk::pipelineBarrier(f.cmd, {}, {}, to_transfer);
+  for (int i = 0; i < images; ++i)
+    for (int c = 1; c < t.config.channels(); ++c) {
+      VkImageCopy2 region{.sType = VK_STRUCTURE_TYPE_IMAGE_COPY_2,
+                          .srcSubresource = {color, 0, 0, 1},
+                          .dstSubresource = {color, 0, 0, 1},
+                          .extent = {uint32_t(t.config.shadow_size), uint32_t(t.config.shadow_size), 1}};
+      VkCopyImageInfo2 copy{.sType = VK_STRUCTURE_TYPE_COPY_IMAGE_INFO_2,
+                            .srcImage = t.moment_image(0, i).handle(),
+                            .srcImageLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                            .dstImage = t.moment_image(c, i).handle(),
+                            .dstImageLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                            .regionCount = 1,
+                            .pRegions = &region};
+      vkCmdCopyImage2(f.cmd, &copy);
+    }
+  vk::pipelineBarrier(f.cmd, {}, {}, to_general);
 }
 
 } // namespace msm::render

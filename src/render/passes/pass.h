@@ -45,7 +45,9 @@ private:
   vk::Program program_;
 };
 
-// shadow_depth -> moments[0..1] mip 0 (GENERAL), visible to compute and fragment reads.
+// shadow_depth -> moments[0..1] mip 0 (GENERAL), visible to compute and fragment reads. With
+// coloured translucency the opaque moments of channel 0 are then copied to the other channels
+// (the same opaque occluders; only the translucent blend differs), in the same timer scope.
 class MomentResolvePass {
 public:
   static const PassDecl& decl();
