@@ -102,9 +102,13 @@ FrameTargets::FrameTargets(const vk::Context& ctx, const FrameConfig& c) : confi
   }
 
   if (soft)
-    for (int i = 0; i < c.moment_images(); ++i)
-      sat_tables[size_t(i)] = vk::createImage(ctx, {.width = shadow, .height = shadow, .format = VK_FORMAT_R32G32B32A32_UINT,
-                                                    .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
+    for (int i = 0; i < c.moment_images(); ++i) {
+      // Two moments per texel (vssm; mssm6's second image) need only RG32_UINT.
+      bool two = c.formats()[size_t(i)] == VK_FORMAT_R32G32_SFLOAT;
+      sat_tables[size_t(i)] = vk::createImage(
+          ctx, {.width = shadow, .height = shadow, .format = two ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32G32B32A32_UINT,
+                .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
+    }
   uint32_t w = uint32_t(c.width), h = uint32_t(c.height);
   color = vk::createImage(ctx, {.width = w, .height = h, .format = VK_FORMAT_R8G8B8A8_SRGB,
                                 .usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});

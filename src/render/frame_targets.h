@@ -45,7 +45,8 @@ struct FrameTargets {
   vk::Image color;                     // RGBA8 sRGB
   vk::Image shadow_buffer;             // RGBA32F: visibility per colour channel, coverage
   vk::Image camera_depth;              // D32
-  // RGBA32_UINT summed-area tables of the moment images (soft shadows only; two for mssm6).
+  // Summed-area tables of the moment images (soft shadows only; two for mssm6): RGBA32_UINT, or
+  // RG32_UINT for an RG image (sampled as uvec4(r, g, 0, 1): only r, g are summed).
   std::array<vk::Image, 2> sat_tables;
   uint32_t mip_levels = 1;
   vk::Sampler point_sampler, moment_sampler;

@@ -24,6 +24,7 @@ bool unorm16Format(VkFormat format) {
 bool floatFormat(VkFormat format) {
   return format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32_SFLOAT;
 }
+bool twoChannels(VkFormat format) { return format == VK_FORMAT_R32G32_SFLOAT || format == VK_FORMAT_R16G16_UNORM; }
 
 void check(const vk::Image& moments, const vk::Image& table, int maxKernelTexels) {
   const char* where = "msm::soft::SatBuilder::record: ";
@@ -32,8 +33,9 @@ void check(const vk::Image& moments, const vk::Image& table, int maxKernelTexels
     throw std::invalid_argument(std::string(where) + "moments must be RGBA32_SFLOAT, RG32_SFLOAT, RGBA16_UNORM or RG16_UNORM");
   if (!(moments.desc().usage & VK_IMAGE_USAGE_SAMPLED_BIT))
     throw std::invalid_argument(std::string(where) + "moments need SAMPLED usage");
-  if (table.format() != VK_FORMAT_R32G32B32A32_UINT)
-    throw std::invalid_argument(std::string(where) + "the table must be RGBA32_UINT");
+  if (table.format() != VK_FORMAT_R32G32B32A32_UINT &&
+      !(table.format() == VK_FORMAT_R32G32_UINT && twoChannels(moments.format())))
+    throw std::invalid_argument(std::string(where) + "the table must be RGBA32_UINT (or RG32_UINT for RG moments)");
   if (!(table.desc().usage & VK_IMAGE_USAGE_STORAGE_BIT) || table.desc().mipLevels != 1 || table.desc().layers != 1)
     throw std::invalid_argument(std::string(where) + "the table needs STORAGE usage, one mip and one layer");
   if (moments.width() != table.width() || moments.height() != table.height())
@@ -50,6 +52,12 @@ SatBuilder::SatBuilder(const vk::Context& ctx)
       blockRows_(vk::createProgram(ctx, "sat_block_rows.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
                                    sizeof(SatPush))),
       blockColumns_(vk::createProgram(ctx, "sat_block_columns.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
+      rowsRg_(vk::createProgram(ctx, "sat_rows_rg.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
+                                sizeof(SatPush))),
+      columnsRg_(vk::createProgram(ctx, "sat_columns_rg.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
+      blockRowsRg_(vk::createProgram(ctx, "sat_block_rows_rg.comp",
+                                     {vk::Binding::SampledImage, vk::Binding::StorageImage}, sizeof(SatPush))),
+      blockColumnsRg_(vk::createProgram(ctx, "sat_block_columns_rg.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
       sampler_(vk::createSampler(ctx, VK_FILTER_NEAREST)) {}
 
 void SatBuilder::record(VkCommandBuffer cmd, const vk::Image& moments, const vk::Image& table, int max_kernel_texels,
@@ -73,8 +81,12 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const vk::Image* const> m
   const VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
   auto push = [&](size_t i) {
     const vk::Image& m = *moments[i];
-    bool two = m.format() == VK_FORMAT_R32G32_SFLOAT || m.format() == VK_FORMAT_R16G16_UNORM;
+    bool two = twoChannels(m.format());
     return SatPush{glm::ivec2(int(m.width()), int(m.height())), scale, (unorm16Format(m.format()) ? 1u : 0u) | (two ? 2u : 0u)};
+  };
+  // The program of each pass for table i: the table's format is part of the shader.
+  auto program = [&](size_t i, const vk::Program& rgba, const vk::Program& rg) -> const vk::Program& {
+    return tables[i]->format() == VK_FORMAT_R32G32_UINT ? rg : rgba;
   };
 
   // Discard the tables' contents (UNDEFINED), after every earlier access to them.
@@ -92,23 +104,23 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const vk::Image* const> m
   if (scheme == Scheme::RowsThenColumns) {
     if (timer) timer->begin(cmd, "sat_rows");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, rows_, vk::groupCount(moments[i]->height(), 64), 1, 1,
+      vk::dispatch(cmd, program(i, rows_, rowsRg_), vk::groupCount(moments[i]->height(), 64), 1, 1,
                    {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)}, push(i));
     if (timer) timer->end(cmd);
     vk::pipelineBarrier(cmd, between);
     if (timer) timer->begin(cmd, "sat_columns");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, columns_, vk::groupCount(moments[i]->width(), 64), 1, 1, {vk::Descriptor(*tables[i], general)},
-                   push(i));
+      vk::dispatch(cmd, program(i, columns_, columnsRg_), vk::groupCount(moments[i]->width(), 64), 1, 1,
+                   {vk::Descriptor(*tables[i], general)}, push(i));
     if (timer) timer->end(cmd);
   } else {
     if (timer) timer->begin(cmd, "sat_blocks");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, blockRows_, vk::groupCount(moments[i]->height(), 8), 1, 1,
+      vk::dispatch(cmd, program(i, blockRows_, blockRowsRg_), vk::groupCount(moments[i]->height(), 8), 1, 1,
                    {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)}, push(i));
     vk::pipelineBarrier(cmd, between);
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, blockColumns_, vk::groupCount(moments[i]->width(), 8), 1, 1,
+      vk::dispatch(cmd, program(i, blockColumns_, blockColumnsRg_), vk::groupCount(moments[i]->width(), 8), 1, 1,
                    {vk::Descriptor(*tables[i], general)}, push(i));
     if (timer) timer->end(cmd);
   }

@@ -82,10 +82,10 @@ vk::Image momentImage(vk::Context& ctx, VkFormat format, int width, int height) 
                                             .format = format,
                                             .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
 }
-vk::Image tableImage(vk::Context& ctx, int width, int height) {
+vk::Image tableImage(vk::Context& ctx, int width, int height, VkFormat format = VK_FORMAT_R32G32B32A32_UINT) {
   return vk::createImage(ctx, vk::ImageDesc{.width = uint32_t(width),
                                             .height = uint32_t(height),
-                                            .format = VK_FORMAT_R32G32B32A32_UINT,
+                                            .format = format,
                                             .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
 }
 
@@ -201,6 +201,34 @@ TEST_F(SatBuilderTest, SixMomentTablesInOneCall) {
   }
 }
 
+// Two-channel moments into RG32_UINT tables (half the memory of RGBA32_UINT): the (r, g) of the
+// CPU table, bitwise, both schemes, float and UNORM16 moments.
+TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
+  SatBuilder builder(ctx());
+  std::mt19937_64 rng(34);
+  const Case cases[] = {{61, 47, 27 * 27, VK_FORMAT_R32G32_SFLOAT, true},
+                        {130, 9, 100, VK_FORMAT_R16G16_UNORM, true},
+                        {256, 256, 27 * 27, VK_FORMAT_R32G32_SFLOAT, true}};
+  for (const Case& c : cases) {
+    std::vector<vec4> m = random_moments(rng, c.width, c.height);
+    vk::Image moments = momentImage(ctx(), c.format, c.width, c.height);
+    std::vector<uvec4> cpu = soft::build_sat_cpu(upload(ctx(), moments, m), c.width, c.height, c.nt);
+    for (Scheme scheme : {Scheme::RowsThenColumns, Scheme::Blocks}) {
+      vk::Image table = tableImage(ctx(), c.width, c.height, VK_FORMAT_R32G32_UINT);
+      vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, table, c.nt, scheme); });
+      std::vector<std::byte> bytes = vk::readbackImage(ctx(), table, VK_IMAGE_LAYOUT_GENERAL);
+      ASSERT_EQ(bytes.size(), cpu.size() * 8);
+      size_t mismatches = 0;
+      for (size_t i = 0; i < cpu.size(); ++i) {
+        uint32_t rg[2];
+        std::memcpy(rg, bytes.data() + 8 * i, 8);
+        mismatches += rg[0] != cpu[i].x || rg[1] != cpu[i].y;
+      }
+      EXPECT_EQ(mismatches, 0u) << c.width << "x" << c.height << ", scheme " << int(scheme);
+    }
+  }
+}
+
 TEST_F(SatBuilderTest, RejectsBadImages) {
   SatBuilder builder(ctx());
   vk::Image moments = momentImage(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, 16, 16);
@@ -212,6 +240,9 @@ TEST_F(SatBuilderTest, RejectsBadImages) {
     EXPECT_THROW(builder.record(cmd, notMoments, table, 729, Scheme::Blocks), std::invalid_argument);
     EXPECT_THROW(builder.record(cmd, moments, moments, 729, Scheme::Blocks), std::invalid_argument);
     EXPECT_THROW(builder.record(cmd, moments, table, 0, Scheme::Blocks), std::invalid_argument);
+    // An RG table cannot hold four moments.
+    vk::Image rg = tableImage(ctx(), 16, 16, VK_FORMAT_R32G32_UINT);
+    EXPECT_THROW(builder.record(cmd, moments, rg, 729, Scheme::Blocks), std::invalid_argument);
   });
   EXPECT_THROW(soft::build_sat_cpu(std::vector<vec4>(10), 3, 3, 729), std::invalid_argument);
 }

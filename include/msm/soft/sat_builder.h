@@ -42,7 +42,8 @@ public:
   //    (r, g, 0, 0); UNORM codes are decoded as the C++ build decodes them, sat.h), SAMPLED usage, mip 0 is
   //    read, in moments_layout (GENERAL or SHADER_READ_ONLY_OPTIMAL); the caller's barrier has
   //    made its writes visible to compute-shader sampled reads.
-  //  - table: RGBA32_UINT, the same width and height, STORAGE usage, one mip. Its contents and
+  //  - table: RGBA32_UINT, or RG32_UINT for RG moments (half the memory and traffic; it holds the
+  //    (r, g) of the RGBA table), the same width and height, STORAGE usage, one mip. Its contents and
   //    layout on entry do not matter (record() discards them: a barrier from UNDEFINED that waits
   //    for earlier writes); on exit it is in GENERAL, written by the COMPUTE_SHADER stage
   //    (SHADER_STORAGE_WRITE): the caller's barrier makes that visible to its readers.
@@ -60,6 +61,7 @@ public:
 
 private:
   vk::Program rows_, columns_, blockRows_, blockColumns_;
+  vk::Program rowsRg_, columnsRg_, blockRowsRg_, blockColumnsRg_; // RG32_UINT tables
   vk::Sampler sampler_;
 };
 

@@ -1,18 +1,4 @@
-// Summed-area table, simple scheme, pass 2: one thread per column turns the row sums of pass 1
-// into the table, in place (each thread reads and writes only its own column).
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#include "sat_common.glsl"
-
-layout(local_size_x = 64) in;
-layout(binding = 0, rgba32ui) uniform uimage2D table;
-
-void main() {
-  int x = int(gl_GlobalInvocationID.x);
-  if (x >= pc.size.x) return;
-  uvec4 sum = uvec4(0u);
-  for (int y = 0; y < pc.size.y; ++y) {
-    sum += imageLoad(table, ivec2(x, y));
-    imageStore(table, ivec2(x, y), sum);
-  }
-}
+#define MSM_SAT_TABLE_FORMAT rgba32ui
+#include "sat_columns.glsl"
