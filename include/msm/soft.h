@@ -156,18 +156,15 @@ MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params)
 // [-1,1] (as the moment estimators, for msm_soft_penumbra_half_width) and 1 - N as the shadow.
 // q: the region's average (z, z²); unit_zf: the unbiased fragment depth in [0,1].
 MSM_FN BlockerResult msm_soft_vssm_blocker(vec2 q, float unit_zf, float min_variance) {
-    float mean = q.x;
-    float d = unit_zf - mean;
-    if (d <= 0.0f) return BlockerResult(msm_signed_depth(unit_zf), 0.0f);
-    float variance = max(q.y - mean * mean, min_variance);
-    float lit = variance / (variance + d * d);
-    float blocked = 1.0f - lit;
-    float blocker = clamp((mean - lit * unit_zf) / max(blocked, 1e-6f), 0.0f, unit_zf);
+    // 1 - N is the VSM shadow intensity (baselines.h): 0 where zf <= μ.
+    float blocked = msm_vsm_shadow(q, unit_zf, min_variance);
+    if (blocked <= 0.0f) return BlockerResult(msm_signed_depth(unit_zf), 0.0f);
+    float blocker = clamp((q.x - (1.0f - blocked) * unit_zf) / blocked, 0.0f, unit_zf);
     return BlockerResult(msm_signed_depth(blocker), blocked);
 }
 // Chebyshev over the filter region, over-darkened like the moment techniques; zf_biased in [-1,1].
 MSM_FN float msm_soft_vssm_shadow(vec2 q, float zf_biased, float min_variance, float umbra_epsilon) {
-    return msm_overdarken(msm_vsm_shadow(q, 0.5f * zf_biased + 0.5f, min_variance), 1.0f - umbra_epsilon);
+    return msm_overdarken(msm_vsm_shadow(q, msm_unit_depth(zf_biased), min_variance), 1.0f - umbra_epsilon);
 }
 
 // ---- Percentage-closer soft shadows [Fernando 2005], the depth-map baseline ----

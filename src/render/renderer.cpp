@@ -242,17 +242,16 @@ struct Renderer::Impl {
       // opacity.
       resolve_passes.at({technique.id, s.msaa, split})->execute(f);
       if (until_resolve) return;
-      for (f.channel = 0; f.channel < targets->config.channels(); ++f.channel) {
-        if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
-        if (msm_technique_is_soft(technique.id)) {
-          sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());
-          shading.execute(f);
-          return;
+      if (msm_technique_is_soft(technique.id)) { // tables instead of blur and mips; no translucency
+        sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());
+      } else {
+        for (f.channel = 0; f.channel < targets->config.channels(); ++f.channel) {
+          if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
+          if (s.filter_size > 1) blur_pass->execute(f);
+          mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
         }
-        if (s.filter_size > 1) blur_pass->execute(f);
-        mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
+        f.channel = 0;
       }
-      f.channel = 0;
     }
     if (until_resolve) return;
     shading.execute(f);

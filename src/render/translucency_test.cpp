@@ -44,6 +44,17 @@ RenderSettings settings(const std::string& technique) {
   return s;
 }
 
+// The scene tests (smoke, glass): 240x135, 512² map, mips on, the receiver-plane bias as given.
+RenderSettings scene_settings(const std::string& technique, float receiver_plane_bias) {
+  RenderSettings s;
+  s.technique = technique;
+  s.width = 240;
+  s.height = 135;
+  s.shadow_size = 512;
+  s.receiver_plane_bias = receiver_plane_bias;
+  return s;
+}
+
 // The ray-traced transmittance of the light at every pixel's visible surface.
 reference::Result transmittance(const scene::Scene& scene, int width, int height) {
   reference::Settings rs;
@@ -152,12 +163,7 @@ TEST_F(TranslucencyTest, GlassSceneColouredAgainstTheRayTracer) {
   Renderer renderer(ctx(), scene);
   std::map<std::string, std::array<double, 3>> mae;
   for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "evsm4-64", "vsm-32"}) {
-    RenderSettings s;
-    s.technique = t;
-    s.width = 240;
-    s.height = 135;
-    s.shadow_size = 512;
-    s.receiver_plane_bias = 1.0f; // the floor is lit at 53° from its normal (see SmokeScene)
+    RenderSettings s = scene_settings(t, 1.0f); // the floor is lit at 53° from its normal (see SmokeScene)
     s.coloured_translucency = true;
     RenderResult coloured = renderer.render(s);
     s.coloured_translucency = false;
@@ -225,14 +231,8 @@ TEST_F(TranslucencyTest, SmokeScene) {
   for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "msm-hausdorff-64", "vsm-32", "vsm-64", "evsm4-64",
                         "evsm4-128", "pcf"}) {
     for (float bias : {1.0f, 0.0f}) {
-      RenderSettings s;
-      s.technique = t;
-      s.width = 240;
-      s.height = 135;
-      s.shadow_size = 512;
-      s.receiver_plane_bias = bias;
       image::Metrics r =
-          image::compute_metrics(renderer.render(s).shadow.channel("visibility"), reference, {.mask = &mask});
+          image::compute_metrics(renderer.render(scene_settings(t, bias)).shadow.channel("visibility"), reference, {.mask = &mask});
       (bias > 0.0f ? m : off)[t] = r;
       fmt::print("smoke {:<18} receiver-plane bias {}: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >10% {:.2f}%\n",
                  t, bias, r.mae, r.light_leaking, r.over_darkening, 100 * r.share_above_10pct);

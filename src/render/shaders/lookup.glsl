@@ -49,7 +49,7 @@ float receiver_plane_bias(ShadowLookup s, float lod) {
   if (!(frame.receiver_bias.y > 0.0f)) return 0.0f; // off (or NaN)
   if (frame.lookup.x == MSM_LOOKUP_BILINEAR) variance += exp2(2.0f * lod) * 0.25f - 1.0f / 12.0f;
   float sigma = frame.receiver_bias.y * msm_receiver_depth_sigma(s.depth_per_texel, variance); // [0,1] depth
-  if (kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96) return MSM_RECEIVER_SIGMAS6 * sigma;
+  if (msm_technique_is_six_moments(kTechnique)) return MSM_RECEIVER_SIGMAS6 * sigma;
   if (kTechnique == MSM_TECH_EVSM4_64 || kTechnique == MSM_TECH_EVSM4_128)
     return 0.5f * msm_receiver_plane_bias_negative_warp(2.0f * sigma, frame.technique_params.z); // [-1,1] warp
   // Cantelli (VSM, EVSM2's positive warp) and Markov (ESM): nothing in front at the mean depth.

@@ -12,17 +12,23 @@ vec2 sample_offset(int k) {
   return (k & 1) == 0 ? vec2(pair.x, pair.y) : vec2(pair.z, pair.w);
 }
 
-// Fraction of the texel's samples in front of the receiver plane, each compared with the plane's
-// depth at its own position (the rasterizer wrote the occluder's depth there).
-float texel_occlusion(ivec2 i, ShadowLookup s) {
+// The texel's samples in front of the receiver plane, each compared with the plane's depth at its
+// own position (the rasterizer wrote the occluder's depth there): x their number, y the sum of
+// their depths (PCSS's blocker search).
+vec2 texel_blockers(ivec2 i, ShadowLookup s) {
   int size = int(frame.shadow_map.x), samples = frame.kernel.y;
   ivec2 c = clamp(i, ivec2(0), ivec2(size - 1));
   float plane = s.z + dot(s.depth_per_texel, vec2(i) - s.t);
-  float occluded = 0.0f;
-  for (int k = 0; k < samples; ++k)
-    occluded += depth_sample(c, k) < plane + dot(s.depth_per_texel, sample_offset(k)) ? 1.0f : 0.0f;
-  return occluded / float(samples);
+  vec2 blockers = vec2(0.0f);
+  for (int k = 0; k < samples; ++k) {
+    float d = depth_sample(c, k);
+    if (d < plane + dot(s.depth_per_texel, sample_offset(k))) blockers += vec2(1.0f, d);
+  }
+  return blockers;
 }
+
+// Fraction of the texel's samples in front of the receiver plane.
+float texel_occlusion(ivec2 i, ShadowLookup s) { return texel_blockers(i, s).x / float(frame.kernel.y); }
 
 // Percentage-closer soft shadows (soft.h): every sample of the grid-aligned search rectangle is
 // tested against the receiver plane, those in front average to the blocker depth; the penumbra
@@ -36,19 +42,10 @@ float pcss_shadow(ShadowLookup s) {
   float zf = msm_signed_depth(s.z);
   vec2 position = s.t + 0.5f; // texel i covers [i, i + 1) in soft.h
   SatRect r = msm_soft_search_rect(position, msm_soft_search_half_width(spread, zf, -1.0f, width), map);
-  float depth_sum = 0.0f, blockers = 0.0f;
+  vec2 blockers = vec2(0.0f);
   for (int y = r.lo.y; y <= r.hi.y; ++y)
-    for (int x = r.lo.x; x <= r.hi.x; ++x) {
-      float plane = s.z + dot(s.depth_per_texel, vec2(x, y) - s.t);
-      for (int k = 0; k < samples; ++k) {
-        float d = depth_sample(ivec2(x, y), k);
-        if (d < plane + dot(s.depth_per_texel, sample_offset(k))) {
-          depth_sum += d;
-          blockers += 1.0f;
-        }
-      }
-    }
-  BlockerResult blocker = msm_soft_pcss_blocker(depth_sum, blockers, float(msm_sat_rect_texels(r) * samples), s.z);
+    for (int x = r.lo.x; x <= r.hi.x; ++x) blockers += texel_blockers(ivec2(x, y), s);
+  BlockerResult blocker = msm_soft_pcss_blocker(blockers.y, blockers.x, float(msm_sat_rect_texels(r) * samples), s.z);
   if (blocker.shadow <= 0.0f) return 0.0f;
   // Every sample of the search region blocks: so does every one of the smaller filter region.
   if (blocker.shadow >= 1.0f) return 1.0f;

@@ -17,7 +17,7 @@ layout(binding = 9) uniform sampler2D moments1_b;
 
 // The shadow intensity from one set of moment images (one colour channel's, or the only one).
 float shadow_from(sampler2D first, sampler2D second_image, ShadowLookup s) {
-  bool six = kTechnique == MSM_TECH_MSM6_192 || kTechnique == MSM_TECH_MSM6_96;
+  bool six = msm_technique_is_six_moments(kTechnique);
   bool second = six || kSplitRG;
   MsmTexel texel = MsmTexel(vec4(0.0f), vec4(0.0f));
   if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
