@@ -31,14 +31,13 @@
 // All functions follow shared.h: valid GLSL 4.60 and C++20 (namespace msm, single precision).
 #ifndef MSM_BASELINES_H
 #define MSM_BASELINES_H
-#include "msm/shared.h"
 #include "msm/config.h"
 #include "msm/quantize.h"
+#include "msm/shared.h"
 
 MSM_BEGIN
 
 // ================================ Shading helpers ================================================
-
 
 // Over-darkening (Annen et al. 2007; JCGT §2.6): shadow intensities are divided by 'factor' and
 // clamped, so that light leaking below 1 - factor disappears: shadow >= factor gives 1, shadow = 0
@@ -71,12 +70,12 @@ MSM_FN vec2 msm_vsm_moments(float z) { return vec2(z, z * z); }
 
 // Reconstruction from b = E(z, z²).
 MSM_FN float msm_vsm_shadow(vec2 b, float zf, float min_variance) {
-    float mean = b[0];
-    if (zf <= mean) return 0.0f;
-    float variance = max(b[1] - mean * mean, min_variance);
-    float d = zf - mean;
-    // d²/(σ² + d²) = 1 - σ²/(σ² + d²), without the cancellation for small shadows.
-    return (d * d) / (variance + d * d);
+  float mean = b[0];
+  if (zf <= mean) return 0.0f;
+  float variance = max(b[1] - mean * mean, min_variance);
+  float d = zf - mean;
+  // d²/(σ² + d²) = 1 - σ²/(σ² + d²), without the cancellation for small shadows.
+  return (d * d) / (variance + d * d);
 }
 MSM_FN float msm_vsm_shadow(vec2 b, float zf) { return msm_vsm_shadow(b, zf, MSM_VSM_MIN_VARIANCE_FLOAT); }
 
@@ -84,19 +83,17 @@ MSM_FN float msm_vsm_shadow(vec2 b, float zf) { return msm_vsm_shadow(b, zf, MSM
 // (2015 §4.3, +2 bits of entropy); the renderer writes it to RG16_UNORM.
 MSM_FN vec2 msm_vsm_moments_theta2(float z) { return msm_theta2(msm_vsm_moments(z)); }
 MSM_FN float msm_vsm_shadow_theta2(vec2 q, float zf, float min_variance) {
-    return msm_vsm_shadow(msm_theta2_inverse(q), zf, min_variance);
+  return msm_vsm_shadow(msm_theta2_inverse(q), zf, min_variance);
 }
 MSM_FN float msm_vsm_shadow_theta2(vec2 q, float zf) {
-    return msm_vsm_shadow_theta2(q, zf, MSM_VSM_MIN_VARIANCE_UNORM16);
+  return msm_vsm_shadow_theta2(q, zf, MSM_VSM_MIN_VARIANCE_UNORM16);
 }
 
 // Light-bleeding reduction (Lauritzen, GPU Gems 3 ch. 8): the lit fraction 1 - shadow is
 // remapped by linstep(amount, 1, .), so that lit fractions below 'amount' become fully shadowed.
 // amount in [0, 1): 0 = off (the default), 0.2-0.3 is typical. Algebraically this equals
 // msm_overdarken(shadow, 1 - amount), which computes it; it is no longer a lower bound.
-MSM_FN float msm_vsm_reduce_light_bleeding(float shadow, float amount) {
-    return msm_overdarken(shadow, 1.0f - amount);
-}
+MSM_FN float msm_vsm_reduce_light_bleeding(float shadow, float amount) { return msm_overdarken(shadow, 1.0f - amount); }
 
 // ================================ ESM (Salvi 2008; Annen et al. 2008) ============================
 // Generation: b(z) = exp(c z). Reconstruction by Markov's inequality applied to the positive
@@ -132,12 +129,10 @@ MSM_FN float msm_esm_log_moment(float z, float c) { return c * z; }
 // log((1 - t) exp(la) + t exp(lb)), t in [0,1]: the blend of two log-moments (a filter tap).
 // Shifting by the larger argument keeps exp() <= 1; with |la - lb| <= 87 nothing underflows to 0.
 MSM_FN float msm_esm_log_mix(float la, float lb, float t) {
-    float m = max(la, lb);
-    return m + log((1.0f - t) * exp(la - m) + t * exp(lb - m));
+  float m = max(la, lb);
+  return m + log((1.0f - t) * exp(la - m) + t * exp(lb - m));
 }
-MSM_FN float msm_esm_shadow_log(float log_b, float zf, float c) {
-    return msm_saturate(1.0f - exp(log_b - c * zf));
-}
+MSM_FN float msm_esm_shadow_log(float log_b, float zf, float c) { return msm_saturate(1.0f - exp(log_b - c * zf)); }
 
 // ================================ EVSM (Lauritzen & McCool 2008) ================================
 // Depth convention: [-1,1] (JCGT Fig. 4); z and zf are clamped to it, which bounds the warped
@@ -175,45 +170,45 @@ const float MSM_EVSM_MIN_VARIANCE_FLOAT = 1.0e-7f;
 
 // (w+(z), w-(z)) for depth z in [-1,1] (clamped).
 MSM_FN vec2 msm_evsm_warp(float z, float c_pos, float c_neg) {
-    float zc = clamp(z, -1.0f, 1.0f);
-    return vec2(exp(c_pos * zc), -exp(-c_neg * zc));
+  float zc = clamp(z, -1.0f, 1.0f);
+  return vec2(exp(c_pos * zc), -exp(-c_neg * zc));
 }
 
 // Generation.
 MSM_FN vec2 msm_evsm2_moments(float z, float c_pos) {
-    float w = exp(c_pos * clamp(z, -1.0f, 1.0f));
-    return vec2(w, w * w);
+  float w = exp(c_pos * clamp(z, -1.0f, 1.0f));
+  return vec2(w, w * w);
 }
 MSM_FN vec4 msm_evsm4_moments(float z, float c_pos, float c_neg) {
-    vec2 w = msm_evsm_warp(z, c_pos, c_neg);
-    return vec4(w[0], w[0] * w[0], w[1], w[1] * w[1]);
+  vec2 w = msm_evsm_warp(z, c_pos, c_neg);
+  return vec4(w[0], w[0] * w[0], w[1], w[1] * w[1]);
 }
 
 // VSM on one warp: b = E(w, w²), wf = w(zf), slope = dw/dz at zf; min_variance in depth units.
 // (min_variance * slope) * slope rather than slope² keeps the product finite up to c = 44.
 MSM_FN float msm_evsm_warped_shadow(vec2 b, float wf, float slope, float min_variance) {
-    return msm_vsm_shadow(b, wf, (min_variance * slope) * slope);
+  return msm_vsm_shadow(b, wf, (min_variance * slope) * slope);
 }
 
 // Reconstruction.
 MSM_FN float msm_evsm2_shadow(vec2 b, float zf, float c_pos, float min_variance) {
-    float wf = exp(c_pos * clamp(zf, -1.0f, 1.0f));
-    return msm_evsm_warped_shadow(b, wf, c_pos * wf, min_variance);
+  float wf = exp(c_pos * clamp(zf, -1.0f, 1.0f));
+  return msm_evsm_warped_shadow(b, wf, c_pos * wf, min_variance);
 }
 MSM_FN float msm_evsm4_shadow(vec4 b, float zf, float c_pos, float c_neg, float min_variance) {
-    vec2 wf = msm_evsm_warp(zf, c_pos, c_neg);
-    float pos = msm_evsm_warped_shadow(vec2(b[0], b[1]), wf[0], c_pos * wf[0], min_variance);
-    // dw-/dz = c- exp(-c- z) = -c- w-; only its square enters.
-    float neg = msm_evsm_warped_shadow(vec2(b[2], b[3]), wf[1], c_neg * wf[1], min_variance);
-    return max(pos, neg);
+  vec2 wf = msm_evsm_warp(zf, c_pos, c_neg);
+  float pos = msm_evsm_warped_shadow(vec2(b[0], b[1]), wf[0], c_pos * wf[0], min_variance);
+  // dw-/dz = c- exp(-c- z) = -c- w-; only its square enters.
+  float neg = msm_evsm_warped_shadow(vec2(b[2], b[3]), wf[1], c_neg * wf[1], min_variance);
+  return max(pos, neg);
 }
 
 // Round-trips through 16-bit float storage (RG16_SFLOAT / RGBA16_SFLOAT).
 MSM_FN vec2 msm_quantize_half2(vec2 v) { return unpackHalf2x16(packHalf2x16(v)); }
 MSM_FN vec4 msm_quantize_half4(vec4 v) {
-    vec2 a = msm_quantize_half2(vec2(v[0], v[1]));
-    vec2 b = msm_quantize_half2(vec2(v[2], v[3]));
-    return vec4(a[0], a[1], b[0], b[1]);
+  vec2 a = msm_quantize_half2(vec2(v[0], v[1]));
+  vec2 b = msm_quantize_half2(vec2(v[2], v[3]));
+  return vec4(a[0], a[1], b[0], b[1]);
 }
 
 // ================================ CSM (Annen et al. 2007) =======================================
@@ -259,15 +254,14 @@ const float MSM_CSM_SCALE_DEFAULT = 2.0f;
 const float MSM_CSM_OFFSET_DEFAULT = 0.0f;
 
 struct CsmParams {
-    int terms;     // M, 1..16
-    float damping; // α of σ_k = exp(-α (k/M)²); 0 = plain truncated series
-    float scale;   // shadow = saturate(1 - scale (1 - S)); 1 = none
-    float offset;  // receiver shift towards the light, in [0,1] depth units; 0 = none
+  int terms;     // M, 1..16
+  float damping; // α of σ_k = exp(-α (k/M)²); 0 = plain truncated series
+  float scale;   // shadow = saturate(1 - scale (1 - S)); 1 = none
+  float offset;  // receiver shift towards the light, in [0,1] depth units; 0 = none
 };
 
 MSM_FN CsmParams msm_csm_default_params() {
-    return CsmParams(MSM_CSM_TERMS_DEFAULT, MSM_CSM_DAMPING_DEFAULT, MSM_CSM_SCALE_DEFAULT,
-                     MSM_CSM_OFFSET_DEFAULT);
+  return CsmParams(MSM_CSM_TERMS_DEFAULT, MSM_CSM_DAMPING_DEFAULT, MSM_CSM_SCALE_DEFAULT, MSM_CSM_OFFSET_DEFAULT);
 }
 // The plain truncated Fourier series (no damping, scale or offset).
 MSM_FN CsmParams msm_csm_plain_params(int terms) { return CsmParams(terms, 0.0f, 1.0f, 0.0f); }
@@ -277,12 +271,12 @@ MSM_FN float msm_csm_frequency(int k) { return float(2 * k - 1) * MSM_PI; }
 
 // Generation: term k (1-based), (sin c_k z, cos c_k z).
 MSM_FN vec2 msm_csm_basis(float z, int k) {
-    float a = msm_csm_frequency(k) * z;
-    return vec2(sin(a), cos(a));
+  float a = msm_csm_frequency(k) * z;
+  return vec2(sin(a), cos(a));
 }
 // RGBA texel t (0-based): terms 2t+1 and 2t+2.
 MSM_FN vec4 msm_csm_basis_texel(float z, int t) {
-    return vec4(msm_csm_basis(z, 2 * t + 1), msm_csm_basis(z, 2 * t + 2));
+  return vec4(msm_csm_basis(z, 2 * t + 1), msm_csm_basis(z, 2 * t + 2));
 }
 // 8-bit (or 16-bit) UNORM storage of basis values in [-1,1].
 MSM_FN vec4 msm_csm_to_unorm(vec4 v) { return 0.5f * v + vec4(0.5f); }
@@ -294,62 +288,62 @@ MSM_FN float msm_csm_receiver(float zf, CsmParams p) { return max(zf - p.offset,
 // Contribution of term k to S_M, from the filtered (E sin c_k z, E cos c_k z) and the receiver
 // depth xf = msm_csm_receiver(zf, p); 0 for k > p.terms.
 MSM_FN float msm_csm_term(vec2 sin_cos, float xf, int k, CsmParams p) {
-    if (k > p.terms) return 0.0f;
-    float r = float(k) / float(p.terms);
-    float ck = msm_csm_frequency(k);
-    float a = ck * xf;
-    return 2.0f * exp(-p.damping * r * r) / ck * (sin(a) * sin_cos[1] - cos(a) * sin_cos[0]);
+  if (k > p.terms) return 0.0f;
+  float r = float(k) / float(p.terms);
+  float ck = msm_csm_frequency(k);
+  float a = ck * xf;
+  return 2.0f * exp(-p.damping * r * r) / ck * (sin(a) * sin_cos[1] - cos(a) * sin_cos[0]);
 }
 // Contribution of the two terms in filtered RGBA texel t.
 MSM_FN float msm_csm_texel_terms(vec4 texel, float xf, int t, CsmParams p) {
-    return msm_csm_term(vec2(texel[0], texel[1]), xf, 2 * t + 1, p) +
-           msm_csm_term(vec2(texel[2], texel[3]), xf, 2 * t + 2, p);
+  return msm_csm_term(vec2(texel[0], texel[1]), xf, 2 * t + 1, p) +
+         msm_csm_term(vec2(texel[2], texel[3]), xf, 2 * t + 2, p);
 }
 // From the sum of all term contributions to the shadow intensity: S = 1/2 + sum, then scale.
-MSM_FN float msm_csm_resolve(float term_sum, CsmParams p) {
-    return msm_saturate(1.0f - p.scale * (0.5f - term_sum));
-}
+MSM_FN float msm_csm_resolve(float term_sum, CsmParams p) { return msm_saturate(1.0f - p.scale * (0.5f - term_sum)); }
 
 // All 16 terms of one texel: columns 0..3 of lo are texels 0..3, columns of hi texels 4..7.
 struct CsmMoments {
-    mat4 lo;
-    mat4 hi;
+  mat4 lo;
+  mat4 hi;
 };
 
 MSM_FN vec4 msm_csm_texel(CsmMoments m, int t) { return t < 4 ? m.lo[t] : m.hi[t - 4]; }
 
 // Generation of the first 'terms' terms (the rest stay 0).
 MSM_FN CsmMoments msm_csm_moments(float z, int terms) {
-    CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
-    for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
-        if (2 * t + 1 > terms) break;
-        vec4 v = msm_csm_basis_texel(z, t);
-        if (2 * t + 2 > terms) v = vec4(v[0], v[1], 0.0f, 0.0f);
-        if (t < 4) m.lo[t] = v;
-        else m.hi[t - 4] = v;
-    }
-    return m;
+  CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
+  for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
+    if (2 * t + 1 > terms) break;
+    vec4 v = msm_csm_basis_texel(z, t);
+    if (2 * t + 2 > terms) v = vec4(v[0], v[1], 0.0f, 0.0f);
+    if (t < 4)
+      m.lo[t] = v;
+    else
+      m.hi[t - 4] = v;
+  }
+  return m;
 }
 // acc + w m (filtering, resolves, blending).
 MSM_FN CsmMoments msm_csm_moments_scale_add(CsmMoments acc, CsmMoments m, float w) {
-    return CsmMoments(acc.lo + w * m.lo, acc.hi + w * m.hi);
+  return CsmMoments(acc.lo + w * m.lo, acc.hi + w * m.hi);
 }
 
 // S_M at receiver depth xf, unclamped (the raw series with p's damping; offset and scale are
 // not applied): what the convergence and ringing tests look at.
 MSM_FN float msm_csm_series(CsmMoments m, float xf, CsmParams p) {
-    float sum = 0.0f;
-    for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
-        if (2 * t + 1 > p.terms) break;
-        sum += msm_csm_texel_terms(msm_csm_texel(m, t), xf, t, p);
-    }
-    return 0.5f + sum;
+  float sum = 0.0f;
+  for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
+    if (2 * t + 1 > p.terms) break;
+    sum += msm_csm_texel_terms(msm_csm_texel(m, t), xf, t, p);
+  }
+  return 0.5f + sum;
 }
 
 // Reconstruction: the shadow intensity for fragment depth zf in [0,1].
 MSM_FN float msm_csm_shadow(CsmMoments m, float zf, CsmParams p) {
-    float series = msm_csm_series(m, msm_csm_receiver(zf, p), p);
-    return msm_csm_resolve(series - 0.5f, p);
+  float series = msm_csm_series(m, msm_csm_receiver(zf, p), p);
+  return msm_csm_resolve(series - 0.5f, p);
 }
 
 MSM_END

@@ -3,9 +3,9 @@
 // depends on how the moments were stored; msm_moment_bias() picks it by representation.
 #ifndef MSM_BIAS_H
 #define MSM_BIAS_H
-#include "msm/shared.h"
 #include "msm/config.h"
 #include "msm/moments.h"
+#include "msm/shared.h"
 
 MSM_BEGIN
 
@@ -21,29 +21,29 @@ const int MSM_REP6_UNORM16 = 11; // 6 x 16-bit (96 bits)
 const int MSM_REP6_FLOAT = 12;   // 6 x 32-bit float (192 bits)
 
 struct MomentBias4 {
-    float alpha;
-    vec4 bstar; // (b1..b4) of the biasing distribution
+  float alpha;
+  vec4 bstar; // (b1..b4) of the biasing distribution
 };
 
 struct MomentBias6 {
-    float alpha;
-    Moments6 bstar;
+  float alpha;
+  Moments6 bstar;
 };
 
 MSM_FN MomentBias4 msm_moment_bias(int representation) {
-    if (representation == MSM_REP_UNIT_FLOAT) return MomentBias4(MSM_ALPHA_UNIT_FLOAT, MSM_BSTAR_UNIT);
-    if (representation == MSM_REP_UNIT_THETA4) return MomentBias4(MSM_ALPHA_UNIT_16BIT, MSM_BSTAR_UNIT);
-    if (representation == MSM_REP_SIGNED_FLOAT) return MomentBias4(MSM_ALPHA_SIGNED_FLOAT, MSM_BSTAR_SIGNED_FLOAT);
-    if (representation == MSM_REP_SIGNED_THETA4) return MomentBias4(MSM_ALPHA_SIGNED_16BIT, MSM_BSTAR_SIGNED_16BIT);
-    // Summed-area tables store Θ4* moments at ~22 bits: the float b* with the stronger α.
-    return MomentBias4(MSM_ALPHA_SAT_INT32, MSM_BSTAR_SIGNED_FLOAT);
+  if (representation == MSM_REP_UNIT_FLOAT) return MomentBias4(MSM_ALPHA_UNIT_FLOAT, MSM_BSTAR_UNIT);
+  if (representation == MSM_REP_UNIT_THETA4) return MomentBias4(MSM_ALPHA_UNIT_16BIT, MSM_BSTAR_UNIT);
+  if (representation == MSM_REP_SIGNED_FLOAT) return MomentBias4(MSM_ALPHA_SIGNED_FLOAT, MSM_BSTAR_SIGNED_FLOAT);
+  if (representation == MSM_REP_SIGNED_THETA4) return MomentBias4(MSM_ALPHA_SIGNED_16BIT, MSM_BSTAR_SIGNED_16BIT);
+  // Summed-area tables store Θ4* moments at ~22 bits: the float b* with the stronger α.
+  return MomentBias4(MSM_ALPHA_SAT_INT32, MSM_BSTAR_SIGNED_FLOAT);
 }
 
 MSM_FN MomentBias6 msm_moment_bias6(int representation) {
-    Moments6 bstar = Moments6(vec3(0.0f), MSM_BSTAR6_EVEN);
-    if (representation == MSM_REP6_UNORM10) return MomentBias6(MSM_ALPHA6_10BIT, bstar);
-    if (representation == MSM_REP6_UNORM16) return MomentBias6(MSM_ALPHA6_16BIT, bstar);
-    return MomentBias6(MSM_ALPHA6_FLOAT, bstar);
+  Moments6 bstar = Moments6(vec3(0.0f), MSM_BSTAR6_EVEN);
+  if (representation == MSM_REP6_UNORM10) return MomentBias6(MSM_ALPHA6_10BIT, bstar);
+  if (representation == MSM_REP6_UNORM16) return MomentBias6(MSM_ALPHA6_16BIT, bstar);
+  return MomentBias6(MSM_ALPHA6_FLOAT, bstar);
 }
 
 // Receiver-plane depth bias of filtered shadow maps (subtracted from the fragment depth zf).
@@ -67,22 +67,20 @@ MSM_FN MomentBias6 msm_moment_bias6(int representation) {
 // - the negative warp −e^{−c z} of EVSM4: Cantelli reports shadow unless the warped zb is below
 //   the warped mean, i.e. e^{−c zb} ≥ E[e^{−c z}] = e^{−c zf + c²σ²/2} for Gaussian depths:
 //   zf − zb ≥ c σ²/2 (depths and σ in the warp's [-1,1] units).
-const float MSM_RECEIVER_SIGMAS4 = 1.0f;        // four moments: exact, for any symmetric kernel
-const float MSM_RECEIVER_SIGMAS6 = 1.7320508f;  // six moments: √3, the Gaussian limit
+const float MSM_RECEIVER_SIGMAS4 = 1.0f;       // four moments: exact, for any symmetric kernel
+const float MSM_RECEIVER_SIGMAS6 = 1.7320508f; // six moments: √3, the Gaussian limit
 
 // σ of the receiver's depth over the kernel: depth_per_texel = (dz/dx, dz/dy) per texel,
 // kernel_variance = the kernel's variance per axis in texels² (the same along x and y).
 MSM_FN float msm_receiver_depth_sigma(vec2 depth_per_texel, float kernel_variance) {
-    return sqrt(max(kernel_variance, 0.0f)) * length(depth_per_texel);
+  return sqrt(max(kernel_variance, 0.0f)) * length(depth_per_texel);
 }
 // The bias a negative exponential warp −e^{−c z} needs (see above), for σ in [-1,1] depth.
 MSM_FN float msm_receiver_plane_bias_negative_warp(float sigma, float c) { return 0.5f * c * sigma * sigma; }
 
 MSM_FN vec4 msm_apply_bias(vec4 b, float alpha, vec4 bstar) { return mix(b, bstar, alpha); }
 MSM_FN vec4 msm_apply_bias(vec4 b, MomentBias4 bias) { return mix(b, bias.bstar, bias.alpha); }
-MSM_FN Moments6 msm_apply_bias6(Moments6 b, MomentBias6 bias) {
-    return msm_moments6_mix(b, bias.bstar, bias.alpha);
-}
+MSM_FN Moments6 msm_apply_bias6(Moments6 b, MomentBias6 bias) { return msm_moments6_mix(b, bias.bstar, bias.alpha); }
 
 MSM_END
 

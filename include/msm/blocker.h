@@ -9,11 +9,11 @@
 //    is the known third surface of Prop. 8.
 #ifndef MSM_BLOCKER_H
 #define MSM_BLOCKER_H
-#include "msm/shared.h"
 #include "msm/config.h"
-#include "msm/moments.h"
 #include "msm/hamburger4.h"
 #include "msm/hamburger6.h"
+#include "msm/moments.h"
+#include "msm/shared.h"
 
 MSM_BEGIN
 
@@ -22,8 +22,8 @@ MSM_BEGIN
 // ε). shadow near 1 means the whole search region occludes the fragment: it is in the umbra
 // and the filtering step can be skipped (JCGT App. D.4).
 struct BlockerResult {
-    float depth;
-    float shadow;
+  float depth;
+  float shadow;
 };
 
 // JCGT Eq. (4) on a canonical distribution given as up to four nodes with weights; unused
@@ -31,18 +31,18 @@ struct BlockerResult {
 // (ε zf + Σ w[l] z[l]) / (ε + Σ w[l]). ε > 0 keeps the quotient defined when nothing occludes
 // (it then returns zf: a small filter kernel); larger ε pulls blockers towards the receiver.
 MSM_FN BlockerResult msm_blocker_from_canonical(vec4 z, vec4 w, float epsilon) {
-    float zf = z[0];
-    float weight_sum = 0.0f;
-    float depth_sum = 0.0f;
-    for (int l = 1; l < 4; ++l) {
-        // Weights of a canonical distribution lie in [0, 1]; saturating them only removes
-        // float noise for valid input and keeps invalid input (e.g. unbiased moments with
-        // coincident roots and infinite weights) finite: the result stays in [min z, zf].
-        float occludes = (z[l] < zf) ? msm_saturate(w[l]) : 0.0f;
-        weight_sum += occludes;
-        depth_sum += occludes * z[l];
-    }
-    return BlockerResult((epsilon * zf + depth_sum) / (epsilon + weight_sum), msm_saturate(weight_sum));
+  float zf = z[0];
+  float weight_sum = 0.0f;
+  float depth_sum = 0.0f;
+  for (int l = 1; l < 4; ++l) {
+    // Weights of a canonical distribution lie in [0, 1]; saturating them only removes
+    // float noise for valid input and keeps invalid input (e.g. unbiased moments with
+    // coincident roots and infinite weights) finite: the result stays in [min z, zf].
+    float occludes = (z[l] < zf) ? msm_saturate(w[l]) : 0.0f;
+    weight_sum += occludes;
+    depth_sum += occludes * z[l];
+  }
+  return BlockerResult((epsilon * zf + depth_sum) / (epsilon + weight_sum), msm_saturate(weight_sum));
 }
 
 // Kneiphof Eq. (19), the upper-bound variant: the average over all nodes z[l] <= zf INCLUDING
@@ -53,45 +53,44 @@ MSM_FN BlockerResult msm_blocker_from_canonical(vec4 z, vec4 w, float epsilon) {
 // δ1 > 0 keeps the divisor positive. δ1 = δ2 = ε gives Eq. (4) (up to roots exactly at zf).
 // shadow is the same lower bound as for Eq. (4), the roots strictly below zf.
 MSM_FN BlockerResult msm_blocker_upper_from_canonical(vec4 z, vec4 w, float delta1, float delta2) {
-    float zf = z[0];
-    float w0 = clamp(msm_saturate(w[0]), delta1, delta2);
-    float shadow = 0.0f;
-    float weight_sum = w0;
-    float depth_sum = w0 * zf;
-    for (int l = 1; l < 4; ++l) {
-        float wl = msm_saturate(w[l]); // as in msm_blocker_from_canonical
-        float below = (z[l] <= zf) ? wl : 0.0f;
-        weight_sum += below;
-        depth_sum += below * z[l];
-        shadow += (z[l] < zf) ? wl : 0.0f;
-    }
-    return BlockerResult(depth_sum / weight_sum, msm_saturate(shadow));
+  float zf = z[0];
+  float w0 = clamp(msm_saturate(w[0]), delta1, delta2);
+  float shadow = 0.0f;
+  float weight_sum = w0;
+  float depth_sum = w0 * zf;
+  for (int l = 1; l < 4; ++l) {
+    float wl = msm_saturate(w[l]); // as in msm_blocker_from_canonical
+    float below = (z[l] <= zf) ? wl : 0.0f;
+    weight_sum += below;
+    depth_sum += below * z[l];
+    shadow += (z[l] < zf) ? wl : 0.0f;
+  }
+  return BlockerResult(depth_sum / weight_sum, msm_saturate(shadow));
 }
 
 // Four moments b = (b1, b2, b3, b4): three nodes (zf, z2, z3) from msm_hamburger4_canonical.
 MSM_FN BlockerResult msm_blocker4(vec4 b, float zf, float epsilon) {
-    Canonical4 c = msm_hamburger4_canonical(b, zf);
-    return msm_blocker_from_canonical(vec4(c.z[0], c.z[1], c.z[2], 0.0f),
-                                      vec4(c.w[0], c.w[1], c.w[2], 0.0f), epsilon);
+  Canonical4 c = msm_hamburger4_canonical(b, zf);
+  return msm_blocker_from_canonical(vec4(c.z[0], c.z[1], c.z[2], 0.0f), vec4(c.w[0], c.w[1], c.w[2], 0.0f), epsilon);
 }
 MSM_FN BlockerResult msm_blocker4(vec4 b, float zf) { return msm_blocker4(b, zf, MSM_BLOCKER_EPSILON); }
 
 MSM_FN BlockerResult msm_blocker4_upper(vec4 b, float zf, float delta1, float delta2) {
-    Canonical4 c = msm_hamburger4_canonical(b, zf);
-    return msm_blocker_upper_from_canonical(vec4(c.z[0], c.z[1], c.z[2], 0.0f),
-                                            vec4(c.w[0], c.w[1], c.w[2], 0.0f), delta1, delta2);
+  Canonical4 c = msm_hamburger4_canonical(b, zf);
+  return msm_blocker_upper_from_canonical(vec4(c.z[0], c.z[1], c.z[2], 0.0f), vec4(c.w[0], c.w[1], c.w[2], 0.0f),
+                                          delta1, delta2);
 }
 
 // Six moments: four nodes (zf, z1, z2, z3) from msm_hamburger6_canonical (Kneiphof §4.2.1).
 MSM_FN BlockerResult msm_blocker6(Moments6 b, float zf, float epsilon) {
-    Canonical6 c = msm_hamburger6_canonical(b, zf);
-    return msm_blocker_from_canonical(c.z, c.w, epsilon);
+  Canonical6 c = msm_hamburger6_canonical(b, zf);
+  return msm_blocker_from_canonical(c.z, c.w, epsilon);
 }
 MSM_FN BlockerResult msm_blocker6(Moments6 b, float zf) { return msm_blocker6(b, zf, MSM_BLOCKER_EPSILON); }
 
 MSM_FN BlockerResult msm_blocker6_upper(Moments6 b, float zf, float delta1, float delta2) {
-    Canonical6 c = msm_hamburger6_canonical(b, zf);
-    return msm_blocker_upper_from_canonical(c.z, c.w, delta1, delta2);
+  Canonical6 c = msm_hamburger6_canonical(b, zf);
+  return msm_blocker_upper_from_canonical(c.z, c.w, delta1, delta2);
 }
 
 MSM_END

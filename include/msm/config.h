@@ -24,7 +24,7 @@ const float MSM_ALPHA6_16BIT = 8.0e-5f;
 const float MSM_ALPHA6_FLOAT = 5.0e-6f;
 
 // Biasing targets b* (without b0 = 1).
-const vec4 MSM_BSTAR_UNIT = vec4(0.5f, 0.5f, 0.5f, 0.5f);          // ½δ0 + ½δ1 on [0,1]
+const vec4 MSM_BSTAR_UNIT = vec4(0.5f, 0.5f, 0.5f, 0.5f);             // ½δ0 + ½δ1 on [0,1]
 const vec4 MSM_BSTAR_SIGNED_FLOAT = vec4(0.0f, 0.375f, 0.0f, 0.375f); // JCGT §2.5 worst case
 const vec4 MSM_BSTAR_SIGNED_16BIT = vec4(0.0f, 0.628f, 0.0f, 0.628f); // JCGT §2.5 after Θ4*
 // JCGT §5.4.3, six moments b* = (1, 0, 0.5566, 0, 0.489, 0, 0.47869382): the odd moments
@@ -55,10 +55,10 @@ const float MSM_VSSM_MIN_VARIANCE = 1.0e-6f;
 const float MSM_OVERDARKEN_DEFAULT = 0.98f;
 
 // --- Baselines (JCGT Fig. 4, HPG §5.1) ---
-const float MSM_EVSM_C_64BIT = 5.54f;         // exponent that 16-bit channels can hold
-const float MSM_EVSM_C_POS_128BIT = 40.0f;    // c+ at 32-bit float channels
-const float MSM_EVSM_C_NEG_128BIT = 5.54f;    // c- at 32-bit float channels
-const float MSM_ESM_C_DEFAULT = 80.0f;        // ESM exponent for [0,1] depth in float
+const float MSM_EVSM_C_64BIT = 5.54f;      // exponent that 16-bit channels can hold
+const float MSM_EVSM_C_POS_128BIT = 40.0f; // c+ at 32-bit float channels
+const float MSM_EVSM_C_NEG_128BIT = 5.54f; // c- at 32-bit float channels
+const float MSM_ESM_C_DEFAULT = 80.0f;     // ESM exponent for [0,1] depth in float
 
 MSM_END
 

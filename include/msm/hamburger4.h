@@ -4,8 +4,8 @@
 // B = [[1,b1,b2],[b1,b2,b3],[b2,b3,b4]] is positive definite; depth convention is the caller's.
 #ifndef MSM_HAMBURGER4_H
 #define MSM_HAMBURGER4_H
-#include "msm/shared.h"
 #include "msm/roots.h"
+#include "msm/shared.h"
 
 MSM_BEGIN
 
@@ -23,9 +23,9 @@ MSM_BEGIN
 //  - a root escaping to infinity (c2 -> 0, 2015 Prop. 3) is clamped to ±MSM_ROOT_LIMIT, where the
 //    closed forms below take their limits to float precision.
 struct Hamburger4Roots {
-    vec3 c;
-    float z2;
-    float z3;
+  vec3 c;
+  float z2;
+  float z3;
 };
 
 const float MSM_MIN_PIVOT1 = 1.0e-10f;
@@ -37,84 +37,82 @@ const float MSM_MIN_PIVOT2 = 1.0e-12f;
 // with one rounding (msm_fma). D1 is floored at MSM_MIN_PIVOT1 so that L21 stays finite; D2 is
 // returned as computed (callers floor or clamp it as they need).
 struct HankelLdl3 {
-    float D1;
-    float L21;
-    float L21D1;
-    float D2;
+  float D1;
+  float L21;
+  float L21D1;
+  float D2;
 };
 
 MSM_FN HankelLdl3 msm_hankel3_ldl(vec4 b) {
-    float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];
-    float D1 = max(msm_fma(-b1, b1, b2), MSM_MIN_PIVOT1);
-    float L21D1 = msm_fma(-b1, b2, b3);
-    float L21 = L21D1 / D1;
-    return HankelLdl3(D1, L21, L21D1, msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)));
+  float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];
+  float D1 = max(msm_fma(-b1, b1, b2), MSM_MIN_PIVOT1);
+  float L21D1 = msm_fma(-b1, b2, b3);
+  float L21 = L21D1 / D1;
+  return HankelLdl3(D1, L21, L21D1, msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)));
 }
 
 MSM_FN Hamburger4Roots msm_hamburger4_roots(vec4 b, float zf) {
-    float b1 = b[0], b2 = b[1];
-    HankelLdl3 f = msm_hankel3_ldl(b);
-    float D1 = f.D1, L21 = f.L21;
-    float D2 = max(f.D2, MSM_MIN_PIVOT2);
-    // Forward substitution, scaling, back substitution.
-    float y1 = zf - b1;
-    float y2 = msm_fma(-L21, y1, msm_fma(zf, zf, -b2));
-    y1 /= D1;
-    y2 /= D2;
-    vec3 c;
-    c[2] = y2;
-    c[1] = y1 - L21 * c[2];
-    c[0] = 1.0f - b1 * c[1] - b2 * c[2];
-    vec2 z = msm_solve_quadratic(c);
-    return Hamburger4Roots(c, z.x, z.y);
+  float b1 = b[0], b2 = b[1];
+  HankelLdl3 f = msm_hankel3_ldl(b);
+  float D1 = f.D1, L21 = f.L21;
+  float D2 = max(f.D2, MSM_MIN_PIVOT2);
+  // Forward substitution, scaling, back substitution.
+  float y1 = zf - b1;
+  float y2 = msm_fma(-L21, y1, msm_fma(zf, zf, -b2));
+  y1 /= D1;
+  y2 /= D2;
+  vec3 c;
+  c[2] = y2;
+  c[1] = y1 - L21 * c[2];
+  c[0] = 1.0f - b1 * c[1] - b2 * c[2];
+  vec2 z = msm_solve_quadratic(c);
+  return Hamburger4Roots(c, z.x, z.y);
 }
 
 // Weight of zf in the canonical representation: w0 = 1 / (pᵀ B⁻¹ p), p = (1, zf, zf²)
 // (2015 supplementary, Proposition 10).
-MSM_FN float msm_hamburger4_w0(Hamburger4Roots r, float zf) {
-    return 1.0f / (r.c[0] + zf * (r.c[1] + zf * r.c[2]));
-}
+MSM_FN float msm_hamburger4_w0(Hamburger4Roots r, float zf) { return 1.0f / (r.c[0] + zf * (r.c[1] + zf * r.c[2])); }
 
 // Sharp lower bound of Z(z < zf) with the closed forms of 2015 Algorithm 3, steps 3-6.
 MSM_FN float msm_hamburger4_lower_from_roots(vec4 b, float zf, Hamburger4Roots r) {
-    float b1 = b[0], b2 = b[1];
-    float z2 = r.z2, z3 = r.z3;
-    if (zf <= z2) return 0.0f;
-    if (zf <= z3) return msm_saturate((zf * z3 - b1 * (zf + z3) + b2) / ((z3 - z2) * (zf - z2)));
-    return msm_saturate(1.0f - (z2 * z3 - b1 * (z2 + z3) + b2) / ((zf - z2) * (zf - z3)));
+  float b1 = b[0], b2 = b[1];
+  float z2 = r.z2, z3 = r.z3;
+  if (zf <= z2) return 0.0f;
+  if (zf <= z3) return msm_saturate((zf * z3 - b1 * (zf + z3) + b2) / ((z3 - z2) * (zf - z2)));
+  return msm_saturate(1.0f - (z2 * z3 - b1 * (z2 + z3) + b2) / ((zf - z2) * (zf - z3)));
 }
 
 MSM_FN float msm_hamburger4_lower(vec4 b, float zf) {
-    return msm_hamburger4_lower_from_roots(b, zf, msm_hamburger4_roots(b, zf));
+  return msm_hamburger4_lower_from_roots(b, zf, msm_hamburger4_roots(b, zf));
 }
 
 // Sharp upper bound of Z(z <= zf): lower bound plus the weight of zf (JCGT §5.3, Fig. 2).
 MSM_FN float msm_hamburger4_upper(vec4 b, float zf) {
-    Hamburger4Roots r = msm_hamburger4_roots(b, zf);
-    return msm_saturate(msm_hamburger4_lower_from_roots(b, zf, r) + msm_hamburger4_w0(r, zf));
+  Hamburger4Roots r = msm_hamburger4_roots(b, zf);
+  return msm_saturate(msm_hamburger4_lower_from_roots(b, zf, r) + msm_hamburger4_w0(r, zf));
 }
 
 // Both bounds at once: (lower, upper).
 MSM_FN vec2 msm_hamburger4_bounds(vec4 b, float zf) {
-    Hamburger4Roots r = msm_hamburger4_roots(b, zf);
-    float lower = msm_hamburger4_lower_from_roots(b, zf, r);
-    return vec2(lower, msm_saturate(lower + msm_hamburger4_w0(r, zf)));
+  Hamburger4Roots r = msm_hamburger4_roots(b, zf);
+  float lower = msm_hamburger4_lower_from_roots(b, zf, r);
+  return vec2(lower, msm_saturate(lower + msm_hamburger4_w0(r, zf)));
 }
 
 // The whole canonical distribution w0 δ(zf) + w1 δ(z[1]) + w2 δ(z[2]), z[1] <= z[2]: what the
 // blocker search (blocker.h) averages. Weights from Lagrange interpolation on b0, b1, b2.
 struct Canonical4 {
-    vec3 z; // (zf, z2, z3)
-    vec3 w;
+  vec3 z; // (zf, z2, z3)
+  vec3 w;
 };
 
 MSM_FN Canonical4 msm_hamburger4_canonical(vec4 b, float zf) {
-    Hamburger4Roots r = msm_hamburger4_roots(b, zf);
-    float b1 = b[0], b2 = b[1];
-    float z2 = r.z2, z3 = r.z3;
-    float w1 = (b2 - b1 * (zf + z3) + zf * z3) / ((z2 - zf) * (z2 - z3));
-    float w2 = (b2 - b1 * (zf + z2) + zf * z2) / ((z3 - zf) * (z3 - z2));
-    return Canonical4(vec3(zf, z2, z3), vec3(msm_hamburger4_w0(r, zf), w1, w2));
+  Hamburger4Roots r = msm_hamburger4_roots(b, zf);
+  float b1 = b[0], b2 = b[1];
+  float z2 = r.z2, z3 = r.z3;
+  float w1 = (b2 - b1 * (zf + z3) + zf * z3) / ((z2 - zf) * (z2 - z3));
+  float w2 = (b2 - b1 * (zf + z2) + zf * z2) / ((z3 - zf) * (z3 - z2));
+  return Canonical4(vec3(zf, z2, z3), vec3(msm_hamburger4_w0(r, zf), w1, w2));
 }
 
 MSM_END

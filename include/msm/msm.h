@@ -1,18 +1,18 @@
 // Umbrella header: every shared (GLSL + C++) header of msm.
 #ifndef MSM_MSM_H
 #define MSM_MSM_H
-#include "msm/shared.h"
+#include "msm/baselines.h"
+#include "msm/bias.h"
+#include "msm/blocker.h"
 #include "msm/config.h"
+#include "msm/hamburger4.h"
+#include "msm/hamburger6.h"
+#include "msm/hausdorff4.h"
 #include "msm/moments.h"
+#include "msm/nonlinear.h"
 #include "msm/quantize.h"
 #include "msm/roots.h"
-#include "msm/bias.h"
-#include "msm/hamburger4.h"
-#include "msm/hausdorff4.h"
-#include "msm/hamburger6.h"
-#include "msm/blocker.h"
-#include "msm/trigonometric.h"
+#include "msm/shared.h"
 #include "msm/three_moments.h"
-#include "msm/nonlinear.h"
-#include "msm/baselines.h"
+#include "msm/trigonometric.h"
 #endif

@@ -26,20 +26,20 @@
 // of Ψ4 up. (The 64-bit format rounds Ψ4 to nearest, as the paper does: half a 16-bit step.)
 #ifndef MSM_NONLINEAR_H
 #define MSM_NONLINEAR_H
-#include "msm/shared.h"
-#include "msm/config.h"
 #include "msm/bias.h"
-#include "msm/quantize.h"
-#include "msm/three_moments.h"
+#include "msm/config.h"
 #include "msm/hamburger4.h"
+#include "msm/quantize.h"
+#include "msm/shared.h"
+#include "msm/three_moments.h"
 
 MSM_BEGIN
 
 struct NonLinearMoments {
-    float y1;  // smaller depth, y1 <= y2, both in [-1,1] for distributions on [-1,1]
-    float y2;  // larger depth
-    float v2;  // weight of y2, in [0,1]; y1 has weight 1 - v2
-    float xi4; // offset of the fourth moment, in [0, 0.25]
+  float y1;  // smaller depth, y1 <= y2, both in [-1,1] for distributions on [-1,1]
+  float y2;  // larger depth
+  float v2;  // weight of y2, in [0,1]; y1 has weight 1 - v2
+  float xi4; // offset of the fourth moment, in [0, 0.25]
 };
 
 // ---- Φ (HPG Algorithm 2) ----
@@ -53,31 +53,29 @@ struct NonLinearMoments {
 // (nonlinear_test measures these). So the result is clamped: y to [-1,1], ξ4 to >= 0. Both
 // clamps only touch values that rounding produced.
 MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
-    // Steps 1-5: the two depths and the weight of the larger one.
-    TwoDepths two = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
-    // Steps 6-7: third diagonal entry of the LDLᵀ factorization of the Hankel matrix (Eq. (3)),
-    // ξ4 = b4 - b2² - L21² σ² with L21 σ² = b3 - b1 b2, shared with Hamburger 4MSM. Its
-    // differences are formed with one rounding (msm_fma): 6x less error in ξ4 than separate
-    // multiplies and subtractions (max 4e-8 instead of 2.3e-7 against double on the same float
-    // moments), which matters because ξ4 is ~1e-7 for the most common texel, a single surface.
-    float xi4 = msm_hankel3_ldl(b).D2;
-    return NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, max(xi4, 0.0f));
+  // Steps 1-5: the two depths and the weight of the larger one.
+  TwoDepths two = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
+  // Steps 6-7: third diagonal entry of the LDLᵀ factorization of the Hankel matrix (Eq. (3)),
+  // ξ4 = b4 - b2² - L21² σ² with L21 σ² = b3 - b1 b2, shared with Hamburger 4MSM. Its
+  // differences are formed with one rounding (msm_fma): 6x less error in ξ4 than separate
+  // multiplies and subtractions (max 4e-8 instead of 2.3e-7 against double on the same float
+  // moments), which matters because ξ4 is ~1e-7 for the most common texel, a single surface.
+  float xi4 = msm_hankel3_ldl(b).D2;
+  return NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, max(xi4, 0.0f));
 }
 
 // Φ of filtered, unbiased float moments: applies the float bias of [-1,1] depth first.
 MSM_FN NonLinearMoments msm_nl_from_filtered(vec4 b) {
-    return msm_nl_from_moments(msm_apply_bias(b, msm_moment_bias(MSM_REP_SIGNED_FLOAT)));
+  return msm_nl_from_moments(msm_apply_bias(b, msm_moment_bias(MSM_REP_SIGNED_FLOAT)));
 }
 
 // HPG Eq. (4): b = (1 - v2) b(y1) + v2 b(y2) + (0, 0, 0, ξ4). Inverse of Φ (for tests, and for
 // true bilinear filtering: convert four texels back to moments, interpolate, apply Φ again).
 MSM_FN vec4 msm_nl_moments_from(NonLinearMoments m) {
-    float v1 = 1.0f - m.v2;
-    float y1s = m.y1 * m.y1, y2s = m.y2 * m.y2;
-    return vec4(v1 * m.y1 + m.v2 * m.y2,
-                v1 * y1s + m.v2 * y2s,
-                v1 * y1s * m.y1 + m.v2 * y2s * m.y2,
-                v1 * y1s * y1s + m.v2 * y2s * y2s + m.xi4);
+  float v1 = 1.0f - m.v2;
+  float y1s = m.y1 * m.y1, y2s = m.y2 * m.y2;
+  return vec4(v1 * m.y1 + m.v2 * m.y2, v1 * y1s + m.v2 * y2s, v1 * y1s * m.y1 + m.v2 * y2s * m.y2,
+              v1 * y1s * y1s + m.v2 * y2s * y2s + m.xi4);
 }
 
 // ---- Ψ4: the warp of ξ4 to [0,1] (HPG §3.3) ----
@@ -89,22 +87,22 @@ const float MSM_NL_PSI4_HI = log(log(MSM_NL_XI4_MAX * MSM_NL_XI4_SCALE));
 
 // Monotone; Ψ4(ξ4 <= ξmin) = 0, Ψ4(ξmax) = 1; larger ξ4 saturate to 1.
 MSM_FN float msm_nl_psi4(float xi4) {
-    float l = log(log(max(MSM_NL_XI4_MIN, xi4) * MSM_NL_XI4_SCALE));
-    return msm_saturate((l - MSM_NL_PSI4_LO) / (MSM_NL_PSI4_HI - MSM_NL_PSI4_LO));
+  float l = log(log(max(MSM_NL_XI4_MIN, xi4) * MSM_NL_XI4_SCALE));
+  return msm_saturate((l - MSM_NL_PSI4_LO) / (MSM_NL_PSI4_HI - MSM_NL_PSI4_LO));
 }
 // Inverse on [0,1]: ξ4 = exp(exp(Ψ4 (hi - lo) + lo)) / 1e7, in [ξmin, ξmax].
 MSM_FN float msm_nl_psi4_inverse(float psi4) {
-    float l = msm_saturate(psi4) * (MSM_NL_PSI4_HI - MSM_NL_PSI4_LO) + MSM_NL_PSI4_LO;
-    return exp(exp(l)) * (1.0f / MSM_NL_XI4_SCALE);
+  float l = msm_saturate(psi4) * (MSM_NL_PSI4_HI - MSM_NL_PSI4_LO) + MSM_NL_PSI4_LO;
+  return exp(exp(l)) * (1.0f / MSM_NL_XI4_SCALE);
 }
 
 // ---- 64 bits: four 16-bit UNORM (HPG §3.3) ----
 MSM_FN uvec2 msm_nl_pack64(NonLinearMoments m) {
-    return msm_pack_unorm16x4(vec4(0.5f * m.y1 + 0.5f, 0.5f * m.y2 + 0.5f, m.v2, msm_nl_psi4(m.xi4)));
+  return msm_pack_unorm16x4(vec4(0.5f * m.y1 + 0.5f, 0.5f * m.y2 + 0.5f, m.v2, msm_nl_psi4(m.xi4)));
 }
 MSM_FN NonLinearMoments msm_nl_unpack64(uvec2 p) {
-    vec4 u = msm_unpack_unorm16x4(p);
-    return NonLinearMoments(2.0f * u[0] - 1.0f, 2.0f * u[1] - 1.0f, u[2], msm_nl_psi4_inverse(u[3]));
+  vec4 u = msm_unpack_unorm16x4(p);
+  return NonLinearMoments(2.0f * u[0] - 1.0f, 2.0f * u[1] - 1.0f, u[2], msm_nl_psi4_inverse(u[3]));
 }
 // What a texture write then read does to m.
 MSM_FN NonLinearMoments msm_nl_quantize64(NonLinearMoments m) { return msm_nl_unpack64(msm_nl_pack64(m)); }
@@ -114,23 +112,23 @@ const uint MSM_NL32_DEPTH_MAX = 1022u; // ỹ in 0..1022
 
 // ỹ = floor(511.5 (y + 1)), y clamped to [-1,1] and y = 1 put into the last bin 1022.
 MSM_FN uint msm_nl_depth10_encode(float y) {
-    return uint(min(floor(511.5f * (clamp(y, -1.0f, 1.0f) + 1.0f)), 1022.0f));
+  return uint(min(floor(511.5f * (clamp(y, -1.0f, 1.0f) + 1.0f)), 1022.0f));
 }
 // Center of bin ỹ: (ỹ + 0.5) / 511.5 - 1 = (2 ỹ + 1) / 1023 - 1.
 MSM_FN float msm_nl_depth10_decode(uint t) { return float(2u * t + 1u) * (1.0f / 1023.0f) - 1.0f; }
 
 // (ỹ1, ỹ2) with ỹ1 <= ỹ2 <= 1022 -> the 19-bit pair code d2 | (d1 << 10) (HPG Fig. 5).
 MSM_FN uint msm_nl_fold_depths(uvec2 t) {
-    bool folded = t.x >= 512u;
-    uint d1 = folded ? 1023u - t.x : t.x;
-    uint d2 = folded ? 1022u - t.y : t.y;
-    return d2 | (d1 << 10u);
+  bool folded = t.x >= 512u;
+  uint d1 = folded ? 1023u - t.x : t.x;
+  uint d2 = folded ? 1022u - t.y : t.y;
+  return d2 | (d1 << 10u);
 }
 // Inverse of msm_nl_fold_depths: d1 <= d2 means unfolded, d1 > d2 folded.
 MSM_FN uvec2 msm_nl_unfold_depths(uint code) {
-    uint d2 = code & 1023u;
-    uint d1 = (code >> 10u) & 511u;
-    return d1 <= d2 ? uvec2(d1, d2) : uvec2(1023u - d1, 1022u - d2);
+  uint d2 = code & 1023u;
+  uint d1 = (code >> 10u) & 511u;
+  return d1 <= d2 ? uvec2(d1, d2) : uvec2(1023u - d1, 1022u - d2);
 }
 
 // Ψ4 in 6 bits, rounded up: the stored q is the least q with decode(q) = q/63 >= Ψ4, so the
@@ -140,26 +138,28 @@ MSM_FN uvec2 msm_nl_unfold_depths(uint code) {
 // float expression. Decoding needs no correction: the rounding up happened on the way in.
 MSM_FN float msm_nl_psi4_decode6(uint q) { return float(q) * (1.0f / 63.0f); }
 MSM_FN uint msm_nl_psi4_encode6(float psi4) {
-    float p = msm_saturate(psi4);
-    uint q = uint(ceil(p * 63.0f)); // 0..63
-    if (q > 0u && msm_nl_psi4_decode6(q - 1u) >= p) q -= 1u;
-    else if (msm_nl_psi4_decode6(q) < p) q += 1u;
-    return min(q, 63u);
+  float p = msm_saturate(psi4);
+  uint q = uint(ceil(p * 63.0f)); // 0..63
+  if (q > 0u && msm_nl_psi4_decode6(q - 1u) >= p)
+    q -= 1u;
+  else if (msm_nl_psi4_decode6(q) < p)
+    q += 1u;
+  return min(q, 63u);
 }
 
 MSM_FN uint msm_nl_pack32(NonLinearMoments m) {
-    uint t1 = msm_nl_depth10_encode(m.y1);
-    uint t2 = msm_nl_depth10_encode(m.y2);
-    uint pair = msm_nl_fold_depths(uvec2(min(t1, t2), max(t1, t2)));
-    uint v = uint(floor(sqrt(msm_saturate(m.v2)) * 127.0f + 0.5f));
-    uint psi = msm_nl_psi4_encode6(msm_nl_psi4(m.xi4));
-    return pair | (v << 19u) | (psi << 26u);
+  uint t1 = msm_nl_depth10_encode(m.y1);
+  uint t2 = msm_nl_depth10_encode(m.y2);
+  uint pair = msm_nl_fold_depths(uvec2(min(t1, t2), max(t1, t2)));
+  uint v = uint(floor(sqrt(msm_saturate(m.v2)) * 127.0f + 0.5f));
+  uint psi = msm_nl_psi4_encode6(msm_nl_psi4(m.xi4));
+  return pair | (v << 19u) | (psi << 26u);
 }
 MSM_FN NonLinearMoments msm_nl_unpack32(uint p) {
-    uvec2 t = msm_nl_unfold_depths(p & 0x7FFFFu);
-    float s = float((p >> 19u) & 127u) * (1.0f / 127.0f);
-    return NonLinearMoments(msm_nl_depth10_decode(t.x), msm_nl_depth10_decode(t.y), s * s,
-                            msm_nl_psi4_inverse(msm_nl_psi4_decode6(p >> 26u)));
+  uvec2 t = msm_nl_unfold_depths(p & 0x7FFFFu);
+  float s = float((p >> 19u) & 127u) * (1.0f / 127.0f);
+  return NonLinearMoments(msm_nl_depth10_decode(t.x), msm_nl_depth10_decode(t.y), s * s,
+                          msm_nl_psi4_inverse(msm_nl_psi4_decode6(p >> 26u)));
 }
 MSM_FN NonLinearMoments msm_nl_quantize32(NonLinearMoments m) { return msm_nl_unpack32(msm_nl_pack32(m)); }
 
@@ -175,34 +175,34 @@ MSM_FN NonLinearMoments msm_nl_quantize32(NonLinearMoments m) { return msm_nl_un
 // far inside float range.
 const float MSM_NL_XI4_SHADING_MIN = 1.0e-12f;
 MSM_FN float msm_nl_shadow(NonLinearMoments m, float zf) {
-    float y1 = m.y1;
-    float y2 = max(m.y2, y1 + MSM_NL_TOLERANCE);
-    float v2 = clamp(m.v2, MSM_NL_TOLERANCE, 1.0f - MSM_NL_TOLERANCE);
-    if (zf <= y1) return 0.0f;
-    // Shift and scale depths so that y1 = 0, y2 = 1; ξ4 scales with the fourth power.
-    float inv_range = 1.0f / (y2 - y1);
-    float zf1 = (zf - y1) * inv_range; // z'f in (0, 1] when zf <= y2
-    float inv_range2 = inv_range * inv_range;
-    float xi = max(m.xi4, MSM_NL_XI4_SHADING_MIN) * (inv_range2 * inv_range2); // ξ'4
-    bool between = zf <= y2;
-    float zl = zf1;
-    if (between) {
-        // The paper's q0 and q1 of the monic z² + q1 z + q0, whose smaller root is z1. q1 has a
-        // pole at z'f = 1 (zf = y2), so the polynomial is multiplied by (1 - z'f) >= 0 first:
-        // a z² + b z + c with a = 1 - z'f, b = (1 - z'f) q1, c = (1 - z'f) q0 <= 0. Its smaller
-        // root is the non-positive one; each branch avoids cancellation, and at z'f = 1 (a = 0,
-        // b = -ξ'4 / v2 < 0) it is the exact 0.
-        float q0 = -xi / ((1.0f - v2) * zf1);
-        float a = 1.0f - zf1;
-        float b = -q0 * (v2 - zf1) / v2 - a;
-        float c = q0 * a;
-        float d = sqrt(max(b * b - 4.0f * a * c, 0.0f));
-        zl = b <= 0.0f ? (2.0f * c) / (d - b) : (-b - d) / (2.0f * a);
-    }
-    // w_l = 1 / (p(zl)ᵀ B⁻¹ p(zl)) with B = M diag(1 - v2, v2, ξ'4) Mᵀ (ERRATA.md).
-    float u = 1.0f - zl;
-    float wl = 1.0f / (u * u / (1.0f - v2) + zl * zl / v2 + (u * u) * (zl * zl) / xi);
-    return msm_saturate(between ? wl : 1.0f - wl);
+  float y1 = m.y1;
+  float y2 = max(m.y2, y1 + MSM_NL_TOLERANCE);
+  float v2 = clamp(m.v2, MSM_NL_TOLERANCE, 1.0f - MSM_NL_TOLERANCE);
+  if (zf <= y1) return 0.0f;
+  // Shift and scale depths so that y1 = 0, y2 = 1; ξ4 scales with the fourth power.
+  float inv_range = 1.0f / (y2 - y1);
+  float zf1 = (zf - y1) * inv_range; // z'f in (0, 1] when zf <= y2
+  float inv_range2 = inv_range * inv_range;
+  float xi = max(m.xi4, MSM_NL_XI4_SHADING_MIN) * (inv_range2 * inv_range2); // ξ'4
+  bool between = zf <= y2;
+  float zl = zf1;
+  if (between) {
+    // The paper's q0 and q1 of the monic z² + q1 z + q0, whose smaller root is z1. q1 has a
+    // pole at z'f = 1 (zf = y2), so the polynomial is multiplied by (1 - z'f) >= 0 first:
+    // a z² + b z + c with a = 1 - z'f, b = (1 - z'f) q1, c = (1 - z'f) q0 <= 0. Its smaller
+    // root is the non-positive one; each branch avoids cancellation, and at z'f = 1 (a = 0,
+    // b = -ξ'4 / v2 < 0) it is the exact 0.
+    float q0 = -xi / ((1.0f - v2) * zf1);
+    float a = 1.0f - zf1;
+    float b = -q0 * (v2 - zf1) / v2 - a;
+    float c = q0 * a;
+    float d = sqrt(max(b * b - 4.0f * a * c, 0.0f));
+    zl = b <= 0.0f ? (2.0f * c) / (d - b) : (-b - d) / (2.0f * a);
+  }
+  // w_l = 1 / (p(zl)ᵀ B⁻¹ p(zl)) with B = M diag(1 - v2, v2, ξ'4) Mᵀ (ERRATA.md).
+  float u = 1.0f - zl;
+  float wl = 1.0f / (u * u / (1.0f - v2) + zl * zl / v2 + (u * u) * (zl * zl) / xi);
+  return msm_saturate(between ? wl : 1.0f - wl);
 }
 
 MSM_END

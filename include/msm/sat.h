@@ -37,8 +37,8 @@
 // the quantization step 1 / s of one texel (1 / (area · s) of the average).
 #ifndef MSM_SAT_H
 #define MSM_SAT_H
-#include "msm/shared.h"
 #include "msm/moments.h"
+#include "msm/shared.h"
 
 MSM_BEGIN
 
@@ -50,7 +50,7 @@ MSM_FN uint msm_sat_scale(int max_kernel_texels) { return 0xFFFFFFFFu / uint(max
 // to int first, which overflows above 2^31). C++: std::nearbyint in the default rounding mode.
 #if MSM_CPP
 MSM_FN vec4 msm_sat_round_even(vec4 x) {
-    return vec4(std::nearbyint(x[0]), std::nearbyint(x[1]), std::nearbyint(x[2]), std::nearbyint(x[3]));
+  return vec4(std::nearbyint(x[0]), std::nearbyint(x[1]), std::nearbyint(x[2]), std::nearbyint(x[3]));
 }
 #else
 MSM_FN vec4 msm_sat_round_even(vec4 x) { return roundEven(x); }
@@ -63,9 +63,9 @@ MSM_FN vec4 msm_sat_round_even(vec4 x) { return roundEven(x); }
 // correctly rounded conversion on both sides), rounding to even is exact, and the clamps keep the
 // conversion to uint in range (4294967040 is the largest float below 2^32).
 MSM_FN uvec4 msm_sat_quantize(vec4 q, uint scale) {
-    vec4 unit = vec4(msm_saturate(q[0]), msm_saturate(q[1]), msm_saturate(q[2]), msm_saturate(q[3]));
-    vec4 x = min(msm_sat_round_even(unit * float(scale)), vec4(4294967040.0f));
-    return min(uvec4(x), uvec4(scale));
+  vec4 unit = vec4(msm_saturate(q[0]), msm_saturate(q[1]), msm_saturate(q[2]), msm_saturate(q[3]));
+  vec4 x = min(msm_sat_round_even(unit * float(scale)), vec4(4294967040.0f));
+  return min(uvec4(x), uvec4(scale));
 }
 
 // A UNORM16 texel as fetched by a shader, re-decoded the way the C++ build decodes it (GLM's
@@ -74,7 +74,7 @@ MSM_FN uvec4 msm_sat_quantize(vec4 q, uint scale) {
 // differ from k / 65535 by some ulp, which would move a few quantized values by one. The fetched
 // value is within a few ulp of k / 65535, so k = round(fetched · 65535) recovers the code exactly.
 MSM_FN vec4 msm_sat_unorm16_texel(vec4 fetched) {
-    return msm_sat_round_even(fetched * 65535.0f) * 1.5259021896696421759365224689097e-5f;
+  return msm_sat_round_even(fetched * 65535.0f) * 1.5259021896696421759365224689097e-5f;
 }
 
 // Back to moments in [0,1] (one texel, or a sum of `texels` texels: msm_sat_rect_average).
@@ -84,8 +84,8 @@ MSM_FN vec4 msm_sat_dequantize(uvec4 value, uint scale) { return vec4(value) / f
 
 // Texels [lo.x, hi.x] × [lo.y, hi.y], both ends inclusive; lo <= hi.
 struct SatRect {
-    ivec2 lo;
-    ivec2 hi;
+  ivec2 lo;
+  ivec2 hi;
 };
 
 MSM_FN int msm_sat_rect_texels(SatRect r) { return (r.hi.x - r.lo.x + 1) * (r.hi.y - r.lo.y + 1); }
@@ -98,7 +98,7 @@ MSM_FN uvec4 msm_sat_rect_sum(uvec4 a, uvec4 b, uvec4 c, uvec4 d) { return a - b
 
 // The average moments (in [0,1]) of a rectangle of `texels` texels from its exact integer sum.
 MSM_FN vec4 msm_sat_rect_average(uvec4 sum, int texels, uint scale) {
-    return vec4(sum) / (float(texels) * float(scale));
+  return vec4(sum) / (float(texels) * float(scale));
 }
 
 // The texels that a continuous region [lo, hi] (texel units: texel i covers [i, i + 1)) touches,
@@ -106,9 +106,9 @@ MSM_FN vec4 msm_sat_rect_average(uvec4 sum, int texels, uint scale) {
 // region to the texel grid so that it costs one 4-lookup query instead of the 16 of the
 // interpolated query below. A region of width w touches at most ceil(w) + 1 texels per axis.
 MSM_FN SatRect msm_sat_grid_rect(vec2 lo, vec2 hi, ivec2 size) {
-    ivec2 first = clamp(ivec2(floor(lo)), ivec2(0), size - ivec2(1));
-    ivec2 last = clamp(ivec2(ceil(hi)) - ivec2(1), first, size - ivec2(1));
-    return SatRect(first, last);
+  ivec2 first = clamp(ivec2(floor(lo)), ivec2(0), size - ivec2(1));
+  ivec2 last = clamp(ivec2(ceil(hi)) - ivec2(1), first, size - ivec2(1));
+  return SatRect(first, last);
 }
 
 // ---- Filter regions with fractional borders: nine regions, 16 lookups (JCGT §4.4, Fig. 7b) ----
@@ -126,43 +126,43 @@ MSM_FN SatRect msm_sat_grid_rect(vec2 lo, vec2 hi, ivec2 size) {
 // are x = (a - 1, a, max(b - 1, a), b) and likewise rows y: 16 lookups (JCGT: 4·4·4·32 = 2048
 // bits per query). Bands that are empty (b <= a + 1) read equal columns and sum to exactly 0.
 struct SatFilter {
-    ivec4 x;    // table columns to read (-1: reads as 0)
-    ivec4 y;    // table rows to read
-    vec3 wx;    // coverage of the left, each middle and the right column
-    vec3 wy;    // coverage of the top, each middle and the bottom row
-    float area; // (u1 - u0)(v1 - v0), texels²
+  ivec4 x;    // table columns to read (-1: reads as 0)
+  ivec4 y;    // table rows to read
+  vec3 wx;    // coverage of the left, each middle and the right column
+  vec3 wy;    // coverage of the top, each middle and the bottom row
+  float area; // (u1 - u0)(v1 - v0), texels²
 };
 
 // Precondition: 0 <= lo < hi <= map size per axis (soft.h's msm_soft_region guarantees it), and
 // ceil(hi) - floor(lo) texels per axis make at most n_t texels (width hi - lo <= kernel width - 1
 // does, see soft.h).
 MSM_FN SatFilter msm_sat_filter(vec2 lo, vec2 hi) {
-    ivec2 a = ivec2(floor(lo));
-    ivec2 b = max(ivec2(ceil(hi)) - ivec2(1), a);
-    vec2 first = min(hi, vec2(a) + vec2(1.0f)) - lo;
-    vec2 last = hi - vec2(b);
-    return SatFilter(ivec4(a.x - 1, a.x, max(b.x - 1, a.x), b.x), ivec4(a.y - 1, a.y, max(b.y - 1, a.y), b.y),
-                     vec3(first.x, 1.0f, last.x), vec3(first.y, 1.0f, last.y), (hi.x - lo.x) * (hi.y - lo.y));
+  ivec2 a = ivec2(floor(lo));
+  ivec2 b = max(ivec2(ceil(hi)) - ivec2(1), a);
+  vec2 first = min(hi, vec2(a) + vec2(1.0f)) - lo;
+  vec2 last = hi - vec2(b);
+  return SatFilter(ivec4(a.x - 1, a.x, max(b.x - 1, a.x), b.x), ivec4(a.y - 1, a.y, max(b.y - 1, a.y), b.y),
+                   vec3(first.x, 1.0f, last.x), vec3(first.y, 1.0f, last.y), (hi.x - lo.x) * (hi.y - lo.y));
 }
 
 // The 16 table values of a filter region: s[4 j + i] = S(f.x[i], f.y[j]) (0 where either
 // coordinate is -1). Declare one and assign its elements: `SatSamples16 t; t.s[k] = ...;`.
 struct SatSamples16 {
-    uvec4 s[16];
+  uvec4 s[16];
 };
 
 // The integral of the moments over the region divided by its area: the box-filtered moments
 // (in [0,1], the same space as the texels), from the 16 lookups of msm_sat_filter.
 MSM_FN vec4 msm_sat_filter_average(SatSamples16 t, SatFilter f, uint scale) {
-    vec4 sum = vec4(0.0f);
-    for (int j = 0; j < 3; ++j) {
-        for (int i = 0; i < 3; ++i) {
-            uvec4 region = msm_sat_rect_sum(t.s[4 * (j + 1) + i + 1], t.s[4 * (j + 1) + i], t.s[4 * j + i + 1],
-                                            t.s[4 * j + i]);
-            sum += (f.wx[i] * f.wy[j]) * vec4(region);
-        }
+  vec4 sum = vec4(0.0f);
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 3; ++i) {
+      uvec4 region =
+          msm_sat_rect_sum(t.s[4 * (j + 1) + i + 1], t.s[4 * (j + 1) + i], t.s[4 * j + i + 1], t.s[4 * j + i]);
+      sum += (f.wx[i] * f.wy[j]) * vec4(region);
     }
-    return sum / (f.area * float(scale));
+  }
+  return sum / (f.area * float(scale));
 }
 
 // ---- Six moments: two tables, the same scheme per channel ----
@@ -170,28 +170,28 @@ MSM_FN vec4 msm_sat_filter_average(SatSamples16 t, SatFilter f, uint scale) {
 // then the first even one), b = (q4, q6, 0, 0); the layout of msm_quantize_unorm16(Moments6).
 // Each table is built and queried exactly like the four-moment one.
 struct SatTexels6 {
-    vec4 a;
-    vec4 b;
+  vec4 a;
+  vec4 b;
 };
 struct SatValues6 {
-    uvec4 a;
-    uvec4 b;
+  uvec4 a;
+  uvec4 b;
 };
 
 MSM_FN SatTexels6 msm_sat_split6(Moments6 q) {
-    return SatTexels6(vec4(q.odd, q.even[0]), vec4(q.even[1], q.even[2], 0.0f, 0.0f));
+  return SatTexels6(vec4(q.odd, q.even[0]), vec4(q.even[1], q.even[2], 0.0f, 0.0f));
 }
 MSM_FN Moments6 msm_sat_join6(vec4 a, vec4 b) { return Moments6(vec3(a[0], a[1], a[2]), vec3(a[3], b[0], b[1])); }
 
 MSM_FN SatValues6 msm_sat_quantize6(Moments6 q, uint scale) {
-    SatTexels6 t = msm_sat_split6(q);
-    return SatValues6(msm_sat_quantize(t.a, scale), msm_sat_quantize(t.b, scale));
+  SatTexels6 t = msm_sat_split6(q);
+  return SatValues6(msm_sat_quantize(t.a, scale), msm_sat_quantize(t.b, scale));
 }
 MSM_FN SatValues6 msm_sat_rect_sum6(SatValues6 a, SatValues6 b, SatValues6 c, SatValues6 d) {
-    return SatValues6(msm_sat_rect_sum(a.a, b.a, c.a, d.a), msm_sat_rect_sum(a.b, b.b, c.b, d.b));
+  return SatValues6(msm_sat_rect_sum(a.a, b.a, c.a, d.a), msm_sat_rect_sum(a.b, b.b, c.b, d.b));
 }
 MSM_FN Moments6 msm_sat_rect_average6(SatValues6 sum, int texels, uint scale) {
-    return msm_sat_join6(msm_sat_rect_average(sum.a, texels, scale), msm_sat_rect_average(sum.b, texels, scale));
+  return msm_sat_join6(msm_sat_rect_average(sum.a, texels, scale), msm_sat_rect_average(sum.b, texels, scale));
 }
 // Filter regions: msm_sat_filter_average on each table, then msm_sat_join6.
 

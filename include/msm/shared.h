@@ -51,7 +51,7 @@ const float MSM_PI = 3.14159265358979323846f;
 // elsewhere: msm::vk::Context probes each device's fma() at creation (src/vk/shaders/fma_probe.comp)
 // and every pipeline it creates sets the specialization constant msm_fused_fma (id
 // MSM_SPEC_FUSED_FMA_ID) to the verdict; the driver then compiles only one of the two branches.
-// Pipelines built outside msm::vk::createProgram must set it too (msm::vk::SharedSpecialization);
+// Pipelines built outside msm::vk::create_program must set it too (msm::vk::SharedSpecialization);
 // left at its default (true), msm_fma is the native fma(), as before.
 //
 // MSM_SPEC_FUSED_FMA_ID: the constant_id, a fixed number that C++ (which sets it) and GLSL share.
@@ -82,26 +82,26 @@ const float MSM_PI = 3.14159265358979323846f;
 // std::fma (gpu_math_test.cpp: EmulatedFmaIsCorrectlyRounded; vk_test.cpp: on the device).
 // Its C++ build is exact only without contraction (-ffp-contract=off): C++ code calls msm_fma.
 MSM_FN float msm_fma_emulated(float a, float b, float c) {
-    MSM_PRECISE float ta = 4097.0f * a;
-    MSM_PRECISE float tb = 4097.0f * b;
-    MSM_PRECISE float ah = ta - (ta - a);
-    MSM_PRECISE float bh = tb - (tb - b);
-    MSM_PRECISE float al = a - ah;
-    MSM_PRECISE float bl = b - bh;
-    MSM_PRECISE float p = a * b;
-    MSM_PRECISE float e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
-    MSM_PRECISE float s = c + p;
-    MSM_PRECISE float sc = s - c;
-    MSM_PRECISE float t = (c - (s - sc)) + (p - sc);
-    MSM_PRECISE float v = t + e;
-    MSM_PRECISE float ve = v - t;
-    MSM_PRECISE float w = (t - (v - ve)) + (e - ve);
-    int bits = floatBitsToInt(v);
-    // Rounded to odd: an inexact v with an even last bit moves to its neighbor on w's side (v != 0
-    // here: t + e rounds to 0 only if it is 0). Sign-magnitude: +1 is away from zero.
-    if (w != 0.0f && (bits & 1) == 0) bits += (w > 0.0f) == (v > 0.0f) ? 1 : -1;
-    MSM_PRECISE float r = s + intBitsToFloat(bits);
-    return r;
+  MSM_PRECISE float ta = 4097.0f * a;
+  MSM_PRECISE float tb = 4097.0f * b;
+  MSM_PRECISE float ah = ta - (ta - a);
+  MSM_PRECISE float bh = tb - (tb - b);
+  MSM_PRECISE float al = a - ah;
+  MSM_PRECISE float bl = b - bh;
+  MSM_PRECISE float p = a * b;
+  MSM_PRECISE float e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
+  MSM_PRECISE float s = c + p;
+  MSM_PRECISE float sc = s - c;
+  MSM_PRECISE float t = (c - (s - sc)) + (p - sc);
+  MSM_PRECISE float v = t + e;
+  MSM_PRECISE float ve = v - t;
+  MSM_PRECISE float w = (t - (v - ve)) + (e - ve);
+  int bits = floatBitsToInt(v);
+  // Rounded to odd: an inexact v with an even last bit moves to its neighbor on w's side (v != 0
+  // here: t + e rounds to 0 only if it is 0). Sign-magnitude: +1 is away from zero.
+  if (w != 0.0f && (bits & 1) == 0) bits += (w > 0.0f) == (v > 0.0f) ? 1 : -1;
+  MSM_PRECISE float r = s + intBitsToFloat(bits);
+  return r;
 }
 
 #if MSM_CPP
@@ -113,8 +113,8 @@ layout(constant_id = MSM_SPEC_FUSED_FMA_ID) const bool msm_fused_fma = true;
 const bool msm_fused_fma = true; // OpenGL: no specialization constants
 #endif
 MSM_FN float msm_fma(float a, float b, float c) {
-    if (msm_fused_fma) return fma(a, b, c);
-    return msm_fma_emulated(a, b, c);
+  if (msm_fused_fma) return fma(a, b, c);
+  return msm_fma_emulated(a, b, c);
 }
 #endif
 

@@ -37,16 +37,16 @@
 // interpolation of the moment map, the hard-shadow limit at contact points.
 #ifndef MSM_SOFT_H
 #define MSM_SOFT_H
-#include "msm/shared.h"
-#include "msm/config.h"
-#include "msm/moments.h"
-#include "msm/quantize.h"
+#include "msm/baselines.h"
 #include "msm/bias.h"
+#include "msm/blocker.h"
+#include "msm/config.h"
 #include "msm/hamburger4.h"
 #include "msm/hamburger6.h"
-#include "msm/blocker.h"
-#include "msm/baselines.h"
+#include "msm/moments.h"
+#include "msm/quantize.h"
 #include "msm/sat.h"
+#include "msm/shared.h"
 
 MSM_BEGIN
 
@@ -62,27 +62,27 @@ const float MSM_SOFT_UMBRA_EPSILON = 0.01f;
 // (frustum depth range / 2 for [-1,1] depth, / 1 for [0,1]); world_per_texel: frustum width and
 // height over the resolution.
 MSM_FN vec2 msm_soft_spread(vec2 tan_half_extent, float world_per_depth, vec2 world_per_texel) {
-    return tan_half_extent * world_per_depth / world_per_texel;
+  return tan_half_extent * world_per_depth / world_per_texel;
 }
 
 // spread · depth_distance, clamped to [0.5, (W - 1) / 2] texels with W = max_kernel_width >= 2
 // (the queries then touch at most W texels per axis: n_t = W²). Negative distances (a blocker
 // depth behind the receiver: not a blocker) give the minimum.
 MSM_FN vec2 msm_soft_kernel_half_width(vec2 spread, float depth_distance, int max_kernel_width) {
-    float largest = max(0.5f * float(max_kernel_width - 1), 0.5f);
-    vec2 h = spread * max(depth_distance, 0.0f);
-    return vec2(min(max(h.x, 0.5f), largest), min(max(h.y, 0.5f), largest));
+  float largest = max(0.5f * float(max_kernel_width - 1), 0.5f);
+  vec2 h = spread * max(depth_distance, 0.0f);
+  return vec2(min(max(h.x, 0.5f), largest), min(max(h.y, 0.5f), largest));
 }
 
 // Blocker search half-width: blockers between the near plane (near_depth; -1 for [-1,1] depth)
 // and the fragment depth zf.
 MSM_FN vec2 msm_soft_search_half_width(vec2 spread, float zf, float near_depth, int max_kernel_width) {
-    return msm_soft_kernel_half_width(spread, zf - near_depth, max_kernel_width);
+  return msm_soft_kernel_half_width(spread, zf - near_depth, max_kernel_width);
 }
 
 // Penumbra (filter) half-width for blockers at the average blocker depth.
 MSM_FN vec2 msm_soft_penumbra_half_width(vec2 spread, float zf, float blocker_depth, int max_kernel_width) {
-    return msm_soft_kernel_half_width(spread, zf - blocker_depth, max_kernel_width);
+  return msm_soft_kernel_half_width(spread, zf - blocker_depth, max_kernel_width);
 }
 
 // A region [center - h, center + h] in texel units (texel i covers [i, i + 1); a shadow-map
@@ -90,19 +90,19 @@ MSM_FN vec2 msm_soft_penumbra_half_width(vec2 spread, float zf, float blocker_de
 // part inside is averaged. The center is clamped into the map first, so with h >= 0.5 the region
 // keeps a width of at least 0.5 and lo < hi (sat.h's precondition).
 struct SoftRegion {
-    vec2 lo;
-    vec2 hi;
+  vec2 lo;
+  vec2 hi;
 };
 MSM_FN SoftRegion msm_soft_region(vec2 center, vec2 half_width, ivec2 size) {
-    vec2 extent = vec2(size);
-    vec2 c = clamp(center, vec2(0.0f), extent);
-    return SoftRegion(max(c - half_width, vec2(0.0f)), min(c + half_width, extent));
+  vec2 extent = vec2(size);
+  vec2 c = clamp(center, vec2(0.0f), extent);
+  return SoftRegion(max(c - half_width, vec2(0.0f)), min(c + half_width, extent));
 }
 
 // The grid-aligned blocker search rectangle (JCGT §4.5): one 4-lookup query (sat.h).
 MSM_FN SatRect msm_soft_search_rect(vec2 center, vec2 half_width, ivec2 size) {
-    SoftRegion r = msm_soft_region(center, half_width, size);
-    return msm_sat_grid_rect(r.lo, r.hi, size);
+  SoftRegion r = msm_soft_region(center, half_width, size);
+  return msm_sat_grid_rect(r.lo, r.hi, size);
 }
 
 // ---- Moments from the tables ----
@@ -113,39 +113,39 @@ MSM_FN SatRect msm_soft_search_rect(vec2 center, vec2 half_width, ivec2 size) {
 // 6 moments 8e-5 · 2^-6.4 = 9.5e-7, below float's 5e-6, whose own rounding then dominates: the
 // float bias MSM_REP6_FLOAT (soft_test checks it on single depths and flat receivers).
 MSM_FN vec4 msm_soft_moments4(vec4 q) {
-    return msm_apply_bias(msm_theta4_star_inverse(q), msm_moment_bias(MSM_REP_SAT_INT32));
+  return msm_apply_bias(msm_theta4_star_inverse(q), msm_moment_bias(MSM_REP_SAT_INT32));
 }
 MSM_FN Moments6 msm_soft_moments6(Moments6 q) {
-    return msm_apply_bias6(msm_theta6_star_inverse(q), msm_moment_bias6(MSM_REP6_FLOAT));
+  return msm_apply_bias6(msm_theta6_star_inverse(q), msm_moment_bias6(MSM_REP6_FLOAT));
 }
 
 // ---- Average blocker depth (blocker.h: JCGT Eq. (4), Kneiphof Eq. (19)) ----
 // q: the search region's average Θ4* / Θ6* moments; zf: the UNBIASED fragment depth ([-1,1]).
 MSM_FN BlockerResult msm_soft_blocker4(vec4 q, float zf) {
-    return msm_blocker4(msm_soft_moments4(q), zf, MSM_BLOCKER_EPSILON);
+  return msm_blocker4(msm_soft_moments4(q), zf, MSM_BLOCKER_EPSILON);
 }
 MSM_FN BlockerResult msm_soft_blocker6(Moments6 q, float zf) {
-    return msm_blocker6(msm_soft_moments6(q), zf, MSM_BLOCKER_EPSILON);
+  return msm_blocker6(msm_soft_moments6(q), zf, MSM_BLOCKER_EPSILON);
 }
 // Kneiphof Eq. (19) with the mass at zf clamped to [delta1, delta2] (0 < delta1 <= delta2):
 // between Eq. (4) with ε = delta1 and Eq. (4) with ε = delta2 on the same reconstruction, so never
 // farther from the receiver than Eq. (4) with ε = delta1 (harder shadows when in doubt).
 MSM_FN BlockerResult msm_soft_blocker6_upper(Moments6 q, float zf, float delta1, float delta2) {
-    return msm_blocker6_upper(msm_soft_moments6(q), zf, delta1, delta2);
+  return msm_blocker6_upper(msm_soft_moments6(q), zf, delta1, delta2);
 }
 MSM_FN BlockerResult msm_soft_blocker4_upper(vec4 q, float zf, float delta1, float delta2) {
-    return msm_blocker4_upper(msm_soft_moments4(q), zf, delta1, delta2);
+  return msm_blocker4_upper(msm_soft_moments4(q), zf, delta1, delta2);
 }
 
 // The estimator chosen by the technique's parameters (techniques.h: x = δ1, y = δ2, z = 1 for
 // Kneiphof Eq. (19), 0 for JCGT Eq. (4) with ε = δ1).
 MSM_FN BlockerResult msm_soft_blocker4_select(vec4 q, float zf, vec4 params) {
-    return params.z > 0.5f ? msm_soft_blocker4_upper(q, zf, params.x, params.y)
-                           : msm_blocker4(msm_soft_moments4(q), zf, params.x);
+  return params.z > 0.5f ? msm_soft_blocker4_upper(q, zf, params.x, params.y)
+                         : msm_blocker4(msm_soft_moments4(q), zf, params.x);
 }
 MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params) {
-    return params.z > 0.5f ? msm_soft_blocker6_upper(q, zf, params.x, params.y)
-                           : msm_blocker6(msm_soft_moments6(q), zf, params.x);
+  return params.z > 0.5f ? msm_soft_blocker6_upper(q, zf, params.x, params.y)
+                         : msm_blocker6(msm_soft_moments6(q), zf, params.x);
 }
 
 // ---- Naive variance soft shadow mapping (Yang et al. 2010, the baseline of JCGT §4) ----
@@ -156,15 +156,15 @@ MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params)
 // [-1,1] (as the moment estimators, for msm_soft_penumbra_half_width) and 1 - N as the shadow.
 // q: the region's average (z, z²); unit_zf: the unbiased fragment depth in [0,1].
 MSM_FN BlockerResult msm_soft_vssm_blocker(vec2 q, float unit_zf, float min_variance) {
-    // 1 - N is the VSM shadow intensity (baselines.h): 0 where zf <= μ.
-    float blocked = msm_vsm_shadow(q, unit_zf, min_variance);
-    if (blocked <= 0.0f) return BlockerResult(msm_signed_depth(unit_zf), 0.0f);
-    float blocker = clamp((q.x - (1.0f - blocked) * unit_zf) / blocked, 0.0f, unit_zf);
-    return BlockerResult(msm_signed_depth(blocker), blocked);
+  // 1 - N is the VSM shadow intensity (baselines.h): 0 where zf <= μ.
+  float blocked = msm_vsm_shadow(q, unit_zf, min_variance);
+  if (blocked <= 0.0f) return BlockerResult(msm_signed_depth(unit_zf), 0.0f);
+  float blocker = clamp((q.x - (1.0f - blocked) * unit_zf) / blocked, 0.0f, unit_zf);
+  return BlockerResult(msm_signed_depth(blocker), blocked);
 }
 // Chebyshev over the filter region, over-darkened like the moment techniques; zf_biased in [-1,1].
 MSM_FN float msm_soft_vssm_shadow(vec2 q, float zf_biased, float min_variance, float umbra_epsilon) {
-    return msm_overdarken(msm_vsm_shadow(q, msm_unit_depth(zf_biased), min_variance), 1.0f - umbra_epsilon);
+  return msm_overdarken(msm_vsm_shadow(q, msm_unit_depth(zf_biased), min_variance), 1.0f - umbra_epsilon);
 }
 
 // ---- Percentage-closer soft shadows [Fernando 2005], the depth-map baseline ----
@@ -174,18 +174,18 @@ MSM_FN float msm_soft_vssm_shadow(vec2 q, float zf_biased, float min_variance, f
 // overlap with the region (the box filter MSSM applies to moments, applied to test results).
 // Overlap of texel i ([i, i + 1)) with [lo, hi] along one axis.
 MSM_FN float msm_soft_texel_overlap(int i, float lo, float hi) {
-    return max(min(hi, float(i + 1)) - max(lo, float(i)), 0.0f);
+  return max(min(hi, float(i + 1)) - max(lo, float(i)), 0.0f);
 }
 // Average blocker depth from the sums over the search region: depth_sum and count of the
 // samples in front of the receiver, total samples. No blocker: the fragment depth, shadow 0.
 MSM_FN BlockerResult msm_soft_pcss_blocker(float depth_sum, float blockers, float samples, float zf) {
-    if (blockers <= 0.0f) return BlockerResult(zf, 0.0f);
-    return BlockerResult(depth_sum / blockers, blockers / samples);
+  if (blockers <= 0.0f) return BlockerResult(zf, 0.0f);
+  return BlockerResult(depth_sum / blockers, blockers / samples);
 }
 
 // Umbra early-out (JCGT §4.5): the search region's shadow intensity above 1 - ε_u.
 MSM_FN bool msm_soft_in_umbra(BlockerResult blocker, float umbra_epsilon) {
-    return blocker.shadow > 1.0f - umbra_epsilon;
+  return blocker.shadow > 1.0f - umbra_epsilon;
 }
 
 // ---- Depth bias growing with the filter size (JCGT §4.4, Fig. 11) ----
@@ -202,7 +202,8 @@ MSM_FN bool msm_soft_in_umbra(BlockerResult blocker, float umbra_epsilon) {
 // passing the receiver plane's own gradient makes it adaptive (Dou et al. 2014). The blocker
 // search keeps the unbiased depth (blocker.h).
 MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float constant_bias) {
-    return constant_bias + abs(depth_per_texel.x) * (half_width.x + 0.5f) + abs(depth_per_texel.y) * (half_width.y + 0.5f);
+  return constant_bias + abs(depth_per_texel.x) * (half_width.x + 0.5f) +
+         abs(depth_per_texel.y) * (half_width.y + 0.5f);
 }
 
 // ---- Shadow intensity from the filtered moments ----
@@ -210,10 +211,10 @@ MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float co
 // fragment depth minus msm_soft_depth_bias. Hamburger lower bound (JCGT App. D.4), over-darkened by
 // 1 / (1 - ε_u) to match the umbra early-out.
 MSM_FN float msm_soft_shadow4(vec4 q, float zf_biased, float umbra_epsilon) {
-    return msm_overdarken(msm_hamburger4_lower(msm_soft_moments4(q), zf_biased), 1.0f - umbra_epsilon);
+  return msm_overdarken(msm_hamburger4_lower(msm_soft_moments4(q), zf_biased), 1.0f - umbra_epsilon);
 }
 MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon) {
-    return msm_overdarken(msm_hamburger6_lower(msm_soft_moments6(q), zf_biased), 1.0f - umbra_epsilon);
+  return msm_overdarken(msm_hamburger6_lower(msm_soft_moments6(q), zf_biased), 1.0f - umbra_epsilon);
 }
 
 // The whole per-pixel flow, with S(x, y) a fetch from the table (0 where x or y is -1), size the

@@ -115,56 +115,56 @@ MSM_FN vec2 msm_trig_cdiv(vec2 a, vec2 b) { return msm_trig_cmul(a, msm_trig_con
 MSM_FN vec2 msm_trig_cis(float t) { return vec2(cos(t), sin(t)); }
 // Principal square root; the smaller component from the larger one (no cancellation in r ± x).
 MSM_FN vec2 msm_trig_csqrt(vec2 z) {
-    float t = sqrt(0.5f * (length(z) + abs(z.x)));
-    if (t == 0.0f) return vec2(0.0f);
-    float o = 0.5f * z.y / t;
-    return z.x >= 0.0f ? vec2(t, o) : vec2(abs(o), z.y < 0.0f ? -t : t);
+  float t = sqrt(0.5f * (length(z) + abs(z.x)));
+  if (t == 0.0f) return vec2(0.0f);
+  float o = 0.5f * z.y / t;
+  return z.x >= 0.0f ? vec2(t, o) : vec2(abs(o), z.y < 0.0f ? -t : t);
 }
 // clamp(x, 0, 1) that maps NaN (rounding noise of inputs outside the moment space) to 0.
 MSM_FN float msm_trig_clamp01(float x) { return x > 0.0f ? min(x, 1.0f) : 0.0f; }
 // Angle of z in [0, 2π).
 MSM_FN float msm_trig_arg(vec2 z) {
-    float a = atan(z.y, z.x);
-    return a < 0.0f ? a + MSM_TRIG_TWO_PI : a;
+  float a = atan(z.y, z.x);
+  return a < 0.0f ? a + MSM_TRIG_TWO_PI : a;
 }
 
 // --- double-float numbers vec2(hi, lo), value hi + lo (Knuth, Dekker) ---
 MSM_FN vec2 msm_trig_two_sum(float a, float b) {
-    MSM_TRIG_PRECISE float s = a + b;
-    MSM_TRIG_PRECISE float v = s - a;
-    MSM_TRIG_PRECISE float e = (a - (s - v)) + (b - v);
-    return vec2(s, e);
+  MSM_TRIG_PRECISE float s = a + b;
+  MSM_TRIG_PRECISE float v = s - a;
+  MSM_TRIG_PRECISE float e = (a - (s - v)) + (b - v);
+  return vec2(s, e);
 }
 MSM_FN vec2 msm_trig_quick_two_sum(float a, float b) { // |a| >= |b|
-    MSM_TRIG_PRECISE float s = a + b;
-    MSM_TRIG_PRECISE float e = b - (s - a);
-    return vec2(s, e);
+  MSM_TRIG_PRECISE float s = a + b;
+  MSM_TRIG_PRECISE float e = b - (s - a);
+  return vec2(s, e);
 }
 MSM_FN vec2 msm_trig_split(float a) {
-    MSM_TRIG_PRECISE float c = 4097.0f * a;
-    MSM_TRIG_PRECISE float hi = c - (c - a);
-    MSM_TRIG_PRECISE float lo = a - hi;
-    return vec2(hi, lo);
+  MSM_TRIG_PRECISE float c = 4097.0f * a;
+  MSM_TRIG_PRECISE float hi = c - (c - a);
+  MSM_TRIG_PRECISE float lo = a - hi;
+  return vec2(hi, lo);
 }
 MSM_FN vec2 msm_trig_two_prod(float a, float b) {
-    vec2 sa = msm_trig_split(a), sb = msm_trig_split(b);
-    MSM_TRIG_PRECISE float p = a * b;
-    MSM_TRIG_PRECISE float e = ((sa.x * sb.x - p) + sa.x * sb.y + sa.y * sb.x) + sa.y * sb.y;
-    return vec2(p, e);
+  vec2 sa = msm_trig_split(a), sb = msm_trig_split(b);
+  MSM_TRIG_PRECISE float p = a * b;
+  MSM_TRIG_PRECISE float e = ((sa.x * sb.x - p) + sa.x * sb.y + sa.y * sb.x) + sa.y * sb.y;
+  return vec2(p, e);
 }
 MSM_FN vec2 msm_trig_df_add(vec2 a, vec2 b) {
-    vec2 s = msm_trig_two_sum(a.x, b.x);
-    MSM_TRIG_PRECISE float lo = s.y + (a.y + b.y);
-    return msm_trig_quick_two_sum(s.x, lo);
+  vec2 s = msm_trig_two_sum(a.x, b.x);
+  MSM_TRIG_PRECISE float lo = s.y + (a.y + b.y);
+  return msm_trig_quick_two_sum(s.x, lo);
 }
 MSM_FN vec2 msm_trig_df_mul(vec2 a, vec2 b) {
-    vec2 p = msm_trig_two_prod(a.x, b.x);
-    MSM_TRIG_PRECISE float lo = p.y + (a.x * b.y + a.y * b.x);
-    return msm_trig_quick_two_sum(p.x, lo);
+  vec2 p = msm_trig_two_prod(a.x, b.x);
+  MSM_TRIG_PRECISE float lo = p.y + (a.x * b.y + a.y * b.x);
+  return msm_trig_quick_two_sum(p.x, lo);
 }
 // a + b c + d e for floats, in double-float.
 MSM_FN vec2 msm_trig_df_sum_prod2(float a, float b, float c, float d, float e) {
-    return msm_trig_df_add(msm_trig_df_add(vec2(a, 0.0f), msm_trig_two_prod(b, c)), msm_trig_two_prod(d, e));
+  return msm_trig_df_add(msm_trig_df_add(vec2(a, 0.0f), msm_trig_two_prod(b, c)), msm_trig_two_prod(d, e));
 }
 
 // T = L D Lᴴ for T = [[1, c1, c2], [c̄1, 1, c1], [c̄2, c̄1, 1]]: L unit lower triangular with
@@ -173,64 +173,64 @@ MSM_FN vec2 msm_trig_df_sum_prod2(float a, float b, float c, float d, float e) {
 // det T = d1 d2 are evaluated in double-float (~44 bits) from the float moments, which makes the
 // factorization as accurate as the moments themselves (in plain float it dominated the error).
 struct TrigLdl {
-    vec2 c1;
-    vec2 c2;
-    vec2 l21;
-    float d1;
-    float d2;
+  vec2 c1;
+  vec2 c2;
+  vec2 l21;
+  float d1;
+  float d2;
 };
 
 MSM_FN TrigLdl msm_trig_ldl(vec4 b) {
-    float x1 = b[1], y1 = b[0], x2 = b[3], y2 = b[2];
-    vec2 d1 = msm_trig_df_sum_prod2(1.0f, -x1, x1, -y1, y1);         // 1 - |c1|²
-    vec2 nr = msm_trig_df_sum_prod2(x1, -x2, x1, -y2, y1);           // Re(c̄1 - c̄2 c1)
-    vec2 ni = msm_trig_df_sum_prod2(-y1, -x2, y1, y2, x1);           // Im(c̄1 - c̄2 c1)
-    vec2 a = msm_trig_df_sum_prod2(1.0f, -x2, x2, -y2, y2);          // 1 - |c2|²
-    vec2 n2 = msm_trig_df_add(msm_trig_df_mul(nr, nr), msm_trig_df_mul(ni, ni));
-    vec2 det = msm_trig_df_add(msm_trig_df_mul(a, d1), -n2);          // (1 - |c2|²) d1 - |n|²
-    // Pivots >= the smallest eigenvalue of T (>= α for biased moments); the floor only keeps
-    // unbiased boundary moments (a missing bias) from dividing by zero.
-    float pivot1 = max(d1.x + d1.y, MSM_TRIG_MIN_PIVOT);
-    float pivot2 = max((det.x + det.y) / pivot1, MSM_TRIG_MIN_PIVOT);
-    return TrigLdl(vec2(x1, y1), vec2(x2, y2), vec2(nr.x + nr.y, ni.x + ni.y) / pivot1, pivot1, pivot2);
+  float x1 = b[1], y1 = b[0], x2 = b[3], y2 = b[2];
+  vec2 d1 = msm_trig_df_sum_prod2(1.0f, -x1, x1, -y1, y1); // 1 - |c1|²
+  vec2 nr = msm_trig_df_sum_prod2(x1, -x2, x1, -y2, y1);   // Re(c̄1 - c̄2 c1)
+  vec2 ni = msm_trig_df_sum_prod2(-y1, -x2, y1, y2, x1);   // Im(c̄1 - c̄2 c1)
+  vec2 a = msm_trig_df_sum_prod2(1.0f, -x2, x2, -y2, y2);  // 1 - |c2|²
+  vec2 n2 = msm_trig_df_add(msm_trig_df_mul(nr, nr), msm_trig_df_mul(ni, ni));
+  vec2 det = msm_trig_df_add(msm_trig_df_mul(a, d1), -n2); // (1 - |c2|²) d1 - |n|²
+  // Pivots >= the smallest eigenvalue of T (>= α for biased moments); the floor only keeps
+  // unbiased boundary moments (a missing bias) from dividing by zero.
+  float pivot1 = max(d1.x + d1.y, MSM_TRIG_MIN_PIVOT);
+  float pivot2 = max((det.x + det.y) / pivot1, MSM_TRIG_MIN_PIVOT);
+  return TrigLdl(vec2(x1, y1), vec2(x2, y2), vec2(nr.x + nr.y, ni.x + ni.y) / pivot1, pivot1, pivot2);
 }
 
 // L⁻¹ r for r = (1, w̄, w̄²), |w| = 1: returns y1 and y2 (y0 = 1).
 struct TrigForward {
-    vec2 y1;
-    vec2 y2;
+  vec2 y1;
+  vec2 y2;
 };
 
 MSM_FN TrigForward msm_trig_forward(TrigLdl f, vec2 w) {
-    vec2 y1 = msm_trig_conj(w) - msm_trig_conj(f.c1);
-    // w̄² - c̄2 cancels down to ~|w - atom| for w near a nearly Dirac atom: double-float.
-    vec2 re = msm_trig_df_sum_prod2(-f.c2.x, w.x, w.x, -w.y, w.y);
-    vec2 im = msm_trig_df_sum_prod2(f.c2.y, -2.0f * w.x, w.y, 0.0f, 0.0f);
-    vec2 y2 = vec2(re.x + re.y, im.x + im.y) - msm_trig_cmul(f.l21, y1);
-    return TrigForward(y1, y2);
+  vec2 y1 = msm_trig_conj(w) - msm_trig_conj(f.c1);
+  // w̄² - c̄2 cancels down to ~|w - atom| for w near a nearly Dirac atom: double-float.
+  vec2 re = msm_trig_df_sum_prod2(-f.c2.x, w.x, w.x, -w.y, w.y);
+  vec2 im = msm_trig_df_sum_prod2(f.c2.y, -2.0f * w.x, w.y, 0.0f, 0.0f);
+  vec2 y2 = vec2(re.x + re.y, im.x + im.y) - msm_trig_cmul(f.l21, y1);
+  return TrigForward(y1, y2);
 }
 
 // Christoffel function ρ(w) = 1 / (rᴴ T⁻¹ r): the largest mass any representation puts at w.
 MSM_FN float msm_trig_christoffel(TrigLdl f, vec2 w) {
-    TrigForward y = msm_trig_forward(f, w);
-    return 1.0f / (1.0f + dot(y.y1, y.y1) / f.d1 + dot(y.y2, y.y2) / f.d2);
+  TrigForward y = msm_trig_forward(f, w);
+  return 1.0f / (1.0f + dot(y.y1, y.y1) / f.d1 + dot(y.y2, y.y2) / f.d2);
 }
 
 // The two atoms other than ξ of the canonical representation through ξ: the roots of
 // h2 w² + h1 w + h0 with h = T⁻¹ (1, ξ̄, ξ̄²), as angles in [0, 2π) measured from the point o.
 MSM_FN vec2 msm_trig_canonical_atoms(TrigLdl f, vec2 xi, vec2 o) {
-    TrigForward y = msm_trig_forward(f, xi);
-    vec2 h2 = y.y2 / f.d2;
-    vec2 h1 = y.y1 / f.d1 - msm_trig_cmul(msm_trig_conj(f.l21), h2);
-    vec2 h0 = vec2(1.0f, 0.0f) - msm_trig_cmul(f.c1, h1) - msm_trig_cmul(f.c2, h2);
-    // Stable quadratic formula: q = -(h1 + sgn sqrt(disc)) / 2, roots q / h2 and h0 / q; only
-    // the arguments are needed (the roots lie on the unit circle).
-    vec2 sq = msm_trig_csqrt(msm_trig_cmul(h1, h1) - 4.0f * msm_trig_cmul(h2, h0));
-    if (dot(h1, sq) < 0.0f) sq = -sq;
-    vec2 q = -0.5f * (h1 + sq);
-    vec2 oc = msm_trig_conj(o);
-    return vec2(msm_trig_arg(msm_trig_cmul(msm_trig_cmul(q, msm_trig_conj(h2)), oc)),
-                msm_trig_arg(msm_trig_cmul(msm_trig_cmul(h0, msm_trig_conj(q)), oc)));
+  TrigForward y = msm_trig_forward(f, xi);
+  vec2 h2 = y.y2 / f.d2;
+  vec2 h1 = y.y1 / f.d1 - msm_trig_cmul(msm_trig_conj(f.l21), h2);
+  vec2 h0 = vec2(1.0f, 0.0f) - msm_trig_cmul(f.c1, h1) - msm_trig_cmul(f.c2, h2);
+  // Stable quadratic formula: q = -(h1 + sgn sqrt(disc)) / 2, roots q / h2 and h0 / q; only
+  // the arguments are needed (the roots lie on the unit circle).
+  vec2 sq = msm_trig_csqrt(msm_trig_cmul(h1, h1) - 4.0f * msm_trig_cmul(h2, h0));
+  if (dot(h1, sq) < 0.0f) sq = -sq;
+  vec2 q = -0.5f * (h1 + sq);
+  vec2 oc = msm_trig_conj(o);
+  return vec2(msm_trig_arg(msm_trig_cmul(msm_trig_cmul(q, msm_trig_conj(h2)), oc)),
+              msm_trig_arg(msm_trig_cmul(msm_trig_cmul(h0, msm_trig_conj(q)), oc)));
 }
 
 // Weight of atom a in the 3-atom representation {a, p, q} (a canonical representation):
@@ -238,153 +238,156 @@ MSM_FN vec2 msm_trig_canonical_atoms(TrigLdl f, vec2 xi, vec2 o) {
 // Christoffel function, which peaks sharply (width ~sqrt(α)) at nearly Dirac atoms, this is
 // insensitive to the rounding error of the atom positions.
 MSM_FN float msm_trig_canonical_weight(vec2 c1, vec2 a, vec2 p, vec2 q) {
-    vec2 num = c1 - (p + q) + msm_trig_cmul(msm_trig_cmul(p, q), msm_trig_conj(c1));
-    return msm_trig_cdiv(msm_trig_cmul(num, a), msm_trig_cmul(a - p, a - q)).x;
+  vec2 num = c1 - (p + q) + msm_trig_cmul(msm_trig_cmul(p, q), msm_trig_conj(c1));
+  return msm_trig_cdiv(msm_trig_cmul(num, a), msm_trig_cmul(a - p, a - q)).x;
 }
 
 // m_j = E(w^{j-2} (w - e0)(w - e1)), j = 0, 1, 2, for the arc ends e0, e1; S = e0 + e1, P = e0 e1.
 struct TrigArcMoments {
-    vec2 m0;
-    vec2 m1;
-    vec2 m2;
+  vec2 m0;
+  vec2 m1;
+  vec2 m2;
 };
 
 MSM_FN TrigArcMoments msm_trig_arc_moments(vec2 c1, vec2 c2, vec2 e0, vec2 e1) {
-    vec2 S = e0 + e1, P = msm_trig_cmul(e0, e1);
-    vec2 c1c = msm_trig_conj(c1);
-    vec2 m0 = vec2(1.0f, 0.0f) - msm_trig_cmul(S, c1c) + msm_trig_cmul(P, msm_trig_conj(c2));
-    vec2 m1 = c1 - S + msm_trig_cmul(P, c1c);
-    vec2 m2 = c2 - msm_trig_cmul(S, c1) + P;
-    return TrigArcMoments(m0, m1, m2);
+  vec2 S = e0 + e1, P = msm_trig_cmul(e0, e1);
+  vec2 c1c = msm_trig_conj(c1);
+  vec2 m0 = vec2(1.0f, 0.0f) - msm_trig_cmul(S, c1c) + msm_trig_cmul(P, msm_trig_conj(c2));
+  vec2 m1 = c1 - S + msm_trig_cmul(P, c1c);
+  vec2 m2 = c2 - msm_trig_cmul(S, c1) + P;
+  return TrigArcMoments(m0, m1, m2);
 }
 
 // The fourth atom v of the representation with atoms e0, e1, u: v = (u m1 - m2) / (u m0 - m1).
 MSM_FN vec2 msm_trig_fourth_atom(TrigArcMoments m, vec2 u) {
-    vec2 v = msm_trig_cdiv(msm_trig_cmul(u, m.m1) - m.m2, msm_trig_cmul(u, m.m0) - m.m1);
-    return v / length(v);
+  vec2 v = msm_trig_cdiv(msm_trig_cmul(u, m.m1) - m.m2, msm_trig_cmul(u, m.m0) - m.m1);
+  return v / length(v);
 }
 
 // Weight of atom a in the representation with atoms {a, p, q, r}: E(w⁻¹ Q(w)) a / Q(a) with
 // Q(w) = (w - p)(w - q)(w - r) (Lagrange interpolation in the span of w^-1..w^2).
 MSM_FN float msm_trig_atom_weight(vec2 c1, vec2 c2, vec2 a, vec2 p, vec2 q, vec2 r) {
-    vec2 pq = msm_trig_cmul(p, q);
-    vec2 e1 = p + q + r;
-    vec2 e2 = pq + msm_trig_cmul(p + q, r);
-    vec2 e3 = msm_trig_cmul(pq, r);
-    // E(w⁻¹ (w³ - e1 w² + e2 w - e3)) = c2 - e1 c1 + e2 - e3 c̄1
-    vec2 num = c2 - msm_trig_cmul(e1, c1) + e2 - msm_trig_cmul(e3, msm_trig_conj(c1));
-    vec2 den = msm_trig_cmul(msm_trig_cmul(a - p, a - q), a - r);
-    return msm_trig_cdiv(msm_trig_cmul(num, a), den).x;
+  vec2 pq = msm_trig_cmul(p, q);
+  vec2 e1 = p + q + r;
+  vec2 e2 = pq + msm_trig_cmul(p + q, r);
+  vec2 e3 = msm_trig_cmul(pq, r);
+  // E(w⁻¹ (w³ - e1 w² + e2 w - e3)) = c2 - e1 c1 + e2 - e3 c̄1
+  vec2 num = c2 - msm_trig_cmul(e1, c1) + e2 - msm_trig_cmul(e3, msm_trig_conj(c1));
+  vec2 den = msm_trig_cmul(msm_trig_cmul(a - p, a - q), a - r);
+  return msm_trig_cdiv(msm_trig_cmul(num, a), den).x;
 }
 
 // The stationarity function g (the sign of f') and its derivative in x, u = e^{ix} on the circle.
 MSM_FN vec2 msm_trig_stationarity(TrigArcMoments m, vec2 e0, vec2 e1, vec2 u, bool two_in_arc) {
-    if (!two_in_arc) {
-        // g_A = Im(P̄ (2 m0 u² - (2 m1 + S m0) u)) = Im(A u² + B u)
-        vec2 Pc = msm_trig_conj(msm_trig_cmul(e0, e1));
-        vec2 A = 2.0f * msm_trig_cmul(Pc, m.m0);
-        vec2 B = -msm_trig_cmul(Pc, 2.0f * m.m1 + msm_trig_cmul(e0 + e1, m.m0));
-        vec2 Au2 = msm_trig_cmul(A, msm_trig_cmul(u, u));
-        vec2 Bu = msm_trig_cmul(B, u);
-        return vec2(Au2.y + Bu.y, 2.0f * Au2.x + Bu.x);
-    }
-    // g_B = |e0-u|² |L1|² - |e1-u|² |L2|² with L1, L2 = L_0, L_1 of the top comment
-    vec2 a1 = msm_trig_cmul(e0, m.m0) - m.m1, b1 = m.m2 - msm_trig_cmul(e0, m.m1);
-    vec2 a2 = msm_trig_cmul(e1, m.m0) - m.m1, b2 = m.m2 - msm_trig_cmul(e1, m.m1);
-    vec2 a1u = msm_trig_cmul(a1, u), a2u = msm_trig_cmul(a2, u);
-    vec2 L1 = a1u + b1, L2 = a2u + b2;
-    vec2 r0 = msm_trig_cmul(u, msm_trig_conj(e0)), r1 = msm_trig_cmul(u, msm_trig_conj(e1));
-    float n1 = 2.0f - 2.0f * r0.x, n2 = 2.0f - 2.0f * r1.x; // |e_k - u|²
-    float dn1 = 2.0f * r0.y, dn2 = 2.0f * r1.y;             // their derivatives in x
-    float dL1 = -2.0f * msm_trig_cmul(msm_trig_conj(L1), a1u).y; // d/dx |L1|²
-    float dL2 = -2.0f * msm_trig_cmul(msm_trig_conj(L2), a2u).y;
-    float q1 = dot(L1, L1), q2 = dot(L2, L2);
-    return vec2(n1 * q1 - n2 * q2, dn1 * q1 + n1 * dL1 - dn2 * q2 - n2 * dL2);
+  if (!two_in_arc) {
+    // g_A = Im(P̄ (2 m0 u² - (2 m1 + S m0) u)) = Im(A u² + B u)
+    vec2 Pc = msm_trig_conj(msm_trig_cmul(e0, e1));
+    vec2 A = 2.0f * msm_trig_cmul(Pc, m.m0);
+    vec2 B = -msm_trig_cmul(Pc, 2.0f * m.m1 + msm_trig_cmul(e0 + e1, m.m0));
+    vec2 Au2 = msm_trig_cmul(A, msm_trig_cmul(u, u));
+    vec2 Bu = msm_trig_cmul(B, u);
+    return vec2(Au2.y + Bu.y, 2.0f * Au2.x + Bu.x);
+  }
+  // g_B = |e0-u|² |L1|² - |e1-u|² |L2|² with L1, L2 = L_0, L_1 of the top comment
+  vec2 a1 = msm_trig_cmul(e0, m.m0) - m.m1, b1 = m.m2 - msm_trig_cmul(e0, m.m1);
+  vec2 a2 = msm_trig_cmul(e1, m.m0) - m.m1, b2 = m.m2 - msm_trig_cmul(e1, m.m1);
+  vec2 a1u = msm_trig_cmul(a1, u), a2u = msm_trig_cmul(a2, u);
+  vec2 L1 = a1u + b1, L2 = a2u + b2;
+  vec2 r0 = msm_trig_cmul(u, msm_trig_conj(e0)), r1 = msm_trig_cmul(u, msm_trig_conj(e1));
+  float n1 = 2.0f - 2.0f * r0.x, n2 = 2.0f - 2.0f * r1.x;      // |e_k - u|²
+  float dn1 = 2.0f * r0.y, dn2 = 2.0f * r1.y;                  // their derivatives in x
+  float dL1 = -2.0f * msm_trig_cmul(msm_trig_conj(L1), a1u).y; // d/dx |L1|²
+  float dL2 = -2.0f * msm_trig_cmul(msm_trig_conj(L2), a2u).y;
+  float q1 = dot(L1, L1), q2 = dot(L2, L2);
+  return vec2(n1 * q1 - n2 * q2, dn1 * q1 + n1 * dL1 - dn2 * q2 - n2 * dL2);
 }
 
 // inf μ(open arc from e0 counterclockwise to e1) over the measures with the factorized moments,
 // for the arc length L = arg(e1 / e0) in (0, 2π] (L = 2π: the circle without e0).
 MSM_FN float msm_trig_lower_arc(TrigLdl f, vec2 e0, vec2 e1, float L) {
-    if (L >= MSM_TRIG_TWO_PI) return msm_trig_clamp01(1.0f - msm_trig_christoffel(f, e0));
-    vec2 tp = msm_trig_canonical_atoms(f, e1, e0); // σ_end, angles from e0
-    vec2 t0 = msm_trig_canonical_atoms(f, e0, e0); // σ_start
-    bool p1 = tp.x > 0.0f && tp.x < L, p2 = tp.y > 0.0f && tp.y < L;
-    bool z1 = t0.x > 0.0f && t0.x < L, z2 = t0.y > 0.0f && t0.y < L;
-    if (!(p1 || p2) || !(z1 || z2)) return 0.0f; // σ_end or σ_start has no mass in the arc
-    bool two = p1 && p2, two0 = z1 && z2;
-    // t and s: the first arc atoms of σ_end and σ_start, the ends of the bracket (t <= s in
-    // exact arithmetic; paired by rank, not by comparing angles, which rounding may swap).
-    float t = p1 ? (p2 ? min(tp.x, tp.y) : tp.x) : tp.y;
-    float s = z1 ? (z2 ? min(t0.x, t0.y) : t0.x) : t0.y;
-    // Weight in the arc of σ_end and σ_start (one atom in it: its weight; two: 1 - the weight
-    // at the arc end).
-    vec2 a1 = msm_trig_cmul(e0, msm_trig_cis(tp.x)), a2 = msm_trig_cmul(e0, msm_trig_cis(tp.y));
-    vec2 b1 = msm_trig_cmul(e0, msm_trig_cis(t0.x)), b2 = msm_trig_cmul(e0, msm_trig_cis(t0.y));
-    float g_end = two ? 1.0f - msm_trig_canonical_weight(f.c1, e1, a1, a2)
-                      : msm_trig_canonical_weight(f.c1, p1 ? a1 : a2, p1 ? a2 : a1, e1);
-    float g_start = two0 ? 1.0f - msm_trig_canonical_weight(f.c1, e0, b1, b2)
-                         : msm_trig_canonical_weight(f.c1, z1 ? b1 : b2, z1 ? b2 : b1, e0);
-    // Both are representations, so both are >= G; the smaller one is the answer when the
-    // minimum of f lies at an end of the bracket, and the fallback for a degenerate bracket
-    // (t = s up to the rounding of the atoms) or atom counts that differ (rounding at an arc end).
-    float best = min(g_end, g_start);
-    if (two != two0 || !(s > t + MSM_TRIG_MIN_BRACKET)) return msm_trig_clamp01(best);
-    // g has the sign of f'. Scan for its first change from - to + (the minimum of f), which is
-    // more robust than the signs at the ends alone: g vanishes at an end where an atom meets
-    // another one (a nearly Dirac distribution), and rounding may flip its sign there.
-    TrigArcMoments m = msm_trig_arc_moments(f.c1, f.c2, e0, e1);
-    float lo = t, hi = t, glo = 0.0f, ghi = 0.0f;
-    vec2 u_k = msm_trig_cmul(e0, msm_trig_cis(t));
-    vec2 rotation = msm_trig_cis((s - t) / float(MSM_TRIG_SCAN));
-    float x_prev = t, g_prev = msm_trig_stationarity(m, e0, e1, u_k, two).x;
-    bool found = false;
-    for (int k = 1; k <= MSM_TRIG_SCAN; ++k) {
-        u_k = msm_trig_cmul(u_k, rotation);
-        float x = k == MSM_TRIG_SCAN ? s : t + (s - t) * (float(k) / float(MSM_TRIG_SCAN));
-        float g = msm_trig_stationarity(m, e0, e1, u_k, two).x;
-        if (g_prev < 0.0f && g > 0.0f) {
-            lo = x_prev, hi = x, glo = g_prev, ghi = g;
-            found = true;
-            break;
-        }
-        x_prev = x, g_prev = g;
+  if (L >= MSM_TRIG_TWO_PI) return msm_trig_clamp01(1.0f - msm_trig_christoffel(f, e0));
+  vec2 tp = msm_trig_canonical_atoms(f, e1, e0); // σ_end, angles from e0
+  vec2 t0 = msm_trig_canonical_atoms(f, e0, e0); // σ_start
+  bool p1 = tp.x > 0.0f && tp.x<L, p2 = tp.y> 0.0f && tp.y < L;
+  bool z1 = t0.x > 0.0f && t0.x<L, z2 = t0.y> 0.0f && t0.y < L;
+  if (!(p1 || p2) || !(z1 || z2)) return 0.0f; // σ_end or σ_start has no mass in the arc
+  bool two = p1 && p2, two0 = z1 && z2;
+  // t and s: the first arc atoms of σ_end and σ_start, the ends of the bracket (t <= s in
+  // exact arithmetic; paired by rank, not by comparing angles, which rounding may swap).
+  float t = p1 ? (p2 ? min(tp.x, tp.y) : tp.x) : tp.y;
+  float s = z1 ? (z2 ? min(t0.x, t0.y) : t0.x) : t0.y;
+  // Weight in the arc of σ_end and σ_start (one atom in it: its weight; two: 1 - the weight
+  // at the arc end).
+  vec2 a1 = msm_trig_cmul(e0, msm_trig_cis(tp.x)), a2 = msm_trig_cmul(e0, msm_trig_cis(tp.y));
+  vec2 b1 = msm_trig_cmul(e0, msm_trig_cis(t0.x)), b2 = msm_trig_cmul(e0, msm_trig_cis(t0.y));
+  float g_end = two ? 1.0f - msm_trig_canonical_weight(f.c1, e1, a1, a2)
+                    : msm_trig_canonical_weight(f.c1, p1 ? a1 : a2, p1 ? a2 : a1, e1);
+  float g_start = two0 ? 1.0f - msm_trig_canonical_weight(f.c1, e0, b1, b2)
+                       : msm_trig_canonical_weight(f.c1, z1 ? b1 : b2, z1 ? b2 : b1, e0);
+  // Both are representations, so both are >= G; the smaller one is the answer when the
+  // minimum of f lies at an end of the bracket, and the fallback for a degenerate bracket
+  // (t = s up to the rounding of the atoms) or atom counts that differ (rounding at an arc end).
+  float best = min(g_end, g_start);
+  if (two != two0 || !(s > t + MSM_TRIG_MIN_BRACKET)) return msm_trig_clamp01(best);
+  // g has the sign of f'. Scan for its first change from - to + (the minimum of f), which is
+  // more robust than the signs at the ends alone: g vanishes at an end where an atom meets
+  // another one (a nearly Dirac distribution), and rounding may flip its sign there.
+  TrigArcMoments m = msm_trig_arc_moments(f.c1, f.c2, e0, e1);
+  float lo = t, hi = t, glo = 0.0f, ghi = 0.0f;
+  vec2 u_k = msm_trig_cmul(e0, msm_trig_cis(t));
+  vec2 rotation = msm_trig_cis((s - t) / float(MSM_TRIG_SCAN));
+  float x_prev = t, g_prev = msm_trig_stationarity(m, e0, e1, u_k, two).x;
+  bool found = false;
+  for (int k = 1; k <= MSM_TRIG_SCAN; ++k) {
+    u_k = msm_trig_cmul(u_k, rotation);
+    float x = k == MSM_TRIG_SCAN ? s : t + (s - t) * (float(k) / float(MSM_TRIG_SCAN));
+    float g = msm_trig_stationarity(m, e0, e1, u_k, two).x;
+    if (g_prev < 0.0f && g > 0.0f) {
+      lo = x_prev, hi = x, glo = g_prev, ghi = g;
+      found = true;
+      break;
     }
-    if (!found) return msm_trig_clamp01(best);
-    // Safeguarded Newton on g in [lo, hi], g(lo) < 0 < g(hi), from the regula falsi point:
-    // Newton steps where they stay inside the bracket, bisection otherwise (g need not be
-    // monotone in the bracket). Ends when a step is below 2e-6 rad: the error of f is second
-    // order in the error of x at the minimum.
-    float x = lo - glo * (hi - lo) / (ghi - glo);
-    for (int i = 0; i < MSM_TRIG_ITERATIONS; ++i) {
-        vec2 g = msm_trig_stationarity(m, e0, e1, msm_trig_cmul(e0, msm_trig_cis(x)), two);
-        if (g.x < 0.0f) lo = x; else hi = x;
-        float next = x - g.x / g.y;
-        if (!(next > lo && next < hi)) next = 0.5f * (lo + hi);
-        float step = abs(next - x);
-        x = next;
-        if (step <= 2.0e-6f) break;
-    }
-    vec2 u = msm_trig_cmul(e0, msm_trig_cis(x));
-    vec2 v = msm_trig_fourth_atom(m, u);
-    float shadow = msm_trig_atom_weight(f.c1, f.c2, u, e0, e1, v);
-    if (two) shadow += msm_trig_atom_weight(f.c1, f.c2, v, e0, e1, u);
-    return msm_trig_clamp01(min(best, shadow));
+    x_prev = x, g_prev = g;
+  }
+  if (!found) return msm_trig_clamp01(best);
+  // Safeguarded Newton on g in [lo, hi], g(lo) < 0 < g(hi), from the regula falsi point:
+  // Newton steps where they stay inside the bracket, bisection otherwise (g need not be
+  // monotone in the bracket). Ends when a step is below 2e-6 rad: the error of f is second
+  // order in the error of x at the minimum.
+  float x = lo - glo * (hi - lo) / (ghi - glo);
+  for (int i = 0; i < MSM_TRIG_ITERATIONS; ++i) {
+    vec2 g = msm_trig_stationarity(m, e0, e1, msm_trig_cmul(e0, msm_trig_cis(x)), two);
+    if (g.x < 0.0f)
+      lo = x;
+    else
+      hi = x;
+    float next = x - g.x / g.y;
+    if (!(next > lo && next < hi)) next = 0.5f * (lo + hi);
+    float step = abs(next - x);
+    x = next;
+    if (step <= 2.0e-6f) break;
+  }
+  vec2 u = msm_trig_cmul(e0, msm_trig_cis(x));
+  vec2 v = msm_trig_fourth_atom(m, u);
+  float shadow = msm_trig_atom_weight(f.c1, f.c2, u, e0, e1, v);
+  if (two) shadow += msm_trig_atom_weight(f.c1, f.c2, v, e0, e1, u);
+  return msm_trig_clamp01(min(best, shadow));
 }
 
 // Sharp lower bound of Z(z < zf): inf μ(open arc (0, 2π zf)).
 MSM_FN float msm_trig_lower_from_ldl(TrigLdl f, float zf) {
-    if (zf <= 0.0f) return 0.0f;
-    if (zf > 1.0f) return 1.0f;
-    float phi = MSM_TRIG_TWO_PI * zf;
-    return msm_trig_lower_arc(f, vec2(1.0f, 0.0f), msm_trig_cis(phi), phi);
+  if (zf <= 0.0f) return 0.0f;
+  if (zf > 1.0f) return 1.0f;
+  float phi = MSM_TRIG_TWO_PI * zf;
+  return msm_trig_lower_arc(f, vec2(1.0f, 0.0f), msm_trig_cis(phi), phi);
 }
 
 // Sharp upper bound of Z(z <= zf) = 1 - inf μ(open arc (2π zf, 2π)).
 MSM_FN float msm_trig_upper_from_ldl(TrigLdl f, float zf) {
-    if (zf < 0.0f) return 0.0f;
-    if (zf >= 1.0f) return 1.0f;
-    float phi = MSM_TRIG_TWO_PI * zf;
-    return msm_trig_clamp01(1.0f - msm_trig_lower_arc(f, msm_trig_cis(phi), vec2(1.0f, 0.0f), MSM_TRIG_TWO_PI - phi));
+  if (zf < 0.0f) return 0.0f;
+  if (zf >= 1.0f) return 1.0f;
+  float phi = MSM_TRIG_TWO_PI * zf;
+  return msm_trig_clamp01(1.0f - msm_trig_lower_arc(f, msm_trig_cis(phi), vec2(1.0f, 0.0f), MSM_TRIG_TWO_PI - phi));
 }
 
 // Sharp lower bound of Z(z < zf) for biased trigonometric moments b (see top of file).
@@ -395,8 +398,8 @@ MSM_FN float msm_trig_upper(vec4 b, float zf) { return msm_trig_upper_from_ldl(m
 
 // Both bounds with one factorization: (lower of Z(z < zf), upper of Z(z <= zf)).
 MSM_FN vec2 msm_trig_bounds(vec4 b, float zf) {
-    TrigLdl f = msm_trig_ldl(b);
-    return vec2(msm_trig_lower_from_ldl(f, zf), msm_trig_upper_from_ldl(f, zf));
+  TrigLdl f = msm_trig_ldl(b);
+  return vec2(msm_trig_lower_from_ldl(f, zf), msm_trig_upper_from_ldl(f, zf));
 }
 
 MSM_END

@@ -22,9 +22,9 @@ std::vector<double> as_double_moments(vec4 b) { return {1.0, b[0], b[1], b[2], b
 
 // A random fragment depth: anywhere, or close to one of the depths (where bounds change fastest).
 float random_fragment_depth(std::mt19937_64& rng, const test::Distribution& d, float lo, float hi) {
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    if (unit(rng) < 0.5f) return lo - 0.1f * (hi - lo) + 1.2f * (hi - lo) * unit(rng);
-    return float(d.z[size_t(unit(rng) * d.z.size()) % d.z.size()]) + (unit(rng) - 0.5f) * 0.02f * (hi - lo);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  if (unit(rng) < 0.5f) return lo - 0.1f * (hi - lo) + 1.2f * (hi - lo) * unit(rng);
+  return float(d.z[size_t(unit(rng) * d.z.size()) % d.z.size()]) + (unit(rng) - 0.5f) * 0.02f * (hi - lo);
 }
 
 // Agreement with JCGT Algorithm 1 on the same (float, biased) moment vector: what remains is the
@@ -33,31 +33,31 @@ float random_fragment_depth(std::mt19937_64& rng, const test::Distribution& d, f
 // single precision; the pivots use fused multiply-adds, which cut this error 100-fold.
 // Measured: p99 1.6e-5 ([-1,1]) and 4.4e-5 ([0,1]), max 8e-3 and 3.9e-2. Bounds: p99 2e-4, max 0.05.
 void check_against_moment_oracle(bool signed_depth, int representation) {
-    std::mt19937_64 rng(signed_depth ? 1 : 2);
-    float lo = signed_depth ? -1.0f : 0.0f, hi = 1.0f;
-    MomentBias4 bias = msm_moment_bias(representation);
-    ErrorStats lower_err, upper_err;
-    int checked = 0;
-    for (int i = 0; i < 20000; ++i) {
-        test::Distribution d = test::random_distribution(rng, lo, hi);
-        vec4 b = msm_apply_bias(test::moments4f(d), bias);
-        float zf = random_fragment_depth(rng, d, lo, hi);
-        oracle::MomentBounds ref = oracle::moment_bounds(as_double_moments(b), zf);
-        if (!ref.ok) continue; // the float rounding left the moment space; the bias is for that
-        vec2 bounds = msm_hamburger4_bounds(b, zf);
-        ASSERT_TRUE(std::isfinite(bounds.x) && std::isfinite(bounds.y));
-        lower_err.add(bounds.x - ref.lower);
-        upper_err.add(bounds.y - std::min(ref.upper, 1.0));
-        ++checked;
-    }
-    EXPECT_GT(checked, 19000);
-    std::printf("[hamburger4 vs JCGT Alg. 1, %s depth] lower: p50 %.2e p99 %.2e max %.2e; upper: p99 %.2e max %.2e\n",
-                signed_depth ? "[-1,1]" : "[0,1]", lower_err.quantile(0.5), lower_err.quantile(0.99), lower_err.max(),
-                upper_err.quantile(0.99), upper_err.max());
-    EXPECT_LT(lower_err.quantile(0.99), 2e-4);
-    EXPECT_LT(lower_err.max(), 0.05);
-    EXPECT_LT(upper_err.quantile(0.99), 2e-4);
-    EXPECT_LT(upper_err.max(), 0.05);
+  std::mt19937_64 rng(signed_depth ? 1 : 2);
+  float lo = signed_depth ? -1.0f : 0.0f, hi = 1.0f;
+  MomentBias4 bias = msm_moment_bias(representation);
+  ErrorStats lower_err, upper_err;
+  int checked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    test::Distribution d = test::random_distribution(rng, lo, hi);
+    vec4 b = msm_apply_bias(test::moments4f(d), bias);
+    float zf = random_fragment_depth(rng, d, lo, hi);
+    oracle::MomentBounds ref = oracle::moment_bounds(as_double_moments(b), zf);
+    if (!ref.ok) continue; // the float rounding left the moment space; the bias is for that
+    vec2 bounds = msm_hamburger4_bounds(b, zf);
+    ASSERT_TRUE(std::isfinite(bounds.x) && std::isfinite(bounds.y));
+    lower_err.add(bounds.x - ref.lower);
+    upper_err.add(bounds.y - std::min(ref.upper, 1.0));
+    ++checked;
+  }
+  EXPECT_GT(checked, 19000);
+  std::printf("[hamburger4 vs JCGT Alg. 1, %s depth] lower: p50 %.2e p99 %.2e max %.2e; upper: p99 %.2e max %.2e\n",
+              signed_depth ? "[-1,1]" : "[0,1]", lower_err.quantile(0.5), lower_err.quantile(0.99), lower_err.max(),
+              upper_err.quantile(0.99), upper_err.max());
+  EXPECT_LT(lower_err.quantile(0.99), 2e-4);
+  EXPECT_LT(lower_err.max(), 0.05);
+  EXPECT_LT(upper_err.quantile(0.99), 2e-4);
+  EXPECT_LT(upper_err.max(), 0.05);
 }
 
 TEST(Hamburger4, EqualsJcgtAlgorithm1UnitDepth) { check_against_moment_oracle(false, MSM_REP_UNIT_FLOAT); }
@@ -66,16 +66,16 @@ TEST(Hamburger4, EqualsJcgtAlgorithm1SignedDepth) { check_against_moment_oracle(
 // Lower <= true CDF <= upper. Biasing replaces Z by (1-α) Z + α Z*, which moves the CDF by at
 // most α, and the float arithmetic adds the error measured above: slack 2e-3 for 99.9% of cases.
 TEST(Hamburger4, BoundsBracketTheTrueCdf) {
-    std::mt19937_64 rng(3);
-    int violations = 0, total = 20000;
-    for (int i = 0; i < total; ++i) {
-        test::Distribution d = test::random_distribution(rng, -1.0, 1.0);
-        vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
-        float zf = random_fragment_depth(rng, d, -1.0f, 1.0f);
-        vec2 bounds = msm_hamburger4_bounds(b, zf);
-        if (bounds.x > test::cdf_less(d, zf) + 2e-3 || bounds.y < test::cdf_less_equal(d, zf) - 2e-3) ++violations;
-    }
-    EXPECT_LE(violations, total / 1000);
+  std::mt19937_64 rng(3);
+  int violations = 0, total = 20000;
+  for (int i = 0; i < total; ++i) {
+    test::Distribution d = test::random_distribution(rng, -1.0, 1.0);
+    vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
+    float zf = random_fragment_depth(rng, d, -1.0f, 1.0f);
+    vec2 bounds = msm_hamburger4_bounds(b, zf);
+    if (bounds.x > test::cdf_less(d, zf) + 2e-3 || bounds.y < test::cdf_less_equal(d, zf) - 2e-3) ++violations;
+  }
+  EXPECT_LE(violations, total / 1000);
 }
 
 // 2015 Proposition 4: with at most m/2 = 2 depths in the kernel the moments determine the
@@ -87,41 +87,41 @@ TEST(Hamburger4, BoundsBracketTheTrueCdf) {
 // fragments >= 0.05 away from every depth, the remaining bias error measured 1.7e-4 (p99) and
 // 6.8e-3 (max, depths 0.2 apart with one weight near 5%): bounds 5e-4 and 1e-2.
 TEST(Hamburger4, ExactForUpToTwoDepths) {
-    std::mt19937_64 rng(4);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    ErrorStats err;
-    for (int i = 0; i < 20000; ++i) {
-        test::Distribution d = test::random_diracs(rng, 1 + i % 2, -1.0, 1.0);
-        if (d.z.size() == 2 && (std::abs(d.z[0] - d.z[1]) < 0.2 || std::min(d.w[0], d.w[1]) < 0.05)) continue;
-        float zf = -1.0f + 2.0f * unit(rng);
-        bool near_atom = false;
-        for (double z : d.z) near_atom |= std::abs(z - zf) < 0.05;
-        if (near_atom) continue;
-        vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
-        err.add(msm_hamburger4_lower(b, zf) - test::cdf_less(d, zf));
-    }
-    std::printf("[hamburger4 exactness, <= 2 depths] n %zu p99 %.2e max %.2e\n", err.errors.size(), err.quantile(0.99),
-                err.max());
-    EXPECT_GT(err.errors.size(), 8000u);
-    EXPECT_LT(err.quantile(0.99), 5e-4);
-    EXPECT_LT(err.max(), 1e-2);
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  ErrorStats err;
+  for (int i = 0; i < 20000; ++i) {
+    test::Distribution d = test::random_diracs(rng, 1 + i % 2, -1.0, 1.0);
+    if (d.z.size() == 2 && (std::abs(d.z[0] - d.z[1]) < 0.2 || std::min(d.w[0], d.w[1]) < 0.05)) continue;
+    float zf = -1.0f + 2.0f * unit(rng);
+    bool near_atom = false;
+    for (double z : d.z) near_atom |= std::abs(z - zf) < 0.05;
+    if (near_atom) continue;
+    vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
+    err.add(msm_hamburger4_lower(b, zf) - test::cdf_less(d, zf));
+  }
+  std::printf("[hamburger4 exactness, <= 2 depths] n %zu p99 %.2e max %.2e\n", err.errors.size(), err.quantile(0.99),
+              err.max());
+  EXPECT_GT(err.errors.size(), 8000u);
+  EXPECT_LT(err.quantile(0.99), 5e-4);
+  EXPECT_LT(err.max(), 1e-2);
 }
 
 // The canonical distribution reproduces b0..b4 (it is what the blocker search averages).
 TEST(Hamburger4, CanonicalDistributionHasTheInputMoments) {
-    std::mt19937_64 rng(5);
-    for (int i = 0; i < 2000; ++i) {
-        test::Distribution d = test::random_continuous(rng, -1.0, 1.0);
-        vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
-        float zf = float(d.z[0]) - 0.3f;
-        oracle::MomentBounds ref = oracle::moment_bounds(as_double_moments(b), zf);
-        if (!ref.ok) continue;
-        Canonical4 c = msm_hamburger4_canonical(b, zf);
-        for (int l = 0; l < 3; ++l) {
-            EXPECT_NEAR(c.z[l], ref.support[l], 2e-3 * (1.0 + std::abs(ref.support[l])));
-            EXPECT_NEAR(c.w[l], ref.weights[l], 2e-3);
-        }
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 2000; ++i) {
+    test::Distribution d = test::random_continuous(rng, -1.0, 1.0);
+    vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
+    float zf = float(d.z[0]) - 0.3f;
+    oracle::MomentBounds ref = oracle::moment_bounds(as_double_moments(b), zf);
+    if (!ref.ok) continue;
+    Canonical4 c = msm_hamburger4_canonical(b, zf);
+    for (int l = 0; l < 3; ++l) {
+      EXPECT_NEAR(c.z[l], ref.support[l], 2e-3 * (1.0 + std::abs(ref.support[l])));
+      EXPECT_NEAR(c.w[l], ref.weights[l], 2e-3);
     }
+  }
 }
 
 // The LP of the 2015 paper on a grid, solved exactly (GLPK's rational re-solve): minimizing over
@@ -131,86 +131,86 @@ TEST(Hamburger4, CanonicalDistributionHasTheInputMoments) {
 // (Hausdorff, 1e-3 spacing on [0,1]); bounds p90 1e-4, max 5e-3. Few cases: an exact LP takes
 // 0.2-0.7 s.
 void check_against_lp(const std::vector<double>& grid, bool hausdorff, int cases, uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    oracle::Basis basis = oracle::power_basis(4);
-    float lo = hausdorff ? 0.0f : -1.0f;
-    ErrorStats err;
-    int four_atom_cases = 0;
-    for (int i = 0; i < cases; ++i) {
-        test::Distribution d = test::random_distribution(rng, lo, 1.0);
-        vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(hausdorff ? MSM_REP_UNIT_FLOAT : MSM_REP_SIGNED_FLOAT));
-        float zf = random_fragment_depth(rng, d, lo, 1.0f);
-        if (hausdorff) zf = std::clamp(zf, 0.0f, 1.0f);
-        std::vector<double> bd = {b[0], b[1], b[2], b[3]};
-        oracle::LpOptions exact;
-        exact.exact = true; // rational re-solve: the simplex's 1e-7 feasibility tolerance admits
-                            // wrong distributions when B is nearly singular (measured: 0.1 off)
-        oracle::LpBounds lp = oracle::lp_bounds(grid, basis, bd, zf, exact);
-        if (!lp.feasible) continue;
-        Hamburger4Roots r = msm_hamburger4_roots(b, zf);
-        four_atom_cases += (r.z2 < 0.0f || r.z3 > 1.0f);
-        float bound = hausdorff ? msm_hausdorff4_lower(b, zf, 0.0f, 1.0f) : msm_hamburger4_lower(b, zf);
-        EXPECT_LE(bound - lp.lower, 1e-3) << "zf " << zf;
-        err.add(bound - lp.lower);
-    }
-    std::printf("[%s vs LP] n %zu p90 %.2e max %.2e (Hausdorff four-atom branch: %d)\n",
-                hausdorff ? "hausdorff4 on [0,1]" : "hamburger4 on a wide grid", err.errors.size(),
-                err.quantile(0.9), err.max(), four_atom_cases);
-    EXPECT_GT(err.errors.size(), size_t(cases * 8 / 10));
-    EXPECT_LT(err.quantile(0.9), 1e-4);
-    EXPECT_LT(err.max(), 5e-3);
-    if (hausdorff) {
-        EXPECT_GT(four_atom_cases, 4); // the branch that differs from Hamburger is exercised
-    }
+  std::mt19937_64 rng(seed);
+  oracle::Basis basis = oracle::power_basis(4);
+  float lo = hausdorff ? 0.0f : -1.0f;
+  ErrorStats err;
+  int four_atom_cases = 0;
+  for (int i = 0; i < cases; ++i) {
+    test::Distribution d = test::random_distribution(rng, lo, 1.0);
+    vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(hausdorff ? MSM_REP_UNIT_FLOAT : MSM_REP_SIGNED_FLOAT));
+    float zf = random_fragment_depth(rng, d, lo, 1.0f);
+    if (hausdorff) zf = std::clamp(zf, 0.0f, 1.0f);
+    std::vector<double> bd = {b[0], b[1], b[2], b[3]};
+    oracle::LpOptions exact;
+    exact.exact = true; // rational re-solve: the simplex's 1e-7 feasibility tolerance admits
+                        // wrong distributions when B is nearly singular (measured: 0.1 off)
+    oracle::LpBounds lp = oracle::lp_bounds(grid, basis, bd, zf, exact);
+    if (!lp.feasible) continue;
+    Hamburger4Roots r = msm_hamburger4_roots(b, zf);
+    four_atom_cases += (r.z2 < 0.0f || r.z3 > 1.0f);
+    float bound = hausdorff ? msm_hausdorff4_lower(b, zf, 0.0f, 1.0f) : msm_hamburger4_lower(b, zf);
+    EXPECT_LE(bound - lp.lower, 1e-3) << "zf " << zf;
+    err.add(bound - lp.lower);
+  }
+  std::printf("[%s vs LP] n %zu p90 %.2e max %.2e (Hausdorff four-atom branch: %d)\n",
+              hausdorff ? "hausdorff4 on [0,1]" : "hamburger4 on a wide grid", err.errors.size(), err.quantile(0.9),
+              err.max(), four_atom_cases);
+  EXPECT_GT(err.errors.size(), size_t(cases * 8 / 10));
+  EXPECT_LT(err.quantile(0.9), 1e-4);
+  EXPECT_LT(err.max(), 5e-3);
+  if (hausdorff) {
+    EXPECT_GT(four_atom_cases, 4); // the branch that differs from Hamburger is exercised
+  }
 }
 
 TEST(Hamburger4, EqualsTheLinearProgramOnAWideGrid) {
-    check_against_lp(oracle::wide_grid(-1.0, 1.0, 2001), false, 30, 6);
+  check_against_lp(oracle::wide_grid(-1.0, 1.0, 2001), false, 30, 6);
 }
 
 // Hausdorff 4MSM is the LP on [0,1] itself (uniform grid, 1001 points plus zf).
 TEST(Hausdorff4, EqualsTheLinearProgramOnTheUnitInterval) {
-    check_against_lp(oracle::uniform_grid(0.0, 1.0, 1001), true, 60, 7);
+  check_against_lp(oracle::uniform_grid(0.0, 1.0, 1001), true, 60, 7);
 }
 
 // Knowing the interval can only sharpen: Hausdorff >= Hamburger (up to float noise).
 TEST(Hausdorff4, IsNeverBelowHamburger) {
-    std::mt19937_64 rng(8);
-    for (int i = 0; i < 20000; ++i) {
-        test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-        vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_UNIT_FLOAT));
-        float zf = std::clamp(random_fragment_depth(rng, d, 0.0f, 1.0f), 0.0f, 1.0f);
-        EXPECT_GE(msm_hausdorff4_lower(b, zf, 0.0f, 1.0f), msm_hamburger4_lower(b, zf) - 2e-3f);
-    }
+  std::mt19937_64 rng(8);
+  for (int i = 0; i < 20000; ++i) {
+    test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
+    vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_UNIT_FLOAT));
+    float zf = std::clamp(random_fragment_depth(rng, d, 0.0f, 1.0f), 0.0f, 1.0f);
+    EXPECT_GE(msm_hausdorff4_lower(b, zf, 0.0f, 1.0f), msm_hamburger4_lower(b, zf) - 2e-3f);
+  }
 }
 
 // JCGT Algorithm 2: two depths from three moments reproduce b1..b3 exactly (in float: 1e-4
 // relative) and recover any two-Dirac distribution.
 TEST(ThreeMoments, RecoversTwoDiracsAndMatchesMoments) {
-    std::mt19937_64 rng(9);
-    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    for (int i = 0; i < 10000; ++i) {
-        float z1 = -1.0f + 2.0f * unit(rng), z2 = -1.0f + 2.0f * unit(rng), w2 = 0.05f + 0.9f * unit(rng);
-        if (std::abs(z1 - z2) < 0.05f) continue;
-        vec4 b = (1.0f - w2) * msm_moments4(z1) + w2 * msm_moments4(z2);
-        TwoDepths t = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
-        EXPECT_NEAR(t.z.x, std::min(z1, z2), 2e-3f);
-        EXPECT_NEAR(t.z.y, std::max(z1, z2), 2e-3f);
-        EXPECT_NEAR(t.w.y, z1 < z2 ? w2 : 1.0f - w2, 2e-3f);
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int i = 0; i < 10000; ++i) {
+    float z1 = -1.0f + 2.0f * unit(rng), z2 = -1.0f + 2.0f * unit(rng), w2 = 0.05f + 0.9f * unit(rng);
+    if (std::abs(z1 - z2) < 0.05f) continue;
+    vec4 b = (1.0f - w2) * msm_moments4(z1) + w2 * msm_moments4(z2);
+    TwoDepths t = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
+    EXPECT_NEAR(t.z.x, std::min(z1, z2), 2e-3f);
+    EXPECT_NEAR(t.z.y, std::max(z1, z2), 2e-3f);
+    EXPECT_NEAR(t.w.y, z1 < z2 ? w2 : 1.0f - w2, 2e-3f);
+  }
+  for (int i = 0; i < 10000; ++i) {
+    test::Distribution d = test::random_continuous(rng, -1.0, 1.0);
+    vec4 b = test::moments4f(d);
+    TwoDepths t = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
+    for (int j = 1; j <= 3; ++j) {
+      float m = t.w.x * std::pow(t.z.x, float(j)) + t.w.y * std::pow(t.z.y, float(j));
+      EXPECT_NEAR(m, b[j - 1], 1e-4f);
     }
-    for (int i = 0; i < 10000; ++i) {
-        test::Distribution d = test::random_continuous(rng, -1.0, 1.0);
-        vec4 b = test::moments4f(d);
-        TwoDepths t = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
-        for (int j = 1; j <= 3; ++j) {
-            float m = t.w.x * std::pow(t.z.x, float(j)) + t.w.y * std::pow(t.z.y, float(j));
-            EXPECT_NEAR(m, b[j - 1], 1e-4f);
-        }
-    }
-    // Zero variance: a single depth comes back as δ(b1).
-    TwoDepths single = msm_two_depths_from_three_moments(vec3(0.25f, 0.0625f, 0.015625f));
-    EXPECT_EQ(single.z.x, 0.25f);
-    EXPECT_EQ(single.w.x, 1.0f);
+  }
+  // Zero variance: a single depth comes back as δ(b1).
+  TwoDepths single = msm_two_depths_from_three_moments(vec3(0.25f, 0.0625f, 0.015625f));
+  EXPECT_EQ(single.z.x, 0.25f);
+  EXPECT_EQ(single.w.x, 1.0f);
 }
 
 } // namespace

@@ -16,15 +16,25 @@ Texel unorm16(const Texel& t) { return from(msm_quantize_unorm16(to_vec4(t))); }
 // ---- Techniques of the shared table (include/msm/techniques.h), with the papers' parameters ----
 Texel from(MsmTexel t) { return {t.a.x, t.a.y, t.a.z, t.a.w, t.b.x, t.b.y, t.b.z, t.b.w}; }
 MsmTexel to_texel(const Texel& t) { return MsmTexel(vec4(t[0], t[1], t[2], t[3]), vec4(t[4], t[5], t[6], t[7])); }
-template <int Id> Texel generate(float d) { return from(msm_technique_generate(Id, d, msm_technique_default_params(Id))); }
-template <int Id> float shade(const Texel& t, float zf) {
-    return msm_technique_shadow(Id, to_texel(t), zf, msm_technique_default_params(Id));
+template <int Id>
+Texel generate(float d) {
+  return from(msm_technique_generate(Id, d, msm_technique_default_params(Id)));
+}
+template <int Id>
+float shade(const Texel& t, float zf) {
+  return msm_technique_shadow(Id, to_texel(t), zf, msm_technique_default_params(Id));
 }
 Texel moments_signed(float d) { return from(msm_moments4(msm_signed_depth(d))); }
 
 // ---- Storage round trips of the texel formats ----
-Texel unorm16x2(const Texel& t) { vec2 q = msm_quantize_unorm16x2(vec2(t[0], t[1])); return {q.x, q.y, 0, 0, 0, 0, 0, 0}; }
-Texel half2(const Texel& t) { vec2 q = msm_quantize_half2(vec2(t[0], t[1])); return {q.x, q.y, 0, 0, 0, 0, 0, 0}; }
+Texel unorm16x2(const Texel& t) {
+  vec2 q = msm_quantize_unorm16x2(vec2(t[0], t[1]));
+  return {q.x, q.y, 0, 0, 0, 0, 0, 0};
+}
+Texel half2(const Texel& t) {
+  vec2 q = msm_quantize_half2(vec2(t[0], t[1]));
+  return {q.x, q.y, 0, 0, 0, 0, 0, 0};
+}
 Texel half4(const Texel& t) { return from(msm_quantize_half4(to_vec4(t))); }
 
 // ---- Non-linearly quantized MSM (HPG 2017): filtered float moments -> Φ -> 64/32 bits ----
@@ -36,16 +46,16 @@ float nl_shade(const Texel& t, float zf) { return msm_nl_shadow(to_nl(t), msm_si
 
 // Convolution shadow map with 4 Fourier terms (8 float channels), damped and scaled to a lower bound.
 Texel csm4(float d) {
-    vec4 a = msm_csm_basis_texel(d, 0), b = msm_csm_basis_texel(d, 1);
-    return {a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w};
+  vec4 a = msm_csm_basis_texel(d, 0), b = msm_csm_basis_texel(d, 1);
+  return {a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w};
 }
 float csm4_shade(const Texel& t, float zf) {
-    CsmParams p = msm_csm_default_params();
-    p.terms = 4;
-    float xf = msm_csm_receiver(zf, p);
-    float sum = msm_csm_texel_terms(vec4(t[0], t[1], t[2], t[3]), xf, 0, p) +
-                msm_csm_texel_terms(vec4(t[4], t[5], t[6], t[7]), xf, 1, p);
-    return msm_csm_resolve(sum, p);
+  CsmParams p = msm_csm_default_params();
+  p.terms = 4;
+  float xf = msm_csm_receiver(zf, p);
+  float sum = msm_csm_texel_terms(vec4(t[0], t[1], t[2], t[3]), xf, 0, p) +
+              msm_csm_texel_terms(vec4(t[4], t[5], t[6], t[7]), xf, 1, p);
+  return msm_csm_resolve(sum, p);
 }
 
 // ---- Six moments in 10-bit UNORM (JCGT §5.4.3): CPU only (the renderer has no 6 x 10-bit format) ----
@@ -54,27 +64,32 @@ Texel from(Moments6 m) { return {m.odd.x, m.odd.y, m.odd.z, m.even.x, m.even.y, 
 Texel m6_unorm16(const Texel& t) { return from(msm_quantize_unorm16(to_m6(t))); }
 Texel m6_unorm10(const Texel& t) { return from(msm_quantize_unorm10(to_m6(t))); }
 float m6_10_shade(const Texel& t, float zf) {
-    Moments6 b = msm_theta6_star_inverse(to_m6(t));
-    return msm_hamburger6_lower(msm_apply_bias6(b, msm_moment_bias6(MSM_REP6_UNORM10)), msm_signed_depth(zf));
+  Moments6 b = msm_theta6_star_inverse(to_m6(t));
+  return msm_hamburger6_lower(msm_apply_bias6(b, msm_moment_bias6(MSM_REP6_UNORM10)), msm_signed_depth(zf));
 }
 
 constexpr Technique kTechniques[] = {
-    {"vsm-32", "VSM, 2 x 16-bit UNORM after θ2, depth in [0,1] (2015)", 32, 2, MSM_TECH_VSM32, generate<MSM_TECH_VSM32>, unorm16x2, shade<MSM_TECH_VSM32>},
+    {"vsm-32", "VSM, 2 x 16-bit UNORM after θ2, depth in [0,1] (2015)", 32, 2, MSM_TECH_VSM32, generate<MSM_TECH_VSM32>,
+     unorm16x2, shade<MSM_TECH_VSM32>},
     {"vsm-64", "VSM, 2 x float", 64, 2, MSM_TECH_VSM64, generate<MSM_TECH_VSM64>, identity, shade<MSM_TECH_VSM64>},
-    {"esm-32", "ESM, 1 x float, c = 80 on [0,1]", 32, 1, MSM_TECH_ESM32, generate<MSM_TECH_ESM32>, identity, shade<MSM_TECH_ESM32>},
-    {"evsm2-32", "EVSM, positive warp, 2 x half, c = 5.54 on [-1,1]", 32, 2, MSM_TECH_EVSM2_32, generate<MSM_TECH_EVSM2_32>, half2, shade<MSM_TECH_EVSM2_32>},
+    {"esm-32", "ESM, 1 x float, c = 80 on [0,1]", 32, 1, MSM_TECH_ESM32, generate<MSM_TECH_ESM32>, identity,
+     shade<MSM_TECH_ESM32>},
+    {"evsm2-32", "EVSM, positive warp, 2 x half, c = 5.54 on [-1,1]", 32, 2, MSM_TECH_EVSM2_32,
+     generate<MSM_TECH_EVSM2_32>, half2, shade<MSM_TECH_EVSM2_32>},
     {"evsm2-64", "EVSM, positive warp, 2 x float, c+ = 40 on [-1,1]", 64, 2, MSM_TECH_EVSM2_64,
      generate<MSM_TECH_EVSM2_64>, identity, shade<MSM_TECH_EVSM2_64>},
-    {"evsm4-64", "EVSM, both warps, 4 x half, c = 5.54 (JCGT Fig. 4a)", 64, 4, MSM_TECH_EVSM4_64, generate<MSM_TECH_EVSM4_64>, half4, shade<MSM_TECH_EVSM4_64>},
-    {"evsm4-128", "EVSM, both warps, 4 x float, c+ = 40, c- = 5.54 (JCGT Fig. 4e)", 128, 4, MSM_TECH_EVSM4_128, generate<MSM_TECH_EVSM4_128>,
-     identity, shade<MSM_TECH_EVSM4_128>},
+    {"evsm4-64", "EVSM, both warps, 4 x half, c = 5.54 (JCGT Fig. 4a)", 64, 4, MSM_TECH_EVSM4_64,
+     generate<MSM_TECH_EVSM4_64>, half4, shade<MSM_TECH_EVSM4_64>},
+    {"evsm4-128", "EVSM, both warps, 4 x float, c+ = 40, c- = 5.54 (JCGT Fig. 4e)", 128, 4, MSM_TECH_EVSM4_128,
+     generate<MSM_TECH_EVSM4_128>, identity, shade<MSM_TECH_EVSM4_128>},
     {"csm-4", "Convolution shadow map, 4 Fourier terms in 8 floats, damped", 256, 8, -1, csm4, identity, csm4_shade},
     {"msm-hamburger-128-unit", "Hamburger 4MSM, 4 x float, depth in [0,1] (2015)", 128, 4, MSM_TECH_HAMBURGER_128_UNIT,
      generate<MSM_TECH_HAMBURGER_128_UNIT>, identity, shade<MSM_TECH_HAMBURGER_128_UNIT>},
     {"msm-hamburger-128", "Hamburger 4MSM, 4 x float, depth in [-1,1] (JCGT 2017)", 128, 4, MSM_TECH_HAMBURGER_128,
      generate<MSM_TECH_HAMBURGER_128>, identity, shade<MSM_TECH_HAMBURGER_128>},
-    {"msm-hamburger-64-theta4", "Hamburger 4MSM, 4 x 16-bit UNORM after θ4, depth in [0,1] (2015)", 64, 4, MSM_TECH_HAMBURGER_64_THETA4,
-     generate<MSM_TECH_HAMBURGER_64_THETA4>, unorm16, shade<MSM_TECH_HAMBURGER_64_THETA4>},
+    {"msm-hamburger-64-theta4", "Hamburger 4MSM, 4 x 16-bit UNORM after θ4, depth in [0,1] (2015)", 64, 4,
+     MSM_TECH_HAMBURGER_64_THETA4, generate<MSM_TECH_HAMBURGER_64_THETA4>, unorm16,
+     shade<MSM_TECH_HAMBURGER_64_THETA4>},
     {"msm-hamburger-64", "Hamburger 4MSM, 4 x 16-bit UNORM after Θ4*, depth in [-1,1] (JCGT 2017)", 64, 4,
      MSM_TECH_HAMBURGER_64, generate<MSM_TECH_HAMBURGER_64>, unorm16, shade<MSM_TECH_HAMBURGER_64>},
     {"msm-hausdorff-128-unit", "Hausdorff 4MSM on [0,1], 4 x float (2015)", 128, 4, MSM_TECH_HAUSDORFF_128_UNIT,
@@ -83,17 +98,21 @@ constexpr Technique kTechniques[] = {
      generate<MSM_TECH_HAUSDORFF_128>, identity, shade<MSM_TECH_HAUSDORFF_128>},
     {"msm-hausdorff-64", "Hausdorff 4MSM on [-1,1], 4 x 16-bit UNORM after Θ4* (JCGT 2017 storage)", 64, 4,
      MSM_TECH_HAUSDORFF_64, generate<MSM_TECH_HAUSDORFF_64>, unorm16, shade<MSM_TECH_HAUSDORFF_64>},
-    {"msm-hausdorff-64-theta4", "Hausdorff 4MSM on [0,1], 4 x 16-bit UNORM after θ4 (2015)", 64, 4, MSM_TECH_HAUSDORFF_64_THETA4,
-     generate<MSM_TECH_HAUSDORFF_64_THETA4>, unorm16, shade<MSM_TECH_HAUSDORFF_64_THETA4>},
-    {"tmsm-128", "Trigonometric MSM, 4 x float, depth in [0,1] (2015)", 128, 4, MSM_TECH_TMSM_128, generate<MSM_TECH_TMSM_128>, identity, shade<MSM_TECH_TMSM_128>},
-    {"msm6-192", "Hamburger 6MSM, 6 x float, depth in [-1,1] (JCGT §5.4)", 192, 6, MSM_TECH_MSM6_192, generate<MSM_TECH_MSM6_192>, identity,
-     shade<MSM_TECH_MSM6_192>},
-    {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", 96, 6, MSM_TECH_MSM6_96, generate<MSM_TECH_MSM6_96>, m6_unorm16,
-     shade<MSM_TECH_MSM6_96>},
-    {"msm6-64", "Hamburger 6MSM, 6 x 10-bit UNORM after Θ6* (JCGT §5.4.3)", 64, 6, -1, generate<MSM_TECH_MSM6_96>, m6_unorm10, m6_10_shade},
+    {"msm-hausdorff-64-theta4", "Hausdorff 4MSM on [0,1], 4 x 16-bit UNORM after θ4 (2015)", 64, 4,
+     MSM_TECH_HAUSDORFF_64_THETA4, generate<MSM_TECH_HAUSDORFF_64_THETA4>, unorm16,
+     shade<MSM_TECH_HAUSDORFF_64_THETA4>},
+    {"tmsm-128", "Trigonometric MSM, 4 x float, depth in [0,1] (2015)", 128, 4, MSM_TECH_TMSM_128,
+     generate<MSM_TECH_TMSM_128>, identity, shade<MSM_TECH_TMSM_128>},
+    {"msm6-192", "Hamburger 6MSM, 6 x float, depth in [-1,1] (JCGT §5.4)", 192, 6, MSM_TECH_MSM6_192,
+     generate<MSM_TECH_MSM6_192>, identity, shade<MSM_TECH_MSM6_192>},
+    {"msm6-96", "Hamburger 6MSM, 6 x 16-bit UNORM after Θ6* (JCGT §5.4.3)", 96, 6, MSM_TECH_MSM6_96,
+     generate<MSM_TECH_MSM6_96>, m6_unorm16, shade<MSM_TECH_MSM6_96>},
+    {"msm6-64", "Hamburger 6MSM, 6 x 10-bit UNORM after Θ6* (JCGT §5.4.3)", 64, 6, -1, generate<MSM_TECH_MSM6_96>,
+     m6_unorm10, m6_10_shade},
     {"msm-nl64", "Non-linearly quantized 4MSM, 4 x 16-bit (y1, y2, v2, Ψ4(ξ4)) (HPG 2017)", 64, 4, MSM_TECH_NL64,
      moments_signed, nl64_store, nl_shade},
-    {"msm-nl32", "Non-linearly quantized 4MSM, 32-bit packed (HPG 2017)", 32, 4, MSM_TECH_NL32, moments_signed, nl32_store, nl_shade},
+    {"msm-nl32", "Non-linearly quantized 4MSM, 32-bit packed (HPG 2017)", 32, 4, MSM_TECH_NL32, moments_signed,
+     nl32_store, nl_shade},
 };
 
 } // namespace
@@ -101,37 +120,37 @@ constexpr Technique kTechniques[] = {
 std::span<const Technique> techniques() { return kTechniques; }
 
 const Technique& find_technique(std::string_view name) {
-    std::string valid;
-    for (const Technique& t : kTechniques) {
-        if (t.name == name) return t;
-        valid += (valid.empty() ? "" : ", ") + std::string(t.name);
-    }
-    throw std::invalid_argument("unknown technique '" + std::string(name) + "'; valid: " + valid);
+  std::string valid;
+  for (const Technique& t : kTechniques) {
+    if (t.name == name) return t;
+    valid += (valid.empty() ? "" : ", ") + std::string(t.name);
+  }
+  throw std::invalid_argument("unknown technique '" + std::string(name) + "'; valid: " + valid);
 }
 
 float filtered_shadow(const Technique& technique, std::span<const float> depths, std::span<const float> weights,
                       float unit_zf) {
-    if (depths.size() != weights.size() || depths.empty())
-        throw std::invalid_argument("filtered_shadow: need as many weights as depths, at least one");
-    Texel sum{};
-    float total = 0.0f;
-    for (size_t i = 0; i < depths.size(); ++i) {
-        Texel t = technique.generate(depths[i]);
-        for (int c = 0; c < technique.channels; ++c) sum[c] += weights[i] * t[c];
-        total += weights[i];
-    }
-    if (!(total > 0.0f)) throw std::invalid_argument("filtered_shadow: weights must have a positive sum");
-    for (int c = 0; c < technique.channels; ++c) sum[c] /= total;
-    return technique.shade(technique.store_load(sum), unit_zf);
+  if (depths.size() != weights.size() || depths.empty())
+    throw std::invalid_argument("filtered_shadow: need as many weights as depths, at least one");
+  Texel sum{};
+  float total = 0.0f;
+  for (size_t i = 0; i < depths.size(); ++i) {
+    Texel t = technique.generate(depths[i]);
+    for (int c = 0; c < technique.channels; ++c) sum[c] += weights[i] * t[c];
+    total += weights[i];
+  }
+  if (!(total > 0.0f)) throw std::invalid_argument("filtered_shadow: weights must have a positive sum");
+  for (int c = 0; c < technique.channels; ++c) sum[c] /= total;
+  return technique.shade(technique.store_load(sum), unit_zf);
 }
 
 float percentage_closer(std::span<const float> depths, std::span<const float> weights, float unit_zf) {
-    float shadow = 0.0f, total = 0.0f;
-    for (size_t i = 0; i < depths.size(); ++i) {
-        if (depths[i] < unit_zf) shadow += weights[i];
-        total += weights[i];
-    }
-    return shadow / total;
+  float shadow = 0.0f, total = 0.0f;
+  for (size_t i = 0; i < depths.size(); ++i) {
+    if (depths[i] < unit_zf) shadow += weights[i];
+    total += weights[i];
+  }
+  return shadow / total;
 }
 
 } // namespace msm::cpu

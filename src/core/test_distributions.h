@@ -4,15 +4,15 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
 #include <random>
 #include <vector>
-#include <glm/glm.hpp>
 
 namespace msm::test {
 
 struct Distribution {
-    std::vector<double> z; // depths
-    std::vector<double> w; // weights, sum 1
+  std::vector<double> z; // depths
+  std::vector<double> w; // weights, sum 1
 };
 
 // 'count' Diracs with random depths in [lo, hi] and random weights (none below 1%).
@@ -34,13 +34,13 @@ glm::vec4 moments4f(const Distribution& d);
 
 // Absolute errors collected over many cases, for quantiles and the maximum.
 struct ErrorStats {
-    std::vector<double> errors;
-    void add(double e) { errors.push_back(std::abs(e)); }
-    double quantile(double q) {
-        std::sort(errors.begin(), errors.end());
-        return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
-    }
-    double max() { return quantile(1.0); }
+  std::vector<double> errors;
+  void add(double e) { errors.push_back(std::abs(e)); }
+  double quantile(double q) {
+    std::sort(errors.begin(), errors.end());
+    return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
+  }
+  double max() { return quantile(1.0); }
 };
 
 } // namespace msm::test

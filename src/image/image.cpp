@@ -10,22 +10,22 @@ namespace msm::image {
 
 namespace {
 std::string describe(const std::filesystem::path& path, const std::string& reason) {
-    return path.empty() ? reason : path.string() + ": " + reason;
+  return path.empty() ? reason : path.string() + ": " + reason;
 }
 
 void check_size(int width, int height) {
-    if (width < 1 || height < 1 || width > max_side || height > max_side)
-        throw ImageError({}, fmt::format("image size {}x{} is outside 1..{} per side", width, height, max_side));
+  if (width < 1 || height < 1 || width > max_side || height > max_side)
+    throw ImageError({}, fmt::format("image size {}x{} is outside 1..{} per side", width, height, max_side));
 }
 
 void check_names(const std::vector<std::string>& names) {
-    if (names.empty() || names.size() > std::size_t(max_channels))
-        throw ImageError({}, fmt::format("{} channels: an image has 1..{}", names.size(), max_channels));
-    std::set<std::string> seen;
-    for (const std::string& n : names) {
-        if (n.empty()) throw ImageError({}, "empty channel name");
-        if (!seen.insert(n).second) throw ImageError({}, fmt::format("duplicate channel name '{}'", n));
-    }
+  if (names.empty() || names.size() > std::size_t(max_channels))
+    throw ImageError({}, fmt::format("{} channels: an image has 1..{}", names.size(), max_channels));
+  std::set<std::string> seen;
+  for (const std::string& n : names) {
+    if (n.empty()) throw ImageError({}, "empty channel name");
+    if (!seen.insert(n).second) throw ImageError({}, fmt::format("duplicate channel name '{}'", n));
+  }
 }
 } // namespace
 
@@ -33,127 +33,129 @@ ImageError::ImageError(std::filesystem::path path, std::string reason)
     : std::runtime_error(describe(path, reason)), path_(std::move(path)), reason_(std::move(reason)) {}
 
 std::vector<std::string> default_channel_names(int channels) {
-    switch (channels) {
-    case 1: return {"Y"};
-    case 2: return {"Y", "A"};
-    case 3: return {"R", "G", "B"};
-    case 4: return {"R", "G", "B", "A"};
-    default: throw ImageError({}, fmt::format("{} channels: an image has 1..{}", channels, max_channels));
-    }
+  switch (channels) {
+  case 1: return {"Y"};
+  case 2: return {"Y", "A"};
+  case 3: return {"R", "G", "B"};
+  case 4: return {"R", "G", "B", "A"};
+  default: throw ImageError({}, fmt::format("{} channels: an image has 1..{}", channels, max_channels));
+  }
 }
 
 Image::Image(int width, int height, int channels, float fill)
     : Image(width, height, default_channel_names(channels), fill) {}
 
 Image::Image(int width, int height, std::vector<std::string> channel_names, float fill) {
-    check_size(width, height);
-    check_names(channel_names);
-    width_ = width;
-    height_ = height;
-    names_ = std::move(channel_names);
-    pixels_.assign(pixel_count() * names_.size(), fill);
+  check_size(width, height);
+  check_names(channel_names);
+  width_ = width;
+  height_ = height;
+  names_ = std::move(channel_names);
+  pixels_.assign(pixel_count() * names_.size(), fill);
 }
 
 void Image::set_channel_names(std::vector<std::string> names) {
-    check_names(names);
-    if (names.size() != names_.size())
-        throw ImageError({}, fmt::format("{} channel names for {} channels", names.size(), names_.size()));
-    names_ = std::move(names);
+  check_names(names);
+  if (names.size() != names_.size())
+    throw ImageError({}, fmt::format("{} channel names for {} channels", names.size(), names_.size()));
+  names_ = std::move(names);
 }
 
 int Image::find_channel(std::string_view name) const noexcept {
-    for (std::size_t i = 0; i < names_.size(); ++i)
-        if (names_[i] == name) return static_cast<int>(i);
-    return -1;
+  for (std::size_t i = 0; i < names_.size(); ++i)
+    if (names_[i] == name) return static_cast<int>(i);
+  return -1;
 }
 
 float& Image::at(int x, int y, int c) {
-    if (x < 0 || y < 0 || c < 0 || x >= width_ || y >= height_ || c >= channels())
-        throw std::out_of_range(fmt::format("pixel ({}, {}) channel {} outside a {}x{} image of {} channels",
-                                            x, y, c, width_, height_, channels()));
-    return pixels_[(std::size_t(y) * std::size_t(width_) + std::size_t(x)) * names_.size() + std::size_t(c)];
+  if (x < 0 || y < 0 || c < 0 || x >= width_ || y >= height_ || c >= channels())
+    throw std::out_of_range(fmt::format("pixel ({}, {}) channel {} outside a {}x{} image of {} channels", x, y, c,
+                                        width_, height_, channels()));
+  return pixels_[(std::size_t(y) * std::size_t(width_) + std::size_t(x)) * names_.size() + std::size_t(c)];
 }
 
 float Image::at(int x, int y, int c) const { return const_cast<Image*>(this)->at(x, y, c); }
 
 Image Image::channel(int c) const {
-    if (c < 0 || c >= channels())
-        throw std::out_of_range(fmt::format("channel {} of an image of {} channels", c, channels()));
-    Image out(width_, height_, 1);
-    const std::size_t n = names_.size();
-    for (std::size_t i = 0; i < pixel_count(); ++i) out.pixels_[i] = pixels_[i * n + std::size_t(c)];
-    return out;
+  if (c < 0 || c >= channels())
+    throw std::out_of_range(fmt::format("channel {} of an image of {} channels", c, channels()));
+  Image out(width_, height_, 1);
+  const std::size_t n = names_.size();
+  for (std::size_t i = 0; i < pixel_count(); ++i) out.pixels_[i] = pixels_[i * n + std::size_t(c)];
+  return out;
 }
 
 Image Image::channel(std::string_view name) const {
-    int c = find_channel(name);
-    if (c < 0) {
-        std::string have;
-        for (const std::string& n : names_) have += (have.empty() ? "" : ", ") + n;
-        throw ImageError({}, fmt::format("no channel '{}' (channels: {})", name, have));
-    }
-    return channel(c);
+  int c = find_channel(name);
+  if (c < 0) {
+    std::string have;
+    for (const std::string& n : names_) have += (have.empty() ? "" : ", ") + n;
+    throw ImageError({}, fmt::format("no channel '{}' (channels: {})", name, have));
+  }
+  return channel(c);
 }
 
 // ---- Colour ----------------------------------------------------------------------------------
 
 float linear_to_srgb(float x) {
-    if (!(x > 0.0f)) return 0.0f; // also NaN
-    if (x >= 1.0f) return 1.0f;
-    double v = x;
-    return static_cast<float>(v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
+  if (!(x > 0.0f)) return 0.0f; // also NaN
+  if (x >= 1.0f) return 1.0f;
+  double v = x;
+  return static_cast<float>(v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
 }
 
 float srgb_to_linear(float e) {
-    if (!(e > 0.0f)) return 0.0f;
-    if (e >= 1.0f) return 1.0f;
-    double v = e;
-    return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+  if (!(e > 0.0f)) return 0.0f;
+  if (e >= 1.0f) return 1.0f;
+  double v = e;
+  return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
 }
 
 std::uint8_t linear_to_srgb8(float x) {
-    return static_cast<std::uint8_t>(std::lround(255.0 * double(linear_to_srgb(x))));
+  return static_cast<std::uint8_t>(std::lround(255.0 * double(linear_to_srgb(x))));
 }
 
 float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
 
 Image tone_map(const Image& image, const ToneMap& tone) {
-    Image out = image;
-    const int alpha = image.find_channel("A");
-    const float scale = std::exp2(tone.exposure_stops);
-    const int n = image.channels();
-    auto px = out.pixels();
-    for (std::size_t i = 0; i < px.size(); ++i) {
-        if (int(i % std::size_t(n)) == alpha) continue;
-        float x = px[i] * scale;
-        if (!(x > 0.0f)) { px[i] = 0.0f; continue; } // negative, NaN
-        switch (tone.curve) {
-        case ToneCurve::clamp: break;
-        case ToneCurve::reinhard: x = std::isinf(x) ? 1.0f : x / (1.0f + x); break;
-        case ToneCurve::aces:
-            x = std::isinf(x) ? 1.0f
-                              : std::clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
-            break;
-        }
-        px[i] = x;
+  Image out = image;
+  const int alpha = image.find_channel("A");
+  const float scale = std::exp2(tone.exposure_stops);
+  const int n = image.channels();
+  auto px = out.pixels();
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    if (int(i % std::size_t(n)) == alpha) continue;
+    float x = px[i] * scale;
+    if (!(x > 0.0f)) {
+      px[i] = 0.0f;
+      continue;
+    } // negative, NaN
+    switch (tone.curve) {
+    case ToneCurve::clamp: break;
+    case ToneCurve::reinhard: x = std::isinf(x) ? 1.0f : x / (1.0f + x); break;
+    case ToneCurve::aces:
+      x = std::isinf(x) ? 1.0f : std::clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+      break;
     }
-    return out;
+    px[i] = x;
+  }
+  return out;
 }
 
 std::vector<std::uint8_t> to_srgb8(const Image& image) {
-    const int alpha = image.find_channel("A");
-    const int n = image.channels();
-    auto px = image.pixels();
-    std::vector<std::uint8_t> out(px.size());
-    for (std::size_t i = 0; i < px.size(); ++i) {
-        if (int(i % std::size_t(n)) == alpha) {
-            float a = px[i];
-            out[i] = static_cast<std::uint8_t>(std::lround(255.0 * (a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f)));
-        } else {
-            out[i] = linear_to_srgb8(px[i]);
-        }
+  const int alpha = image.find_channel("A");
+  const int n = image.channels();
+  auto px = image.pixels();
+  std::vector<std::uint8_t> out(px.size());
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    if (int(i % std::size_t(n)) == alpha) {
+      float a = px[i];
+      out[i] = static_cast<std::uint8_t>(std::lround(255.0 * (a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f)));
+    } else {
+      out[i] = linear_to_srgb8(px[i]);
     }
-    return out;
+  }
+  return out;
 }
 
 } // namespace msm::image

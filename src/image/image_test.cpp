@@ -19,47 +19,47 @@ namespace {
 
 // A fresh directory per test under the system temp dir (removed afterwards).
 class ImageTest : public ::testing::Test {
-protected:
-    void SetUp() override {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir = fs::temp_directory_path() / ("msm_image_test_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir = fs::temp_directory_path() / ("msm_image_test_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  void TearDown() override { fs::remove_all(dir); }
 
-    // Files in dir other than the listed ones (temporary leftovers).
-    std::vector<std::string> entries() const {
-        std::vector<std::string> out;
-        for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
-        std::sort(out.begin(), out.end());
-        return out;
-    }
-    static std::string slurp(const fs::path& p) {
-        std::ifstream in(p, std::ios::binary);
-        return {std::istreambuf_iterator<char>(in), {}};
-    }
-    static void spit(const fs::path& p, const std::string& bytes) {
-        std::ofstream out(p, std::ios::binary);
-        out << bytes;
-    }
-    fs::path dir;
+  // Files in dir other than the listed ones (temporary leftovers).
+  std::vector<std::string> entries() const {
+    std::vector<std::string> out;
+    for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  static std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+  }
+  static void spit(const fs::path& p, const std::string& bytes) {
+    std::ofstream out(p, std::ios::binary);
+    out << bytes;
+  }
+  fs::path dir;
 };
 
 Image ramp(int w, int h, std::vector<std::string> names) {
-    Image im(w, h, std::move(names));
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            for (int c = 0; c < im.channels(); ++c)
-                im.at(x, y, c) = std::fmod(0.37f * float(x) + 0.11f * float(y) + 0.23f * float(c), 1.0f);
-    return im;
+  Image im(w, h, std::move(names));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < im.channels(); ++c)
+        im.at(x, y, c) = std::fmod(0.37f * float(x) + 0.11f * float(y) + 0.23f * float(c), 1.0f);
+  return im;
 }
 
 Image step(int w, int h, int edge) { // 0 left of the edge, 1 from it on
-    Image im(w, h, 1);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) im.at(x, y) = x >= edge ? 1.0f : 0.0f;
-    return im;
+  Image im(w, h, 1);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) im.at(x, y) = x >= edge ? 1.0f : 0.0f;
+  return im;
 }
 
 } // namespace
@@ -67,342 +67,340 @@ Image step(int w, int h, int edge) { // 0 left of the edge, 1 from it on
 // ---- Image and colour ------------------------------------------------------------------------
 
 TEST(Image, LayoutNamesAndBoundsChecks) {
-    Image im(3, 2, 4, 0.5f);
-    EXPECT_EQ(im.channel_names(), (std::vector<std::string>{"R", "G", "B", "A"}));
-    EXPECT_EQ(Image(1, 1, 1).channel_names(), std::vector<std::string>{"Y"});
-    im.at(2, 1, 3) = 7.0f;
-    EXPECT_EQ(im.pixels()[(1 * 3 + 2) * 4 + 3], 7.0f);
-    EXPECT_THROW(im.at(3, 0), std::out_of_range);
-    EXPECT_THROW(im.at(0, 2), std::out_of_range);
-    EXPECT_THROW(im.at(-1, 0), std::out_of_range);
-    EXPECT_THROW(im.at(0, 0, 4), std::out_of_range);
-    EXPECT_EQ(im.channel("A").at(2, 1), 7.0f);
-    EXPECT_THROW(im.channel("visibility"), ImageError);
-    EXPECT_THROW(Image(0, 4, 1), ImageError);
-    EXPECT_THROW(Image(4, max_side + 1, 1), ImageError);
-    EXPECT_THROW(Image(4, 4, 5), ImageError);
-    EXPECT_THROW(Image(4, 4, 0), ImageError);
-    EXPECT_THROW(Image(4, 4, std::vector<std::string>{"a", "a"}), ImageError);
-    EXPECT_THROW(Image(4, 4, std::vector<std::string>{""}), ImageError);
+  Image im(3, 2, 4, 0.5f);
+  EXPECT_EQ(im.channel_names(), (std::vector<std::string>{"R", "G", "B", "A"}));
+  EXPECT_EQ(Image(1, 1, 1).channel_names(), std::vector<std::string>{"Y"});
+  im.at(2, 1, 3) = 7.0f;
+  EXPECT_EQ(im.pixels()[(1 * 3 + 2) * 4 + 3], 7.0f);
+  EXPECT_THROW(im.at(3, 0), std::out_of_range);
+  EXPECT_THROW(im.at(0, 2), std::out_of_range);
+  EXPECT_THROW(im.at(-1, 0), std::out_of_range);
+  EXPECT_THROW(im.at(0, 0, 4), std::out_of_range);
+  EXPECT_EQ(im.channel("A").at(2, 1), 7.0f);
+  EXPECT_THROW(im.channel("visibility"), ImageError);
+  EXPECT_THROW(Image(0, 4, 1), ImageError);
+  EXPECT_THROW(Image(4, max_side + 1, 1), ImageError);
+  EXPECT_THROW(Image(4, 4, 5), ImageError);
+  EXPECT_THROW(Image(4, 4, 0), ImageError);
+  EXPECT_THROW(Image(4, 4, std::vector<std::string>{"a", "a"}), ImageError);
+  EXPECT_THROW(Image(4, 4, std::vector<std::string>{""}), ImageError);
 }
 
 TEST(Colour, ExactSrgbTransfer) {
-    EXPECT_EQ(linear_to_srgb(0.0f), 0.0f);
-    EXPECT_EQ(linear_to_srgb(1.0f), 1.0f);
-    EXPECT_FLOAT_EQ(linear_to_srgb(0.002f), 12.92f * 0.002f);              // linear segment
-    EXPECT_NEAR(linear_to_srgb(0.5f), 0.735356983, 1e-6);                   // 1.055 * 0.5^(1/2.4) - 0.055
-    EXPECT_NEAR(linear_to_srgb(0.214041144f), 0.5, 1e-6);
-    EXPECT_EQ(linear_to_srgb8(0.5f), 188);
-    EXPECT_EQ(linear_to_srgb8(-1.0f), 0);
-    EXPECT_EQ(linear_to_srgb8(std::nanf("")), 0);
-    EXPECT_EQ(linear_to_srgb8(5.0f), 255);
-    for (int i = 0; i <= 255; ++i) // decode then encode is the identity on 8-bit codes
-        EXPECT_EQ(linear_to_srgb8(srgb_to_linear(float(i) / 255.0f)), i) << i;
+  EXPECT_EQ(linear_to_srgb(0.0f), 0.0f);
+  EXPECT_EQ(linear_to_srgb(1.0f), 1.0f);
+  EXPECT_FLOAT_EQ(linear_to_srgb(0.002f), 12.92f * 0.002f); // linear segment
+  EXPECT_NEAR(linear_to_srgb(0.5f), 0.735356983, 1e-6);     // 1.055 * 0.5^(1/2.4) - 0.055
+  EXPECT_NEAR(linear_to_srgb(0.214041144f), 0.5, 1e-6);
+  EXPECT_EQ(linear_to_srgb8(0.5f), 188);
+  EXPECT_EQ(linear_to_srgb8(-1.0f), 0);
+  EXPECT_EQ(linear_to_srgb8(std::nanf("")), 0);
+  EXPECT_EQ(linear_to_srgb8(5.0f), 255);
+  for (int i = 0; i <= 255; ++i) // decode then encode is the identity on 8-bit codes
+    EXPECT_EQ(linear_to_srgb8(srgb_to_linear(float(i) / 255.0f)), i) << i;
 }
 
 TEST(Colour, ToneMapping) {
-    Image im(3, 1, 4, 1.0f);
-    im.at(0, 0, 0) = 1.0f;
-    im.at(1, 0, 0) = 3.0f;
-    im.at(2, 0, 0) = -2.0f;
-    im.at(0, 0, 3) = 0.25f;
-    Image r = tone_map(im, {.exposure_stops = 1.0f, .curve = ToneCurve::reinhard});
-    EXPECT_FLOAT_EQ(r.at(0, 0, 0), 2.0f / 3.0f);
-    EXPECT_FLOAT_EQ(r.at(1, 0, 0), 6.0f / 7.0f);
-    EXPECT_EQ(r.at(2, 0, 0), 0.0f);
-    EXPECT_EQ(r.at(0, 0, 3), 0.25f); // alpha untouched
-    Image a = tone_map(im, {.curve = ToneCurve::aces});
-    EXPECT_NEAR(a.at(0, 0, 0), 2.54f / 3.16f, 1e-6);
-    EXPECT_GT(a.at(1, 0, 0), a.at(0, 0, 0));
-    EXPECT_LE(a.at(1, 0, 0), 1.0f);
+  Image im(3, 1, 4, 1.0f);
+  im.at(0, 0, 0) = 1.0f;
+  im.at(1, 0, 0) = 3.0f;
+  im.at(2, 0, 0) = -2.0f;
+  im.at(0, 0, 3) = 0.25f;
+  Image r = tone_map(im, {.exposure_stops = 1.0f, .curve = ToneCurve::reinhard});
+  EXPECT_FLOAT_EQ(r.at(0, 0, 0), 2.0f / 3.0f);
+  EXPECT_FLOAT_EQ(r.at(1, 0, 0), 6.0f / 7.0f);
+  EXPECT_EQ(r.at(2, 0, 0), 0.0f);
+  EXPECT_EQ(r.at(0, 0, 3), 0.25f); // alpha untouched
+  Image a = tone_map(im, {.curve = ToneCurve::aces});
+  EXPECT_NEAR(a.at(0, 0, 0), 2.54f / 3.16f, 1e-6);
+  EXPECT_GT(a.at(1, 0, 0), a.at(0, 0, 0));
+  EXPECT_LE(a.at(1, 0, 0), 1.0f);
 }
 
 // ---- I/O -------------------------------------------------------------------------------------
 
 TEST_F(ImageTest, ExrRoundTripIsExact) {
-    for (int n = 1; n <= 4; ++n) {
-        Image im = ramp(37, 11, default_channel_names(n));
-        im.at(0, 0, 0) = -3.5f;         // out of [0,1] and special values survive
-        im.at(1, 0, 0) = 1e30f;
-        im.at(2, 0, 0) = std::nanf("");
-        im.at(3, 0, 0) = 1e-40f;        // denormal
-        const fs::path p = dir / ("im" + std::to_string(n) + ".exr");
-        write_exr(p, im);
-        Image back = read_exr(p);
-        ASSERT_EQ(back.channel_names(), im.channel_names());
-        ASSERT_EQ(back.width(), 37);
-        ASSERT_EQ(back.height(), 11);
-        EXPECT_TRUE(std::isnan(back.at(2, 0, 0)));
-        back.at(2, 0, 0) = im.at(2, 0, 0) = 0.0f; // NaN != NaN
-        EXPECT_TRUE(back == im) << n;
-        Image again = read_image(p);               // by content, same result
-        again.at(2, 0, 0) = 0.0f;
-        EXPECT_TRUE(again == im);
-    }
+  for (int n = 1; n <= 4; ++n) {
+    Image im = ramp(37, 11, default_channel_names(n));
+    im.at(0, 0, 0) = -3.5f; // out of [0,1] and special values survive
+    im.at(1, 0, 0) = 1e30f;
+    im.at(2, 0, 0) = std::nanf("");
+    im.at(3, 0, 0) = 1e-40f; // denormal
+    const fs::path p = dir / ("im" + std::to_string(n) + ".exr");
+    write_exr(p, im);
+    Image back = read_exr(p);
+    ASSERT_EQ(back.channel_names(), im.channel_names());
+    ASSERT_EQ(back.width(), 37);
+    ASSERT_EQ(back.height(), 11);
+    EXPECT_TRUE(std::isnan(back.at(2, 0, 0)));
+    back.at(2, 0, 0) = im.at(2, 0, 0) = 0.0f; // NaN != NaN
+    EXPECT_TRUE(back == im) << n;
+    Image again = read_image(p); // by content, same result
+    again.at(2, 0, 0) = 0.0f;
+    EXPECT_TRUE(again == im);
+  }
 }
 
 TEST_F(ImageTest, ExrNamedChannelsKeepTheirOrder) {
-    Image im = ramp(5, 4, {"visibility", "sample_count", "std_error"});
-    write_image(dir / "gt.EXR", im);
-    Image back = read_exr(dir / "gt.EXR");
-    EXPECT_EQ(back.channel_names(), (std::vector<std::string>{"visibility", "sample_count", "std_error"}));
-    EXPECT_TRUE(back == im);
-    EXPECT_EQ(back.channel("std_error").at(4, 3), im.at(4, 3, 2));
+  Image im = ramp(5, 4, {"visibility", "sample_count", "std_error"});
+  write_image(dir / "gt.EXR", im);
+  Image back = read_exr(dir / "gt.EXR");
+  EXPECT_EQ(back.channel_names(), (std::vector<std::string>{"visibility", "sample_count", "std_error"}));
+  EXPECT_TRUE(back == im);
+  EXPECT_EQ(back.channel("std_error").at(4, 3), im.at(4, 3, 2));
 }
 
 TEST_F(ImageTest, PngRoundTripWithinOneCode) {
-    for (int n : {1, 2, 3, 4}) {
-        Image im = ramp(19, 7, default_channel_names(n));
-        const fs::path p = dir / ("im" + std::to_string(n) + ".png");
-        write_png(p, im);
-        Image back = read_png(p);
-        ASSERT_EQ(back.channels(), n);
-        ASSERT_EQ(back.width(), 19);
-        for (int y = 0; y < 7; ++y)
-            for (int x = 0; x < 19; ++x)
-                for (int c = 0; c < n; ++c) {
-                    const bool alpha = (n == 2 || n == 4) && c == n - 1;
-                    const float v = im.at(x, y, c), w = back.at(x, y, c);
-                    if (alpha)
-                        EXPECT_NEAR(w, v, 0.5f / 255.0f + 1e-6f);
-                    else // within half a code after sRGB encoding, so within 1/255 in sRGB terms
-                        EXPECT_NEAR(linear_to_srgb(w), linear_to_srgb(v), 0.5f / 255.0f + 1e-6f);
-                }
-        // Re-encoding the decoded image gives the same bytes.
-        write_png(dir / "again.png", back);
-        EXPECT_EQ(slurp(dir / "again.png"), slurp(p));
-    }
+  for (int n : {1, 2, 3, 4}) {
+    Image im = ramp(19, 7, default_channel_names(n));
+    const fs::path p = dir / ("im" + std::to_string(n) + ".png");
+    write_png(p, im);
+    Image back = read_png(p);
+    ASSERT_EQ(back.channels(), n);
+    ASSERT_EQ(back.width(), 19);
+    for (int y = 0; y < 7; ++y)
+      for (int x = 0; x < 19; ++x)
+        for (int c = 0; c < n; ++c) {
+          const bool alpha = (n == 2 || n == 4) && c == n - 1;
+          const float v = im.at(x, y, c), w = back.at(x, y, c);
+          if (alpha)
+            EXPECT_NEAR(w, v, 0.5f / 255.0f + 1e-6f);
+          else // within half a code after sRGB encoding, so within 1/255 in sRGB terms
+            EXPECT_NEAR(linear_to_srgb(w), linear_to_srgb(v), 0.5f / 255.0f + 1e-6f);
+        }
+    // Re-encoding the decoded image gives the same bytes.
+    write_png(dir / "again.png", back);
+    EXPECT_EQ(slurp(dir / "again.png"), slurp(p));
+  }
 }
 
 TEST_F(ImageTest, AtomicWriteFailureLeavesNoTraceAndKeepsTheOldFile) {
-    // Tests may run as root, where permissions do not stop writes: the parent is a regular file.
-    spit(dir / "blocker", "not a directory");
-    EXPECT_THROW(write_exr(dir / "blocker" / "out.exr", Image(2, 2, 1)), ImageError);
-    EXPECT_THROW(write_png(dir / "blocker" / "out.png", Image(2, 2, 1)), ImageError);
-    try {
-        write_png(dir / "blocker" / "out.png", Image(2, 2, 1));
-    } catch (const ImageError& e) {
-        EXPECT_EQ(e.path(), dir / "blocker" / "out.png");
-        EXPECT_NE(std::string(e.what()).find("out.png"), std::string::npos);
-        EXPECT_NE(e.reason().find("Not a directory"), std::string::npos) << e.reason();
-    }
-    EXPECT_THROW(write_exr(dir / "missing_dir" / "out.exr", Image(2, 2, 1)), ImageError);
+  // Tests may run as root, where permissions do not stop writes: the parent is a regular file.
+  spit(dir / "blocker", "not a directory");
+  EXPECT_THROW(write_exr(dir / "blocker" / "out.exr", Image(2, 2, 1)), ImageError);
+  EXPECT_THROW(write_png(dir / "blocker" / "out.png", Image(2, 2, 1)), ImageError);
+  try {
+    write_png(dir / "blocker" / "out.png", Image(2, 2, 1));
+  } catch (const ImageError& e) {
+    EXPECT_EQ(e.path(), dir / "blocker" / "out.png");
+    EXPECT_NE(std::string(e.what()).find("out.png"), std::string::npos);
+    EXPECT_NE(e.reason().find("Not a directory"), std::string::npos) << e.reason();
+  }
+  EXPECT_THROW(write_exr(dir / "missing_dir" / "out.exr", Image(2, 2, 1)), ImageError);
 
-    // A failure at the rename (the target is a non-empty directory): the temporary file is
-    // removed. And an old target is replaced only by a complete file.
-    fs::create_directories(dir / "target.exr" / "inside");
-    EXPECT_THROW(write_exr(dir / "target.exr", Image(2, 2, 1)), ImageError);
-    EXPECT_EQ(entries(), (std::vector<std::string>{"blocker", "target.exr"}));
-    EXPECT_EQ(slurp(dir / "blocker"), "not a directory");
+  // A failure at the rename (the target is a non-empty directory): the temporary file is
+  // removed. And an old target is replaced only by a complete file.
+  fs::create_directories(dir / "target.exr" / "inside");
+  EXPECT_THROW(write_exr(dir / "target.exr", Image(2, 2, 1)), ImageError);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"blocker", "target.exr"}));
+  EXPECT_EQ(slurp(dir / "blocker"), "not a directory");
 
-    const Image old_image = ramp(4, 4, {"Y"});
-    write_exr(dir / "old.exr", old_image);
-    const std::string old_bytes = slurp(dir / "old.exr");
-    EXPECT_THROW(write_exr(dir / "old.exr", Image()), ImageError); // nothing to write
-    EXPECT_EQ(slurp(dir / "old.exr"), old_bytes);
-    write_exr(dir / "old.exr", ramp(8, 8, {"Y"}));                // a successful overwrite
-    EXPECT_TRUE(read_exr(dir / "old.exr") == ramp(8, 8, {"Y"}));
-    EXPECT_EQ(entries(), (std::vector<std::string>{"blocker", "old.exr", "target.exr"}));
-    EXPECT_THROW(write_image(dir / "x.tiff", old_image), ImageError);
+  const Image old_image = ramp(4, 4, {"Y"});
+  write_exr(dir / "old.exr", old_image);
+  const std::string old_bytes = slurp(dir / "old.exr");
+  EXPECT_THROW(write_exr(dir / "old.exr", Image()), ImageError); // nothing to write
+  EXPECT_EQ(slurp(dir / "old.exr"), old_bytes);
+  write_exr(dir / "old.exr", ramp(8, 8, {"Y"})); // a successful overwrite
+  EXPECT_TRUE(read_exr(dir / "old.exr") == ramp(8, 8, {"Y"}));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"blocker", "old.exr", "target.exr"}));
+  EXPECT_THROW(write_image(dir / "x.tiff", old_image), ImageError);
 }
 
 TEST_F(ImageTest, ReadErrors) {
-    EXPECT_THROW(read_image(dir / "missing.exr"), ImageError);
-    EXPECT_THROW(read_png(dir / "missing.png"), ImageError);
-    EXPECT_THROW(read_image(dir), ImageError);
-    spit(dir / "empty.exr", "");
-    EXPECT_THROW(read_image(dir / "empty.exr"), ImageError);
-    spit(dir / "garbage.exr", std::string(1000, 'x'));
-    EXPECT_THROW(read_exr(dir / "garbage.exr"), ImageError);
-    EXPECT_THROW(read_image(dir / "garbage.exr"), ImageError);
+  EXPECT_THROW(read_image(dir / "missing.exr"), ImageError);
+  EXPECT_THROW(read_png(dir / "missing.png"), ImageError);
+  EXPECT_THROW(read_image(dir), ImageError);
+  spit(dir / "empty.exr", "");
+  EXPECT_THROW(read_image(dir / "empty.exr"), ImageError);
+  spit(dir / "garbage.exr", std::string(1000, 'x'));
+  EXPECT_THROW(read_exr(dir / "garbage.exr"), ImageError);
+  EXPECT_THROW(read_image(dir / "garbage.exr"), ImageError);
 
-    write_exr(dir / "good.exr", ramp(64, 64, {"R", "G", "B"}));
-    write_png(dir / "good.png", ramp(64, 64, {"R", "G", "B"}));
-    EXPECT_THROW(read_png(dir / "good.exr"), ImageError); // wrong format for the reader
-    EXPECT_THROW(read_exr(dir / "good.png"), ImageError);
-    for (const char* name : {"good.exr", "good.png"}) {
-        const std::string bytes = slurp(dir / name);
-        for (std::size_t keep : {std::size_t(6), std::size_t(40), bytes.size() / 2, bytes.size() - 20}) {
-            spit(dir / "cut", bytes.substr(0, keep));
-            EXPECT_THROW(read_image(dir / "cut"), ImageError) << name << " cut to " << keep;
-        }
-        std::string corrupt = bytes; // header intact, payload garbage
-        for (std::size_t i = corrupt.size() / 2; i < corrupt.size(); ++i) corrupt[i] = char(i * 7);
-        spit(dir / "corrupt", corrupt);
-        EXPECT_THROW(read_image(dir / "corrupt"), ImageError) << name;
+  write_exr(dir / "good.exr", ramp(64, 64, {"R", "G", "B"}));
+  write_png(dir / "good.png", ramp(64, 64, {"R", "G", "B"}));
+  EXPECT_THROW(read_png(dir / "good.exr"), ImageError); // wrong format for the reader
+  EXPECT_THROW(read_exr(dir / "good.png"), ImageError);
+  for (const char* name : {"good.exr", "good.png"}) {
+    const std::string bytes = slurp(dir / name);
+    for (std::size_t keep : {std::size_t(6), std::size_t(40), bytes.size() / 2, bytes.size() - 20}) {
+      spit(dir / "cut", bytes.substr(0, keep));
+      EXPECT_THROW(read_image(dir / "cut"), ImageError) << name << " cut to " << keep;
     }
+    std::string corrupt = bytes; // header intact, payload garbage
+    for (std::size_t i = corrupt.size() / 2; i < corrupt.size(); ++i) corrupt[i] = char(i * 7);
+    spit(dir / "corrupt", corrupt);
+    EXPECT_THROW(read_image(dir / "corrupt"), ImageError) << name;
+  }
 }
 
 TEST_F(ImageTest, AbsurdSizesAreRejected) {
-    // A PNG header claiming 70000 x 1: rejected before decoding.
-    write_png(dir / "one.png", Image(1, 1, 1));
-    std::string png = slurp(dir / "one.png");
-    auto put32 = [&](std::size_t at, std::uint32_t v) {
-        for (int i = 0; i < 4; ++i) png[at + std::size_t(i)] = char((v >> (24 - 8 * i)) & 0xff);
-    };
-    put32(16, 70000); // IHDR width (stb ignores the chunk CRC)
-    spit(dir / "huge.png", png);
-    try {
-        read_image(dir / "huge.png");
-        ADD_FAILURE() << "no error";
-    } catch (const ImageError& e) {
-        EXPECT_NE(e.reason().find("70000"), std::string::npos) << e.reason();
-    }
-    EXPECT_THROW(Image(max_side + 1, 1, 1), ImageError);
-    EXPECT_NO_THROW(Image(max_side, 1, 1));
+  // A PNG header claiming 70000 x 1: rejected before decoding.
+  write_png(dir / "one.png", Image(1, 1, 1));
+  std::string png = slurp(dir / "one.png");
+  auto put32 = [&](std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) png[at + std::size_t(i)] = char((v >> (24 - 8 * i)) & 0xff);
+  };
+  put32(16, 70000); // IHDR width (stb ignores the chunk CRC)
+  spit(dir / "huge.png", png);
+  try {
+    read_image(dir / "huge.png");
+    ADD_FAILURE() << "no error";
+  } catch (const ImageError& e) { EXPECT_NE(e.reason().find("70000"), std::string::npos) << e.reason(); }
+  EXPECT_THROW(Image(max_side + 1, 1, 1), ImageError);
+  EXPECT_NO_THROW(Image(max_side, 1, 1));
 }
 
 // ---- Metrics ---------------------------------------------------------------------------------
 
 TEST(Metrics, ShiftedStepHasExactErrors) {
-    // Reference edge at x = 8, test edge at x = 7 in a 16 x 8 image: one column of 8 pixels is 1
-    // instead of 0 (test brighter): MAE = 8/128, RMSE = sqrt(8/128), max 1, all light leaking.
-    const Image ref = step(16, 8, 8), test = step(16, 8, 7);
-    const Metrics m = compute_metrics(test, ref);
-    EXPECT_EQ(m.pixels, 128u);
-    EXPECT_EQ(m.mae, 0.0625);
-    EXPECT_EQ(m.rmse, 0.25);
-    EXPECT_EQ(m.max_error, 1.0);
-    EXPECT_EQ(m.max_error_x, 7);
-    EXPECT_EQ(m.max_error_y, 0);
-    EXPECT_EQ(m.share_above_1pct, 0.0625);
-    EXPECT_EQ(m.share_above_3pct, 0.0625);
-    EXPECT_EQ(m.share_above_10pct, 0.0625);
-    EXPECT_EQ(m.light_leaking, 0.0625);
-    EXPECT_EQ(m.over_darkening, 0.0);
-    EXPECT_EQ(m.mean_error, 0.0625);
+  // Reference edge at x = 8, test edge at x = 7 in a 16 x 8 image: one column of 8 pixels is 1
+  // instead of 0 (test brighter): MAE = 8/128, RMSE = sqrt(8/128), max 1, all light leaking.
+  const Image ref = step(16, 8, 8), test = step(16, 8, 7);
+  const Metrics m = compute_metrics(test, ref);
+  EXPECT_EQ(m.pixels, 128u);
+  EXPECT_EQ(m.mae, 0.0625);
+  EXPECT_EQ(m.rmse, 0.25);
+  EXPECT_EQ(m.max_error, 1.0);
+  EXPECT_EQ(m.max_error_x, 7);
+  EXPECT_EQ(m.max_error_y, 0);
+  EXPECT_EQ(m.share_above_1pct, 0.0625);
+  EXPECT_EQ(m.share_above_3pct, 0.0625);
+  EXPECT_EQ(m.share_above_10pct, 0.0625);
+  EXPECT_EQ(m.light_leaking, 0.0625);
+  EXPECT_EQ(m.over_darkening, 0.0);
+  EXPECT_EQ(m.mean_error, 0.0625);
 
-    // The other way round the test is darker: over-darkening.
-    const Metrics d = compute_metrics(ref, test);
-    EXPECT_EQ(d.light_leaking, 0.0);
-    EXPECT_EQ(d.over_darkening, 0.0625);
-    EXPECT_EQ(d.mean_error, -0.0625);
+  // The other way round the test is darker: over-darkening.
+  const Metrics d = compute_metrics(ref, test);
+  EXPECT_EQ(d.light_leaking, 0.0);
+  EXPECT_EQ(d.over_darkening, 0.0625);
+  EXPECT_EQ(d.mean_error, -0.0625);
 
-    // As shadow intensity (larger = darker), a larger test value is over-darkening.
-    const Metrics s = compute_metrics(test, ref, {.signal = Signal::shadow_intensity});
-    EXPECT_EQ(s.light_leaking, 0.0);
-    EXPECT_EQ(s.over_darkening, 0.0625);
-    EXPECT_EQ(s.mae, 0.0625);
+  // As shadow intensity (larger = darker), a larger test value is over-darkening.
+  const Metrics s = compute_metrics(test, ref, {.signal = Signal::shadow_intensity});
+  EXPECT_EQ(s.light_leaking, 0.0);
+  EXPECT_EQ(s.over_darkening, 0.0625);
+  EXPECT_EQ(s.mae, 0.0625);
 
-    const Metrics same = compute_metrics(ref, ref);
-    EXPECT_EQ(same.mae, 0.0);
-    EXPECT_EQ(same.rmse, 0.0);
-    EXPECT_EQ(same.max_error, 0.0);
-    EXPECT_EQ(same.share_above_1pct, 0.0);
+  const Metrics same = compute_metrics(ref, ref);
+  EXPECT_EQ(same.mae, 0.0);
+  EXPECT_EQ(same.rmse, 0.0);
+  EXPECT_EQ(same.max_error, 0.0);
+  EXPECT_EQ(same.share_above_1pct, 0.0);
 }
 
 TEST(Metrics, ThresholdsAreStrictAndShareIsAFraction) {
-    // Differences 0.005, 0.02, 0.05, 0.2 (exactly representable offsets from 0.5 are not all
-    // possible in float, so use values well away from the thresholds).
-    Image ref(4, 1, 1, 0.5f), test(4, 1, 1, 0.5f);
-    const float d[4] = {0.005f, -0.02f, 0.05f, -0.2f};
-    for (int x = 0; x < 4; ++x) test.at(x, 0) += d[x];
-    const Metrics m = compute_metrics(test, ref);
-    EXPECT_EQ(m.share_above_1pct, 0.75);
-    EXPECT_EQ(m.share_above_3pct, 0.5);
-    EXPECT_EQ(m.share_above_10pct, 0.25);
-    EXPECT_NEAR(m.mae, (0.005 + 0.02 + 0.05 + 0.2) / 4, 1e-7);
-    EXPECT_NEAR(m.light_leaking, (0.005 + 0.05) / 4, 1e-7);
-    EXPECT_NEAR(m.over_darkening, (0.02 + 0.2) / 4, 1e-7);
-    EXPECT_NEAR(m.light_leaking + m.over_darkening, m.mae, 1e-12);
-    EXPECT_NEAR(m.rmse, std::sqrt((0.005 * 0.005 + 0.02 * 0.02 + 0.05 * 0.05 + 0.2 * 0.2) / 4), 1e-7);
-    EXPECT_EQ(m.max_error_x, 3);
+  // Differences 0.005, 0.02, 0.05, 0.2 (exactly representable offsets from 0.5 are not all
+  // possible in float, so use values well away from the thresholds).
+  Image ref(4, 1, 1, 0.5f), test(4, 1, 1, 0.5f);
+  const float d[4] = {0.005f, -0.02f, 0.05f, -0.2f};
+  for (int x = 0; x < 4; ++x) test.at(x, 0) += d[x];
+  const Metrics m = compute_metrics(test, ref);
+  EXPECT_EQ(m.share_above_1pct, 0.75);
+  EXPECT_EQ(m.share_above_3pct, 0.5);
+  EXPECT_EQ(m.share_above_10pct, 0.25);
+  EXPECT_NEAR(m.mae, (0.005 + 0.02 + 0.05 + 0.2) / 4, 1e-7);
+  EXPECT_NEAR(m.light_leaking, (0.005 + 0.05) / 4, 1e-7);
+  EXPECT_NEAR(m.over_darkening, (0.02 + 0.2) / 4, 1e-7);
+  EXPECT_NEAR(m.light_leaking + m.over_darkening, m.mae, 1e-12);
+  EXPECT_NEAR(m.rmse, std::sqrt((0.005 * 0.005 + 0.02 * 0.02 + 0.05 * 0.05 + 0.2 * 0.2) / 4), 1e-7);
+  EXPECT_EQ(m.max_error_x, 3);
 }
 
 TEST(Metrics, MaskNonFiniteChannelsAndLuminance) {
-    const Image ref = step(16, 8, 8), test = step(16, 8, 7);
-    Image mask(16, 8, 1, 0.0f);
-    for (int y = 0; y < 8; ++y) mask.at(7, y) = 1.0f; // ignore the differing column
-    const Metrics m = compute_metrics(test, ref, {.mask = &mask});
-    EXPECT_EQ(m.masked, 8u);
-    EXPECT_EQ(m.pixels, 120u);
-    EXPECT_EQ(m.mae, 0.0);
+  const Image ref = step(16, 8, 8), test = step(16, 8, 7);
+  Image mask(16, 8, 1, 0.0f);
+  for (int y = 0; y < 8; ++y) mask.at(7, y) = 1.0f; // ignore the differing column
+  const Metrics m = compute_metrics(test, ref, {.mask = &mask});
+  EXPECT_EQ(m.masked, 8u);
+  EXPECT_EQ(m.pixels, 120u);
+  EXPECT_EQ(m.mae, 0.0);
 
-    Image nan_test = test;
-    nan_test.at(0, 0) = std::nanf("");
-    nan_test.at(1, 0) = INFINITY;
-    const Metrics n = compute_metrics(nan_test, ref);
-    EXPECT_EQ(n.non_finite, 2u);
-    EXPECT_EQ(n.pixels, 126u);
-    EXPECT_EQ(n.mae, 8.0 / 126.0);
+  Image nan_test = test;
+  nan_test.at(0, 0) = std::nanf("");
+  nan_test.at(1, 0) = INFINITY;
+  const Metrics n = compute_metrics(nan_test, ref);
+  EXPECT_EQ(n.non_finite, 2u);
+  EXPECT_EQ(n.pixels, 126u);
+  EXPECT_EQ(n.mae, 8.0 / 126.0);
 
-    // RGB: compared as Rec. 709 luminance; a named channel on request.
-    Image rgb_ref(2, 1, 3, 0.0f), rgb_test(2, 1, 3, 0.0f);
-    rgb_test.at(0, 0, 1) = 1.0f; // green +1 -> luminance +0.7152
-    const Metrics l = compute_metrics(rgb_test, rgb_ref);
-    EXPECT_NEAR(l.mae, 0.7152 / 2, 1e-6);
-    EXPECT_NEAR(compute_metrics(rgb_test, rgb_ref, {.channel = "G"}).mae, 0.5, 0);
-    EXPECT_EQ(compute_metrics(rgb_test, rgb_ref, {.channel = "B"}).mae, 0.0);
-    EXPECT_THROW(compute_metrics(rgb_test, rgb_ref, {.channel = "visibility"}), ImageError);
+  // RGB: compared as Rec. 709 luminance; a named channel on request.
+  Image rgb_ref(2, 1, 3, 0.0f), rgb_test(2, 1, 3, 0.0f);
+  rgb_test.at(0, 0, 1) = 1.0f; // green +1 -> luminance +0.7152
+  const Metrics l = compute_metrics(rgb_test, rgb_ref);
+  EXPECT_NEAR(l.mae, 0.7152 / 2, 1e-6);
+  EXPECT_NEAR(compute_metrics(rgb_test, rgb_ref, {.channel = "G"}).mae, 0.5, 0);
+  EXPECT_EQ(compute_metrics(rgb_test, rgb_ref, {.channel = "B"}).mae, 0.0);
+  EXPECT_THROW(compute_metrics(rgb_test, rgb_ref, {.channel = "visibility"}), ImageError);
 
-    Image gt = ramp(4, 4, {"visibility", "sample_count", "std_error"});
-    EXPECT_THROW(compute_metrics(gt, gt), ImageError); // several channels, none chosen
-    EXPECT_EQ(compute_metrics(gt, gt, {.channel = "visibility"}).mae, 0.0);
+  Image gt = ramp(4, 4, {"visibility", "sample_count", "std_error"});
+  EXPECT_THROW(compute_metrics(gt, gt), ImageError); // several channels, none chosen
+  EXPECT_EQ(compute_metrics(gt, gt, {.channel = "visibility"}).mae, 0.0);
 
-    EXPECT_THROW(compute_metrics(step(16, 8, 8), step(15, 8, 8)), ImageError);
-    Image small_mask(2, 2, 1);
-    EXPECT_THROW(compute_metrics(test, ref, {.mask = &small_mask}), ImageError);
+  EXPECT_THROW(compute_metrics(step(16, 8, 8), step(15, 8, 8)), ImageError);
+  Image small_mask(2, 2, 1);
+  EXPECT_THROW(compute_metrics(test, ref, {.mask = &small_mask}), ImageError);
 }
 
 TEST_F(ImageTest, ErrorImageColours) {
-    Image ref(5, 1, 1, 0.5f), test(5, 1, 1, 0.5f);
-    test.at(0, 0) = 0.6f;  // brighter by the full range: red
-    test.at(1, 0) = 0.4f;  // darker by the full range: blue
-    test.at(2, 0) = 0.525f; // a quarter of the range brighter: light red (1, 0.75, 0.75)
-    test.at(4, 0) = std::nanf("");
-    Image mask(5, 1, 1, 0.0f);
-    mask.at(3, 0) = 1.0f;
-    const MetricOptions options{.mask = &mask};
-    write_error_png(dir / "err.png", test, ref, 0.1, options);
-    const std::vector<std::uint8_t> bytes = to_srgb8(read_png(dir / "err.png"));
-    const std::vector<std::uint8_t> expected = {255, 0, 0, 0, 0, 255, 255, 191, 191, 128, 128, 128, 0, 255, 0};
-    EXPECT_EQ(bytes, expected);
-    EXPECT_THROW(error_image(test, ref, 0.0), ImageError);
-    // For shadow intensity the colours swap: a larger test value is darker (blue).
-    const Image s = error_image(test, ref, 0.1, {.signal = Signal::shadow_intensity});
-    EXPECT_EQ(linear_to_srgb8(s.at(0, 0, 2)), 255);
-    EXPECT_EQ(linear_to_srgb8(s.at(0, 0, 0)), 0);
+  Image ref(5, 1, 1, 0.5f), test(5, 1, 1, 0.5f);
+  test.at(0, 0) = 0.6f;   // brighter by the full range: red
+  test.at(1, 0) = 0.4f;   // darker by the full range: blue
+  test.at(2, 0) = 0.525f; // a quarter of the range brighter: light red (1, 0.75, 0.75)
+  test.at(4, 0) = std::nanf("");
+  Image mask(5, 1, 1, 0.0f);
+  mask.at(3, 0) = 1.0f;
+  const MetricOptions options{.mask = &mask};
+  write_error_png(dir / "err.png", test, ref, 0.1, options);
+  const std::vector<std::uint8_t> bytes = to_srgb8(read_png(dir / "err.png"));
+  const std::vector<std::uint8_t> expected = {255, 0, 0, 0, 0, 255, 255, 191, 191, 128, 128, 128, 0, 255, 0};
+  EXPECT_EQ(bytes, expected);
+  EXPECT_THROW(error_image(test, ref, 0.0), ImageError);
+  // For shadow intensity the colours swap: a larger test value is darker (blue).
+  const Image s = error_image(test, ref, 0.1, {.signal = Signal::shadow_intensity});
+  EXPECT_EQ(linear_to_srgb8(s.at(0, 0, 2)), 255);
+  EXPECT_EQ(linear_to_srgb8(s.at(0, 0, 0)), 0);
 }
 
 // ---- The image-test helper -------------------------------------------------------------------
 
 TEST_F(ImageTest, CompareDumpsActualReferenceAndErrorOnFailure) {
-    const Image ref = step(16, 8, 8), test = step(16, 8, 7);
-    const fs::path out = dir / "test-failures" / "Shadow.Step";
+  const Image ref = step(16, 8, 8), test = step(16, 8, 7);
+  const fs::path out = dir / "test-failures" / "Shadow.Step";
 
-    CompareResult ok = compare(ref, ref, {}, {.failure_dir = out});
-    EXPECT_TRUE(ok.passed) << ok.report;
-    EXPECT_TRUE(ok);
-    EXPECT_EQ(ok.report.rfind("PASS", 0), 0u) << ok.report;
-    EXPECT_FALSE(fs::exists(out));
+  CompareResult ok = compare(ref, ref, {}, {.failure_dir = out});
+  EXPECT_TRUE(ok.passed) << ok.report;
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(ok.report.rfind("PASS", 0), 0u) << ok.report;
+  EXPECT_FALSE(fs::exists(out));
 
-    // MAE 0.0625 is within 0.1, but 6.25% of the pixels are off by more than 3% (> 1%).
-    CompareResult bad = compare(test, ref, {.max_mae = 0.1, .max_share_above_3pct = 0.01}, {.failure_dir = out});
-    EXPECT_FALSE(bad.passed);
-    EXPECT_EQ(bad.report.rfind("FAIL", 0), 0u) << bad.report;
-    EXPECT_NE(bad.report.find("share_above_3pct = 0.0625 > tolerance 0.01"), std::string::npos) << bad.report;
-    EXPECT_EQ(bad.report.find("mae = "), std::string::npos) << bad.report; // within tolerance
-    EXPECT_NE(bad.report.find(out.string()), std::string::npos) << bad.report;
-    EXPECT_TRUE(read_exr(out / "actual.exr") == test);
-    EXPECT_TRUE(read_exr(out / "reference.exr") == ref);
-    EXPECT_EQ(read_png(out / "actual.png").width(), 16);
-    EXPECT_EQ(read_png(out / "reference.png").width(), 16);
-    const Image err = read_png(out / "error.png");
-    EXPECT_EQ(err.channels(), 3);
-    EXPECT_EQ(to_srgb8(err)[3 * 7], 255);     // the leaking column is red
-    EXPECT_EQ(to_srgb8(err)[3 * 7 + 1], 0);
+  // MAE 0.0625 is within 0.1, but 6.25% of the pixels are off by more than 3% (> 1%).
+  CompareResult bad = compare(test, ref, {.max_mae = 0.1, .max_share_above_3pct = 0.01}, {.failure_dir = out});
+  EXPECT_FALSE(bad.passed);
+  EXPECT_EQ(bad.report.rfind("FAIL", 0), 0u) << bad.report;
+  EXPECT_NE(bad.report.find("share_above_3pct = 0.0625 > tolerance 0.01"), std::string::npos) << bad.report;
+  EXPECT_EQ(bad.report.find("mae = "), std::string::npos) << bad.report; // within tolerance
+  EXPECT_NE(bad.report.find(out.string()), std::string::npos) << bad.report;
+  EXPECT_TRUE(read_exr(out / "actual.exr") == test);
+  EXPECT_TRUE(read_exr(out / "reference.exr") == ref);
+  EXPECT_EQ(read_png(out / "actual.png").width(), 16);
+  EXPECT_EQ(read_png(out / "reference.png").width(), 16);
+  const Image err = read_png(out / "error.png");
+  EXPECT_EQ(err.channels(), 3);
+  EXPECT_EQ(to_srgb8(err)[3 * 7], 255); // the leaking column is red
+  EXPECT_EQ(to_srgb8(err)[3 * 7 + 1], 0);
 
-    // Tolerances loose enough pass; a size mismatch fails without throwing and dumps no error.png.
-    EXPECT_TRUE(compare(test, ref, {.max_mae = 0.07, .max_share_above_3pct = 0.07}).passed);
-    const fs::path out2 = dir / "mismatch";
-    CompareResult mismatch = compare(step(15, 8, 7), ref, {}, {.failure_dir = out2});
-    EXPECT_FALSE(mismatch.passed);
-    EXPECT_NE(mismatch.report.find("size mismatch"), std::string::npos) << mismatch.report;
-    EXPECT_TRUE(fs::exists(out2 / "actual.exr"));
-    EXPECT_TRUE(fs::exists(out2 / "reference.exr"));
-    EXPECT_FALSE(fs::exists(out2 / "error.png"));
+  // Tolerances loose enough pass; a size mismatch fails without throwing and dumps no error.png.
+  EXPECT_TRUE(compare(test, ref, {.max_mae = 0.07, .max_share_above_3pct = 0.07}).passed);
+  const fs::path out2 = dir / "mismatch";
+  CompareResult mismatch = compare(step(15, 8, 7), ref, {}, {.failure_dir = out2});
+  EXPECT_FALSE(mismatch.passed);
+  EXPECT_NE(mismatch.report.find("size mismatch"), std::string::npos) << mismatch.report;
+  EXPECT_TRUE(fs::exists(out2 / "actual.exr"));
+  EXPECT_TRUE(fs::exists(out2 / "reference.exr"));
+  EXPECT_FALSE(fs::exists(out2 / "error.png"));
 
-    Image nan_test = ref;
-    nan_test.at(0, 0) = std::nanf("");
-    EXPECT_FALSE(compare(nan_test, ref).passed);
+  Image nan_test = ref;
+  nan_test.at(0, 0) = std::nanf("");
+  EXPECT_FALSE(compare(nan_test, ref).passed);
 }

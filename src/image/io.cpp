@@ -13,6 +13,7 @@
 
 #include <fmt/core.h>
 
+#include <OpenEXR/Iex.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
@@ -20,7 +21,6 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringVectorAttribute.h>
-#include <OpenEXR/Iex.h>
 
 // stb's PNG reader and writer, compiled here with internal linkage (io.cpp is their only user):
 // msm_image then neither needs Debian's libstb nor clashes with a downstream copy of stb.
@@ -45,170 +45,169 @@ constexpr const char* channel_order_attribute = "msmChannelOrder";
 std::string errno_text(int err) { return std::strerror(err); }
 
 std::vector<std::uint8_t> read_file(const fs::path& path) {
-    std::error_code ec;
-    if (fs::is_directory(path, ec)) throw ImageError(path, "is a directory");
-    int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw ImageError(path, "cannot open: " + errno_text(errno));
-    std::vector<std::uint8_t> bytes;
-    std::uint8_t buffer[1 << 16];
-    for (;;) {
-        ssize_t n = ::read(fd, buffer, sizeof buffer);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            int err = errno;
-            ::close(fd);
-            throw ImageError(path, "cannot read: " + errno_text(err));
-        }
-        if (n == 0) break;
-        bytes.insert(bytes.end(), buffer, buffer + n);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw ImageError(path, "is a directory");
+  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw ImageError(path, "cannot open: " + errno_text(errno));
+  std::vector<std::uint8_t> bytes;
+  std::uint8_t buffer[1 << 16];
+  for (;;) {
+    ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      int err = errno;
+      ::close(fd);
+      throw ImageError(path, "cannot read: " + errno_text(err));
     }
-    ::close(fd);
-    return bytes;
+    if (n == 0) break;
+    bytes.insert(bytes.end(), buffer, buffer + n);
+  }
+  ::close(fd);
+  return bytes;
 }
 
 void check_size(const fs::path& path, long long width, long long height) {
-    if (width < 1 || height < 1 || width > max_side || height > max_side)
-        throw ImageError(path, fmt::format("image size {}x{} is outside 1..{} per side", width, height, max_side));
+  if (width < 1 || height < 1 || width > max_side || height > max_side)
+    throw ImageError(path, fmt::format("image size {}x{} is outside 1..{} per side", width, height, max_side));
 }
 
 bool is_png(std::span<const std::uint8_t> b) {
-    static constexpr std::uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    return b.size() >= 8 && std::equal(sig, sig + 8, b.begin());
+  static constexpr std::uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  return b.size() >= 8 && std::equal(sig, sig + 8, b.begin());
 }
 bool is_exr(std::span<const std::uint8_t> b) {
-    return b.size() >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
+  return b.size() >= 4 && b[0] == 0x76 && b[1] == 0x2f && b[2] == 0x31 && b[3] == 0x01;
 }
 
 // ---- EXR streams in memory -------------------------------------------------------------------
 
 class MemoryOStream : public Imf::OStream {
-public:
-    MemoryOStream() : Imf::OStream("<memory>") {}
-    void write(const char c[], int n) override {
-        if (pos_ + std::size_t(n) > bytes.size()) bytes.resize(pos_ + std::size_t(n));
-        std::memcpy(bytes.data() + pos_, c, std::size_t(n));
-        pos_ += std::size_t(n);
-    }
-    uint64_t tellp() override { return pos_; }
-    void seekp(uint64_t pos) override { pos_ = pos; }
-    std::vector<std::uint8_t> bytes;
+ public:
+  MemoryOStream() : Imf::OStream("<memory>") {}
+  void write(const char c[], int n) override {
+    if (pos_ + std::size_t(n) > bytes.size()) bytes.resize(pos_ + std::size_t(n));
+    std::memcpy(bytes.data() + pos_, c, std::size_t(n));
+    pos_ += std::size_t(n);
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = pos; }
+  std::vector<std::uint8_t> bytes;
 
-private:
-    std::size_t pos_ = 0;
+ private:
+  std::size_t pos_ = 0;
 };
 
 class MemoryIStream : public Imf::IStream {
-public:
-    MemoryIStream(std::span<const std::uint8_t> bytes, const std::string& name) : Imf::IStream(name.c_str()), bytes_(bytes) {}
-    bool read(char c[], int n) override {
-        if (n < 0 || pos_ > bytes_.size() || bytes_.size() - pos_ < std::size_t(n))
-            throw IEX_NAMESPACE::InputExc("unexpected end of file");
-        std::memcpy(c, bytes_.data() + pos_, std::size_t(n));
-        pos_ += std::size_t(n);
-        return pos_ < bytes_.size();
-    }
-    uint64_t tellg() override { return pos_; }
-    void seekg(uint64_t pos) override { pos_ = pos; }
-    void clear() override {}
+ public:
+  MemoryIStream(std::span<const std::uint8_t> bytes, const std::string& name)
+      : Imf::IStream(name.c_str()), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || pos_ > bytes_.size() || bytes_.size() - pos_ < std::size_t(n))
+      throw IEX_NAMESPACE::InputExc("unexpected end of file");
+    std::memcpy(c, bytes_.data() + pos_, std::size_t(n));
+    pos_ += std::size_t(n);
+    return pos_ < bytes_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override { pos_ = pos; }
+  void clear() override {}
 
-private:
-    std::span<const std::uint8_t> bytes_;
-    std::size_t pos_ = 0;
+ private:
+  std::span<const std::uint8_t> bytes_;
+  std::size_t pos_ = 0;
 };
 
 // ---- PNG -------------------------------------------------------------------------------------
 
 void append_bytes(void* context, void* data, int size) {
-    auto* out = static_cast<std::vector<std::uint8_t>*>(context);
-    auto* p = static_cast<const std::uint8_t*>(data);
-    out->insert(out->end(), p, p + size);
+  auto* out = static_cast<std::vector<std::uint8_t>*>(context);
+  auto* p = static_cast<const std::uint8_t*>(data);
+  out->insert(out->end(), p, p + size);
 }
 
 Image decode_png(const fs::path& path, std::span<const std::uint8_t> bytes) {
-    if (bytes.size() > std::size_t(INT32_MAX)) throw ImageError(path, "file too large");
-    const int len = static_cast<int>(bytes.size());
-    int w = 0, h = 0, n = 0;
-    if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &n))
-        throw ImageError(path, std::string("not a readable PNG: ") + stbi_failure_reason());
-    check_size(path, w, h);
-    if (n < 1 || n > 4) throw ImageError(path, fmt::format("{} channels", n));
-    const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
-    Image image(w, h, n);
-    auto px = image.pixels();
-    const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
-    auto convert = [&](auto* data, double max) {
-        if (!data) throw ImageError(path, std::string("malformed or truncated PNG: ") + stbi_failure_reason());
-        for (std::size_t i = 0; i < px.size(); ++i) {
-            float v = static_cast<float>(double(data[i]) / max);
-            px[i] = int(i % std::size_t(n)) == alpha ? v : srgb_to_linear(v);
-        }
-        stbi_image_free(data);
-    };
-    int rw = 0, rh = 0, rn = 0;
-    if (sixteen)
-        convert(stbi_load_16_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 65535.0);
-    else
-        convert(stbi_load_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 255.0);
-    return image;
+  if (bytes.size() > std::size_t(INT32_MAX)) throw ImageError(path, "file too large");
+  const int len = static_cast<int>(bytes.size());
+  int w = 0, h = 0, n = 0;
+  if (!stbi_info_from_memory(bytes.data(), len, &w, &h, &n))
+    throw ImageError(path, std::string("not a readable PNG: ") + stbi_failure_reason());
+  check_size(path, w, h);
+  if (n < 1 || n > 4) throw ImageError(path, fmt::format("{} channels", n));
+  const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
+  Image image(w, h, n);
+  auto px = image.pixels();
+  const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
+  auto convert = [&](auto* data, double max) {
+    if (!data) throw ImageError(path, std::string("malformed or truncated PNG: ") + stbi_failure_reason());
+    for (std::size_t i = 0; i < px.size(); ++i) {
+      float v = static_cast<float>(double(data[i]) / max);
+      px[i] = int(i % std::size_t(n)) == alpha ? v : srgb_to_linear(v);
+    }
+    stbi_image_free(data);
+  };
+  int rw = 0, rh = 0, rn = 0;
+  if (sixteen)
+    convert(stbi_load_16_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 65535.0);
+  else
+    convert(stbi_load_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 255.0);
+  return image;
 }
 
 // ---- EXR -------------------------------------------------------------------------------------
 
 Image decode_exr(const fs::path& path, std::span<const std::uint8_t> bytes) {
-    try {
-        MemoryIStream stream(bytes, path.string());
-        Imf::InputFile file(stream);
-        const Imf::Header& header = file.header();
-        const Imath::Box2i dw = header.dataWindow();
-        const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
-        check_size(path, w, h);
-        std::vector<std::string> names;
-        for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-            const Imf::Channel& ch = it.channel();
-            if (ch.xSampling != 1 || ch.ySampling != 1)
-                throw ImageError(path, fmt::format("channel '{}' is subsampled (unsupported)", it.name()));
-            names.emplace_back(it.name());
-        }
-        if (names.empty() || names.size() > std::size_t(max_channels))
-            throw ImageError(path, fmt::format("{} channels (1..{} supported)", names.size(), max_channels));
-        // Order: the attribute we write, else R,G,B,A / Y,A, else the file's order.
-        std::set<std::string> have(names.begin(), names.end());
-        std::vector<std::string> order;
-        if (auto* attr = header.findTypedAttribute<Imf::StringVectorAttribute>(channel_order_attribute)) {
-            const auto& v = attr->value();
-            if (std::set<std::string>(v.begin(), v.end()) == have && v.size() == have.size()) order = v;
-        }
-        if (order.empty()) {
-            for (const auto& known : {std::vector<std::string>{"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}})
-                if (std::set<std::string>(known.begin(), known.end()) == have) order = known;
-        }
-        if (order.empty()) order = names;
-        Image image(int(w), int(h), order);
-        if (!file.isComplete()) throw ImageError(path, "truncated EXR (missing pixel data)");
-        const std::size_t n = order.size();
-        float* base = image.pixels().data();
-        Imf::FrameBuffer fb;
-        for (std::size_t c = 0; c < n; ++c)
-            fb.insert(order[c], Imf::Slice::Make(Imf::FLOAT, base + c, dw, sizeof(float) * n,
-                                                 sizeof(float) * n * std::size_t(w)));
-        file.setFrameBuffer(fb);
-        file.readPixels(dw.min.y, dw.max.y);
-        return image;
-    } catch (const ImageError&) {
-        throw;
-    } catch (const std::exception& e) {
-        throw ImageError(path, std::string("malformed or truncated EXR: ") + e.what());
+  try {
+    MemoryIStream stream(bytes, path.string());
+    Imf::InputFile file(stream);
+    const Imf::Header& header = file.header();
+    const Imath::Box2i dw = header.dataWindow();
+    const long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
+    check_size(path, w, h);
+    std::vector<std::string> names;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+      const Imf::Channel& ch = it.channel();
+      if (ch.xSampling != 1 || ch.ySampling != 1)
+        throw ImageError(path, fmt::format("channel '{}' is subsampled (unsupported)", it.name()));
+      names.emplace_back(it.name());
     }
+    if (names.empty() || names.size() > std::size_t(max_channels))
+      throw ImageError(path, fmt::format("{} channels (1..{} supported)", names.size(), max_channels));
+    // Order: the attribute we write, else R,G,B,A / Y,A, else the file's order.
+    std::set<std::string> have(names.begin(), names.end());
+    std::vector<std::string> order;
+    if (auto* attr = header.findTypedAttribute<Imf::StringVectorAttribute>(channel_order_attribute)) {
+      const auto& v = attr->value();
+      if (std::set<std::string>(v.begin(), v.end()) == have && v.size() == have.size()) order = v;
+    }
+    if (order.empty()) {
+      for (const auto& known : {std::vector<std::string>{"Y"}, {"Y", "A"}, {"R", "G", "B"}, {"R", "G", "B", "A"}})
+        if (std::set<std::string>(known.begin(), known.end()) == have) order = known;
+    }
+    if (order.empty()) order = names;
+    Image image(int(w), int(h), order);
+    if (!file.isComplete()) throw ImageError(path, "truncated EXR (missing pixel data)");
+    const std::size_t n = order.size();
+    float* base = image.pixels().data();
+    Imf::FrameBuffer fb;
+    for (std::size_t c = 0; c < n; ++c)
+      fb.insert(order[c],
+                Imf::Slice::Make(Imf::FLOAT, base + c, dw, sizeof(float) * n, sizeof(float) * n * std::size_t(w)));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return image;
+  } catch (const ImageError&) { throw; } catch (const std::exception& e) {
+    throw ImageError(path, std::string("malformed or truncated EXR: ") + e.what());
+  }
 }
 
 std::string lower_extension(const fs::path& path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
-    return ext;
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  return ext;
 }
 
 void require_image(const fs::path& path, const Image& image) {
-    if (image.empty()) throw ImageError(path, "cannot write an empty image");
+  if (image.empty()) throw ImageError(path, "cannot write an empty image");
 }
 
 } // namespace
@@ -216,107 +215,104 @@ void require_image(const fs::path& path, const Image& image) {
 // ---- Atomic write ----------------------------------------------------------------------------
 
 void write_file_atomic(const fs::path& path, std::span<const std::uint8_t> bytes) {
-    if (path.empty() || !path.has_filename()) throw ImageError(path, "not a file path");
-    static std::atomic<unsigned> counter{0};
-    const fs::path dir = path.parent_path();
-    const fs::path tmp = (dir.empty() ? fs::path(".") : dir) /
-        fmt::format(".{}.tmp.{}.{}", path.filename().string(), ::getpid(), counter++);
-    int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0) throw ImageError(path, "cannot create temporary file " + tmp.string() + ": " + errno_text(errno));
-    auto fail = [&](const std::string& what, int err) {
-        if (fd >= 0) ::close(fd);
-        ::unlink(tmp.c_str());
-        throw ImageError(path, what + ": " + errno_text(err));
-    };
-    std::size_t done = 0;
-    while (done < bytes.size()) {
-        ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            fail("cannot write", errno);
-        }
-        done += std::size_t(n);
+  if (path.empty() || !path.has_filename()) throw ImageError(path, "not a file path");
+  static std::atomic<unsigned> counter{0};
+  const fs::path dir = path.parent_path();
+  const fs::path tmp = (dir.empty() ? fs::path(".") : dir) /
+                       fmt::format(".{}.tmp.{}.{}", path.filename().string(), ::getpid(), counter++);
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) throw ImageError(path, "cannot create temporary file " + tmp.string() + ": " + errno_text(errno));
+  auto fail = [&](const std::string& what, int err) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    throw ImageError(path, what + ": " + errno_text(err));
+  };
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("cannot write", errno);
     }
-    if (::fsync(fd) != 0) fail("cannot flush", errno);
-    int rc = ::close(fd);
-    fd = -1;
-    if (rc != 0) fail("cannot close", errno);
-    if (::rename(tmp.c_str(), path.c_str()) != 0) fail("cannot rename the temporary file over the target", errno);
+    done += std::size_t(n);
+  }
+  if (::fsync(fd) != 0) fail("cannot flush", errno);
+  int rc = ::close(fd);
+  fd = -1;
+  if (rc != 0) fail("cannot close", errno);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) fail("cannot rename the temporary file over the target", errno);
 }
 
 // ---- PNG -------------------------------------------------------------------------------------
 
 void write_png(const fs::path& path, const Image& image) {
-    require_image(path, image);
-    const int n = image.channels();
-    const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
-    auto px = image.pixels();
-    std::vector<std::uint8_t> data(px.size());
-    for (std::size_t i = 0; i < px.size(); ++i) {
-        if (int(i % std::size_t(n)) == alpha) {
-            float a = px[i];
-            data[i] = static_cast<std::uint8_t>(std::lround(255.0 * (a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f)));
-        } else {
-            data[i] = linear_to_srgb8(px[i]);
-        }
+  require_image(path, image);
+  const int n = image.channels();
+  const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
+  auto px = image.pixels();
+  std::vector<std::uint8_t> data(px.size());
+  for (std::size_t i = 0; i < px.size(); ++i) {
+    if (int(i % std::size_t(n)) == alpha) {
+      float a = px[i];
+      data[i] = static_cast<std::uint8_t>(std::lround(255.0 * (a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f)));
+    } else {
+      data[i] = linear_to_srgb8(px[i]);
     }
-    std::vector<std::uint8_t> encoded;
-    if (!stbi_write_png_to_func(append_bytes, &encoded, image.width(), image.height(), n, data.data(), image.width() * n))
-        throw ImageError(path, "PNG encoding failed");
-    write_file_atomic(path, encoded);
+  }
+  std::vector<std::uint8_t> encoded;
+  if (!stbi_write_png_to_func(append_bytes, &encoded, image.width(), image.height(), n, data.data(), image.width() * n))
+    throw ImageError(path, "PNG encoding failed");
+  write_file_atomic(path, encoded);
 }
 
 Image read_png(const fs::path& path) {
-    auto bytes = read_file(path);
-    if (!is_png(bytes)) throw ImageError(path, "not a PNG file (bad signature)");
-    return decode_png(path, bytes);
+  auto bytes = read_file(path);
+  if (!is_png(bytes)) throw ImageError(path, "not a PNG file (bad signature)");
+  return decode_png(path, bytes);
 }
 
 // ---- EXR -------------------------------------------------------------------------------------
 
 void write_exr(const fs::path& path, const Image& image) {
-    require_image(path, image);
-    MemoryOStream stream;
-    try {
-        Imf::Header header(image.width(), image.height());
-        header.compression() = Imf::ZIP_COMPRESSION;
-        const std::size_t n = std::size_t(image.channels());
-        for (const std::string& name : image.channel_names()) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
-        header.insert(channel_order_attribute, Imf::StringVectorAttribute(image.channel_names()));
-        Imf::FrameBuffer fb;
-        // OpenEXR only reads through the slices of an OutputFile.
-        char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels().data()));
-        for (std::size_t c = 0; c < n; ++c)
-            fb.insert(image.channel_names()[c],
-                      Imf::Slice(Imf::FLOAT, base + c * sizeof(float), sizeof(float) * n,
-                                 sizeof(float) * n * std::size_t(image.width())));
-        Imf::OutputFile file(stream, header);
-        file.setFrameBuffer(fb);
-        file.writePixels(image.height());
-    } catch (const std::exception& e) {
-        throw ImageError(path, std::string("EXR encoding failed: ") + e.what());
-    }
-    write_file_atomic(path, stream.bytes);
+  require_image(path, image);
+  MemoryOStream stream;
+  try {
+    Imf::Header header(image.width(), image.height());
+    header.compression() = Imf::ZIP_COMPRESSION;
+    const std::size_t n = std::size_t(image.channels());
+    for (const std::string& name : image.channel_names()) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    header.insert(channel_order_attribute, Imf::StringVectorAttribute(image.channel_names()));
+    Imf::FrameBuffer fb;
+    // OpenEXR only reads through the slices of an OutputFile.
+    char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels().data()));
+    for (std::size_t c = 0; c < n; ++c)
+      fb.insert(image.channel_names()[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), sizeof(float) * n,
+                                                     sizeof(float) * n * std::size_t(image.width())));
+    Imf::OutputFile file(stream, header);
+    file.setFrameBuffer(fb);
+    file.writePixels(image.height());
+  } catch (const std::exception& e) { throw ImageError(path, std::string("EXR encoding failed: ") + e.what()); }
+  write_file_atomic(path, stream.bytes);
 }
 
 Image read_exr(const fs::path& path) {
-    auto bytes = read_file(path);
-    if (!is_exr(bytes)) throw ImageError(path, "not an EXR file (bad signature)");
-    return decode_exr(path, bytes);
+  auto bytes = read_file(path);
+  if (!is_exr(bytes)) throw ImageError(path, "not an EXR file (bad signature)");
+  return decode_exr(path, bytes);
 }
 
 Image read_image(const fs::path& path) {
-    auto bytes = read_file(path);
-    if (is_png(bytes)) return decode_png(path, bytes);
-    if (is_exr(bytes)) return decode_exr(path, bytes);
-    throw ImageError(path, bytes.empty() ? "empty file" : "neither a PNG nor an EXR file");
+  auto bytes = read_file(path);
+  if (is_png(bytes)) return decode_png(path, bytes);
+  if (is_exr(bytes)) return decode_exr(path, bytes);
+  throw ImageError(path, bytes.empty() ? "empty file" : "neither a PNG nor an EXR file");
 }
 
 void write_image(const fs::path& path, const Image& image) {
-    const std::string ext = lower_extension(path);
-    if (ext == ".png") return write_png(path, image);
-    if (ext == ".exr") return write_exr(path, image);
-    throw ImageError(path, "unknown image extension '" + ext + "' (.png or .exr)");
+  const std::string ext = lower_extension(path);
+  if (ext == ".png") return write_png(path, image);
+  if (ext == ".exr") return write_exr(path, image);
+  throw ImageError(path, "unknown image extension '" + ext + "' (.png or .exr)");
 }
 
 } // namespace msm::image

@@ -14,45 +14,45 @@ using namespace msm::image;
 
 namespace {
 Image step(int edge) {
-    Image im(16, 8, 1);
-    for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 16; ++x) im.at(x, y) = x >= edge ? 1.0f : 0.0f;
-    return im;
+  Image im(16, 8, 1);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x) im.at(x, y) = x >= edge ? 1.0f : 0.0f;
+  return im;
 }
 } // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 2) {
-        std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
-        return 2;
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
+    return 2;
+  }
+  try {
+    const std::filesystem::path dir = argv[1];
+    std::filesystem::create_directories(dir);
+    const Image a = step(8), b = step(7);
+    Image named(16, 8, {"visibility", "sample_count", "std_error"});
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 16; ++x) {
+        named.at(x, y, 0) = x >= 8 ? 1.0f : 0.0f;
+        named.at(x, y, 1) = 64.0f;
+        named.at(x, y, 2) = 0.01f;
+      }
+    write_exr(dir / "step.exr", a);
+    write_exr(dir / "step_shift.exr", b);
+    write_exr(dir / "small.exr", Image(8, 8, 1, 0.5f));
+    write_exr(dir / "named.exr", named);
+    if (!(read_image(dir / "step.exr") == a) || !(read_image(dir / "named.exr") == named)) {
+      std::fprintf(stderr, "read back differs\n");
+      return 1;
     }
-    try {
-        const std::filesystem::path dir = argv[1];
-        std::filesystem::create_directories(dir);
-        const Image a = step(8), b = step(7);
-        Image named(16, 8, {"visibility", "sample_count", "std_error"});
-        for (int y = 0; y < 8; ++y)
-            for (int x = 0; x < 16; ++x) {
-                named.at(x, y, 0) = x >= 8 ? 1.0f : 0.0f;
-                named.at(x, y, 1) = 64.0f;
-                named.at(x, y, 2) = 0.01f;
-            }
-        write_exr(dir / "step.exr", a);
-        write_exr(dir / "step_shift.exr", b);
-        write_exr(dir / "small.exr", Image(8, 8, 1, 0.5f));
-        write_exr(dir / "named.exr", named);
-        if (!(read_image(dir / "step.exr") == a) || !(read_image(dir / "named.exr") == named)) {
-            std::fprintf(stderr, "read back differs\n");
-            return 1;
-        }
-        const Metrics m = compute_metrics(read_image(dir / "step_shift.exr"), read_image(dir / "step.exr"));
-        if (m.mae != 0.0625 || m.light_leaking != 0.0625 || m.over_darkening != 0.0) {
-            std::fprintf(stderr, "unexpected metrics:\n%s", format_metrics(m).c_str());
-            return 1;
-        }
-        return 0;
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
-        return 1;
+    const Metrics m = compute_metrics(read_image(dir / "step_shift.exr"), read_image(dir / "step.exr"));
+    if (m.mae != 0.0625 || m.light_leaking != 0.0625 || m.over_darkening != 0.0) {
+      std::fprintf(stderr, "unexpected metrics:\n%s", format_metrics(m).c_str());
+      return 1;
     }
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
 }

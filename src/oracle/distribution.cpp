@@ -17,10 +17,12 @@ void require(bool condition, const char* message) {
 }
 
 void check_discrete(std::span<const double> depths, std::span<const double> weights) {
-  require(!depths.empty() && depths.size() == weights.size(), "discrete: depths and weights must have the same size >= 1");
+  require(!depths.empty() && depths.size() == weights.size(),
+          "discrete: depths and weights must have the same size >= 1");
   Real total = 0;
   for (std::size_t i = 0; i < depths.size(); ++i) {
-    require(std::isfinite(depths[i]) && std::isfinite(weights[i]) && weights[i] >= 0, "discrete: finite depths, weights >= 0");
+    require(std::isfinite(depths[i]) && std::isfinite(weights[i]) && weights[i] >= 0,
+            "discrete: finite depths, weights >= 0");
     total += weights[i];
   }
   require(total > 0, "discrete: weights must have a positive sum");
@@ -100,7 +102,8 @@ double beta_continued_fraction(double a, double b, double x) {
 double regularized_incomplete_beta(double a, double b, double x) {
   if (x <= 0) return 0;
   if (x >= 1) return 1;
-  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
+  const double front =
+      std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
   // The fraction converges fast on the side of the mean; use the symmetry I_x(a,b) = 1 - I_{1-x}(b,a).
   if (x < (a + 1) / (a + b + 2)) return front * beta_continued_fraction(a, b, x) / a;
   return 1 - front * beta_continued_fraction(b, a, 1 - x) / b;
@@ -147,14 +150,16 @@ Mixture& Mixture::uniform(double a, double b, double weight) {
 }
 
 Mixture& Mixture::truncated_gaussian(double mean, double sigma, double a, double b, double weight) {
-  require(std::isfinite(a) && std::isfinite(b) && a < b && sigma > 0 && weight > 0, "Mixture::truncated_gaussian: a < b, sigma > 0");
+  require(std::isfinite(a) && std::isfinite(b) && a < b && sigma > 0 && weight > 0,
+          "Mixture::truncated_gaussian: a < b, sigma > 0");
   const double nearest = std::clamp(mean, a, b);
   require(std::fabs(nearest - mean) <= 30 * sigma, "Mixture::truncated_gaussian: [a, b] within 30 sigma of the mean");
   return add({Kind::gaussian, weight, a, b, mean, sigma, {}});
 }
 
 Mixture& Mixture::beta(double alpha, double beta, double a, double b, double weight) {
-  require(std::isfinite(a) && std::isfinite(b) && a < b && alpha > 0 && beta > 0 && weight > 0, "Mixture::beta: alpha, beta > 0, a < b");
+  require(std::isfinite(a) && std::isfinite(b) && a < b && alpha > 0 && beta > 0 && weight > 0,
+          "Mixture::beta: alpha, beta > 0, a < b");
   return add({Kind::beta, weight, a, b, alpha, beta, {}});
 }
 
@@ -204,7 +209,10 @@ double Mixture::cdf(double zf, bool inclusive) const {
     case Kind::uniform: f = std::clamp((zf - c.a) / (c.b - c.a), 0.0, 1.0); break;
     case Kind::gaussian: {
       if (zf <= c.a) break;
-      if (zf >= c.b) { f = 1; break; }
+      if (zf >= c.b) {
+        f = 1;
+        break;
+      }
       const double lo = (c.a - c.p) / c.q, hi = (c.b - c.p) / c.q, t = (zf - c.p) / c.q;
       // Difference the tail on the interval's side: both terms are then not close to 1.
       f = lo > 0 ? (upper_tail(lo) - upper_tail(t)) / (upper_tail(lo) - upper_tail(hi))

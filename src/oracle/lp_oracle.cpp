@@ -43,10 +43,15 @@ struct DeleteProblem {
 };
 
 std::string glpk_failure(const char* routine, int code) {
-  const char* name = code == GLP_EBADB ? "invalid basis" : code == GLP_ESING ? "singular basis matrix"
-                   : code == GLP_ECOND ? "ill-conditioned basis matrix" : code == GLP_EBOUND ? "bad bounds"
-                   : code == GLP_EFAIL ? "solver failure" : code == GLP_EITLIM ? "iteration limit"
-                   : code == GLP_ETMLIM ? "time limit" : code == GLP_ENODFS ? "no dual feasible solution" : "error";
+  const char* name = code == GLP_EBADB    ? "invalid basis"
+                     : code == GLP_ESING  ? "singular basis matrix"
+                     : code == GLP_ECOND  ? "ill-conditioned basis matrix"
+                     : code == GLP_EBOUND ? "bad bounds"
+                     : code == GLP_EFAIL  ? "solver failure"
+                     : code == GLP_EITLIM ? "iteration limit"
+                     : code == GLP_ETMLIM ? "time limit"
+                     : code == GLP_ENODFS ? "no dual feasible solution"
+                                          : "error";
   return std::string(routine) + " failed: " + name + " (" + std::to_string(code) + ")";
 }
 
@@ -67,8 +72,10 @@ struct Attempt {
 // Runs the simplex, from the current basis when `warm` (else from GLPK's advanced basis), and
 // says why its result is unusable, or "" when GLPK reports an optimum.
 std::string simplex(glp_prob* problem, const Attempt& attempt, bool warm, int iteration_limit) {
-  if (attempt.scaling) glp_scale_prob(problem, GLP_SF_AUTO);
-  else glp_unscale_prob(problem);
+  if (attempt.scaling)
+    glp_scale_prob(problem, GLP_SF_AUTO);
+  else
+    glp_unscale_prob(problem);
   glp_smcp parameters;
   glp_init_smcp(&parameters);
   parameters.msg_lev = GLP_MSG_OFF;
@@ -81,7 +88,9 @@ std::string simplex(glp_prob* problem, const Attempt& attempt, bool warm, int it
   // With presolve GLPK reports infeasibility as an error code, without it as a status.
   if (code == GLP_ENOPFS || (code == 0 && glp_get_status(problem) == GLP_NOFEAS)) return "infeasible";
   if (code != 0) return glpk_failure("glp_simplex", code);
-  return glp_get_status(problem) == GLP_OPT ? "" : "not optimal (GLPK status " + std::to_string(glp_get_status(problem)) + ")";
+  return glp_get_status(problem) == GLP_OPT
+             ? ""
+             : "not optimal (GLPK status " + std::to_string(glp_get_status(problem)) + ")";
 }
 
 using Real = long double;
@@ -129,11 +138,13 @@ Preconditioned precondition(const Matrix& a, const Vector& target) {
 
 // GLPK's final basis, re-solved and checked in long double on the preconditioned data.
 struct Checked {
-  std::vector<Real> w;      // the optimal weights, w = d v
-  Real residual = 0;        // max_j |sum_i A_ji w_i - t_j| / (1 + |t_j|), original rows
-  Real negative = 0;        // -min(0, min_i v_i), in the preconditioned variables
-  Real dual_violation = 0;  // largest reduced cost of the wrong sign (preconditioned units)
-  bool acceptable(Real tolerance) const { return residual <= tolerance && negative <= tolerance && dual_violation <= tolerance; }
+  std::vector<Real> w;     // the optimal weights, w = d v
+  Real residual = 0;       // max_j |sum_i A_ji w_i - t_j| / (1 + |t_j|), original rows
+  Real negative = 0;       // -min(0, min_i v_i), in the preconditioned variables
+  Real dual_violation = 0; // largest reduced cost of the wrong sign (preconditioned units)
+  bool acceptable(Real tolerance) const {
+    return residual <= tolerance && negative <= tolerance && dual_violation <= tolerance;
+  }
 };
 
 // The basic columns S solve rows_S v_S = target; y from rows_S^T y = c_S gives the reduced costs
@@ -317,8 +328,10 @@ LpBounds lp_bounds(std::span<const double> grid_in, const Basis& basis, std::spa
   // T amplifies).
   for (int j = 0; j < rows; ++j) {
     const double centre = double(p.target[j]), width = double(options.rounding_band * p.band[j]);
-    if (width > 0) glp_set_row_bnds(problem, j + 1, GLP_DB, centre - width, centre + width);
-    else glp_set_row_bnds(problem, j + 1, GLP_FX, centre, centre);
+    if (width > 0)
+      glp_set_row_bnds(problem, j + 1, GLP_DB, centre - width, centre + width);
+    else
+      glp_set_row_bnds(problem, j + 1, GLP_FX, centre, centre);
   }
   glp_add_cols(problem, columns);
   for (int i = 0; i < columns; ++i) glp_set_col_bnds(problem, i + 1, GLP_LO, 0.0, 0.0);
@@ -358,13 +371,18 @@ LpBounds lp_bounds(std::span<const double> grid_in, const Basis& basis, std::spa
         parameters.msg_lev = GLP_MSG_OFF;
         const int code = glp_exact(problem, &parameters);
         const int status = glp_get_status(problem);
-        why = code != 0 ? glpk_failure("glp_exact", code) : status == GLP_OPT ? "" : status == GLP_NOFEAS ? "infeasible" : "glp_exact: not optimal";
+        why = code != 0              ? glpk_failure("glp_exact", code)
+              : status == GLP_OPT    ? ""
+              : status == GLP_NOFEAS ? "infeasible"
+                                     : "glp_exact: not optimal";
       }
       if (why.empty()) {
         Checked c = check(problem, p, a, target, objective, minimize);
-        if (c.acceptable(options.check_tolerance)) best = std::move(c), solver = attempt.name;
-        else why = "inaccurate (residual " + scientific(c.residual) + ", negative weight " + scientific(c.negative) +
-                   ", dual violation " + scientific(c.dual_violation) + ")";
+        if (c.acceptable(options.check_tolerance))
+          best = std::move(c), solver = attempt.name;
+        else
+          why = "inaccurate (residual " + scientific(c.residual) + ", negative weight " + scientific(c.negative) +
+                ", dual violation " + scientific(c.dual_violation) + ")";
       }
       if (!best) failures.push_back(std::string(attempt.name) + ": " + why);
     }
@@ -386,8 +404,12 @@ LpBounds lp_bounds(std::span<const double> grid_in, const Basis& basis, std::spa
     result.solver = result.solver.empty() || result.solver == solver ? solver : result.solver + ", " + solver;
     return true;
   };
-  if (!optimize(true, [zf](double z) { return z < zf; }, result.lower, result.lower_argmin)) return result;
-  if (!optimize(false, [zf](double z) { return z <= zf; }, result.upper, result.upper_argmax)) return result;
+  if (!optimize(
+          true, [zf](double z) { return z < zf; }, result.lower, result.lower_argmin))
+    return result;
+  if (!optimize(
+          false, [zf](double z) { return z <= zf; }, result.upper, result.upper_argmax))
+    return result;
   result.feasible = true;
   result.status = "optimal";
   return result;

@@ -140,7 +140,7 @@ MomentBounds failure(std::string reason) {
 struct Standardized {
   Real mu = 0, sigma = 0, variance = 0, variance_noise = 0;
   std::vector<Real> central, central_noise; // E (z - mu)^j and its rounding error
-  std::vector<Real> s, noise;                // E u^j and its rounding error (sigma > 0 only)
+  std::vector<Real> s, noise;               // E u^j and its rounding error (sigma > 0 only)
 };
 
 Standardized standardize(std::span<const double> b) {
@@ -234,7 +234,8 @@ MomentBounds moment_bounds(std::span<const double> b, double zf, const MomentOpt
     if (tolerance == 0) return failure("B is singular (zero variance)");
     for (int j = 3; j <= m; ++j)
       if (std::fabs(st.central[j]) > tolerance * st.central_noise[j])
-        return failure("B is singular, but b is no finite distribution's moments (zero variance but not higher moments: mass at infinity)");
+        return failure("B is singular, but b is no finite distribution's moments (zero variance but not higher "
+                       "moments: mass at infinity)");
     sigma = 1, atoms = {0}, w = Vector::Ones(1);
   } else {
     Matrix hankel(n, n), noise_b(n, n);
@@ -285,7 +286,8 @@ MomentBounds moment_bounds(std::span<const double> b, double zf, const MomentOpt
 
   // Degenerate: the distribution is known; zf is a support point only if an atom sits there.
   result.degenerate = true;
-  result.residual = st.s.empty() || st.sigma == 0 || atoms.size() == 1 ? 0 : double(moment_residual(atoms, w, st.s, m + 1, st.noise));
+  result.residual =
+      st.s.empty() || st.sigma == 0 || atoms.size() == 1 ? 0 : double(moment_residual(atoms, w, st.s, m + 1, st.noise));
   const Real uf = (Real(zf) - st.mu) / sigma;
   Real lower = 0, at = 0;
   result.support.push_back(zf);

@@ -336,13 +336,15 @@ TEST(MomentOracle, BiasedMomentsBracketTheBiasedDistribution) {
         for (double w : z.weights) total += w;
         for (int i = 0; i < m / 2; ++i) truth.dirac(z.depths[i], (1 - alpha) * z.weights[i] / total);
         truth.uniform(0, 1, alpha);
-        const std::string where = "a=" + std::to_string(alpha) + " m=" + std::to_string(m) + " zf=" + std::to_string(zf);
+        const std::string where =
+            "a=" + std::to_string(alpha) + " m=" + std::to_string(m) + " zf=" + std::to_string(zf);
         const MomentBounds r = moment_bounds(biased, zf);
         expect_consistent(r, zf, where);
         EXPECT_FALSE(r.degenerate) << where;
         EXPECT_LE(r.lower, truth.cdf_below(zf) + tolerance[m / 2]) << where;
         EXPECT_GE(r.upper, truth.cdf_at_or_below(zf) - tolerance[m / 2]) << where;
-        if (alpha == 1e-6) worst_small_bias = std::max(worst_small_bias, std::fabs(r.lower - cdf_below(z.depths, z.weights, zf)));
+        if (alpha == 1e-6)
+          worst_small_bias = std::max(worst_small_bias, std::fabs(r.lower - cdf_below(z.depths, z.weights, zf)));
       }
   EXPECT_LT(worst_small_bias, 0.1);
 }
@@ -407,7 +409,8 @@ TEST(LpOracle, DiracsOnGridAreBracketed) {
       const int k = 1 + trial % 6;
       Mixture z;
       std::vector<double> atoms;
-      for (int i = 0; i < k; ++i) atoms.push_back(grid[rng() % grid.size()]), z.dirac(atoms.back(), 0.05 + double(rng() % 100) / 100);
+      for (int i = 0; i < k; ++i)
+        atoms.push_back(grid[rng() % grid.size()]), z.dirac(atoms.back(), 0.05 + double(rng() % 100) / 100);
       const double zf = trial % 2 ? atoms[0] : double(rng() % 1000) / 999;
       const std::string where = basis.name + " k=" + std::to_string(k) + " zf=" + std::to_string(zf);
       const LpBounds r = lp_bounds(grid, basis, expectations(z, basis), zf);
@@ -460,11 +463,13 @@ TEST(LpOracle, PowerBasisOnWideGridAgreesWithHamburger) {
         ASSERT_TRUE(inserted.feasible) << where << ": " << inserted.status;
         EXPECT_NEAR(inserted.lower, hamburger.lower, 1e-9) << where;
         EXPECT_NEAR(inserted.upper, hamburger.upper, 1e-9) << where;
-        worst_inserted = std::max({worst_inserted, std::fabs(inserted.lower - hamburger.lower), std::fabs(inserted.upper - hamburger.upper)});
+        worst_inserted = std::max(
+            {worst_inserted, std::fabs(inserted.lower - hamburger.lower), std::fabs(inserted.upper - hamburger.upper)});
       }
     }
   std::printf("[ measured ] wide grid (%zu points): max |LP - Hamburger| %.3g, with Hamburger atoms added %.3g, "
-              "%.1f ms per lp_bounds\n", wide.size(), worst_gap, worst_inserted, 1e3 * seconds / calls);
+              "%.1f ms per lp_bounds\n",
+              wide.size(), worst_gap, worst_inserted, 1e3 * seconds / calls);
   RecordProperty("max_gap", std::to_string(worst_gap));
   RecordProperty("max_gap_inserted", std::to_string(worst_inserted));
   RecordProperty("ms_per_call", std::to_string(1e3 * seconds / calls));
@@ -557,9 +562,11 @@ TEST(LpOracle, SolverSettingsAgree) {
     const auto b = without_b0(z.power_moments(4));
     for (double zf : {0.1, 0.5, 0.9}) {
       const LpBounds plain = lp_bounds(grid, power_basis(4), b, zf);
-      const LpBounds glpk = lp_bounds(grid, power_basis(4), b, zf, {.tolerance = 1e-7, .presolve = true, .glpk_scaling = true});
+      const LpBounds glpk =
+          lp_bounds(grid, power_basis(4), b, zf, {.tolerance = 1e-7, .presolve = true, .glpk_scaling = true});
       const LpBounds exact = lp_bounds(grid, power_basis(4), b, zf, {.exact = true});
-      ASSERT_TRUE(plain.feasible && glpk.feasible && exact.feasible) << name << ": " << glpk.status << " " << exact.status;
+      ASSERT_TRUE(plain.feasible && glpk.feasible && exact.feasible)
+          << name << ": " << glpk.status << " " << exact.status;
       EXPECT_NEAR(plain.lower, glpk.lower, 1e-9) << name;
       EXPECT_NEAR(plain.upper, glpk.upper, 1e-9) << name;
       EXPECT_NEAR(plain.lower, exact.lower, 1e-9) << name;

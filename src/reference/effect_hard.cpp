@@ -4,11 +4,11 @@
 namespace msm::reference::detail {
 
 EffectResult effect_hard(const EffectContext& ctx, const SurfaceHit& hit, Rng&) {
-    const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
-    EffectResult r;
-    r.value = ctx.tracer.occluded(origin, ctx.towards_light) ? 0.0 : 1.0;
-    r.rays = 1;
-    return r;
+  const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
+  EffectResult r;
+  r.value = ctx.tracer.occluded(origin, ctx.towards_light) ? 0.0 : 1.0;
+  r.rays = 1;
+  return r;
 }
 
-}  // namespace msm::reference::detail
+} // namespace msm::reference::detail

@@ -7,20 +7,20 @@
 namespace msm::reference::detail {
 
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng) {
-    const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
-    const bool disc = ctx.settings.light_shape == LightShape::disc;
-    // The origin is on the side of the surface facing the light's centre (as in `hard`); sampled
-    // directions below that side's horizon cross the surface itself and are blocked.
-    const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
-    RunningStats stats;
-    for (int i = 0; i < set.count(); ++i) {
-        const glm::dvec2 u = set.point(i, rng);
-        const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
-                                   : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
-        const glm::dvec3 dir = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
-        stats.add(ctx.tracer.occluded(origin, dir) ? 0.0 : 1.0);
-    }
-    return monte_carlo_result(stats);
+  const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
+  const bool disc = ctx.settings.light_shape == LightShape::disc;
+  // The origin is on the side of the surface facing the light's centre (as in `hard`); sampled
+  // directions below that side's horizon cross the surface itself and are blocked.
+  const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
+  RunningStats stats;
+  for (int i = 0; i < set.count(); ++i) {
+    const glm::dvec2 u = set.point(i, rng);
+    const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
+                               : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
+    const glm::dvec3 dir = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
+    stats.add(ctx.tracer.occluded(origin, dir) ? 0.0 : 1.0);
+  }
+  return monte_carlo_result(stats);
 }
 
-}  // namespace msm::reference::detail
+} // namespace msm::reference::detail

@@ -7,13 +7,13 @@
 namespace msm::reference::detail {
 
 EffectResult effect_translucent(const EffectContext& ctx, const SurfaceHit& hit, Rng&) {
-    const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
-    const Tracer::Transmission t = ctx.tracer.transmission(origin, ctx.towards_light, ctx.settings.max_crossings);
-    EffectResult r;
-    r.value = t.transmittance;
-    r.rgb = t.channels;
-    r.rays = t.rays;
-    return r;
+  const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
+  const Tracer::Transmission t = ctx.tracer.transmission(origin, ctx.towards_light, ctx.settings.max_crossings);
+  EffectResult r;
+  r.value = t.transmittance;
+  r.rgb = t.channels;
+  r.rays = t.rays;
+  return r;
 }
 
-}  // namespace msm::reference::detail
+} // namespace msm::reference::detail

@@ -18,21 +18,21 @@ namespace msm::reference::detail {
 // ---- Random numbers --------------------------------------------------------------------------
 
 inline std::uint64_t splitmix64(std::uint64_t& state) {
-    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
 }
 
 // SplitMix64: small, fast, statistically fine for sampling; one per pixel.
 class Rng {
-public:
-    explicit Rng(std::uint64_t seed) : state_(seed) {}
-    std::uint64_t next() { return splitmix64(state_); }
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+ public:
+  explicit Rng(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() { return splitmix64(state_); }
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; } // [0, 1)
 
-private:
-    std::uint64_t state_;
+ private:
+  std::uint64_t state_;
 };
 
 // The generator of pixel (x, y): depends on nothing but these (not on threads or order).
@@ -41,14 +41,14 @@ Rng pixel_rng(std::uint64_t seed, int x, int y, Effect effect);
 // N points of [0,1)^2 drawn by a Sampler (see reference.h): point(i) for i = 0..N-1, each call
 // consuming random numbers from the pixel's generator.
 class SampleSet {
-public:
-    SampleSet(Sampler sampler, int count);
-    int count() const { return count_; }
-    glm::dvec2 point(int i, Rng& rng) const;
+ public:
+  SampleSet(Sampler sampler, int count);
+  int count() const { return count_; }
+  glm::dvec2 point(int i, Rng& rng) const;
 
-private:
-    Sampler sampler_;
-    int count_, grid_;
+ private:
+  Sampler sampler_;
+  int count_, grid_;
 };
 
 // Shirley-Chiu concentric map of [0,1)^2 onto the unit disc (area-preserving, keeps strata).
@@ -56,110 +56,109 @@ glm::dvec2 concentric_disc(glm::dvec2 u);
 
 // Running mean and unbiased variance (Welford).
 struct RunningStats {
-    int n = 0;
-    double mean = 0.0, m2 = 0.0;
-    void add(double v) {
-        ++n;
-        const double d = v - mean;
-        mean += d / n;
-        m2 += d * (v - mean);
-    }
-    double std_error() const { return n > 1 ? std::sqrt(std::max(0.0, m2 / (n - 1)) / n) : 0.0; }
+  int n = 0;
+  double mean = 0.0, m2 = 0.0;
+  void add(double v) {
+    ++n;
+    const double d = v - mean;
+    mean += d / n;
+    m2 += d * (v - mean);
+  }
+  double std_error() const { return n > 1 ? std::sqrt(std::max(0.0, m2 / (n - 1)) / n) : 0.0; }
 };
 
 // ---- Tracer ----------------------------------------------------------------------------------
 
 // The visible surface at a primary (or continuation) ray's hit.
 struct SurfaceHit {
-    glm::dvec3 p{0.0};       // on the plane of the hit triangle, on the ray
-    glm::dvec3 normal{0.0};  // unit geometric normal of the triangle (counter-clockwise front)
-    double scale = 1.0;      // max(|p|_inf, |vertex coordinates|_inf of the triangle)
-    std::uint32_t object = 0, triangle = 0;
-    float u = 0.0f, v = 0.0f;  // Embree barycentrics (of vertices 1 and 2)
+  glm::dvec3 p{0.0};      // on the plane of the hit triangle, on the ray
+  glm::dvec3 normal{0.0}; // unit geometric normal of the triangle (counter-clockwise front)
+  double scale = 1.0;     // max(|p|_inf, |vertex coordinates|_inf of the triangle)
+  std::uint32_t object = 0, triangle = 0;
+  float u = 0.0f, v = 0.0f; // Embree barycentrics (of vertices 1 and 2)
 };
 
 // Offset of a shadow-ray origin: eps = kOffsetScale * scale along the normal's side facing `towards`.
-inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& normal, double scale, const glm::dvec3& towards) {
-    const double side = glm::dot(normal, towards) >= 0.0 ? 1.0 : -1.0;
-    return p + (side * kOffsetScale * scale) * normal;
+inline glm::dvec3 offset_origin(const glm::dvec3& p, const glm::dvec3& normal, double scale,
+                                const glm::dvec3& towards) {
+  const double side = glm::dot(normal, towards) >= 0.0 ? 1.0 : -1.0;
+  return p + (side * kOffsetScale * scale) * normal;
 }
-inline double point_scale(const glm::dvec3& p) {
-    return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-}
+inline double point_scale(const glm::dvec3& p) { return std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}); }
 
 class Tracer {
-public:
-    explicit Tracer(const scene::Scene& scene);  // builds the Embree scene; throws on failure
-    ~Tracer();
-    Tracer(const Tracer&) = delete;
-    Tracer& operator=(const Tracer&) = delete;
+ public:
+  explicit Tracer(const scene::Scene& scene); // builds the Embree scene; throws on failure
+  ~Tracer();
+  Tracer(const Tracer&) = delete;
+  Tracer& operator=(const Tracer&) = delete;
 
-    const scene::Scene& scene() const { return scene_; }
+  const scene::Scene& scene() const { return scene_; }
 
-    // Closest hit of origin + t dir, t in [0, tfar] (dir unit); false if none.
-    bool closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const;
-    // True if anything lies on origin + t dir, t in [0, inf).
-    bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
+  // Closest hit of origin + t dir, t in [0, tfar] (dir unit); false if none.
+  bool closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const;
+  // True if anything lies on origin + t dir, t in [0, inf).
+  bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
 
-    struct Transmission {
-        glm::dvec3 channels{1.0};   // per RGB channel
-        double transmittance = 1.0; // the mean of the three channels (exactly channels.r when all equal)
-        int crossings = 0;
-        std::uint64_t rays = 0;
-    };
-    // Per channel c, the product of (1 - alpha * (1 - transmission_color_c)) (the material's
-    // channel_opacity, in double precision) over the surfaces crossed by origin + t dir, t >= 0,
-    // counting at most max_crossings of them; stops early when every channel is 0. alpha = the
-    // material's constant times its opacity texture or noise (scene::opacity_image) at the hit's
-    // uv. Without transmission colours every channel is the product of (1 - alpha).
-    Transmission transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const;
+  struct Transmission {
+    glm::dvec3 channels{1.0};   // per RGB channel
+    double transmittance = 1.0; // the mean of the three channels (exactly channels.r when all equal)
+    int crossings = 0;
+    std::uint64_t rays = 0;
+  };
+  // Per channel c, the product of (1 - alpha * (1 - transmission_color_c)) (the material's
+  // channel_opacity, in double precision) over the surfaces crossed by origin + t dir, t >= 0,
+  // counting at most max_crossings of them; stops early when every channel is 0. alpha = the
+  // material's constant times its opacity texture or noise (scene::opacity_image) at the hit's
+  // uv. Without transmission colours every channel is the product of (1 - alpha).
+  Transmission transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const;
 
-    // Interpolated vertex normal at a hit (unit).
-    glm::dvec3 shading_normal(const SurfaceHit& hit) const;
-    const scene::Material& material(const SurfaceHit& hit) const;
-    double opacity(const SurfaceHit& hit) const;
+  // Interpolated vertex normal at a hit (unit).
+  glm::dvec3 shading_normal(const SurfaceHit& hit) const;
+  const scene::Material& material(const SurfaceHit& hit) const;
+  double opacity(const SurfaceHit& hit) const;
 
-    struct Impl;  // Embree device and scene
+  struct Impl; // Embree device and scene
 
-private:
-    const scene::Scene& scene_;
-    std::vector<scene::OpacityImage> opacity_images_; // per material (width 0: none)
-    std::unique_ptr<Impl> impl_;
+ private:
+  const scene::Scene& scene_;
+  std::vector<scene::OpacityImage> opacity_images_; // per material (width 0: none)
+  std::unique_ptr<Impl> impl_;
 };
 
 // ---- Effects ---------------------------------------------------------------------------------
 
 // Everything an effect needs, computed once per render.
 struct EffectContext {
-    const Tracer& tracer;
-    const Settings& settings;
-    LightFrame frame;
-    glm::dvec3 towards_light{0.0};
-    // filtered
-    FilterKernel kernel;
-    glm::dvec3 texel_x{0.0}, texel_y{0.0};  // world vector of one texel along light-space x / y
-    // soft: half-sizes of the light in the plane at unit distance along towards_light (tangents
-    // of the half-angles); the disc uses half_x as its radius.
-    double half_x = 0.0, half_y = 0.0;
-    glm::dvec3 light_x{0.0}, light_y{0.0};  // unit, orthogonal to towards_light
+  const Tracer& tracer;
+  const Settings& settings;
+  LightFrame frame;
+  glm::dvec3 towards_light{0.0};
+  // filtered
+  FilterKernel kernel;
+  glm::dvec3 texel_x{0.0}, texel_y{0.0}; // world vector of one texel along light-space x / y
+  // soft: half-sizes of the light in the plane at unit distance along towards_light (tangents
+  // of the half-angles); the disc uses half_x as its radius.
+  double half_x = 0.0, half_y = 0.0;
+  glm::dvec3 light_x{0.0}, light_y{0.0}; // unit, orthogonal to towards_light
 };
 
 struct EffectResult {
-    double value = 1.0;      // visibility or transmittance (translucent: the mean of rgb)
-    std::optional<glm::dvec3> rgb;  // translucent only: transmittance per RGB channel
-    double std_error = 0.0;
-    int samples = 1;
-    std::uint64_t rays = 0;  // shadow rays traced
+  double value = 1.0;            // visibility or transmittance (translucent: the mean of rgb)
+  std::optional<glm::dvec3> rgb; // translucent only: transmittance per RGB channel
+  double std_error = 0.0;
+  int samples = 1;
+  std::uint64_t rays = 0; // shadow rays traced
 };
 
 // The result of a Monte Carlo effect with one shadow ray per sample.
 inline EffectResult monte_carlo_result(const RunningStats& stats) {
-    EffectResult r;
-    r.value = stats.mean;
-    r.std_error = stats.std_error();
-    r.samples = stats.n;
-    r.rays = std::uint64_t(stats.n);
-    return r;
+  EffectResult r;
+  r.value = stats.mean;
+  r.std_error = stats.std_error();
+  r.samples = stats.n;
+  r.rays = std::uint64_t(stats.n);
+  return r;
 }
 
 using EffectFunction = EffectResult (*)(const EffectContext&, const SurfaceHit&, Rng&);
@@ -169,4 +168,4 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 EffectResult effect_translucent(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 
-}  // namespace msm::reference::detail
+} // namespace msm::reference::detail

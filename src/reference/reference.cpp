@@ -22,19 +22,19 @@ namespace msm::reference {
 // ---- Names -------------------------------------------------------------------------------------
 
 std::string_view to_string(Effect effect) {
-    switch (effect) {
-    case Effect::hard: return "hard";
-    case Effect::filtered: return "filtered";
-    case Effect::soft: return "soft";
-    case Effect::translucent: return "translucent";
-    }
-    return "?";
+  switch (effect) {
+  case Effect::hard: return "hard";
+  case Effect::filtered: return "filtered";
+  case Effect::soft: return "soft";
+  case Effect::translucent: return "translucent";
+  }
+  return "?";
 }
 
 std::optional<Effect> parse_effect(std::string_view name) {
-    for (Effect e : kEffects)
-        if (to_string(e) == name) return e;
-    return std::nullopt;
+  for (Effect e : kEffects)
+    if (to_string(e) == name) return e;
+  return std::nullopt;
 }
 
 bool is_monte_carlo(Effect effect) { return effect == Effect::filtered || effect == Effect::soft; }
@@ -42,17 +42,17 @@ bool is_monte_carlo(Effect effect) { return effect == Effect::filtered || effect
 std::string_view to_string(LightShape shape) { return shape == LightShape::disc ? "disc" : "rectangle"; }
 
 std::optional<LightShape> parse_light_shape(std::string_view name) {
-    if (name == "disc") return LightShape::disc;
-    if (name == "rectangle") return LightShape::rectangle;
-    return std::nullopt;
+  if (name == "disc") return LightShape::disc;
+  if (name == "rectangle") return LightShape::rectangle;
+  return std::nullopt;
 }
 
 std::string_view to_string(Sampler sampler) { return sampler == Sampler::stratified ? "stratified" : "independent"; }
 
 std::optional<Sampler> parse_sampler(std::string_view name) {
-    if (name == "stratified") return Sampler::stratified;
-    if (name == "independent") return Sampler::independent;
-    return std::nullopt;
+  if (name == "stratified") return Sampler::stratified;
+  if (name == "independent") return Sampler::independent;
+  return std::nullopt;
 }
 
 // ---- Settings ----------------------------------------------------------------------------------
@@ -60,49 +60,49 @@ std::optional<Sampler> parse_sampler(std::string_view name) {
 namespace {
 
 void check_range(const char* what, long long value, long long lo, long long hi) {
-    if (value < lo || value > hi)
-        throw std::invalid_argument(fmt::format("{} {} is out of range [{}, {}]", what, value, lo, hi));
+  if (value < lo || value > hi)
+    throw std::invalid_argument(fmt::format("{} {} is out of range [{}, {}]", what, value, lo, hi));
 }
 
 void check_angle(const char* what, const std::optional<double>& deg) {
-    if (deg && !(std::isfinite(*deg) && *deg >= 0.0 && *deg < 90.0))
-        throw std::invalid_argument(fmt::format("{} {} degrees is out of range [0, 90)", what, *deg));
+  if (deg && !(std::isfinite(*deg) && *deg >= 0.0 && *deg < 90.0))
+    throw std::invalid_argument(fmt::format("{} {} degrees is out of range [0, 90)", what, *deg));
 }
 
-}  // namespace
+} // namespace
 
 void validate(const Settings& s) {
-    check_range("width", s.width, 1, kMaxSide);
-    check_range("height", s.height, 1, kMaxSide);
-    check_range("samples", s.samples, 1, kMaxSamples);
-    check_range("shadow map size", s.shadow_size, 1, kMaxShadowSize);
-    check_range("max crossings", s.max_crossings, 1, kMaxCrossings);
-    check_range("threads", s.threads, 0, kMaxThreads);
-    FilterKernel(s.filter_size, s.filter_sigma);  // throws for a bad size or sigma
-    check_angle("light extent", s.light_extent_deg);
-    check_angle("light width", s.light_width_deg);
-    check_angle("light height", s.light_height_deg);
+  check_range("width", s.width, 1, kMaxSide);
+  check_range("height", s.height, 1, kMaxSide);
+  check_range("samples", s.samples, 1, kMaxSamples);
+  check_range("shadow map size", s.shadow_size, 1, kMaxShadowSize);
+  check_range("max crossings", s.max_crossings, 1, kMaxCrossings);
+  check_range("threads", s.threads, 0, kMaxThreads);
+  FilterKernel(s.filter_size, s.filter_sigma); // throws for a bad size or sigma
+  check_angle("light extent", s.light_extent_deg);
+  check_angle("light width", s.light_width_deg);
+  check_angle("light height", s.light_height_deg);
 }
 
 glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, float visibility) {
-    return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>) + kAmbient * albedo;
+  return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>)+kAmbient * albedo;
 }
 
 glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, glm::vec3 visibility) {
-    // Channel by channel exactly the scalar formula (same operations in the same order).
-    return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>) + kAmbient * albedo;
+  // Channel by channel exactly the scalar formula (same operations in the same order).
+  return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>)+kAmbient * albedo;
 }
 
 LightFrame LightFrame::of(const scene::Scene& scene) {
-    const glm::dmat4 inv = glm::inverse(glm::dmat4(scene.light_view_projection()));
-    LightFrame f;
-    f.towards_light = glm::normalize(glm::dvec3(scene.light.towards_light));
-    // Orthographic: a unit step of clip x (y) moves by inv[0] (inv[1]) in world space.
-    const glm::dvec3 cx(inv[0]), cy(inv[1]);
-    f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
-    f.x_axis = glm::normalize(cx);
-    f.y_axis = glm::normalize(cy);
-    return f;
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(scene.light_view_projection()));
+  LightFrame f;
+  f.towards_light = glm::normalize(glm::dvec3(scene.light.towards_light));
+  // Orthographic: a unit step of clip x (y) moves by inv[0] (inv[1]) in world space.
+  const glm::dvec3 cx(inv[0]), cy(inv[1]);
+  f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
+  f.x_axis = glm::normalize(cx);
+  f.y_axis = glm::normalize(cy);
+  return f;
 }
 
 // ---- Rendering ---------------------------------------------------------------------------------
@@ -112,173 +112,175 @@ namespace {
 using namespace detail;
 
 EffectFunction effect_function(Effect effect) {
-    switch (effect) {
-    case Effect::hard: return effect_hard;
-    case Effect::filtered: return effect_filtered;
-    case Effect::soft: return effect_soft;
-    case Effect::translucent: return effect_translucent;
-    }
-    throw std::invalid_argument("unknown effect");
+  switch (effect) {
+  case Effect::hard: return effect_hard;
+  case Effect::filtered: return effect_filtered;
+  case Effect::soft: return effect_soft;
+  case Effect::translucent: return effect_translucent;
+  }
+  throw std::invalid_argument("unknown effect");
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 Result render_in_arena(const scene::Scene& scene, const Settings& settings);
 
-}  // namespace
+} // namespace
 
 Result render(const scene::Scene& scene, const Settings& settings) {
-    validate(settings);
-    if (settings.threads == 0) return render_in_arena(scene, settings);
-    tbb::task_arena arena(settings.threads);
-    return arena.execute([&] { return render_in_arena(scene, settings); });
+  validate(settings);
+  if (settings.threads == 0) return render_in_arena(scene, settings);
+  tbb::task_arena arena(settings.threads);
+  return arena.execute([&] { return render_in_arena(scene, settings); });
 }
 
 namespace {
 
 Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
-    const auto start = std::chrono::steady_clock::now();
-    Result result;
-    const int W = settings.width, H = settings.height;
-    const bool mc = is_monte_carlo(settings.effect);
+  const auto start = std::chrono::steady_clock::now();
+  Result result;
+  const int W = settings.width, H = settings.height;
+  const bool mc = is_monte_carlo(settings.effect);
 
-    const Tracer tracer(scene);
-    result.build_seconds = seconds_since(start);
+  const Tracer tracer(scene);
+  result.build_seconds = seconds_since(start);
 
-    EffectContext ctx{tracer, settings, LightFrame::of(scene), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
-    ctx.towards_light = ctx.frame.towards_light;
-    ctx.texel_x = ctx.frame.x_axis * (ctx.frame.extent.x / settings.shadow_size);
-    ctx.texel_y = ctx.frame.y_axis * (ctx.frame.extent.y / settings.shadow_size);
-    // The soft light's axes: the light-space axes, made exactly orthonormal to towards_light.
-    ctx.light_x = glm::normalize(ctx.frame.x_axis - glm::dot(ctx.frame.x_axis, ctx.towards_light) * ctx.towards_light);
-    ctx.light_y = glm::cross(ctx.towards_light, ctx.light_x);
-    if (glm::dot(ctx.light_y, ctx.frame.y_axis) < 0.0) ctx.light_y = -ctx.light_y;
-    const double extent = settings.light_extent_deg.value_or(scene.light.angular_extent_deg);
-    if (!(std::isfinite(extent) && extent >= 0.0 && extent < 90.0))
-        throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", extent));
-    result.light_extent_deg = extent;
-    if (settings.light_shape == LightShape::disc) {
-        result.light_width_deg = result.light_height_deg = extent;
-    } else {
-        result.light_width_deg = settings.light_width_deg.value_or(extent);
-        result.light_height_deg = settings.light_height_deg.value_or(extent);
-    }
-    const auto half_tan = [](double deg) { return std::tan(deg * std::numbers::pi / 360.0); };
-    ctx.half_x = half_tan(result.light_width_deg);
-    ctx.half_y = half_tan(result.light_height_deg);
-    const EffectFunction effect = effect_function(settings.effect);
+  EffectContext ctx{
+      tracer, settings, LightFrame::of(scene), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
+  ctx.towards_light = ctx.frame.towards_light;
+  ctx.texel_x = ctx.frame.x_axis * (ctx.frame.extent.x / settings.shadow_size);
+  ctx.texel_y = ctx.frame.y_axis * (ctx.frame.extent.y / settings.shadow_size);
+  // The soft light's axes: the light-space axes, made exactly orthonormal to towards_light.
+  ctx.light_x = glm::normalize(ctx.frame.x_axis - glm::dot(ctx.frame.x_axis, ctx.towards_light) * ctx.towards_light);
+  ctx.light_y = glm::cross(ctx.towards_light, ctx.light_x);
+  if (glm::dot(ctx.light_y, ctx.frame.y_axis) < 0.0) ctx.light_y = -ctx.light_y;
+  const double extent = settings.light_extent_deg.value_or(scene.light.angular_extent_deg);
+  if (!(std::isfinite(extent) && extent >= 0.0 && extent < 90.0))
+    throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", extent));
+  result.light_extent_deg = extent;
+  if (settings.light_shape == LightShape::disc) {
+    result.light_width_deg = result.light_height_deg = extent;
+  } else {
+    result.light_width_deg = settings.light_width_deg.value_or(extent);
+    result.light_height_deg = settings.light_height_deg.value_or(extent);
+  }
+  const auto half_tan = [](double deg) { return std::tan(deg * std::numbers::pi / 360.0); };
+  ctx.half_x = half_tan(result.light_width_deg);
+  ctx.half_y = half_tan(result.light_height_deg);
+  const EffectFunction effect = effect_function(settings.effect);
 
-    std::vector<std::string> names{"visibility", "background"};
-    if (mc) names.insert(names.end(), {"sample_count", "std_error"});
-    result.visibility = image::Image(W, H, names);
-    // translucent: the transmittance per RGB channel (coloured shadows; "visibility" is their
-    // mean), in an image of its own (an image has at most 4 channels).
-    const bool coloured = settings.effect == Effect::translucent;
-    if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
-    result.radiance = image::Image(W, H, 3);
-    result.samples = mc ? settings.samples : 1;
+  std::vector<std::string> names{"visibility", "background"};
+  if (mc) names.insert(names.end(), {"sample_count", "std_error"});
+  result.visibility = image::Image(W, H, names);
+  // translucent: the transmittance per RGB channel (coloured shadows; "visibility" is their
+  // mean), in an image of its own (an image has at most 4 channels).
+  const bool coloured = settings.effect == Effect::translucent;
+  if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
+  result.radiance = image::Image(W, H, 3);
+  result.samples = mc ? settings.samples : 1;
 
-    // Camera: unproject NDC depth 0 and 1 with the inverse of the rasterizer's matrix.
-    const glm::dmat4 inv_vp = glm::inverse(glm::dmat4(scene.camera_view_projection(float(W) / float(H))));
-    const auto unproject = [&](double nx, double ny, double depth) {
-        const glm::dvec4 q = inv_vp * glm::dvec4(nx, ny, depth, 1.0);
-        return glm::dvec3(q) / q.w;
-    };
-    const glm::dvec3 irradiance(scene.light.irradiance);
+  // Camera: unproject NDC depth 0 and 1 with the inverse of the rasterizer's matrix.
+  const glm::dmat4 inv_vp = glm::inverse(glm::dmat4(scene.camera_view_projection(float(W) / float(H))));
+  const auto unproject = [&](double nx, double ny, double depth) {
+    const glm::dvec4 q = inv_vp * glm::dvec4(nx, ny, depth, 1.0);
+    return glm::dvec3(q) / q.w;
+  };
+  const glm::dvec3 irradiance(scene.light.irradiance);
 
-    std::vector<double> row_sum(H, 0.0);
-    std::vector<std::size_t> row_background(H, 0);
-    std::atomic<std::uint64_t> rays{0};
-    std::atomic<std::size_t> rows_done{0};
-    std::mutex progress_mutex;
-    std::size_t progress_reported = 0;
-    const std::size_t progress_step = std::max<std::size_t>(1, std::size_t(H) / 200);
-    const int channels = result.visibility.channels();
-    float* vis = result.visibility.pixels().data();
-    float* rad = result.radiance.pixels().data();
-    float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
-    const auto trace_start = std::chrono::steady_clock::now();
+  std::vector<double> row_sum(H, 0.0);
+  std::vector<std::size_t> row_background(H, 0);
+  std::atomic<std::uint64_t> rays{0};
+  std::atomic<std::size_t> rows_done{0};
+  std::mutex progress_mutex;
+  std::size_t progress_reported = 0;
+  const std::size_t progress_step = std::max<std::size_t>(1, std::size_t(H) / 200);
+  const int channels = result.visibility.channels();
+  float* vis = result.visibility.pixels().data();
+  float* rad = result.radiance.pixels().data();
+  float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
+  const auto trace_start = std::chrono::steady_clock::now();
 
-    tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& range) {
-        for (int y = range.begin(); y != range.end(); ++y) {
-            std::uint64_t row_rays = 0;
-            for (int x = 0; x < W; ++x) {
-                const double nx = (x + 0.5) / W * 2.0 - 1.0, ny = (y + 0.5) / H * 2.0 - 1.0;
-                const glm::dvec3 near = unproject(nx, ny, 0.0), far = unproject(nx, ny, 1.0);
-                const double length = glm::length(far - near);
-                const glm::dvec3 dir = (far - near) / length;
-                float* v = vis + (std::size_t(y) * W + x) * channels;
-                float* c = rad + (std::size_t(y) * W + x) * 3;
-                SurfaceHit hit;
-                ++row_rays;
-                // The visible surface is the closest opaque one: translucent surfaces (opacity
-                // < 1) are looked through, as the renderer's shadow buffer does.
-                bool found = tracer.closest(near, dir, length, hit);
-                for (int crossed = 0; found && tracer.material(hit).translucent() && crossed < kMaxCrossings; ++crossed) {
-                    const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
-                    found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
-                    ++row_rays;
-                }
-                if (!found) {
-                    v[0] = 1.0f;
-                    v[1] = 1.0f;
-                    ++row_background[y];
-                    continue;  // radiance 0, sample_count and std_error 0
-                }
-                Rng rng = pixel_rng(settings.seed, x, y, settings.effect);
-                const EffectResult e = effect(ctx, hit, rng);
-                row_rays += e.rays;
-                v[0] = float(e.value);
-                if (mc) {
-                    v[2] = float(e.samples);
-                    v[3] = float(e.std_error);
-                }
-                const glm::vec3 rgb = e.rgb ? glm::vec3(*e.rgb) : glm::vec3(float(e.value));
-                if (vis_rgb) {
-                    float* t = vis_rgb + (std::size_t(y) * W + x) * 3;
-                    t[0] = rgb.r;
-                    t[1] = rgb.g;
-                    t[2] = rgb.b;
-                }
-                row_sum[y] += e.value;
-                // Shading: interpolated normal turned towards the viewer; per channel where the
-                // effect gives a visibility per channel (translucent).
-                glm::dvec3 n = tracer.shading_normal(hit);
-                if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-                const glm::vec3 colour = e.rgb ? shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                                       float(glm::dot(n, ctx.towards_light)), rgb)
-                                               : shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                                       float(glm::dot(n, ctx.towards_light)), float(e.value));
-                c[0] = colour.r;
-                c[1] = colour.g;
-                c[2] = colour.b;
-            }
-            rays += row_rays;
-            const std::size_t done = ++rows_done;
-            if (settings.progress && (done % progress_step == 0 || done == std::size_t(H))) {
-                std::lock_guard lock(progress_mutex);
-                if (done > progress_reported) {
-                    progress_reported = done;
-                    settings.progress(Progress{done, std::size_t(H), seconds_since(start)});
-                }
-            }
+  tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& range) {
+    for (int y = range.begin(); y != range.end(); ++y) {
+      std::uint64_t row_rays = 0;
+      for (int x = 0; x < W; ++x) {
+        const double nx = (x + 0.5) / W * 2.0 - 1.0, ny = (y + 0.5) / H * 2.0 - 1.0;
+        const glm::dvec3 near = unproject(nx, ny, 0.0), far = unproject(nx, ny, 1.0);
+        const double length = glm::length(far - near);
+        const glm::dvec3 dir = (far - near) / length;
+        float* v = vis + (std::size_t(y) * W + x) * channels;
+        float* c = rad + (std::size_t(y) * W + x) * 3;
+        SurfaceHit hit;
+        ++row_rays;
+        // The visible surface is the closest opaque one: translucent surfaces (opacity
+        // < 1) are looked through, as the renderer's shadow buffer does.
+        bool found = tracer.closest(near, dir, length, hit);
+        for (int crossed = 0; found && tracer.material(hit).translucent() && crossed < kMaxCrossings; ++crossed) {
+          const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
+          found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
+          ++row_rays;
         }
-    });
-    result.render_seconds = seconds_since(trace_start);
-    result.rays = rays.load();
-    double sum = 0.0;
-    for (int y = 0; y < H; ++y) {
-        sum += row_sum[y];
-        result.background_pixels += row_background[y];
+        if (!found) {
+          v[0] = 1.0f;
+          v[1] = 1.0f;
+          ++row_background[y];
+          continue; // radiance 0, sample_count and std_error 0
+        }
+        Rng rng = pixel_rng(settings.seed, x, y, settings.effect);
+        const EffectResult e = effect(ctx, hit, rng);
+        row_rays += e.rays;
+        v[0] = float(e.value);
+        if (mc) {
+          v[2] = float(e.samples);
+          v[3] = float(e.std_error);
+        }
+        const glm::vec3 rgb = e.rgb ? glm::vec3(*e.rgb) : glm::vec3(float(e.value));
+        if (vis_rgb) {
+          float* t = vis_rgb + (std::size_t(y) * W + x) * 3;
+          t[0] = rgb.r;
+          t[1] = rgb.g;
+          t[2] = rgb.b;
+        }
+        row_sum[y] += e.value;
+        // Shading: interpolated normal turned towards the viewer; per channel where the
+        // effect gives a visibility per channel (translucent).
+        glm::dvec3 n = tracer.shading_normal(hit);
+        if (glm::dot(hit.normal, dir) > 0.0) n = -n;
+        const glm::vec3 colour = e.rgb ? shade(tracer.material(hit).albedo, glm::vec3(irradiance),
+                                               float(glm::dot(n, ctx.towards_light)), rgb)
+                                       : shade(tracer.material(hit).albedo, glm::vec3(irradiance),
+                                               float(glm::dot(n, ctx.towards_light)), float(e.value));
+        c[0] = colour.r;
+        c[1] = colour.g;
+        c[2] = colour.b;
+      }
+      rays += row_rays;
+      const std::size_t done = ++rows_done;
+      if (settings.progress && (done % progress_step == 0 || done == std::size_t(H))) {
+        std::lock_guard lock(progress_mutex);
+        if (done > progress_reported) {
+          progress_reported = done;
+          settings.progress(Progress{done, std::size_t(H), seconds_since(start)});
+        }
+      }
     }
-    const std::size_t covered = std::size_t(W) * H - result.background_pixels;
-    result.mean_visibility = covered ? sum / double(covered) : 1.0;
-    result.threads = unsigned(std::min<std::size_t>(tbb::this_task_arena::max_concurrency(),
-                                                    tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
-    return result;
+  });
+  result.render_seconds = seconds_since(trace_start);
+  result.rays = rays.load();
+  double sum = 0.0;
+  for (int y = 0; y < H; ++y) {
+    sum += row_sum[y];
+    result.background_pixels += row_background[y];
+  }
+  const std::size_t covered = std::size_t(W) * H - result.background_pixels;
+  result.mean_visibility = covered ? sum / double(covered) : 1.0;
+  result.threads =
+      unsigned(std::min<std::size_t>(tbb::this_task_arena::max_concurrency(),
+                                     tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+  return result;
 }
 
-}  // namespace
-}  // namespace msm::reference
+} // namespace
+} // namespace msm::reference

@@ -40,89 +40,93 @@ using msm::scene::Scene;
 constexpr double kPi = std::numbers::pi;
 
 std::string num(double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
 }
 std::string vec(glm::dvec3 v) { return "[" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + "]"; }
 
 struct CameraSpec {
-    glm::dvec3 position, target, up{0.0, 1.0, 0.0};
-    double fov_deg = 45.0, near = 0.01, far = 100.0;
-    std::string json() const {
-        return R"("camera": {"position": )" + vec(position) + R"(, "target": )" + vec(target) + R"(, "up": )" + vec(up) +
-               R"(, "fov_y_deg": )" + num(fov_deg) + R"(, "near": )" + num(near) + R"(, "far": )" + num(far) + "}";
-    }
-    // The ray through the centre of pixel (x, y), y = 0 the top row (an independent model of the
-    // rasterizer's conventions: look-at basis, vertical fov, aspect W / H).
-    glm::dvec3 ray(int x, int y, int W, int H) const {
-        const glm::dvec3 f = glm::normalize(target - position);
-        const glm::dvec3 r = glm::normalize(glm::cross(f, up));
-        const glm::dvec3 u = glm::cross(r, f);
-        const double t = std::tan(fov_deg * kPi / 360.0);
-        const double sx = ((x + 0.5) / W * 2.0 - 1.0) * t * double(W) / H;
-        const double sy = ((y + 0.5) / H * 2.0 - 1.0) * t;
-        return glm::normalize(f + sx * r - sy * u);
-    }
+  glm::dvec3 position, target, up{0.0, 1.0, 0.0};
+  double fov_deg = 45.0, near = 0.01, far = 100.0;
+  std::string json() const {
+    return R"("camera": {"position": )" + vec(position) + R"(, "target": )" + vec(target) + R"(, "up": )" + vec(up) +
+           R"(, "fov_y_deg": )" + num(fov_deg) + R"(, "near": )" + num(near) + R"(, "far": )" + num(far) + "}";
+  }
+  // The ray through the centre of pixel (x, y), y = 0 the top row (an independent model of the
+  // rasterizer's conventions: look-at basis, vertical fov, aspect W / H).
+  glm::dvec3 ray(int x, int y, int W, int H) const {
+    const glm::dvec3 f = glm::normalize(target - position);
+    const glm::dvec3 r = glm::normalize(glm::cross(f, up));
+    const glm::dvec3 u = glm::cross(r, f);
+    const double t = std::tan(fov_deg * kPi / 360.0);
+    const double sx = ((x + 0.5) / W * 2.0 - 1.0) * t * double(W) / H;
+    const double sy = ((y + 0.5) / H * 2.0 - 1.0) * t;
+    return glm::normalize(f + sx * r - sy * u);
+  }
 };
 
 Scene make_scene(const CameraSpec& camera, const std::string& light, const std::string& objects,
                  const std::string& extra = "") {
-    const std::string json = R"({"msm_scene": 1, )" + camera.json() + ", " + light + ", " + extra + R"("objects": [)" +
-                             objects + "]}";
-    return msm::scene::load_scene_json(json, std::filesystem::current_path(), "test.json");
+  const std::string json =
+      R"({"msm_scene": 1, )" + camera.json() + ", " + light + ", " + extra + R"("objects": [)" + objects + "]}";
+  return msm::scene::load_scene_json(json, std::filesystem::current_path(), "test.json");
 }
 
 std::string light_json(glm::dvec3 towards, double extent_deg = 0.0) {
-    return R"("light": {"towards_light": )" + vec(towards) + R"(, "irradiance": [2, 2, 2], "angular_extent_deg": )" +
-           num(extent_deg) + "}";
+  return R"("light": {"towards_light": )" + vec(towards) + R"(, "irradiance": [2, 2, 2], "angular_extent_deg": )" +
+         num(extent_deg) + "}";
 }
 
 // Where the pixel's ray meets the ground y = 0 (the camera is above it, looking down).
 glm::dvec3 ground_point(const CameraSpec& c, int x, int y, int W, int H) {
-    const glm::dvec3 d = c.ray(x, y, W, H);
-    return c.position + (-c.position.y / d.y) * d;
+  const glm::dvec3 d = c.ray(x, y, W, H);
+  return c.position + (-c.position.y / d.y) * d;
 }
 
 // The ground (20 x 20, albedo 0.5) and a half-plane occluder covering x < 0 at height h.
 std::string ground_and_half_plane(double h) {
-    return R"({"name": "ground", "primitive": {"type": "plane", "size": [20, 20]}, "material": {"albedo": [0.5, 0.5, 0.5]}},
+  return R"({"name": "ground", "primitive": {"type": "plane", "size": [20, 20]}, "material": {"albedo": [0.5, 0.5, 0.5]}},
               {"name": "half", "primitive": {"type": "plane", "size": [10, 20]},
-               "transform": {"translate": [-5, )" + num(h) + R"(, 0]}})";
+               "transform": {"translate": [-5, )" +
+         num(h) + R"(, 0]}})";
 }
 
 // ---- The filter kernel, independently: k(s) = sum_k w_k tent(s - k), CDF per tap ---------------
 
 double kernel_cdf(double s, int size, double sigma) {
-    const int r = (size - 1) / 2;
-    double total = 0.0, c = 0.0;
-    for (int k = -r; k <= r; ++k) total += std::exp(-k * k / (2.0 * sigma * sigma));
-    for (int k = -r; k <= r; ++k) {
-        const double u = s - k;
-        const double tent = u <= -1.0 ? 0.0 : u >= 1.0 ? 1.0 : u < 0.0 ? 0.5 * (u + 1) * (u + 1) : 1.0 - 0.5 * (1 - u) * (1 - u);
-        c += std::exp(-k * k / (2.0 * sigma * sigma)) / total * tent;
-    }
-    return c;
+  const int r = (size - 1) / 2;
+  double total = 0.0, c = 0.0;
+  for (int k = -r; k <= r; ++k) total += std::exp(-k * k / (2.0 * sigma * sigma));
+  for (int k = -r; k <= r; ++k) {
+    const double u = s - k;
+    const double tent = u <= -1.0  ? 0.0
+                        : u >= 1.0 ? 1.0
+                        : u < 0.0  ? 0.5 * (u + 1) * (u + 1)
+                                   : 1.0 - 0.5 * (1 - u) * (1 - u);
+    c += std::exp(-k * k / (2.0 * sigma * sigma)) / total * tent;
+  }
+  return c;
 }
 
 float channel(const Image& image, const char* name, int x, int y) {
-    const int c = image.find_channel(name);
-    if (c < 0) throw std::runtime_error(std::string("no channel ") + name);
-    return image.at(x, y, c);
+  const int c = image.find_channel(name);
+  if (c < 0) throw std::runtime_error(std::string("no channel ") + name);
+  return image.at(x, y, c);
 }
 
 template <class F>
 void expect_invalid(F&& f, const std::string& fragment) {
-    try {
-        f();
-        ADD_FAILURE() << "no exception (expected one mentioning '" << fragment << "')";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << "'" << fragment << "' not in: " << e.what();
-    }
+  try {
+    f();
+    ADD_FAILURE() << "no exception (expected one mentioning '" << fragment << "')";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << "'" << fragment << "' not in: " << e.what();
+  }
 }
 
-}  // namespace
+} // namespace
 
 // ---- hard ----------------------------------------------------------------------------------------
 
@@ -132,115 +136,113 @@ void expect_invalid(F&& f, const std::string& fragment) {
 // from below (visible to the light from its upper side, unlit on the viewer's side), and the
 // radiance formula.
 TEST(reference_hard, HalfPlaneEdgeIsExactPerPixel) {
-    const double h = 1.0, inf = std::numeric_limits<double>::infinity();
-    for (const glm::dvec3& towards : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(0.4, 1.0, 0.3))}) {
-        SCOPED_TRACE("towards_light " + vec(towards));
-        // Below the occluder, looking down and to the side, so that the edge runs diagonally
-        // across the image; the top rows see the occluder from below, or nothing.
-        const CameraSpec camera{{0.3, 0.6, 1.5}, {-0.6, 0.0, -0.5}};
-        const Scene scene = make_scene(camera, light_json(towards), ground_and_half_plane(h));
-        Settings s;
-        s.effect = Effect::hard;
-        s.width = 160;
-        s.height = 120;
-        const Result r = render(scene, s);
-        ASSERT_EQ(r.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
-        ASSERT_EQ(r.radiance.channels(), 3);
-        const double edge_x = -h * towards.x / towards.y;
-        int lit = 0, shadowed = 0, background = 0, underside = 0, skipped = 0;
-        for (int y = 0; y < s.height; ++y)
-            for (int x = 0; x < s.width; ++x) {
-                const glm::dvec3 d = camera.ray(x, y, s.width, s.height);
-                // Analytic first hit: the ground (y = 0, |x|, |z| < 10) or the occluder (y = h,
-                // -10 < x < 0, |z| < 10).
-                const double tg = d.y < 0.0 ? -camera.position.y / d.y : inf;
-                const double to = d.y > 0.0 ? (h - camera.position.y) / d.y : inf;
-                const glm::dvec3 pg = camera.position + (std::isfinite(tg) ? tg : 0.0) * d;
-                const glm::dvec3 po = camera.position + (std::isfinite(to) ? to : 0.0) * d;
-                const double rim_g = std::min(10.0 - std::abs(pg.x), 10.0 - std::abs(pg.z));
-                const double rim_o = std::min({-po.x, 10.0 + po.x, 10.0 - std::abs(po.z)});
-                const bool ground = std::isfinite(tg) && rim_g > 0.0;
-                const bool occluder = std::isfinite(to) && rim_o > 0.0;
-                if ((std::isfinite(tg) && std::abs(rim_g) < 1e-3) || (std::isfinite(to) && std::abs(rim_o) < 1e-3)) {
-                    ++skipped;
-                    continue;
-                }
-                const float v = channel(r.visibility, "visibility", x, y);
-                const float bg = channel(r.visibility, "background", x, y);
-                if (!ground && !occluder) {
-                    ASSERT_EQ(bg, 1.0f) << x << "," << y;
-                    ASSERT_EQ(v, 1.0f);
-                    ASSERT_EQ(r.radiance.at(x, y, 0), 0.0f);
-                    ++background;
-                    continue;
-                }
-                ASSERT_EQ(bg, 0.0f) << x << "," << y;
-                if (occluder) {  // seen from below: nothing above it; n faces the viewer, n.l < 0
-                    ASSERT_EQ(v, 1.0f) << x << "," << y;
-                    ASSERT_NEAR(r.radiance.at(x, y, 0), 0.03 * 0.8, 1e-7);
-                    ++underside;
-                    continue;
-                }
-                if (std::abs(pg.x - edge_x) < 1e-5) {
-                    ++skipped;
-                    continue;
-                }
-                const float expected = pg.x > edge_x ? 1.0f : 0.0f;
-                ASSERT_EQ(v, expected) << "pixel " << x << "," << y << " ground x " << pg.x << " edge " << edge_x;
-                (expected > 0.5f ? lit : shadowed)++;
-                // albedo * E * cos / pi * V + 0.03 albedo, with n = +Y.
-                const double radiance = 0.5 * 2.0 * towards.y / kPi * expected + 0.03 * 0.5;
-                for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.radiance.at(x, y, c), radiance, 1e-6 * radiance);
-            }
-        EXPECT_GT(lit, 2000);
-        EXPECT_GT(shadowed, 2000);
-        EXPECT_GT(background, 200);
-        EXPECT_GT(underside, 200);
-        EXPECT_LE(skipped, 10);
-        RecordProperty(towards.x == 0.0 ? "pixels_straight" : "pixels_tilted",
-                       std::to_string(lit) + " lit, " + std::to_string(shadowed) + " shadowed, " +
-                           std::to_string(underside) + " occluder, " + std::to_string(background) + " background, " +
-                           std::to_string(skipped) + " skipped");
-        EXPECT_NEAR(double(r.background_pixels), background, skipped);
-        EXPECT_EQ(r.samples, 1);
-        // One primary ray per pixel, one shadow ray per covered pixel.
-        EXPECT_EQ(r.rays, std::uint64_t(s.width * s.height) * 2 - r.background_pixels);
-    }
+  const double h = 1.0, inf = std::numeric_limits<double>::infinity();
+  for (const glm::dvec3& towards : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(0.4, 1.0, 0.3))}) {
+    SCOPED_TRACE("towards_light " + vec(towards));
+    // Below the occluder, looking down and to the side, so that the edge runs diagonally
+    // across the image; the top rows see the occluder from below, or nothing.
+    const CameraSpec camera{{0.3, 0.6, 1.5}, {-0.6, 0.0, -0.5}};
+    const Scene scene = make_scene(camera, light_json(towards), ground_and_half_plane(h));
+    Settings s;
+    s.effect = Effect::hard;
+    s.width = 160;
+    s.height = 120;
+    const Result r = render(scene, s);
+    ASSERT_EQ(r.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
+    ASSERT_EQ(r.radiance.channels(), 3);
+    const double edge_x = -h * towards.x / towards.y;
+    int lit = 0, shadowed = 0, background = 0, underside = 0, skipped = 0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        const glm::dvec3 d = camera.ray(x, y, s.width, s.height);
+        // Analytic first hit: the ground (y = 0, |x|, |z| < 10) or the occluder (y = h,
+        // -10 < x < 0, |z| < 10).
+        const double tg = d.y < 0.0 ? -camera.position.y / d.y : inf;
+        const double to = d.y > 0.0 ? (h - camera.position.y) / d.y : inf;
+        const glm::dvec3 pg = camera.position + (std::isfinite(tg) ? tg : 0.0) * d;
+        const glm::dvec3 po = camera.position + (std::isfinite(to) ? to : 0.0) * d;
+        const double rim_g = std::min(10.0 - std::abs(pg.x), 10.0 - std::abs(pg.z));
+        const double rim_o = std::min({-po.x, 10.0 + po.x, 10.0 - std::abs(po.z)});
+        const bool ground = std::isfinite(tg) && rim_g > 0.0;
+        const bool occluder = std::isfinite(to) && rim_o > 0.0;
+        if ((std::isfinite(tg) && std::abs(rim_g) < 1e-3) || (std::isfinite(to) && std::abs(rim_o) < 1e-3)) {
+          ++skipped;
+          continue;
+        }
+        const float v = channel(r.visibility, "visibility", x, y);
+        const float bg = channel(r.visibility, "background", x, y);
+        if (!ground && !occluder) {
+          ASSERT_EQ(bg, 1.0f) << x << "," << y;
+          ASSERT_EQ(v, 1.0f);
+          ASSERT_EQ(r.radiance.at(x, y, 0), 0.0f);
+          ++background;
+          continue;
+        }
+        ASSERT_EQ(bg, 0.0f) << x << "," << y;
+        if (occluder) { // seen from below: nothing above it; n faces the viewer, n.l < 0
+          ASSERT_EQ(v, 1.0f) << x << "," << y;
+          ASSERT_NEAR(r.radiance.at(x, y, 0), 0.03 * 0.8, 1e-7);
+          ++underside;
+          continue;
+        }
+        if (std::abs(pg.x - edge_x) < 1e-5) {
+          ++skipped;
+          continue;
+        }
+        const float expected = pg.x > edge_x ? 1.0f : 0.0f;
+        ASSERT_EQ(v, expected) << "pixel " << x << "," << y << " ground x " << pg.x << " edge " << edge_x;
+        (expected > 0.5f ? lit : shadowed)++;
+        // albedo * E * cos / pi * V + 0.03 albedo, with n = +Y.
+        const double radiance = 0.5 * 2.0 * towards.y / kPi * expected + 0.03 * 0.5;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.radiance.at(x, y, c), radiance, 1e-6 * radiance);
+      }
+    EXPECT_GT(lit, 2000);
+    EXPECT_GT(shadowed, 2000);
+    EXPECT_GT(background, 200);
+    EXPECT_GT(underside, 200);
+    EXPECT_LE(skipped, 10);
+    RecordProperty(towards.x == 0.0 ? "pixels_straight" : "pixels_tilted",
+                   std::to_string(lit) + " lit, " + std::to_string(shadowed) + " shadowed, " +
+                       std::to_string(underside) + " occluder, " + std::to_string(background) + " background, " +
+                       std::to_string(skipped) + " skipped");
+    EXPECT_NEAR(double(r.background_pixels), background, skipped);
+    EXPECT_EQ(r.samples, 1);
+    // One primary ray per pixel, one shadow ray per covered pixel.
+    EXPECT_EQ(r.rays, std::uint64_t(s.width * s.height) * 2 - r.background_pixels);
+  }
 }
 
 // Row 0 is the top of the image and column 0 its left: a box to the right of and above the view
 // centre shows up in the top-right quadrant; the ground fills the bottom rows.
 TEST(reference_hard, ImageOrientation) {
-    const CameraSpec camera{{0, 1, 5}, {0, 1, 0}};
-    const Scene scene = make_scene(camera, light_json({0, 1, 0}),
-                                   R"({"primitive": {"type": "plane", "size": [1000, 1000]}},
+  const CameraSpec camera{{0, 1, 5}, {0, 1, 0}};
+  const Scene scene = make_scene(camera, light_json({0, 1, 0}),
+                                 R"({"primitive": {"type": "plane", "size": [1000, 1000]}},
                                       {"primitive": {"type": "box", "size": [0.4, 0.4, 0.4]}, "transform": {"translate": [1, 1.6, 0]}})");
-    Settings s;
-    s.width = 40;
-    s.height = 30;
-    const Result r = render(scene, s);
-    int box_pixels = 0;
-    for (int y = 0; y < s.height; ++y)
-        for (int x = 0; x < s.width; ++x) {
-            const bool bg = channel(r.visibility, "background", x, y) > 0.5f;
-            if (y >= s.height / 2) {
-                EXPECT_FALSE(bg) << "bottom half must show the ground: " << x << "," << y;
-            }
-            if (y < s.height / 2 && !bg) {
-                EXPECT_GE(x, s.width / 2) << "the box is to the right";
-                ++box_pixels;
-            }
-        }
-    EXPECT_GT(box_pixels, 4);
-    EXPECT_EQ(channel(r.visibility, "background", 0, 0), 1.0f);
+  Settings s;
+  s.width = 40;
+  s.height = 30;
+  const Result r = render(scene, s);
+  int box_pixels = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const bool bg = channel(r.visibility, "background", x, y) > 0.5f;
+      if (y >= s.height / 2) { EXPECT_FALSE(bg) << "bottom half must show the ground: " << x << "," << y; }
+      if (y < s.height / 2 && !bg) {
+        EXPECT_GE(x, s.width / 2) << "the box is to the right";
+        ++box_pixels;
+      }
+    }
+  EXPECT_GT(box_pixels, 4);
+  EXPECT_EQ(channel(r.visibility, "background", 0, 0), 1.0f);
 }
 
 // ---- filtered ------------------------------------------------------------------------------------
 
 struct ProfileCase {
-    glm::dvec3 towards;
-    double texel;  // the texel size along the light-space axis the edge crosses
-    double stretch;  // ground distance per light-space distance across the edge (1 / cos)
+  glm::dvec3 towards;
+  double texel;   // the texel size along the light-space axis the edge crosses
+  double stretch; // ground distance per light-space distance across the edge (1 / cos)
 };
 
 // The filtered visibility across the half-plane's edge is the kernel's 1D CDF of the light-space
@@ -248,81 +250,82 @@ struct ProfileCase {
 // light-space x is world x (texel 6/256). Light tilted by 30 degrees in the x-y plane: the edge
 // crosses light-space y (texel 8/256) and the receiver plane stretches it by 1 / cos 30.
 TEST(reference_filtered, EdgeProfileMatchesTheKernel) {
-    const double h = 1.0, phi = 30.0 * kPi / 180.0;
-    const ProfileCase cases[] = {{{0, 1, 0}, 6.0 / 256, 1.0},
-                                 {{std::sin(phi), std::cos(phi), 0}, 8.0 / 256, 1.0 / std::cos(phi)}};
-    for (const ProfileCase& pc : cases) {
-        SCOPED_TRACE("towards_light " + vec(pc.towards));
-        const double edge_x = -h * pc.towards.x / pc.towards.y;
-        const CameraSpec camera{{edge_x, 0.06, 0.0}, {edge_x, 0.0, 0.0}, {0, 0, -1}};
-        const Scene scene = make_scene(camera, light_json(pc.towards), ground_and_half_plane(h),
-                                       R"("shadow_map": {"framing": "explicit", "center": [0, 0.5, 0], "extent": [6, 8], "depth_range": [-5, 5]}, )");
-        const LightFrame frame = LightFrame::of(scene);
-        EXPECT_NEAR(frame.extent.x, 6.0, 1e-5);
-        EXPECT_NEAR(frame.extent.y, 8.0, 1e-5);
-        Settings s;
-        s.effect = Effect::filtered;
-        s.width = 96;
-        s.height = 8;
-        s.samples = 4096;
-        s.shadow_size = 256;
-        s.seed = 7;
-        const Result r = render(scene, s);
-        ASSERT_EQ(r.visibility.channel_names(),
-                  (std::vector<std::string>{"visibility", "background", "sample_count", "std_error"}));
-        double sum_err = 0, sum_err2 = 0, sum_var = 0, sum_iid_var = 0, worst = 0;
-        int penumbra = 0;
-        for (int y = 0; y < s.height; ++y)
-            for (int x = 0; x < s.width; ++x) {
-                const glm::dvec3 p = ground_point(camera, x, y, s.width, s.height);
-                const double expected = kernel_cdf((p.x - edge_x) / pc.stretch / pc.texel, 9, 2.4);
-                const double v = channel(r.visibility, "visibility", x, y);
-                const double se = channel(r.visibility, "std_error", x, y);
-                ASSERT_EQ(channel(r.visibility, "sample_count", x, y), 4096.0f);
-                ASSERT_EQ(channel(r.visibility, "background", x, y), 0.0f);
-                // The error bound: 4 standard errors of independent sampling (an upper bound of
-                // the stratified sampler's error), reported or from the true value, + 1e-6.
-                const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
-                ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-6)
-                    << "pixel " << x << "," << y << " ground x " << p.x << " expected " << expected << " got " << v;
-                worst = std::max(worst, std::abs(v - expected));
-                if (expected > 0.02 && expected < 0.98) {
-                    ++penumbra;
-                    sum_err += v - expected;
-                    sum_err2 += (v - expected) * (v - expected);
-                    sum_var += se * se;
-                    sum_iid_var += iid * iid;
-                }
-            }
-        ASSERT_GT(penumbra, 200);
-        // No bias: the mean error over the penumbra within 4 of its standard errors.
-        EXPECT_LE(std::abs(sum_err / penumbra), 4.0 * std::sqrt(sum_var) / penumbra);
-        // The reported standard error is that of independent samples (within 10 %), and the
-        // stratified estimate is at least that good (RMS error below the RMS standard error).
-        EXPECT_NEAR(std::sqrt(sum_var / sum_iid_var), 1.0, 0.1);
-        EXPECT_LT(std::sqrt(sum_err2 / penumbra), std::sqrt(sum_var / penumbra));
-        RecordProperty("rms_max_error_" + std::to_string(int(pc.texel * 256)),
-                       num(std::sqrt(sum_err2 / penumbra)) + " " + num(worst) + " over " + std::to_string(penumbra));
-    }
+  const double h = 1.0, phi = 30.0 * kPi / 180.0;
+  const ProfileCase cases[] = {{{0, 1, 0}, 6.0 / 256, 1.0},
+                               {{std::sin(phi), std::cos(phi), 0}, 8.0 / 256, 1.0 / std::cos(phi)}};
+  for (const ProfileCase& pc : cases) {
+    SCOPED_TRACE("towards_light " + vec(pc.towards));
+    const double edge_x = -h * pc.towards.x / pc.towards.y;
+    const CameraSpec camera{{edge_x, 0.06, 0.0}, {edge_x, 0.0, 0.0}, {0, 0, -1}};
+    const Scene scene = make_scene(
+        camera, light_json(pc.towards), ground_and_half_plane(h),
+        R"("shadow_map": {"framing": "explicit", "center": [0, 0.5, 0], "extent": [6, 8], "depth_range": [-5, 5]}, )");
+    const LightFrame frame = LightFrame::of(scene);
+    EXPECT_NEAR(frame.extent.x, 6.0, 1e-5);
+    EXPECT_NEAR(frame.extent.y, 8.0, 1e-5);
+    Settings s;
+    s.effect = Effect::filtered;
+    s.width = 96;
+    s.height = 8;
+    s.samples = 4096;
+    s.shadow_size = 256;
+    s.seed = 7;
+    const Result r = render(scene, s);
+    ASSERT_EQ(r.visibility.channel_names(),
+              (std::vector<std::string>{"visibility", "background", "sample_count", "std_error"}));
+    double sum_err = 0, sum_err2 = 0, sum_var = 0, sum_iid_var = 0, worst = 0;
+    int penumbra = 0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        const glm::dvec3 p = ground_point(camera, x, y, s.width, s.height);
+        const double expected = kernel_cdf((p.x - edge_x) / pc.stretch / pc.texel, 9, 2.4);
+        const double v = channel(r.visibility, "visibility", x, y);
+        const double se = channel(r.visibility, "std_error", x, y);
+        ASSERT_EQ(channel(r.visibility, "sample_count", x, y), 4096.0f);
+        ASSERT_EQ(channel(r.visibility, "background", x, y), 0.0f);
+        // The error bound: 4 standard errors of independent sampling (an upper bound of
+        // the stratified sampler's error), reported or from the true value, + 1e-6.
+        const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
+        ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-6)
+            << "pixel " << x << "," << y << " ground x " << p.x << " expected " << expected << " got " << v;
+        worst = std::max(worst, std::abs(v - expected));
+        if (expected > 0.02 && expected < 0.98) {
+          ++penumbra;
+          sum_err += v - expected;
+          sum_err2 += (v - expected) * (v - expected);
+          sum_var += se * se;
+          sum_iid_var += iid * iid;
+        }
+      }
+    ASSERT_GT(penumbra, 200);
+    // No bias: the mean error over the penumbra within 4 of its standard errors.
+    EXPECT_LE(std::abs(sum_err / penumbra), 4.0 * std::sqrt(sum_var) / penumbra);
+    // The reported standard error is that of independent samples (within 10 %), and the
+    // stratified estimate is at least that good (RMS error below the RMS standard error).
+    EXPECT_NEAR(std::sqrt(sum_var / sum_iid_var), 1.0, 0.1);
+    EXPECT_LT(std::sqrt(sum_err2 / penumbra), std::sqrt(sum_var / penumbra));
+    RecordProperty("rms_max_error_" + std::to_string(int(pc.texel * 256)),
+                   num(std::sqrt(sum_err2 / penumbra)) + " " + num(worst) + " over " + std::to_string(penumbra));
+  }
 }
 
 TEST(reference_filtered, KernelSamplingHasTheKernelsDistribution) {
-    // FilterKernel::sample maps uniform u to offsets with CDF cdf(); cdf matches the test's own.
-    const FilterKernel k(9, 2.4);
-    double total = 0.0;
-    for (double w : k.weights()) total += w;
-    EXPECT_NEAR(total, 1.0, 1e-15);
-    for (double s = -6.0; s <= 6.0; s += 0.37) EXPECT_NEAR(k.cdf(s), kernel_cdf(s, 9, 2.4), 1e-14);
-    // Empirical CDF of 2^16 evenly spaced u against cdf(): Kolmogorov distance ~ 1 / 2^16.
-    std::vector<double> samples;
-    const int n = 1 << 16;
-    for (int i = 0; i < n; ++i) samples.push_back(k.sample((i + 0.5) / n));
-    std::sort(samples.begin(), samples.end());
-    double worst = 0.0;
-    for (int i = 0; i < n; i += 7) worst = std::max(worst, std::abs(k.cdf(samples[i]) - (i + 0.5) / n));
-    EXPECT_LT(worst, 2e-5);
-    EXPECT_THROW(FilterKernel(8, 2.4), std::invalid_argument);
-    EXPECT_THROW(FilterKernel(9, 0.0), std::invalid_argument);
+  // FilterKernel::sample maps uniform u to offsets with CDF cdf(); cdf matches the test's own.
+  const FilterKernel k(9, 2.4);
+  double total = 0.0;
+  for (double w : k.weights()) total += w;
+  EXPECT_NEAR(total, 1.0, 1e-15);
+  for (double s = -6.0; s <= 6.0; s += 0.37) EXPECT_NEAR(k.cdf(s), kernel_cdf(s, 9, 2.4), 1e-14);
+  // Empirical CDF of 2^16 evenly spaced u against cdf(): Kolmogorov distance ~ 1 / 2^16.
+  std::vector<double> samples;
+  const int n = 1 << 16;
+  for (int i = 0; i < n; ++i) samples.push_back(k.sample((i + 0.5) / n));
+  std::sort(samples.begin(), samples.end());
+  double worst = 0.0;
+  for (int i = 0; i < n; i += 7) worst = std::max(worst, std::abs(k.cdf(samples[i]) - (i + 0.5) / n));
+  EXPECT_LT(worst, 2e-5);
+  EXPECT_THROW(FilterKernel(8, 2.4), std::invalid_argument);
+  EXPECT_THROW(FilterKernel(9, 0.0), std::invalid_argument);
 }
 
 // ---- soft ----------------------------------------------------------------------------------------
@@ -334,80 +337,80 @@ namespace {
 // straight down; the light straight down. The answer is disc_occluder_visibility (analytic.h),
 // whose defaults are the scene's values (checked by BuiltinDiscSceneHasTheAnalyticGeometry).
 struct DiscScene {
-    Scene scene;
-    CameraSpec camera;  // the scene's camera, for the test's own camera model
-    explicit DiscScene(double extent_deg) : scene(msm::scene::builtin_scene("disc")) {
-        scene.light.angular_extent_deg = float(extent_deg);
-        const msm::scene::Camera& c = scene.camera;
-        camera = CameraSpec{glm::dvec3(c.position), glm::dvec3(c.target), glm::dvec3(c.up), double(c.fov_y_deg)};
-    }
+  Scene scene;
+  CameraSpec camera; // the scene's camera, for the test's own camera model
+  explicit DiscScene(double extent_deg) : scene(msm::scene::builtin_scene("disc")) {
+    scene.light.angular_extent_deg = float(extent_deg);
+    const msm::scene::Camera& c = scene.camera;
+    camera = CameraSpec{glm::dvec3(c.position), glm::dvec3(c.target), glm::dvec3(c.up), double(c.fov_y_deg)};
+  }
 };
 
 struct SoftErrors {
-    double rms = 0.0;
-    int penumbra = 0;
+  double rms = 0.0;
+  int penumbra = 0;
 };
 
 SoftErrors soft_errors(const DiscScene& ds, Sampler sampler, int samples, std::uint64_t seed, bool check_bound) {
-    Settings s;
-    s.effect = Effect::soft;
-    s.width = s.height = 64;
-    s.samples = samples;
-    s.seed = seed;
-    s.sampler = sampler;
-    const Result r = render(ds.scene, s);
-    EXPECT_NEAR(r.light_extent_deg, 10.0, 1e-12);
-    double sum2 = 0.0;
-    SoftErrors e;
-    for (int y = 0; y < s.height; ++y)
-        for (int x = 0; x < s.width; ++x) {
-            const glm::dvec3 p = ground_point(ds.camera, x, y, s.width, s.height);
-            const double expected = disc_occluder_visibility(p, 10.0);
-            const double v = channel(r.visibility, "visibility", x, y);
-            const double se = channel(r.visibility, "std_error", x, y);
-            if (check_bound) {
-                EXPECT_EQ(channel(r.visibility, "sample_count", x, y), float(samples));
-                const double iid = std::sqrt(expected * (1.0 - expected) / samples);
-                EXPECT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-4)
-                    << "pixel " << x << "," << y << " expected " << expected << " got " << v << " se " << se;
-            }
-            if (expected > 0.01 && expected < 0.99) {
-                sum2 += (v - expected) * (v - expected);
-                ++e.penumbra;
-            }
-        }
-    e.rms = std::sqrt(sum2 / e.penumbra);
-    return e;
+  Settings s;
+  s.effect = Effect::soft;
+  s.width = s.height = 64;
+  s.samples = samples;
+  s.seed = seed;
+  s.sampler = sampler;
+  const Result r = render(ds.scene, s);
+  EXPECT_NEAR(r.light_extent_deg, 10.0, 1e-12);
+  double sum2 = 0.0;
+  SoftErrors e;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const glm::dvec3 p = ground_point(ds.camera, x, y, s.width, s.height);
+      const double expected = disc_occluder_visibility(p, 10.0);
+      const double v = channel(r.visibility, "visibility", x, y);
+      const double se = channel(r.visibility, "std_error", x, y);
+      if (check_bound) {
+        EXPECT_EQ(channel(r.visibility, "sample_count", x, y), float(samples));
+        const double iid = std::sqrt(expected * (1.0 - expected) / samples);
+        EXPECT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-4)
+            << "pixel " << x << "," << y << " expected " << expected << " got " << v << " se " << se;
+      }
+      if (expected > 0.01 && expected < 0.99) {
+        sum2 += (v - expected) * (v - expected);
+        ++e.penumbra;
+      }
+    }
+  e.rms = std::sqrt(sum2 / e.penumbra);
+  return e;
 }
 
-}  // namespace
+} // namespace
 
 // The scene file and the analytic model describe the same geometry: DiscOccluder's defaults are
 // the "disc" scene's values, the light is straight down, and the camera sits between the ground
 // and the disc (it sees ground points only).
 TEST(reference_soft, BuiltinDiscSceneHasTheAnalyticGeometry) {
-    const Scene scene = msm::scene::builtin_scene("disc");
-    const DiscOccluder disc;
-    ASSERT_EQ(scene.objects.size(), 2u);
-    const msm::scene::Object& ground = scene.objects[0];
-    const msm::scene::Object& occluder = scene.objects[1];
-    EXPECT_EQ(ground.name, "ground");
-    EXPECT_EQ(occluder.name, "disc");
-    EXPECT_EQ(ground.bounds.min.y, 0.0f);
-    EXPECT_EQ(ground.bounds.max.y, 0.0f);
-    // The 1024-gon has vertices on the four axis directions: its bounds are the disc's, up to
-    // float rounding of the radius and of the height (1 +- 5e-5 rounds to 6e-8).
-    EXPECT_NEAR(occluder.bounds.min.x, -disc.radius, 1e-6);
-    EXPECT_NEAR(occluder.bounds.max.x, disc.radius, 1e-6);
-    EXPECT_NEAR(occluder.bounds.min.z, -disc.radius, 1e-6);
-    EXPECT_NEAR(occluder.bounds.max.z, disc.radius, 1e-6);
-    EXPECT_NEAR(occluder.bounds.min.y, disc.center_height - 0.5 * disc.thickness, 1e-6);
-    EXPECT_NEAR(occluder.bounds.max.y, disc.center_height + 0.5 * disc.thickness, 1e-6);
-    EXPECT_EQ(occluder.mesh.triangle_count(), 4u * 1024u);
-    EXPECT_EQ(scene.light.towards_light, glm::vec3(0.0f, 1.0f, 0.0f));
-    EXPECT_EQ(scene.light.angular_extent_deg, 10.0f);
-    EXPECT_GT(scene.camera.position.y, 0.0f);
-    EXPECT_LT(scene.camera.position.y, occluder.bounds.min.y);
+  const Scene scene = msm::scene::builtin_scene("disc");
+  const DiscOccluder disc;
+  ASSERT_EQ(scene.objects.size(), 2u);
+  const msm::scene::Object& ground = scene.objects[0];
+  const msm::scene::Object& occluder = scene.objects[1];
+  EXPECT_EQ(ground.name, "ground");
+  EXPECT_EQ(occluder.name, "disc");
+  EXPECT_EQ(ground.bounds.min.y, 0.0f);
+  EXPECT_EQ(ground.bounds.max.y, 0.0f);
+  // The 1024-gon has vertices on the four axis directions: its bounds are the disc's, up to
+  // float rounding of the radius and of the height (1 +- 5e-5 rounds to 6e-8).
+  EXPECT_NEAR(occluder.bounds.min.x, -disc.radius, 1e-6);
+  EXPECT_NEAR(occluder.bounds.max.x, disc.radius, 1e-6);
+  EXPECT_NEAR(occluder.bounds.min.z, -disc.radius, 1e-6);
+  EXPECT_NEAR(occluder.bounds.max.z, disc.radius, 1e-6);
+  EXPECT_NEAR(occluder.bounds.min.y, disc.center_height - 0.5 * disc.thickness, 1e-6);
+  EXPECT_NEAR(occluder.bounds.max.y, disc.center_height + 0.5 * disc.thickness, 1e-6);
+  EXPECT_EQ(occluder.mesh.triangle_count(), 4u * 1024u);
+  EXPECT_EQ(scene.light.towards_light, glm::vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(scene.light.angular_extent_deg, 10.0f);
+  EXPECT_GT(scene.camera.position.y, 0.0f);
+  EXPECT_LT(scene.camera.position.y, occluder.bounds.min.y);
 }
 
 // disc_occluder_visibility against a midpoint-rule integral over the light's disc (a 1200 x 1200
@@ -418,39 +421,39 @@ TEST(reference_soft, BuiltinDiscSceneHasTheAnalyticGeometry) {
 // when it is larger (60 degrees: the light's image has radius tan 30 = 0.58 > 0.25); extent 0
 // is the hard shadow; a bad extent throws.
 TEST(reference_soft, DiscVisibilityFormulaMatchesNumericIntegration) {
-    const DiscOccluder disc;
-    const double h = disc.center_height - 0.5 * disc.thickness;
-    const auto integral = [&](glm::dvec3 p, double extent_deg) {
-        const double t = std::tan(extent_deg * kPi / 360.0);
-        const int n = 1200;
-        long inside = 0, visible = 0;
-        for (int i = 0; i < n; ++i)
-            for (int j = 0; j < n; ++j) {
-                const double a = ((i + 0.5) / n * 2.0 - 1.0) * t, b = ((j + 0.5) / n * 2.0 - 1.0) * t;
-                if (a * a + b * b > t * t) continue;
-                ++inside;
-                // The ray p + s (a, 1, b) reaches y = h at s = h.
-                visible += std::hypot(p.x + h * a, p.z + h * b) >= disc.radius;
-            }
-        return double(visible) / double(inside);
-    };
-    for (double extent : {2.0, 10.0, 30.0})
-        for (double r : {0.0, 0.2, 0.24, 0.25, 0.26, 0.3, 0.4}) {
-            const glm::dvec3 p(r * 0.6, 0.0, -r * 0.8);
-            SCOPED_TRACE("extent " + num(extent) + " r " + num(r));
-            EXPECT_NEAR(disc_occluder_visibility(p, extent), integral(p, extent), 2e-3);
-        }
-    EXPECT_EQ(disc_occluder_visibility({2.0, 0.0, 0.0}, 10.0), 1.0);
-    EXPECT_EQ(disc_occluder_visibility({0.0, 0.0, 0.0}, 10.0), 0.0);
-    EXPECT_GT(disc_occluder_visibility({0.0, 0.0, 0.0}, 60.0), 0.1);
-    EXPECT_NEAR(disc_occluder_visibility({0.0, 0.0, 0.0}, 60.0), integral({0.0, 0.0, 0.0}, 60.0), 2e-3);
-    EXPECT_EQ(disc_occluder_visibility({0.2499, 0.0, 0.0}, 0.0), 0.0);
-    EXPECT_EQ(disc_occluder_visibility({0.2501, 0.0, 0.0}, 0.0), 1.0);
-    // Scaling the scene leaves the visibility unchanged (it depends on ratios only).
-    EXPECT_NEAR(disc_occluder_visibility({0.6, 0.0, 0.0}, 10.0, {0.5, 2.0, 2e-4}),
-                disc_occluder_visibility({0.3, 0.0, 0.0}, 10.0), 1e-12);
-    EXPECT_THROW(disc_occluder_visibility({0.0, 0.0, 0.0}, 90.0), std::invalid_argument);
-    EXPECT_THROW(disc_occluder_visibility({0.0, 0.0, 0.0}, -1.0), std::invalid_argument);
+  const DiscOccluder disc;
+  const double h = disc.center_height - 0.5 * disc.thickness;
+  const auto integral = [&](glm::dvec3 p, double extent_deg) {
+    const double t = std::tan(extent_deg * kPi / 360.0);
+    const int n = 1200;
+    long inside = 0, visible = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        const double a = ((i + 0.5) / n * 2.0 - 1.0) * t, b = ((j + 0.5) / n * 2.0 - 1.0) * t;
+        if (a * a + b * b > t * t) continue;
+        ++inside;
+        // The ray p + s (a, 1, b) reaches y = h at s = h.
+        visible += std::hypot(p.x + h * a, p.z + h * b) >= disc.radius;
+      }
+    return double(visible) / double(inside);
+  };
+  for (double extent : {2.0, 10.0, 30.0})
+    for (double r : {0.0, 0.2, 0.24, 0.25, 0.26, 0.3, 0.4}) {
+      const glm::dvec3 p(r * 0.6, 0.0, -r * 0.8);
+      SCOPED_TRACE("extent " + num(extent) + " r " + num(r));
+      EXPECT_NEAR(disc_occluder_visibility(p, extent), integral(p, extent), 2e-3);
+    }
+  EXPECT_EQ(disc_occluder_visibility({2.0, 0.0, 0.0}, 10.0), 1.0);
+  EXPECT_EQ(disc_occluder_visibility({0.0, 0.0, 0.0}, 10.0), 0.0);
+  EXPECT_GT(disc_occluder_visibility({0.0, 0.0, 0.0}, 60.0), 0.1);
+  EXPECT_NEAR(disc_occluder_visibility({0.0, 0.0, 0.0}, 60.0), integral({0.0, 0.0, 0.0}, 60.0), 2e-3);
+  EXPECT_EQ(disc_occluder_visibility({0.2499, 0.0, 0.0}, 0.0), 0.0);
+  EXPECT_EQ(disc_occluder_visibility({0.2501, 0.0, 0.0}, 0.0), 1.0);
+  // Scaling the scene leaves the visibility unchanged (it depends on ratios only).
+  EXPECT_NEAR(disc_occluder_visibility({0.6, 0.0, 0.0}, 10.0, {0.5, 2.0, 2e-4}),
+              disc_occluder_visibility({0.3, 0.0, 0.0}, 10.0), 1e-12);
+  EXPECT_THROW(disc_occluder_visibility({0.0, 0.0, 0.0}, 90.0), std::invalid_argument);
+  EXPECT_THROW(disc_occluder_visibility({0.0, 0.0, 0.0}, -1.0), std::invalid_argument);
 }
 
 // The built-in "disc" scene as it is (its 10-degree light, its camera, 16:9): every pixel of the
@@ -458,152 +461,154 @@ TEST(reference_soft, DiscVisibilityFormulaMatchesNumericIntegration) {
 // 4 standard errors (of independent sampling, an upper bound for the stratified sampler) + 1e-4
 // (the model's own error, see analytic.h); RMS over the penumbra below 0.01 at 256 samples.
 TEST(reference_soft, DiscLightOverDiscOccluderMatchesTheCircleIntersection) {
-    const DiscScene ds(10.0);
-    const Scene scene = msm::scene::builtin_scene("disc");
-    Settings s;
-    s.effect = Effect::soft;
-    s.width = 160;
-    s.height = 90;
-    s.samples = 256;
-    s.seed = 3;
-    const Result r = render(scene, s);
-    EXPECT_NEAR(r.light_extent_deg, 10.0, 1e-12);
-    EXPECT_EQ(r.background_pixels, 0u);
-    double sum2 = 0.0, worst = 0.0;
-    int penumbra = 0, umbra = 0, lit = 0;
-    for (int y = 0; y < s.height; ++y)
-        for (int x = 0; x < s.width; ++x) {
-            const glm::dvec3 p = ground_point(ds.camera, x, y, s.width, s.height);
-            const double expected = disc_occluder_visibility(p, 10.0);
-            const double v = channel(r.visibility, "visibility", x, y);
-            const double se = channel(r.visibility, "std_error", x, y);
-            const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
-            ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-4)
-                << "pixel " << x << "," << y << " expected " << expected << " got " << v << " se " << se;
-            worst = std::max(worst, std::abs(v - expected));
-            if (expected > 0.01 && expected < 0.99) {
-                sum2 += (v - expected) * (v - expected);
-                ++penumbra;
-            }
-            umbra += expected == 0.0;
-            lit += expected == 1.0;
-        }
-    // The view holds the whole shadow: umbra (r < 0.1625), penumbra ring and lit ground.
-    EXPECT_GT(penumbra, 3500);
-    EXPECT_GT(umbra, 1000);
-    EXPECT_GT(lit, 5000);
-    const double rms = std::sqrt(sum2 / penumbra);
-    EXPECT_LT(rms, 0.01);
-    RecordProperty("rms_max_error_256_stratified", num(rms) + " " + num(worst) + " over " + std::to_string(penumbra));
+  const DiscScene ds(10.0);
+  const Scene scene = msm::scene::builtin_scene("disc");
+  Settings s;
+  s.effect = Effect::soft;
+  s.width = 160;
+  s.height = 90;
+  s.samples = 256;
+  s.seed = 3;
+  const Result r = render(scene, s);
+  EXPECT_NEAR(r.light_extent_deg, 10.0, 1e-12);
+  EXPECT_EQ(r.background_pixels, 0u);
+  double sum2 = 0.0, worst = 0.0;
+  int penumbra = 0, umbra = 0, lit = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const glm::dvec3 p = ground_point(ds.camera, x, y, s.width, s.height);
+      const double expected = disc_occluder_visibility(p, 10.0);
+      const double v = channel(r.visibility, "visibility", x, y);
+      const double se = channel(r.visibility, "std_error", x, y);
+      const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
+      ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-4)
+          << "pixel " << x << "," << y << " expected " << expected << " got " << v << " se " << se;
+      worst = std::max(worst, std::abs(v - expected));
+      if (expected > 0.01 && expected < 0.99) {
+        sum2 += (v - expected) * (v - expected);
+        ++penumbra;
+      }
+      umbra += expected == 0.0;
+      lit += expected == 1.0;
+    }
+  // The view holds the whole shadow: umbra (r < 0.1625), penumbra ring and lit ground.
+  EXPECT_GT(penumbra, 3500);
+  EXPECT_GT(umbra, 1000);
+  EXPECT_GT(lit, 5000);
+  const double rms = std::sqrt(sum2 / penumbra);
+  EXPECT_LT(rms, 0.01);
+  RecordProperty("rms_max_error_256_stratified", num(rms) + " " + num(worst) + " over " + std::to_string(penumbra));
 }
 
 // Plain Monte Carlo (independent samples): the RMS error halves when the samples quadruple
 // (ratio 2, accepted in [1.6, 2.5]); stratified samples converge at least as fast and are more
 // accurate at equal count.
 TEST(reference_soft, ErrorConvergence) {
-    const DiscScene ds(10.0);
-    const SoftErrors i16 = soft_errors(ds, Sampler::independent, 16, 11, true);
-    const SoftErrors i64 = soft_errors(ds, Sampler::independent, 64, 12, true);
-    const SoftErrors i256 = soft_errors(ds, Sampler::independent, 256, 13, true);
-    const SoftErrors s16 = soft_errors(ds, Sampler::stratified, 16, 14, true);
-    const SoftErrors s64 = soft_errors(ds, Sampler::stratified, 64, 15, true);
-    EXPECT_GE(i16.rms / i64.rms, 1.6);
-    EXPECT_LE(i16.rms / i64.rms, 2.5);
-    EXPECT_GE(i64.rms / i256.rms, 1.6);
-    EXPECT_LE(i64.rms / i256.rms, 2.5);
-    EXPECT_GE(s16.rms / s64.rms, 1.6);
-    EXPECT_LT(s16.rms, i16.rms);
-    EXPECT_LT(s64.rms, i64.rms);
-    RecordProperty("rms_independent_16_64_256", num(i16.rms) + " " + num(i64.rms) + " " + num(i256.rms));
-    RecordProperty("rms_stratified_16_64", num(s16.rms) + " " + num(s64.rms));
-    std::printf("RMS error, independent 16/64/256: %.5f %.5f %.5f; stratified 16/64: %.5f %.5f\n", i16.rms, i64.rms,
-                i256.rms, s16.rms, s64.rms);
+  const DiscScene ds(10.0);
+  const SoftErrors i16 = soft_errors(ds, Sampler::independent, 16, 11, true);
+  const SoftErrors i64 = soft_errors(ds, Sampler::independent, 64, 12, true);
+  const SoftErrors i256 = soft_errors(ds, Sampler::independent, 256, 13, true);
+  const SoftErrors s16 = soft_errors(ds, Sampler::stratified, 16, 14, true);
+  const SoftErrors s64 = soft_errors(ds, Sampler::stratified, 64, 15, true);
+  EXPECT_GE(i16.rms / i64.rms, 1.6);
+  EXPECT_LE(i16.rms / i64.rms, 2.5);
+  EXPECT_GE(i64.rms / i256.rms, 1.6);
+  EXPECT_LE(i64.rms / i256.rms, 2.5);
+  EXPECT_GE(s16.rms / s64.rms, 1.6);
+  EXPECT_LT(s16.rms, i16.rms);
+  EXPECT_LT(s64.rms, i64.rms);
+  RecordProperty("rms_independent_16_64_256", num(i16.rms) + " " + num(i64.rms) + " " + num(i256.rms));
+  RecordProperty("rms_stratified_16_64", num(s16.rms) + " " + num(s64.rms));
+  std::printf("RMS error, independent 16/64/256: %.5f %.5f %.5f; stratified 16/64: %.5f %.5f\n", i16.rms, i64.rms,
+              i256.rms, s16.rms, s64.rms);
 }
 
 // A rectangle light 8 x 20 degrees over the half-plane occluder, light straight down: light-space
 // x is world x, so the visibility is a linear ramp across the light's 8-degree WIDTH:
 // V = clamp((x / h + tan 4) / (2 tan 4), 0, 1).
 TEST(reference_soft, RectangleLightOverHalfPlaneIsALinearRamp) {
-    const double h = 1.0, tw = std::tan(4.0 * kPi / 180.0);
-    const CameraSpec camera{{0.0, 0.06, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
-    const Scene scene = make_scene(camera, light_json({0, 1, 0}), ground_and_half_plane(h));
-    Settings s;
-    s.effect = Effect::soft;
-    s.width = 96;
-    s.height = 8;
-    s.samples = 256;
-    s.light_shape = LightShape::rectangle;
-    s.light_width_deg = 8.0;
-    s.light_height_deg = 20.0;
-    const Result r = render(scene, s);
-    EXPECT_DOUBLE_EQ(r.light_width_deg, 8.0);
-    EXPECT_DOUBLE_EQ(r.light_height_deg, 20.0);
-    int ramp = 0;
-    for (int y = 0; y < s.height; ++y)
-        for (int x = 0; x < s.width; ++x) {
-            const glm::dvec3 p = ground_point(camera, x, y, s.width, s.height);
-            const double expected = std::clamp((p.x / h + tw) / (2.0 * tw), 0.0, 1.0);
-            const double v = channel(r.visibility, "visibility", x, y);
-            const double se = channel(r.visibility, "std_error", x, y);
-            const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
-            ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-5)
-                << "pixel " << x << "," << y << " ground x " << p.x << " expected " << expected << " got " << v;
-            ramp += expected > 0.05 && expected < 0.95;
-        }
-    EXPECT_GT(ramp, 100);
+  const double h = 1.0, tw = std::tan(4.0 * kPi / 180.0);
+  const CameraSpec camera{{0.0, 0.06, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+  const Scene scene = make_scene(camera, light_json({0, 1, 0}), ground_and_half_plane(h));
+  Settings s;
+  s.effect = Effect::soft;
+  s.width = 96;
+  s.height = 8;
+  s.samples = 256;
+  s.light_shape = LightShape::rectangle;
+  s.light_width_deg = 8.0;
+  s.light_height_deg = 20.0;
+  const Result r = render(scene, s);
+  EXPECT_DOUBLE_EQ(r.light_width_deg, 8.0);
+  EXPECT_DOUBLE_EQ(r.light_height_deg, 20.0);
+  int ramp = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const glm::dvec3 p = ground_point(camera, x, y, s.width, s.height);
+      const double expected = std::clamp((p.x / h + tw) / (2.0 * tw), 0.0, 1.0);
+      const double v = channel(r.visibility, "visibility", x, y);
+      const double se = channel(r.visibility, "std_error", x, y);
+      const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
+      ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-5)
+          << "pixel " << x << "," << y << " ground x " << p.x << " expected " << expected << " got " << v;
+      ramp += expected > 0.05 && expected < 0.95;
+    }
+  EXPECT_GT(ramp, 100);
 }
 
 TEST(reference_soft, ZeroExtentIsTheHardShadow) {
-    const DiscScene ds(0.0);
-    Settings s;
-    s.width = s.height = 24;
-    s.effect = Effect::hard;
-    const Result hard = render(ds.scene, s);
-    s.effect = Effect::soft;
-    s.samples = 4;
-    const Result soft = render(ds.scene, s);
-    EXPECT_EQ(hard.visibility.channel("visibility"), soft.visibility.channel("visibility"));
-    EXPECT_EQ(soft.visibility.channel("std_error"), Image(24, 24, 1, 0.0f));
+  const DiscScene ds(0.0);
+  Settings s;
+  s.width = s.height = 24;
+  s.effect = Effect::hard;
+  const Result hard = render(ds.scene, s);
+  s.effect = Effect::soft;
+  s.samples = 4;
+  const Result soft = render(ds.scene, s);
+  EXPECT_EQ(hard.visibility.channel("visibility"), soft.visibility.channel("visibility"));
+  EXPECT_EQ(soft.visibility.channel("std_error"), Image(24, 24, 1, 0.0f));
 }
 
 // ---- translucent ---------------------------------------------------------------------------------
 
 // k parallel planes of opacity a between the ground and a tilted light: T = (1 - a)^k.
 TEST(reference_translucent, StackOfPlanesGivesPowerOfOneMinusOpacity) {
-    const double alpha = 0.3;
-    const glm::dvec3 towards = glm::normalize(glm::dvec3(0.3, 1.0, 0.2));
-    const CameraSpec camera{{0.0, 0.5, 0.3}, {0.0, 0.0, -0.2}};
-    for (int k = 0; k <= 4; ++k) {
-        std::string objects = R"({"primitive": {"type": "plane", "size": [10, 10]}, "material": {"albedo": [0.5, 0.5, 0.5]}})";
-        for (int i = 1; i <= k; ++i)
-            objects += R"(, {"primitive": {"type": "plane", "size": [60, 60]}, "transform": {"translate": [0, )" +
-                       num(i) + R"(, 0]}, "material": {"opacity": )" + num(alpha) + "}}";
-        const Scene scene = make_scene(camera, light_json(towards), objects);
-        Settings s;
-        s.effect = Effect::translucent;
-        s.width = s.height = 16;
-        const Result r = render(scene, s);
-        ASSERT_EQ(r.background_pixels, 0u);
-        const double expected = std::pow(1.0 - alpha, k);
-        double worst = 0.0;
-        for (int y = 0; y < s.height; ++y)
-            for (int x = 0; x < s.width; ++x) {
-                ASSERT_NEAR(channel(r.visibility, "visibility", x, y), expected, 1e-6) << "k " << k << " pixel " << x << "," << y;
-                worst = std::max(worst, std::abs(channel(r.visibility, "visibility", x, y) - expected));
-                // Grey materials: three equal channels, exactly the scalar visibility.
-                for (const char* c : {"visibility_r", "visibility_g", "visibility_b"})
-                    ASSERT_EQ(channel(r.visibility_rgb, c, x, y), channel(r.visibility, "visibility", x, y)) << c;
-                const double radiance = 0.5 * 2.0 * towards.y / kPi * expected + 0.03 * 0.5;
-                for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.radiance.at(x, y, c), radiance, 1e-6);
-                ASSERT_EQ(r.radiance.at(x, y, 0), r.radiance.at(x, y, 2));
-            }
-        RecordProperty("max_error_k" + std::to_string(k), num(worst));
-        if (k == 4) {  // the crossing cap counts the first max_crossings surfaces only
-            s.max_crossings = 2;
-            const Result capped = render(scene, s);
-            EXPECT_NEAR(channel(capped.visibility, "visibility", 5, 5), (1.0 - alpha) * (1.0 - alpha), 1e-6);
-        }
+  const double alpha = 0.3;
+  const glm::dvec3 towards = glm::normalize(glm::dvec3(0.3, 1.0, 0.2));
+  const CameraSpec camera{{0.0, 0.5, 0.3}, {0.0, 0.0, -0.2}};
+  for (int k = 0; k <= 4; ++k) {
+    std::string objects =
+        R"({"primitive": {"type": "plane", "size": [10, 10]}, "material": {"albedo": [0.5, 0.5, 0.5]}})";
+    for (int i = 1; i <= k; ++i)
+      objects += R"(, {"primitive": {"type": "plane", "size": [60, 60]}, "transform": {"translate": [0, )" + num(i) +
+                 R"(, 0]}, "material": {"opacity": )" + num(alpha) + "}}";
+    const Scene scene = make_scene(camera, light_json(towards), objects);
+    Settings s;
+    s.effect = Effect::translucent;
+    s.width = s.height = 16;
+    const Result r = render(scene, s);
+    ASSERT_EQ(r.background_pixels, 0u);
+    const double expected = std::pow(1.0 - alpha, k);
+    double worst = 0.0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        ASSERT_NEAR(channel(r.visibility, "visibility", x, y), expected, 1e-6)
+            << "k " << k << " pixel " << x << "," << y;
+        worst = std::max(worst, std::abs(channel(r.visibility, "visibility", x, y) - expected));
+        // Grey materials: three equal channels, exactly the scalar visibility.
+        for (const char* c : {"visibility_r", "visibility_g", "visibility_b"})
+          ASSERT_EQ(channel(r.visibility_rgb, c, x, y), channel(r.visibility, "visibility", x, y)) << c;
+        const double radiance = 0.5 * 2.0 * towards.y / kPi * expected + 0.03 * 0.5;
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(r.radiance.at(x, y, c), radiance, 1e-6);
+        ASSERT_EQ(r.radiance.at(x, y, 0), r.radiance.at(x, y, 2));
+      }
+    RecordProperty("max_error_k" + std::to_string(k), num(worst));
+    if (k == 4) { // the crossing cap counts the first max_crossings surfaces only
+      s.max_crossings = 2;
+      const Result capped = render(scene, s);
+      EXPECT_NEAR(channel(capped.visibility, "visibility", 5, 5), (1.0 - alpha) * (1.0 - alpha), 1e-6);
     }
+  }
 }
 
 // Coloured transmission (JCGT 2017, Sec. 3): under plane 1 (alpha 0.6, transmission colour
@@ -611,184 +616,187 @@ TEST(reference_translucent, StackOfPlanesGivesPowerOfOneMinusOpacity) {
 // 0.4 * 1) = (0.5, 0.2, 0.4) and visibility = their mean; radiance per channel. A stained glass of
 // opacity 1 lets its colour through and is looked through by the primary rays.
 TEST(reference_translucent, TransmissionColourPerChannel) {
-    const glm::dvec3 towards(0, 1, 0);
-    const std::string ground = R"({"primitive": {"type": "plane", "size": [10, 10]}, "material": {"albedo": [0.5, 0.5, 0.5]}})";
-    const auto plane = [](double height, double alpha, const std::string& colour) {
-        return R"(, {"primitive": {"type": "plane", "size": [20, 20]}, "transform": {"translate": [0, )" + num(height) +
-               R"(, 0]}, "material": {"opacity": )" + num(alpha) + R"(, "transmission_color": )" + colour + "}}";
-    };
-    const auto check = [&](const Result& r, int W, int H, glm::dvec3 expected, const std::string& what) {
-        SCOPED_TRACE(what);
-        ASSERT_EQ(r.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
-        ASSERT_EQ(r.visibility_rgb.channel_names(), (std::vector<std::string>{"visibility_r", "visibility_g", "visibility_b"}));
-        ASSERT_EQ(r.background_pixels, 0u);
-        const double mean = (expected.r + expected.g + expected.b) / 3.0;
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                ASSERT_NEAR(channel(r.visibility_rgb, "visibility_r", x, y), expected.r, 1e-5) << x << "," << y;
-                ASSERT_NEAR(channel(r.visibility_rgb, "visibility_g", x, y), expected.g, 1e-5) << x << "," << y;
-                ASSERT_NEAR(channel(r.visibility_rgb, "visibility_b", x, y), expected.b, 1e-5) << x << "," << y;
-                ASSERT_NEAR(channel(r.visibility, "visibility", x, y), mean, 1e-5) << x << "," << y;
-                for (int c = 0; c < 3; ++c)
-                    ASSERT_NEAR(r.radiance.at(x, y, c), 0.5 * 2.0 / kPi * expected[c] + 0.03 * 0.5, 1e-5) << x << "," << y;
-            }
-        EXPECT_NEAR(r.mean_visibility, mean, 1e-5);
-    };
-    Settings s;
-    s.effect = Effect::translucent;
-    s.width = s.height = 12;
-    // Camera below the planes, looking straight down at the ground.
-    const CameraSpec below{{0.0, 0.5, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
-    const std::string stack = ground + plane(1.0, 0.6, "[1, 0, 0]") + plane(2.0, 0.5, "[0, 0, 1]");
-    check(render(make_scene(below, light_json(towards), stack), s), s.width, s.height, {0.5, 0.2, 0.4}, "stack");
+  const glm::dvec3 towards(0, 1, 0);
+  const std::string ground =
+      R"({"primitive": {"type": "plane", "size": [10, 10]}, "material": {"albedo": [0.5, 0.5, 0.5]}})";
+  const auto plane = [](double height, double alpha, const std::string& colour) {
+    return R"(, {"primitive": {"type": "plane", "size": [20, 20]}, "transform": {"translate": [0, )" + num(height) +
+           R"(, 0]}, "material": {"opacity": )" + num(alpha) + R"(, "transmission_color": )" + colour + "}}";
+  };
+  const auto check = [&](const Result& r, int W, int H, glm::dvec3 expected, const std::string& what) {
+    SCOPED_TRACE(what);
+    ASSERT_EQ(r.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
+    ASSERT_EQ(r.visibility_rgb.channel_names(),
+              (std::vector<std::string>{"visibility_r", "visibility_g", "visibility_b"}));
+    ASSERT_EQ(r.background_pixels, 0u);
+    const double mean = (expected.r + expected.g + expected.b) / 3.0;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        ASSERT_NEAR(channel(r.visibility_rgb, "visibility_r", x, y), expected.r, 1e-5) << x << "," << y;
+        ASSERT_NEAR(channel(r.visibility_rgb, "visibility_g", x, y), expected.g, 1e-5) << x << "," << y;
+        ASSERT_NEAR(channel(r.visibility_rgb, "visibility_b", x, y), expected.b, 1e-5) << x << "," << y;
+        ASSERT_NEAR(channel(r.visibility, "visibility", x, y), mean, 1e-5) << x << "," << y;
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(r.radiance.at(x, y, c), 0.5 * 2.0 / kPi * expected[c] + 0.03 * 0.5, 1e-5) << x << "," << y;
+      }
+    EXPECT_NEAR(r.mean_visibility, mean, 1e-5);
+  };
+  Settings s;
+  s.effect = Effect::translucent;
+  s.width = s.height = 12;
+  // Camera below the planes, looking straight down at the ground.
+  const CameraSpec below{{0.0, 0.5, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+  const std::string stack = ground + plane(1.0, 0.6, "[1, 0, 0]") + plane(2.0, 0.5, "[0, 0, 1]");
+  check(render(make_scene(below, light_json(towards), stack), s), s.width, s.height, {0.5, 0.2, 0.4}, "stack");
 
-    // Opacity 1, transmission colour (0.2, 0.5, 0.8): T = the colour; the camera above it sees the
-    // ground through it.
-    const CameraSpec above{{0.0, 3.0, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
-    const std::string glass = ground + plane(1.0, 1.0, "[0.2, 0.5, 0.8]");
-    check(render(make_scene(above, light_json(towards), glass), s), s.width, s.height, {0.2, 0.5, 0.8}, "stained glass");
+  // Opacity 1, transmission colour (0.2, 0.5, 0.8): T = the colour; the camera above it sees the
+  // ground through it.
+  const CameraSpec above{{0.0, 3.0, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+  const std::string glass = ground + plane(1.0, 1.0, "[0.2, 0.5, 0.8]");
+  check(render(make_scene(above, light_json(towards), glass), s), s.width, s.height, {0.2, 0.5, 0.8}, "stained glass");
 
-    // The other effects keep their channels; for them every surface blocks.
-    s.effect = Effect::hard;
-    const Result hard = render(make_scene(below, light_json(towards), stack), s);
-    EXPECT_EQ(hard.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
-    EXPECT_TRUE(hard.visibility_rgb.empty());
-    EXPECT_EQ(channel(hard.visibility, "visibility", 5, 5), 0.0f);
+  // The other effects keep their channels; for them every surface blocks.
+  s.effect = Effect::hard;
+  const Result hard = render(make_scene(below, light_json(towards), stack), s);
+  EXPECT_EQ(hard.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
+  EXPECT_TRUE(hard.visibility_rgb.empty());
+  EXPECT_EQ(channel(hard.visibility, "visibility", 5, 5), 0.0f);
 }
 
 // A closed box is crossed twice; an opaque plane stops the light; hard ignores opacity.
 TEST(reference_translucent, ClosedMeshesAndOpaqueSurfaces) {
-    const glm::dvec3 towards(0, 1, 0);
-    const CameraSpec camera{{0.0, 0.5, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
-    const Scene box = make_scene(camera, light_json(towards),
-                                 R"({"primitive": {"type": "plane", "size": [10, 10]}},
+  const glm::dvec3 towards(0, 1, 0);
+  const CameraSpec camera{{0.0, 0.5, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+  const Scene box = make_scene(camera, light_json(towards),
+                               R"({"primitive": {"type": "plane", "size": [10, 10]}},
                                     {"primitive": {"type": "box", "size": [20, 0.5, 20]}, "transform": {"translate": [0, 2, 0]},
                                      "material": {"opacity": 0.4}})");
-    Settings s;
-    s.effect = Effect::translucent;
-    s.width = s.height = 8;
-    Result r = render(box, s);
-    EXPECT_NEAR(channel(r.visibility, "visibility", 3, 3), 0.36, 1e-6);
-    s.effect = Effect::hard;
-    r = render(box, s);
-    EXPECT_EQ(channel(r.visibility, "visibility", 3, 3), 0.0f);
+  Settings s;
+  s.effect = Effect::translucent;
+  s.width = s.height = 8;
+  Result r = render(box, s);
+  EXPECT_NEAR(channel(r.visibility, "visibility", 3, 3), 0.36, 1e-6);
+  s.effect = Effect::hard;
+  r = render(box, s);
+  EXPECT_EQ(channel(r.visibility, "visibility", 3, 3), 0.0f);
 
-    const Scene opaque = make_scene(camera, light_json(towards),
-                                    R"({"primitive": {"type": "plane", "size": [10, 10]}},
+  const Scene opaque = make_scene(camera, light_json(towards),
+                                  R"({"primitive": {"type": "plane", "size": [10, 10]}},
                                        {"primitive": {"type": "plane", "size": [20, 20]}, "transform": {"translate": [0, 2, 0]},
                                         "material": {"opacity": 0.5}},
                                        {"primitive": {"type": "plane", "size": [20, 20]}, "transform": {"translate": [0, 3, 0]},
                                         "material": {"opacity": 1}})");
-    s.effect = Effect::translucent;
-    r = render(opaque, s);
-    EXPECT_EQ(channel(r.visibility, "visibility", 3, 3), 0.0f);
+  s.effect = Effect::translucent;
+  r = render(opaque, s);
+  EXPECT_EQ(channel(r.visibility, "visibility", 3, 3), 0.0f);
 }
 
 // ---- determinism ---------------------------------------------------------------------------------
 
 TEST(reference_determinism, SameSeedSameImageForAnyThreadCount) {
-    const DiscScene ds(10.0);
-    Settings s;
-    s.effect = Effect::soft;
-    s.width = s.height = 32;
-    s.samples = 16;
-    s.seed = 42;
-    Result one, many, again;
-    {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        one = render(ds.scene, s);
-        EXPECT_EQ(one.threads, 1u);
-    }
-    {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
-        tbb::task_arena arena(8);
-        arena.execute([&] { many = render(ds.scene, s); });
-        EXPECT_GT(many.threads, 1u);
-    }
-    again = render(ds.scene, s);
-    EXPECT_TRUE(one.visibility == many.visibility);
-    EXPECT_TRUE(one.radiance == many.radiance);
-    EXPECT_TRUE(one.visibility == again.visibility);
-    s.seed = 43;
-    const Result other = render(ds.scene, s);
-    EXPECT_FALSE(one.visibility == other.visibility) << "the seed must matter";
+  const DiscScene ds(10.0);
+  Settings s;
+  s.effect = Effect::soft;
+  s.width = s.height = 32;
+  s.samples = 16;
+  s.seed = 42;
+  Result one, many, again;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = render(ds.scene, s);
+    EXPECT_EQ(one.threads, 1u);
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
+    tbb::task_arena arena(8);
+    arena.execute([&] { many = render(ds.scene, s); });
+    EXPECT_GT(many.threads, 1u);
+  }
+  again = render(ds.scene, s);
+  EXPECT_TRUE(one.visibility == many.visibility);
+  EXPECT_TRUE(one.radiance == many.radiance);
+  EXPECT_TRUE(one.visibility == again.visibility);
+  s.seed = 43;
+  const Result other = render(ds.scene, s);
+  EXPECT_FALSE(one.visibility == other.visibility) << "the seed must matter";
 
-    s.effect = Effect::filtered;
-    s.seed = 42;
-    Result f1, f8;
-    {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-        f1 = render(ds.scene, s);
-    }
-    {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
-        tbb::task_arena arena(8);
-        arena.execute([&] { f8 = render(ds.scene, s); });
-    }
-    EXPECT_TRUE(f1.visibility == f8.visibility);
+  s.effect = Effect::filtered;
+  s.seed = 42;
+  Result f1, f8;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    f1 = render(ds.scene, s);
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
+    tbb::task_arena arena(8);
+    arena.execute([&] { f8 = render(ds.scene, s); });
+  }
+  EXPECT_TRUE(f1.visibility == f8.visibility);
 }
 
 TEST(reference_progress, ReportsEveryRowUpToTheTotal) {
-    const DiscScene ds(10.0);
-    Settings s;
-    s.width = 16;
-    s.height = 20;
-    std::size_t last = 0, calls = 0;
-    bool increasing = true;
-    s.progress = [&](const Progress& p) {
-        increasing = increasing && p.rows_done > last && p.rows_total == 20;
-        last = p.rows_done;
-        ++calls;
-    };
-    render(ds.scene, s);
-    EXPECT_TRUE(increasing);
-    EXPECT_EQ(last, 20u);
-    EXPECT_GE(calls, 1u);
+  const DiscScene ds(10.0);
+  Settings s;
+  s.width = 16;
+  s.height = 20;
+  std::size_t last = 0, calls = 0;
+  bool increasing = true;
+  s.progress = [&](const Progress& p) {
+    increasing = increasing && p.rows_done > last && p.rows_total == 20;
+    last = p.rows_done;
+    ++calls;
+  };
+  render(ds.scene, s);
+  EXPECT_TRUE(increasing);
+  EXPECT_EQ(last, 20u);
+  EXPECT_GE(calls, 1u);
 }
 
 // ---- bad input -----------------------------------------------------------------------------------
 
 TEST(reference_bad_input, SettingsAreValidated) {
-    const auto with = [](auto change) {
-        Settings s;
-        change(s);
-        return [s] { validate(s); };
-    };
-    EXPECT_NO_THROW(validate(Settings{}));
-    expect_invalid(with([](Settings& s) { s.width = 0; }), "width 0");
-    expect_invalid(with([](Settings& s) { s.height = 16385; }), "height 16385");
-    expect_invalid(with([](Settings& s) { s.samples = 0; }), "samples 0");
-    expect_invalid(with([](Settings& s) { s.samples = 1'000'001; }), "samples 1000001");
-    expect_invalid(with([](Settings& s) { s.shadow_size = 0; }), "shadow map size");
-    expect_invalid(with([](Settings& s) { s.filter_size = 8; }), "filter size 8");
-    expect_invalid(with([](Settings& s) { s.filter_sigma = std::nan(""); }), "filter sigma");
-    expect_invalid(with([](Settings& s) { s.light_extent_deg = 90.0; }), "light extent");
-    expect_invalid(with([](Settings& s) { s.light_width_deg = -1.0; }), "light width");
-    expect_invalid(with([](Settings& s) { s.max_crossings = 0; }), "max crossings");
-    EXPECT_EQ(parse_effect("soft"), Effect::soft);
-    EXPECT_FALSE(parse_effect("nope"));
-    EXPECT_EQ(parse_light_shape("rectangle"), LightShape::rectangle);
-    EXPECT_FALSE(parse_light_shape("square"));
+  const auto with = [](auto change) {
+    Settings s;
+    change(s);
+    return [s] { validate(s); };
+  };
+  EXPECT_NO_THROW(validate(Settings{}));
+  expect_invalid(with([](Settings& s) { s.width = 0; }), "width 0");
+  expect_invalid(with([](Settings& s) { s.height = 16385; }), "height 16385");
+  expect_invalid(with([](Settings& s) { s.samples = 0; }), "samples 0");
+  expect_invalid(with([](Settings& s) { s.samples = 1'000'001; }), "samples 1000001");
+  expect_invalid(with([](Settings& s) { s.shadow_size = 0; }), "shadow map size");
+  expect_invalid(with([](Settings& s) { s.filter_size = 8; }), "filter size 8");
+  expect_invalid(with([](Settings& s) { s.filter_sigma = std::nan(""); }), "filter sigma");
+  expect_invalid(with([](Settings& s) { s.light_extent_deg = 90.0; }), "light extent");
+  expect_invalid(with([](Settings& s) { s.light_width_deg = -1.0; }), "light width");
+  expect_invalid(with([](Settings& s) { s.max_crossings = 0; }), "max crossings");
+  EXPECT_EQ(parse_effect("soft"), Effect::soft);
+  EXPECT_FALSE(parse_effect("nope"));
+  EXPECT_EQ(parse_light_shape("rectangle"), LightShape::rectangle);
+  EXPECT_FALSE(parse_light_shape("square"));
 }
 
 TEST(reference_bad_input, NonFiniteVerticesAreReported) {
-    // The loader rejects them (SceneError naming the file); a scene built in code is checked by
-    // render() itself.
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "msm_reference_test_nan";
-    std::filesystem::create_directories(dir);
-    std::ofstream(dir / "nan.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
-                                      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
-                                      "end_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-    std::ofstream(dir / "scene.json") << R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"mesh": "nan.ply"}]})";
-    try {
-        msm::scene::load_scene((dir / "scene.json").string());
-        ADD_FAILURE() << "no SceneError";
-    } catch (const msm::scene::SceneError& e) {
-        EXPECT_NE(std::string(e.what()).find("NaN or infinite"), std::string::npos) << e.what();
-    }
-    std::filesystem::remove_all(dir);
+  // The loader rejects them (SceneError naming the file); a scene built in code is checked by
+  // render() itself.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "msm_reference_test_nan";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "nan.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                    "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                                    "end_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::ofstream(dir / "scene.json")
+      << R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"mesh": "nan.ply"}]})";
+  try {
+    msm::scene::load_scene((dir / "scene.json").string());
+    ADD_FAILURE() << "no SceneError";
+  } catch (const msm::scene::SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("NaN or infinite"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 
-    Scene scene = DiscScene(1.0).scene;
-    scene.objects[1].mesh.positions[3].y = std::nanf("");
-    expect_invalid([&] { render(scene, Settings{}); }, "object 'disc': vertex 3 has a NaN or infinite position");
+  Scene scene = DiscScene(1.0).scene;
+  scene.objects[1].mesh.positions[3].y = std::nanf("");
+  expect_invalid([&] { render(scene, Settings{}); }, "object 'disc': vertex 3 has a NaN or infinite position");
 }

@@ -7,47 +7,47 @@
 namespace msm::reference::detail {
 
 Rng pixel_rng(std::uint64_t seed, int x, int y, Effect effect) {
-    // Hash the seed, the pixel and the effect into an independent-looking stream per pixel.
-    std::uint64_t s = seed;
-    std::uint64_t h = splitmix64(s);
-    s = h ^ (std::uint64_t(std::uint32_t(x)) | (std::uint64_t(std::uint32_t(y)) << 32));
-    h = splitmix64(s);
-    s = h ^ (0xD1B54A32D192ED03ull * (std::uint64_t(effect) + 1));
-    return Rng(splitmix64(s));
+  // Hash the seed, the pixel and the effect into an independent-looking stream per pixel.
+  std::uint64_t s = seed;
+  std::uint64_t h = splitmix64(s);
+  s = h ^ (std::uint64_t(std::uint32_t(x)) | (std::uint64_t(std::uint32_t(y)) << 32));
+  h = splitmix64(s);
+  s = h ^ (0xD1B54A32D192ED03ull * (std::uint64_t(effect) + 1));
+  return Rng(splitmix64(s));
 }
 
 SampleSet::SampleSet(Sampler sampler, int count) : sampler_(sampler), count_(count), grid_(0) {
-    if (sampler_ == Sampler::stratified) {
-        grid_ = int(std::sqrt(double(count)));
-        while (grid_ * grid_ > count) --grid_;
-        while ((grid_ + 1) * (grid_ + 1) <= count) ++grid_;
-    }
+  if (sampler_ == Sampler::stratified) {
+    grid_ = int(std::sqrt(double(count)));
+    while (grid_ * grid_ > count) --grid_;
+    while ((grid_ + 1) * (grid_ + 1) <= count) ++grid_;
+  }
 }
 
 glm::dvec2 SampleSet::point(int i, Rng& rng) const {
-    const double a = rng.uniform(), b = rng.uniform();
-    if (i < grid_ * grid_) {
-        // Jittered cell (i mod m, i div m) of the m x m grid.
-        const double inv = 1.0 / grid_;
-        return {std::min((i % grid_ + a) * inv, std::nextafter(1.0, 0.0)),
-                std::min((i / grid_ + b) * inv, std::nextafter(1.0, 0.0))};
-    }
-    return {a, b};
+  const double a = rng.uniform(), b = rng.uniform();
+  if (i < grid_ * grid_) {
+    // Jittered cell (i mod m, i div m) of the m x m grid.
+    const double inv = 1.0 / grid_;
+    return {std::min((i % grid_ + a) * inv, std::nextafter(1.0, 0.0)),
+            std::min((i / grid_ + b) * inv, std::nextafter(1.0, 0.0))};
+  }
+  return {a, b};
 }
 
 glm::dvec2 concentric_disc(glm::dvec2 u) {
-    const double a = 2.0 * u.x - 1.0, b = 2.0 * u.y - 1.0;
-    if (a == 0.0 && b == 0.0) return {0.0, 0.0};
-    constexpr double quarter = std::numbers::pi / 4.0;
-    double r, phi;
-    if (std::abs(a) > std::abs(b)) {
-        r = a;
-        phi = quarter * (b / a);
-    } else {
-        r = b;
-        phi = 2.0 * quarter - quarter * (a / b);
-    }
-    return {r * std::cos(phi), r * std::sin(phi)};
+  const double a = 2.0 * u.x - 1.0, b = 2.0 * u.y - 1.0;
+  if (a == 0.0 && b == 0.0) return {0.0, 0.0};
+  constexpr double quarter = std::numbers::pi / 4.0;
+  double r, phi;
+  if (std::abs(a) > std::abs(b)) {
+    r = a;
+    phi = quarter * (b / a);
+  } else {
+    r = b;
+    phi = 2.0 * quarter - quarter * (a / b);
+  }
+  return {r * std::cos(phi), r * std::sin(phi)};
 }
 
-}  // namespace msm::reference::detail
+} // namespace msm::reference::detail

@@ -14,201 +14,201 @@
 namespace msm::reference::detail {
 
 struct Tracer::Impl {
-    RTCDevice device = nullptr;
-    RTCScene scene = nullptr;
-    std::mutex error_mutex;
-    std::string error;
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::mutex error_mutex;
+  std::string error;
 
-    ~Impl() {
-        if (scene) rtcReleaseScene(scene);
-        if (device) rtcReleaseDevice(device);
-    }
-    void check(const char* what) {
-        if (rtcGetDeviceError(device) == RTC_ERROR_NONE) return;
-        std::lock_guard lock(error_mutex);
-        throw std::runtime_error(fmt::format("Embree: {} failed: {}", what, error.empty() ? "unknown error" : error));
-    }
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+  void check(const char* what) {
+    if (rtcGetDeviceError(device) == RTC_ERROR_NONE) return;
+    std::lock_guard lock(error_mutex);
+    throw std::runtime_error(fmt::format("Embree: {} failed: {}", what, error.empty() ? "unknown error" : error));
+  }
 };
 
 namespace {
 
 void on_embree_error(void* user, RTCError code, const char* message) {
-    auto* impl = static_cast<Tracer::Impl*>(user);
-    std::lock_guard lock(impl->error_mutex);
-    impl->error = fmt::format("{} (code {})", message ? message : "", int(code));
+  auto* impl = static_cast<Tracer::Impl*>(user);
+  std::lock_guard lock(impl->error_mutex);
+  impl->error = fmt::format("{} (code {})", message ? message : "", int(code));
 }
 
 RTCRay make_ray(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) {
-    RTCRay ray{};
-    ray.org_x = float(origin.x);
-    ray.org_y = float(origin.y);
-    ray.org_z = float(origin.z);
-    ray.tnear = 0.0f;
-    ray.dir_x = float(dir.x);
-    ray.dir_y = float(dir.y);
-    ray.dir_z = float(dir.z);
-    ray.time = 0.0f;
-    ray.tfar = std::isfinite(tfar) ? float(tfar) : std::numeric_limits<float>::infinity();
-    ray.mask = 0xFFFFFFFFu;
-    ray.id = 0;
-    ray.flags = 0;
-    return ray;
+  RTCRay ray{};
+  ray.org_x = float(origin.x);
+  ray.org_y = float(origin.y);
+  ray.org_z = float(origin.z);
+  ray.tnear = 0.0f;
+  ray.dir_x = float(dir.x);
+  ray.dir_y = float(dir.y);
+  ray.dir_z = float(dir.z);
+  ray.time = 0.0f;
+  ray.tfar = std::isfinite(tfar) ? float(tfar) : std::numeric_limits<float>::infinity();
+  ray.mask = 0xFFFFFFFFu;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
 }
 
-}  // namespace
+} // namespace
 
 Tracer::Tracer(const scene::Scene& scene) : scene_(scene), impl_(std::make_unique<Impl>()) {
-    for (const scene::Material& m : scene.materials) opacity_images_.push_back(scene::opacity_image(m));
-    // Refuse non-finite vertices (possible in scenes not built by the loader).
-    for (const scene::Object& o : scene.objects)
-        for (std::size_t i = 0; i < o.mesh.positions.size(); ++i) {
-            const glm::vec3& p = o.mesh.positions[i];
-            if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-                throw std::invalid_argument(fmt::format("object '{}': vertex {} has a NaN or infinite position", o.name, i));
-        }
-    if (scene.objects.size() >= std::size_t(RTC_INVALID_GEOMETRY_ID))
-        throw std::invalid_argument("too many objects");
-
-    impl_->device = rtcNewDevice("verbose=0");
-    if (!impl_->device)
-        throw std::runtime_error(fmt::format("Embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
-    rtcSetDeviceErrorFunction(impl_->device, on_embree_error, impl_.get());
-    if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED))
-        throw std::runtime_error("Embree was built with back-face culling; the reference needs both sides");
-    impl_->scene = rtcNewScene(impl_->device);
-    rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-    impl_->check("scene creation");
-
-    for (std::size_t id = 0; id < scene.objects.size(); ++id) {
-        const scene::Mesh& mesh = scene.objects[id].mesh;
-        if (mesh.triangle_count() == 0) continue;
-        for (std::uint32_t index : mesh.indices)
-            if (index >= mesh.positions.size())
-                throw std::invalid_argument(fmt::format("object '{}': vertex index {} out of range", scene.objects[id].name, index));
-        RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                                     3 * sizeof(float), mesh.positions.size()));
-        auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                       3 * sizeof(unsigned), mesh.triangle_count()));
-        if (!vertices || !indices) {
-            rtcReleaseGeometry(geom);
-            impl_->check("geometry buffers");
-            throw std::runtime_error("Embree: cannot allocate geometry buffers");
-        }
-        for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-            vertices[3 * i + 0] = mesh.positions[i].x;
-            vertices[3 * i + 1] = mesh.positions[i].y;
-            vertices[3 * i + 2] = mesh.positions[i].z;
-        }
-        for (std::size_t i = 0; i < mesh.indices.size(); ++i) indices[i] = mesh.indices[i];
-        rtcCommitGeometry(geom);
-        rtcAttachGeometryByID(impl_->scene, geom, unsigned(id));
-        rtcReleaseGeometry(geom);
-        impl_->check("geometry");
+  for (const scene::Material& m : scene.materials) opacity_images_.push_back(scene::opacity_image(m));
+  // Refuse non-finite vertices (possible in scenes not built by the loader).
+  for (const scene::Object& o : scene.objects)
+    for (std::size_t i = 0; i < o.mesh.positions.size(); ++i) {
+      const glm::vec3& p = o.mesh.positions[i];
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw std::invalid_argument(fmt::format("object '{}': vertex {} has a NaN or infinite position", o.name, i));
     }
-    rtcCommitScene(impl_->scene);
-    impl_->check("scene build");
+  if (scene.objects.size() >= std::size_t(RTC_INVALID_GEOMETRY_ID)) throw std::invalid_argument("too many objects");
+
+  impl_->device = rtcNewDevice("verbose=0");
+  if (!impl_->device)
+    throw std::runtime_error(fmt::format("Embree: cannot create a device (error {})", int(rtcGetDeviceError(nullptr))));
+  rtcSetDeviceErrorFunction(impl_->device, on_embree_error, impl_.get());
+  if (rtcGetDeviceProperty(impl_->device, RTC_DEVICE_PROPERTY_BACKFACE_CULLING_ENABLED))
+    throw std::runtime_error("Embree was built with back-face culling; the reference needs both sides");
+  impl_->scene = rtcNewScene(impl_->device);
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  impl_->check("scene creation");
+
+  for (std::size_t id = 0; id < scene.objects.size(); ++id) {
+    const scene::Mesh& mesh = scene.objects[id].mesh;
+    if (mesh.triangle_count() == 0) continue;
+    for (std::uint32_t index : mesh.indices)
+      if (index >= mesh.positions.size())
+        throw std::invalid_argument(
+            fmt::format("object '{}': vertex index {} out of range", scene.objects[id].name, index));
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                 3 * sizeof(float), mesh.positions.size()));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                                   3 * sizeof(unsigned), mesh.triangle_count()));
+    if (!vertices || !indices) {
+      rtcReleaseGeometry(geom);
+      impl_->check("geometry buffers");
+      throw std::runtime_error("Embree: cannot allocate geometry buffers");
+    }
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      vertices[3 * i + 0] = mesh.positions[i].x;
+      vertices[3 * i + 1] = mesh.positions[i].y;
+      vertices[3 * i + 2] = mesh.positions[i].z;
+    }
+    for (std::size_t i = 0; i < mesh.indices.size(); ++i) indices[i] = mesh.indices[i];
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, unsigned(id));
+    rtcReleaseGeometry(geom);
+    impl_->check("geometry");
+  }
+  rtcCommitScene(impl_->scene);
+  impl_->check("scene build");
 }
 
 Tracer::~Tracer() = default;
 
 bool Tracer::closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const {
-    RTCRayHit rh{};
-    rh.ray = make_ray(origin, dir, tfar);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    rtcIntersect1(impl_->scene, &context, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  RTCRayHit rh{};
+  rh.ray = make_ray(origin, dir, tfar);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcIntersect1(impl_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
-    hit.object = rh.hit.geomID;
-    hit.triangle = rh.hit.primID;
-    hit.u = rh.hit.u;
-    hit.v = rh.hit.v;
-    const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
-    const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
-    const glm::dvec3 v0(mesh.positions[tri[0]]), v1(mesh.positions[tri[1]]), v2(mesh.positions[tri[2]]);
-    glm::dvec3 n = glm::cross(v1 - v0, v2 - v0);
-    const double len = glm::length(n);
-    hit.normal = len > 0.0 ? n / len : glm::dvec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-    if (len == 0.0) hit.normal = glm::normalize(hit.normal);
-    // The point: the double-precision ray meets the triangle's plane (exactly on both, up to
-    // rounding); barycentric interpolation where the ray grazes the plane.
-    const double cosine = glm::dot(hit.normal, dir);
-    const double t = std::abs(cosine) > 1e-9 ? glm::dot(hit.normal, v0 - origin) / cosine : -1.0;
-    if (std::isfinite(t) && t >= 0.0)
-        hit.p = origin + t * dir;
-    else
-        hit.p = v0 + double(hit.u) * (v1 - v0) + double(hit.v) * (v2 - v0);
-    hit.scale = std::max({point_scale(hit.p), point_scale(v0), point_scale(v1), point_scale(v2)});
-    return true;
+  hit.object = rh.hit.geomID;
+  hit.triangle = rh.hit.primID;
+  hit.u = rh.hit.u;
+  hit.v = rh.hit.v;
+  const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
+  const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
+  const glm::dvec3 v0(mesh.positions[tri[0]]), v1(mesh.positions[tri[1]]), v2(mesh.positions[tri[2]]);
+  glm::dvec3 n = glm::cross(v1 - v0, v2 - v0);
+  const double len = glm::length(n);
+  hit.normal = len > 0.0 ? n / len : glm::dvec3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+  if (len == 0.0) hit.normal = glm::normalize(hit.normal);
+  // The point: the double-precision ray meets the triangle's plane (exactly on both, up to
+  // rounding); barycentric interpolation where the ray grazes the plane.
+  const double cosine = glm::dot(hit.normal, dir);
+  const double t = std::abs(cosine) > 1e-9 ? glm::dot(hit.normal, v0 - origin) / cosine : -1.0;
+  if (std::isfinite(t) && t >= 0.0)
+    hit.p = origin + t * dir;
+  else
+    hit.p = v0 + double(hit.u) * (v1 - v0) + double(hit.v) * (v2 - v0);
+  hit.scale = std::max({point_scale(hit.p), point_scale(v0), point_scale(v1), point_scale(v2)});
+  return true;
 }
 
 bool Tracer::occluded(const glm::dvec3& origin, const glm::dvec3& dir) const {
-    RTCRay ray = make_ray(origin, dir, std::numeric_limits<double>::infinity());
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    rtcOccluded1(impl_->scene, &context, &ray);
-    return ray.tfar < 0.0f;  // set to -inf on a hit
+  RTCRay ray = make_ray(origin, dir, std::numeric_limits<double>::infinity());
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcOccluded1(impl_->scene, &context, &ray);
+  return ray.tfar < 0.0f; // set to -inf on a hit
 }
 
 Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const {
-    Transmission result;
-    glm::dvec3 o = origin;
-    SurfaceHit hit;
-    while (result.crossings < max_crossings) {
-        ++result.rays;
-        if (!closest(o, dir, std::numeric_limits<double>::infinity(), hit)) break;
-        const double alpha = opacity(hit);
-        const glm::vec3 colour = material(hit).transmission_color;
-        for (int c = 0; c < 3; ++c) {
-            // 1 - channel_opacity(alpha)_c, in double; exactly 1 - alpha for colour 0.
-            result.channels[c] *= 1.0 - alpha * (1.0 - double(colour[c]));
-            if (result.channels[c] <= 0.0) result.channels[c] = 0.0;
-        }
-        ++result.crossings;
-        if (result.channels.r == 0.0 && result.channels.g == 0.0 && result.channels.b == 0.0) break;
-        // Continue from just beyond the crossed surface.
-        o = offset_origin(hit.p, hit.normal, hit.scale, dir);
+  Transmission result;
+  glm::dvec3 o = origin;
+  SurfaceHit hit;
+  while (result.crossings < max_crossings) {
+    ++result.rays;
+    if (!closest(o, dir, std::numeric_limits<double>::infinity(), hit)) break;
+    const double alpha = opacity(hit);
+    const glm::vec3 colour = material(hit).transmission_color;
+    for (int c = 0; c < 3; ++c) {
+      // 1 - channel_opacity(alpha)_c, in double; exactly 1 - alpha for colour 0.
+      result.channels[c] *= 1.0 - alpha * (1.0 - double(colour[c]));
+      if (result.channels[c] <= 0.0) result.channels[c] = 0.0;
     }
-    // The mean, written so that three equal channels give exactly that value.
-    const glm::dvec3& t = result.channels;
-    result.transmittance = t.r + ((t.g - t.r) + (t.b - t.r)) / 3.0;
-    return result;
+    ++result.crossings;
+    if (result.channels.r == 0.0 && result.channels.g == 0.0 && result.channels.b == 0.0) break;
+    // Continue from just beyond the crossed surface.
+    o = offset_origin(hit.p, hit.normal, hit.scale, dir);
+  }
+  // The mean, written so that three equal channels give exactly that value.
+  const glm::dvec3& t = result.channels;
+  result.transmittance = t.r + ((t.g - t.r) + (t.b - t.r)) / 3.0;
+  return result;
 }
 
 glm::dvec3 Tracer::shading_normal(const SurfaceHit& hit) const {
-    const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
-    const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
-    if (mesh.normals.size() != mesh.positions.size()) return hit.normal;
-    const double u = hit.u, v = hit.v;
-    const glm::dvec3 n = (1.0 - u - v) * glm::dvec3(mesh.normals[tri[0]]) + u * glm::dvec3(mesh.normals[tri[1]]) +
-                         v * glm::dvec3(mesh.normals[tri[2]]);
-    const double len = glm::length(n);
-    return len > 1e-12 ? n / len : hit.normal;
+  const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
+  const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
+  if (mesh.normals.size() != mesh.positions.size()) return hit.normal;
+  const double u = hit.u, v = hit.v;
+  const glm::dvec3 n = (1.0 - u - v) * glm::dvec3(mesh.normals[tri[0]]) + u * glm::dvec3(mesh.normals[tri[1]]) +
+                       v * glm::dvec3(mesh.normals[tri[2]]);
+  const double len = glm::length(n);
+  return len > 1e-12 ? n / len : hit.normal;
 }
 
 double Tracer::opacity(const SurfaceHit& hit) const {
-    const scene::Material& m = material(hit);
-    double alpha = m.opacity;
-    const std::uint32_t index = scene_.objects[hit.object].material;
-    if (index < opacity_images_.size() && opacity_images_[index].width > 0) {
-        const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
-        if (mesh.uvs.size() == mesh.positions.size()) {
-            const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
-            const float u = hit.u, v = hit.v;
-            const glm::vec2 uv = (1.0f - u - v) * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
-            alpha *= double(opacity_images_[index].sample(uv));
-        }
+  const scene::Material& m = material(hit);
+  double alpha = m.opacity;
+  const std::uint32_t index = scene_.objects[hit.object].material;
+  if (index < opacity_images_.size() && opacity_images_[index].width > 0) {
+    const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
+    if (mesh.uvs.size() == mesh.positions.size()) {
+      const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
+      const float u = hit.u, v = hit.v;
+      const glm::vec2 uv = (1.0f - u - v) * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
+      alpha *= double(opacity_images_[index].sample(uv));
     }
-    return alpha;
+  }
+  return alpha;
 }
 
 const scene::Material& Tracer::material(const SurfaceHit& hit) const {
-    const std::uint32_t m = scene_.objects[hit.object].material;
-    return scene_.materials.at(m < scene_.materials.size() ? m : 0);
+  const std::uint32_t m = scene_.objects[hit.object].material;
+  return scene_.materials.at(m < scene_.materials.size() ? m : 0);
 }
 
-}  // namespace msm::reference::detail
+} // namespace msm::reference::detail

@@ -27,435 +27,437 @@ namespace fs = std::filesystem;
 
 // Bounds every blue-noise channel must meet and the controls must break (see the header for the
 // definitions; the measured values are in docs/results.md, "Blue noise").
-constexpr double max_low_to_high = 0.01;  // white noise: ~1; ours: ~2e-4
-constexpr double max_low_to_high_tiled = 5e-4; // what our tileable textures reach (max 3e-4 at 64²)
-constexpr double max_anisotropy_64 = 0.2;  // any isotropic noise at 64²: ~0.08 (periodogram scatter)
-constexpr double min_seam = 0.8, max_seam = 1.25;           // per texture (scatter ±0.06 at 64²)
+constexpr double max_low_to_high = 0.01;          // white noise: ~1; ours: ~2e-4
+constexpr double max_low_to_high_tiled = 5e-4;    // what our tileable textures reach (max 3e-4 at 64²)
+constexpr double max_anisotropy_64 = 0.2;         // any isotropic noise at 64²: ~0.08 (periodogram scatter)
+constexpr double min_seam = 0.8, max_seam = 1.25; // per texture (scatter ±0.06 at 64²)
 constexpr double min_seam_pooled = 0.95, max_seam_pooled = 1.05; // mean over a set's channels
 
 std::vector<float> to_floats(const std::vector<std::uint32_t>& ranks) {
-    std::vector<float> v(ranks.size());
-    for (std::size_t i = 0; i < ranks.size(); ++i) v[i] = float(ranks[i]) / float(ranks.size() - 1);
-    return v;
+  std::vector<float> v(ranks.size());
+  for (std::size_t i = 0; i < ranks.size(); ++i) v[i] = float(ranks[i]) / float(ranks.size() - 1);
+  return v;
 }
 
 std::vector<float> white_noise(int size, std::uint64_t seed) {
-    std::mt19937_64 rng(seed);
-    std::vector<float> v(std::size_t(size) * std::size_t(size));
-    for (float& x : v) x = float(rng() >> 40) / float(1 << 24);
-    return v;
+  std::mt19937_64 rng(seed);
+  std::vector<float> v(std::size_t(size) * std::size_t(size));
+  for (float& x : v) x = float(rng() >> 40) / float(1 << 24);
+  return v;
 }
 
 // The Bayer ordered-dither matrix (a permutation of 0..size²-1 that tiles, with strong peaks at a
 // few frequencies: the anisotropy control).
 std::vector<std::uint32_t> bayer(int size) {
-    std::vector<std::uint32_t> m(std::size_t(size) * std::size_t(size));
-    int bits = 0;
-    while ((1 << bits) < size) ++bits;
-    for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-            std::uint32_t r = 0;
-            for (int b = 0; b < bits; ++b) {
-                const int xb = (x >> b) & 1, yb = (y >> b) & 1;
-                r |= std::uint32_t((xb ^ yb) << (2 * (bits - 1 - b) + 1) | (yb << (2 * (bits - 1 - b))));
-            }
-            m[std::size_t(y) * std::size_t(size) + std::size_t(x)] = r;
-        }
-    return m;
+  std::vector<std::uint32_t> m(std::size_t(size) * std::size_t(size));
+  int bits = 0;
+  while ((1 << bits) < size) ++bits;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      std::uint32_t r = 0;
+      for (int b = 0; b < bits; ++b) {
+        const int xb = (x >> b) & 1, yb = (y >> b) & 1;
+        r |= std::uint32_t((xb ^ yb) << (2 * (bits - 1 - b) + 1) | (yb << (2 * (bits - 1 - b))));
+      }
+      m[std::size_t(y) * std::size_t(size) + std::size_t(x)] = r;
+    }
+  return m;
 }
 
 struct Summary {
-    double low_to_high_mean = 0, low_to_high_max = 0;
-    double anisotropy_mean = 0, anisotropy_max = 0;
-    double seam_mean = 0, seam_min = 1e9, seam_max = 0;
-    bool all_unique = true;
-    int channels = 0;
+  double low_to_high_mean = 0, low_to_high_max = 0;
+  double anisotropy_mean = 0, anisotropy_max = 0;
+  double seam_mean = 0, seam_min = 1e9, seam_max = 0;
+  bool all_unique = true;
+  int channels = 0;
 };
 
 void add(Summary& s, const BlueNoiseMeasures& m) {
-    s.low_to_high_mean += m.low_to_high_power;
-    s.low_to_high_max = std::max(s.low_to_high_max, m.low_to_high_power);
-    s.anisotropy_mean += m.radial_anisotropy;
-    s.anisotropy_max = std::max(s.anisotropy_max, m.radial_anisotropy);
-    s.seam_mean += m.tiling_seam;
-    s.seam_min = std::min(s.seam_min, m.tiling_seam);
-    s.seam_max = std::max(s.seam_max, m.tiling_seam);
-    s.all_unique = s.all_unique && m.ranks_unique;
-    ++s.channels;
+  s.low_to_high_mean += m.low_to_high_power;
+  s.low_to_high_max = std::max(s.low_to_high_max, m.low_to_high_power);
+  s.anisotropy_mean += m.radial_anisotropy;
+  s.anisotropy_max = std::max(s.anisotropy_max, m.radial_anisotropy);
+  s.seam_mean += m.tiling_seam;
+  s.seam_min = std::min(s.seam_min, m.tiling_seam);
+  s.seam_max = std::max(s.seam_max, m.tiling_seam);
+  s.all_unique = s.all_unique && m.ranks_unique;
+  ++s.channels;
 }
 
 Summary finish(Summary s) {
-    s.low_to_high_mean /= s.channels;
-    s.anisotropy_mean /= s.channels;
-    s.seam_mean /= s.channels;
-    return s;
+  s.low_to_high_mean /= s.channels;
+  s.anisotropy_mean /= s.channels;
+  s.seam_mean /= s.channels;
+  return s;
 }
 
 Summary summarize(const BlueNoise& noise) {
-    Summary s;
-    for (int t = 0; t < noise.count; ++t)
-        for (int c = 0; c < noise.channels; ++c) add(s, measure_blue_noise(blue_noise_channel(noise, t, c), noise.size));
-    return finish(s);
+  Summary s;
+  for (int t = 0; t < noise.count; ++t)
+    for (int c = 0; c < noise.channels; ++c) add(s, measure_blue_noise(blue_noise_channel(noise, t, c), noise.size));
+  return finish(s);
 }
 
 void print(const char* name, int size, const Summary& s) {
-    std::printf("  %-34s %4d² x %3d  low/high %.1e (max %.1e)  anisotropy %.4f (max %.4f)  seam %.3f (%.3f..%.3f)  unique %s\n",
-                name, size, s.channels, s.low_to_high_mean, s.low_to_high_max, s.anisotropy_mean, s.anisotropy_max,
-                s.seam_mean, s.seam_min, s.seam_max, s.all_unique ? "yes" : "no");
+  std::printf(
+      "  %-34s %4d² x %3d  low/high %.1e (max %.1e)  anisotropy %.4f (max %.4f)  seam %.3f (%.3f..%.3f)  unique %s\n",
+      name, size, s.channels, s.low_to_high_mean, s.low_to_high_max, s.anisotropy_mean, s.anisotropy_max, s.seam_mean,
+      s.seam_min, s.seam_max, s.all_unique ? "yes" : "no");
 }
 
 bool histogram_flat(const BlueNoise& noise) {
-    const std::size_t pixels = std::size_t(noise.size) * std::size_t(noise.size);
-    for (int t = 0; t < noise.count; ++t)
-        for (int c = 0; c < noise.channels; ++c) {
-            std::array<std::size_t, 256> h{};
-            for (std::size_t i = 0; i < pixels; ++i)
-                ++h[noise.texels[(std::size_t(t) * pixels + i) * std::size_t(noise.channels) + std::size_t(c)]];
-            for (std::size_t k : h)
-                if (k != pixels / 256) return false;
-        }
-    return true;
+  const std::size_t pixels = std::size_t(noise.size) * std::size_t(noise.size);
+  for (int t = 0; t < noise.count; ++t)
+    for (int c = 0; c < noise.channels; ++c) {
+      std::array<std::size_t, 256> h{};
+      for (std::size_t i = 0; i < pixels; ++i)
+        ++h[noise.texels[(std::size_t(t) * pixels + i) * std::size_t(noise.channels) + std::size_t(c)]];
+      for (std::size_t k : h)
+        if (k != pixels / 256) return false;
+    }
+  return true;
 }
 
 class TempDir {
-public:
-    TempDir() {
-        static int counter = 0;
-        path_ = fs::temp_directory_path() /
-                ("msm_blue_noise_test." + std::to_string(::getpid()) + "." + std::to_string(counter++));
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    const fs::path& path() const { return path_; }
+ public:
+  TempDir() {
+    static int counter = 0;
+    path_ = fs::temp_directory_path() /
+            ("msm_blue_noise_test." + std::to_string(::getpid()) + "." + std::to_string(counter++));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
 
-private:
-    fs::path path_;
+ private:
+  fs::path path_;
 };
 
 // ---- Generator -------------------------------------------------------------------------------
 
 TEST(VoidAndCluster, EveryRankOnce) {
-    for (int size : {2, 3, 5, 8, 16, 64}) {
-        const auto ranks = void_and_cluster_ranks(size, 1.9, 7);
-        ASSERT_EQ(ranks.size(), std::size_t(size * size));
-        auto sorted = ranks;
-        std::sort(sorted.begin(), sorted.end());
-        for (std::size_t i = 0; i < sorted.size(); ++i) ASSERT_EQ(sorted[i], i) << "size " << size;
-        if (size >= 8) {
-            EXPECT_TRUE(measure_blue_noise(to_floats(ranks), size).ranks_unique);
-        }
-    }
+  for (int size : {2, 3, 5, 8, 16, 64}) {
+    const auto ranks = void_and_cluster_ranks(size, 1.9, 7);
+    ASSERT_EQ(ranks.size(), std::size_t(size * size));
+    auto sorted = ranks;
+    std::sort(sorted.begin(), sorted.end());
+    for (std::size_t i = 0; i < sorted.size(); ++i) ASSERT_EQ(sorted[i], i) << "size " << size;
+    if (size >= 8) { EXPECT_TRUE(measure_blue_noise(to_floats(ranks), size).ranks_unique); }
+  }
 }
 
 TEST(VoidAndCluster, DeterministicForASeed) {
-    EXPECT_EQ(void_and_cluster_ranks(32, 1.9, 42), void_and_cluster_ranks(32, 1.9, 42));
-    EXPECT_NE(void_and_cluster_ranks(32, 1.9, 42), void_and_cluster_ranks(32, 1.9, 43));
-    const BlueNoise a = generate_blue_noise(32, 3, 2, 1.9, 5), b = generate_blue_noise(32, 3, 2, 1.9, 5);
-    EXPECT_EQ(a, b);
-    // Every channel of every texture is its own run.
-    EXPECT_NE(blue_noise_channel(a, 0, 0), blue_noise_channel(a, 0, 1));
-    EXPECT_NE(blue_noise_channel(a, 0, 0), blue_noise_channel(a, 1, 0));
-    EXPECT_NE(a, generate_blue_noise(32, 3, 2, 1.9, 6));
+  EXPECT_EQ(void_and_cluster_ranks(32, 1.9, 42), void_and_cluster_ranks(32, 1.9, 42));
+  EXPECT_NE(void_and_cluster_ranks(32, 1.9, 42), void_and_cluster_ranks(32, 1.9, 43));
+  const BlueNoise a = generate_blue_noise(32, 3, 2, 1.9, 5), b = generate_blue_noise(32, 3, 2, 1.9, 5);
+  EXPECT_EQ(a, b);
+  // Every channel of every texture is its own run.
+  EXPECT_NE(blue_noise_channel(a, 0, 0), blue_noise_channel(a, 0, 1));
+  EXPECT_NE(blue_noise_channel(a, 0, 0), blue_noise_channel(a, 1, 0));
+  EXPECT_NE(a, generate_blue_noise(32, 3, 2, 1.9, 6));
 }
 
 TEST(VoidAndCluster, Preconditions) {
-    EXPECT_THROW(void_and_cluster_ranks(1, 1.9, 0), std::invalid_argument);
-    EXPECT_THROW(void_and_cluster_ranks(8, 0.0, 0), std::invalid_argument);
-    EXPECT_THROW(void_and_cluster_ranks(8, NAN, 0), std::invalid_argument);
-    EXPECT_THROW(generate_blue_noise(24, 1, 1, 1.9, 0), std::invalid_argument); // 256 does not divide 24²
-    EXPECT_THROW(generate_blue_noise(16, 0, 1, 1.9, 0), std::invalid_argument);
-    EXPECT_THROW(generate_blue_noise(16, 1, 5, 1.9, 0), std::invalid_argument);
-    EXPECT_THROW(measure_blue_noise(std::vector<float>(63), 8), std::invalid_argument);
-    const BlueNoise one = generate_blue_noise(16, 1, 1, 1.9, 0);
-    EXPECT_THROW(blue_noise_channel(one, 1, 0), std::out_of_range);
-    EXPECT_THROW(blue_noise_channel(one, 0, 1), std::out_of_range);
+  EXPECT_THROW(void_and_cluster_ranks(1, 1.9, 0), std::invalid_argument);
+  EXPECT_THROW(void_and_cluster_ranks(8, 0.0, 0), std::invalid_argument);
+  EXPECT_THROW(void_and_cluster_ranks(8, NAN, 0), std::invalid_argument);
+  EXPECT_THROW(generate_blue_noise(24, 1, 1, 1.9, 0), std::invalid_argument); // 256 does not divide 24²
+  EXPECT_THROW(generate_blue_noise(16, 0, 1, 1.9, 0), std::invalid_argument);
+  EXPECT_THROW(generate_blue_noise(16, 1, 5, 1.9, 0), std::invalid_argument);
+  EXPECT_THROW(measure_blue_noise(std::vector<float>(63), 8), std::invalid_argument);
+  const BlueNoise one = generate_blue_noise(16, 1, 1, 1.9, 0);
+  EXPECT_THROW(blue_noise_channel(one, 1, 0), std::out_of_range);
+  EXPECT_THROW(blue_noise_channel(one, 0, 1), std::out_of_range);
 }
 
 // ---- Measures, and controls that fail them -----------------------------------------------------
 
 TEST(BlueNoiseMeasures, GeneratedSetIsBlueIsotropicAndTiles) {
-    const BlueNoise noise = generate_blue_noise(64, 8, 2, 1.9, 11);
-    EXPECT_TRUE(histogram_flat(noise)) << "every 8-bit value must occur 4096/256 = 16 times per channel";
-    Summary s;
-    for (int t = 0; t < noise.count; ++t)
-        for (int c = 0; c < noise.channels; ++c) {
-            const BlueNoiseMeasures m = measure_blue_noise(blue_noise_channel(noise, t, c), noise.size);
-            EXPECT_LT(m.low_to_high_power, max_low_to_high) << "texture " << t << " channel " << c;
-            EXPECT_LT(m.radial_anisotropy, max_anisotropy_64) << "texture " << t << " channel " << c;
-            EXPECT_TRUE(m.ranks_unique) << "texture " << t << " channel " << c;
-            EXPECT_GE(m.tiling_seam, min_seam) << "texture " << t << " channel " << c;
-            EXPECT_LE(m.tiling_seam, max_seam) << "texture " << t << " channel " << c;
-            EXPECT_NEAR(m.mean, 127.5 / 255.0, 1e-6);
-            add(s, m);
-        }
-    s = finish(s);
-    print("void-and-cluster, sigma 1.9", 64, s);
-    EXPECT_GE(s.seam_mean, min_seam_pooled);
-    EXPECT_LE(s.seam_mean, max_seam_pooled);
+  const BlueNoise noise = generate_blue_noise(64, 8, 2, 1.9, 11);
+  EXPECT_TRUE(histogram_flat(noise)) << "every 8-bit value must occur 4096/256 = 16 times per channel";
+  Summary s;
+  for (int t = 0; t < noise.count; ++t)
+    for (int c = 0; c < noise.channels; ++c) {
+      const BlueNoiseMeasures m = measure_blue_noise(blue_noise_channel(noise, t, c), noise.size);
+      EXPECT_LT(m.low_to_high_power, max_low_to_high) << "texture " << t << " channel " << c;
+      EXPECT_LT(m.radial_anisotropy, max_anisotropy_64) << "texture " << t << " channel " << c;
+      EXPECT_TRUE(m.ranks_unique) << "texture " << t << " channel " << c;
+      EXPECT_GE(m.tiling_seam, min_seam) << "texture " << t << " channel " << c;
+      EXPECT_LE(m.tiling_seam, max_seam) << "texture " << t << " channel " << c;
+      EXPECT_NEAR(m.mean, 127.5 / 255.0, 1e-6);
+      add(s, m);
+    }
+  s = finish(s);
+  print("void-and-cluster, sigma 1.9", 64, s);
+  EXPECT_GE(s.seam_mean, min_seam_pooled);
+  EXPECT_LE(s.seam_mean, max_seam_pooled);
 }
 
 TEST(BlueNoiseMeasures, WhiteNoiseFails) {
-    Summary s;
-    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-        const BlueNoiseMeasures m = measure_blue_noise(white_noise(64, seed), 64);
-        EXPECT_GT(m.low_to_high_power, 5 * max_low_to_high) << "white noise has a flat spectrum";
-        EXPECT_FALSE(m.ranks_unique);
-        add(s, m);
-    }
-    print("white noise (control)", 64, finish(s));
+  Summary s;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const BlueNoiseMeasures m = measure_blue_noise(white_noise(64, seed), 64);
+    EXPECT_GT(m.low_to_high_power, 5 * max_low_to_high) << "white noise has a flat spectrum";
+    EXPECT_FALSE(m.ranks_unique);
+    add(s, m);
+  }
+  print("white noise (control)", 64, finish(s));
 }
 
 TEST(BlueNoiseMeasures, OrderedDitherIsAnisotropic) {
-    // Bayer: every rank once and tileable, but its power sits in a few lattice directions.
-    const BlueNoiseMeasures m = measure_blue_noise(to_floats(bayer(64)), 64);
-    EXPECT_TRUE(m.ranks_unique);
-    EXPECT_GT(m.radial_anisotropy, 2 * max_anisotropy_64);
-    // Rows of white noise, constant along x: all power on one axis.
-    std::vector<float> rows = white_noise(64, 3);
-    for (int y = 0; y < 64; ++y)
-        for (int x = 1; x < 64; ++x) rows[std::size_t(y * 64 + x)] = rows[std::size_t(y * 64)];
-    const BlueNoiseMeasures r = measure_blue_noise(rows, 64);
-    EXPECT_GT(r.radial_anisotropy, 2 * max_anisotropy_64);
-    std::printf("  Bayer 64²: low/high %.4f anisotropy %.3f seam %.3f; constant rows: anisotropy %.3f\n",
-                m.low_to_high_power, m.radial_anisotropy, m.tiling_seam, r.radial_anisotropy);
+  // Bayer: every rank once and tileable, but its power sits in a few lattice directions.
+  const BlueNoiseMeasures m = measure_blue_noise(to_floats(bayer(64)), 64);
+  EXPECT_TRUE(m.ranks_unique);
+  EXPECT_GT(m.radial_anisotropy, 2 * max_anisotropy_64);
+  // Rows of white noise, constant along x: all power on one axis.
+  std::vector<float> rows = white_noise(64, 3);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 1; x < 64; ++x) rows[std::size_t(y * 64 + x)] = rows[std::size_t(y * 64)];
+  const BlueNoiseMeasures r = measure_blue_noise(rows, 64);
+  EXPECT_GT(r.radial_anisotropy, 2 * max_anisotropy_64);
+  std::printf("  Bayer 64²: low/high %.4f anisotropy %.3f seam %.3f; constant rows: anisotropy %.3f\n",
+              m.low_to_high_power, m.radial_anisotropy, m.tiling_seam, r.radial_anisotropy);
 }
 
 TEST(BlueNoiseMeasures, CropOfALargerTextureDoesNotTile) {
-    // The four 64² quadrants of 128² blue noise are blue but do not tile: across their wrap,
-    // neighbours are uncorrelated instead of anti-correlated. Per texture that is a ~15% drop of the
-    // seam ratio, within its scatter (±0.06 at 64²), so the control is pooled over 8 crops, like the
-    // pooled bound of the generated sets. The wrap discontinuity also leaks power into the low
-    // frequencies (along the axes): the low/high ratio rises ~50-fold.
-    Summary s;
-    for (std::uint64_t seed = 1; seed <= 2; ++seed) {
-        const std::vector<float> big = to_floats(void_and_cluster_ranks(128, 1.9, seed));
-        for (int q = 0; q < 4; ++q) {
-            std::vector<float> quadrant(64 * 64);
-            for (int y = 0; y < 64; ++y)
-                for (int x = 0; x < 64; ++x)
-                    quadrant[std::size_t(y * 64 + x)] = big[std::size_t((y + 64 * (q / 2)) * 128 + x + 64 * (q % 2))];
-            const BlueNoiseMeasures m = measure_blue_noise(quadrant, 64);
-            EXPECT_GT(m.low_to_high_power, 10 * max_low_to_high_tiled) << "seed " << seed << " quadrant " << q;
-            add(s, m);
-        }
+  // The four 64² quadrants of 128² blue noise are blue but do not tile: across their wrap,
+  // neighbours are uncorrelated instead of anti-correlated. Per texture that is a ~15% drop of the
+  // seam ratio, within its scatter (±0.06 at 64²), so the control is pooled over 8 crops, like the
+  // pooled bound of the generated sets. The wrap discontinuity also leaks power into the low
+  // frequencies (along the axes): the low/high ratio rises ~50-fold.
+  Summary s;
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    const std::vector<float> big = to_floats(void_and_cluster_ranks(128, 1.9, seed));
+    for (int q = 0; q < 4; ++q) {
+      std::vector<float> quadrant(64 * 64);
+      for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x)
+          quadrant[std::size_t(y * 64 + x)] = big[std::size_t((y + 64 * (q / 2)) * 128 + x + 64 * (q % 2))];
+      const BlueNoiseMeasures m = measure_blue_noise(quadrant, 64);
+      EXPECT_GT(m.low_to_high_power, 10 * max_low_to_high_tiled) << "seed " << seed << " quadrant " << q;
+      add(s, m);
     }
-    s = finish(s);
-    print("64² quadrants of 128² (seam control)", 64, s);
-    EXPECT_LT(s.seam_mean, min_seam_pooled);
+  }
+  s = finish(s);
+  print("64² quadrants of 128² (seam control)", 64, s);
+  EXPECT_LT(s.seam_mean, min_seam_pooled);
 }
 
 // ---- A published texture as reference ------------------------------------------------------------
 
 TEST(BlueNoiseMeasures, ComparableToPublishedTexture) {
-    const fs::path file = fs::path(MSM_BLUE_NOISE_DATA_DIR) / "n8ao_blue_noise_128_rgba.png";
-    if (!fs::exists(file)) GTEST_SKIP() << "reference texture missing: " << file;
-    const msm::image::Image image = msm::image::read_png(file);
-    ASSERT_EQ(image.width(), 128);
-    ASSERT_EQ(image.height(), 128);
-    ASSERT_EQ(image.channels(), 4);
-    // read_png decodes R, G, B from sRGB and A linearly; recover the stored bytes exactly.
-    for (int k = 0; k < 256; ++k)
-        ASSERT_EQ(msm::image::linear_to_srgb8(msm::image::srgb_to_linear(float(k) / 255.0f)), k);
-    BlueNoise theirs{128, 1, 4, std::vector<std::uint8_t>(128 * 128 * 4)};
-    const auto pixels = image.pixels();
-    for (std::size_t i = 0; i < pixels.size(); ++i)
-        theirs.texels[i] = i % 4 == 3 ? std::uint8_t(std::lround(pixels[i] * 255.0f)) : msm::image::linear_to_srgb8(pixels[i]);
-    ASSERT_TRUE(histogram_flat(theirs)) << "the reference texture has 64 of every 8-bit value per channel";
+  const fs::path file = fs::path(MSM_BLUE_NOISE_DATA_DIR) / "n8ao_blue_noise_128_rgba.png";
+  if (!fs::exists(file)) GTEST_SKIP() << "reference texture missing: " << file;
+  const msm::image::Image image = msm::image::read_png(file);
+  ASSERT_EQ(image.width(), 128);
+  ASSERT_EQ(image.height(), 128);
+  ASSERT_EQ(image.channels(), 4);
+  // read_png decodes R, G, B from sRGB and A linearly; recover the stored bytes exactly.
+  for (int k = 0; k < 256; ++k)
+    ASSERT_EQ(msm::image::linear_to_srgb8(msm::image::srgb_to_linear(float(k) / 255.0f)), k);
+  BlueNoise theirs{128, 1, 4, std::vector<std::uint8_t>(128 * 128 * 4)};
+  const auto pixels = image.pixels();
+  for (std::size_t i = 0; i < pixels.size(); ++i)
+    theirs.texels[i] =
+        i % 4 == 3 ? std::uint8_t(std::lround(pixels[i] * 255.0f)) : msm::image::linear_to_srgb8(pixels[i]);
+  ASSERT_TRUE(histogram_flat(theirs)) << "the reference texture has 64 of every 8-bit value per channel";
 
-    const Summary reference = summarize(theirs);
-    const Summary ours128 = summarize(generate_blue_noise(128, 2, 4, 1.9, 2024));
-    const Summary ours64 = summarize(generate_blue_noise(64, 4, 2, 1.9, 2024));
-    std::printf("  side by side (anisotropy depends on the size: compare at 128²):\n");
-    print("n8ao 2.1.0 (CC0), RGBA", 128, reference);
-    print("ours, sigma 1.9", 128, ours128);
-    print("ours, sigma 1.9", 64, ours64);
-    EXPECT_TRUE(reference.all_unique && ours128.all_unique);
-    // The reference meets the bounds the generated sets are held to.
-    EXPECT_LT(reference.low_to_high_max, max_low_to_high);
-    EXPECT_GE(reference.seam_min, min_seam);
-    EXPECT_LE(reference.seam_max, max_seam);
-    EXPECT_LE(ours128.low_to_high_mean, 2 * reference.low_to_high_mean);
-    EXPECT_LE(ours128.anisotropy_mean, 2 * reference.anisotropy_mean);
-    EXPECT_LE(ours64.low_to_high_mean, 2 * reference.low_to_high_mean);
-    EXPECT_GE(ours128.seam_min, min_seam);
-    EXPECT_LE(ours128.seam_max, max_seam);
+  const Summary reference = summarize(theirs);
+  const Summary ours128 = summarize(generate_blue_noise(128, 2, 4, 1.9, 2024));
+  const Summary ours64 = summarize(generate_blue_noise(64, 4, 2, 1.9, 2024));
+  std::printf("  side by side (anisotropy depends on the size: compare at 128²):\n");
+  print("n8ao 2.1.0 (CC0), RGBA", 128, reference);
+  print("ours, sigma 1.9", 128, ours128);
+  print("ours, sigma 1.9", 64, ours64);
+  EXPECT_TRUE(reference.all_unique && ours128.all_unique);
+  // The reference meets the bounds the generated sets are held to.
+  EXPECT_LT(reference.low_to_high_max, max_low_to_high);
+  EXPECT_GE(reference.seam_min, min_seam);
+  EXPECT_LE(reference.seam_max, max_seam);
+  EXPECT_LE(ours128.low_to_high_mean, 2 * reference.low_to_high_mean);
+  EXPECT_LE(ours128.anisotropy_mean, 2 * reference.anisotropy_mean);
+  EXPECT_LE(ours64.low_to_high_mean, 2 * reference.low_to_high_mean);
+  EXPECT_GE(ours128.seam_min, min_seam);
+  EXPECT_LE(ours128.seam_max, max_seam);
 }
 
 // ---- Cache ---------------------------------------------------------------------------------------
 
 TEST(BlueNoiseCache, RoundTripAndCorruptFilesAreRegenerated) {
-    TempDir dir;
-    const BlueNoiseParams params{32, 3, 2, 1.9, 99};
-    const BlueNoise expected = generate_blue_noise(32, 3, 2, 1.9, 99);
+  TempDir dir;
+  const BlueNoiseParams params{32, 3, 2, 1.9, 99};
+  const BlueNoise expected = generate_blue_noise(32, 3, 2, 1.9, 99);
 
-    const CachedBlueNoise first = load_or_generate_blue_noise(params, dir.path());
-    EXPECT_EQ(first.source, BlueNoiseSource::generated);
-    EXPECT_FALSE(first.rejected_file);
-    EXPECT_EQ(first.file, dir.path() / blue_noise_cache_file_name(params));
-    EXPECT_EQ(first.noise, expected);
-    ASSERT_TRUE(fs::exists(first.file));
-    const auto file_size = fs::file_size(first.file);
-    EXPECT_EQ(file_size, 56u + 32u * 32u * 3u * 2u);
+  const CachedBlueNoise first = load_or_generate_blue_noise(params, dir.path());
+  EXPECT_EQ(first.source, BlueNoiseSource::generated);
+  EXPECT_FALSE(first.rejected_file);
+  EXPECT_EQ(first.file, dir.path() / blue_noise_cache_file_name(params));
+  EXPECT_EQ(first.noise, expected);
+  ASSERT_TRUE(fs::exists(first.file));
+  const auto file_size = fs::file_size(first.file);
+  EXPECT_EQ(file_size, 56u + 32u * 32u * 3u * 2u);
 
-    const CachedBlueNoise second = load_or_generate_blue_noise(params, dir.path());
-    EXPECT_EQ(second.source, BlueNoiseSource::loaded);
-    EXPECT_EQ(second.noise, expected);
+  const CachedBlueNoise second = load_or_generate_blue_noise(params, dir.path());
+  EXPECT_EQ(second.source, BlueNoiseSource::loaded);
+  EXPECT_EQ(second.noise, expected);
 
-    const auto corrupt_and_reload = [&](auto&& corrupt, const char* what) {
-        corrupt();
-        const CachedBlueNoise again = load_or_generate_blue_noise(params, dir.path());
-        EXPECT_TRUE(again.rejected_file) << what;
-        EXPECT_EQ(again.source, BlueNoiseSource::generated) << what;
-        EXPECT_EQ(again.noise, expected) << what;
-        EXPECT_EQ(fs::file_size(first.file), file_size) << what;
-        EXPECT_EQ(load_or_generate_blue_noise(params, dir.path()).source, BlueNoiseSource::loaded) << what;
-    };
-    corrupt_and_reload(
-        [&] {
-            std::fstream f(first.file, std::ios::in | std::ios::out | std::ios::binary);
-            f.seekp(1000);
-            char c = 0;
-            f.read(&c, 1);
-            f.seekp(1000);
-            c = char(c ^ 0x10);
-            f.write(&c, 1);
-        },
-        "one payload bit flipped");
-    corrupt_and_reload([&] { fs::resize_file(first.file, file_size - 100); }, "truncated");
-    corrupt_and_reload([&] { fs::resize_file(first.file, 0); }, "empty");
-    corrupt_and_reload([&] { std::ofstream(first.file, std::ios::app) << "x"; }, "one byte too many");
-    corrupt_and_reload(
-        [&] {
-            // A valid file of other parameters under this name.
-            const BlueNoiseParams other{32, 3, 2, 1.9, 100};
-            const CachedBlueNoise o = load_or_generate_blue_noise(other, dir.path());
-            fs::rename(o.file, first.file);
-        },
-        "other seed");
-    // No temporary files left behind.
-    int files = 0;
-    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir.path())) ++files;
-    EXPECT_EQ(files, 1);
+  const auto corrupt_and_reload = [&](auto&& corrupt, const char* what) {
+    corrupt();
+    const CachedBlueNoise again = load_or_generate_blue_noise(params, dir.path());
+    EXPECT_TRUE(again.rejected_file) << what;
+    EXPECT_EQ(again.source, BlueNoiseSource::generated) << what;
+    EXPECT_EQ(again.noise, expected) << what;
+    EXPECT_EQ(fs::file_size(first.file), file_size) << what;
+    EXPECT_EQ(load_or_generate_blue_noise(params, dir.path()).source, BlueNoiseSource::loaded) << what;
+  };
+  corrupt_and_reload(
+      [&] {
+        std::fstream f(first.file, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(1000);
+        char c = 0;
+        f.read(&c, 1);
+        f.seekp(1000);
+        c = char(c ^ 0x10);
+        f.write(&c, 1);
+      },
+      "one payload bit flipped");
+  corrupt_and_reload([&] { fs::resize_file(first.file, file_size - 100); }, "truncated");
+  corrupt_and_reload([&] { fs::resize_file(first.file, 0); }, "empty");
+  corrupt_and_reload([&] { std::ofstream(first.file, std::ios::app) << "x"; }, "one byte too many");
+  corrupt_and_reload(
+      [&] {
+        // A valid file of other parameters under this name.
+        const BlueNoiseParams other{32, 3, 2, 1.9, 100};
+        const CachedBlueNoise o = load_or_generate_blue_noise(other, dir.path());
+        fs::rename(o.file, first.file);
+      },
+      "other seed");
+  // No temporary files left behind.
+  int files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir.path())) ++files;
+  EXPECT_EQ(files, 1);
 }
 
 TEST(BlueNoiseCache, UnwritableDirectoryKeepsTheSetInMemory) {
-    TempDir dir;
-    const fs::path blocker = dir.path() / "a_file";
-    std::ofstream(blocker) << "not a directory";
-    const BlueNoiseParams params{16, 2, 1, 1.9, 3};
-    const CachedBlueNoise r = load_or_generate_blue_noise(params, blocker / "cache");
-    EXPECT_EQ(r.source, BlueNoiseSource::generated_only);
-    EXPECT_EQ(r.noise, generate_blue_noise(16, 2, 1, 1.9, 3));
-    const CachedBlueNoise none = load_or_generate_blue_noise(params, std::nullopt);
-    EXPECT_EQ(none.source, BlueNoiseSource::generated_only);
-    EXPECT_TRUE(none.file.empty());
-    EXPECT_THROW(load_or_generate_blue_noise(BlueNoiseParams{20, 1, 1, 1.9, 0}, dir.path()), std::invalid_argument);
+  TempDir dir;
+  const fs::path blocker = dir.path() / "a_file";
+  std::ofstream(blocker) << "not a directory";
+  const BlueNoiseParams params{16, 2, 1, 1.9, 3};
+  const CachedBlueNoise r = load_or_generate_blue_noise(params, blocker / "cache");
+  EXPECT_EQ(r.source, BlueNoiseSource::generated_only);
+  EXPECT_EQ(r.noise, generate_blue_noise(16, 2, 1, 1.9, 3));
+  const CachedBlueNoise none = load_or_generate_blue_noise(params, std::nullopt);
+  EXPECT_EQ(none.source, BlueNoiseSource::generated_only);
+  EXPECT_TRUE(none.file.empty());
+  EXPECT_THROW(load_or_generate_blue_noise(BlueNoiseParams{20, 1, 1, 1.9, 0}, dir.path()), std::invalid_argument);
 }
 
 TEST(BlueNoiseCache, DirectoryFromTheEnvironment) {
-    const auto saved = [](const char* name) -> std::optional<std::string> {
-        const char* v = std::getenv(name);
-        return v ? std::optional<std::string>(v) : std::nullopt;
-    };
-    const auto restore = [](const char* name, const std::optional<std::string>& v) {
-        if (v) ::setenv(name, v->c_str(), 1);
-        else ::unsetenv(name);
-    };
-    const auto msm = saved("MSM_CACHE_DIR"), xdg = saved("XDG_CACHE_HOME"), home = saved("HOME");
-    ::setenv("MSM_CACHE_DIR", "/tmp/a", 1);
-    ::setenv("XDG_CACHE_HOME", "/tmp/b", 1);
-    ::setenv("HOME", "/tmp/c", 1);
-    EXPECT_EQ(blue_noise_cache_dir(), fs::path("/tmp/a"));
-    ::setenv("MSM_CACHE_DIR", "", 1);
-    EXPECT_EQ(blue_noise_cache_dir(), fs::path("/tmp/b/msm"));
-    ::unsetenv("XDG_CACHE_HOME");
-    EXPECT_EQ(blue_noise_cache_dir(), fs::path("/tmp/c/.cache/msm"));
-    ::unsetenv("HOME");
-    EXPECT_EQ(blue_noise_cache_dir(), std::nullopt);
-    restore("MSM_CACHE_DIR", msm);
-    restore("XDG_CACHE_HOME", xdg);
-    restore("HOME", home);
-    EXPECT_EQ(blue_noise_cache_file_name(BlueNoiseParams{}),
-              fs::path("blue_noise-v1-64x64-n64-c2-sigma1.900-seed6d736d2d626e3031.bin"));
+  const auto saved = [](const char* name) -> std::optional<std::string> {
+    const char* v = std::getenv(name);
+    return v ? std::optional<std::string>(v) : std::nullopt;
+  };
+  const auto restore = [](const char* name, const std::optional<std::string>& v) {
+    if (v)
+      ::setenv(name, v->c_str(), 1);
+    else
+      ::unsetenv(name);
+  };
+  const auto msm = saved("MSM_CACHE_DIR"), xdg = saved("XDG_CACHE_HOME"), home = saved("HOME");
+  ::setenv("MSM_CACHE_DIR", "/tmp/a", 1);
+  ::setenv("XDG_CACHE_HOME", "/tmp/b", 1);
+  ::setenv("HOME", "/tmp/c", 1);
+  EXPECT_EQ(blue_noise_cache_dir(), fs::path("/tmp/a"));
+  ::setenv("MSM_CACHE_DIR", "", 1);
+  EXPECT_EQ(blue_noise_cache_dir(), fs::path("/tmp/b/msm"));
+  ::unsetenv("XDG_CACHE_HOME");
+  EXPECT_EQ(blue_noise_cache_dir(), fs::path("/tmp/c/.cache/msm"));
+  ::unsetenv("HOME");
+  EXPECT_EQ(blue_noise_cache_dir(), std::nullopt);
+  restore("MSM_CACHE_DIR", msm);
+  restore("XDG_CACHE_HOME", xdg);
+  restore("HOME", home);
+  EXPECT_EQ(blue_noise_cache_file_name(BlueNoiseParams{}),
+            fs::path("blue_noise-v1-64x64-n64-c2-sigma1.900-seed6d736d2d626e3031.bin"));
 }
 
 // ---- The renderer's set ----------------------------------------------------------------------------
 
 TEST(BlueNoiseSet, RendererSetIsGeneratedOnceCachedAndBlue) {
-    TempDir dir;
-    ::setenv("MSM_CACHE_DIR", dir.path().c_str(), 1);
-    // Four threads ask at once: one generation, one object.
-    const auto start = std::chrono::steady_clock::now();
-    std::array<const BlueNoise*, 4> seen{};
-    {
-        std::vector<std::thread> threads;
-        for (std::size_t i = 0; i < seen.size(); ++i) threads.emplace_back([&seen, i] { seen[i] = &blue_noise(); });
-        for (std::thread& t : threads) t.join();
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("  blue_noise(): 64 textures x 64² x 2 channels generated in %.2f s\n", seconds);
-    const BlueNoise& noise = blue_noise();
-    for (const BlueNoise* p : seen) EXPECT_EQ(p, &noise);
-    ASSERT_EQ(noise.size, 64);
-    ASSERT_EQ(noise.count, 64);
-    ASSERT_EQ(noise.channels, 2);
-    ASSERT_EQ(noise.texels.size(), 64u * 64u * 64u * 2u);
-    EXPECT_TRUE(histogram_flat(noise));
+  TempDir dir;
+  ::setenv("MSM_CACHE_DIR", dir.path().c_str(), 1);
+  // Four threads ask at once: one generation, one object.
+  const auto start = std::chrono::steady_clock::now();
+  std::array<const BlueNoise*, 4> seen{};
+  {
+    std::vector<std::thread> threads;
+    for (std::size_t i = 0; i < seen.size(); ++i) threads.emplace_back([&seen, i] { seen[i] = &blue_noise(); });
+    for (std::thread& t : threads) t.join();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("  blue_noise(): 64 textures x 64² x 2 channels generated in %.2f s\n", seconds);
+  const BlueNoise& noise = blue_noise();
+  for (const BlueNoise* p : seen) EXPECT_EQ(p, &noise);
+  ASSERT_EQ(noise.size, 64);
+  ASSERT_EQ(noise.count, 64);
+  ASSERT_EQ(noise.channels, 2);
+  ASSERT_EQ(noise.texels.size(), 64u * 64u * 64u * 2u);
+  EXPECT_TRUE(histogram_flat(noise));
 
-    // Written to the cache (no other test of this program calls blue_noise(), so the calls above
-    // generated the set with MSM_CACHE_DIR pointing at dir).
-    const auto load_start = std::chrono::steady_clock::now();
-    const CachedBlueNoise cached = load_or_generate_blue_noise(BlueNoiseParams{}, dir.path());
-    const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
-    EXPECT_EQ(cached.source, BlueNoiseSource::loaded);
-    EXPECT_EQ(cached.noise, noise);
-    std::printf("  loaded back from the cache file in %.1f ms\n", 1e3 * load_seconds);
+  // Written to the cache (no other test of this program calls blue_noise(), so the calls above
+  // generated the set with MSM_CACHE_DIR pointing at dir).
+  const auto load_start = std::chrono::steady_clock::now();
+  const CachedBlueNoise cached = load_or_generate_blue_noise(BlueNoiseParams{}, dir.path());
+  const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - load_start).count();
+  EXPECT_EQ(cached.source, BlueNoiseSource::loaded);
+  EXPECT_EQ(cached.noise, noise);
+  std::printf("  loaded back from the cache file in %.1f ms\n", 1e3 * load_seconds);
 
-    Summary s;
-    for (int t = 0; t < noise.count; ++t)
-        for (int c = 0; c < noise.channels; ++c) {
-            const BlueNoiseMeasures m = measure_blue_noise(blue_noise_channel(noise, t, c), noise.size);
-            EXPECT_LT(m.low_to_high_power, max_low_to_high) << "texture " << t << " channel " << c;
-            EXPECT_LT(m.radial_anisotropy, max_anisotropy_64) << "texture " << t << " channel " << c;
-            EXPECT_TRUE(m.ranks_unique) << "texture " << t << " channel " << c;
-            EXPECT_GE(m.tiling_seam, min_seam) << "texture " << t << " channel " << c;
-            EXPECT_LE(m.tiling_seam, max_seam) << "texture " << t << " channel " << c;
-            add(s, m);
-        }
-    s = finish(s);
-    print("blue_noise() (the renderer's set)", 64, s);
-    EXPECT_GE(s.seam_mean, min_seam_pooled);
-    EXPECT_LE(s.seam_mean, max_seam_pooled);
-    // The two channels of a texture are independent: their correlation is small.
-    double corr = 0;
-    for (int t = 0; t < noise.count; ++t) {
-        const auto a = blue_noise_channel(noise, t, 0), b = blue_noise_channel(noise, t, 1);
-        double sab = 0, saa = 0, sbb = 0;
-        for (std::size_t i = 0; i < a.size(); ++i) {
-            sab += (a[i] - 0.5) * (b[i] - 0.5);
-            saa += (a[i] - 0.5) * (a[i] - 0.5);
-            sbb += (b[i] - 0.5) * (b[i] - 0.5);
-        }
-        corr = std::max(corr, std::abs(sab / std::sqrt(saa * sbb)));
+  Summary s;
+  for (int t = 0; t < noise.count; ++t)
+    for (int c = 0; c < noise.channels; ++c) {
+      const BlueNoiseMeasures m = measure_blue_noise(blue_noise_channel(noise, t, c), noise.size);
+      EXPECT_LT(m.low_to_high_power, max_low_to_high) << "texture " << t << " channel " << c;
+      EXPECT_LT(m.radial_anisotropy, max_anisotropy_64) << "texture " << t << " channel " << c;
+      EXPECT_TRUE(m.ranks_unique) << "texture " << t << " channel " << c;
+      EXPECT_GE(m.tiling_seam, min_seam) << "texture " << t << " channel " << c;
+      EXPECT_LE(m.tiling_seam, max_seam) << "texture " << t << " channel " << c;
+      add(s, m);
     }
-    EXPECT_LT(corr, 0.1);
+  s = finish(s);
+  print("blue_noise() (the renderer's set)", 64, s);
+  EXPECT_GE(s.seam_mean, min_seam_pooled);
+  EXPECT_LE(s.seam_mean, max_seam_pooled);
+  // The two channels of a texture are independent: their correlation is small.
+  double corr = 0;
+  for (int t = 0; t < noise.count; ++t) {
+    const auto a = blue_noise_channel(noise, t, 0), b = blue_noise_channel(noise, t, 1);
+    double sab = 0, saa = 0, sbb = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      sab += (a[i] - 0.5) * (b[i] - 0.5);
+      saa += (a[i] - 0.5) * (a[i] - 0.5);
+      sbb += (b[i] - 0.5) * (b[i] - 0.5);
+    }
+    corr = std::max(corr, std::abs(sab / std::sqrt(saa * sbb)));
+  }
+  EXPECT_LT(corr, 0.1);
 }
 
 TEST(BlueNoiseSet, FirstCallsFromInsideTbbTasks) {
-    // Callers that are themselves TBB tasks: the generation's own parallel_for is isolated so that
-    // a waiting thread cannot run another caller's task (a recursive initialization: deadlock or
-    // abort). A smoke test: without the isolation it also passed 3 runs of 3 (the hazard depends
-    // on scheduling). Meaningful when it runs in its own process (ctest); otherwise the set exists.
-    TempDir dir;
-    ::setenv("MSM_CACHE_DIR", dir.path().c_str(), 1);
-    std::array<const BlueNoise*, 16> seen{};
-    tbb::parallel_for(std::size_t(0), seen.size(), [&seen](std::size_t i) { seen[i] = &blue_noise(); });
-    for (const BlueNoise* p : seen) EXPECT_EQ(p, &blue_noise());
-    EXPECT_EQ(blue_noise().count, 64);
+  // Callers that are themselves TBB tasks: the generation's own parallel_for is isolated so that
+  // a waiting thread cannot run another caller's task (a recursive initialization: deadlock or
+  // abort). A smoke test: without the isolation it also passed 3 runs of 3 (the hazard depends
+  // on scheduling). Meaningful when it runs in its own process (ctest); otherwise the set exists.
+  TempDir dir;
+  ::setenv("MSM_CACHE_DIR", dir.path().c_str(), 1);
+  std::array<const BlueNoise*, 16> seen{};
+  tbb::parallel_for(std::size_t(0), seen.size(), [&seen](std::size_t i) { seen[i] = &blue_noise(); });
+  for (const BlueNoise* p : seen) EXPECT_EQ(p, &blue_noise());
+  EXPECT_EQ(blue_noise().count, 64);
 }
 
 } // namespace

@@ -13,7 +13,7 @@ struct FrameConfig {
   const Technique* technique = nullptr;
   int width = 0, height = 0, shadow_size = 0, msaa = 1, taps = 1;
   bool mipmaps = true;
-  bool one_pass = false;   // one_pass_filter instead of moment_resolve + blur
+  bool one_pass = false; // one_pass_filter instead of moment_resolve + blur
   // Translucent occluders are blended into the map (JCGT §3): a four-channel technique then
   // stores its moments as two RG images, because the blend factor is the fragment's alpha.
   bool translucent = false;
@@ -21,16 +21,16 @@ struct FrameConfig {
   // blended with the channel's opacity α (1 − transmission colour); only with translucent.
   bool coloured = false;
   bool operator==(const FrameConfig&) const = default;
-  bool split_rg() const;          // translucent and four channels in one image
-  std::array<int, 2> formats() const; // of the moment images as allocated
-  int moment_images() const; // 0 (depth-based), 1 or 2 (6MSM, split_rg)
+  bool split_rg() const;                            // translucent and four channels in one image
+  std::array<int, 2> formats() const;               // of the moment images as allocated
+  int moment_images() const;                        // 0 (depth-based), 1 or 2 (6MSM, split_rg)
   int channels() const { return coloured ? 3 : 1; } // sets of moment images
 };
 
 struct FrameTargets {
   FrameConfig config;
-  vk::Image shadow_depth;              // D16, config.msaa samples
-  std::array<vk::Image, 2> moments;    // the technique's formats, mip_levels mips
+  vk::Image shadow_depth;                    // D16, config.msaa samples
+  std::array<vk::Image, 2> moments;          // the technique's formats, mip_levels mips
   std::array<vk::ImageView, 2> moments_mip0; // mip 0 alone: what resolve and blur write (GENERAL)
   // Coloured translucency: the moment images of the green and blue channels (moments: red).
   std::array<std::array<vk::Image, 2>, 2> colour_moments;
@@ -41,10 +41,10 @@ struct FrameTargets {
   VkImageView moment_mip0(int channel, int i) const {
     return channel == 0 ? moments_mip0[size_t(i)] : colour_moments_mip0[size_t(channel - 1)][size_t(i)];
   }
-  std::array<vk::Image, 2> blur_temp;  // RGBA32F, between the two blur directions
-  vk::Image color;                     // RGBA8 sRGB
-  vk::Image shadow_buffer;             // RGBA32F: visibility per colour channel, coverage
-  vk::Image camera_depth;              // D32
+  std::array<vk::Image, 2> blur_temp; // RGBA32F, between the two blur directions
+  vk::Image color;                    // RGBA8 sRGB
+  vk::Image shadow_buffer;            // RGBA32F: visibility per colour channel, coverage
+  vk::Image camera_depth;             // D32
   // Summed-area tables of the moment images (soft shadows only; two for mssm6): RGBA32_UINT, or
   // RG32_UINT for an RG image (sampled as uvec4(r, g, 0, 1): only r, g are summed).
   std::array<vk::Image, 2> sat_tables;

@@ -7,18 +7,22 @@ namespace msm::render {
 namespace {
 
 vk::Image upload_rgba8(const vk::Context& ctx, int width, int height, std::span<const std::uint8_t> rgba) {
-  vk::Image image = vk::createImage(ctx, {.width = uint32_t(width), .height = uint32_t(height),
-                                          .format = VK_FORMAT_R8G8B8A8_SRGB,
-                                          .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-  vk::uploadImage(ctx, image, std::as_bytes(rgba), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  vk::Image image = vk::create_image(ctx, {.width = uint32_t(width),
+                                           .height = uint32_t(height),
+                                           .format = VK_FORMAT_R8G8B8A8_SRGB,
+                                           .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  vk::upload_image(ctx, image, std::as_bytes(rgba), VK_IMAGE_LAYOUT_UNDEFINED,
+                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   return image;
 }
 
 vk::Image upload_r8(const vk::Context& ctx, int width, int height, std::span<const std::uint8_t> texels) {
-  vk::Image image = vk::createImage(ctx, {.width = uint32_t(width), .height = uint32_t(height),
-                                          .format = VK_FORMAT_R8_UNORM,
-                                          .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-  vk::uploadImage(ctx, image, std::as_bytes(texels), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  vk::Image image = vk::create_image(ctx, {.width = uint32_t(width),
+                                           .height = uint32_t(height),
+                                           .format = VK_FORMAT_R8_UNORM,
+                                           .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  vk::upload_image(ctx, image, std::as_bytes(texels), VK_IMAGE_LAYOUT_UNDEFINED,
+                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   return image;
 }
 
@@ -69,23 +73,25 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
     }
     draw.double_sided = material.double_sided;
     draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);
-    draw.push.flags = glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0,
-                                 draw.opacity_texture >= 0 ? 1 : 0, -1);
+    draw.push.flags =
+        glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0, draw.opacity_texture >= 0 ? 1 : 0, -1);
     draw.push.transmission = glm::vec4(material.transmission_color, 0.0f);
     if (!draw.index_count) continue;
-    if (is_translucent) translucent_by_depth.emplace_back(glm::dot(draw.center, travel), draw);
-    else draws.push_back(draw);
+    if (is_translucent)
+      translucent_by_depth.emplace_back(glm::dot(draw.center, travel), draw);
+    else
+      draws.push_back(draw);
   }
   std::stable_sort(translucent_by_depth.begin(), translucent_by_depth.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [depth, draw] : translucent_by_depth) translucent.push_back(draw);
-  vertices = vk::createBuffer(ctx, vertex_data.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  vk::uploadBuffer(ctx, vertices, std::as_bytes(std::span(vertex_data)));
-  indices = vk::createBuffer(ctx, index_data.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-  vk::uploadBuffer(ctx, indices, std::as_bytes(std::span(index_data)));
+  vertices = vk::create_buffer(ctx, vertex_data.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vk::upload_buffer(ctx, vertices, std::as_bytes(std::span(vertex_data)));
+  indices = vk::create_buffer(ctx, index_data.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  vk::upload_buffer(ctx, indices, std::as_bytes(std::span(index_data)));
   const std::uint8_t white_texel[4] = {255, 255, 255, 255};
   white = upload_rgba8(ctx, 1, 1, white_texel);
-  texture_sampler = vk::createSampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
+  texture_sampler = vk::create_sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
 }
 
 } // namespace msm::render

@@ -54,8 +54,8 @@ TEST_F(GroundTruthTest, RasterizerAndRayTracerSeeTheSameSurfaces) {
     image::Image raster = renderer.render(settings("plain")).shadow.channel("background");
     image::Image traced = ground_truth(scene, reference::Effect::hard).visibility.channel("background");
     image::Metrics m = image::compute_metrics(raster, traced);
-    EXPECT_LT(m.share_above_10pct, 0.004) << name << ": background differs at " << m.share_above_10pct * 100
-                                         << "% of the pixels";
+    EXPECT_LT(m.share_above_10pct, 0.004)
+        << name << ": background differs at " << m.share_above_10pct * 100 << "% of the pixels";
   }
 }
 
@@ -78,14 +78,14 @@ TEST_F(GroundTruthTest, PcfAgreesWithTheRayTracedFilteredShadow) {
     // plane differently and the Lambert term hides the shadow anyway.
     tolerances.max_share_above_10pct = 0.03;
     tolerances.max_share_above_3pct = 0.05;
-    image::CompareResult c = image::compare(pcf.shadow.channel("visibility"), truth.visibility.channel("visibility"),
-                                            tolerances,
-                                            {.metrics = {.mask = &mask},
-                                             .failure_dir = "test-failures/ground-truth/pcf-" + name});
+    image::CompareResult c =
+        image::compare(pcf.shadow.channel("visibility"), truth.visibility.channel("visibility"), tolerances,
+                       {.metrics = {.mask = &mask}, .failure_dir = "test-failures/ground-truth/pcf-" + name});
     EXPECT_TRUE(c.passed) << name << ": " << c.report;
-    fmt::print("{:<8} PCF vs ray traced: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >3% {:.2f}%, >10% {:.2f}%\n",
-               name, c.metrics.mae, c.metrics.light_leaking, c.metrics.over_darkening, 100 * c.metrics.share_above_3pct,
-               100 * c.metrics.share_above_10pct);
+    fmt::print(
+        "{:<8} PCF vs ray traced: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >3% {:.2f}%, >10% {:.2f}%\n", name,
+        c.metrics.mae, c.metrics.light_leaking, c.metrics.over_darkening, 100 * c.metrics.share_above_3pct,
+        100 * c.metrics.share_above_10pct);
   }
 }
 
@@ -103,8 +103,8 @@ TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
     image::Image reference = truth.visibility.channel("visibility");
     for (const Technique& t : techniques()) {
       if (msm_technique_is_area_light(t.id)) continue; // against the area light: soft_shadow_test.cpp
-      image::Metrics m = image::compute_metrics(renderer.render(settings(std::string(t.name))).shadow.channel("visibility"),
-                                                reference, {.mask = &mask});
+      image::Metrics m = image::compute_metrics(
+          renderer.render(settings(std::string(t.name))).shadow.channel("visibility"), reference, {.mask = &mask});
       EXPECT_LT(m.mae, t.name == "plain" ? 0.12 : 0.07) << name << ", " << t.name;
       EXPECT_EQ(m.non_finite, 0u);
       table[std::string(t.name)][name] = m;

@@ -4,19 +4,19 @@
 #include "msm/render/renderer.h"
 
 #include "msm/image/compare.h"
-#include "msm/render/frame.h"
 #include "msm/image/metrics.h"
-#include "msm/techniques.h"
 #include "msm/nonlinear.h"
-#include "msm/vk/vk.h"
+#include "msm/render/frame.h"
+#include "msm/techniques.h"
 #include "msm/vk/test_support.h"
+#include "msm/vk/vk.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 namespace msm::render {
@@ -51,17 +51,27 @@ struct Bound {
   double mae, share_above_3pct;
 };
 const std::map<std::string, Bound> kBounds = {
-    {"plain", {0.14, 0.45}},          // unfiltered: differs in every penumbra
-    {"vsm-32", {0.06, 0.44}},         {"vsm-64", {0.06, 0.44}},
-    {"esm-32", {0.085, 0.45}},        {"evsm2-32", {0.07, 0.45}},
-    {"evsm2-64", {0.09, 0.46}},       {"evsm4-64", {0.065, 0.44}},
-    {"evsm4-128", {0.06, 0.44}},      {"msm-hamburger-128-unit", {0.052, 0.44}},
-    {"msm-hamburger-128", {0.052, 0.41}}, {"msm-hamburger-64-theta4", {0.065, 0.44}},
-    {"msm-hamburger-64", {0.066, 0.44}},  {"msm-hausdorff-128-unit", {0.052, 0.44}},
-    {"msm-hausdorff-128", {0.052, 0.41}}, {"msm-hausdorff-64-theta4", {0.057, 0.44}},
-    {"msm-hausdorff-64", {0.058, 0.44}},  {"tmsm-128", {0.05, 0.44}},
-    {"msm6-192", {0.052, 0.44}},      {"msm6-96", {0.059, 0.44}},
-    {"msm-nl64", {0.05, 0.41}},       {"msm-nl32", {0.055, 0.41}}, // dithered lookups
+    {"plain", {0.14, 0.45}}, // unfiltered: differs in every penumbra
+    {"vsm-32", {0.06, 0.44}},
+    {"vsm-64", {0.06, 0.44}},
+    {"esm-32", {0.085, 0.45}},
+    {"evsm2-32", {0.07, 0.45}},
+    {"evsm2-64", {0.09, 0.46}},
+    {"evsm4-64", {0.065, 0.44}},
+    {"evsm4-128", {0.06, 0.44}},
+    {"msm-hamburger-128-unit", {0.052, 0.44}},
+    {"msm-hamburger-128", {0.052, 0.41}},
+    {"msm-hamburger-64-theta4", {0.065, 0.44}},
+    {"msm-hamburger-64", {0.066, 0.44}},
+    {"msm-hausdorff-128-unit", {0.052, 0.44}},
+    {"msm-hausdorff-128", {0.052, 0.41}},
+    {"msm-hausdorff-64-theta4", {0.057, 0.44}},
+    {"msm-hausdorff-64", {0.058, 0.44}},
+    {"tmsm-128", {0.05, 0.44}},
+    {"msm6-192", {0.052, 0.44}},
+    {"msm6-96", {0.059, 0.44}},
+    {"msm-nl64", {0.05, 0.41}},
+    {"msm-nl32", {0.055, 0.41}}, // dithered lookups
 };
 
 struct SceneRenders {
@@ -123,7 +133,9 @@ TEST_F(RenderTest, EveryTechniqueIsWithinItsBoundOfPcfOnEveryScene) {
 // shadows) and everywhere: 128 bits leak less than 64; JCGT §2.4: [-1,1] depth leaks less than
 // [0,1] depth at 128 bits. Strict inequalities with a margin of 1% of the larger value.
 TEST_F(RenderTest, LeakingOrderingsOfThePapersHold) {
-  auto leak = [&](const std::string& scene, const std::string& t) { return against_pcf(ctx(), scene, t).light_leaking; };
+  auto leak = [&](const std::string& scene, const std::string& t) {
+    return against_pcf(ctx(), scene, t).light_leaking;
+  };
   auto less = [&](const std::string& scene, const std::string& a, const std::string& b) {
     double la = leak(scene, a), lb = leak(scene, b);
     EXPECT_LT(la, 0.99 * lb) << scene << ": " << a << " leaks " << la << ", " << b << " " << lb;
@@ -186,9 +198,7 @@ TEST_F(RenderTest, ResolvedMomentsEqualTheCpuComputationOnTheSameDepths) {
       // tie may round either way); float (moments in [-1,1]): 1e-6, a few ulps of 1 (the device
       // may convert D16 to float or contract a * b + c differently).
       EXPECT_LE(worst, unorm ? 1.0 : 1e-6);
-      if (msaa > 1) {
-        EXPECT_GT(distinct_depths, 100) << "edges give texels whose samples differ";
-      }
+      if (msaa > 1) { EXPECT_GT(distinct_depths, 100) << "edges give texels whose samples differ"; }
     }
   }
 }
@@ -204,7 +214,11 @@ TEST_F(RenderTest, KernelSizesAndMipmapsKeepUnshadowedSurfacesLit) {
       s.filter_sigma = taps / 3.0f;
       s.mipmaps = mips;
       RenderResult r = renderer.render(s);
-      RenderResult p = renderer.render([&] { RenderSettings q = s; q.technique = "pcf"; return q; }());
+      RenderResult p = renderer.render([&] {
+        RenderSettings q = s;
+        q.technique = "pcf";
+        return q;
+      }());
       image::Image mask = background(p);
       image::Metrics m = image::compute_metrics(visibility(r), visibility(p), {.mask = &mask});
       EXPECT_LT(m.mae, 0.03) << taps << " taps, mips " << mips;
@@ -245,47 +259,53 @@ TEST_F(RenderTest, FlatReceiverFacingTheLightIsLit) {
 // nothing non-finite comes out, and texels whose kernel misses it are blurred as usual.
 TEST_F(RenderTest, BlurNeverSpreadsNaN) {
   const int n = 32, taps = 9, radius = 4;
-  vk::Program blur = vk::createProgram(ctx(), "blur.comp",
-                                       {vk::Binding::UniformBuffer, vk::Binding::SampledImage, vk::Binding::StorageImage},
-                                       sizeof(ImagePassPush));
+  vk::Program blur = vk::create_program(
+      ctx(), "blur.comp", {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
+      sizeof(ImagePassPush));
   FrameUniforms u{};
   u.kernel = glm::ivec4(taps, 1, radius, 0);
   std::vector<float> w(taps);
   float sum = 0;
-  for (int k = 0; k < taps; ++k) sum += w[size_t(k)] = std::exp(-float((k - radius) * (k - radius)) / (2 * 2.4f * 2.4f));
+  for (int k = 0; k < taps; ++k)
+    sum += w[size_t(k)] = std::exp(-float((k - radius) * (k - radius)) / (2 * 2.4f * 2.4f));
   for (int k = 0; k < taps; ++k) u.filter_weights[k / 4][k % 4] = w[size_t(k)] / sum;
-  vk::Buffer uniforms = vk::createBuffer(ctx(), sizeof(u), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::Host);
+  vk::Buffer uniforms = vk::create_buffer(ctx(), sizeof(u), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host);
   std::memcpy(uniforms.data(), &u, sizeof(u));
   std::vector<float> texels(size_t(n * n * 4));
   for (size_t i = 0; i < texels.size(); ++i) texels[i] = float((i * 7919) % 1000) / 1000.0f;
   for (int c = 0; c < 4; ++c) texels[size_t((10 * n + 10) * 4 + c)] = NAN;
   auto make = [&] {
-    return vk::createImage(ctx(), {.width = n, .height = n, .format = VK_FORMAT_R32G32B32A32_SFLOAT,
-                                   .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
-                                            VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    return vk::create_image(ctx(), {.width = n,
+                                    .height = n,
+                                    .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                    .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
   };
   vk::Image input = make(), temp = make(), output = make();
-  vk::uploadImage(ctx(), input, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  vk::Sampler sampler = vk::createSampler(ctx(), VK_FILTER_NEAREST);
-  vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+  vk::upload_image(ctx(), input, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+  vk::Sampler sampler = vk::create_sampler(ctx(), VK_FILTER_NEAREST);
+  vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
     VkImageMemoryBarrier2 init[2];
     int i = 0;
     for (const vk::Image* image : {&temp, &output})
-      init[i++] = vk::imageBarrier(image->handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_NONE, 0,
-                                   VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                   VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
-    vk::pipelineBarrier(cmd, {}, {}, init);
-    uint32_t groups = vk::groupCount(n, 8);
-    vk::dispatch(cmd, blur, groups, groups, 1,
-                 {vk::Descriptor(uniforms), vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp)},
-                 ImagePassPush{glm::ivec4(n, n, 0, 0)});
-    vk::pipelineBarrier(cmd, vk::memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                               VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
-    vk::dispatch(cmd, blur, groups, groups, 1,
-                 {vk::Descriptor(uniforms), vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output)},
-                 ImagePassPush{glm::ivec4(n, n, 1, 0)});
+      init[i++] = vk::image_barrier(image->handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_NONE, 0,
+                                    VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
+    vk::pipeline_barrier(cmd, {}, {}, init);
+    uint32_t groups = vk::group_count(n, 8);
+    vk::dispatch(
+        cmd, blur, groups, groups, 1,
+        {vk::Descriptor(uniforms), vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp)},
+        ImagePassPush{glm::ivec4(n, n, 0, 0)});
+    vk::pipeline_barrier(
+        cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
+    vk::dispatch(
+        cmd, blur, groups, groups, 1,
+        {vk::Descriptor(uniforms), vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output)},
+        ImagePassPush{glm::ivec4(n, n, 1, 0)});
   });
-  std::vector<std::byte> bytes = vk::readbackImage(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
+  std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
   std::vector<float> out(texels.size());
   std::memcpy(out.data(), bytes.data(), bytes.size());
   auto at = [&](const std::vector<float>& v, int x, int y, int c) {
@@ -300,7 +320,8 @@ TEST_F(RenderTest, BlurNeverSpreadsNaN) {
         double expected = 0;
         for (int j = 0; j < taps; ++j)
           for (int i = 0; i < taps; ++i)
-            expected += double(w[size_t(i)] / sum) * (w[size_t(j)] / sum) * at(texels, x + i - radius, y + j - radius, c);
+            expected +=
+                double(w[size_t(i)] / sum) * (w[size_t(j)] / sum) * at(texels, x + i - radius, y + j - radius, c);
         EXPECT_NEAR(v, expected, 1e-5) << x << "," << y;
       }
 }
@@ -326,7 +347,6 @@ TEST_F(RenderTest, ParametersReachTheShaders) {
   EXPECT_GT(darkened, 50);
   EXPECT_GT(brightened, 50);
 }
-
 
 // The one-pass filter (resolve + Gaussian in shared memory) computes what resolve, blur H and
 // blur V through device memory compute: on float storage up to rounding of the sums; on 16-bit
@@ -371,7 +391,8 @@ TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
   std::vector<float> w(taps);
   double wsum = 0;
   for (int k = 0; k < taps; ++k) wsum += std::exp(-double((k - radius) * (k - radius)) / (2 * 2.4 * 2.4));
-  for (int k = 0; k < taps; ++k) w[size_t(k)] = float(std::exp(-double((k - radius) * (k - radius)) / (2 * 2.4 * 2.4)) / wsum);
+  for (int k = 0; k < taps; ++k)
+    w[size_t(k)] = float(std::exp(-double((k - radius) * (k - radius)) / (2 * 2.4 * 2.4)) / wsum);
   auto cpu_filtered = [&](const Intermediates& in, int msaa) {
     std::vector<glm::vec4> resolved(size_t(n * n)), horizontal(size_t(n * n)), out(size_t(n * n));
     for (int i = 0; i < n * n; ++i) {
@@ -406,7 +427,8 @@ TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
   float worst_moment = 0;
   for (int i = 0; i < n * n; ++i)
     for (int c = 0; c < 4; ++c)
-      worst_moment = std::max(worst_moment, std::abs(lin.moments.pixels()[size_t(4 * i + c)] - expected_moments[size_t(i)][c]));
+      worst_moment =
+          std::max(worst_moment, std::abs(lin.moments.pixels()[size_t(4 * i + c)] - expected_moments[size_t(i)][c]));
   EXPECT_LE(worst_moment, 1e-6f) << "filtered float moments, one-pass filter against the CPU";
 
   for (const char* name : {"msm-nl64", "msm-nl32"}) {
@@ -425,7 +447,8 @@ TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
         NonLinearMoments e, a;
         if (std::string(name) == "msm-nl64") {
           glm::vec4 expected = msm_nl64_encode(f);
-          glm::vec4 actual(in.moments.at(x, y, 0), in.moments.at(x, y, 1), in.moments.at(x, y, 2), in.moments.at(x, y, 3));
+          glm::vec4 actual(in.moments.at(x, y, 0), in.moments.at(x, y, 1), in.moments.at(x, y, 2),
+                           in.moments.at(x, y, 3));
           identical += actual == expected;
           e = msm_nl64_decode(expected);
           a = msm_nl64_decode(actual);
@@ -489,31 +512,153 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
     try {
       renderer.render(s);
       ADD_FAILURE() << "accepted; expected an error mentioning " << needle;
-    } catch (const RenderError& e) {
-      EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-    }
+    } catch (const RenderError& e) { EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what(); }
   };
   RenderSettings s = small("msm-hamburger-64");
-  rejects([&] { auto q = s; q.technique = "nope"; return q; }(), "unknown technique 'nope'");
-  rejects([&] { auto q = s; q.width = 0; return q; }(), "width = 0");
-  rejects([&] { auto q = s; q.height = 1000000; return q; }(), "height = 1000000");
-  rejects([&] { auto q = s; q.width = 16384; q.height = 16384; return q; }(), "pixels");
-  rejects([&] { auto q = s; q.shadow_size = 1000000; return q; }(), "shadow size");
-  rejects([&] { auto q = s; q.msaa = 2; return q; }(), "msaa = 2");
-  rejects([&] { auto q = s; q.filter_size = 8; return q; }(), "odd");
-  rejects([&] { auto q = s; q.filter_sigma = NAN; return q; }(), "filter sigma");
-  rejects([&] { auto q = s; q.params = glm::vec4(NAN); return q; }(), "finite");
-  rejects([&] { auto q = s; q.technique = "msm-nl64"; q.one_pass = false; return q; }(), "needs the one-pass filter");
-  rejects([&] { auto q = s; q.technique = "msm6-96"; q.one_pass = true; return q; }(), "one moment image");
-  rejects([&] { auto q = s; q.one_pass = true; q.filter_size = 19; return q; }(), "at most 17 taps");
-  rejects([&] { auto q = s; q.technique = "mssm4"; q.params = glm::vec4(0.0f); return q; }(), "0 < δ1 <= δ2 <= 1");
-  rejects([&] { auto q = s; q.technique = "mssm6"; q.params = glm::vec4(0.1f, 0.01f, 1, 0); return q; }(), "δ1 <= δ2");
-  rejects([&] { auto q = s; q.technique = "vssm"; q.params = glm::vec4(0.0f); return q; }(), "minimum variance");
-  rejects([&] { auto q = s; q.technique = "pcss"; q.soft_kernel = 64; return q; }(), "soft kernel = 64");
-  rejects([&] { auto q = s; q.technique = "mssm4"; q.soft_kernel = 256; return q; }(), "soft kernel = 256");
-  rejects([&] { auto q = s; q.technique = "mssm4"; q.one_pass = true; return q; }(), "summed-area table");
-  if (!vk::supportsAttachment(ctx(), VK_FORMAT_D16_UNORM, VK_SAMPLE_COUNT_8_BIT))
-    rejects([&] { auto q = s; q.msaa = 8; return q; }(), "8x MSAA");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "nope";
+        return q;
+      }(),
+      "unknown technique 'nope'");
+  rejects(
+      [&] {
+        auto q = s;
+        q.width = 0;
+        return q;
+      }(),
+      "width = 0");
+  rejects(
+      [&] {
+        auto q = s;
+        q.height = 1000000;
+        return q;
+      }(),
+      "height = 1000000");
+  rejects(
+      [&] {
+        auto q = s;
+        q.width = 16384;
+        q.height = 16384;
+        return q;
+      }(),
+      "pixels");
+  rejects(
+      [&] {
+        auto q = s;
+        q.shadow_size = 1000000;
+        return q;
+      }(),
+      "shadow size");
+  rejects(
+      [&] {
+        auto q = s;
+        q.msaa = 2;
+        return q;
+      }(),
+      "msaa = 2");
+  rejects(
+      [&] {
+        auto q = s;
+        q.filter_size = 8;
+        return q;
+      }(),
+      "odd");
+  rejects(
+      [&] {
+        auto q = s;
+        q.filter_sigma = NAN;
+        return q;
+      }(),
+      "filter sigma");
+  rejects(
+      [&] {
+        auto q = s;
+        q.params = glm::vec4(NAN);
+        return q;
+      }(),
+      "finite");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "msm-nl64";
+        q.one_pass = false;
+        return q;
+      }(),
+      "needs the one-pass filter");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "msm6-96";
+        q.one_pass = true;
+        return q;
+      }(),
+      "one moment image");
+  rejects(
+      [&] {
+        auto q = s;
+        q.one_pass = true;
+        q.filter_size = 19;
+        return q;
+      }(),
+      "at most 17 taps");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "mssm4";
+        q.params = glm::vec4(0.0f);
+        return q;
+      }(),
+      "0 < δ1 <= δ2 <= 1");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "mssm6";
+        q.params = glm::vec4(0.1f, 0.01f, 1, 0);
+        return q;
+      }(),
+      "δ1 <= δ2");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "vssm";
+        q.params = glm::vec4(0.0f);
+        return q;
+      }(),
+      "minimum variance");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "pcss";
+        q.soft_kernel = 64;
+        return q;
+      }(),
+      "soft kernel = 64");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "mssm4";
+        q.soft_kernel = 256;
+        return q;
+      }(),
+      "soft kernel = 256");
+  rejects(
+      [&] {
+        auto q = s;
+        q.technique = "mssm4";
+        q.one_pass = true;
+        return q;
+      }(),
+      "summed-area table");
+  if (!vk::supports_attachment(ctx(), VK_FORMAT_D16_UNORM, VK_SAMPLE_COUNT_8_BIT))
+    rejects(
+        [&] {
+          auto q = s;
+          q.msaa = 8;
+          return q;
+        }(),
+        "8x MSAA");
   // The renderer still works afterwards.
   EXPECT_NO_THROW(renderer.render(s));
 }

@@ -43,12 +43,24 @@ std::vector<glm::vec2> standard_sample_offsets(int samples) {
 
 image::Image to_float_image(std::span<const std::byte> bytes, VkFormat format, int width, int height) {
   int channels = 0;
-  enum { Unorm16, Half, Float } kind = Float;
+  enum { unorm16, half, Float } kind = Float;
   switch (format) {
-  case VK_FORMAT_R16G16B16A16_UNORM: channels = 4; kind = Unorm16; break;
-  case VK_FORMAT_R16G16_UNORM: channels = 2; kind = Unorm16; break;
-  case VK_FORMAT_R16G16B16A16_SFLOAT: channels = 4; kind = Half; break;
-  case VK_FORMAT_R16G16_SFLOAT: channels = 2; kind = Half; break;
+  case VK_FORMAT_R16G16B16A16_UNORM:
+    channels = 4;
+    kind = unorm16;
+    break;
+  case VK_FORMAT_R16G16_UNORM:
+    channels = 2;
+    kind = unorm16;
+    break;
+  case VK_FORMAT_R16G16B16A16_SFLOAT:
+    channels = 4;
+    kind = half;
+    break;
+  case VK_FORMAT_R16G16_SFLOAT:
+    channels = 2;
+    kind = half;
+    break;
   case VK_FORMAT_R32G32B32A32_SFLOAT: channels = 4; break;
   case VK_FORMAT_R32G32_SFLOAT: channels = 2; break;
   case VK_FORMAT_R32_SFLOAT: channels = 1; break;
@@ -57,11 +69,11 @@ image::Image to_float_image(std::span<const std::byte> bytes, VkFormat format, i
   image::Image out(width, height, channels);
   std::span<float> px = out.pixels();
   for (size_t i = 0; i < px.size(); ++i) {
-    if (kind == Unorm16) {
+    if (kind == unorm16) {
       uint16_t v;
       std::memcpy(&v, bytes.data() + 2 * i, 2);
       px[i] = float(v) / 65535.0f;
-    } else if (kind == Half) {
+    } else if (kind == half) {
       uint16_t v;
       std::memcpy(&v, bytes.data() + 2 * i, 2);
       px[i] = glm::unpackHalf1x16(v);
@@ -95,21 +107,24 @@ struct Renderer::Impl {
 
   Impl(const vk::Context& c, const scene::Scene& s)
       : ctx(c), scene(s), gpu(c, s), light_view_projection(s.light_view_projection()),
-        uniforms(vk::createBuffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::Host)),
+        uniforms(vk::create_buffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         timer(c, 32), noise(upload_blue_noise(c)) {}
 
   static vk::Image upload_blue_noise(const vk::Context& ctx) {
     const BlueNoise& n = blue_noise();
     if (n.size != 64 || n.channels != 2) throw RenderError("blue noise: expected 64² textures with two channels");
-    vk::Image image = vk::createImage(ctx, {.width = 64, .height = 64, .format = VK_FORMAT_R8G8_UNORM,
-                                            .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                                            .layers = uint32_t(n.count)});
-    vk::uploadImage(ctx, image, std::as_bytes(std::span(n.texels)), VK_IMAGE_LAYOUT_UNDEFINED,
-                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    vk::Image image = vk::create_image(ctx, {.width = 64,
+                                             .height = 64,
+                                             .format = VK_FORMAT_R8G8_UNORM,
+                                             .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                             .layers = uint32_t(n.count)});
+    vk::upload_image(ctx, image, std::as_bytes(std::span(n.texels)), VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     return image;
   }
 
-  template <class Map, class Key, class Make> auto& cached(Map& map, const Key& key, Make make) {
+  template <class Map, class Key, class Make>
+  auto& cached(Map& map, const Key& key, Make make) {
     auto it = map.find(key);
     if (it == map.end()) it = map.emplace(key, make()).first;
     return *it->second;
@@ -128,8 +143,8 @@ struct Renderer::Impl {
     float texel = glm::length(glm::vec3(inverse * glm::vec4(2.0f, 0.0f, 0.0f, 0.0f))) / float(s.shadow_size);
     bool soft = msm_technique_is_soft(technique.id);
     float depth_bias = s.resolved_depth_bias();
-    u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel,
-                             soft ? 0.0f : depth_bias);
+    u.shadow_map =
+        glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel, soft ? 0.0f : depth_bias);
     if (msm_technique_is_area_light(technique.id)) {
       // soft.h: texels of reach per unit of [-1,1] depth = tan(θ/2) w_d / w_t.
       float extent = s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg;
@@ -187,18 +202,18 @@ struct Renderer::Impl {
     s.validate();
     const Technique& technique = find_technique(s.technique);
     VkSampleCountFlagBits samples = VkSampleCountFlagBits(s.msaa);
-    if (!vk::supportsAttachment(ctx, VK_FORMAT_D16_UNORM, samples))
-      throw RenderError(fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name,
-                                    s.msaa));
+    if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, samples))
+      throw RenderError(
+          fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name, s.msaa));
     if (uint32_t(std::max(s.width, s.height)) > ctx.properties().limits.maxImageDimension2D ||
         uint32_t(s.shadow_size) > ctx.properties().limits.maxImageDimension2D)
       throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
                                     ctx.properties().limits.maxImageDimension2D));
     bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(technique.id));
-    bool translucent = s.translucent_occluders && !gpu.translucent.empty() && supports_translucency(technique) &&
-                       !one_pass;
-    FrameConfig config{&technique, s.width, s.height, s.shadow_size, s.msaa, s.filter_size, s.mipmaps, one_pass,
-                       translucent, translucent && s.coloured_translucency};
+    bool translucent =
+        s.translucent_occluders && !gpu.translucent.empty() && supports_translucency(technique) && !one_pass;
+    FrameConfig config{&technique,    s.width,   s.height, s.shadow_size, s.msaa,
+                       s.filter_size, s.mipmaps, one_pass, translucent,   translucent && s.coloured_translucency};
     bool split = config.split_rg();
     if (!targets || !(targets->config == config)) {
       targets.reset();
@@ -212,9 +227,8 @@ struct Renderer::Impl {
       cached(resolve_passes, std::tuple(technique.id, s.msaa, split),
              [&] { return std::make_unique<MomentResolvePass>(ctx, technique, s.msaa, split); });
       if (translucent)
-        cached(translucent_passes, std::tuple(technique.id, s.msaa, split), [&] {
-          return std::make_unique<TranslucentPass>(ctx, technique, s.msaa, split, config.formats());
-        });
+        cached(translucent_passes, std::tuple(technique.id, s.msaa, split),
+               [&] { return std::make_unique<TranslucentPass>(ctx, technique, s.msaa, split, config.formats()); });
       if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
       if (msm_technique_is_soft(technique.id) && !sat_pass) sat_pass = std::make_unique<SatPass>(ctx);
     }
@@ -264,11 +278,12 @@ struct Renderer::Impl {
   }
 
   void read_intermediates(const RenderSettings& s, const Technique& technique, Intermediates& out) {
-    vk::submitAndWait(ctx, [&](VkCommandBuffer cmd) { record(cmd, s, technique, true); });
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) { record(cmd, s, technique, true); });
     timer.read();
     int size = s.shadow_size;
     if (s.msaa == 1) {
-      std::vector<std::byte> bytes = vk::readbackImage(ctx, targets->shadow_depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+      std::vector<std::byte> bytes =
+          vk::readback_image(ctx, targets->shadow_depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
       out.depth_samples.resize(size_t(size) * size);
       for (size_t i = 0; i < out.depth_samples.size(); ++i) {
         uint16_t v;
@@ -277,12 +292,14 @@ struct Renderer::Impl {
       }
     } else {
       if (!depth_copy)
-        depth_copy = std::make_unique<vk::Program>(vk::createProgram(
-            ctx, "depth_samples.comp", {vk::Binding::SampledImage, vk::Binding::StorageBuffer}, sizeof(ImagePassPush)));
+        depth_copy = std::make_unique<vk::Program>(
+            vk::create_program(ctx, "depth_samples.comp", {vk::Binding::sampled_image, vk::Binding::storage_buffer},
+                               sizeof(ImagePassPush)));
       size_t count = size_t(size) * size * size_t(s.msaa);
-      vk::Buffer buffer = vk::createBuffer(ctx, count * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::Host);
-      vk::submitAndWait(ctx, [&](VkCommandBuffer cmd) {
-        uint32_t groups = vk::groupCount(uint32_t(size), 8);
+      vk::Buffer buffer =
+          vk::create_buffer(ctx, count * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+      vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+        uint32_t groups = vk::group_count(uint32_t(size), 8);
         vk::dispatch(cmd, *depth_copy, groups, groups, 1,
                      {vk::Descriptor(targets->shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                      targets->point_sampler),
@@ -293,7 +310,7 @@ struct Renderer::Impl {
       out.depth_samples.assign(mapped.begin(), mapped.begin() + std::ptrdiff_t(count));
     }
     for (int i = 0; i < targets->config.moment_images(); ++i) {
-      std::vector<std::byte> bytes = vk::readbackImage(ctx, targets->moments[size_t(i)], VK_IMAGE_LAYOUT_GENERAL);
+      std::vector<std::byte> bytes = vk::readback_image(ctx, targets->moments[size_t(i)], VK_IMAGE_LAYOUT_GENERAL);
       VkFormat format = VkFormat(targets->config.formats()[size_t(i)]);
       if (format == VK_FORMAT_R32_UINT) {
         out.packed.resize(size_t(size) * size);
@@ -313,22 +330,23 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   Impl& m = *impl_;
   const Technique& technique = m.prepare(s);
   if (intermediates) m.read_intermediates(s, technique, *intermediates);
-  vk::submitAndWait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
+  vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
   RenderResult r;
   r.passes = m.read_times();
   for (const PassTime& p : r.passes) r.total_ms += p.ms;
   if (intermediates && m.targets->config.moment_images() && m.targets->config.formats()[0] != VK_FORMAT_R32_UINT)
-    intermediates->filtered = to_float_image(vk::readbackImage(m.ctx, m.targets->moments[0],
-                                                               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL),
-                                             VkFormat(m.targets->config.formats()[0]), s.shadow_size, s.shadow_size);
+    intermediates->filtered =
+        to_float_image(vk::readback_image(m.ctx, m.targets->moments[0], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL),
+                       VkFormat(m.targets->config.formats()[0]), s.shadow_size, s.shadow_size);
 
-  std::vector<std::byte> color = vk::readbackImage(m.ctx, m.targets->color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  std::vector<std::byte> color = vk::readback_image(m.ctx, m.targets->color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   r.color = image::Image(s.width, s.height, 3);
   std::span<float> c = r.color.pixels();
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
     for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
 
-  std::vector<std::byte> shadow = vk::readbackImage(m.ctx, m.targets->shadow_buffer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  std::vector<std::byte> shadow =
+      vk::readback_image(m.ctx, m.targets->shadow_buffer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   // RGBA32F: visibility per colour channel, coverage. With coloured translucency "visibility" is
   // the mean of the channels (as the ray tracer's), and the channels come along.
   bool coloured = m.targets->config.coloured;
@@ -352,7 +370,7 @@ std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s
   const Technique& technique = m.prepare(s);
   std::vector<std::vector<PassTime>> out;
   for (int i = 0; i < frames; ++i) {
-    vk::submitAndWait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
+    vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
     out.push_back(m.read_times());
   }
   return out;

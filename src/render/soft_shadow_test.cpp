@@ -56,11 +56,12 @@ std::map<std::string, image::Metrics> errors(const vk::Context& ctx, const scene
   Renderer renderer(ctx, scene);
   std::map<std::string, image::Metrics> out;
   for (const std::string& t : techniques) {
-    image::Image v = renderer.render(soft_settings(t, width, height, extent_deg, shadow_size)).shadow.channel("visibility");
+    image::Image v =
+        renderer.render(soft_settings(t, width, height, extent_deg, shadow_size)).shadow.channel("visibility");
     out[t] = image::compute_metrics(v, truth.visibility.channel("visibility"), {.mask = &mask});
     EXPECT_EQ(out[t].non_finite, 0u) << t;
-    fmt::print("{} {}°: {:<16} MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >10% {:.2f}%\n", scene.name, extent_deg,
-               t, out[t].mae, out[t].light_leaking, out[t].over_darkening, 100 * out[t].share_above_10pct);
+    fmt::print("{} {}°: {:<16} MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >10% {:.2f}%\n", scene.name,
+               extent_deg, t, out[t].mae, out[t].light_leaking, out[t].over_darkening, 100 * out[t].share_above_10pct);
   }
   return out;
 }
@@ -116,7 +117,8 @@ TEST_F(SoftShadowTest, ZeroExtentGivesHardShadows) {
   for (const std::string& t : kSoftTechniques) {
     image::Image soft = renderer.render(soft_settings(t, 240, 135, 0.0f)).shadow.channel("visibility");
     image::Metrics m = image::compute_metrics(soft, hard.shadow.channel("visibility"), {.mask = &mask});
-    fmt::print("fence, extent 0: {} against 1-tap PCF: MAE {:.4f}, >10% {:.2f}%\n", t, m.mae, 100 * m.share_above_10pct);
+    fmt::print("fence, extent 0: {} against 1-tap PCF: MAE {:.4f}, >10% {:.2f}%\n", t, m.mae,
+               100 * m.share_above_10pct);
     EXPECT_LT(m.mae, 0.02) << t;
   }
 }
@@ -238,8 +240,8 @@ TEST_F(SoftShadowTest, PenumbraeWidenWithReceiverDistance) {
     EXPECT_NEAR(expected[i], 0.687 * 4 * std::tan(glm::radians(3.0)) * heights[i], 0.01) << "h = " << heights[i];
   Renderer renderer(ctx(), scene);
   for (std::string t : {"mssm4", "mssm6", "vssm", "pcss", "msm-hamburger-64"}) {
-    std::vector<double> got =
-        penumbra_widths(scene, renderer.render(soft_settings(t, width, height, 6.0f)).shadow.channel("visibility"), heights);
+    std::vector<double> got = penumbra_widths(
+        scene, renderer.render(soft_settings(t, width, height, 6.0f)).shadow.channel("visibility"), heights);
     fmt::print("penumbra width (m) at h = 0.4, 0.8, 1.2, 1.6: {:<16} {:.3f} {:.3f} {:.3f} {:.3f}\n", t, got[0], got[1],
                got[2], got[3]);
     if (t == "msm-hamburger-64") {
@@ -252,8 +254,10 @@ TEST_F(SoftShadowTest, PenumbraeWidenWithReceiverDistance) {
     // (~0.3 m here) caps its penumbra: at h = 1.6 it falls short by more than 10% (JCGT's reason
     // for a 27² search), so it is held to the tolerance up to h = 1.2 only.
     bool pcss = t == "pcss";
-    if (!pcss) EXPECT_GT(got[3], 3.0 * got[0]) << t;
-    else EXPECT_GT(got[2], 2.0 * got[0]) << t;
+    if (!pcss)
+      EXPECT_GT(got[3], 3.0 * got[0]) << t;
+    else
+      EXPECT_GT(got[2], 2.0 * got[0]) << t;
     for (size_t i = 0; i < heights.size(); ++i) {
       if (pcss && heights[i] > 1.3) {
         EXPECT_LT(got[i], 0.9 * expected[i]) << "pcss at h = " << heights[i];

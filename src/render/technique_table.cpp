@@ -1,15 +1,15 @@
 // The renderer's techniques: names, storage formats and the meaning of their parameters; the
 // per-texel math is msm/techniques.h. Settings validation lives here too (it needs the table).
-#include "msm/render/renderer.h"
 #include "msm/cpu/techniques.h"
+#include "msm/render/renderer.h"
 #include "msm/techniques.h"
 
 #include <vulkan/vulkan.h>
 
 #include <cmath>
+#include <fmt/format.h>
 #include <stdexcept>
 #include <vector>
-#include <fmt/format.h>
 
 namespace msm::render {
 namespace {
@@ -35,11 +35,19 @@ struct Row {
 };
 
 const Row kRows[] = {
-    {MSM_TECH_PLAIN, {kNone, kNone}, "", "plain",
-     "Shadow map, one depth comparison per fragment (receiver plane at the texel centre)", 16},
-    {MSM_TECH_PCF, {kNone, kNone}, "", "pcf",
+    {MSM_TECH_PLAIN,
+     {kNone, kNone},
+     "",
+     "plain",
+     "Shadow map, one depth comparison per fragment (receiver plane at the texel centre)",
+     16},
+    {MSM_TECH_PCF,
+     {kNone, kNone},
+     "",
+     "pcf",
      "PCF with the Gaussian kernel of the blur (taps x taps, sigma), bilinear, every MSAA sample: the reference for "
-     "filtered hard shadows (2015)", 16},
+     "filtered hard shadows (2015)",
+     16},
     {MSM_TECH_VSM32, {VK_FORMAT_R16G16_UNORM, kNone}, kVsm},
     {MSM_TECH_VSM64, {VK_FORMAT_R32G32_SFLOAT, kNone}, kVsm},
     {MSM_TECH_ESM32, {VK_FORMAT_R32_SFLOAT, kNone}, kEsm},
@@ -59,19 +67,35 @@ const Row kRows[] = {
     {MSM_TECH_MSM6_192, {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kMoment},
     {MSM_TECH_MSM6_96, {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM}, kMoment},
     {MSM_TECH_NL64, {VK_FORMAT_R16G16B16A16_UNORM, kNone}, ""},
-    {MSM_TECH_MSSM4, {VK_FORMAT_R32G32B32A32_SFLOAT, kNone}, kSoftMoments, "mssm4",
+    {MSM_TECH_MSSM4,
+     {VK_FORMAT_R32G32B32A32_SFLOAT, kNone},
+     kSoftMoments,
+     "mssm4",
      "Moment soft shadow mapping (JCGT §4): Θ4* moments in a 32-bit integer summed-area table, blocker search, "
-     "nine-region filter over the penumbra of a directional area light (--light-extent)", 128},
+     "nine-region filter over the penumbra of a directional area light (--light-extent)",
+     128},
     {MSM_TECH_NL32, {VK_FORMAT_R32_UINT, kNone}, ""},
-    {MSM_TECH_MSSM6, {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT}, kSoftMoments, "mssm6",
+    {MSM_TECH_MSSM6,
+     {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT},
+     kSoftMoments,
+     "mssm6",
      "Moment soft shadows with six moments (Kneiphof §4.2): Θ6* in two 32-bit integer summed-area tables, "
-     "upper-bound blocker depth (Eq. 19, clamp [δ1, δ2]), nine-region filter", 192},
-    {MSM_TECH_VSSM, {VK_FORMAT_R32G32_SFLOAT, kNone}, "w: minimum variance", "vssm",
+     "upper-bound blocker depth (Eq. 19, clamp [δ1, δ2]), nine-region filter",
+     192},
+    {MSM_TECH_VSSM,
+     {VK_FORMAT_R32G32_SFLOAT, kNone},
+     "w: minimum variance",
+     "vssm",
      "Naive variance soft shadow mapping (Yang et al. 2010): the mssm4 pipeline with two moments (z, z²), "
-     "Chebyshev blocker estimate and filter (the baseline of JCGT §4)", 64},
-    {MSM_TECH_PCSS, {kNone, kNone}, "", "pcss",
+     "Chebyshev blocker estimate and filter (the baseline of JCGT §4)",
+     64},
+    {MSM_TECH_PCSS,
+     {kNone, kNone},
+     "",
+     "pcss",
      "Percentage-closer soft shadows (Fernando 2005): every texel of a search region up to 15², then PCF over "
-     "the penumbra, every MSAA sample against the receiver plane (the baseline of JCGT §4)", 16},
+     "the penumbra, every MSAA sample against the receiver plane (the baseline of JCGT §4)",
+     16},
 };
 
 std::vector<Technique> build_table() {
@@ -153,7 +177,8 @@ void RenderSettings::validate() const {
   range("filter size", filter_size, 1, kMaxFilterTaps);
   if (filter_size % 2 == 0) throw RenderError(fmt::format("filter size = {} must be odd", filter_size));
   auto finite = [](std::string_view what, float v, float lo, float hi) {
-    if (!std::isfinite(v) || v < lo || v > hi) throw RenderError(fmt::format("{} = {} is outside [{}, {}]", what, v, lo, hi));
+    if (!std::isfinite(v) || v < lo || v > hi)
+      throw RenderError(fmt::format("{} = {} is outside [{}, {}]", what, v, lo, hi));
   };
   finite("filter sigma", filter_sigma, 1e-3f, 1e3f);
   finite("over-darkening factor", overdarken, 0.5f, 1.0f);
@@ -169,14 +194,16 @@ void RenderSettings::validate() const {
     throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
   if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
   if (soft_kernel != 0) {
-    if (t.id == MSM_TECH_PCSS) range("soft kernel", soft_kernel, 3, kMaxPcssKernel);
-    else range("soft kernel", soft_kernel, 3, 255);
+    if (t.id == MSM_TECH_PCSS)
+      range("soft kernel", soft_kernel, 3, kMaxPcssKernel);
+    else
+      range("soft kernel", soft_kernel, 3, 255);
   }
   if (uses_one_pass && (t.formats[0] == 0 || t.formats[1] != 0))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
   if (uses_one_pass && filter_size > kMaxOnePassTaps)
-    throw RenderError(fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size,
-                                  kMaxOnePassTaps));
+    throw RenderError(
+        fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size, kMaxOnePassTaps));
   if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
   finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
   if (params) {
@@ -185,8 +212,8 @@ void RenderSettings::validate() const {
     const glm::vec4& p = *params;
     // The blocker estimators divide by δ1 + (blocker mass) and VSSM by the variance.
     if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
-      throw RenderError(fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique,
-                                    p.x, p.y));
+      throw RenderError(
+          fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
     if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
       throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
   }

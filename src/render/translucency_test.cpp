@@ -30,7 +30,8 @@ scene::Scene stack(int k, float alpha) {
   std::string json = fmt::format(R"({{ "msm_scene": 1, "name": "stack",
       "camera": {{ "position": [0, 6, 3], "target": [0, 0, 0], "fov_y_deg": 40 }},
       "light": {{ "towards_light": [0, 1, 0] }},
-      "objects": [ {} ] }})", objects);
+      "objects": [ {} ] }})",
+                                 objects);
   return scene::load_scene_json(json, ".", "stack");
 }
 
@@ -94,9 +95,7 @@ TEST_F(TranslucencyTest, StackOfPlanesTransmitsAsTheRayTracerSays) {
       } else if (name == "vsm-32") {
         // Two moments cannot hold k + 1 depths: VSM leaks (measured 0.018 at k = 2, 0.037 at 3).
         EXPECT_NEAR(v, truth, 0.05) << name << ", k = " << k;
-        if (k >= 2) {
-          EXPECT_GT(std::abs(v - truth), msm_error) << "VSM leaks more than MSM";
-        }
+        if (k >= 2) { EXPECT_GT(std::abs(v - truth), msm_error) << "VSM leaks more than MSM"; }
       } else {
         // Four moments: within 0.01 (measured <= 0.002 for MSM up to k = 3).
         EXPECT_NEAR(v, truth, 0.01) << name << ", k = " << k;
@@ -128,7 +127,8 @@ TEST_F(TranslucencyTest, ColouredGlassCastsColouredShadows) {
   rs.height = 72;
   reference::Result truth = reference::render(scene, rs);
   for (int c = 0; c < 3; ++c)
-    EXPECT_NEAR(centre_visibility(truth.visibility_rgb.channel(std::string("visibility_") + "rgb"[c])), expected[c], 1e-5)
+    EXPECT_NEAR(centre_visibility(truth.visibility_rgb.channel(std::string("visibility_") + "rgb"[c])), expected[c],
+                1e-5)
         << "the ray tracer, channel " << c;
   Renderer renderer(ctx(), scene);
   for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "evsm4-64", "vsm-32"}) {
@@ -139,8 +139,8 @@ TEST_F(TranslucencyTest, ColouredGlassCastsColouredShadows) {
     for (int c = 0; c < 3; ++c) got[c] = centre_visibility(r.shadow_rgb.channel(std::string("visibility_") + "rgb"[c]));
     s.coloured_translucency = false;
     double grey = centre_visibility(renderer.render(s).shadow);
-    fmt::print("coloured glass: {:<18} visibility ({:.4f}, {:.4f}, {:.4f}), ray traced (0.5, 0.2, 0.4); grey {:.4f}\n", t,
-               got.r, got.g, got.b, grey);
+    fmt::print("coloured glass: {:<18} visibility ({:.4f}, {:.4f}, {:.4f}), ray traced (0.5, 0.2, 0.4); grey {:.4f}\n",
+               t, got.r, got.g, got.b, grey);
     // Two layers per channel (at most one of them translucent in red and blue): four moments hold
     // them (measured <= 0.002); VSM leaks as on the grey stacks (0.05).
     double tolerance = std::string(t) == "vsm-32" ? 0.05 : 0.01;
@@ -231,11 +231,12 @@ TEST_F(TranslucencyTest, SmokeScene) {
   for (const char* t : {"msm-hamburger-64", "msm-hamburger-128", "msm-hausdorff-64", "vsm-32", "vsm-64", "evsm4-64",
                         "evsm4-128", "pcf"}) {
     for (float bias : {1.0f, 0.0f}) {
-      image::Metrics r =
-          image::compute_metrics(renderer.render(scene_settings(t, bias)).shadow.channel("visibility"), reference, {.mask = &mask});
+      image::Metrics r = image::compute_metrics(renderer.render(scene_settings(t, bias)).shadow.channel("visibility"),
+                                                reference, {.mask = &mask});
       (bias > 0.0f ? m : off)[t] = r;
-      fmt::print("smoke {:<18} receiver-plane bias {}: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >10% {:.2f}%\n",
-                 t, bias, r.mae, r.light_leaking, r.over_darkening, 100 * r.share_above_10pct);
+      fmt::print(
+          "smoke {:<18} receiver-plane bias {}: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}, >10% {:.2f}%\n", t,
+          bias, r.mae, r.light_leaking, r.over_darkening, 100 * r.share_above_10pct);
     }
   }
   // Measured: MSM 64 MAE 0.025 against 0.032 (VSM) and 0.031 (EVSM4-64); leaking 0.021 against

@@ -8,7 +8,7 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
-#define STB_IMAGE_STATIC  // private copy: no clash with a libstb linked by the application
+#define STB_IMAGE_STATIC // private copy: no clash with a libstb linked by the application
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
 
@@ -26,16 +26,15 @@ void check_regular_file(const std::filesystem::path& file, const char* what) {
     throw SceneError(file.string(), "", fmt::format("{} path is not a regular file", what));
 }
 
-}  // namespace
+} // namespace
 
 Mesh import_mesh(const std::filesystem::path& file) {
   check_regular_file(file, "mesh");
   Assimp::Importer importer;
   // Points and lines are removed; only triangles are kept.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                         aiProcess_PreTransformVertices | aiProcess_GenSmoothNormals |
-                         aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
+                         aiProcess_GenSmoothNormals | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
   const aiScene* s = importer.ReadFile(file.string(), flags);
   if (!s || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !s->mRootNode)
     throw SceneError(file.string(), "", fmt::format("Assimp cannot read the mesh: {}", importer.GetErrorString()));
@@ -61,9 +60,7 @@ Mesh import_mesh(const std::filesystem::path& file) {
   if (m.indices.empty()) throw SceneError(file.string(), "", "the mesh file contains no triangles");
   try {
     detail::finalize_mesh(m, "");
-  } catch (const SceneError& e) {
-    throw SceneError(file.string(), "", e.problem());
-  }
+  } catch (const SceneError& e) { throw SceneError(file.string(), "", e.problem()); }
   return m;
 }
 
@@ -80,7 +77,7 @@ Image load_texture(const std::filesystem::path& file) {
   return img;
 }
 
-}  // namespace msm::scene
+} // namespace msm::scene
 
 namespace msm::scene {
 
@@ -130,7 +127,8 @@ float value_noise(std::uint32_t seed, float x, float y) {
   int i = int(std::floor(x)), j = int(std::floor(y));
   float fx = x - float(i), fy = y - float(j);
   float sx = fx * fx * (3 - 2 * fx), sy = fy * fy * (3 - 2 * fy);
-  float a = lattice(seed, i, j), b = lattice(seed, i + 1, j), c = lattice(seed, i, j + 1), d = lattice(seed, i + 1, j + 1);
+  float a = lattice(seed, i, j), b = lattice(seed, i + 1, j), c = lattice(seed, i, j + 1),
+        d = lattice(seed, i + 1, j + 1);
   return (1 - sy) * ((1 - sx) * a + sx * b) + sy * ((1 - sx) * c + sx * d);
 }
 

@@ -14,4 +14,4 @@ void finalize_mesh(Mesh& mesh, const std::string& where);
 // Flips triangles [first_triangle, end) whose winding disagrees with their vertex normals.
 void fix_winding(Mesh& mesh, std::size_t first_triangle);
 
-}  // namespace msm::scene::detail
+} // namespace msm::scene::detail

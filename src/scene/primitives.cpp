@@ -25,8 +25,8 @@ void check_count(const char* what, int v, int min) {
 
 void check_triangles(std::size_t n) {
   if (n > kMaxPrimitiveTriangles)
-    throw SceneError("", "", fmt::format("would have {} triangles, more than the cap of {}", n,
-                                         kMaxPrimitiveTriangles));
+    throw SceneError("", "",
+                     fmt::format("would have {} triangles, more than the cap of {}", n, kMaxPrimitiveTriangles));
 }
 
 std::uint32_t add_vertex(Mesh& m, glm::vec3 p, glm::vec3 n, glm::vec2 uv) {
@@ -64,11 +64,12 @@ void add_grid(Mesh& m, int nu, int nv, F&& f) {
 
 void add_box(Mesh& m, glm::vec3 lo, glm::vec3 hi) {
   const glm::vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
-  struct Face { glm::vec3 n, u, v; };
-  static const Face faces[6] = {
-      {{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-      {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-      {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}}};
+  struct Face {
+    glm::vec3 n, u, v;
+  };
+  static const Face faces[6] = {{{1, 0, 0}, {0, 0, -1}, {0, 1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+                                {{0, 1, 0}, {1, 0, 0}, {0, 0, -1}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+                                {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, 1, 0}}};
   static const glm::vec2 corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
   for (const Face& f : faces) {
     const glm::vec3 pn = f.n * glm::dot(glm::abs(f.n), h);
@@ -81,7 +82,7 @@ void add_box(Mesh& m, glm::vec3 lo, glm::vec3 hi) {
   }
 }
 
-}  // namespace
+} // namespace
 
 namespace detail {
 
@@ -116,7 +117,7 @@ void finalize_mesh(Mesh& m, const std::string& where) {
     const glm::dvec3 a(m.positions[i[0]]), b(m.positions[i[1]]), c(m.positions[i[2]]);
     const double cross = glm::length(glm::cross(b - a, c - a));
     const double edge2 = std::max({glm::dot(b - a, b - a), glm::dot(c - a, c - a), glm::dot(c - b, c - b)});
-    if (!(cross > 1e-10 * edge2) || edge2 == 0.0) continue;  // degenerate: dropped
+    if (!(cross > 1e-10 * edge2) || edge2 == 0.0) continue; // degenerate: dropped
     for (int k = 0; k < 3; ++k) m.indices[3 * kept + k] = i[k];
     ++kept;
   }
@@ -124,7 +125,7 @@ void finalize_mesh(Mesh& m, const std::string& where) {
   if (kept == 0) throw SceneError("", where, "the mesh has no triangles with a non-zero area");
 }
 
-}  // namespace detail
+} // namespace detail
 
 Mesh make_plane(glm::vec2 size, glm::ivec2 sub) {
   check_size("size", size.x);
@@ -167,7 +168,7 @@ Mesh make_sphere(float radius, int segments, int rings) {
     p = radius * n;
     uv = {float(i) / segments, float(j) / rings};
   });
-  detail::finalize_mesh(m, "sphere");  // drops the degenerate half of each pole quad
+  detail::finalize_mesh(m, "sphere"); // drops the degenerate half of each pole quad
   return m;
 }
 
@@ -205,8 +206,7 @@ Mesh make_cylinder(float radius, float height, int segments, bool caps) {
   return m;
 }
 
-Mesh make_fence(float length, float height, int bars, float bar_width, float bar_depth, int rails,
-                float rail_height) {
+Mesh make_fence(float length, float height, int bars, float bar_width, float bar_depth, int rails, float rail_height) {
   check_size("length", length);
   check_size("height", height);
   check_size("bar_width", bar_width);
@@ -264,7 +264,7 @@ Mesh make_torus_knot(int p, int q, float radius, float tube_radius, int segments
     glm::vec3 b = glm::normalize(glm::cross(t, p2 + p1));
     const glm::vec3 nn = glm::normalize(glm::cross(b, t));
     const float v = float(i % tube_segments) / tube_segments * 2.0f * kPi;
-    n = -std::cos(v) * nn + std::sin(v) * b;  // outward from the tube's centre line
+    n = -std::cos(v) * nn + std::sin(v) * b; // outward from the tube's centre line
     pos = p1 + tube_radius * n;
     uv = {float(i) / tube_segments, float(j) / segments};
   });
@@ -313,7 +313,8 @@ Mesh make_brick_wall(int rows, int columns, float brick_length, float brick_heig
 double Mesh::area() const {
   double a = 0.0;
   for (std::size_t t = 0; t < triangle_count(); ++t) {
-    const glm::dvec3 p0(positions[indices[3 * t]]), p1(positions[indices[3 * t + 1]]), p2(positions[indices[3 * t + 2]]);
+    const glm::dvec3 p0(positions[indices[3 * t]]), p1(positions[indices[3 * t + 1]]),
+        p2(positions[indices[3 * t + 2]]);
     a += 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
   }
   return a;
@@ -325,4 +326,4 @@ Bounds Mesh::bounds() const {
   return b;
 }
 
-}  // namespace msm::scene
+} // namespace msm::scene

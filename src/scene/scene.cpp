@@ -41,14 +41,14 @@ glm::mat4 flip_y(const glm::mat4& p) {
 }
 
 class Parser {
-public:
+ public:
   Parser(std::string file, fs::path base) : file_(file.empty() ? "<json>" : std::move(file)), base_(std::move(base)) {}
 
   Scene parse(std::string_view text) {
     json root;
     try {
       root = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
-    } catch (const json::exception& e) {  // parse_error, out_of_range (number overflow), ...
+    } catch (const json::exception& e) { // parse_error, out_of_range (number overflow), ...
       fail("", fmt::format("malformed JSON: {}", e.what()));
     }
     keys(root, "", {"msm_scene", "name", "camera", "light", "shadow_map", "materials", "objects"});
@@ -80,16 +80,17 @@ public:
     const json* objs = find(root, "objects");
     if (!objs) fail("/objects", "required key missing");
     if (!objs->is_array() || objs->empty()) fail("/objects", "must be a non-empty array");
-    for (std::size_t i = 0; i < objs->size(); ++i) s.objects.push_back(object((*objs)[i], fmt::format("/objects/{}", i), i, s));
+    for (std::size_t i = 0; i < objs->size(); ++i)
+      s.objects.push_back(object((*objs)[i], fmt::format("/objects/{}", i), i, s));
     return s;
   }
 
-private:
+ private:
   [[noreturn]] void fail(const std::string& where, const std::string& problem) const {
     throw SceneError(file_, where, problem);
   }
 
-  static std::string escape(const std::string& key) {  // JSON pointer escaping
+  static std::string escape(const std::string& key) { // JSON pointer escaping
     std::string r;
     for (char c : key) r += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
     return r;
@@ -127,7 +128,8 @@ private:
   float number_in(const json& v, const std::string& ptr, float lo, float hi, bool open_lo, bool open_hi) const {
     const float x = number(v, ptr);
     if ((open_lo ? x <= lo : x < lo) || (open_hi ? x >= hi : x > hi))
-      fail(ptr, fmt::format("must be in {}{:g}, {:g}{} (got {:g})", open_lo ? '(' : '[', lo, hi, open_hi ? ')' : ']', x));
+      fail(ptr,
+           fmt::format("must be in {}{:g}, {:g}{} (got {:g})", open_lo ? '(' : '[', lo, hi, open_hi ? ')' : ']', x));
     return x;
   }
 
@@ -166,7 +168,8 @@ private:
     if (!(c.far > c.near)) fail(ptr + "/far", "must be greater than near");
     const glm::vec3 view = c.target - c.position;
     if (!(glm::length(view) > 0.0f)) fail(ptr + "/target", "must differ from position");
-    if (!(glm::length(glm::cross(glm::normalize(view), c.up)) > 1e-4f)) fail(ptr + "/up", "must not be parallel to the view direction");
+    if (!(glm::length(glm::cross(glm::normalize(view), c.up)) > 1e-4f))
+      fail(ptr + "/up", "must not be parallel to the view direction");
     return c;
   }
 
@@ -195,7 +198,7 @@ private:
       return f;
     }
     if (mode != "explicit") fail(ptr + "/framing", fmt::format("unknown framing '{}' (fit, explicit)", mode));
-    f.mode = ShadowFraming::Mode::Explicit;
+    f.mode = ShadowFraming::Mode::given;
     for (const char* k : {"center", "extent", "depth_range"})
       if (!find(j, k)) fail(ptr + "/" + k, "required with \"framing\": \"explicit\"");
     f.center = vec<3>(*find(j, "center"), ptr + "/center");
@@ -210,13 +213,15 @@ private:
     if (rel.empty()) fail(ptr, "empty path");
     const fs::path p = (base_ / fs::path(rel)).lexically_normal();
     std::error_code ec;
-    if (!fs::is_regular_file(p, ec)) fail(ptr, fmt::format("{} file '{}' does not exist or is not a file", what, p.string()));
+    if (!fs::is_regular_file(p, ec))
+      fail(ptr, fmt::format("{} file '{}' does not exist or is not a file", what, p.string()));
     return p;
   }
 
   Material material(const json& j, const std::string& ptr) const {
-    keys(j, ptr, {"albedo", "albedo_texture", "opacity", "opacity_texture", "opacity_noise", "transmission_color",
-                  "double_sided"});
+    keys(j, ptr,
+         {"albedo", "albedo_texture", "opacity", "opacity_texture", "opacity_noise", "transmission_color",
+          "double_sided"});
     Material m;
     if (const json* v = find(j, "albedo")) {
       m.albedo = vec<3>(*v, ptr + "/albedo");
@@ -233,7 +238,8 @@ private:
       if (!m.opacity_texture.empty()) fail(q, "give either opacity_texture or opacity_noise, not both");
       keys(*v, q, {"seed", "scale", "octaves", "density", "softness"});
       SmokeNoise n;
-      if (const json* x = find(*v, "seed")) n.seed = std::uint32_t(number_in(*x, q + "/seed", 0.0f, 1e9f, false, false));
+      if (const json* x = find(*v, "seed"))
+        n.seed = std::uint32_t(number_in(*x, q + "/seed", 0.0f, 1e9f, false, false));
       if (const json* x = find(*v, "scale")) n.scale = number_in(*x, q + "/scale", 0.0f, 64.0f, true, false);
       if (const json* x = find(*v, "octaves")) n.octaves = int(number_in(*x, q + "/octaves", 1.0f, 8.0f, false, false));
       if (const json* x = find(*v, "density")) n.density = number_in(*x, q + "/density", 0.0f, 1.0f, false, false);
@@ -243,7 +249,8 @@ private:
     if (const json* v = find(j, "transmission_color")) {
       const std::string q = ptr + "/transmission_color";
       if (!v->is_array() || v->size() != 3) fail(q, "must be an array of 3 numbers (r, g, b)");
-      for (int c = 0; c < 3; ++c) m.transmission_color[c] = number_in((*v)[c], fmt::format("{}/{}", q, c), 0.0f, 1.0f, false, false);
+      for (int c = 0; c < 3; ++c)
+        m.transmission_color[c] = number_in((*v)[c], fmt::format("{}/{}", q, c), 0.0f, 1.0f, false, false);
     }
     if (const json* v = find(j, "double_sided")) m.double_sided = boolean(*v, ptr + "/double_sided");
     return m;
@@ -261,11 +268,13 @@ private:
       glm::mat4 r(1.0f);
       if (v->is_array()) {
         const glm::vec3 e = glm::radians(vec<3>(*v, ptr + "/rotate"));
-        r = glm::rotate(glm::mat4(1.0f), e.z, glm::vec3(0, 0, 1)) * glm::rotate(glm::mat4(1.0f), e.y, glm::vec3(0, 1, 0)) *
+        r = glm::rotate(glm::mat4(1.0f), e.z, glm::vec3(0, 0, 1)) *
+            glm::rotate(glm::mat4(1.0f), e.y, glm::vec3(0, 1, 0)) *
             glm::rotate(glm::mat4(1.0f), e.x, glm::vec3(1, 0, 0));
       } else if (v->is_object()) {
         keys(*v, ptr + "/rotate", {"axis", "angle_deg"});
-        if (!find(*v, "axis") || !find(*v, "angle_deg")) fail(ptr + "/rotate", "axis-angle needs \"axis\" and \"angle_deg\"");
+        if (!find(*v, "axis") || !find(*v, "angle_deg"))
+          fail(ptr + "/rotate", "axis-angle needs \"axis\" and \"angle_deg\"");
         const glm::vec3 axis = direction(*find(*v, "axis"), ptr + "/rotate/axis");
         r = glm::rotate(glm::mat4(1.0f), glm::radians(number(*find(*v, "angle_deg"), ptr + "/rotate/angle_deg")), axis);
       } else {
@@ -277,7 +286,8 @@ private:
       t.scale = v->is_array() ? vec<3>(*v, ptr + "/scale") : glm::vec3(number(*v, ptr + "/scale"));
       for (int i = 0; i < 3; ++i)
         if (!(t.scale[i] > 0.0f) || t.scale[i] > kMaxSize)
-          fail(ptr + "/scale", fmt::format("must be > 0 and <= {:g} (got {:g}); mirroring is not supported", kMaxSize, t.scale[i]));
+          fail(ptr + "/scale",
+               fmt::format("must be > 0 and <= {:g} (got {:g}); mirroring is not supported", kMaxSize, t.scale[i]));
     }
     return t;
   }
@@ -285,10 +295,17 @@ private:
   Mesh primitive(const json& j, const std::string& ptr, std::string& type) const {
     if (!j.is_object()) fail(ptr, "must be an object with a \"type\"");
     const json* tj = find(j, "type");
-    if (!tj) fail(ptr + "/type", "required key missing (plane, box, sphere, cylinder, fence, stair, torus_knot, brick_wall)");
+    if (!tj)
+      fail(ptr + "/type", "required key missing (plane, box, sphere, cylinder, fence, stair, torus_knot, brick_wall)");
     type = string(*tj, ptr + "/type");
-    auto num = [&](const char* k, float def) { const json* v = find(j, k); return v ? number(*v, ptr + "/" + k) : def; };
-    auto intg = [&](const char* k, int def) { const json* v = find(j, k); return v ? integer(*v, ptr + "/" + k) : def; };
+    auto num = [&](const char* k, float def) {
+      const json* v = find(j, k);
+      return v ? number(*v, ptr + "/" + k) : def;
+    };
+    auto intg = [&](const char* k, int def) {
+      const json* v = find(j, k);
+      return v ? integer(*v, ptr + "/" + k) : def;
+    };
     try {
       if (type == "plane") {
         keys(j, ptr, {"type", "size", "subdivisions"});
@@ -334,10 +351,12 @@ private:
                                num("thickness", 0.2f));
       }
     } catch (const SceneError& e) {
-      if (!e.file().empty()) throw;  // already complete (from this parser)
+      if (!e.file().empty()) throw; // already complete (from this parser)
       fail(e.where().empty() ? ptr : ptr + "/" + e.where(), e.problem());
     }
-    fail(ptr + "/type", fmt::format("unknown primitive '{}' (plane, box, sphere, cylinder, fence, stair, torus_knot, brick_wall)", type));
+    fail(ptr + "/type",
+         fmt::format("unknown primitive '{}' (plane, box, sphere, cylinder, fence, stair, torus_knot, brick_wall)",
+                     type));
   }
 
   Object object(const json& j, const std::string& ptr, std::size_t index, Scene& s) const {
@@ -380,9 +399,7 @@ private:
       }
       try {
         detail::finalize_mesh(m, "");
-      } catch (const SceneError& e) {
-        fail(ptr, "after the transform: " + e.problem());
-      }
+      } catch (const SceneError& e) { fail(ptr, "after the transform: " + e.problem()); }
       o.mesh = std::move(m);
       o.bounds = o.mesh.bounds();
     } catch (const SceneError& e) {
@@ -397,7 +414,7 @@ private:
   std::map<std::string, std::uint32_t> named_;
 };
 
-}  // namespace
+} // namespace
 
 SceneError::SceneError(std::string file, std::string where, std::string problem)
     : std::runtime_error(compose(file, where, problem)), file_(std::move(file)), where_(std::move(where)),
@@ -436,12 +453,13 @@ glm::mat4 Scene::light_view() const {
   const glm::vec3 d = light.travel();
   const glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
   const Bounds b = bounds();
-  const glm::vec3 c = shadow.mode == ShadowFraming::Mode::Explicit ? shadow.center : (b.empty() ? glm::vec3(0.0f) : b.center());
+  const glm::vec3 c =
+      shadow.mode == ShadowFraming::Mode::given ? shadow.center : (b.empty() ? glm::vec3(0.0f) : b.center());
   return glm::lookAtRH(c, c + d, up);
 }
 
 glm::mat4 Scene::light_projection() const {
-  if (shadow.mode == ShadowFraming::Mode::Explicit) {
+  if (shadow.mode == ShadowFraming::Mode::given) {
     const glm::vec2 h = 0.5f * shadow.extent;
     return flip_y(glm::orthoRH_ZO(-h.x, h.x, -h.y, h.y, shadow.depth_range.x, shadow.depth_range.y));
   }
@@ -465,14 +483,16 @@ glm::mat4 Scene::light_projection() const {
   return flip_y(glm::orthoRH_ZO(lo.x, hi.x, lo.y, hi.y, -hi.z, -lo.z));
 }
 
-Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir, const std::string& source_name) {
+Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir,
+                      const std::string& source_name) {
   return Parser(source_name, base_dir).parse(json_text);
 }
 
 Scene load_scene_file(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw SceneError(file.string(), "", "scene file does not exist");
-  if (!std::filesystem::is_regular_file(file, ec)) throw SceneError(file.string(), "", "scene path is not a regular file");
+  if (!std::filesystem::is_regular_file(file, ec))
+    throw SceneError(file.string(), "", "scene path is not a regular file");
   const auto size = std::filesystem::file_size(file, ec);
   if (ec || size > (64u << 20)) throw SceneError(file.string(), "", "scene file unreadable or larger than 64 MiB");
   std::ifstream in(file, std::ios::binary);
@@ -495,7 +515,8 @@ std::string_view default_scene_name() { return "fence"; }
 std::string_view builtin_scene_json(std::string_view name) {
   for (const BuiltinScene& b : kBuiltinScenes)
     if (b.name == name) return b.json;
-  throw SceneError("", "", fmt::format("unknown built-in scene '{}' (known: {})", name, fmt::join(builtin_scene_names(), ", ")));
+  throw SceneError(
+      "", "", fmt::format("unknown built-in scene '{}' (known: {})", name, fmt::join(builtin_scene_names(), ", ")));
 }
 
 Scene builtin_scene(std::string_view name) {
@@ -510,8 +531,9 @@ Scene load_scene(std::string_view name_or_path) {
   std::error_code ec;
   if (!std::filesystem::exists(p, ec))
     throw SceneError(std::string(name_or_path), "",
-                     fmt::format("neither a built-in scene ({}) nor an existing scene file", fmt::join(builtin_scene_names(), ", ")));
+                     fmt::format("neither a built-in scene ({}) nor an existing scene file",
+                                 fmt::join(builtin_scene_names(), ", ")));
   return load_scene_file(p);
 }
 
-}  // namespace msm::scene
+} // namespace msm::scene

@@ -21,7 +21,7 @@ constexpr double kPi = std::numbers::pi;
 
 // A fresh temporary directory per test.
 class TempDir {
-public:
+ public:
   TempDir() {
     std::random_device rd;
     path_ = fs::temp_directory_path() / ("msm_scene_test_" + std::to_string(rd()) + std::to_string(rd()));
@@ -38,14 +38,15 @@ public:
     return p;
   }
 
-private:
+ private:
   fs::path path_;
 };
 
 double signed_volume(const Mesh& m) {
   double v = 0.0;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]), c(m.positions[m.indices[3 * t + 2]]);
+    const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+        c(m.positions[m.indices[3 * t + 2]]);
     v += glm::dot(a, glm::cross(b, c)) / 6.0;
   }
   return v;
@@ -77,17 +78,16 @@ void expect_error(F&& f, std::initializer_list<std::string> fragments) {
     ADD_FAILURE() << "no SceneError thrown (expected one mentioning '" << *fragments.begin() << "')";
   } catch (const SceneError& e) {
     const std::string what = e.what();
-    for (const std::string& frag : fragments) EXPECT_NE(what.find(frag), std::string::npos) << "'" << frag << "' not in: " << what;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "not a SceneError: " << e.what();
-  }
+    for (const std::string& frag : fragments)
+      EXPECT_NE(what.find(frag), std::string::npos) << "'" << frag << "' not in: " << what;
+  } catch (const std::exception& e) { ADD_FAILURE() << "not a SceneError: " << e.what(); }
 }
 
 void expect_json_error(const std::string& json, std::initializer_list<std::string> fragments) {
   expect_error([&] { load_scene_json(json, fs::current_path(), "test.json"); }, fragments);
 }
 
-}  // namespace
+} // namespace
 
 // ---------------------------------------------------------------------------------------------
 // Built-in scenes
@@ -109,7 +109,7 @@ TEST(BuiltinScenes, LoadWithSaneBoundsAndCounts) {
     EXPECT_LT(s.triangle_count(), 200000u);
     const Bounds b = s.bounds();
     ASSERT_FALSE(b.empty());
-    EXPECT_NEAR(b.min.y, 0.0f, 1e-5f);  // everything stands on the ground plane y = 0
+    EXPECT_NEAR(b.min.y, 0.0f, 1e-5f); // everything stands on the ground plane y = 0
     EXPECT_GT(b.max.y, 0.5f);
     EXPECT_LT(glm::length(b.size()), 100.0f);
     for (const Object& o : s.objects) {
@@ -138,7 +138,7 @@ TEST(BuiltinScenes, JsonFilesLoadToTheBuiltins) {
     }
     EXPECT_EQ(a.camera.position, b.camera.position);
     EXPECT_EQ(a.light.towards_light, b.light.towards_light);
-    EXPECT_EQ(load_scene(name).triangle_count(), a.triangle_count());  // by name
+    EXPECT_EQ(load_scene(name).triangle_count(), a.triangle_count()); // by name
   }
 }
 
@@ -196,7 +196,7 @@ TEST(BuiltinScenes, SoftShadowScenes) {
   EXPECT_EQ(high.primitive, "torus_knot");
   EXPECT_EQ(low.primitive, "torus_knot");
   EXPECT_GT(high.bounds.min.y, 1.0f);
-  EXPECT_GT(low.bounds.min.y, 0.01f);  // hovering, not intersecting the ground
+  EXPECT_GT(low.bounds.min.y, 0.01f); // hovering, not intersecting the ground
   EXPECT_LT(low.bounds.min.y, 0.1f);
   EXPECT_LT(low.bounds.max.y, high.bounds.min.y);
   EXPECT_EQ(models.light.angular_extent_deg, 5.0f);
@@ -223,7 +223,7 @@ TEST(BuiltinScenes, SoftShadowScenes) {
   EXPECT_GT(gap, 0.05f);
   EXPECT_LT(gap, 0.5f);
   EXPECT_GT(pw.light.angular_extent_deg, 0.0f);
-  EXPECT_GT(pw.light.towards_light.z, 0.0f);  // the wall's front faces the light
+  EXPECT_GT(pw.light.towards_light.z, 0.0f); // the wall's front faces the light
   // The pillar's top front corners, moved along the light onto the bricks' front plane, land on
   // the wall: the shadow crosses the bricks.
   const glm::vec3 travel = pw.light.travel();
@@ -272,7 +272,7 @@ TEST(Matrices, LightFrustumContainsAllVerticesWithDepthInUnitRange) {
         zmin = std::min(zmin, c.z);
         zmax = std::max(zmax, c.z);
       }
-    EXPECT_LT(zmin, 1e-4f);  // tight: near plane at the closest vertex
+    EXPECT_LT(zmin, 1e-4f); // tight: near plane at the closest vertex
     EXPECT_GT(zmax, 1.0f - 1e-4f);
     // Points nearer to the light get smaller depths.
     const glm::vec3 c = s.bounds().center();
@@ -282,17 +282,20 @@ TEST(Matrices, LightFrustumContainsAllVerticesWithDepthInUnitRange) {
 }
 
 TEST(Matrices, ExplicitShadowFraming) {
-  const Scene s = load_scene_json(scene_with_object(R"({"primitive": {"type": "box"}})",
-      R"("shadow_map": {"framing": "explicit", "center": [0, 0, 0], "extent": [4, 2], "depth_range": [-5, 5]},)"),
+  const Scene s = load_scene_json(
+      scene_with_object(
+          R"({"primitive": {"type": "box"}})",
+          R"("shadow_map": {"framing": "explicit", "center": [0, 0, 0], "extent": [4, 2], "depth_range": [-5, 5]},)"),
       ".", "explicit.json");
-  const glm::mat4 m = s.light_view_projection();  // light straight down
+  const glm::mat4 m = s.light_view_projection(); // light straight down
   const glm::vec4 c = m * glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
   EXPECT_NEAR(c.z, 0.5f, 1e-6f);
-  EXPECT_NEAR((m * glm::vec4(0.0f, 5.0f, 0.0f, 1.0f)).z, 0.0f, 1e-6f);  // towards the light: near
+  EXPECT_NEAR((m * glm::vec4(0.0f, 5.0f, 0.0f, 1.0f)).z, 0.0f, 1e-6f); // towards the light: near
   EXPECT_NEAR((m * glm::vec4(0.0f, -5.0f, 0.0f, 1.0f)).z, 1.0f, 1e-6f);
   const glm::vec4 edge = m * glm::vec4(2.0f, 0.0f, 0.0f, 1.0f);
   const glm::vec4 edge2 = m * glm::vec4(0.0f, 0.0f, 1.0f, 1.0f);
-  EXPECT_NEAR(std::max(std::abs(edge.x), std::abs(edge.y)) + std::max(std::abs(edge2.x), std::abs(edge2.y)), 2.0f, 1e-5f);
+  EXPECT_NEAR(std::max(std::abs(edge.x), std::abs(edge.y)) + std::max(std::abs(edge2.x), std::abs(edge2.y)), 2.0f,
+              1e-5f);
 }
 
 TEST(Matrices, CameraUsesVulkanClipConventions) {
@@ -305,7 +308,7 @@ TEST(Matrices, CameraUsesVulkanClipConventions) {
   EXPECT_GT(t.z, 0.0f);
   EXPECT_LT(t.z, 1.0f);
   glm::vec4 above = m * glm::vec4(s.camera.target + 0.5f * s.camera.up, 1.0f);
-  EXPECT_LT(above.y / above.w, 0.0f);  // y down in NDC: up in the world is up in the image
+  EXPECT_LT(above.y / above.w, 0.0f); // y down in NDC: up in the world is up in the image
   const glm::vec3 dir = glm::normalize(s.camera.target - s.camera.position);
   glm::vec4 n = m * glm::vec4(s.camera.position + s.camera.near * dir, 1.0f);
   glm::vec4 f = m * glm::vec4(s.camera.position + s.camera.far * dir, 1.0f);
@@ -325,7 +328,7 @@ TEST(Primitives, SphereAreaVolumeAndNormals) {
   EXPECT_NEAR(signed_volume(m) / (4.0 / 3.0 * kPi * r * r * r), 1.0, 0.02);
   for (std::size_t v = 0; v < m.positions.size(); ++v) {
     EXPECT_NEAR(glm::length(m.positions[v]), r, 1e-5f);
-    EXPECT_GT(glm::dot(m.normals[v], m.positions[v]), 0.99f * r);  // outward
+    EXPECT_GT(glm::dot(m.normals[v], m.positions[v]), 0.99f * r); // outward
   }
 }
 
@@ -338,7 +341,7 @@ TEST(Primitives, Box) {
   std::vector<glm::vec3> normals;
   for (const glm::vec3& n : m.normals)
     if (std::find(normals.begin(), normals.end(), n) == normals.end()) normals.push_back(n);
-  EXPECT_EQ(normals.size(), 6u);  // 6 faces
+  EXPECT_EQ(normals.size(), 6u); // 6 faces
   EXPECT_EQ(m.bounds().min, glm::vec3(-0.5f, -1.0f, -1.5f));
   EXPECT_EQ(m.bounds().max, glm::vec3(0.5f, 1.0f, 1.5f));
 }
@@ -374,7 +377,7 @@ TEST(Primitives, CylinderPlaneStairFenceKnot) {
 
   const Mesh k = make_torus_knot(2, 3, 1.0f, 0.1f, 256, 16);
   expect_consistent(k);
-  EXPECT_GT(signed_volume(k), 0.0);  // closed, outward
+  EXPECT_GT(signed_volume(k), 0.0); // closed, outward
 }
 
 // A 3-row, 4-column wall: a mortar core and 4 + 5 + 4 bricks (the middle row shifted by half a
@@ -399,10 +402,13 @@ TEST(Primitives, BrickWall) {
   // is lost or overlaps another; the core's front (z = 0) is covered by bricks except the mortar.
   double front = 0.0, core_front = 0.0;
   for (std::size_t t = 0; t < w.triangle_count(); ++t) {
-    const glm::vec3 p0 = w.positions[w.indices[3 * t]], p1 = w.positions[w.indices[3 * t + 1]], p2 = w.positions[w.indices[3 * t + 2]];
+    const glm::vec3 p0 = w.positions[w.indices[3 * t]], p1 = w.positions[w.indices[3 * t + 1]],
+                    p2 = w.positions[w.indices[3 * t + 2]];
     const double area = 0.5 * glm::length(glm::cross(glm::dvec3(p1 - p0), glm::dvec3(p2 - p0)));
     // Corners are centre +- half size in float: within 1e-6 of the intended planes.
-    const auto on = [&](float z) { return std::abs(p0.z - z) < 1e-6f && std::abs(p1.z - z) < 1e-6f && std::abs(p2.z - z) < 1e-6f; };
+    const auto on = [&](float z) {
+      return std::abs(p0.z - z) < 1e-6f && std::abs(p1.z - z) < 1e-6f && std::abs(p2.z - z) < 1e-6f;
+    };
     if (on(relief)) front += area;
     if (on(0.0f)) core_front += area;
   }
@@ -417,12 +423,12 @@ TEST(Primitives, BrickWall) {
 
 TEST(Primitives, TransformsApply) {
   const Scene s = load_scene_json(scene_with_object(
-      R"({"name": "b", "primitive": {"type": "box", "size": [1, 1, 1]},
+                                      R"({"name": "b", "primitive": {"type": "box", "size": [1, 1, 1]},
           "transform": {"translate": [10, 0, 0], "rotate": [0, 90, 0], "scale": [2, 1, 1]}},
          {"name": "c", "primitive": {"type": "box", "size": [1, 1, 1]},
           "transform": {"translate": [10, 0, 0], "rotate": {"axis": [0, 2, 0], "angle_deg": 90}, "scale": [2, 1, 1]}},
          {"name": "d", "primitive": {"type": "sphere", "radius": 1}, "transform": {"scale": [1, 3, 1]}})"),
-      ".", "t.json");
+                                  ".", "t.json");
   const Bounds b = s.objects[0].bounds;
   EXPECT_NEAR(b.min.x, 9.5f, 1e-5f);
   EXPECT_NEAR(b.max.x, 10.5f, 1e-5f);
@@ -450,9 +456,10 @@ TEST(Import, ObjPlyOffGltf) {
   const fs::path obj = dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\n"
                                           "f 1 2 3 4\nf 5 6 7\n");
   // PLY: a tetrahedron.
-  const fs::path ply = dir.write("m.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-                                          "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
-                                          "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  const fs::path ply =
+      dir.write("m.ply", "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                         "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+                         "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
   // OFF: a cube of 6 quads.
   const fs::path off = dir.write("m.off", "OFF\n8 6 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n"
                                           "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n");
@@ -478,13 +485,14 @@ TEST(Import, ObjPlyOffGltf) {
   EXPECT_NEAR(import_mesh(off).area(), 6.0, 1e-5);
   const Mesh mg = import_mesh(gl);
   EXPECT_EQ(mg.triangle_count(), 1u);
-  EXPECT_NEAR(mg.bounds().min.x, 5.0f, 1e-6f);  // the node transform is applied
+  EXPECT_NEAR(mg.bounds().min.x, 5.0f, 1e-6f); // the node transform is applied
   EXPECT_NEAR(mg.area(), 0.5, 1e-6);
 
   // Through a scene file: path relative to the scene file, then transformed.
   fs::create_directories(dir.path() / "scenes");
-  const fs::path scene = dir.write("scenes/s.json", scene_with_object(
-      R"({"name": "m", "mesh": "../m.obj", "transform": {"translate": [0, 0, 7]}})"));
+  const fs::path scene =
+      dir.write("scenes/s.json",
+                scene_with_object(R"({"name": "m", "mesh": "../m.obj", "transform": {"translate": [0, 0, 7]}})"));
   const Scene s = load_scene_file(scene);
   EXPECT_EQ(s.triangle_count(), 3u);
   EXPECT_NEAR(s.bounds().min.z, 7.0f, 1e-6f);
@@ -522,8 +530,9 @@ TEST(Import, RealModelIfInstalled) {
 TEST(Textures, PathRecordedAndLoadedLazily) {
   TempDir dir;
   dir.write("t.ppm", std::string("P6\n2 1\n255\n") + std::string("\xff\x00\x00\x00\x80\xff", 6));
-  const Scene s = load_scene_json(scene_with_object(
-      R"({"primitive": {"type": "box"}, "material": {"albedo_texture": "t.ppm", "opacity": 0.5, "double_sided": true}})"),
+  const Scene s = load_scene_json(
+      scene_with_object(
+          R"({"primitive": {"type": "box"}, "material": {"albedo_texture": "t.ppm", "opacity": 0.5, "double_sided": true}})"),
       dir.path(), "tex.json");
   const Material& m = s.materials[s.objects[0].material];
   EXPECT_EQ(m.albedo_texture, (dir.path() / "t.ppm").lexically_normal());
@@ -551,8 +560,9 @@ TEST(Materials, TransmissionColor) {
 
   // Parsed, named and inline; opacity 1 with a transmission colour is still translucent.
   const Scene s = load_scene_json(
-      scene_with_object(R"({"primitive": {"type": "box"}, "material": "glass"}, {"primitive": {"type": "box"}, "material": {"transmission_color": [0, 0.5, 1]}})",
-                        R"("materials": {"glass": {"opacity": 0.6, "transmission_color": [1, 0.25, 0]}},)"),
+      scene_with_object(
+          R"({"primitive": {"type": "box"}, "material": "glass"}, {"primitive": {"type": "box"}, "material": {"transmission_color": [0, 0.5, 1]}})",
+          R"("materials": {"glass": {"opacity": 0.6, "transmission_color": [1, 0.25, 0]}},)"),
       fs::current_path(), "t.json");
   const Material& glass = s.materials[s.objects[0].material];
   EXPECT_EQ(glass.name, "glass");
@@ -584,8 +594,9 @@ TEST(Materials, TransmissionColor) {
   expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": "g"})",
                                       R"("materials": {"g": {"transmission_color": [2, 0, 0]}},)"),
                     {"/materials/g/transmission_color/0", "[0, 1]"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": {"transmission_colour": [1, 0, 0]}})"),
-                    {"/objects/0/material/transmission_colour", "unknown key", "transmission_color"});
+  expect_json_error(
+      scene_with_object(R"({"primitive": {"type": "box"}, "material": {"transmission_colour": [1, 0, 0]}})"),
+      {"/objects/0/material/transmission_colour", "unknown key", "transmission_color"});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -604,17 +615,23 @@ TEST(Errors, Files) {
 TEST(Errors, Structure) {
   expect_json_error("[1, 2]", {"test.json", "must be a JSON object"});
   expect_json_error(R"({"light": {"towards_light": [0,1,0]}, "objects": []})", {"/msm_scene", "required"});
-  expect_json_error(R"({"msm_scene": 2, "light": {"towards_light": [0,1,0]}, "objects": []})", {"/msm_scene", "version"});
+  expect_json_error(R"({"msm_scene": 2, "light": {"towards_light": [0,1,0]}, "objects": []})",
+                    {"/msm_scene", "version"});
   expect_json_error(R"({"msm_scene": 1, "objects": [{"primitive": {"type": "box"}}]})", {"/light", "required"});
-  expect_json_error(R"({"msm_scene": 1, "light": {"towards_light": [0,1,0]}, "objects": []})", {"/objects", "non-empty"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "colour": 1})"), {"/objects/0/colour", "unknown key"});
+  expect_json_error(R"({"msm_scene": 1, "light": {"towards_light": [0,1,0]}, "objects": []})",
+                    {"/objects", "non-empty"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "colour": 1})"),
+                    {"/objects/0/colour", "unknown key"});
   expect_json_error(scene_with_object(R"({"name": "p", "primitive": {"type": "pyramid"}})"),
                     {"/objects/0/primitive/type", "object 'p'", "unknown primitive 'pyramid'"});
   expect_json_error(scene_with_object(R"({"name": "x"})"), {"/objects/0", "exactly one of"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": "steel"})"), {"unknown material 'steel'"});
-  expect_json_error(R"({"msm_scene": 1, "light": {"towards_light": [0,0,0]}, "objects": [{"primitive": {"type": "box"}}]})",
-                    {"/light/towards_light", "non-zero"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "box", "size": [1, "2", 1]}})"), {"/objects/0/primitive/size/1", "number"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": "steel"})"),
+                    {"unknown material 'steel'"});
+  expect_json_error(
+      R"({"msm_scene": 1, "light": {"towards_light": [0,0,0]}, "objects": [{"primitive": {"type": "box"}}]})",
+      {"/light/towards_light", "non-zero"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box", "size": [1, "2", 1]}})"),
+                    {"/objects/0/primitive/size/1", "number"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}})", R"("shadow_map": {"framing": "tight"},)"),
                     {"/shadow_map/framing", "unknown framing"});
 }
@@ -622,17 +639,20 @@ TEST(Errors, Structure) {
 TEST(Errors, Values) {
   expect_json_error(scene_with_object(R"({"name": "s", "primitive": {"type": "box"}, "transform": {"scale": -1}})"),
                     {"/objects/0/transform/scale", "object 's'", "> 0"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "transform": {"scale": [1, 0, 1]}})"), {"scale", "> 0"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "transform": {"scale": [1, 0, 1]}})"),
+                    {"scale", "> 0"});
   for (const char* fov : {"0", "180", "-5", "200"})
-    expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}})",
-                                        std::string(R"("camera": {"fov_y_deg": )") + fov + "},"),
-                      {"/camera/fov_y_deg", "(0, 180)"});
+    expect_json_error(
+        scene_with_object(R"({"primitive": {"type": "box"}})", std::string(R"("camera": {"fov_y_deg": )") + fov + "},"),
+        {"/camera/fov_y_deg", "(0, 180)"});
   for (const char* opacity : {"1.5", "-0.1"})
-    expect_json_error(scene_with_object(std::string(R"({"primitive": {"type": "box"}, "material": {"opacity": )") + opacity + "}}"),
-                      {"/objects/0/material/opacity", "[0, 1]"});
+    expect_json_error(
+        scene_with_object(std::string(R"({"primitive": {"type": "box"}, "material": {"opacity": )") + opacity + "}}"),
+        {"/objects/0/material/opacity", "[0, 1]"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 1000000000}})"),
                     {"/objects/0/primitive/segments", "4096"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 1e30}})"), {"segments", "absurd"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 1e30}})"),
+                    {"segments", "absurd"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "sphere", "segments": 4096, "rings": 4096}})"),
                     {"/objects/0/primitive", "cap"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "box", "size": [1e9, 1, 1]}})"), {"size", "<= 1e+06"});
@@ -651,23 +671,28 @@ TEST(Errors, Values) {
   expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "columns": 4000, "brick_length": 900}})"),
                     {"/objects/0/primitive", "more than 1e+06"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "brick_wall", "bricks": 3}})"), {"bricks"});
-  expect_json_error(scene_with_object(R"({"primitive": {"type": "plane", "size": [1e400, 1]}})"), {"test.json", "number overflow"});
+  expect_json_error(scene_with_object(R"({"primitive": {"type": "plane", "size": [1e400, 1]}})"),
+                    {"test.json", "number overflow"});
   expect_json_error(scene_with_object(R"({"primitive": {"type": "box"}, "material": {"albedo_texture": "nope.png"}})"),
                     {"/objects/0/material/albedo_texture", "nope.png", "does not exist"});
 }
 
 TEST(Errors, Meshes) {
   TempDir dir;
-  auto load = [&](const std::string& object_json) { load_scene_file(dir.write("s.json", scene_with_object(object_json))); };
-  expect_error([&] { load(R"({"name": "m", "mesh": "missing.obj"})"); }, {"s.json", "/objects/0/mesh", "object 'm'", "missing.obj", "does not exist"});
+  auto load = [&](const std::string& object_json) {
+    load_scene_file(dir.write("s.json", scene_with_object(object_json)));
+  };
+  expect_error([&] { load(R"({"name": "m", "mesh": "missing.obj"})"); },
+               {"s.json", "/objects/0/mesh", "object 'm'", "missing.obj", "does not exist"});
   dir.write("garbage.ply", "ply\nthis is not a ply file\n\x01\x02\x03");
   expect_error([&] { load(R"({"mesh": "garbage.ply"})"); }, {"/objects/0/mesh", "garbage.ply", "Assimp cannot read"});
   dir.write("empty.obj", "# nothing\n");
   expect_error([&] { load(R"({"mesh": "empty.obj"})"); }, {"/objects/0/mesh", "empty.obj"});
   dir.write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 4\n");
   expect_error([&] { load(R"({"mesh": "degenerate.obj"})"); }, {"/objects/0/mesh", "non-zero area"});
-  dir.write("nan.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                       "element face 1\nproperty list uchar int vertex_indices\nend_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  dir.write("nan.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 1\nproperty list uchar int vertex_indices\nend_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   expect_error([&] { load(R"({"mesh": "nan.ply"})"); }, {"/objects/0/mesh", "nan.ply", "NaN or infinite"});
   dir.write("inf.obj", "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   expect_error([&] { load(R"({"mesh": "inf.obj"})"); }, {"/objects/0/mesh", "inf.obj", "NaN or infinite"});

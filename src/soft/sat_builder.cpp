@@ -18,47 +18,49 @@ struct SatPush {
 };
 static_assert(sizeof(SatPush) == 16, "SatPush must match the shaders' push constant block");
 
-bool unorm16Format(VkFormat format) {
+bool unorm16_format(VkFormat format) {
   return format == VK_FORMAT_R16G16B16A16_UNORM || format == VK_FORMAT_R16G16_UNORM;
 }
-bool floatFormat(VkFormat format) {
+bool float_format(VkFormat format) {
   return format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32_SFLOAT;
 }
-bool twoChannels(VkFormat format) { return format == VK_FORMAT_R32G32_SFLOAT || format == VK_FORMAT_R16G16_UNORM; }
+bool two_channels(VkFormat format) { return format == VK_FORMAT_R32G32_SFLOAT || format == VK_FORMAT_R16G16_UNORM; }
 
-void check(const vk::Image& moments, const vk::Image& table, int maxKernelTexels) {
+void check(const vk::Image& moments, const vk::Image& table, int max_kernel_texels) {
   const char* where = "msm::soft::SatBuilder::record: ";
   if (!moments || !table) throw std::invalid_argument(std::string(where) + "null image");
-  if (!unorm16Format(moments.format()) && !floatFormat(moments.format()))
-    throw std::invalid_argument(std::string(where) + "moments must be RGBA32_SFLOAT, RG32_SFLOAT, RGBA16_UNORM or RG16_UNORM");
+  if (!unorm16_format(moments.format()) && !float_format(moments.format()))
+    throw std::invalid_argument(std::string(where) +
+                                "moments must be RGBA32_SFLOAT, RG32_SFLOAT, RGBA16_UNORM or RG16_UNORM");
   if (!(moments.desc().usage & VK_IMAGE_USAGE_SAMPLED_BIT))
     throw std::invalid_argument(std::string(where) + "moments need SAMPLED usage");
   if (table.format() != VK_FORMAT_R32G32B32A32_UINT &&
-      !(table.format() == VK_FORMAT_R32G32_UINT && twoChannels(moments.format())))
+      !(table.format() == VK_FORMAT_R32G32_UINT && two_channels(moments.format())))
     throw std::invalid_argument(std::string(where) + "the table must be RGBA32_UINT (or RG32_UINT for RG moments)");
-  if (!(table.desc().usage & VK_IMAGE_USAGE_STORAGE_BIT) || table.desc().mipLevels != 1 || table.desc().layers != 1)
+  if (!(table.desc().usage & VK_IMAGE_USAGE_STORAGE_BIT) || table.desc().mip_levels != 1 || table.desc().layers != 1)
     throw std::invalid_argument(std::string(where) + "the table needs STORAGE usage, one mip and one layer");
   if (moments.width() != table.width() || moments.height() != table.height())
     throw std::invalid_argument(std::string(where) + "moments and table differ in size");
-  if (maxKernelTexels < 1) throw std::invalid_argument(std::string(where) + "max_kernel_texels < 1");
+  if (max_kernel_texels < 1) throw std::invalid_argument(std::string(where) + "max_kernel_texels < 1");
 }
 
 } // namespace
 
 SatBuilder::SatBuilder(const vk::Context& ctx)
-    : rows_(vk::createProgram(ctx, "sat_rows.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
-                              sizeof(SatPush))),
-      columns_(vk::createProgram(ctx, "sat_columns.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
-      blockRows_(vk::createProgram(ctx, "sat_block_rows.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
-                                   sizeof(SatPush))),
-      blockColumns_(vk::createProgram(ctx, "sat_block_columns.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
-      rowsRg_(vk::createProgram(ctx, "sat_rows_rg.comp", {vk::Binding::SampledImage, vk::Binding::StorageImage},
-                                sizeof(SatPush))),
-      columnsRg_(vk::createProgram(ctx, "sat_columns_rg.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
-      blockRowsRg_(vk::createProgram(ctx, "sat_block_rows_rg.comp",
-                                     {vk::Binding::SampledImage, vk::Binding::StorageImage}, sizeof(SatPush))),
-      blockColumnsRg_(vk::createProgram(ctx, "sat_block_columns_rg.comp", {vk::Binding::StorageImage}, sizeof(SatPush))),
-      sampler_(vk::createSampler(ctx, VK_FILTER_NEAREST)) {}
+    : rows_(vk::create_program(ctx, "sat_rows.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
+                               sizeof(SatPush))),
+      columns_(vk::create_program(ctx, "sat_columns.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      blockRows_(vk::create_program(ctx, "sat_block_rows.comp",
+                                    {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
+      blockColumns_(vk::create_program(ctx, "sat_block_columns.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      rowsRg_(vk::create_program(ctx, "sat_rows_rg.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
+                                 sizeof(SatPush))),
+      columnsRg_(vk::create_program(ctx, "sat_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      blockRowsRg_(vk::create_program(ctx, "sat_block_rows_rg.comp",
+                                      {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
+      blockColumnsRg_(
+          vk::create_program(ctx, "sat_block_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      sampler_(vk::create_sampler(ctx, VK_FILTER_NEAREST)) {}
 
 void SatBuilder::record(VkCommandBuffer cmd, const vk::Image& moments, const vk::Image& table, int max_kernel_texels,
                         Scheme scheme, vk::GpuTimer* timer, VkImageLayout moments_layout) const {
@@ -81,8 +83,9 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const vk::Image* const> m
   const VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
   auto push = [&](size_t i) {
     const vk::Image& m = *moments[i];
-    bool two = twoChannels(m.format());
-    return SatPush{glm::ivec2(int(m.width()), int(m.height())), scale, (unorm16Format(m.format()) ? 1u : 0u) | (two ? 2u : 0u)};
+    bool two = two_channels(m.format());
+    return SatPush{glm::ivec2(int(m.width()), int(m.height())), scale,
+                   (unorm16_format(m.format()) ? 1u : 0u) | (two ? 2u : 0u)};
   };
   // The program of each pass for table i: the table's format is part of the shader.
   auto program = [&](size_t i, const vk::Program& rgba, const vk::Program& rg) -> const vk::Program& {
@@ -91,42 +94,45 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const vk::Image* const> m
 
   // Discard the tables' contents (UNDEFINED), after every earlier access to them.
   for (const vk::Image* table : tables)
-    vk::pipelineBarrier(cmd, vk::imageBarrier(table->handle(), table->aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                                              VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                                              VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                              VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
+    vk::pipeline_barrier(cmd, vk::image_barrier(table->handle(), table->aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                                VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
   // Pass 1 writes every texel; pass 2 reads and rewrites them in place.
   const VkMemoryBarrier2 between =
-      vk::memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+      vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 
-  if (scheme == Scheme::RowsThenColumns) {
+  if (scheme == Scheme::rows_then_columns) {
     if (timer) timer->begin(cmd, "sat_rows");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, program(i, rows_, rowsRg_), vk::groupCount(moments[i]->height(), 64), 1, 1,
-                   {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)}, push(i));
+      vk::dispatch(cmd, program(i, rows_, rowsRg_), vk::group_count(moments[i]->height(), 64), 1, 1,
+                   {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)},
+                   push(i));
     if (timer) timer->end(cmd);
-    vk::pipelineBarrier(cmd, between);
+    vk::pipeline_barrier(cmd, between);
     if (timer) timer->begin(cmd, "sat_columns");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, program(i, columns_, columnsRg_), vk::groupCount(moments[i]->width(), 64), 1, 1,
+      vk::dispatch(cmd, program(i, columns_, columnsRg_), vk::group_count(moments[i]->width(), 64), 1, 1,
                    {vk::Descriptor(*tables[i], general)}, push(i));
     if (timer) timer->end(cmd);
   } else {
     if (timer) timer->begin(cmd, "sat_blocks");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, program(i, blockRows_, blockRowsRg_), vk::groupCount(moments[i]->height(), 8), 1, 1,
-                   {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)}, push(i));
-    vk::pipelineBarrier(cmd, between);
+      vk::dispatch(cmd, program(i, blockRows_, blockRowsRg_), vk::group_count(moments[i]->height(), 8), 1, 1,
+                   {vk::Descriptor(*moments[i], moments_layout, sampler_), vk::Descriptor(*tables[i], general)},
+                   push(i));
+    vk::pipeline_barrier(cmd, between);
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, program(i, blockColumns_, blockColumnsRg_), vk::groupCount(moments[i]->width(), 8), 1, 1,
+      vk::dispatch(cmd, program(i, blockColumns_, blockColumnsRg_), vk::group_count(moments[i]->width(), 8), 1, 1,
                    {vk::Descriptor(*tables[i], general)}, push(i));
     if (timer) timer->end(cmd);
   }
 }
 
-std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int width, int height, int max_kernel_texels) {
+std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int width, int height,
+                                      int max_kernel_texels) {
   if (width < 0 || height < 0 || moments.size() != size_t(width) * size_t(height))
     throw std::invalid_argument("msm::soft::build_sat_cpu: moments.size() != width * height");
   const uint32_t scale = msm_sat_scale(max_kernel_texels);
@@ -140,7 +146,8 @@ std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int wi
     }
   }
   for (int y = 1; y < height; ++y)
-    for (int x = 0; x < width; ++x) table[size_t(y) * size_t(width) + size_t(x)] += table[size_t(y - 1) * size_t(width) + size_t(x)];
+    for (int x = 0; x < width; ++x)
+      table[size_t(y) * size_t(width) + size_t(x)] += table[size_t(y - 1) * size_t(width) + size_t(x)];
   return table;
 }
 

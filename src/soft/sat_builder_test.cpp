@@ -76,17 +76,17 @@ std::vector<uvec4> reference_table(const std::vector<vec4>& m, int width, int he
   return out;
 }
 
-vk::Image momentImage(vk::Context& ctx, VkFormat format, int width, int height) {
-  return vk::createImage(ctx, vk::ImageDesc{.width = uint32_t(width),
-                                            .height = uint32_t(height),
-                                            .format = format,
-                                            .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+vk::Image moment_image(vk::Context& ctx, VkFormat format, int width, int height) {
+  return vk::create_image(ctx, vk::ImageDesc{.width = uint32_t(width),
+                                             .height = uint32_t(height),
+                                             .format = format,
+                                             .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
 }
-vk::Image tableImage(vk::Context& ctx, int width, int height, VkFormat format = VK_FORMAT_R32G32B32A32_UINT) {
-  return vk::createImage(ctx, vk::ImageDesc{.width = uint32_t(width),
-                                            .height = uint32_t(height),
-                                            .format = format,
-                                            .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+vk::Image table_image(vk::Context& ctx, int width, int height, VkFormat format = VK_FORMAT_R32G32B32A32_UINT) {
+  return vk::create_image(ctx, vk::ImageDesc{.width = uint32_t(width),
+                                             .height = uint32_t(height),
+                                             .format = format,
+                                             .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
 }
 
 // Uploads the moments in `format` and returns the values as the CPU sees them (UNORM16: decoded by
@@ -113,12 +113,12 @@ std::vector<vec4> upload(vk::Context& ctx, const vk::Image& image, const std::ve
       seen[i] = msm_unpack_unorm16x4(p);
     }
   }
-  vk::uploadImage(ctx, image, bytes, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+  vk::upload_image(ctx, image, bytes, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
   return seen;
 }
 
-std::vector<uvec4> readTable(vk::Context& ctx, const vk::Image& table) {
-  std::vector<std::byte> bytes = vk::readbackImage(ctx, table, VK_IMAGE_LAYOUT_GENERAL);
+std::vector<uvec4> read_table(vk::Context& ctx, const vk::Image& table) {
+  std::vector<std::byte> bytes = vk::readback_image(ctx, table, VK_IMAGE_LAYOUT_GENERAL);
   std::vector<uvec4> out(bytes.size() / sizeof(uvec4));
   std::memcpy(static_cast<void*>(out.data()), bytes.data(), bytes.size());
   return out;
@@ -145,19 +145,19 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
   };
   for (const Case& c : cases) {
     std::vector<vec4> m = random_moments(rng, c.width, c.height);
-    vk::Image moments = momentImage(ctx(), c.format, c.width, c.height);
+    vk::Image moments = moment_image(ctx(), c.format, c.width, c.height);
     std::vector<vec4> seen = upload(ctx(), moments, m);
     std::vector<uvec4> cpu = soft::build_sat_cpu(seen, c.width, c.height, c.nt);
     ASSERT_EQ(cpu, reference_table(seen, c.width, c.height, c.nt)) << c.width << "x" << c.height;
-    for (Scheme scheme : {Scheme::RowsThenColumns, Scheme::Blocks}) {
-      if (scheme == Scheme::RowsThenColumns && !c.rows_then_columns) continue;
-      vk::Image table = tableImage(ctx(), c.width, c.height);
+    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
+      if (scheme == Scheme::rows_then_columns && !c.rows_then_columns) continue;
+      vk::Image table = table_image(ctx(), c.width, c.height);
       vk::GpuTimer timer(ctx());
-      vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+      vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
         timer.reset(cmd);
         builder.record(cmd, moments, table, c.nt, scheme, &timer);
       });
-      std::vector<uvec4> gpu = readTable(ctx(), table);
+      std::vector<uvec4> gpu = read_table(ctx(), table);
       ASSERT_EQ(gpu.size(), cpu.size());
       size_t mismatches = 0, first = gpu.size();
       for (size_t i = 0; i < gpu.size(); ++i)
@@ -166,7 +166,7 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
           first = std::min(first, i);
         }
       vk::TimerResults times = timer.read();
-      bool blocks = scheme == Scheme::Blocks;
+      bool blocks = scheme == Scheme::blocks;
       EXPECT_EQ(times.count(blocks ? "sat_blocks" : "sat_rows"), 1u);
       EXPECT_EQ(times.count("sat_columns"), blocks ? 0u : 1u);
       std::printf("[sat-builder] %dx%d n_t %d format %d %s: %zu of %zu texels differ\n", c.width, c.height, c.nt,
@@ -188,16 +188,16 @@ TEST_F(SatBuilderTest, SixMomentTablesInOneCall) {
     a[i] = t.a;
     b[i] = t.b;
   }
-  vk::Image ma = momentImage(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
-  vk::Image mb = momentImage(ctx(), VK_FORMAT_R32G32_SFLOAT, w, h);
+  vk::Image ma = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
+  vk::Image mb = moment_image(ctx(), VK_FORMAT_R32G32_SFLOAT, w, h);
   std::vector<vec4> sa = upload(ctx(), ma, a), sb = upload(ctx(), mb, b);
-  for (Scheme scheme : {Scheme::RowsThenColumns, Scheme::Blocks}) {
-    vk::Image ta = tableImage(ctx(), w, h), tb = tableImage(ctx(), w, h);
+  for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
+    vk::Image ta = table_image(ctx(), w, h), tb = table_image(ctx(), w, h);
     const vk::Image* moments[] = {&ma, &mb};
     const vk::Image* tables[] = {&ta, &tb};
-    vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, tables, nt, scheme); });
-    EXPECT_EQ(readTable(ctx(), ta), soft::build_sat_cpu(sa, w, h, nt));
-    EXPECT_EQ(readTable(ctx(), tb), soft::build_sat_cpu(sb, w, h, nt));
+    vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, tables, nt, scheme); });
+    EXPECT_EQ(read_table(ctx(), ta), soft::build_sat_cpu(sa, w, h, nt));
+    EXPECT_EQ(read_table(ctx(), tb), soft::build_sat_cpu(sb, w, h, nt));
   }
 }
 
@@ -211,12 +211,12 @@ TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
                         {256, 256, 27 * 27, VK_FORMAT_R32G32_SFLOAT, true}};
   for (const Case& c : cases) {
     std::vector<vec4> m = random_moments(rng, c.width, c.height);
-    vk::Image moments = momentImage(ctx(), c.format, c.width, c.height);
+    vk::Image moments = moment_image(ctx(), c.format, c.width, c.height);
     std::vector<uvec4> cpu = soft::build_sat_cpu(upload(ctx(), moments, m), c.width, c.height, c.nt);
-    for (Scheme scheme : {Scheme::RowsThenColumns, Scheme::Blocks}) {
-      vk::Image table = tableImage(ctx(), c.width, c.height, VK_FORMAT_R32G32_UINT);
-      vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, table, c.nt, scheme); });
-      std::vector<std::byte> bytes = vk::readbackImage(ctx(), table, VK_IMAGE_LAYOUT_GENERAL);
+    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
+      vk::Image table = table_image(ctx(), c.width, c.height, VK_FORMAT_R32G32_UINT);
+      vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, table, c.nt, scheme); });
+      std::vector<std::byte> bytes = vk::readback_image(ctx(), table, VK_IMAGE_LAYOUT_GENERAL);
       ASSERT_EQ(bytes.size(), cpu.size() * 8);
       size_t mismatches = 0;
       for (size_t i = 0; i < cpu.size(); ++i) {
@@ -231,18 +231,18 @@ TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
 
 TEST_F(SatBuilderTest, RejectsBadImages) {
   SatBuilder builder(ctx());
-  vk::Image moments = momentImage(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, 16, 16);
-  vk::Image wrongSize = tableImage(ctx(), 16, 15);
-  vk::Image table = tableImage(ctx(), 16, 16);
-  vk::Image notMoments = momentImage(ctx(), VK_FORMAT_R8G8B8A8_UNORM, 16, 16);
-  vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
-    EXPECT_THROW(builder.record(cmd, moments, wrongSize, 729, Scheme::Blocks), std::invalid_argument);
-    EXPECT_THROW(builder.record(cmd, notMoments, table, 729, Scheme::Blocks), std::invalid_argument);
-    EXPECT_THROW(builder.record(cmd, moments, moments, 729, Scheme::Blocks), std::invalid_argument);
-    EXPECT_THROW(builder.record(cmd, moments, table, 0, Scheme::Blocks), std::invalid_argument);
+  vk::Image moments = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, 16, 16);
+  vk::Image wrong_size = table_image(ctx(), 16, 15);
+  vk::Image table = table_image(ctx(), 16, 16);
+  vk::Image not_moments = moment_image(ctx(), VK_FORMAT_R8G8B8A8_UNORM, 16, 16);
+  vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+    EXPECT_THROW(builder.record(cmd, moments, wrong_size, 729, Scheme::blocks), std::invalid_argument);
+    EXPECT_THROW(builder.record(cmd, not_moments, table, 729, Scheme::blocks), std::invalid_argument);
+    EXPECT_THROW(builder.record(cmd, moments, moments, 729, Scheme::blocks), std::invalid_argument);
+    EXPECT_THROW(builder.record(cmd, moments, table, 0, Scheme::blocks), std::invalid_argument);
     // An RG table cannot hold four moments.
-    vk::Image rg = tableImage(ctx(), 16, 16, VK_FORMAT_R32G32_UINT);
-    EXPECT_THROW(builder.record(cmd, moments, rg, 729, Scheme::Blocks), std::invalid_argument);
+    vk::Image rg = table_image(ctx(), 16, 16, VK_FORMAT_R32G32_UINT);
+    EXPECT_THROW(builder.record(cmd, moments, rg, 729, Scheme::blocks), std::invalid_argument);
   });
   EXPECT_THROW(soft::build_sat_cpu(std::vector<vec4>(10), 3, 3, 729), std::invalid_argument);
 }
@@ -275,10 +275,10 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
   }
   std::vector<vec4> m(depth.size());
   for (size_t i = 0; i < m.size(); ++i) m[i] = msm_theta4_star(msm_moments4(depth[i]));
-  vk::Image moments = momentImage(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
+  vk::Image moments = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
   std::vector<vec4> seen = upload(ctx(), moments, m);
   std::vector<uvec4> cpu = soft::build_sat_cpu(seen, w, h, nt);
-  vk::Image table = tableImage(ctx(), w, h);
+  vk::Image table = table_image(ctx(), w, h);
 
   struct Query {
     vec4 region, fragment;
@@ -300,23 +300,25 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
     q.region = vec4(lo, lo + extent);
     q.fragment = vec4(float(px) + 0.5f, float(py) + 0.5f, 0.6f + 0.001f * float(px - w / 2), 0.001f);
   }
-  vk::Buffer queryBuffer = vk::createBuffer(ctx(), sizeof(Query) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::Host);
-  vk::Buffer resultBuffer =
-      vk::createBuffer(ctx(), sizeof(SoftFlow) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::Host);
-  std::memcpy(queryBuffer.data(), queries.data(), sizeof(Query) * count);
-  vk::Program program = vk::createProgram(
-      ctx(), "sat_queries.comp", {vk::Binding::StorageImage, vk::Binding::StorageBuffer, vk::Binding::StorageBuffer},
+  vk::Buffer query_buffer =
+      vk::create_buffer(ctx(), sizeof(Query) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+  vk::Buffer result_buffer =
+      vk::create_buffer(ctx(), sizeof(SoftFlow) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+  std::memcpy(query_buffer.data(), queries.data(), sizeof(Query) * count);
+  vk::Program program = vk::create_program(
+      ctx(), "sat_queries.comp", {vk::Binding::storage_image, vk::Binding::storage_buffer, vk::Binding::storage_buffer},
       sizeof(Push));
   const vec2 spread(30.0f, 30.0f); // texels per unit of depth
-  vk::submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
-    builder.record(cmd, moments, table, nt, Scheme::Blocks);
-    vk::pipelineBarrier(cmd, vk::memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                               VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT));
-    vk::dispatch(cmd, program, vk::groupCount(count, 64), 1, 1, {vk::Descriptor(table), queryBuffer, resultBuffer},
+  vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+    builder.record(cmd, moments, table, nt, Scheme::blocks);
+    vk::pipeline_barrier(
+        cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT));
+    vk::dispatch(cmd, program, vk::group_count(count, 64), 1, 1, {vk::Descriptor(table), query_buffer, result_buffer},
                  Push{ivec2(w, h), scale, width, spread, count, 0});
   });
   std::vector<SoftFlow> gpu(count);
-  std::memcpy(static_cast<void*>(gpu.data()), resultBuffer.data(), sizeof(SoftFlow) * count);
+  std::memcpy(static_cast<void*>(gpu.data()), result_buffer.data(), sizeof(SoftFlow) * count);
 
   g_table = &cpu;
   g_width = w;
@@ -325,7 +327,8 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
   for (uint32_t i = 0; i < count; ++i) {
     SoftFlow c = msm_test_soft_flow(queries[i].region, queries[i].fragment, ivec2(w, h), scale, width, spread);
     rect_mismatches += c.rect_sum != gpu[i].rect_sum ? 1 : 0;
-    for (int k = 0; k < 4; ++k) filtered_max = std::max(filtered_max, double(std::abs(c.filtered[k] - gpu[i].filtered[k])));
+    for (int k = 0; k < 4; ++k)
+      filtered_max = std::max(filtered_max, double(std::abs(c.filtered[k] - gpu[i].filtered[k])));
     double dd = std::abs(c.soft[1] - gpu[i].soft[1]), ds = std::abs(c.soft[0] - gpu[i].soft[0]);
     depth_max = std::max(depth_max, dd);
     shadow_max = std::max(shadow_max, ds);
@@ -334,9 +337,10 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
     penumbra += (c.soft[0] > 0.02f && c.soft[0] < 0.98f) ? 1 : 0;
     lit += c.soft[0] <= 0.02f ? 1 : 0;
   }
-  std::printf("[sat-queries] %u queries (%d umbra early-outs, %d in penumbrae, %d lit): rect sums differ %d, filtered max "
-              "%.2e, blocker depth max %.2e, shadow max %.2e, beyond 1e-3: %d\n",
-              count, umbra, penumbra, lit, rect_mismatches, filtered_max, depth_max, shadow_max, beyond);
+  std::printf(
+      "[sat-queries] %u queries (%d umbra early-outs, %d in penumbrae, %d lit): rect sums differ %d, filtered max "
+      "%.2e, blocker depth max %.2e, shadow max %.2e, beyond 1e-3: %d\n",
+      count, umbra, penumbra, lit, rect_mismatches, filtered_max, depth_max, shadow_max, beyond);
   EXPECT_EQ(rect_mismatches, 0);
   EXPECT_LT(filtered_max, 1e-6);
   EXPECT_LE(beyond, int(count / 500));

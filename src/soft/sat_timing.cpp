@@ -41,8 +41,10 @@ int main(int argc, char** argv) {
   int repeat = 7;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
-    if (a == "--repeat" && i + 1 < argc) repeat = std::max(1, std::atoi(argv[++i]));
-    else sizes.push_back(std::atoi(a.c_str()));
+    if (a == "--repeat" && i + 1 < argc)
+      repeat = std::max(1, std::atoi(argv[++i]));
+    else
+      sizes.push_back(std::atoi(a.c_str()));
   }
   if (sizes.empty()) sizes = {1024, 2048};
 
@@ -57,48 +59,49 @@ int main(int argc, char** argv) {
     std::uniform_real_distribution<float> depth(-1.0f, 1.0f);
     std::vector<vec4> m(size_t(size) * size);
     for (vec4& v : m) v = msm_theta4_star(msm_moments4(depth(rng)));
-    vk::Image moments = vk::createImage(
-        ctx, vk::ImageDesc{.width = size,
-                           .height = size,
-                           .format = VK_FORMAT_R32G32B32A32_SFLOAT,
-                           .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
-    vk::Image copy = vk::createImage(ctx, vk::ImageDesc{.width = size,
-                                                        .height = size,
-                                                        .format = VK_FORMAT_R32G32B32A32_SFLOAT,
-                                                        .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-    vk::Image table = vk::createImage(ctx, vk::ImageDesc{.width = size,
+    vk::Image moments =
+        vk::create_image(ctx, vk::ImageDesc{.width = size,
+                                            .height = size,
+                                            .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                            .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                                     VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    vk::Image copy = vk::create_image(ctx, vk::ImageDesc{.width = size,
                                                          .height = size,
-                                                         .format = VK_FORMAT_R32G32B32A32_UINT,
-                                                         .usage = VK_IMAGE_USAGE_STORAGE_BIT});
-    vk::uploadImage(ctx, moments, std::as_bytes(std::span(m)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+                                                         .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                                         .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    vk::Image table = vk::create_image(ctx, vk::ImageDesc{.width = size,
+                                                          .height = size,
+                                                          .format = VK_FORMAT_R32G32B32A32_UINT,
+                                                          .usage = VK_IMAGE_USAGE_STORAGE_BIT});
+    vk::upload_image(ctx, moments, std::as_bytes(std::span(m)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
     vk::GpuTimer timer(ctx);
 
     std::vector<double> copies;
     for (int r = 0; r <= repeat; ++r) {
-      vk::submitAndWait(ctx, [&](VkCommandBuffer cmd) {
-        vk::pipelineBarrier(cmd, vk::imageBarrier(copy.handle(), copy.aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                                                  VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                                                  VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL));
+      vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+        vk::pipeline_barrier(cmd, vk::image_barrier(copy.handle(), copy.aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                                    VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                                    VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL));
         timer.reset(cmd);
         timer.begin(cmd, "copy");
         VkImageCopy region{.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
                            .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
                            .extent = {size, size, 1}};
-        vkCmdCopyImage(cmd, moments.handle(), VK_IMAGE_LAYOUT_GENERAL, copy.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                       1, &region);
+        vkCmdCopyImage(cmd, moments.handle(), VK_IMAGE_LAYOUT_GENERAL, copy.handle(),
+                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
         timer.end(cmd);
       });
       if (r > 0) copies.push_back(timer.read().total("copy"));
     }
     const double texels = double(size) * size;
-    const double copyMs = median(copies);
-    const double bandwidth = 32.0 * texels / (copyMs * 1e-3); // bytes per second
-    for (auto scheme : {soft::SatBuilder::Scheme::RowsThenColumns, soft::SatBuilder::Scheme::Blocks}) {
-      const bool blocks = scheme == soft::SatBuilder::Scheme::Blocks;
+    const double copy_ms = median(copies);
+    const double bandwidth = 32.0 * texels / (copy_ms * 1e-3); // bytes per second
+    for (auto scheme : {soft::SatBuilder::Scheme::rows_then_columns, soft::SatBuilder::Scheme::blocks}) {
+      const bool blocks = scheme == soft::SatBuilder::Scheme::blocks;
       std::vector<double> times, rows, columns;
       for (int r = 0; r <= repeat; ++r) {
-        vk::submitAndWait(ctx, [&](VkCommandBuffer cmd) {
+        vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
           timer.reset(cmd);
           timer.begin(cmd, "sat");
           builder.record(cmd, moments, table, 27 * 27, scheme, &timer);
@@ -111,12 +114,11 @@ int main(int argc, char** argv) {
         columns.push_back(t.total("sat_columns"));
       }
       const double ms = median(times);
-      std::string name = blocks ? "blocks (App. C)"
-                                : fmt::format("rows + columns ({:.2f} + {:.2f})", median(rows), median(columns));
+      std::string name =
+          blocks ? "blocks (App. C)" : fmt::format("rows + columns ({:.2f} + {:.2f})", median(rows), median(columns));
       const double bound64 = 64.0 * texels / bandwidth * 1e3, bound32 = 32.0 * texels / bandwidth * 1e3;
-      fmt::print("| {}² | {:.2f} | {:.2f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", n, copyMs,
-                 bandwidth * 1e-9, name, ms,
-                 bound64, bound64 / ms, bound32, bound32 / ms);
+      fmt::print("| {}² | {:.2f} | {:.2f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", n, copy_ms,
+                 bandwidth * 1e-9, name, ms, bound64, bound64 / ms, bound32, bound32 / ms);
     }
   }
   return 0;

@@ -27,7 +27,7 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-bool envFlag(const char* name) {
+bool env_flag(const char* name) {
   const char* value = std::getenv(name);
   if (!value) return false;
   std::string v = lower(value);
@@ -39,7 +39,7 @@ bool contains(const std::vector<VkExtensionProperties>& list, const char* name) 
                      [&](const VkExtensionProperties& e) { return std::strcmp(e.extensionName, name) == 0; });
 }
 
-std::vector<VkExtensionProperties> instanceExtensions(const char* layer) {
+std::vector<VkExtensionProperties> instance_extensions(const char* layer) {
   uint32_t count = 0;
   if (vkEnumerateInstanceExtensionProperties(layer, &count, nullptr) != VK_SUCCESS) return {};
   std::vector<VkExtensionProperties> list(count);
@@ -48,7 +48,7 @@ std::vector<VkExtensionProperties> instanceExtensions(const char* layer) {
   return list;
 }
 
-bool hasLayer(const char* name) {
+bool has_layer(const char* name) {
   uint32_t count = 0;
   MSM_VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
   std::vector<VkLayerProperties> layers(count);
@@ -58,7 +58,7 @@ bool hasLayer(const char* name) {
                      [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
 }
 
-const char* typeName(VkPhysicalDeviceType type) {
+const char* type_name(VkPhysicalDeviceType type) {
   switch (type) {
   case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
   case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
@@ -68,19 +68,19 @@ const char* typeName(VkPhysicalDeviceType type) {
   }
 }
 
-VKAPI_ATTR VkBool32 VKAPI_CALL onMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                         VkDebugUtilsMessageTypeFlagsEXT, const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                         void* user) {
-  static_cast<ValidationLog*>(user)->add({severity, data->pMessageIdName ? data->pMessageIdName : "",
-                                          data->pMessage ? data->pMessage : ""});
+VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                          VkDebugUtilsMessageTypeFlagsEXT,
+                                          const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+  static_cast<ValidationLog*>(user)->add(
+      {severity, data->pMessageIdName ? data->pMessageIdName : "", data->pMessage ? data->pMessage : ""});
   return VK_FALSE; // the spec reserves VK_TRUE for layer development
 }
 
 struct Candidate {
   VkPhysicalDevice device;
   DeviceInfo info;
-  uint32_t queueFamily = 0;
-  uint32_t timestampValidBits = 0;
+  uint32_t queue_family = 0;
+  uint32_t timestamp_valid_bits = 0;
   std::string unsuitable; // why it cannot be used; empty if it can
 };
 
@@ -89,26 +89,31 @@ Candidate inspect(VkPhysicalDevice device, uint32_t index) {
   VkPhysicalDeviceDriverProperties driver{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
   VkPhysicalDeviceProperties2 props{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &driver};
   vkGetPhysicalDeviceProperties2(device, &props);
-  c.info = {index, props.properties.deviceName, props.properties.deviceType, driver.driverName, driver.driverInfo,
+  c.info = {index,
+            props.properties.deviceName,
+            props.properties.deviceType,
+            driver.driverName,
+            driver.driverInfo,
             props.properties.apiVersion};
 
-  uint32_t familyCount = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, nullptr);
-  std::vector<VkQueueFamilyProperties> families(familyCount);
-  vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, families.data());
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(device, &family_count, families.data());
   // Graphics+compute first: the renderer draws shadow maps and filters them on one queue.
   int best = -1;
-  for (uint32_t i = 0; i < familyCount; ++i) {
+  for (uint32_t i = 0; i < family_count; ++i) {
     VkQueueFlags flags = families[i].queueFlags;
     if (!(flags & VK_QUEUE_COMPUTE_BIT)) continue;
-    if (best < 0 || ((flags & VK_QUEUE_GRAPHICS_BIT) && !(families[best].queueFlags & VK_QUEUE_GRAPHICS_BIT))) best = int(i);
+    if (best < 0 || ((flags & VK_QUEUE_GRAPHICS_BIT) && !(families[best].queueFlags & VK_QUEUE_GRAPHICS_BIT)))
+      best = int(i);
   }
 
-  uint32_t extCount = 0;
-  vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, nullptr);
-  std::vector<VkExtensionProperties> extensions(extCount);
-  vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, extensions.data());
-  extensions.resize(extCount);
+  uint32_t ext_count = 0;
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &ext_count, nullptr);
+  std::vector<VkExtensionProperties> extensions(ext_count);
+  vkEnumerateDeviceExtensionProperties(device, nullptr, &ext_count, extensions.data());
+  extensions.resize(ext_count);
 
   if (props.properties.apiVersion < VK_API_VERSION_1_3)
     c.unsuitable = "Vulkan 1.3 not supported";
@@ -117,13 +122,13 @@ Candidate inspect(VkPhysicalDevice device, uint32_t index) {
   else if (!contains(extensions, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME))
     c.unsuitable = "no " VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME;
   else {
-    c.queueFamily = uint32_t(best);
-    c.timestampValidBits = families[best].timestampValidBits;
+    c.queue_family = uint32_t(best);
+    c.timestamp_valid_bits = families[best].timestampValidBits;
   }
   return c;
 }
 
-std::string listDevices(const std::vector<Candidate>& candidates) {
+std::string list_devices(const std::vector<Candidate>& candidates) {
   std::string out;
   for (const Candidate& c : candidates)
     out += fmt::format("\n  {}: {}{}", c.info.index, c.info.describe(),
@@ -135,10 +140,10 @@ std::string listDevices(const std::vector<Candidate>& candidates) {
 size_t select(const std::vector<Candidate>& candidates, const std::string& selector, const char* source) {
   auto fail = [&](const std::string& why) -> size_t {
     throw std::runtime_error(fmt::format("msm::vk: {} (device selector '{}' from {}); devices:{}", why, selector,
-                                         source, listDevices(candidates)));
+                                         source, list_devices(candidates)));
   };
   auto usable = [&](size_t i) { return candidates[i].unsuitable.empty(); };
-  auto firstOfType = [&](VkPhysicalDeviceType type) -> std::optional<size_t> {
+  auto first_of_type = [&](VkPhysicalDeviceType type) -> std::optional<size_t> {
     for (size_t i = 0; i < candidates.size(); ++i)
       if (usable(i) && candidates[i].info.type == type) return i;
     return std::nullopt;
@@ -146,19 +151,19 @@ size_t select(const std::vector<Candidate>& candidates, const std::string& selec
 
   if (selector.empty()) {
     for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
-      if (auto i = firstOfType(type)) return *i;
+      if (auto i = first_of_type(type)) return *i;
     for (size_t i = 0; i < candidates.size(); ++i)
       if (usable(i)) return i;
     return fail("no suitable Vulkan device (Vulkan 1.3, a compute queue, VK_KHR_push_descriptor)");
   }
   std::string wanted = lower(selector);
   if (wanted == "cpu") {
-    if (auto i = firstOfType(VK_PHYSICAL_DEVICE_TYPE_CPU)) return *i;
+    if (auto i = first_of_type(VK_PHYSICAL_DEVICE_TYPE_CPU)) return *i;
     return fail("no suitable CPU device (install mesa-vulkan-drivers for lavapipe)");
   }
   if (wanted == "gpu") {
     for (VkPhysicalDeviceType type : {VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU, VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU})
-      if (auto i = firstOfType(type)) return *i;
+      if (auto i = first_of_type(type)) return *i;
     return fail("no suitable discrete or integrated GPU");
   }
   size_t index = 0;
@@ -180,7 +185,7 @@ size_t select(const std::vector<Candidate>& candidates, const std::string& selec
 // the moment math use them where present (64-bit/16-bit arithmetic and storage for the quantized
 // moment formats, depth clamp for shadow casters behind the near plane, storage images without a
 // format qualifier for the filters, min/max samplers and host query reset for the timers).
-DeviceFeatures pickFeatures(VkPhysicalDevice device) {
+DeviceFeatures pick_features(VkPhysicalDevice device) {
   DeviceFeatures s;
   s.v13 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
   s.v12 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, .pNext = &s.v13};
@@ -232,27 +237,27 @@ DeviceFeatures pickFeatures(VkPhysicalDevice device) {
 }
 
 // Twice rounded: a * b to float, then + c (volatile: no contraction whatever the flags).
-float unfusedFma(float a, float b, float c) {
+float unfused_fma(float a, float b, float c) {
   volatile float p = a * b;
   return p + c;
 }
 
 // The cases of the fma probe: a * b + c where the result rounded once (std::fma) and rounded twice
 // (a * b to float, then + c) differ, and in some of them also a * b + c computed in double and then
-// rounded to float (checked in probeFusedFma, so a mistake here fails loudly). All results are
+// rounded to float (checked in probe_fused_fma, so a mistake here fails loudly). All results are
 // normal floats: no flush to zero.
 struct FmaCase {
   float a, b, c;
 };
-std::vector<FmaCase> fmaCases() {
+std::vector<FmaCase> fma_cases() {
   constexpr float p12 = 1.0f + 0x1p-12f, p20 = 1.0f + 0x1p-20f;
   return {
       {p12, p12, -1.0f},                            // 2^-11 + 2^-24; twice: 2^-11 (a tie, to even)
-      {0.1f, 0.1f, -unfusedFma(0.1f, 0.1f, 0.0f)},  // the error of 0.1f², as in b2 - b1²; twice: 0
+      {0.1f, 0.1f, -unfused_fma(0.1f, 0.1f, 0.0f)}, // the error of 0.1f², as in b2 - b1²; twice: 0
       {-p20, p20, 1.0f},                            // -(2^-19 + 2^-40); twice: -2^-19
-      {p12, p12, 0x1p-70f},  // just above a tie: 1 + 2^-11 + 2^-23; twice and via double: 1 + 2^-11
-      {-p12, p12, -0x1p-70f},                       // the same, negative
-      {0.7f, 1.3f, -unfusedFma(0.7f, 1.3f, 0.0f)},  // a product's rounding error
+      {p12, p12, 0x1p-70f},   // just above a tie: 1 + 2^-11 + 2^-23; twice and via double: 1 + 2^-11
+      {-p12, p12, -0x1p-70f}, // the same, negative
+      {0.7f, 1.3f, -unfused_fma(0.7f, 1.3f, 0.0f)}, // a product's rounding error
       {3.0f, 0x1.555556p-2f, -1.0f},                // 3 RN(1/3) - 1 = 2^-25; twice: 0
       {1.0e6f + 1.0f, 1.0e6f - 1.0f, -1.0e12f},     // 10^12 - 1 - RN(10^12) = 4095; twice: 0
   };
@@ -285,7 +290,7 @@ void ValidationLog::clear() {
   messages_.clear();
 }
 
-void ValidationLog::setEcho(bool echo) {
+void ValidationLog::set_echo(bool echo) {
   std::lock_guard lock(mutex_);
   echo_ = echo;
 }
@@ -299,70 +304,74 @@ std::string ValidationLog::format(const std::vector<ValidationMessage>& messages
 }
 
 std::string DeviceInfo::describe() const {
-  return fmt::format("{} ({}, driver {} {}, Vulkan {}.{}.{})", name, typeName(type), driverName, driverInfo,
-                     VK_API_VERSION_MAJOR(apiVersion), VK_API_VERSION_MINOR(apiVersion),
-                     VK_API_VERSION_PATCH(apiVersion));
+  return fmt::format("{} ({}, driver {} {}, Vulkan {}.{}.{})", name, type_name(type), driver_name, driver_info,
+                     VK_API_VERSION_MAJOR(api_version), VK_API_VERSION_MINOR(api_version),
+                     VK_API_VERSION_PATCH(api_version));
 }
 
 Context::Context(const ContextOptions& options) {
   try {
-    uint32_t loaderVersion = 0;
-    MSM_VK_CHECK(vkEnumerateInstanceVersion(&loaderVersion));
-    if (loaderVersion < VK_API_VERSION_1_3)
+    uint32_t loader_version = 0;
+    MSM_VK_CHECK(vkEnumerateInstanceVersion(&loader_version));
+    if (loader_version < VK_API_VERSION_1_3)
       throw std::runtime_error(fmt::format("msm::vk: the Vulkan loader supports {}.{}, 1.3 is needed",
-                                           VK_API_VERSION_MAJOR(loaderVersion), VK_API_VERSION_MINOR(loaderVersion)));
+                                           VK_API_VERSION_MAJOR(loader_version), VK_API_VERSION_MINOR(loader_version)));
 
-    log_->setEcho(options.echoValidation);
-    bool wantValidation = options.validation || envFlag("MSM_VALIDATION");
+    log_->set_echo(options.echo_validation);
+    bool want_validation = options.validation || env_flag("MSM_VALIDATION");
     std::vector<const char*> layers, extensions;
-    bool syncValidation = false;
-    if (wantValidation) {
-      std::vector<VkExtensionProperties> layerExtensions = instanceExtensions(kValidationLayer);
-      bool debugUtils = contains(instanceExtensions(nullptr), VK_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
-                        contains(layerExtensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-      if (!hasLayer(kValidationLayer)) {
-        std::fprintf(stderr, "msm::vk: validation requested but %s is not installed (Debian: apt install "
-                             "vulkan-validationlayers); running WITHOUT validation\n", kValidationLayer);
-      } else if (!debugUtils) {
+    bool sync_validation = false;
+    if (want_validation) {
+      std::vector<VkExtensionProperties> layer_extensions = instance_extensions(kValidationLayer);
+      bool debug_utils = contains(instance_extensions(nullptr), VK_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
+                         contains(layer_extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+      if (!has_layer(kValidationLayer)) {
+        std::fprintf(stderr,
+                     "msm::vk: validation requested but %s is not installed (Debian: apt install "
+                     "vulkan-validationlayers); running WITHOUT validation\n",
+                     kValidationLayer);
+      } else if (!debug_utils) {
         std::fprintf(stderr, "msm::vk: validation requested but " VK_EXT_DEBUG_UTILS_EXTENSION_NAME
                              " is missing; running WITHOUT validation\n");
       } else {
         validation_ = true;
         layers.push_back(kValidationLayer);
         extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-        syncValidation = options.synchronizationValidation &&
-                         contains(layerExtensions, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
-        if (syncValidation) extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+        sync_validation =
+            options.synchronization_validation && contains(layer_extensions, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+        if (sync_validation) extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
       }
     }
 
     // The messenger is also chained into VkInstanceCreateInfo so that vkCreateInstance and
     // vkDestroyInstance are covered; it keeps a pointer to *log_, which outlives the instance.
-    VkDebugUtilsMessengerCreateInfoEXT messengerInfo{
+    VkDebugUtilsMessengerCreateInfoEXT messenger_info{
         .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
-        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageSeverity =
+            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
         .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                        VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
-        .pfnUserCallback = onMessage,
+        .pfnUserCallback = on_message,
         .pUserData = log_.get()};
     VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
-    VkValidationFeaturesEXT validationFeatures{.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
-                                               .pNext = &messengerInfo,
-                                               .enabledValidationFeatureCount = 1,
-                                               .pEnabledValidationFeatures = enables};
+    VkValidationFeaturesEXT validation_features{.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+                                                .pNext = &messenger_info,
+                                                .enabledValidationFeatureCount = 1,
+                                                .pEnabledValidationFeatures = enables};
     VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
-                          .pApplicationName = options.applicationName.c_str(),
+                          .pApplicationName = options.application_name.c_str(),
                           .pEngineName = "msm",
                           .apiVersion = VK_API_VERSION_1_3};
-    VkInstanceCreateInfo instanceInfo{
+    VkInstanceCreateInfo instance_info{
         .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-        .pNext = validation_ ? (syncValidation ? static_cast<const void*>(&validationFeatures) : &messengerInfo) : nullptr,
+        .pNext = validation_ ? (sync_validation ? static_cast<const void*>(&validation_features) : &messenger_info)
+                             : nullptr,
         .pApplicationInfo = &app,
         .enabledLayerCount = uint32_t(layers.size()),
         .ppEnabledLayerNames = layers.data(),
         .enabledExtensionCount = uint32_t(extensions.size()),
         .ppEnabledExtensionNames = extensions.data()};
-    MSM_VK_CHECK(vkCreateInstance(&instanceInfo, nullptr, &instance_));
+    MSM_VK_CHECK(vkCreateInstance(&instance_info, nullptr, &instance_));
 
     if (validation_) {
       auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
@@ -372,7 +381,7 @@ Context::Context(const ContextOptions& options) {
       setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
           vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
       if (!create || !destroyMessenger_) throw std::runtime_error("msm::vk: VK_EXT_debug_utils entry points missing");
-      MSM_VK_CHECK(create(instance_, &messengerInfo, nullptr, &messenger_));
+      MSM_VK_CHECK(create(instance_, &messenger_info, nullptr, &messenger_));
     }
 
     uint32_t count = 0;
@@ -393,31 +402,30 @@ Context::Context(const ContextOptions& options) {
     const Candidate& chosen = candidates[select(candidates, selector, source)];
     physicalDevice_ = chosen.device;
     info_ = chosen.info;
-    queueFamily_ = chosen.queueFamily;
-    timestampValidBits_ = chosen.timestampValidBits;
+    queueFamily_ = chosen.queue_family;
+    timestampValidBits_ = chosen.timestamp_valid_bits;
     vkGetPhysicalDeviceProperties(physicalDevice_, &properties_);
     vkGetPhysicalDeviceMemoryProperties(physicalDevice_, &memory_);
 
-    features_ = pickFeatures(physicalDevice_);
+    features_ = pick_features(physicalDevice_);
     DeviceFeatures chain = features_;
     chain.v11.pNext = &chain.v12;
     chain.v12.pNext = &chain.v13;
-    VkPhysicalDeviceFeatures2 features2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2,
-                                        .pNext = &chain.v11,
-                                        .features = chain.core};
+    VkPhysicalDeviceFeatures2 features2{
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &chain.v11, .features = chain.core};
     float priority = 1.0f;
-    VkDeviceQueueCreateInfo queueInfo{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
-                                      .queueFamilyIndex = queueFamily_,
-                                      .queueCount = 1,
-                                      .pQueuePriorities = &priority};
-    const char* deviceExtensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
-    VkDeviceCreateInfo deviceInfo{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
-                                  .pNext = &features2,
-                                  .queueCreateInfoCount = 1,
-                                  .pQueueCreateInfos = &queueInfo,
-                                  .enabledExtensionCount = 1,
-                                  .ppEnabledExtensionNames = deviceExtensions};
-    MSM_VK_CHECK(vkCreateDevice(physicalDevice_, &deviceInfo, nullptr, &device_));
+    VkDeviceQueueCreateInfo queue_info{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+                                       .queueFamilyIndex = queueFamily_,
+                                       .queueCount = 1,
+                                       .pQueuePriorities = &priority};
+    const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    VkDeviceCreateInfo device_info{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+                                   .pNext = &features2,
+                                   .queueCreateInfoCount = 1,
+                                   .pQueueCreateInfos = &queue_info,
+                                   .enabledExtensionCount = 1,
+                                   .ppEnabledExtensionNames = device_extensions};
+    MSM_VK_CHECK(vkCreateDevice(physicalDevice_, &device_info, nullptr, &device_));
     vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
 
     pushDescriptorSet_ =
@@ -427,20 +435,21 @@ Context::Context(const ContextOptions& options) {
     if (!pushDescriptorSet_ || !pushDescriptorSetWithTemplate_)
       throw std::runtime_error("msm::vk: VK_KHR_push_descriptor entry points missing");
 
-    VkCommandPoolCreateInfo poolInfo{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
-                                     .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
-                                     .queueFamilyIndex = queueFamily_};
-    MSM_VK_CHECK(vkCreateCommandPool(device_, &poolInfo, nullptr, &commandPool_));
+    VkCommandPoolCreateInfo pool_info{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+                                      .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
+                                      .queueFamilyIndex = queueFamily_};
+    MSM_VK_CHECK(vkCreateCommandPool(device_, &pool_info, nullptr, &commandPool_));
 
-    fusedFma_ = probeFusedFma();
-    ContextOptions::FmaMode fmaMode = options.fmaMode;
-    if (fmaMode == ContextOptions::FmaMode::Probe && envFlag("MSM_FORCE_EMULATED_FMA"))
-      fmaMode = ContextOptions::FmaMode::Emulated;
-    useNativeFma_ = fmaMode == ContextOptions::FmaMode::Native || (fmaMode == ContextOptions::FmaMode::Probe && fusedFma_);
+    fusedFma_ = probe_fused_fma();
+    ContextOptions::FmaMode fma_mode = options.fma_mode;
+    if (fma_mode == ContextOptions::FmaMode::probe && env_flag("MSM_FORCE_EMULATED_FMA"))
+      fma_mode = ContextOptions::FmaMode::emulated;
+    useNativeFma_ =
+        fma_mode == ContextOptions::FmaMode::native || (fma_mode == ContextOptions::FmaMode::probe && fusedFma_);
 
     if (options.verbose)
       std::fprintf(stderr, "msm::vk: device %u: %s; validation %s; fma() %s, msm_fma %s\n", info_.index,
-                   info_.describe().c_str(), validation_ ? (syncValidation ? "on (+synchronization)" : "on") : "off",
+                   info_.describe().c_str(), validation_ ? (sync_validation ? "on (+synchronization)" : "on") : "off",
                    fusedFma_ ? "fused" : "NOT fused",
                    useNativeFma_ ? (fusedFma_ ? "native" : "native (forced, NOT exact)")
                                  : (fusedFma_ ? "emulated (forced)" : "emulated"));
@@ -468,28 +477,28 @@ void Context::destroy() noexcept {
 
 // Runs fma_probe.comp over kFmaCases (see there): fused if every case, in both of the shader's
 // forms, comes back rounded once. Anything else (twice rounded, evaluated in double, mixed): not.
-bool Context::probeFusedFma() const {
-  const std::vector<FmaCase> cases = fmaCases();
+bool Context::probe_fused_fma() const {
+  const std::vector<FmaCase> cases = fma_cases();
   const uint32_t n = uint32_t(cases.size());
   std::vector<float> words(4 * 3 * n, 0.0f); // vec4 per case: (a, b, c, 0) twice, then the results
-  bool catchesDouble = false;
+  bool catches_double = false;
   for (uint32_t i = 0; i < n; ++i) {
     const FmaCase& k = cases[i];
     float fused = std::fma(k.a, k.b, k.c);
-    if (fused == unfusedFma(k.a, k.b, k.c) || !std::isnormal(fused))
+    if (fused == unfused_fma(k.a, k.b, k.c) || !std::isnormal(fused))
       throw std::logic_error(fmt::format("msm::vk: fma probe case {} does not tell fused from unfused", i));
-    catchesDouble |= fused != float(double(k.a) * double(k.b) + double(k.c));
+    catches_double |= fused != float(double(k.a) * double(k.b) + double(k.c));
     for (uint32_t copy = 0; copy < 2; ++copy) {
       float* v = &words[4 * (copy * n + i)];
       v[0] = k.a, v[1] = k.b, v[2] = k.c;
     }
   }
-  if (!catchesDouble) throw std::logic_error("msm::vk: no fma probe case tells fused from computed in double");
+  if (!catches_double) throw std::logic_error("msm::vk: no fma probe case tells fused from computed in double");
   VkDeviceSize size = words.size() * sizeof(float);
-  Buffer buffer = createBuffer(*this, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
+  Buffer buffer = create_buffer(*this, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   std::memcpy(buffer.data(), words.data(), size);
-  Program probe = createProgram(*this, "fma_probe", {Binding::StorageBuffer});
-  submitAndWait(*this, [&](VkCommandBuffer cmd) { dispatch(cmd, probe, groupCount(n, 64), 1, 1, {buffer}); });
+  Program probe = create_program(*this, "fma_probe", {Binding::storage_buffer});
+  submit_and_wait(*this, [&](VkCommandBuffer cmd) { dispatch(cmd, probe, group_count(n, 64), 1, 1, {buffer}); });
   std::memcpy(words.data(), buffer.data(), size);
   for (uint32_t i = 0; i < n; ++i) {
     float fused = std::fma(cases[i].a, cases[i].b, cases[i].c);
@@ -500,7 +509,7 @@ bool Context::probeFusedFma() const {
   return true;
 }
 
-void Context::setObjectName(VkObjectType type, uint64_t handle, const std::string& name) const {
+void Context::set_object_name(VkObjectType type, uint64_t handle, const std::string& name) const {
   if (!setObjectName_ || !handle) return;
   VkDebugUtilsObjectNameInfoEXT info{.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT,
                                      .objectType = type,

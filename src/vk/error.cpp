@@ -4,9 +4,10 @@
 
 namespace msm::vk {
 
-const char* resultName(VkResult result) noexcept {
+const char* result_name(VkResult result) noexcept {
   switch (result) {
-#define MSM_CASE(name) case name: return #name;
+#define MSM_CASE(name)                                                                                                 \
+  case name: return #name;
     MSM_CASE(VK_SUCCESS)
     MSM_CASE(VK_NOT_READY)
     MSM_CASE(VK_TIMEOUT)
@@ -55,8 +56,8 @@ const char* resultName(VkResult result) noexcept {
   return buffer;
 }
 
-void throwError(VkResult result, const char* call, std::source_location where) {
-  throw Error(result, fmt::format("{} failed: {} at {}:{} ({})", call, resultName(result), where.file_name(),
+void throw_error(VkResult result, const char* call, std::source_location where) {
+  throw Error(result, fmt::format("{} failed: {} at {}:{} ({})", call, result_name(result), where.file_name(),
                                   where.line(), where.function_name()));
 }
 

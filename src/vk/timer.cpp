@@ -33,19 +33,18 @@ std::vector<std::pair<std::string, double>> TimerResults::totals() const {
   return out;
 }
 
-GpuTimer::GpuTimer(const Context& ctx, uint32_t reserveScopes)
-    : device_(ctx.device()), supported_(ctx.timestampValidBits() > 0),
+GpuTimer::GpuTimer(const Context& ctx, uint32_t reserve_scopes)
+    : device_(ctx.device()), supported_(ctx.timestamp_valid_bits() > 0),
       hostQueryReset_(ctx.features().v12.hostQueryReset),
       msPerTick_(double(ctx.properties().limits.timestampPeriod) * 1e-6),
-      mask_(ctx.timestampValidBits() >= 64 ? ~0ull : (1ull << ctx.timestampValidBits()) - 1),
-      poolSize_(2 * std::max(reserveScopes, 1u)) {
-  if (supported_) addPool(VK_NULL_HANDLE); // reset by reset(cmd) before first use
+      mask_(ctx.timestamp_valid_bits() >= 64 ? ~0ull : (1ull << ctx.timestamp_valid_bits()) - 1),
+      poolSize_(2 * std::max(reserve_scopes, 1u)) {
+  if (supported_) add_pool(VK_NULL_HANDLE); // reset by reset(cmd) before first use
 }
 
-void GpuTimer::addPool(VkCommandBuffer cmd) {
-  VkQueryPoolCreateInfo info{.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
-                             .queryType = VK_QUERY_TYPE_TIMESTAMP,
-                             .queryCount = poolSize_};
+void GpuTimer::add_pool(VkCommandBuffer cmd) {
+  VkQueryPoolCreateInfo info{
+      .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = poolSize_};
   VkQueryPool pool = VK_NULL_HANDLE;
   MSM_VK_CHECK(vkCreateQueryPool(device_, &info, nullptr, &pool));
   pools_.emplace_back(device_, pool);
@@ -66,8 +65,8 @@ void GpuTimer::reset(VkCommandBuffer cmd) {
   for (const auto& pool : pools_) vkCmdResetQueryPool(cmd, pool, 0, poolSize_);
 }
 
-uint32_t GpuTimer::nextQuery(VkCommandBuffer cmd) {
-  if (used_ == pools_.size() * poolSize_) addPool(cmd);
+uint32_t GpuTimer::next_query(VkCommandBuffer cmd) {
+  if (used_ == pools_.size() * poolSize_) add_pool(cmd);
   return used_++;
 }
 
@@ -75,8 +74,8 @@ void GpuTimer::begin(VkCommandBuffer cmd, std::string_view name, VkPipelineStage
   if (!recording_) throw std::logic_error("msm::vk::GpuTimer::begin: call reset(cmd) first");
   Record record{std::string(name), uint32_t(open_.size()), 0, 0};
   if (supported_) {
-    record.beginQuery = nextQuery(cmd);
-    vkCmdWriteTimestamp2(cmd, stage, pools_[record.beginQuery / poolSize_], record.beginQuery % poolSize_);
+    record.begin_query = next_query(cmd);
+    vkCmdWriteTimestamp2(cmd, stage, pools_[record.begin_query / poolSize_], record.begin_query % poolSize_);
   }
   open_.push_back(records_.size());
   records_.push_back(std::move(record));
@@ -87,14 +86,15 @@ void GpuTimer::end(VkCommandBuffer cmd, VkPipelineStageFlags2 stage) {
   Record& record = records_[open_.back()];
   open_.pop_back();
   if (supported_) {
-    record.endQuery = nextQuery(cmd);
-    vkCmdWriteTimestamp2(cmd, stage, pools_[record.endQuery / poolSize_], record.endQuery % poolSize_);
+    record.end_query = next_query(cmd);
+    vkCmdWriteTimestamp2(cmd, stage, pools_[record.end_query / poolSize_], record.end_query % poolSize_);
   }
 }
 
 TimerResults GpuTimer::read() {
   if (!open_.empty())
-    throw std::logic_error(fmt::format("msm::vk::GpuTimer::read: scope '{}' was not ended", records_[open_.back()].name));
+    throw std::logic_error(
+        fmt::format("msm::vk::GpuTimer::read: scope '{}' was not ended", records_[open_.back()].name));
   recording_ = false; // the queries must be reset before they are written again
   TimerResults results;
   if (!supported_ || records_.empty()) return results;
@@ -110,11 +110,11 @@ TimerResults GpuTimer::read() {
                                "wait for it first");
     MSM_VK_CHECK(r);
   }
-  // Differences modulo 2^timestampValidBits: the counter may wrap between two timestamps.
-  uint64_t origin = ticks[records_.front().beginQuery];
+  // Differences modulo 2^timestamp_valid_bits: the counter may wrap between two timestamps.
+  uint64_t origin = ticks[records_.front().begin_query];
   auto ms = [&](uint32_t query) { return double((ticks[query] - origin) & mask_) * msPerTick_; };
   for (const Record& record : records_)
-    results.scopes.push_back({record.name, record.depth, ms(record.beginQuery), ms(record.endQuery)});
+    results.scopes.push_back({record.name, record.depth, ms(record.begin_query), ms(record.end_query)});
   return results;
 }
 

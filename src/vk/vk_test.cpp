@@ -7,9 +7,9 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdio>
 #include <cfloat>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -23,7 +23,8 @@ namespace {
 using test::VulkanTest;
 
 // Runs `body` with an environment variable set, restoring the old value.
-template <class F> void withEnv(const char* name, const char* value, F&& body) {
+template <class F>
+void with_env(const char* name, const char* value, F&& body) {
   const char* old = std::getenv(name);
   std::string saved = old ? old : "";
   setenv(name, value, 1);
@@ -36,8 +37,8 @@ template <class F> void withEnv(const char* name, const char* value, F&& body) {
   old ? setenv(name, saved.c_str(), 1) : unsetenv(name);
 }
 
-ContextOptions quietOptions(std::string device = "") {
-  ContextOptions options = test::testOptions();
+ContextOptions quiet_options(std::string device = "") {
+  ContextOptions options = test::test_options();
   options.device = std::move(device);
   options.verbose = false;
   return options;
@@ -54,16 +55,16 @@ TEST(ErrorTest, CheckThrowsWithResultNameAndCallSite) {
     EXPECT_NE(what.find("vk_test.cpp"), std::string::npos) << what;
   }
   EXPECT_NO_THROW(MSM_VK_CHECK(VK_SUCCESS));
-  EXPECT_STREQ(resultName(VK_ERROR_OUT_OF_DEVICE_MEMORY), "VK_ERROR_OUT_OF_DEVICE_MEMORY");
-  EXPECT_STREQ(resultName(VkResult(-12345)), "VkResult(-12345)");
+  EXPECT_STREQ(result_name(VK_ERROR_OUT_OF_DEVICE_MEMORY), "VK_ERROR_OUT_OF_DEVICE_MEMORY");
+  EXPECT_STREQ(result_name(VkResult(-12345)), "VkResult(-12345)");
 }
 
 TEST(ShaderRegistryTest, FindsShadersByFileNameAndStem) {
-  std::span<const uint32_t> byStem = embedded_shader("selftest");
-  ASSERT_GT(byStem.size(), 5u);
-  EXPECT_EQ(byStem[0], 0x07230203u); // SPIR-V magic
-  EXPECT_EQ(embedded_shader("selftest.comp").data(), byStem.data());
-  EXPECT_NE(embedded_shader("selftest_image").data(), byStem.data());
+  std::span<const uint32_t> by_stem = embedded_shader("selftest");
+  ASSERT_GT(by_stem.size(), 5u);
+  EXPECT_EQ(by_stem[0], 0x07230203u); // SPIR-V magic
+  EXPECT_EQ(embedded_shader("selftest.comp").data(), by_stem.data());
+  EXPECT_NE(embedded_shader("selftest_image").data(), by_stem.data());
   std::vector<std::string> names = embedded_shader_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "selftest_image.comp"), names.end());
   // msm_vk's own (the Context's fma probe), linked through the static library's anchor.
@@ -86,39 +87,37 @@ TEST(ContextTest, CreatesLavapipeDeviceWithValidation) {
   {
     std::unique_ptr<Context> ctx;
     try {
-      ctx = std::make_unique<Context>(quietOptions("cpu"));
-    } catch (const std::runtime_error& e) {
-      GTEST_SKIP() << "no lavapipe here: " << e.what();
-    }
-    ASSERT_TRUE(test::validationActive(*ctx));
-    log = ctx->validationLog();
+      ctx = std::make_unique<Context>(quiet_options("cpu"));
+    } catch (const std::runtime_error& e) { GTEST_SKIP() << "no lavapipe here: " << e.what(); }
+    ASSERT_TRUE(test::validation_active(*ctx));
+    log = ctx->validation_log();
     EXPECT_EQ(ctx->info().type, VK_PHYSICAL_DEVICE_TYPE_CPU);
     EXPECT_NE(ctx->info().name.find("llvmpipe"), std::string::npos) << ctx->info().describe();
-    EXPECT_GE(ctx->info().apiVersion, VK_API_VERSION_1_3);
-    EXPECT_NE(ctx->info().describe().find(ctx->info().driverName), std::string::npos);
+    EXPECT_GE(ctx->info().api_version, VK_API_VERSION_1_3);
+    EXPECT_NE(ctx->info().describe().find(ctx->info().driver_name), std::string::npos);
     EXPECT_TRUE(ctx->features().v13.synchronization2);
     EXPECT_TRUE(ctx->features().v13.dynamicRendering);
     EXPECT_TRUE(ctx->features().v12.timelineSemaphore);
-    EXPECT_NE(ctx->cmdPushDescriptorSetWithTemplate(), nullptr);
+    EXPECT_NE(ctx->cmd_push_descriptor_set_with_template(), nullptr);
     EXPECT_NE(ctx->queue(), VK_NULL_HANDLE);
   }
   // Destruction included: the layer reports leaked objects at vkDestroyDevice.
-  EXPECT_TRUE(test::noValidationMessages(*log));
+  EXPECT_TRUE(test::no_validation_messages(*log));
 }
 
 TEST(ContextTest, SelectsDevicesByIndexNameAndEnvironment) {
-  Context byIndex(quietOptions("0"));
-  EXPECT_EQ(byIndex.info().index, 0u);
-  std::string name = byIndex.info().name;
+  Context by_index(quiet_options("0"));
+  EXPECT_EQ(by_index.info().index, 0u);
+  std::string name = by_index.info().name;
   // Case-insensitive substring of the name.
   std::string upper = name.substr(0, 4);
   std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return char(std::toupper(c)); });
-  EXPECT_EQ(Context(quietOptions(upper)).info().index, 0u);
-  withEnv("MSM_DEVICE", "0", [] { EXPECT_EQ(Context(quietOptions()).info().index, 0u); });
+  EXPECT_EQ(Context(quiet_options(upper)).info().index, 0u);
+  with_env("MSM_DEVICE", "0", [] { EXPECT_EQ(Context(quiet_options()).info().index, 0u); });
   // An unknown selector fails, naming what it looked for and what exists.
-  withEnv("MSM_DEVICE", "no-such-device", [&] {
+  with_env("MSM_DEVICE", "no-such-device", [&] {
     try {
-      Context ctx(quietOptions());
+      Context ctx(quiet_options());
       FAIL() << "no exception";
     } catch (const std::runtime_error& e) {
       std::string what = e.what();
@@ -129,56 +128,55 @@ TEST(ContextTest, SelectsDevicesByIndexNameAndEnvironment) {
   });
   // "gpu" gives a GPU or an error, never lavapipe.
   try {
-    Context gpu(quietOptions("gpu"));
+    Context gpu(quiet_options("gpu"));
     EXPECT_TRUE(gpu.info().type == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU ||
                 gpu.info().type == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU);
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("GPU"), std::string::npos) << e.what();
-  }
+  } catch (const std::runtime_error& e) { EXPECT_NE(std::string(e.what()).find("GPU"), std::string::npos) << e.what(); }
 }
 
 // The checks of the other tests can fail: a deliberate misuse is reported.
 TEST(ValidationTest, ReportsAnOutOfRangeBufferBarrier) {
-  ContextOptions options = quietOptions();
-  options.echoValidation = false;
+  ContextOptions options = quiet_options();
+  options.echo_validation = false;
   std::shared_ptr<ValidationLog> log;
   {
     Context ctx(options);
-    if (!ctx.validationEnabled()) {
-      ASSERT_TRUE(test::validationActive(ctx));
+    if (!ctx.validation_enabled()) {
+      ASSERT_TRUE(test::validation_active(ctx));
       GTEST_SKIP() << "validation layer not installed";
     }
-    log = ctx.validationLog();
-    Buffer buffer = createBuffer(ctx, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    log = ctx.validation_log();
+    Buffer buffer = create_buffer(ctx, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     ASSERT_EQ(log->count(), 0u) << ValidationLog::format(log->messages());
-    submitAndWait(ctx, [&](VkCommandBuffer cmd) {
+    submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
       // offset must be less than the buffer's size (VUID-VkBufferMemoryBarrier2-offset-01187).
-      pipelineBarrier(cmd, bufferBarrier(buffer.handle(), VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                         VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                         VK_ACCESS_2_SHADER_READ_BIT, 1024, 16));
+      pipeline_barrier(cmd, buffer_barrier(buffer.handle(), VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                           VK_ACCESS_2_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                           VK_ACCESS_2_SHADER_READ_BIT, 1024, 16));
     });
     std::vector<ValidationMessage> messages = log->messages();
     ASSERT_FALSE(messages.empty());
     EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const ValidationMessage& m) {
-      return m.severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT && m.id.find("offset-01187") != std::string::npos;
+      return m.severity == VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT &&
+             m.id.find("offset-01187") != std::string::npos;
     })) << ValidationLog::format(messages);
     log->clear();
   }
-  EXPECT_TRUE(test::noValidationMessages(*log)); // nothing else went wrong, destruction included
+  EXPECT_TRUE(test::no_validation_messages(*log)); // nothing else went wrong, destruction included
 }
 
 // ... and an object never destroyed is reported when the Context goes.
 TEST(ValidationTest, ReportsObjectsAliveAtDeviceDestruction) {
-  ContextOptions options = quietOptions();
-  options.echoValidation = false;
+  ContextOptions options = quiet_options();
+  options.echo_validation = false;
   std::shared_ptr<ValidationLog> log;
   {
     Context ctx(options);
-    if (!ctx.validationEnabled()) {
-      ASSERT_TRUE(test::validationActive(ctx));
+    if (!ctx.validation_enabled()) {
+      ASSERT_TRUE(test::validation_active(ctx));
       GTEST_SKIP() << "validation layer not installed";
     }
-    log = ctx.validationLog();
+    log = ctx.validation_log();
     VkSamplerCreateInfo info{.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .maxLod = 1.0f};
     VkSampler leaked = VK_NULL_HANDLE;
     MSM_VK_CHECK(vkCreateSampler(ctx.device(), &info, nullptr, &leaked));
@@ -199,15 +197,29 @@ TEST_F(VkLayerTest, SaturateShaderMatchesCpu) {
   for (float& x : input) x = dist(rng);
   // Edges and extremes. No NaN (what msm_saturate does with it is the shared header's contract, not
   // this layer's) and no subnormals (GPUs may flush them to zero, which is not what is tested here).
-  const float specials[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, std::nextafter(1.0f, 2.0f), std::nextafter(1.0f, 0.0f),
-                            FLT_MIN, -FLT_MIN, FLT_MAX, -FLT_MAX, INFINITY, -INFINITY, 1e-30f, 1e30f};
+  const float specials[] = {0.0f,
+                            -0.0f,
+                            1.0f,
+                            -1.0f,
+                            0.5f,
+                            std::nextafter(1.0f, 2.0f),
+                            std::nextafter(1.0f, 0.0f),
+                            FLT_MIN,
+                            -FLT_MIN,
+                            FLT_MAX,
+                            -FLT_MAX,
+                            INFINITY,
+                            -INFINITY,
+                            1e-30f,
+                            1e30f};
   std::copy(std::begin(specials), std::end(specials), input.begin());
 
-  Buffer src = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Device);
-  Buffer dst = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
-  uploadBuffer(ctx(), src, std::as_bytes(std::span(input)));
-  Program program = createProgram(ctx(), "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(uint32_t));
-  submitAndWait(ctx(), [&](VkCommandBuffer cmd) { dispatch(cmd, program, groupCount(n, 64), 1, 1, {src, dst}, n); });
+  Buffer src = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::device);
+  Buffer dst = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
+  upload_buffer(ctx(), src, std::as_bytes(std::span(input)));
+  Program program =
+      create_program(ctx(), "selftest", {Binding::storage_buffer, Binding::storage_buffer}, sizeof(uint32_t));
+  submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { dispatch(cmd, program, group_count(n, 64), 1, 1, {src, dst}, n); });
 
   std::span<const float> out = dst.mapped<const float>();
   ASSERT_EQ(out.size(), n);
@@ -217,13 +229,13 @@ TEST_F(VkLayerTest, SaturateShaderMatchesCpu) {
       ADD_FAILURE() << "i=" << i << " x=" << input[i] << " gpu=" << out[i] << " cpu=" << msm::msm_saturate(input[i]);
   EXPECT_EQ(mismatches, 0);
   // The Device buffer reads back what was uploaded (staging path both ways).
-  EXPECT_EQ(readbackBuffer<float>(ctx(), src, n), input);
+  EXPECT_EQ(readback_buffer<float>(ctx(), src, n), input);
 }
 
 // Inputs a, b, c for msm_fma where rounding a * b first changes the result: the residuals of the
 // Hankel pivots (b2 - b1 b1, b3 - b1 b2 of moments of depths in [-1, 1]), random operands over
 // 2^±20 with c anywhere relative to a b, exact ties, near-ties and ties broken by a tiny c.
-std::vector<float> fmaInputs(uint32_t n) {
+std::vector<float> fma_inputs(uint32_t n) {
   std::mt19937 rng(777);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   std::uniform_int_distribution<int> exponent(-20, 20), shift(-30, 30);
@@ -258,13 +270,14 @@ std::vector<float> fmaInputs(uint32_t n) {
 
 // msm_fma (shared.h) in a shader (selftest_fma.comp) on the Context `ctx`; the number of results
 // that differ from std::fma (bitwise; +0 and -0 alike), the first few reported as failures if `report`.
-int fmaMismatches(Context& ctx, const std::vector<float>& in, const char* setting, bool report = true) {
+int fma_mismatches(Context& ctx, const std::vector<float>& in, const char* setting, bool report = true) {
   uint32_t n = uint32_t(in.size() / 4);
-  Buffer src = createBuffer(ctx, in.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
-  Buffer dst = createBuffer(ctx, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::Host);
+  Buffer src = create_buffer(ctx, in.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
+  Buffer dst = create_buffer(ctx, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   std::memcpy(src.data(), in.data(), in.size() * sizeof(float));
-  Program program = createProgram(ctx, "selftest_fma", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(uint32_t));
-  submitAndWait(ctx, [&](VkCommandBuffer cmd) { dispatch(cmd, program, groupCount(n, 64), 1, 1, {src, dst}, n); });
+  Program program =
+      create_program(ctx, "selftest_fma", {Binding::storage_buffer, Binding::storage_buffer}, sizeof(uint32_t));
+  submit_and_wait(ctx, [&](VkCommandBuffer cmd) { dispatch(cmd, program, group_count(n, 64), 1, 1, {src, dst}, n); });
   std::span<const float> out = dst.mapped<const float>();
   int mismatches = 0;
   for (uint32_t i = 0; i < n; ++i) {
@@ -283,53 +296,55 @@ int fmaMismatches(Context& ctx, const std::vector<float>& in, const char* settin
 // (FmaMode::Emulated, MSM_FORCE_EMULATED_FMA) everywhere. FmaMode::Native on a device that does not
 // fuse shows what the probe protects from: msm_fma rounding twice.
 TEST_F(VkLayerTest, FmaProbeAndExactMsmFma) {
-  std::vector<float> in = fmaInputs(50000);
+  std::vector<float> in = fma_inputs(50000);
   uint32_t n = uint32_t(in.size() / 4);
-  std::printf("[vk] %s: fma() %s; msm_fma %s\n", ctx().info().name.c_str(), ctx().fusedFma() ? "fused" : "NOT fused",
-              ctx().useNativeFma() ? "native" : "emulated");
+  std::printf("[vk] %s: fma() %s; msm_fma %s\n", ctx().info().name.c_str(), ctx().fused_fma() ? "fused" : "NOT fused",
+              ctx().use_native_fma() ? "native" : "emulated");
   bool forced = [] {
     const char* v = std::getenv("MSM_FORCE_EMULATED_FMA");
-    return v && (std::string(v) == "1" || std::string(v) == "true" || std::string(v) == "on" || std::string(v) == "yes");
+    return v &&
+           (std::string(v) == "1" || std::string(v) == "true" || std::string(v) == "on" || std::string(v) == "yes");
   }();
-  EXPECT_EQ(ctx().useNativeFma(), ctx().fusedFma() && !forced);
-  if (ctx().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU && ctx().info().driverName.find("llvmpipe") != std::string::npos) {
-    EXPECT_FALSE(ctx().fusedFma()) << "lavapipe's fma() was measured unfused (a * b, then + c)";
+  EXPECT_EQ(ctx().use_native_fma(), ctx().fused_fma() && !forced);
+  if (ctx().info().type == VK_PHYSICAL_DEVICE_TYPE_CPU &&
+      ctx().info().driver_name.find("llvmpipe") != std::string::npos) {
+    EXPECT_FALSE(ctx().fused_fma()) << "lavapipe's fma() was measured unfused (a * b, then + c)";
   }
   // The shared Context, as the probe set it up.
-  EXPECT_EQ(fmaMismatches(ctx(), in, ctx().useNativeFma() ? "native (probed fused)" : "emulated"), 0);
+  EXPECT_EQ(fma_mismatches(ctx(), in, ctx().use_native_fma() ? "native (probed fused)" : "emulated"), 0);
 
   // Each setting on a Context of its own (same device), validation on.
-  auto withMode = [&](ContextOptions::FmaMode mode, auto&& body) {
-    ContextOptions options = quietOptions();
-    options.fmaMode = mode;
+  auto with_mode = [&](ContextOptions::FmaMode mode, auto&& body) {
+    ContextOptions options = quiet_options();
+    options.fma_mode = mode;
     std::shared_ptr<ValidationLog> log;
     {
       Context other(options);
-      log = other.validationLog();
-      EXPECT_EQ(other.fusedFma(), ctx().fusedFma()) << "the probe is deterministic";
+      log = other.validation_log();
+      EXPECT_EQ(other.fused_fma(), ctx().fused_fma()) << "the probe is deterministic";
       body(other);
     }
-    EXPECT_TRUE(test::noValidationMessages(*log));
+    EXPECT_TRUE(test::no_validation_messages(*log));
   };
-  withMode(ContextOptions::FmaMode::Emulated, [&](Context& c) {
-    EXPECT_FALSE(c.useNativeFma());
-    EXPECT_EQ(fmaMismatches(c, in, "forced emulation"), 0);
+  with_mode(ContextOptions::FmaMode::emulated, [&](Context& c) {
+    EXPECT_FALSE(c.use_native_fma());
+    EXPECT_EQ(fma_mismatches(c, in, "forced emulation"), 0);
   });
-  withMode(ContextOptions::FmaMode::Native, [&](Context& c) {
-    EXPECT_TRUE(c.useNativeFma());
-    if (c.fusedFma()) {
-      EXPECT_EQ(fmaMismatches(c, in, "native"), 0);
+  with_mode(ContextOptions::FmaMode::native, [&](Context& c) {
+    EXPECT_TRUE(c.use_native_fma());
+    if (c.fused_fma()) {
+      EXPECT_EQ(fma_mismatches(c, in, "native"), 0);
     } else { // the native fma() rounds twice: many of these inputs come out wrong
-      int wrong = fmaMismatches(c, in, "native", false);
+      int wrong = fma_mismatches(c, in, "native", false);
       std::printf("[vk] native unfused fma(): %d of %u results differ from std::fma\n", wrong, n);
       EXPECT_GT(wrong, int(n / 10));
     }
   });
   // The environment variable forces the emulation, as FmaMode::Emulated does.
-  withEnv("MSM_FORCE_EMULATED_FMA", "1", [&] {
-    Context forcedCtx(quietOptions());
-    EXPECT_FALSE(forcedCtx.useNativeFma());
-    EXPECT_EQ(forcedCtx.fusedFma(), ctx().fusedFma());
+  with_env("MSM_FORCE_EMULATED_FMA", "1", [&] {
+    Context forced_ctx(quiet_options());
+    EXPECT_FALSE(forced_ctx.use_native_fma());
+    EXPECT_EQ(forced_ctx.fused_fma(), ctx().fused_fma());
   });
 }
 
@@ -352,29 +367,31 @@ TEST_F(VkLayerTest, PushConstantsAndEveryBindingType) {
     }
 
   VkFormat format = VK_FORMAT_R32G32B32A32_SFLOAT;
-  Image sourceImage = createImage(ctx(), {W, H, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-  Image tableImage = createImage(ctx(), {W, H, format, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-  Image result = createImage(ctx(), {W, H, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
-  Buffer params = createBuffer(ctx(), sizeof(offset), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, Memory::Host);
-  Sampler sampler = createSampler(ctx(), VK_FILTER_NEAREST);
-  uploadImage(ctx(), sourceImage, std::as_bytes(std::span(source)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  uploadImage(ctx(), tableImage, std::as_bytes(std::span(table)), VK_IMAGE_LAYOUT_UNDEFINED,
-              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  uploadBuffer(ctx(), params, std::as_bytes(std::span(offset)));
+  Image source_image =
+      create_image(ctx(), {W, H, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  Image table_image = create_image(ctx(), {W, H, format, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  Image result = create_image(ctx(), {W, H, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+  Buffer params = create_buffer(ctx(), sizeof(offset), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, Memory::host);
+  Sampler sampler = create_sampler(ctx(), VK_FILTER_NEAREST);
+  upload_image(ctx(), source_image, std::as_bytes(std::span(source)), VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_GENERAL);
+  upload_image(ctx(), table_image, std::as_bytes(std::span(table)), VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  upload_buffer(ctx(), params, std::as_bytes(std::span(offset)));
 
-  Program program = createProgram(
+  Program program = create_program(
       ctx(), "selftest_image",
-      {Binding::StorageImage, Binding::StorageImage, Binding::SampledImage, Binding::UniformBuffer}, sizeof(Push));
-  submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
-    pipelineBarrier(cmd, imageBarrier(result.handle(), result.aspect(), VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
-                                      VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL));
-    dispatch(cmd, program, groupCount(W, 8), groupCount(H, 8), 1,
-             {sourceImage, result, Descriptor(tableImage, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler), params},
+      {Binding::storage_image, Binding::storage_image, Binding::sampled_image, Binding::uniform_buffer}, sizeof(Push));
+  submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+    pipeline_barrier(cmd, image_barrier(result.handle(), result.aspect(), VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
+                                        VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL));
+    dispatch(cmd, program, group_count(W, 8), group_count(H, 8), 1,
+             {source_image, result, Descriptor(table_image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler), params},
              push);
   });
 
-  std::vector<std::byte> bytes = readbackImage(ctx(), result, VK_IMAGE_LAYOUT_GENERAL);
+  std::vector<std::byte> bytes = readback_image(ctx(), result, VK_IMAGE_LAYOUT_GENERAL);
   ASSERT_EQ(bytes.size(), source.size() * sizeof(float));
   std::vector<float> out(source.size());
   std::memcpy(out.data(), bytes.data(), bytes.size());
@@ -395,61 +412,60 @@ TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
   GpuTimer timer(ctx(), 2); // 4 queries per pool: the scopes below need several pools
   if (!timer.supported()) GTEST_SKIP() << "no timestamps on this queue";
   constexpr uint32_t n = 1 << 16;
-  Buffer a = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  Buffer b = createBuffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  Buffer a = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  Buffer b = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   std::vector<float> zeros(n, 0.5f);
-  uploadBuffer(ctx(), a, std::as_bytes(std::span(zeros)));
-  Program program = createProgram(ctx(), "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(uint32_t));
-  auto computeToCompute = memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                        VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                        VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-  const std::vector<std::string> tinyNames(12, "tiny");
+  upload_buffer(ctx(), a, std::as_bytes(std::span(zeros)));
+  Program program =
+      create_program(ctx(), "selftest", {Binding::storage_buffer, Binding::storage_buffer}, sizeof(uint32_t));
+  auto compute_to_compute = memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                           VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+  const std::vector<std::string> tiny_names(12, "tiny");
 
   for (int frame = 0; frame < 2; ++frame) { // the second frame reuses the grown pools
-    submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+    submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
       timer.reset(cmd);
       timer.begin(cmd, "frame");
       timer.begin(cmd, "shadow_depth");
-      dispatch(cmd, program, groupCount(n, 64), 1, 1, {a, b}, n);
+      dispatch(cmd, program, group_count(n, 64), 1, 1, {a, b}, n);
       timer.end(cmd);
-      pipelineBarrier(cmd, computeToCompute);
+      pipeline_barrier(cmd, compute_to_compute);
       timer.begin(cmd, "filter");
-      dispatch(cmd, program, groupCount(n, 64), 1, 1, {b, a}, n);
+      dispatch(cmd, program, group_count(n, 64), 1, 1, {b, a}, n);
       timer.end(cmd);
-      pipelineBarrier(cmd, computeToCompute);
+      pipeline_barrier(cmd, compute_to_compute);
       timer.begin(cmd, "shadow_depth");
-      dispatch(cmd, program, groupCount(n, 64), 1, 1, {a, b}, n);
+      dispatch(cmd, program, group_count(n, 64), 1, 1, {a, b}, n);
       timer.end(cmd);
-      pipelineBarrier(cmd, computeToCompute);
+      pipeline_barrier(cmd, compute_to_compute);
       timer.end(cmd);
-      for (const std::string& name : tinyNames) {
+      for (const std::string& name : tiny_names) {
         timer.begin(cmd, name);
         timer.end(cmd);
       }
     });
     TimerResults r = timer.read();
-    ASSERT_EQ(r.scopes.size(), 4 + tinyNames.size());
+    ASSERT_EQ(r.scopes.size(), 4 + tiny_names.size());
     std::vector<std::string> names;
     for (const TimerScope& s : r.scopes) names.push_back(s.name);
     std::vector<std::string> expected = {"frame", "shadow_depth", "filter", "shadow_depth"};
-    expected.insert(expected.end(), tinyNames.begin(), tinyNames.end());
+    expected.insert(expected.end(), tiny_names.begin(), tiny_names.end());
     EXPECT_EQ(names, expected);
     EXPECT_EQ(r.scopes[0].depth, 0u);
     EXPECT_EQ(r.scopes[1].depth, 1u);
     EXPECT_EQ(r.scopes[4].depth, 0u);
-    EXPECT_EQ(r.scopes[0].startMs, 0.0);
+    EXPECT_EQ(r.scopes[0].start_ms, 0.0);
     for (const TimerScope& s : r.scopes) {
-      EXPECT_GE(s.startMs, 0.0) << s.name;
+      EXPECT_GE(s.start_ms, 0.0) << s.name;
       EXPECT_GE(s.ms(), 0.0) << s.name;
     }
     // Sequential scopes do not overlap; nested ones lie inside their parent.
     for (size_t i = 1; i + 1 < r.scopes.size(); ++i)
-      if (i != 3) {
-        EXPECT_LE(r.scopes[i].endMs, r.scopes[i + 1].startMs) << i;
-      }
+      if (i != 3) { EXPECT_LE(r.scopes[i].end_ms, r.scopes[i + 1].start_ms) << i; }
     for (size_t i = 1; i <= 3; ++i) {
-      EXPECT_GE(r.scopes[i].startMs, r.scopes[0].startMs);
-      EXPECT_LE(r.scopes[i].endMs, r.scopes[0].endMs);
+      EXPECT_GE(r.scopes[i].start_ms, r.scopes[0].start_ms);
+      EXPECT_LE(r.scopes[i].end_ms, r.scopes[0].end_ms);
     }
     EXPECT_GT(r.scopes[0].ms(), 0.0); // three dispatches of 65536 invocations take some time
     EXPECT_EQ(r.count("shadow_depth"), 2u);
@@ -462,7 +478,7 @@ TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
   }
 
   // Misuse is an exception, not a validation error or a hang.
-  submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+  submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
     EXPECT_THROW(timer.begin(cmd, "no reset"), std::logic_error);
     timer.reset(cmd);
     EXPECT_THROW(timer.end(cmd), std::logic_error);
@@ -474,80 +490,87 @@ TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
 }
 
 TEST_F(VkLayerTest, ArgumentErrorsThrowBeforeAnythingIsRecorded) {
-  Buffer buffer = createBuffer(ctx(), 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  Program program = createProgram(ctx(), "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, 4);
+  Buffer buffer = create_buffer(ctx(), 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  Program program = create_program(ctx(), "selftest", {Binding::storage_buffer, Binding::storage_buffer}, 4);
   EXPECT_EQ(program.name(), "selftest");
   EXPECT_EQ(program.bindings().size(), 2u);
-  submitAndWait(ctx(), [&](VkCommandBuffer cmd) {
+  submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
     EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer}, 1u), std::invalid_argument);
     EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer, buffer}), std::invalid_argument);
     EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer, buffer}, uint64_t(1)), std::invalid_argument);
   });
-  EXPECT_THROW(createProgram(ctx(), "selftest", {Binding::StorageBuffer}, 6), std::invalid_argument);
-  const uint32_t notSpirv[] = {1, 2, 3};
-  EXPECT_THROW(createProgram(ctx(), notSpirv, "junk", {}), std::invalid_argument);
-  EXPECT_THROW(createProgram(ctx(), "no_such_shader", {}), std::runtime_error);
+  EXPECT_THROW(create_program(ctx(), "selftest", {Binding::storage_buffer}, 6), std::invalid_argument);
+  const uint32_t not_spirv[] = {1, 2, 3};
+  EXPECT_THROW(create_program(ctx(), not_spirv, "junk", {}), std::invalid_argument);
+  EXPECT_THROW(create_program(ctx(), "no_such_shader", {}), std::runtime_error);
   // An exception while recording leaves nothing behind (the command buffer is freed, unsubmitted).
-  EXPECT_THROW(submitAndWait(ctx(), [](VkCommandBuffer) { throw std::runtime_error("recording failed"); }),
+  EXPECT_THROW(submit_and_wait(ctx(), [](VkCommandBuffer) { throw std::runtime_error("recording failed"); }),
                std::runtime_error);
   std::byte bytes[16]{};
-  EXPECT_THROW(uploadBuffer(ctx(), buffer, bytes, 56), std::out_of_range);
-  EXPECT_THROW(readbackBuffer(ctx(), buffer, bytes, 64), std::out_of_range);
+  EXPECT_THROW(upload_buffer(ctx(), buffer, bytes, 56), std::out_of_range);
+  EXPECT_THROW(readback_buffer(ctx(), buffer, bytes, 64), std::out_of_range);
 }
 
 TEST_F(VkLayerTest, BuffersRoundTripAtOffsets) {
   std::vector<uint32_t> words(256);
   for (uint32_t i = 0; i < words.size(); ++i) words[i] = i * 2654435761u;
-  for (Memory memory : {Memory::Device, Memory::Host}) {
-    Buffer buffer = createBuffer(ctx(), 4096, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, memory);
+  for (Memory memory : {Memory::device, Memory::host}) {
+    Buffer buffer = create_buffer(ctx(), 4096, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, memory);
     EXPECT_EQ(buffer.memory(), memory);
-    EXPECT_EQ(buffer.data() != nullptr, memory == Memory::Host);
-    uploadBuffer(ctx(), buffer, std::as_bytes(std::span(words)), 1024);
-    EXPECT_EQ(readbackBuffer<uint32_t>(ctx(), buffer, words.size(), 1024), words);
+    EXPECT_EQ(buffer.data() != nullptr, memory == Memory::host);
+    upload_buffer(ctx(), buffer, std::as_bytes(std::span(words)), 1024);
+    EXPECT_EQ(readback_buffer<uint32_t>(ctx(), buffer, words.size(), 1024), words);
     Buffer moved = std::move(buffer); // move-only handles: the moved-from one owns nothing
     EXPECT_FALSE(buffer);
-    EXPECT_EQ(readbackBuffer<uint32_t>(ctx(), moved, 4, 1024 + 8), std::vector<uint32_t>(words.begin() + 2, words.begin() + 6));
+    EXPECT_EQ(readback_buffer<uint32_t>(ctx(), moved, 4, 1024 + 8),
+              std::vector<uint32_t>(words.begin() + 2, words.begin() + 6));
   }
 }
 
 TEST_F(VkLayerTest, ImagesWithMipsLayersSamplesAndViews) {
   // Layers round trip through upload/readback.
-  Image layered = createImage(ctx(), {.width = 16, .height = 8, .format = VK_FORMAT_R32_SFLOAT,
-                                      .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                                               VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                                      .layers = 3});
+  Image layered = create_image(
+      ctx(), {.width = 16,
+              .height = 8,
+              .format = VK_FORMAT_R32_SFLOAT,
+              .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+              .layers = 3});
   std::vector<float> texels(16 * 8 * 3);
   for (size_t i = 0; i < texels.size(); ++i) texels[i] = float(i) * 0.5f;
-  uploadImage(ctx(), layered, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED,
-              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  std::vector<std::byte> bytes = readbackImage(ctx(), layered, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  upload_image(ctx(), layered, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED,
+               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  std::vector<std::byte> bytes = readback_image(ctx(), layered, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   ASSERT_EQ(bytes.size(), texels.size() * sizeof(float));
   EXPECT_EQ(std::memcmp(bytes.data(), texels.data(), bytes.size()), 0);
 
   // A mip chain with one view per mip, as a reduction pass would use.
-  Image mips = createImage(ctx(), {.width = 64, .height = 64, .format = VK_FORMAT_R16G16B16A16_SFLOAT,
-                                   .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT,
-                                   .mipLevels = 7});
+  Image mips = create_image(ctx(), {.width = 64,
+                                    .height = 64,
+                                    .format = VK_FORMAT_R16G16B16A16_SFLOAT,
+                                    .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_STORAGE_BIT,
+                                    .mip_levels = 7});
   EXPECT_NE(mips.view(), VK_NULL_HANDLE);
-  std::vector<ImageView> mipViews;
+  std::vector<ImageView> mip_views;
   for (uint32_t mip = 0; mip < 7; ++mip)
-    mipViews.push_back(createImageView(ctx(), mips.handle(), mips.format(), VK_IMAGE_ASPECT_COLOR_BIT,
-                                       VK_IMAGE_VIEW_TYPE_2D, mip, 1));
+    mip_views.push_back(create_image_view(ctx(), mips.handle(), mips.format(), VK_IMAGE_ASPECT_COLOR_BIT,
+                                          VK_IMAGE_VIEW_TYPE_2D, mip, 1));
 
   // A multisampled depth target and a comparison sampler for shadow lookups.
   VkSampleCountFlags counts = ctx().properties().limits.framebufferDepthSampleCounts;
   VkSampleCountFlagBits samples = (counts & VK_SAMPLE_COUNT_4_BIT) ? VK_SAMPLE_COUNT_4_BIT : VK_SAMPLE_COUNT_1_BIT;
-  Image depth = createImage(ctx(), {.width = 32, .height = 32, .format = VK_FORMAT_D32_SFLOAT,
-                                    .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-                                    .samples = samples});
+  Image depth = create_image(ctx(), {.width = 32,
+                                     .height = 32,
+                                     .format = VK_FORMAT_D32_SFLOAT,
+                                     .usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                                     .samples = samples});
   EXPECT_EQ(depth.aspect(), VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT));
-  Sampler shadowSampler = createSampler(ctx(), VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER,
-                                        VK_COMPARE_OP_LESS_OR_EQUAL);
-  EXPECT_TRUE(shadowSampler);
+  Sampler shadow_sampler =
+      create_sampler(ctx(), VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER, VK_COMPARE_OP_LESS_OR_EQUAL);
+  EXPECT_TRUE(shadow_sampler);
 
   // Transfer-only images get no view; move assignment releases the old image first.
-  Image plain = createImage(ctx(), {.width = 4, .height = 4, .format = VK_FORMAT_R8G8B8A8_UNORM,
-                                    .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  Image plain = create_image(
+      ctx(), {.width = 4, .height = 4, .format = VK_FORMAT_R8G8B8A8_UNORM, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
   EXPECT_EQ(plain.view(), VK_NULL_HANDLE);
   plain = std::move(depth);
   EXPECT_FALSE(depth);

@@ -59,9 +59,11 @@ void add_bench(CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
                                           "pixel, shadow map per texel)");
   cmd->add_option("--techniques", opt->techniques, "Techniques (default: all)")->delimiter(',');
-  cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")->delimiter(',')
+  cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")
+      ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--shadow-sizes", opt->shadow_sizes, "Shadow map sizes for the shadow-map cost")->delimiter(',')
+  cmd->add_option("--shadow-sizes", opt->shadow_sizes, "Shadow map sizes for the shadow-map cost")
+      ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--frames", opt->frames, "Timed frames per configuration")->capture_default_str();
   cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str();
@@ -82,23 +84,30 @@ void add_bench(CLI::App& app) {
     for (const std::string& name : names) {
       render::RenderSettings s = settings_for(opt->frame, name);
       try {
-        for (auto [w, h] : resolutions) { s.width = w; s.height = h; s.validate(); }
-        for (int size : opt->shadow_sizes) { s.shadow_size = size; s.validate(); }
-      } catch (const render::RenderError& e) {
-        throw UsageError(e.what());
-      }
+        for (auto [w, h] : resolutions) {
+          s.width = w;
+          s.height = h;
+          s.validate();
+        }
+        for (int size : opt->shadow_sizes) {
+          s.shadow_size = size;
+          s.validate();
+        }
+      } catch (const render::RenderError& e) { throw UsageError(e.what()); }
     }
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
-    const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve", "translucent", "blur", "mipmaps",
-                                                    "one_pass_filter", "sat"};
+    const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve",  "translucent", "blur",
+                                                    "mipmaps",      "one_pass_filter", "sat"};
 
     // A progress line: rewritten in place on a terminal, one line per step in a log.
     bool tty = isatty(fileno(stderr));
     auto progress = [&](const std::string& line) {
-      if (tty) fmt::print(stderr, "\r{:<70}", line);
-      else fmt::print(stderr, "{}\n", line);
+      if (tty)
+        fmt::print(stderr, "\r{:<70}", line);
+      else
+        fmt::print(stderr, "{}\n", line);
     };
     auto run = [&](render::RenderSettings s) {
       if (opt->warmup) renderer.time_frames(s, opt->warmup);
@@ -108,8 +117,10 @@ void add_bench(CLI::App& app) {
     std::map<std::string, std::map<std::string, double>> per_unit; // technique -> config -> ns per unit
     size_t total = names.size() * (resolutions.size() + opt->shadow_sizes.size()), done = 0;
     for (const std::string& name : names) {
-      nlohmann::json entry = {{"technique", name}, {"shading", nlohmann::json::object()},
-                              {"shadow_map", nlohmann::json::object()}, {"passes", nlohmann::json::object()}};
+      nlohmann::json entry = {{"technique", name},
+                              {"shading", nlohmann::json::object()},
+                              {"shadow_map", nlohmann::json::object()},
+                              {"passes", nlohmann::json::object()}};
       for (auto [w, h] : resolutions) {
         render::RenderSettings s = settings_for(opt->frame, name);
         s.width = w;
@@ -120,7 +131,8 @@ void add_bench(CLI::App& app) {
         std::string key = fmt::format("{}x{}", w, h);
         double ns = st.median * 1e6 / (double(w) * h);
         per_unit[name]["shading " + key] = ns;
-        entry["shading"][key] = {{"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_pixel", ns}};
+        entry["shading"][key] = {
+            {"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_pixel", ns}};
         if (key == fmt::format("{}x{}", resolutions[0].first, resolutions[0].second))
           for (const render::PassTime& p : frames[0]) {
             Stats ps = pass_sum(frames, {p.name});
@@ -137,8 +149,8 @@ void add_bench(CLI::App& app) {
         std::string key = std::to_string(size);
         double ns = st.median * 1e6 / (double(size) * size);
         per_unit[name]["shadow " + key] = ns;
-        entry["shadow_map"][key] = {{"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90},
-                                    {"ns_per_texel", ns}};
+        entry["shadow_map"][key] = {
+            {"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_texel", ns}};
       }
       results.push_back(entry);
     }
@@ -179,9 +191,8 @@ void add_bench(CLI::App& app) {
       md += "\n";
     }
     if (with_pcss) {
-      md += fmt::format("\nSoft shadows, shading time relative to pcss ({}² search):", opt->frame.settings.soft_kernel
-                                                                                         ? opt->frame.settings.soft_kernel
-                                                                                         : render::kDefaultPcssKernel);
+      md += fmt::format("\nSoft shadows, shading time relative to pcss ({}² search):",
+                        opt->frame.settings.soft_kernel ? opt->frame.settings.soft_kernel : render::kDefaultPcssKernel);
       for (const nlohmann::json& entry : results)
         for (auto [w, h] : resolutions) {
           const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
@@ -192,15 +203,17 @@ void add_bench(CLI::App& app) {
       md += "\n";
     }
     fmt::print("{}", md);
-    nlohmann::json doc = {{"device", ctx->info().describe()}, {"scene", scene.name}, {"frames", opt->frames},
-                          {"warmup", opt->warmup}, {"msaa", opt->frame.settings.msaa},
-                          {"filter_size", opt->frame.settings.filter_size}, {"results", results}};
+    nlohmann::json doc = {{"device", ctx->info().describe()},
+                          {"scene", scene.name},
+                          {"frames", opt->frames},
+                          {"warmup", opt->warmup},
+                          {"msaa", opt->frame.settings.msaa},
+                          {"filter_size", opt->frame.settings.filter_size},
+                          {"results", results}};
     auto write = [](const std::string& path, const std::string& text) {
       try {
         image::write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-      } catch (const image::ImageError& e) {
-        throw UsageError(e.what());
-      }
+      } catch (const image::ImageError& e) { throw UsageError(e.what()); }
     };
     if (!opt->json.empty()) write(opt->json, doc.dump(2) + "\n");
     if (!opt->markdown.empty()) write(opt->markdown, md);

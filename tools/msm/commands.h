@@ -16,7 +16,7 @@ void add_scenes(CLI::App& app);
 
 // Thrown by commands for bad input: main prints the message and exits with status 2.
 struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
+  using std::runtime_error::runtime_error;
 };
 
 } // namespace msm::tool

@@ -66,8 +66,8 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   if (truth_rgb) panels.push_back({"ray traced", *truth_rgb, "reference"});
   std::vector<std::string> pass_names;
   // Every pass any technique ran, in the order of a frame.
-  for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur",
-                           "mipmaps", "shading"})
+  for (const char* name :
+       {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps", "shading"})
     for (const render::RenderResult& r : results)
       if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
         pass_names.push_back(name);
@@ -88,8 +88,8 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
       line += ms < 0 ? fmt::format(" {:>14}", "-") : fmt::format(" {:>14.3f}", ms);
     }
     fmt::print("{} {:>10.3f}\n", line, results[i].total_ms);
-    std::string caption = i == 0 && !truth ? std::string("reference")
-                                           : fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking);
+    std::string caption =
+        i == 0 && !truth ? std::string("reference") : fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking);
     panels.push_back({std::string(t.name), results[i].color, caption});
   }
   image::ComposeOptions options;
@@ -99,9 +99,7 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   std::filesystem::path file = std::filesystem::path(out) / figure_name;
   try {
     image::write_png(file, figure);
-  } catch (const image::ImageError& e) {
-    throw UsageError(e.what());
-  }
+  } catch (const image::ImageError& e) { throw UsageError(e.what()); }
   fmt::print("\nErrors are in visibility against {}, background excluded; times are GPU timestamps, median of 5 "
              "frames.\nWrote {} ({}x{}) and per technique PNG, shadow-buffer EXR and JSON in {}/\n",
              truth ? "the ray-traced area light" : techniques[0] + " (same kernel)", file.string(), figure.width(),
@@ -114,7 +112,7 @@ void add_demo(CLI::App& app) {
   struct Options {
     FrameOptions frame;
     std::string out = "msm-demo";
-    std::vector<std::string> techniques = {"pcf",          "vsm-32",   "evsm4-64", "msm-hamburger-64", "msm-hamburger-128",
+    std::vector<std::string> techniques = {"pcf",      "vsm-32",  "evsm4-64", "msm-hamburger-64", "msm-hamburger-128",
                                            "msm-nl64", "msm-nl32"};
     std::string soft_scene = "models";
     std::vector<std::string> soft_techniques = {"mssm4", "mssm6", "vssm", "pcss"};

@@ -7,26 +7,24 @@
 #include <exception>
 
 int main(int argc, char** argv) {
-    CLI::App app{"msm: moment shadow mapping toolkit (filtered, soft and volumetric shadows)"};
-    app.require_subcommand(1);
-    msm::tool::add_kernels(app);
-    msm::tool::add_techniques(app);
-    msm::tool::add_reconstruct(app);
-    msm::tool::add_compare(app);
+  CLI::App app{"msm: moment shadow mapping toolkit (filtered, soft and volumetric shadows)"};
+  app.require_subcommand(1);
+  msm::tool::add_kernels(app);
+  msm::tool::add_techniques(app);
+  msm::tool::add_reconstruct(app);
+  msm::tool::add_compare(app);
 #if MSM_TOOL_RENDER
-    msm::tool::add_demo(app);
-    msm::tool::add_bench(app);
-    msm::tool::add_render(app);
-    msm::tool::add_scenes(app);
+  msm::tool::add_demo(app);
+  msm::tool::add_bench(app);
+  msm::tool::add_render(app);
+  msm::tool::add_scenes(app);
 #endif
-    msm::tool::add_reference(app);
-    try {
-        app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
-        return app.exit(e);
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "msm: error: {}\n", e.what());
-        return 2;
-    }
-    return 0;
+  msm::tool::add_reference(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) { return app.exit(e); } catch (const std::exception& e) {
+    fmt::print(stderr, "msm: error: {}\n", e.what());
+    return 2;
+  }
+  return 0;
 }

@@ -27,178 +27,174 @@ namespace fs = std::filesystem;
 using msm::reference::Settings;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // Creates DIR and checks that a file can be written there, before any long render.
 void prepare_output(const fs::path& dir) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw UsageError(fmt::format("--out {}: cannot create the directory: {}", dir.string(), ec.message()));
-    if (!fs::is_directory(dir, ec)) throw UsageError(fmt::format("--out {}: not a directory", dir.string()));
-    const fs::path probe = dir / fmt::format(".msm-reference-probe.{}", ::getpid());
-    {
-        std::ofstream out(probe, std::ios::binary);
-        if (!out || !(out << "probe") || !out.flush()) {
-            fs::remove(probe, ec);
-            throw UsageError(fmt::format("--out {}: the directory is not writable", dir.string()));
-        }
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw UsageError(fmt::format("--out {}: cannot create the directory: {}", dir.string(), ec.message()));
+  if (!fs::is_directory(dir, ec)) throw UsageError(fmt::format("--out {}: not a directory", dir.string()));
+  const fs::path probe = dir / fmt::format(".msm-reference-probe.{}", ::getpid());
+  {
+    std::ofstream out(probe, std::ios::binary);
+    if (!out || !(out << "probe") || !out.flush()) {
+      fs::remove(probe, ec);
+      throw UsageError(fmt::format("--out {}: the directory is not writable", dir.string()));
     }
-    fs::remove(probe, ec);
+  }
+  fs::remove(probe, ec);
 }
 
 // A one-line progress bar on stderr.
 class ProgressBar {
-public:
-    void operator()(const msm::reference::Progress& p) {
-        const double fraction = p.rows_total ? double(p.rows_done) / double(p.rows_total) : 1.0;
-        const int width = 40, filled = int(fraction * width + 0.5);
-        const double eta = fraction > 0.0 ? p.seconds * (1.0 - fraction) / fraction : 0.0;
-        fmt::print(stderr, "\rmsm reference [{}{}] {:3.0f}%  {:.1f} s, {:.1f} s left ", std::string(filled, '#'),
-                   std::string(width - filled, ' '), 100.0 * fraction, p.seconds, eta);
-        if (p.rows_done == p.rows_total) fmt::print(stderr, "\n");
-        std::fflush(stderr);
-    }
+ public:
+  void operator()(const msm::reference::Progress& p) {
+    const double fraction = p.rows_total ? double(p.rows_done) / double(p.rows_total) : 1.0;
+    const int width = 40, filled = int(fraction * width + 0.5);
+    const double eta = fraction > 0.0 ? p.seconds * (1.0 - fraction) / fraction : 0.0;
+    fmt::print(stderr, "\rmsm reference [{}{}] {:3.0f}%  {:.1f} s, {:.1f} s left ", std::string(filled, '#'),
+               std::string(width - filled, ' '), 100.0 * fraction, p.seconds, eta);
+    if (p.rows_done == p.rows_total) fmt::print(stderr, "\n");
+    std::fflush(stderr);
+  }
 };
 
-}  // namespace
+} // namespace
 
 void add_reference(CLI::App& app) {
-    struct Options {
-        std::string scene{msm::scene::default_scene_name()};
-        std::string effect, out = "out/reference", light_shape = "disc", sampler = "stratified";
-        int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = 9, max_crossings = 64, threads = 0;
-        std::uint64_t seed = 1;
-        double filter_sigma = 2.4;
-        std::optional<double> light_extent, light_width, light_height;
-        bool json = false, progress = false;
-    };
-    auto opt = std::make_shared<Options>();
-    auto* cmd = app.add_subcommand("reference", "Ground-truth shadows of a scene by CPU ray tracing (Embree): "
-                                                "visibility.exr, radiance.exr, reference.json");
-    cmd->add_option("--scene", opt->scene, "Built-in scene name or scene file (default fence)");
-    cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent")->required();
-    cmd->add_option("--width", opt->width, "Image width (default 640)");
-    cmd->add_option("--height", opt->height, "Image height (default 360)");
-    cmd->add_option("--samples", opt->samples, "Samples per pixel of filtered and soft (default 256)");
-    cmd->add_option("--seed", opt->seed, "Seed of the per-pixel generators (default 1)");
-    cmd->add_option("--sampler", opt->sampler, "stratified (default) | independent");
-    cmd->add_option("--shadow-size", opt->shadow_size, "filtered: shadow map size in texels (default 1024)");
-    cmd->add_option("--filter-size", opt->filter_size, "filtered: Gaussian taps per axis, odd (default 9)");
-    cmd->add_option("--filter-sigma", opt->filter_sigma, "filtered: Gaussian sigma in texels (default 2.4)");
-    cmd->add_option("--light-extent", opt->light_extent,
-                    "soft: angular diameter of the light in degrees (default: the scene's)");
-    cmd->add_option("--light-shape", opt->light_shape, "soft: disc (default) | rectangle");
-    cmd->add_option("--light-width", opt->light_width, "soft, rectangle: angular width in degrees (default: extent)");
-    cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
-    cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
-    cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
-    cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
-    cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
-    cmd->add_flag("--progress", opt->progress, "Progress bar on stderr (default: when stderr is a terminal)");
-    cmd->callback([opt] {
-        const auto start = std::chrono::steady_clock::now();
-        Settings settings;
-        const auto effect = msm::reference::parse_effect(opt->effect);
-        if (!effect) throw UsageError(fmt::format("--effect {}: expected hard, filtered, soft or translucent", opt->effect));
-        settings.effect = *effect;
-        const auto shape = msm::reference::parse_light_shape(opt->light_shape);
-        if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
-        settings.light_shape = *shape;
-        const auto sampler = msm::reference::parse_sampler(opt->sampler);
-        if (!sampler) throw UsageError(fmt::format("--sampler {}: expected stratified or independent", opt->sampler));
-        settings.sampler = *sampler;
-        settings.width = opt->width;
-        settings.height = opt->height;
-        settings.samples = opt->samples;
-        settings.seed = opt->seed;
-        settings.shadow_size = opt->shadow_size;
-        settings.filter_size = opt->filter_size;
-        settings.filter_sigma = opt->filter_sigma;
-        settings.light_extent_deg = opt->light_extent;
-        settings.light_width_deg = opt->light_width;
-        settings.light_height_deg = opt->light_height;
-        settings.max_crossings = opt->max_crossings;
-        settings.threads = opt->threads;
-        try {
-            msm::reference::validate(settings);
-        } catch (const std::invalid_argument& e) {
-            throw UsageError(e.what());
-        }
-        if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
-            throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
-        const msm::scene::Scene scene = msm::scene::load_scene(opt->scene);  // SceneError: printed by main
-        const double load_seconds = seconds_since(start);
-        const fs::path out = opt->out;
-        prepare_output(out);
-        ProgressBar bar;
-        if (opt->progress || ::isatty(::fileno(stderr))) settings.progress = bar;
+  struct Options {
+    std::string scene{msm::scene::default_scene_name()};
+    std::string effect, out = "out/reference", light_shape = "disc", sampler = "stratified";
+    int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = 9, max_crossings = 64, threads = 0;
+    std::uint64_t seed = 1;
+    double filter_sigma = 2.4;
+    std::optional<double> light_extent, light_width, light_height;
+    bool json = false, progress = false;
+  };
+  auto opt = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("reference", "Ground-truth shadows of a scene by CPU ray tracing (Embree): "
+                                              "visibility.exr, radiance.exr, reference.json");
+  cmd->add_option("--scene", opt->scene, "Built-in scene name or scene file (default fence)");
+  cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent")->required();
+  cmd->add_option("--width", opt->width, "Image width (default 640)");
+  cmd->add_option("--height", opt->height, "Image height (default 360)");
+  cmd->add_option("--samples", opt->samples, "Samples per pixel of filtered and soft (default 256)");
+  cmd->add_option("--seed", opt->seed, "Seed of the per-pixel generators (default 1)");
+  cmd->add_option("--sampler", opt->sampler, "stratified (default) | independent");
+  cmd->add_option("--shadow-size", opt->shadow_size, "filtered: shadow map size in texels (default 1024)");
+  cmd->add_option("--filter-size", opt->filter_size, "filtered: Gaussian taps per axis, odd (default 9)");
+  cmd->add_option("--filter-sigma", opt->filter_sigma, "filtered: Gaussian sigma in texels (default 2.4)");
+  cmd->add_option("--light-extent", opt->light_extent,
+                  "soft: angular diameter of the light in degrees (default: the scene's)");
+  cmd->add_option("--light-shape", opt->light_shape, "soft: disc (default) | rectangle");
+  cmd->add_option("--light-width", opt->light_width, "soft, rectangle: angular width in degrees (default: extent)");
+  cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
+  cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
+  cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
+  cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
+  cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
+  cmd->add_flag("--progress", opt->progress, "Progress bar on stderr (default: when stderr is a terminal)");
+  cmd->callback([opt] {
+    const auto start = std::chrono::steady_clock::now();
+    Settings settings;
+    const auto effect = msm::reference::parse_effect(opt->effect);
+    if (!effect)
+      throw UsageError(fmt::format("--effect {}: expected hard, filtered, soft or translucent", opt->effect));
+    settings.effect = *effect;
+    const auto shape = msm::reference::parse_light_shape(opt->light_shape);
+    if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
+    settings.light_shape = *shape;
+    const auto sampler = msm::reference::parse_sampler(opt->sampler);
+    if (!sampler) throw UsageError(fmt::format("--sampler {}: expected stratified or independent", opt->sampler));
+    settings.sampler = *sampler;
+    settings.width = opt->width;
+    settings.height = opt->height;
+    settings.samples = opt->samples;
+    settings.seed = opt->seed;
+    settings.shadow_size = opt->shadow_size;
+    settings.filter_size = opt->filter_size;
+    settings.filter_sigma = opt->filter_sigma;
+    settings.light_extent_deg = opt->light_extent;
+    settings.light_width_deg = opt->light_width;
+    settings.light_height_deg = opt->light_height;
+    settings.max_crossings = opt->max_crossings;
+    settings.threads = opt->threads;
+    try {
+      msm::reference::validate(settings);
+    } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
+    if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
+      throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
+    const msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    const double load_seconds = seconds_since(start);
+    const fs::path out = opt->out;
+    prepare_output(out);
+    ProgressBar bar;
+    if (opt->progress || ::isatty(::fileno(stderr))) settings.progress = bar;
 
-        msm::reference::Result result;
-        try {
-            result = msm::reference::render(scene, settings);
-        } catch (const std::invalid_argument& e) {
-            throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
-        }
-        const auto write_start = std::chrono::steady_clock::now();
-        try {
-            msm::image::write_exr(out / "visibility.exr", result.visibility);
-            msm::image::write_exr(out / "radiance.exr", result.radiance);
-            // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
-            // from an earlier run into the same folder for the other effects.
-            if (!result.visibility_rgb.empty()) {
-                msm::image::write_exr(out / "visibility_rgb.exr", result.visibility_rgb);
-            } else {
-                std::error_code ec;
-                fs::remove(out / "visibility_rgb.exr", ec);
-            }
-        } catch (const msm::image::ImageError& e) {
-            throw UsageError(e.what());
-        }
+    msm::reference::Result result;
+    try {
+      result = msm::reference::render(scene, settings);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
+    }
+    const auto write_start = std::chrono::steady_clock::now();
+    try {
+      msm::image::write_exr(out / "visibility.exr", result.visibility);
+      msm::image::write_exr(out / "radiance.exr", result.radiance);
+      // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
+      // from an earlier run into the same folder for the other effects.
+      if (!result.visibility_rgb.empty()) {
+        msm::image::write_exr(out / "visibility_rgb.exr", result.visibility_rgb);
+      } else {
+        std::error_code ec;
+        fs::remove(out / "visibility_rgb.exr", ec);
+      }
+    } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
 
-        nlohmann::ordered_json j;
-        j["scene"] = {{"name", scene.name}, {"source", scene.source.string()}, {"triangles", scene.triangle_count()}};
-        j["effect"] = std::string(msm::reference::to_string(settings.effect));
-        j["width"] = settings.width;
-        j["height"] = settings.height;
-        j["samples"] = result.samples;
-        j["sampler"] = std::string(msm::reference::to_string(settings.sampler));
-        j["seed"] = settings.seed;
-        j["filter"] = {{"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
-        j["light"] = {{"shape", std::string(msm::reference::to_string(settings.light_shape))},
-                      {"extent_deg", result.light_extent_deg},
-                      {"width_deg", result.light_width_deg},
-                      {"height_deg", result.light_height_deg}};
-        j["max_crossings"] = settings.max_crossings;
-        j["threads"] = result.threads;
-        j["rays"] = result.rays;
-        j["background_pixels"] = result.background_pixels;
-        j["mean_visibility"] = result.mean_visibility;
-        j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}};
-        j["channels"] = {{"visibility", result.visibility.channel_names()}, {"radiance", result.radiance.channel_names()}};
-        if (!result.visibility_rgb.empty()) {
-            j["files"]["visibility_rgb"] = "visibility_rgb.exr";
-            j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();
-        }
-        j["seconds"] = {{"load", load_seconds},
-                        {"build", result.build_seconds},
-                        {"render", result.render_seconds},
-                        {"write_images", seconds_since(write_start)},
-                        {"total", seconds_since(start)}};
-        const std::string text = j.dump(2) + "\n";
-        try {
-            msm::image::write_file_atomic(out / "reference.json",
-                                          {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
-        } catch (const msm::image::ImageError& e) {
-            throw UsageError(e.what());
-        }
-        if (opt->json)
-            fmt::print("{}", text);
-        else
-            fmt::print("msm reference: {} {} {}x{}, {} spp: mean visibility {:.4f}, {:.2f} s ({} rays) -> {}\n",
-                       scene.name, opt->effect, settings.width, settings.height, result.samples, result.mean_visibility,
-                       result.render_seconds, result.rays, out.string());
-    });
+    nlohmann::ordered_json j;
+    j["scene"] = {{"name", scene.name}, {"source", scene.source.string()}, {"triangles", scene.triangle_count()}};
+    j["effect"] = std::string(msm::reference::to_string(settings.effect));
+    j["width"] = settings.width;
+    j["height"] = settings.height;
+    j["samples"] = result.samples;
+    j["sampler"] = std::string(msm::reference::to_string(settings.sampler));
+    j["seed"] = settings.seed;
+    j["filter"] = {
+        {"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
+    j["light"] = {{"shape", std::string(msm::reference::to_string(settings.light_shape))},
+                  {"extent_deg", result.light_extent_deg},
+                  {"width_deg", result.light_width_deg},
+                  {"height_deg", result.light_height_deg}};
+    j["max_crossings"] = settings.max_crossings;
+    j["threads"] = result.threads;
+    j["rays"] = result.rays;
+    j["background_pixels"] = result.background_pixels;
+    j["mean_visibility"] = result.mean_visibility;
+    j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}};
+    j["channels"] = {{"visibility", result.visibility.channel_names()}, {"radiance", result.radiance.channel_names()}};
+    if (!result.visibility_rgb.empty()) {
+      j["files"]["visibility_rgb"] = "visibility_rgb.exr";
+      j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();
+    }
+    j["seconds"] = {{"load", load_seconds},
+                    {"build", result.build_seconds},
+                    {"render", result.render_seconds},
+                    {"write_images", seconds_since(write_start)},
+                    {"total", seconds_since(start)}};
+    const std::string text = j.dump(2) + "\n";
+    try {
+      msm::image::write_file_atomic(out / "reference.json",
+                                    {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
+    if (opt->json)
+      fmt::print("{}", text);
+    else
+      fmt::print("msm reference: {} {} {}x{}, {} spp: mean visibility {:.4f}, {:.2f} s ({} rays) -> {}\n", scene.name,
+                 opt->effect, settings.width, settings.height, result.samples, result.mean_visibility,
+                 result.render_seconds, result.rays, out.string());
+  });
 }
 
-}  // namespace msm::tool
+} // namespace msm::tool

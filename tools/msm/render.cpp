@@ -33,7 +33,8 @@ void add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
                                            "EXR and JSON per technique)");
   cmd->add_option("--technique,-t", opt->techniques,
-                  "Technique, comma-separated list, or 'all' (msm techniques lists them)")->capture_default_str();
+                  "Technique, comma-separated list, or 'all' (msm techniques lists them)")
+      ->capture_default_str();
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
@@ -55,14 +56,13 @@ void add_render(CLI::App& app) {
       render::RenderResult result;
       try {
         result = renderer.render(s);
-      } catch (const render::RenderError& e) {
-        throw UsageError(e.what());
-      }
+      } catch (const render::RenderError& e) { throw UsageError(e.what()); }
       write_render(opt->out, names[i], result, render_json(s, scene, *ctx, result));
       if (names.size() > 1 || tty || !result.shadow_rgb.empty())
         fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU -> {}/{}.png{}\n", i + 1, names.size(), names[i],
                    result.total_ms, opt->out, names[i],
-                   result.shadow_rgb.empty() ? "" : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]));
+                   result.shadow_rgb.empty() ? ""
+                                             : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]));
     }
   });
 }

@@ -20,12 +20,15 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--filter", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
   cmd->add_option("--sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
   cmd->add_flag("--no-mipmaps", o.no_mipmaps, "No mip chain for the moment images");
-  cmd->add_option("--param", o.params, "Technique parameters x,y,z,w (see msm techniques)")->delimiter(',')->expected(4);
+  cmd->add_option("--param", o.params, "Technique parameters x,y,z,w (see msm techniques)")
+      ->delimiter(',')
+      ->expected(4);
   cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
-  cmd->add_flag_callback("--no-translucent-occluders", [&s] { s.translucent_occluders = false; },
-                         "Translucent objects cast no shadow (not blended into the moment map)");
+  cmd->add_flag_callback(
+      "--no-translucent-occluders", [&s] { s.translucent_occluders = false; },
+      "Translucent objects cast no shadow (not blended into the moment map)");
   cmd->add_option("--alpha-threshold", s.translucent_alpha_threshold,
                   "Translucent fragments below this opacity are not blended (JCGT: 1%)")
       ->capture_default_str();
@@ -37,16 +40,22 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
       ->check(CLI::Range(0.0f, 4.0f))
       ->capture_default_str();
   cmd->add_option("--exposure", s.exposure, "Exposure before tone mapping")->capture_default_str();
-  cmd->add_option("--lookup", o.lookup, "Shadow-map lookup: auto (dither for msm-nl*, else bilinear), bilinear, "
-                                         "nearest, dither")->capture_default_str();
-  cmd->add_option("--filter-mode", o.filter_mode, "auto (one-pass for msm-nl*), one-pass (resolve + blur in shared "
-                                                  "memory), three-pass (resolve, blur H, blur V)")->capture_default_str();
-  cmd->add_option("--light-extent", s.light_extent_deg, "Angular diameter of the light in degrees, for soft "
-                                                      "shadows (default: the scene's)");
+  cmd->add_option("--lookup", o.lookup,
+                  "Shadow-map lookup: auto (dither for msm-nl*, else bilinear), bilinear, "
+                  "nearest, dither")
+      ->capture_default_str();
+  cmd->add_option("--filter-mode", o.filter_mode,
+                  "auto (one-pass for msm-nl*), one-pass (resolve + blur in shared "
+                  "memory), three-pass (resolve, blur H, blur V)")
+      ->capture_default_str();
+  cmd->add_option("--light-extent", s.light_extent_deg,
+                  "Angular diameter of the light in degrees, for soft "
+                  "shadows (default: the scene's)");
   cmd->add_option("--soft-kernel", s.soft_kernel,
                   "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15");
   cmd->add_option("--frame", s.frame, "Frame number (blue-noise layer and offset)")->capture_default_str();
-  cmd->add_option("--device", o.device, "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
+  cmd->add_option("--device", o.device,
+                  "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
 }
 
 void finish_frame_options(FrameOptions& o) {
@@ -56,13 +65,20 @@ void finish_frame_options(FrameOptions& o) {
   }
   o.settings.mipmaps = !o.no_mipmaps;
   using Lookup = render::RenderSettings::Lookup;
-  if (o.lookup == "auto") o.settings.lookup = Lookup::automatic;
-  else if (o.lookup == "bilinear") o.settings.lookup = Lookup::bilinear;
-  else if (o.lookup == "nearest") o.settings.lookup = Lookup::nearest;
-  else if (o.lookup == "dither") o.settings.lookup = Lookup::dither;
-  else throw UsageError(fmt::format("--lookup {}: use auto, bilinear, nearest or dither", o.lookup));
-  if (o.filter_mode == "one-pass") o.settings.one_pass = true;
-  else if (o.filter_mode == "three-pass") o.settings.one_pass = false;
+  if (o.lookup == "auto")
+    o.settings.lookup = Lookup::automatic;
+  else if (o.lookup == "bilinear")
+    o.settings.lookup = Lookup::bilinear;
+  else if (o.lookup == "nearest")
+    o.settings.lookup = Lookup::nearest;
+  else if (o.lookup == "dither")
+    o.settings.lookup = Lookup::dither;
+  else
+    throw UsageError(fmt::format("--lookup {}: use auto, bilinear, nearest or dither", o.lookup));
+  if (o.filter_mode == "one-pass")
+    o.settings.one_pass = true;
+  else if (o.filter_mode == "three-pass")
+    o.settings.one_pass = false;
   else if (o.filter_mode != "auto")
     throw UsageError(fmt::format("--filter-mode {}: use auto, one-pass or three-pass", o.filter_mode));
 }
@@ -83,9 +99,7 @@ void validate_techniques(const FrameOptions& options, const std::vector<std::str
   for (const std::string& name : techniques) {
     try {
       settings_for(options, name).validate();
-    } catch (const render::RenderError& e) {
-      throw UsageError(e.what());
-    }
+    } catch (const render::RenderError& e) { throw UsageError(e.what()); }
   }
 }
 
@@ -95,25 +109,21 @@ std::unique_ptr<vk::Context> open_device(const std::string& device) {
   options.verbose = false;
   try {
     return std::make_unique<vk::Context>(options);
-  } catch (const std::exception& e) {
-    throw UsageError(fmt::format("no usable Vulkan device: {}", e.what()));
-  }
+  } catch (const std::exception& e) { throw UsageError(fmt::format("no usable Vulkan device: {}", e.what())); }
 }
 
 scene::Scene load_scene_or_fail(const std::string& name_or_path) {
   try {
     return scene::load_scene(name_or_path);
-  } catch (const scene::SceneError& e) {
-    throw UsageError(e.what());
-  }
+  } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
 }
 
 void ensure_output_dir(const std::filesystem::path& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
-    throw UsageError(fmt::format("{}: cannot create the output directory: {}", dir.string(),
-                                 ec ? ec.message() : "not a directory"));
+    throw UsageError(
+        fmt::format("{}: cannot create the output directory: {}", dir.string(), ec ? ec.message() : "not a directory"));
   if (access(dir.c_str(), W_OK) != 0)
     throw UsageError(fmt::format("{}: the output directory is not writable", dir.string()));
 }
@@ -146,8 +156,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"lookup", s.lookup == render::RenderSettings::Lookup::bilinear  ? "bilinear"
                      : s.lookup == render::RenderSettings::Lookup::nearest ? "nearest"
                      : s.lookup == render::RenderSettings::Lookup::dither  ? "dither"
-                     : msm_technique_is_nonlinear(t.id)                     ? "dither (auto)"
-                                                                            : "bilinear (auto)"},
+                     : msm_technique_is_nonlinear(t.id)                    ? "dither (auto)"
+                                                                           : "bilinear (auto)"},
           {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
           {"frame", s.frame},
           {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg},
@@ -169,9 +179,7 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
     std::string text = json.dump(2) + "\n";
     image::write_file_atomic(dir / (stem + ".json"),
                              std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-  } catch (const image::ImageError& e) {
-    throw UsageError(e.what());
-  }
+  } catch (const image::ImageError& e) { throw UsageError(e.what()); }
 }
 
 } // namespace msm::tool

@@ -17,11 +17,11 @@ namespace msm::tool {
 
 struct FrameOptions {
   render::RenderSettings settings;
-  std::string scene = "fence";   // built-in name or scene file
-  std::string device;             // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
-  std::vector<float> params;      // technique parameter override (4 values)
+  std::string scene = "fence"; // built-in name or scene file
+  std::string device;          // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
+  std::vector<float> params;   // technique parameter override (4 values)
   bool no_mipmaps = false;
-  std::string lookup = "auto";    // auto, bilinear, nearest, dither
+  std::string lookup = "auto";      // auto, bilinear, nearest, dither
   std::string filter_mode = "auto"; // auto, one-pass, three-pass
 };
 

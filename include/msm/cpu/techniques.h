@@ -16,19 +16,19 @@ namespace msm::cpu {
 using Texel = std::array<float, 8>;
 
 struct Technique {
-    std::string_view name;
-    std::string_view description;
-    int bits_per_texel;
-    int channels;
-    // The id in the shared technique table (include/msm/techniques.h, MSM_TECH_*), which the
-    // renderer uses too; -1 for the techniques only this CPU pipeline has.
-    int id;
-    // Channels for one depth sample; depth is the shadow map's [0,1] depth.
-    Texel (*generate)(float unit_depth);
-    // What writing the filtered texel to its storage format and reading it back returns.
-    Texel (*store_load)(const Texel& filtered);
-    // Shadow intensity in [0,1] (1 = fully shadowed) at fragment depth unit_zf in [0,1].
-    float (*shade)(const Texel& stored, float unit_zf);
+  std::string_view name;
+  std::string_view description;
+  int bits_per_texel;
+  int channels;
+  // The id in the shared technique table (include/msm/techniques.h, MSM_TECH_*), which the
+  // renderer uses too; -1 for the techniques only this CPU pipeline has.
+  int id;
+  // Channels for one depth sample; depth is the shadow map's [0,1] depth.
+  Texel (*generate)(float unit_depth);
+  // What writing the filtered texel to its storage format and reading it back returns.
+  Texel (*store_load)(const Texel& filtered);
+  // Shadow intensity in [0,1] (1 = fully shadowed) at fragment depth unit_zf in [0,1].
+  float (*shade)(const Texel& stored, float unit_zf);
 };
 
 // All techniques, in the order of the comparison tables.
@@ -37,8 +37,8 @@ std::span<const Technique> techniques();
 const Technique& find_technique(std::string_view name);
 
 // Filtered shadow for a kernel holding 'depths' with 'weights' (non-negative, any sum > 0).
-float filtered_shadow(const Technique& technique, std::span<const float> depths,
-                      std::span<const float> weights, float unit_zf);
+float filtered_shadow(const Technique& technique, std::span<const float> depths, std::span<const float> weights,
+                      float unit_zf);
 
 // The exact answer, Z(z < zf): percentage-closer filtering with the same kernel.
 float percentage_closer(std::span<const float> depths, std::span<const float> weights, float unit_zf);

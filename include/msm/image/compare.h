@@ -17,30 +17,30 @@ namespace msm::image {
 // Each metric must be <= its tolerance (inclusive). Defaults: strict on MAE and share > 3%,
 // no NaN/inf allowed, everything else unbounded.
 struct Tolerances {
-    static constexpr double none = std::numeric_limits<double>::infinity();
-    double max_mae = 0.01;
-    double max_rmse = none;
-    double max_error = none;
-    double max_share_above_1pct = none;
-    double max_share_above_3pct = 0.01;
-    double max_share_above_10pct = none;
-    double max_light_leaking = none;
-    double max_over_darkening = none;
-    std::size_t max_non_finite = 0;
+  static constexpr double none = std::numeric_limits<double>::infinity();
+  double max_mae = 0.01;
+  double max_rmse = none;
+  double max_error = none;
+  double max_share_above_1pct = none;
+  double max_share_above_3pct = 0.01;
+  double max_share_above_10pct = none;
+  double max_light_leaking = none;
+  double max_over_darkening = none;
+  std::size_t max_non_finite = 0;
 };
 
 struct CompareOptions {
-    MetricOptions metrics{};           // signal, channel, mask
-    std::filesystem::path failure_dir{}; // where to dump on failure (created); empty: no dump
-    double error_range = 0.1;        // scale of the false-colour error image
+  MetricOptions metrics{};             // signal, channel, mask
+  std::filesystem::path failure_dir{}; // where to dump on failure (created); empty: no dump
+  double error_range = 0.1;            // scale of the false-colour error image
 };
 
 struct CompareResult {
-    bool passed = false;
-    Metrics metrics;    // zero if the images could not be compared (size mismatch, bad channel)
-    std::string report; // one line "PASS ..." / "FAIL ..." then the metrics and any violations,
-                        // and on failure the files written (or why they could not be)
-    explicit operator bool() const noexcept { return passed; }
+  bool passed = false;
+  Metrics metrics;    // zero if the images could not be compared (size mismatch, bad channel)
+  std::string report; // one line "PASS ..." / "FAIL ..." then the metrics and any violations,
+                      // and on failure the files written (or why they could not be)
+  explicit operator bool() const noexcept { return passed; }
 };
 
 // Never throws for bad images: a size mismatch or an unknown channel is a failed comparison.

@@ -26,8 +26,8 @@ namespace msm::image {
 
 // A pixel window: x in [x, x + width), y in [y, y + height).
 struct Rect {
-    int x = 0, y = 0, width = 0, height = 0;
-    bool operator==(const Rect&) const = default;
+  int x = 0, y = 0, width = 0, height = 0;
+  bool operator==(const Rect&) const = default;
 };
 
 // ---- Text ------------------------------------------------------------------------------------
@@ -51,10 +51,10 @@ void draw_text(Image& rgb, int x, int y, std::string_view text, glm::vec3 colour
 // [y, y + text_height + 2 * scale), then the text inset by `scale` pixels (one font unit).
 // Nothing is drawn for empty text. Same requirements and clipping as draw_text.
 struct LabelStyle {
-    glm::vec3 text_colour{1.0f};
-    glm::vec3 box_colour{0.0f};
-    float box_opacity = 0.75f;
-    int scale = 2;
+  glm::vec3 text_colour{1.0f};
+  glm::vec3 box_colour{0.0f};
+  float box_opacity = 0.75f;
+  int scale = 2;
 };
 void draw_label(Image& rgb, int x, int y, std::string_view text, const LabelStyle& style = {});
 
@@ -81,22 +81,22 @@ std::vector<Rect> find_difference_regions(std::span<const Image> signals, int in
 // ---- Comparison figure -----------------------------------------------------------------------
 
 struct Panel {
-    std::string label;   // drawn on the image, top-left (may be empty)
-    Image rgb;           // linear; 3 or 4 channels = R,G,B(,A), 1 or 2 = grey(,A); alpha is ignored
-    std::string caption; // optional line(s) under the cell, e.g. "MAE 0.012 vs PCF"
+  std::string label;   // drawn on the image, top-left (may be empty)
+  Image rgb;           // linear; 3 or 4 channels = R,G,B(,A), 1 or 2 = grey(,A); alpha is ignored
+  std::string caption; // optional line(s) under the cell, e.g. "MAE 0.012 vs PCF"
 };
 
 struct ComposeOptions {
-    std::vector<Rect> insets;      // windows in panel pixels, each inside the panel (same for all)
-    int magnification = 3;         // >= 1: inset scale when the row of insets fits the panel width
-    int columns = 0;               // panels per row; 0 (or >= the panel count): all in one row
-    int margin = 8;                // >= 0: around the figure, between cells and between a cell's parts
-    int outline = 2;               // >= 0: thickness of the inset frames
-    int text_scale = 2;            // >= 1: labels and captions (a glyph is 9 * scale pixels tall)
-    glm::vec3 background{0.02f};   // linear
-    std::vector<glm::vec3> inset_colours; // frame colour of inset i = inset_colours[i % size];
-                                          // empty: a built-in palette of saturated hues
-    LabelStyle label{};            // the label's scale is text_scale
+  std::vector<Rect> insets;             // windows in panel pixels, each inside the panel (same for all)
+  int magnification = 3;                // >= 1: inset scale when the row of insets fits the panel width
+  int columns = 0;                      // panels per row; 0 (or >= the panel count): all in one row
+  int margin = 8;                       // >= 0: around the figure, between cells and between a cell's parts
+  int outline = 2;                      // >= 0: thickness of the inset frames
+  int text_scale = 2;                   // >= 1: labels and captions (a glyph is 9 * scale pixels tall)
+  glm::vec3 background{0.02f};          // linear
+  std::vector<glm::vec3> inset_colours; // frame colour of inset i = inset_colours[i % size];
+                                        // empty: a built-in palette of saturated hues
+  LabelStyle label{};                   // the label's scale is text_scale
 };
 
 // One linear RGB image (channels R,G,B) of all panels in a grid. With W x H the panel size,

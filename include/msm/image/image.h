@@ -21,14 +21,14 @@ namespace msm::image {
 // Every failure of this library to read, write or build an image: the path (empty where none is
 // involved) and the reason. what() is "<path>: <reason>".
 class ImageError : public std::runtime_error {
-public:
-    ImageError(std::filesystem::path path, std::string reason);
-    const std::filesystem::path& path() const noexcept { return path_; }
-    const std::string& reason() const noexcept { return reason_; }
+ public:
+  ImageError(std::filesystem::path path, std::string reason);
+  const std::filesystem::path& path() const noexcept { return path_; }
+  const std::string& reason() const noexcept { return reason_; }
 
-private:
-    std::filesystem::path path_;
-    std::string reason_;
+ private:
+  std::filesystem::path path_;
+  std::string reason_;
 };
 
 // Largest width or height accepted anywhere (construction, reading, writing).
@@ -39,42 +39,42 @@ inline constexpr int max_channels = 4;
 std::vector<std::string> default_channel_names(int channels);
 
 class Image {
-public:
-    Image() = default; // empty: 0 x 0, no channels; only assignable, readable as empty()
-    // Throws ImageError for a side outside 1..max_side or channels outside 1..max_channels.
-    Image(int width, int height, int channels, float fill = 0.0f);
-    // Channel count = names.size(); names must be distinct and non-empty.
-    Image(int width, int height, std::vector<std::string> channel_names, float fill = 0.0f);
+ public:
+  Image() = default; // empty: 0 x 0, no channels; only assignable, readable as empty()
+  // Throws ImageError for a side outside 1..max_side or channels outside 1..max_channels.
+  Image(int width, int height, int channels, float fill = 0.0f);
+  // Channel count = names.size(); names must be distinct and non-empty.
+  Image(int width, int height, std::vector<std::string> channel_names, float fill = 0.0f);
 
-    int width() const noexcept { return width_; }
-    int height() const noexcept { return height_; }
-    int channels() const noexcept { return static_cast<int>(names_.size()); }
-    bool empty() const noexcept { return pixels_.empty(); }
-    std::size_t pixel_count() const noexcept { return std::size_t(width_) * std::size_t(height_); }
+  int width() const noexcept { return width_; }
+  int height() const noexcept { return height_; }
+  int channels() const noexcept { return static_cast<int>(names_.size()); }
+  bool empty() const noexcept { return pixels_.empty(); }
+  std::size_t pixel_count() const noexcept { return std::size_t(width_) * std::size_t(height_); }
 
-    const std::vector<std::string>& channel_names() const noexcept { return names_; }
-    void set_channel_names(std::vector<std::string> names); // same count, distinct, non-empty
-    // Index of the channel with that name, or -1.
-    int find_channel(std::string_view name) const noexcept;
+  const std::vector<std::string>& channel_names() const noexcept { return names_; }
+  void set_channel_names(std::vector<std::string> names); // same count, distinct, non-empty
+  // Index of the channel with that name, or -1.
+  int find_channel(std::string_view name) const noexcept;
 
-    // Bounds-checked access: throws std::out_of_range outside the image or the channels.
-    float& at(int x, int y, int c = 0);
-    float at(int x, int y, int c = 0) const;
+  // Bounds-checked access: throws std::out_of_range outside the image or the channels.
+  float& at(int x, int y, int c = 0);
+  float at(int x, int y, int c = 0) const;
 
-    // The raw interleaved row-major values (size width * height * channels).
-    std::span<float> pixels() noexcept { return pixels_; }
-    std::span<const float> pixels() const noexcept { return pixels_; }
+  // The raw interleaved row-major values (size width * height * channels).
+  std::span<float> pixels() noexcept { return pixels_; }
+  std::span<const float> pixels() const noexcept { return pixels_; }
 
-    // One channel as a 1-channel image named "Y" (by index, or by name: ImageError if unknown).
-    Image channel(int c) const;
-    Image channel(std::string_view name) const;
+  // One channel as a 1-channel image named "Y" (by index, or by name: ImageError if unknown).
+  Image channel(int c) const;
+  Image channel(std::string_view name) const;
 
-    bool operator==(const Image&) const = default; // exact: sizes, names and every value
+  bool operator==(const Image&) const = default; // exact: sizes, names and every value
 
-private:
-    int width_ = 0, height_ = 0;
-    std::vector<std::string> names_;
-    std::vector<float> pixels_;
+ private:
+  int width_ = 0, height_ = 0;
+  std::vector<std::string> names_;
+  std::vector<float> pixels_;
 };
 
 // ---- Colour conversions ----------------------------------------------------------------------
@@ -91,15 +91,15 @@ std::uint8_t linear_to_srgb8(float linear);
 float luminance(float r, float g, float b);
 
 enum class ToneCurve {
-    clamp,    // x (clamped to [0,1] only when encoded)
-    reinhard, // x / (1 + x)
-    aces,     // Narkowicz 2015 fit of the ACES filmic curve:
-              //   x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped to [0,1]
+  clamp,    // x (clamped to [0,1] only when encoded)
+  reinhard, // x / (1 + x)
+  aces,     // Narkowicz 2015 fit of the ACES filmic curve:
+            //   x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped to [0,1]
 };
 
 struct ToneMap {
-    float exposure_stops = 0.0f; // colour channels are scaled by 2^exposure_stops first
-    ToneCurve curve = ToneCurve::clamp;
+  float exposure_stops = 0.0f; // colour channels are scaled by 2^exposure_stops first
+  ToneCurve curve = ToneCurve::clamp;
 };
 
 // Applies exposure and the curve to every channel except one named "A" (alpha, kept as is).

@@ -34,25 +34,25 @@
 namespace msm::image {
 
 enum class Signal {
-    visibility,       // larger = brighter (visibility, light intensity, luminance)
-    shadow_intensity, // larger = darker (shadow intensity = 1 - visibility)
+  visibility,       // larger = brighter (visibility, light intensity, luminance)
+  shadow_intensity, // larger = darker (shadow intensity = 1 - visibility)
 };
 
 struct MetricOptions {
-    Signal signal = Signal::visibility;
-    std::string channel{};       // channel to compare (empty: see select_signal)
-    const Image* mask = nullptr; // pixels to ignore where > 0.5
+  Signal signal = Signal::visibility;
+  std::string channel{};       // channel to compare (empty: see select_signal)
+  const Image* mask = nullptr; // pixels to ignore where > 0.5
 };
 
 struct Metrics {
-    int width = 0, height = 0;
-    std::size_t pixels = 0;     // counted pixels N
-    std::size_t masked = 0;     // ignored by the mask
-    std::size_t non_finite = 0; // NaN/inf in test or reference (not masked)
-    double mae = 0, rmse = 0, max_error = 0;
-    int max_error_x = -1, max_error_y = -1;
-    double share_above_1pct = 0, share_above_3pct = 0, share_above_10pct = 0;
-    double light_leaking = 0, over_darkening = 0, mean_error = 0;
+  int width = 0, height = 0;
+  std::size_t pixels = 0;     // counted pixels N
+  std::size_t masked = 0;     // ignored by the mask
+  std::size_t non_finite = 0; // NaN/inf in test or reference (not masked)
+  double mae = 0, rmse = 0, max_error = 0;
+  int max_error_x = -1, max_error_y = -1;
+  double share_above_1pct = 0, share_above_3pct = 0, share_above_10pct = 0;
+  double light_leaking = 0, over_darkening = 0, mean_error = 0;
 };
 
 // The scalar signal compared (1 channel, named "Y"); channel empty = automatic (see above).
@@ -71,9 +71,8 @@ std::string metrics_json(const Metrics& metrics, int indent = 2);
 // t > 0: (1, 1 - t, 1 - t), t < 0: (1 - |t|, 1 - |t|, 1). Masked pixels are mid grey (0.5),
 // non-finite ones green (0, 1, 0). Values are stored linear so that write_png yields exactly
 // these display colours. range must be > 0 (else ImageError).
-Image error_image(const Image& test, const Image& reference, double range = 0.1,
-                  const MetricOptions& options = {});
-void write_error_png(const std::filesystem::path& path, const Image& test, const Image& reference,
-                     double range = 0.1, const MetricOptions& options = {});
+Image error_image(const Image& test, const Image& reference, double range = 0.1, const MetricOptions& options = {});
+void write_error_png(const std::filesystem::path& path, const Image& test, const Image& reference, double range = 0.1,
+                     const MetricOptions& options = {});
 
 } // namespace msm::image

@@ -38,7 +38,7 @@ double cdf_at_or_below(std::span<const double> depths, std::span<const double> w
 // polynomials of the stated degree and accurate to rounding for smooth functions such as
 // sin(2 pi k z) (k <= 16) or exp(c z) (|c| (b - a) <= 200) on the component's interval.
 class Mixture {
-public:
+ public:
   // delta(z). Precondition: z finite, weight > 0.
   Mixture& dirac(double z, double weight = 1.0);
   // Uniform on [a, b]. Precondition: a < b finite, weight > 0.
@@ -71,7 +71,7 @@ public:
   double mean() const;
   double variance() const;
 
-private:
+ private:
   enum class Kind { dirac, uniform, gaussian, beta };
   struct Component {
     Kind kind;

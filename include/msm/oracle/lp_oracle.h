@@ -57,9 +57,9 @@ std::vector<double> merge_grids(std::span<const double> a, std::span<const doubl
 // up to 20 (relative); without them the rows hold to 1e-19 and the bounds match the moment
 // oracle to 3e-12 once its atoms are grid points.
 struct LpOptions {
-  double tolerance = 1e-10;     // glp_smcp tol_bnd and tol_dj (GLPK default 1e-7; 1e-12 can cycle)
-  bool presolve = false;        // glp_smcp presolve (which also scales the presolved problem)
-  bool glpk_scaling = false;    // glp_scale_prob(GLP_SF_AUTO)
+  double tolerance = 1e-10;  // glp_smcp tol_bnd and tol_dj (GLPK default 1e-7; 1e-12 can cycle)
+  bool presolve = false;     // glp_smcp presolve (which also scales the presolved problem)
+  bool glpk_scaling = false; // glp_scale_prob(GLP_SF_AUTO)
   // glp_exact (rational arithmetic on the preconditioned double data) after the simplex, from its
   // basis. Removes the simplex tolerances; measured 0.07-0.5 s per call on 1001-1443 points for
   // m = 4..8, against 1-25 ms without.
@@ -88,8 +88,8 @@ struct LpBounds {
   // on the boundary of the grid's moment cone that can include b that rounding moved just
   // outside, see rounding_band); else what went wrong.
   std::string status;
-  double lower = 0;      // min sum_{z_i < zf} w_i
-  double upper = 0;      // max sum_{z_i <= zf} w_i
+  double lower = 0;                          // min sum_{z_i < zf} w_i
+  double upper = 0;                          // max sum_{z_i <= zf} w_i
   LpDistribution lower_argmin, upper_argmax; // optimal distributions, for debugging
   // The checks of LpOptions::check_tolerance, worst over both optima.
   double residual = 0, dual_violation = 0;

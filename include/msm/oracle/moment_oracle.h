@@ -14,7 +14,7 @@ namespace msm::oracle {
 
 struct MomentBounds {
   bool ok = false;
-  std::string reason;          // why !ok, empty when ok
+  std::string reason; // why !ok, empty when ok
   // B was singular (to the rounding of b, see MomentOptions): by 2015 Proposition 4 b then has a
   // unique representing distribution with at most m/2 atoms, which is what support/weights hold.
   // Also when rounding hides the higher moments and fewer atoms explain b to within its rounding
@@ -75,7 +75,9 @@ MomentBounds moment_bounds(std::span<const double> b, double zf, const MomentOpt
 // Cantelli's inequality, i.e. moment_bounds for m = 2 (VSM) in closed form, for a distribution
 // with this mean and variance > 0: the lower bound is (zf - mean)^2 / (variance + (zf - mean)^2)
 // for zf > mean and 0 otherwise; the upper bound 1 - (the lower bound mirrored at the mean).
-struct CantelliBounds { double lower, upper; };
+struct CantelliBounds {
+  double lower, upper;
+};
 CantelliBounds cantelli_bounds(double mean, double variance, double zf);
 
 } // namespace msm::oracle

@@ -11,9 +11,9 @@ namespace msm::reference {
 // "disc" (scenes/disc.json: radius 0.25, centred 1 above the origin, 1e-4 thick, light straight
 // down with an angular extent of 10 degrees); a test of that scene's geometry keeps them in step.
 struct DiscOccluder {
-    double radius = 0.25;
-    double center_height = 1.0;
-    double thickness = 1e-4;
+  double radius = 0.25;
+  double center_height = 1.0;
+  double thickness = 1e-4;
 };
 
 // Area of the intersection of two discs of radii a, b >= 0 whose centres are d >= 0 apart.
@@ -39,4 +39,4 @@ double disc_intersection_area(double d, double a, double b);
 // (1 outside the disc's shadow, 0 inside, 1 on its rim).
 double disc_occluder_visibility(glm::dvec3 ground_point, double light_extent_deg, const DiscOccluder& disc = {});
 
-}  // namespace msm::reference
+} // namespace msm::reference

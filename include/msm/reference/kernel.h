@@ -21,30 +21,30 @@
 namespace msm::reference {
 
 class FilterKernel {
-public:
-    // size odd in [1, kMaxSize], sigma finite and > 0 (in texels); else std::invalid_argument.
-    FilterKernel(int size = 9, double sigma = 2.4);
-    static constexpr int kMaxSize = 255;
+ public:
+  // size odd in [1, kMaxSize], sigma finite and > 0 (in texels); else std::invalid_argument.
+  FilterKernel(int size = 9, double sigma = 2.4);
+  static constexpr int kMaxSize = 255;
 
-    int size() const noexcept { return size_; }
-    int radius() const noexcept { return (size_ - 1) / 2; }
-    double sigma() const noexcept { return sigma_; }
-    // Normalized 1D weights w_k for k = -radius..radius (index k + radius).
-    const std::vector<double>& weights() const noexcept { return weights_; }
+  int size() const noexcept { return size_; }
+  int radius() const noexcept { return (size_ - 1) / 2; }
+  double sigma() const noexcept { return sigma_; }
+  // Normalized 1D weights w_k for k = -radius..radius (index k + radius).
+  const std::vector<double>& weights() const noexcept { return weights_; }
 
-    // The 1D marginal k(s) and its cumulative distribution K1(s) = integral of k up to s.
-    double density(double s) const;
-    double cdf(double s) const;
+  // The 1D marginal k(s) and its cumulative distribution K1(s) = integral of k up to s.
+  double density(double s) const;
+  double cdf(double s) const;
 
-    // Inverse-transform-like map of u in [0, 1) to a 1D offset distributed with density k:
-    // the tap whose cumulative weight interval holds u, then the tent's inverse CDF of u rescaled
-    // within that interval. Measure-preserving, so stratified u give stratified offsets per tap.
-    double sample(double u) const;
+  // Inverse-transform-like map of u in [0, 1) to a 1D offset distributed with density k:
+  // the tap whose cumulative weight interval holds u, then the tent's inverse CDF of u rescaled
+  // within that interval. Measure-preserving, so stratified u give stratified offsets per tap.
+  double sample(double u) const;
 
-private:
-    int size_;
-    double sigma_;
-    std::vector<double> weights_, cumulative_;  // cumulative_[i] = sum of weights_[0..i)
+ private:
+  int size_;
+  double sigma_;
+  std::vector<double> weights_, cumulative_; // cumulative_[i] = sum of weights_[0..i)
 };
 
-}  // namespace msm::reference
+} // namespace msm::reference

@@ -100,7 +100,7 @@ enum class Effect { hard, filtered, soft, translucent };
 inline constexpr std::array<Effect, 4> kEffects{Effect::hard, Effect::filtered, Effect::soft, Effect::translucent};
 std::string_view to_string(Effect effect);
 std::optional<Effect> parse_effect(std::string_view name);
-bool is_monte_carlo(Effect effect);  // filtered, soft
+bool is_monte_carlo(Effect effect); // filtered, soft
 
 enum class LightShape { disc, rectangle };
 std::string_view to_string(LightShape shape);
@@ -115,9 +115,9 @@ inline constexpr int kMaxSamples = 1'000'000;
 inline constexpr int kMaxShadowSize = 65536;
 inline constexpr int kMaxCrossings = 4096;
 inline constexpr int kMaxThreads = 1024;
-inline constexpr double kOffsetScale = 1e-5;       // shadow-ray origin offset, relative
-inline constexpr double kMaxReceiverSlope = 16.0;  // |t| / |o_world| on grazing receivers
-inline constexpr float kAmbient = 0.03f;           // ambient term, times the albedo
+inline constexpr double kOffsetScale = 1e-5;      // shadow-ray origin offset, relative
+inline constexpr double kMaxReceiverSlope = 16.0; // |t| / |o_world| on grazing receivers
+inline constexpr float kAmbient = 0.03f;          // ambient term, times the albedo
 
 // The radiance formula shared with the renderer: Lambert shading of the directional light plus a
 // constant ambient term,
@@ -135,60 +135,60 @@ glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, glm::vec3
 // units, so that one texel is extent.x / shadow_size along x_axis and extent.y / shadow_size along
 // y_axis. Both axes are orthogonal to towards_light.
 struct LightFrame {
-    glm::dvec3 towards_light{0.0, 1.0, 0.0};
-    glm::dvec3 x_axis{1.0, 0.0, 0.0}, y_axis{0.0, 0.0, 1.0};
-    glm::dvec2 extent{1.0, 1.0};
-    static LightFrame of(const scene::Scene& scene);
+  glm::dvec3 towards_light{0.0, 1.0, 0.0};
+  glm::dvec3 x_axis{1.0, 0.0, 0.0}, y_axis{0.0, 0.0, 1.0};
+  glm::dvec2 extent{1.0, 1.0};
+  static LightFrame of(const scene::Scene& scene);
 };
 
 struct Progress {
-    std::size_t rows_done = 0, rows_total = 0;
-    double seconds = 0.0;  // since the start of the render (BVH build included)
+  std::size_t rows_done = 0, rows_total = 0;
+  double seconds = 0.0; // since the start of the render (BVH build included)
 };
 
 struct Settings {
-    Effect effect = Effect::hard;
-    int width = 640, height = 360;        // 1..kMaxSide
-    int samples = 256;                    // per pixel (filtered, soft), 1..kMaxSamples
-    std::uint64_t seed = 1;
-    Sampler sampler = Sampler::stratified;
-    // filtered: the renderer's shadow map and filter.
-    int shadow_size = 1024;               // 1..kMaxShadowSize
-    int filter_size = 9;                  // odd, 1..FilterKernel::kMaxSize
-    double filter_sigma = 2.4;            // texels, > 0
-    // soft: light extent in degrees, in [0, 90). Unset: the scene's angular_extent_deg (the disc's
-    // diameter, and the rectangle's width and height unless given).
-    std::optional<double> light_extent_deg;
-    LightShape light_shape = LightShape::disc;
-    std::optional<double> light_width_deg, light_height_deg;  // rectangle only
-    // translucent
-    int max_crossings = 64;               // 1..kMaxCrossings
-    // Worker threads: 0 = TBB's default (all cores, or a tbb::global_control limit), else a
-    // task arena of that many (1..kMaxThreads). The image does not depend on it.
-    int threads = 0;
-    // Called from worker threads (one at a time) as rows complete, at most ~200 times.
-    std::function<void(const Progress&)> progress;
+  Effect effect = Effect::hard;
+  int width = 640, height = 360; // 1..kMaxSide
+  int samples = 256;             // per pixel (filtered, soft), 1..kMaxSamples
+  std::uint64_t seed = 1;
+  Sampler sampler = Sampler::stratified;
+  // filtered: the renderer's shadow map and filter.
+  int shadow_size = 1024;    // 1..kMaxShadowSize
+  int filter_size = 9;       // odd, 1..FilterKernel::kMaxSize
+  double filter_sigma = 2.4; // texels, > 0
+  // soft: light extent in degrees, in [0, 90). Unset: the scene's angular_extent_deg (the disc's
+  // diameter, and the rectangle's width and height unless given).
+  std::optional<double> light_extent_deg;
+  LightShape light_shape = LightShape::disc;
+  std::optional<double> light_width_deg, light_height_deg; // rectangle only
+  // translucent
+  int max_crossings = 64; // 1..kMaxCrossings
+  // Worker threads: 0 = TBB's default (all cores, or a tbb::global_control limit), else a
+  // task arena of that many (1..kMaxThreads). The image does not depend on it.
+  int threads = 0;
+  // Called from worker threads (one at a time) as rows complete, at most ~200 times.
+  std::function<void(const Progress&)> progress;
 };
 
 // Throws std::invalid_argument naming the setting and its allowed range.
 void validate(const Settings& settings);
 
 struct Result {
-    image::Image visibility;  // see above for the channels
-    image::Image visibility_rgb;  // translucent: T_r, T_g, T_b ("visibility_r/_g/_b"); else empty
-    image::Image radiance;    // R, G, B
-    int samples = 1;          // per covered pixel (1 for hard and translucent)
-    double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0;  // as used (soft)
-    double build_seconds = 0.0;   // Embree scene
-    double render_seconds = 0.0;  // tracing
-    std::uint64_t rays = 0;       // primary + shadow rays traced
-    std::size_t background_pixels = 0;
-    double mean_visibility = 0.0;  // over the covered (non-background) pixels; 1 if none
-    unsigned threads = 0;          // TBB concurrency used
+  image::Image visibility;     // see above for the channels
+  image::Image visibility_rgb; // translucent: T_r, T_g, T_b ("visibility_r/_g/_b"); else empty
+  image::Image radiance;       // R, G, B
+  int samples = 1;             // per covered pixel (1 for hard and translucent)
+  double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0; // as used (soft)
+  double build_seconds = 0.0;                                                   // Embree scene
+  double render_seconds = 0.0;                                                  // tracing
+  std::uint64_t rays = 0;                                                       // primary + shadow rays traced
+  std::size_t background_pixels = 0;
+  double mean_visibility = 0.0; // over the covered (non-background) pixels; 1 if none
+  unsigned threads = 0;         // TBB concurrency used
 };
 
 // Throws std::invalid_argument for bad settings or a scene with non-finite vertices, and
 // std::runtime_error when Embree fails.
 Result render(const scene::Scene& scene, const Settings& settings);
 
-}  // namespace msm::reference
+} // namespace msm::reference

@@ -21,12 +21,12 @@ namespace msm::render {
 // after texture (layer-major), row-major. Channel c of pixel (x, y) of texture t is
 // texels[((t * size + y) * size + x) * channels + c]. texels.size() == count * size² * channels.
 struct BlueNoise {
-    int size = 0;
-    int count = 0;
-    int channels = 0;
-    std::vector<std::uint8_t> texels;
+  int size = 0;
+  int count = 0;
+  int channels = 0;
+  std::vector<std::uint8_t> texels;
 
-    bool operator==(const BlueNoise&) const = default;
+  bool operator==(const BlueNoise&) const = default;
 };
 
 // ---- Generation ------------------------------------------------------------------------------
@@ -66,11 +66,11 @@ std::vector<float> blue_noise_channel(const BlueNoise& noise, int texture, int c
 // ---- The renderer's set and its cache --------------------------------------------------------
 
 struct BlueNoiseParams {
-    int size = 64;
-    int count = 64;
-    int channels = 2;
-    double sigma = 1.9;
-    std::uint64_t seed = 0x6d736d2d626e3031; // "msm-bn01"
+  int size = 64;
+  int count = 64;
+  int channels = 2;
+  double sigma = 1.9;
+  std::uint64_t seed = 0x6d736d2d626e3031; // "msm-bn01"
 };
 
 // Version of the cache file format (part of the file name and of the header).
@@ -85,16 +85,16 @@ std::optional<std::filesystem::path> blue_noise_cache_dir();
 std::filesystem::path blue_noise_cache_file_name(const BlueNoiseParams& params);
 
 enum class BlueNoiseSource {
-    loaded,         // read from a valid cache file
-    generated,      // generated and written to the cache file
-    generated_only, // generated; no cache directory, or the file could not be written
+  loaded,         // read from a valid cache file
+  generated,      // generated and written to the cache file
+  generated_only, // generated; no cache directory, or the file could not be written
 };
 
 struct CachedBlueNoise {
-    BlueNoise noise;
-    BlueNoiseSource source = BlueNoiseSource::generated_only;
-    bool rejected_file = false; // a cache file existed but was short, corrupt or for other parameters
-    std::filesystem::path file; // the cache file (empty when there is no cache directory)
+  BlueNoise noise;
+  BlueNoiseSource source = BlueNoiseSource::generated_only;
+  bool rejected_file = false; // a cache file existed but was short, corrupt or for other parameters
+  std::filesystem::path file; // the cache file (empty when there is no cache directory)
 };
 
 // Reads the set from <cache_dir>/<blue_noise_cache_file_name(params)> when that file is valid;
@@ -117,35 +117,35 @@ const BlueNoise& blue_noise();
 // ---- Measures ---------------------------------------------------------------------------------
 
 struct BlueNoiseMeasures {
-    // Periodogram P(u,v) = |DFT(values - mean)|² / size² (white noise of variance s² has
-    // E[P] = s²), at signed frequencies fu, fv in (-size/2, size/2], radius r = sqrt(fu² + fv²)
-    // in cycles per tile.
-    // Mean P over 0 < r <= size/8 divided by mean P over r >= size/4 (all bins out to the
-    // corners). White noise: ~1. Blue noise: << 1.
-    double low_to_high_power = 0;
-    double low_band_power = 0;  // the numerator
-    double high_band_power = 0; // the denominator
-    // Coefficient of variation (standard deviation / mean) of the mean power in 8 angular sectors
-    // of 22.5 degrees covering [0, 180) (P is symmetric: P(-f) = P(f)), within the annulus
-    // size/4 <= r < size/2. 0 for a perfectly isotropic spectrum; an isotropic random texture
-    // still shows ~1/sqrt(bins per sector) from the periodogram's own scatter (about 0.08 at size
-    // 64, 0.04 at 128), so compare textures of the same size.
-    double radial_anisotropy = 0;
-    // With n = size²: true when round(v (n-1)) is a permutation of 0..n-1 (a rank array scaled to
-    // [0,1]), or when 256 divides n and every 8-bit value round(255 v) occurs exactly n/256 times
-    // (an 8-bit dither texture).
-    bool ranks_unique = false;
-    // Squared differences of the neighbour pairs that cross the wrap (from column size-1 to 0 or
-    // row size-1 to 0) at the lags (1,0), (0,1), (1,1), (1,-1) (6 size - 2 pairs), divided by what
-    // the interior pairs at the same lags predict (their mean per lag times the crossing count).
-    // ~1 when the texture tiles without a seam (scatter about ±0.06 for one 64² texture). Blue
-    // noise that does not tile scores ~0.85: across its wrap, neighbours are uncorrelated instead
-    // of anti-correlated. A seam also leaks power into the low band along the axes, which
-    // low_to_high_power shows (about 50-fold for such a crop).
-    double tiling_seam = 0;
-    // Mean and variance of the values.
-    double mean = 0;
-    double variance = 0;
+  // Periodogram P(u,v) = |DFT(values - mean)|² / size² (white noise of variance s² has
+  // E[P] = s²), at signed frequencies fu, fv in (-size/2, size/2], radius r = sqrt(fu² + fv²)
+  // in cycles per tile.
+  // Mean P over 0 < r <= size/8 divided by mean P over r >= size/4 (all bins out to the
+  // corners). White noise: ~1. Blue noise: << 1.
+  double low_to_high_power = 0;
+  double low_band_power = 0;  // the numerator
+  double high_band_power = 0; // the denominator
+  // Coefficient of variation (standard deviation / mean) of the mean power in 8 angular sectors
+  // of 22.5 degrees covering [0, 180) (P is symmetric: P(-f) = P(f)), within the annulus
+  // size/4 <= r < size/2. 0 for a perfectly isotropic spectrum; an isotropic random texture
+  // still shows ~1/sqrt(bins per sector) from the periodogram's own scatter (about 0.08 at size
+  // 64, 0.04 at 128), so compare textures of the same size.
+  double radial_anisotropy = 0;
+  // With n = size²: true when round(v (n-1)) is a permutation of 0..n-1 (a rank array scaled to
+  // [0,1]), or when 256 divides n and every 8-bit value round(255 v) occurs exactly n/256 times
+  // (an 8-bit dither texture).
+  bool ranks_unique = false;
+  // Squared differences of the neighbour pairs that cross the wrap (from column size-1 to 0 or
+  // row size-1 to 0) at the lags (1,0), (0,1), (1,1), (1,-1) (6 size - 2 pairs), divided by what
+  // the interior pairs at the same lags predict (their mean per lag times the crossing count).
+  // ~1 when the texture tiles without a seam (scatter about ±0.06 for one 64² texture). Blue
+  // noise that does not tile scores ~0.85: across its wrap, neighbours are uncorrelated instead
+  // of anti-correlated. A seam also leaks power into the low band along the axes, which
+  // low_to_high_power shows (about 50-fold for such a crop).
+  double tiling_seam = 0;
+  // Mean and variance of the values.
+  double mean = 0;
+  double variance = 0;
 };
 
 // The measures of one channel of one texture, values in [0,1] row-major.

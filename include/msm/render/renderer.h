@@ -39,17 +39,17 @@ namespace msm::render {
 
 // Bad settings or an unknown technique: the message says what and which values are allowed.
 class RenderError : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 
 struct Technique {
   std::string_view name;
   std::string_view description;
-  int id;                          // MSM_TECH_* of msm/techniques.h
-  int bits_per_texel;              // of the filtered shadow map (depth-based: bits per depth sample)
-  std::array<int, 2> formats;      // VkFormat of the moment images (0: none)
-  std::string_view parameters;     // meaning of the technique_params components it uses
+  int id;                      // MSM_TECH_* of msm/techniques.h
+  int bits_per_texel;          // of the filtered shadow map (depth-based: bits per depth sample)
+  std::array<int, 2> formats;  // VkFormat of the moment images (0: none)
+  std::string_view parameters; // meaning of the technique_params components it uses
 };
 
 // Every technique of the renderer, in the order of the comparison tables.
@@ -65,29 +65,29 @@ glm::vec4 default_params(const Technique& technique);
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxImagePixels = 64ll << 20; // 64 Mpixels
 inline constexpr int kMaxShadowSize = 8192;
-inline constexpr int kMaxFilterTaps = 63;                // MSM_MAX_FILTER_TAPS
-inline constexpr int kMaxOnePassTaps = 17;               // radius 8 in one_pass_filter.glsl
-inline constexpr int kDefaultSatKernel = 27;             // JCGT §4.5: a 27² search region
-inline constexpr int kDefaultPcssKernel = 15;            // the PCSS baseline's 15² search
-inline constexpr int kMaxPcssKernel = 63;                // 63² taps per pixel and loop
+inline constexpr int kMaxFilterTaps = 63;     // MSM_MAX_FILTER_TAPS
+inline constexpr int kMaxOnePassTaps = 17;    // radius 8 in one_pass_filter.glsl
+inline constexpr int kDefaultSatKernel = 27;  // JCGT §4.5: a 27² search region
+inline constexpr int kDefaultPcssKernel = 15; // the PCSS baseline's 15² search
+inline constexpr int kMaxPcssKernel = 63;     // 63² taps per pixel and loop
 
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
   int width = 1280, height = 720;
-  int shadow_size = 1024;          // texels per side of the square shadow map
-  int msaa = 4;                    // samples of the shadow depth pass: 1, 4 or 8
-  int filter_size = 9;             // Gaussian taps per axis (odd, 1..63; 1 = no blur)
-  float filter_sigma = 2.4f;       // in texels
-  bool mipmaps = true;             // mip chain of the moment images (trilinear lookups)
-  std::optional<glm::vec4> params; // technique parameters (msm/techniques.h); default: the papers'
-  float overdarken = 1.0f;         // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
-  float normal_offset = 0.0f;      // lookup offset along the normal, in shadow-map texels
-  std::optional<float> depth_bias; // subtracted from the fragment depth ([0,1] units); default:
-                                   // 2e-5 for the depth-based techniques (16-bit depth rounding),
-                                   // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
-                                   // 1e-5 for the filtered ones (the D16 rounding that their
-                                   // moment bias does not cover), 5e-4 for the non-linear ones
-                                   // (HPG §5: 1e-3 in [-1,1] depth)
+  int shadow_size = 1024;            // texels per side of the square shadow map
+  int msaa = 4;                      // samples of the shadow depth pass: 1, 4 or 8
+  int filter_size = 9;               // Gaussian taps per axis (odd, 1..63; 1 = no blur)
+  float filter_sigma = 2.4f;         // in texels
+  bool mipmaps = true;               // mip chain of the moment images (trilinear lookups)
+  std::optional<glm::vec4> params;   // technique parameters (msm/techniques.h); default: the papers'
+  float overdarken = 1.0f;           // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
+  float normal_offset = 0.0f;        // lookup offset along the normal, in shadow-map texels
+  std::optional<float> depth_bias;   // subtracted from the fragment depth ([0,1] units); default:
+                                     // 2e-5 for the depth-based techniques (16-bit depth rounding),
+                                     // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
+                                     // 1e-5 for the filtered ones (the D16 rounding that their
+                                     // moment bias does not cover), 5e-4 for the non-linear ones
+                                     // (HPG §5: 1e-3 in [-1,1] depth)
   float resolved_depth_bias() const; // depth_bias or the technique's default
   // Receiver-plane bias of the filtered techniques (msm/bias.h): the fragment depth moves towards
   // the light by the spread of the receiver's own depth over the kernel (σ = slope x the kernel's
@@ -106,7 +106,7 @@ struct RenderSettings {
   // H, blur V through device memory. Default: on for the non-linear techniques (they need it),
   // off for the others; not for 6MSM; at most 17 taps.
   std::optional<bool> one_pass;
-  int frame = 0;                   // frame number: picks the blue-noise layer and offset
+  int frame = 0; // frame number: picks the blue-noise layer and offset
   // Translucent occluders (materials with opacity < 1 or an opacity texture): blended into the
   // moment map back to front after the opaque resolve (JCGT §3), by the linear techniques with
   // one moment image (four-channel ones then store two RG images) in the three-pass pipeline.
@@ -138,11 +138,11 @@ struct PassTime {
 };
 
 struct RenderResult {
-  image::Image color;  // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
-  image::Image shadow; // "visibility" (of the light at the visible surface, 0 where the surface
-                       // faces away from the light) and "background" (1 where no surface)
-  image::Image shadow_rgb; // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
-                           // "visibility" is then their mean, as the ray tracer's); else empty
+  image::Image color;           // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
+  image::Image shadow;          // "visibility" (of the light at the visible surface, 0 where the surface
+                                // faces away from the light) and "background" (1 where no surface)
+  image::Image shadow_rgb;      // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
+                                // "visibility" is then their mean, as the ray tracer's); else empty
   std::vector<PassTime> passes; // in execution order; empty where the queue has no timestamps
   double total_ms = 0;          // sum of the passes
 };
@@ -150,18 +150,18 @@ struct RenderResult {
 // What tests compare against the CPU: the depth samples and the resolved moment image (before
 // the blur), read back when requested.
 struct Intermediates {
-  std::vector<float> depth_samples; // shadow_size² x msaa, sample-major per texel, row-major
-  image::Image moments;             // resolve output of image 0 (as stored: UNORM/half/float);
-                                    // with the one-pass filter: its (filtered, encoded) output
+  std::vector<float> depth_samples;  // shadow_size² x msaa, sample-major per texel, row-major
+  image::Image moments;              // resolve output of image 0 (as stored: UNORM/half/float);
+                                     // with the one-pass filter: its (filtered, encoded) output
   std::vector<std::uint32_t> packed; // R32_UINT maps (msm-nl32): the texels as stored
-  image::Image moments1;            // of image 1 (6MSM), else empty
-  image::Image filtered;            // image 0 after blur (mip 0)
+  image::Image moments1;             // of image 1 (6MSM), else empty
+  image::Image filtered;             // image 0 after blur (mip 0)
 };
 
 // Owns the scene's GPU buffers and textures and the pipelines it has built (cached per
 // technique, MSAA and filter configuration). Externally synchronized; the Context outlives it.
 class Renderer {
-public:
+ public:
   Renderer(const vk::Context& ctx, const scene::Scene& scene);
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -176,7 +176,7 @@ public:
 
   const scene::Scene& scene() const noexcept;
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

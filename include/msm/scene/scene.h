@@ -118,19 +118,19 @@
 namespace msm::scene {
 
 // Caps against absurd input (checked before anything is allocated).
-inline constexpr int kMaxSegments = 4096;              // any one segment/ring/step/bar count
+inline constexpr int kMaxSegments = 4096; // any one segment/ring/step/bar count
 inline constexpr std::size_t kMaxPrimitiveTriangles = 4'000'000;
-inline constexpr float kMaxSize = 1e6f;                // any primitive dimension / |translate|
+inline constexpr float kMaxSize = 1e6f; // any primitive dimension / |translate|
 
 class SceneError : public std::runtime_error {
-public:
+ public:
   // what() = "<file>: <where>: <problem>" (file or where omitted when empty).
   SceneError(std::string file, std::string where, std::string problem);
   const std::string& file() const noexcept { return file_; }
-  const std::string& where() const noexcept { return where_; }    // JSON pointer (+ object name)
+  const std::string& where() const noexcept { return where_; } // JSON pointer (+ object name)
   const std::string& problem() const noexcept { return problem_; }
 
-private:
+ private:
   std::string file_, where_, problem_;
 };
 
@@ -138,8 +138,16 @@ struct Bounds {
   glm::vec3 min{1e30f};
   glm::vec3 max{-1e30f};
   bool empty() const { return min.x > max.x; }
-  void extend(const glm::vec3& p) { min = glm::min(min, p); max = glm::max(max, p); }
-  void extend(const Bounds& b) { if (!b.empty()) { extend(b.min); extend(b.max); } }
+  void extend(const glm::vec3& p) {
+    min = glm::min(min, p);
+    max = glm::max(max, p);
+  }
+  void extend(const Bounds& b) {
+    if (!b.empty()) {
+      extend(b.min);
+      extend(b.max);
+    }
+  }
   glm::vec3 center() const { return 0.5f * (min + max); }
   glm::vec3 size() const { return max - min; }
 };
@@ -149,23 +157,23 @@ struct Mesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;
-  std::vector<std::uint32_t> indices;  // 3 per triangle, counter-clockwise seen from the front
+  std::vector<std::uint32_t> indices; // 3 per triangle, counter-clockwise seen from the front
   std::size_t triangle_count() const { return indices.size() / 3; }
-  double area() const;                 // sum of triangle areas
+  double area() const; // sum of triangle areas
   Bounds bounds() const;
 };
 
 // A procedural opacity texture: a round puff of smoke (fractal value noise under a soft disc).
 struct SmokeNoise {
   std::uint32_t seed = 1;
-  float scale = 4.0f;    // noise cells across the texture, (0, 64]
-  int octaves = 4;       // 1..8
-  float density = 0.5f;  // noise level at which the opacity is one half, [0, 1]
+  float scale = 4.0f;     // noise cells across the texture, (0, 64]
+  int octaves = 4;        // 1..8
+  float density = 0.5f;   // noise level at which the opacity is one half, [0, 1]
   float softness = 0.25f; // width of the noise-to-opacity ramp, (0, 1]
 };
 
 struct Material {
-  std::string name;                     // key in "materials", or empty for inline ones
+  std::string name; // key in "materials", or empty for inline ones
   glm::vec3 albedo{0.8f};
   std::filesystem::path albedo_texture; // absolute or relative to the CWD; empty = none
   float opacity = 1.0f;
@@ -191,17 +199,17 @@ struct Transform {
   glm::vec3 translate{0.0f};
   glm::mat3 rotate{1.0f};
   glm::vec3 scale{1.0f};
-  glm::mat4 matrix() const;  // translate * rotate * scale
+  glm::mat4 matrix() const; // translate * rotate * scale
 };
 
 struct Object {
   std::string name;
-  std::filesystem::path mesh_file;  // empty for primitives
-  std::string primitive;            // primitive type, empty for meshes
+  std::filesystem::path mesh_file; // empty for primitives
+  std::string primitive;           // primitive type, empty for meshes
   Transform transform;
-  std::uint32_t material = 0;       // index into Scene::materials
-  Mesh mesh;                        // world space
-  Bounds bounds;                    // world space
+  std::uint32_t material = 0; // index into Scene::materials
+  Mesh mesh;                  // world space
+  Bounds bounds;              // world space
 };
 
 struct Camera {
@@ -212,18 +220,18 @@ struct Camera {
   float near = 0.1f;
   float far = 1000.0f;
   glm::mat4 view() const;
-  glm::mat4 projection(float aspect) const;  // Vulkan clip conventions (see above)
+  glm::mat4 projection(float aspect) const; // Vulkan clip conventions (see above)
 };
 
 struct DirectionalLight {
-  glm::vec3 towards_light{0.0f, 1.0f, 0.0f};  // unit, from the scene towards the light
+  glm::vec3 towards_light{0.0f, 1.0f, 0.0f}; // unit, from the scene towards the light
   glm::vec3 irradiance{3.0f};
-  float angular_extent_deg = 0.0f;             // 0 = hard shadows
+  float angular_extent_deg = 0.0f; // 0 = hard shadows
   glm::vec3 travel() const { return -towards_light; }
 };
 
 struct ShadowFraming {
-  enum class Mode { Fit, Explicit } mode = Mode::Fit;
+  enum class Mode { fit, given } mode = Mode::fit;
   glm::vec3 center{0.0f};
   glm::vec2 extent{1.0f};
   glm::vec2 depth_range{-1.0f, 1.0f};
@@ -231,7 +239,7 @@ struct ShadowFraming {
 
 struct Scene {
   std::string name;
-  std::filesystem::path source;  // the scene file, or "builtin:<name>"
+  std::filesystem::path source; // the scene file, or "builtin:<name>"
   std::vector<Material> materials;
   std::vector<Object> objects;
   Camera camera;
@@ -260,8 +268,8 @@ Scene load_scene_json(std::string_view json_text, const std::filesystem::path& b
 // Built-in scenes (scenes/README.md): "fence" (the default), "railing", "stair", "column", "smoke",
 // "models", "pillar_wall", "disc".
 std::vector<std::string> builtin_scene_names();
-std::string_view default_scene_name();               // "fence"
-std::string_view builtin_scene_json(std::string_view name);  // throws SceneError if unknown
+std::string_view default_scene_name();                      // "fence"
+std::string_view builtin_scene_json(std::string_view name); // throws SceneError if unknown
 Scene builtin_scene(std::string_view name);
 // A built-in name, or else a path to a scene file.
 Scene load_scene(std::string_view name_or_path);
@@ -275,8 +283,7 @@ Mesh make_plane(glm::vec2 size, glm::ivec2 subdivisions = {1, 1});
 Mesh make_box(glm::vec3 size);
 Mesh make_sphere(float radius, int segments = 64, int rings = 32);
 Mesh make_cylinder(float radius, float height, int segments = 64, bool caps = true);
-Mesh make_fence(float length, float height, int bars, float bar_width, float bar_depth, int rails,
-                float rail_height);
+Mesh make_fence(float length, float height, int bars, float bar_width, float bar_depth, int rails, float rail_height);
 Mesh make_stair(int steps, float width, float step_depth, float step_height);
 Mesh make_torus_knot(int p, int q, float radius, float tube_radius, int segments, int tube_segments);
 Mesh make_brick_wall(int rows, int columns, float brick_length, float brick_height, float mortar, float relief,
@@ -302,4 +309,4 @@ OpacityImage opacity_image(const Material& material);
 // 128² procedural smoke: deterministic for its parameters.
 OpacityImage make_smoke_opacity(const SmokeNoise& noise);
 
-}  // namespace msm::scene
+} // namespace msm::scene

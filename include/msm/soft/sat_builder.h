@@ -23,14 +23,14 @@
 namespace msm::soft {
 
 class SatBuilder {
-public:
+ public:
   enum class Scheme {
     // Two passes, one thread per row, then one per column (Klehm et al. 2014; JCGT §4.2, App. D.4).
     // Timer scopes "sat_rows" and "sat_columns".
-    RowsThenColumns,
+    rows_then_columns,
     // JCGT Appendix C: 8 × 8 workgroups walking 8 × 8 blocks, eight threads per row (then per
     // column), each writing one prefix sum per block. Timer scope "sat_blocks" (both passes).
-    Blocks,
+    blocks,
   };
 
   // Creates the four compute pipelines and a nearest sampler.
@@ -59,7 +59,7 @@ public:
               int max_kernel_texels, Scheme scheme, vk::GpuTimer* timer = nullptr,
               VkImageLayout moments_layout = VK_IMAGE_LAYOUT_GENERAL) const;
 
-private:
+ private:
   vk::Program rows_, columns_, blockRows_, blockColumns_;
   vk::Program rowsRg_, columnsRg_, blockRowsRg_, blockColumnsRg_; // RG32_UINT tables
   vk::Sampler sampler_;

@@ -15,34 +15,35 @@ class Context;
 // commands wrote visible to the host, so a Host buffer can be read right after the return. If
 // `record` throws, nothing is submitted and the exception propagates. For tests, uploads and
 // readbacks, not for per-frame work (it stalls).
-void submitAndWait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record);
+void submit_and_wait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record);
 
 // Barrier structs for vkCmdPipelineBarrier2; queue family ownership is never transferred.
-VkMemoryBarrier2 memoryBarrier(VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
-                               VkAccessFlags2 dstAccess);
+VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access);
 
-VkBufferMemoryBarrier2 bufferBarrier(VkBuffer buffer, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                                     VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess, VkDeviceSize offset = 0,
-                                     VkDeviceSize size = VK_WHOLE_SIZE);
+VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                                      VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                      VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE);
 
-// Covers mips [baseMip, baseMip + mipCount) of all layers.
-VkImageMemoryBarrier2 imageBarrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 srcStage,
-                                   VkAccessFlags2 srcAccess, VkImageLayout oldLayout, VkPipelineStageFlags2 dstStage,
-                                   VkAccessFlags2 dstAccess, VkImageLayout newLayout, uint32_t baseMip = 0,
-                                   uint32_t mipCount = VK_REMAINING_MIP_LEVELS);
+// Covers mips [base_mip, base_mip + mip_count) of all layers.
+VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 src_stage,
+                                    VkAccessFlags2 src_access, VkImageLayout old_layout,
+                                    VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
+                                    VkImageLayout new_layout, uint32_t base_mip = 0,
+                                    uint32_t mip_count = VK_REMAINING_MIP_LEVELS);
 
 // vkCmdPipelineBarrier2 with any mix of barriers.
-void pipelineBarrier(VkCommandBuffer cmd, std::span<const VkMemoryBarrier2> memory,
-                     std::span<const VkBufferMemoryBarrier2> buffers, std::span<const VkImageMemoryBarrier2> images,
-                     VkDependencyFlags flags = 0);
-inline void pipelineBarrier(VkCommandBuffer cmd, const VkMemoryBarrier2& barrier) {
-  pipelineBarrier(cmd, {&barrier, 1}, {}, {});
+void pipeline_barrier(VkCommandBuffer cmd, std::span<const VkMemoryBarrier2> memory,
+                      std::span<const VkBufferMemoryBarrier2> buffers, std::span<const VkImageMemoryBarrier2> images,
+                      VkDependencyFlags flags = 0);
+inline void pipeline_barrier(VkCommandBuffer cmd, const VkMemoryBarrier2& barrier) {
+  pipeline_barrier(cmd, {&barrier, 1}, {}, {});
 }
-inline void pipelineBarrier(VkCommandBuffer cmd, const VkBufferMemoryBarrier2& barrier) {
-  pipelineBarrier(cmd, {}, {&barrier, 1}, {});
+inline void pipeline_barrier(VkCommandBuffer cmd, const VkBufferMemoryBarrier2& barrier) {
+  pipeline_barrier(cmd, {}, {&barrier, 1}, {});
 }
-inline void pipelineBarrier(VkCommandBuffer cmd, const VkImageMemoryBarrier2& barrier) {
-  pipelineBarrier(cmd, {}, {}, {&barrier, 1});
+inline void pipeline_barrier(VkCommandBuffer cmd, const VkImageMemoryBarrier2& barrier) {
+  pipeline_barrier(cmd, {}, {}, {&barrier, 1});
 }
 
 } // namespace msm::vk

@@ -15,31 +15,30 @@ namespace msm::vk {
 
 // A Vulkan call that did not return VK_SUCCESS.
 class Error : public std::runtime_error {
-public:
+ public:
   Error(VkResult result, const std::string& what) : std::runtime_error(what), result_(result) {}
   VkResult result() const noexcept { return result_; }
 
-private:
+ private:
   VkResult result_;
 };
 
 // "VK_ERROR_DEVICE_LOST"; "VkResult(<n>)" for a value this build does not know.
-const char* resultName(VkResult result) noexcept;
+const char* result_name(VkResult result) noexcept;
 
-[[noreturn]] void throwError(VkResult result, const char* call, std::source_location where);
+[[noreturn]] void throw_error(VkResult result, const char* call, std::source_location where);
 
 // Throws Error unless result is VK_SUCCESS. `where` defaults to the caller's location, which is the
 // line of the MSM_VK_CHECK below. (Not VK_CHECK: a public header must not take that common name.)
-inline void check(VkResult result, const char* call,
-                  std::source_location where = std::source_location::current()) {
-  if (result != VK_SUCCESS) throwError(result, call, where);
+inline void check(VkResult result, const char* call, std::source_location where = std::source_location::current()) {
+  if (result != VK_SUCCESS) throw_error(result, call, where);
 }
 
 // Owns one device-level handle, destroyed with Destroy(device, handle, nullptr); move-only.
 // Precondition: destroyed (or reset) before the VkDevice it was created on.
 template <class Handle, void (*Destroy)(VkDevice, Handle, const VkAllocationCallbacks*)>
 class Unique {
-public:
+ public:
   Unique() = default;
   Unique(VkDevice device, Handle handle) noexcept : device_(device), handle_(handle) {}
   Unique(Unique&& other) noexcept
@@ -63,7 +62,7 @@ public:
   explicit operator bool() const noexcept { return handle_ != VK_NULL_HANDLE; }
   VkDevice device() const noexcept { return device_; }
 
-private:
+ private:
   VkDevice device_ = VK_NULL_HANDLE;
   Handle handle_ = VK_NULL_HANDLE;
 };

@@ -13,25 +13,25 @@ namespace msm::vk {
 
 struct ValidationMessage {
   VkDebugUtilsMessageSeverityFlagBitsEXT severity; // WARNING or ERROR
-  std::string id;   // message id name, e.g. "VUID-VkBufferMemoryBarrier2-offset-01187"
-  std::string text; // the full message
+  std::string id;                                  // message id name, e.g. "VUID-VkBufferMemoryBarrier2-offset-01187"
+  std::string text;                                // the full message
 };
 
 // Every validation-layer (and loader) WARNING or ERROR a Context's messenger received; thread-safe.
 // A Context hands it out as a shared_ptr so that what vkDestroyDevice/vkDestroyInstance report
 // (leaked objects) can still be read once the Context is gone.
 class ValidationLog {
-public:
+ public:
   void add(ValidationMessage message);
   std::size_t count() const;
   std::vector<ValidationMessage> messages(std::size_t first = 0) const; // those from index `first` on
   void clear();
   // Print each message to stderr as it arrives (default on): a message appears next to the output
   // of the code that caused it. Tests that provoke messages on purpose turn it off.
-  void setEcho(bool echo);
+  void set_echo(bool echo);
   static std::string format(const std::vector<ValidationMessage>& messages);
 
-private:
+ private:
   mutable std::mutex mutex_;
   std::vector<ValidationMessage> messages_;
   bool echo_ = true;
@@ -46,28 +46,28 @@ struct ContextOptions {
   std::string device;
   // VK_LAYER_KHRONOS_validation + a VK_EXT_debug_utils messenger that records into validation().
   // Also turned on by MSM_VALIDATION=1 (or true/on/yes) for any program. A missing layer is not an
-  // error here: it is reported on stderr and validationEnabled() is false (tests check that).
+  // error here: it is reported on stderr and validation_enabled() is false (tests check that).
   bool validation = false;
-  bool synchronizationValidation = true; // with validation: the layer's hazard checks as well
-  bool echoValidation = true;            // see ValidationLog::setEcho
-  bool verbose = true;                   // one line on stderr naming the device picked
-  // How msm_fma (shared.h) computes in the pipelines of this Context (useNativeFma()):
+  bool synchronization_validation = true; // with validation: the layer's hazard checks as well
+  bool echo_validation = true;            // see ValidationLog::set_echo
+  bool verbose = true;                    // one line on stderr naming the device picked
+  // How msm_fma (shared.h) computes in the pipelines of this Context (use_native_fma()):
   //  Probe: the native fma() where the probe found it fused, else the exact emulation. With
   //         MSM_FORCE_EMULATED_FMA=1 (or true/on/yes) in the environment: Emulated;
   //  Emulated: the emulation even where fma() is fused (tests of the emulation on such devices);
   //  Native: the native fma() even where it is NOT fused (tests measuring what that costs).
-  enum class FmaMode { Probe, Emulated, Native };
-  FmaMode fmaMode = FmaMode::Probe;
-  std::string applicationName = "msm";
+  enum class FmaMode { probe, emulated, native };
+  FmaMode fma_mode = FmaMode::probe;
+  std::string application_name = "msm";
 };
 
 struct DeviceInfo {
   uint32_t index = 0; // in vkEnumeratePhysicalDevices order
   std::string name;
   VkPhysicalDeviceType type = VK_PHYSICAL_DEVICE_TYPE_OTHER;
-  std::string driverName; // e.g. "llvmpipe", "NVIDIA"
-  std::string driverInfo; // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
-  uint32_t apiVersion = 0;
+  std::string driver_name; // e.g. "llvmpipe", "NVIDIA"
+  std::string driver_info; // e.g. "Mesa 22.3.6 (LLVM 15.0.6)"
+  uint32_t api_version = 0;
   std::string describe() const; // one line with all of the above
 };
 
@@ -82,60 +82,61 @@ struct DeviceFeatures {
 };
 
 // Instance, physical device, device with one queue (graphics+compute where the device has such a
-// family, else compute) and a command pool for one-shot submissions (submitAndWait).
+// family, else compute) and a command pool for one-shot submissions (submit_and_wait).
 // Not copyable or movable (the messenger holds its address). Externally synchronized: use it from
 // one thread at a time (the queue and the command pool are). Precondition for the destructor: every
 // object created from it (Buffer, Image, Program, GpuTimer, ...) has been destroyed; the destructor
 // waits for the device to be idle.
 class Context {
-public:
+ public:
   explicit Context(const ContextOptions& options = ContextOptions());
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
 
   VkInstance instance() const noexcept { return instance_; }
-  VkPhysicalDevice physicalDevice() const noexcept { return physicalDevice_; }
+  VkPhysicalDevice physical_device() const noexcept { return physicalDevice_; }
   VkDevice device() const noexcept { return device_; }
   VkQueue queue() const noexcept { return queue_; }
-  uint32_t queueFamily() const noexcept { return queueFamily_; }
-  VkCommandPool commandPool() const noexcept { return commandPool_; }
+  uint32_t queue_family() const noexcept { return queueFamily_; }
+  VkCommandPool command_pool() const noexcept { return commandPool_; }
 
   const DeviceInfo& info() const noexcept { return info_; }
   const DeviceFeatures& features() const noexcept { return features_; }
   const VkPhysicalDeviceProperties& properties() const noexcept { return properties_; }
-  const VkPhysicalDeviceMemoryProperties& memoryProperties() const noexcept { return memory_; }
+  const VkPhysicalDeviceMemoryProperties& memory_properties() const noexcept { return memory_; }
   // Of the queue's family: 0 means no timestamps (GpuTimer then measures nothing).
-  uint32_t timestampValidBits() const noexcept { return timestampValidBits_; }
+  uint32_t timestamp_valid_bits() const noexcept { return timestampValidBits_; }
 
   // Whether the device's GLSL fma() is the fused multiply-add (one rounding), as found at creation
   // by the probe shader fma_probe.comp: on cases where one rounding, two roundings and a double
   // evaluation all differ, fused only if every case is rounded once. NVIDIA and AMD GPUs: fused;
   // lavapipe (llvmpipe): a * b, then + c.
-  bool fusedFma() const noexcept { return fusedFma_; }
+  bool fused_fma() const noexcept { return fusedFma_; }
   // The value of the shared headers' specialization constant msm_fused_fma (shared.h,
-  // MSM_SPEC_FUSED_FMA_ID) in every pipeline created from this Context: fusedFma(), unless
-  // ContextOptions::fmaMode (or MSM_FORCE_EMULATED_FMA) says otherwise.
-  bool useNativeFma() const noexcept { return useNativeFma_; }
+  // MSM_SPEC_FUSED_FMA_ID) in every pipeline created from this Context: fused_fma(), unless
+  // ContextOptions::fma_mode (or MSM_FORCE_EMULATED_FMA) says otherwise.
+  bool use_native_fma() const noexcept { return useNativeFma_; }
 
-  bool validationEnabled() const noexcept { return validation_; }
+  bool validation_enabled() const noexcept { return validation_; }
   ValidationLog& validation() const noexcept { return *log_; }
-  std::shared_ptr<ValidationLog> validationLog() const noexcept { return log_; }
+  std::shared_ptr<ValidationLog> validation_log() const noexcept { return log_; }
 
   // VK_KHR_push_descriptor entry points (device-level, loaded at creation).
-  PFN_vkCmdPushDescriptorSetKHR cmdPushDescriptorSet() const noexcept { return pushDescriptorSet_; }
-  PFN_vkCmdPushDescriptorSetWithTemplateKHR cmdPushDescriptorSetWithTemplate() const noexcept {
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const noexcept { return pushDescriptorSet_; }
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR cmd_push_descriptor_set_with_template() const noexcept {
     return pushDescriptorSetWithTemplate_;
   }
   // Names an object in validation messages and debuggers; a no-op without validation.
-  void setObjectName(VkObjectType type, uint64_t handle, const std::string& name) const;
-  template <class Handle> void setObjectName(VkObjectType type, Handle handle, const std::string& name) const {
-    setObjectName(type, (uint64_t)handle, name); // C cast: handles are pointers, or uint64_t on 32-bit
+  void set_object_name(VkObjectType type, uint64_t handle, const std::string& name) const;
+  template <class Handle>
+  void set_object_name(VkObjectType type, Handle handle, const std::string& name) const {
+    set_object_name(type, (uint64_t)handle, name); // C cast: handles are pointers, or uint64_t on 32-bit
   }
 
-private:
+ private:
   void destroy() noexcept;
-  bool probeFusedFma() const;
+  bool probe_fused_fma() const;
 
   std::shared_ptr<ValidationLog> log_ = std::make_shared<ValidationLog>();
   VkInstance instance_ = VK_NULL_HANDLE;

@@ -1,8 +1,8 @@
 // Compute programs: a pipeline from embedded SPIR-V whose descriptors are pushed
 // (VK_KHR_push_descriptor, through a descriptor update template), and a one-call dispatch.
 //
-//   Program p = createProgram(ctx, "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(Push));
-//   dispatch(cmd, p, groupCount(n, 64), 1, 1, {input, output}, Push{n});
+//   Program p = create_program(ctx, "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(Push));
+//   dispatch(cmd, p, group_count(n, 64), 1, 1, {input, output}, Push{n});
 #pragma once
 
 #include "msm/vk/common.h"
@@ -24,10 +24,10 @@ struct GraphicsDesc; // graphics.h
 
 // The type of descriptor at binding i of set 0 is the i-th entry of a program's binding list.
 enum class Binding : uint8_t {
-  StorageBuffer, // layout(binding = i) buffer
-  UniformBuffer, // layout(binding = i) uniform
-  StorageImage,  // layout(binding = i, <format>) uniform image2D
-  SampledImage,  // layout(binding = i) uniform sampler2D (combined image + sampler)
+  storage_buffer, // layout(binding = i) buffer
+  uniform_buffer, // layout(binding = i) uniform
+  storage_image,  // layout(binding = i, <format>) uniform image2D
+  sampled_image,  // layout(binding = i) uniform sampler2D (combined image + sampler)
 };
 
 // The value of one binding for dispatch(): a buffer range, or an image view in a layout (plus a
@@ -40,7 +40,8 @@ struct Descriptor {
   Descriptor(VkBuffer b, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE) : buffer{b, offset, range} {}
   Descriptor(const Buffer& b, VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE)
       : buffer{b.handle(), offset, range} {}
-  Descriptor(VkImageView view, VkImageLayout layout, VkSampler sampler = VK_NULL_HANDLE) : image{sampler, view, layout} {}
+  Descriptor(VkImageView view, VkImageLayout layout, VkSampler sampler = VK_NULL_HANDLE)
+      : image{sampler, view, layout} {}
   // GENERAL: the layout of storage images. For a SampledImage pass the layout and the sampler.
   Descriptor(const Image& i, VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL, VkSampler sampler = VK_NULL_HANDLE)
       : image{sampler, i.view(), layout} {}
@@ -54,26 +55,26 @@ struct SpecConstant {
 
 // A pipeline (compute, or graphics from graphics.h) with its push-descriptor layout.
 class Program {
-public:
+ public:
   VkPipeline pipeline() const noexcept { return pipeline_; }
   VkPipelineLayout layout() const noexcept { return layout_; }
-  VkPipelineBindPoint bindPoint() const noexcept { return bindPoint_; }
-  VkShaderStageFlags stages() const noexcept { return stages_; } // of the descriptors and push constants
-  VkDescriptorSetLayout setLayout() const noexcept { return setLayout_; } // null without bindings
+  VkPipelineBindPoint bind_point() const noexcept { return bindPoint_; }
+  VkShaderStageFlags stages() const noexcept { return stages_; }           // of the descriptors and push constants
+  VkDescriptorSetLayout set_layout() const noexcept { return setLayout_; } // null without bindings
   std::span<const Binding> bindings() const noexcept { return bindings_; }
-  uint32_t pushConstantSize() const noexcept { return pushConstantSize_; }
+  uint32_t push_constant_size() const noexcept { return pushConstantSize_; }
   const std::string& name() const noexcept { return name_; }
   explicit operator bool() const noexcept { return bool(pipeline_); }
 
-private:
-  friend Program createProgram(const Context&, std::span<const uint32_t>, std::string_view, std::span<const Binding>,
-                               uint32_t, std::span<const SpecConstant>);
-  friend Program createProgramLayout(const Context&, std::string_view, std::span<const Binding>, uint32_t,
-                                     VkShaderStageFlags, VkPipelineBindPoint);
-  friend void bindProgram(VkCommandBuffer, const Program&, std::span<const Descriptor>, std::span<const std::byte>);
+ private:
+  friend Program create_program(const Context&, std::span<const uint32_t>, std::string_view, std::span<const Binding>,
+                                uint32_t, std::span<const SpecConstant>);
+  friend Program create_program_layout(const Context&, std::string_view, std::span<const Binding>, uint32_t,
+                                       VkShaderStageFlags, VkPipelineBindPoint);
+  friend void bind_program(VkCommandBuffer, const Program&, std::span<const Descriptor>, std::span<const std::byte>);
   friend void dispatch(VkCommandBuffer, const Program&, uint32_t, uint32_t, uint32_t, std::span<const Descriptor>,
                        std::span<const std::byte>);
-  friend Program createGraphicsProgram(const Context&, const GraphicsDesc&);
+  friend Program create_graphics_program(const Context&, const GraphicsDesc&);
   std::string name_;
   std::vector<Binding> bindings_;
   uint32_t pushConstantSize_ = 0;
@@ -89,86 +90,93 @@ private:
 
 // The specialization constants of one pipeline stage: those of the shared headers
 // (include/msm/shared.h) — msm_fused_fma (id MSM_SPEC_FUSED_FMA_ID) = ctx.useNativeFma() — plus
-// any given. createProgram sets them on every pipeline; a pipeline created elsewhere passes info()
+// any given. create_program sets them on every pipeline; a pipeline created elsewhere passes info()
 // as each stage's pSpecializationInfo. Ids that a shader does not declare are ignored, so every
 // stage can take it. info() points into this object: keep it alive until the pipeline is created.
 // Precondition: the extra ids are distinct and not MSM_SPEC_FUSED_FMA_ID.
 class SharedSpecialization {
-public:
+ public:
   explicit SharedSpecialization(const Context& ctx, std::span<const SpecConstant> extra = {});
   SharedSpecialization(const SharedSpecialization&) = delete;
   SharedSpecialization& operator=(const SharedSpecialization&) = delete;
   const VkSpecializationInfo* info() const noexcept { return &info_; }
-  bool nativeFma() const noexcept { return values_[0] != VK_FALSE; }
+  bool native_fma() const noexcept { return values_[0] != VK_FALSE; }
 
-private:
+ private:
   std::vector<uint32_t> values_; // [0]: msm_fused_fma as a VkBool32
   std::vector<VkSpecializationMapEntry> entries_;
   VkSpecializationInfo info_{};
 };
 
 // A compute pipeline from SPIR-V with entry point "main", specialized with SharedSpecialization. The push-constant range is
-// [0, pushConstantSize) for the compute stage (none if 0). Preconditions (std::invalid_argument
-// otherwise): SPIR-V words start with the magic number; pushConstantSize is a multiple of 4 and at
+// [0, push_constant_size) for the compute stage (none if 0). Preconditions (std::invalid_argument
+// otherwise): SPIR-V words start with the magic number; push_constant_size is a multiple of 4 and at
 // most maxPushConstantsSize; bindings.size() <= maxPushDescriptors. That the list matches the
 // shader's declarations is checked by the validation layer, not here.
 // `constants` are further specialization constants (SharedSpecialization).
-Program createProgram(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
-                      std::span<const Binding> bindings, uint32_t pushConstantSize = 0,
-                      std::span<const SpecConstant> constants = {});
+Program create_program(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
+                       std::span<const Binding> bindings, uint32_t push_constant_size = 0,
+                       std::span<const SpecConstant> constants = {});
 // The same from an embedded shader (see shaders.h), looked up by name.
-Program createProgram(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
-                      uint32_t pushConstantSize = 0, std::initializer_list<SpecConstant> constants = {});
+Program create_program(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
+                       uint32_t push_constant_size = 0, std::initializer_list<SpecConstant> constants = {});
 
 // The layout of a program without its pipeline (for pipeline kinds built elsewhere, graphics.h):
-// descriptors and push constants visible to `stages`. Preconditions as for createProgram.
-Program createProgramLayout(const Context& ctx, std::string_view name, std::span<const Binding> bindings,
-                            uint32_t pushConstantSize, VkShaderStageFlags stages, VkPipelineBindPoint bindPoint);
+// descriptors and push constants visible to `stages`. Preconditions as for create_program.
+Program create_program_layout(const Context& ctx, std::string_view name, std::span<const Binding> bindings,
+                              uint32_t push_constant_size, VkShaderStageFlags stages, VkPipelineBindPoint bind_point);
 
 // Binds the pipeline at its bind point, pushes one descriptor per binding and the push constants
 // (preconditions as for dispatch); draws or dispatches follow.
-void bindProgram(VkCommandBuffer cmd, const Program& program, std::span<const Descriptor> bindings,
-                 std::span<const std::byte> pushConstants = {});
-inline void bindProgram(VkCommandBuffer cmd, const Program& program, std::initializer_list<Descriptor> bindings,
-                        std::span<const std::byte> pushConstants = {}) {
-  bindProgram(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()), pushConstants);
+void bind_program(VkCommandBuffer cmd, const Program& program, std::span<const Descriptor> bindings,
+                  std::span<const std::byte> push_constants = {});
+inline void bind_program(VkCommandBuffer cmd, const Program& program, std::initializer_list<Descriptor> bindings,
+                         std::span<const std::byte> push_constants = {}) {
+  bind_program(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()), push_constants);
 }
 template <class PushConstants>
-  requires(std::is_standard_layout_v<PushConstants> && std::is_trivially_destructible_v<PushConstants> &&
-           !std::is_convertible_v<const PushConstants&, std::span<const std::byte>>)
-void bindProgram(VkCommandBuffer cmd, const Program& program, std::initializer_list<Descriptor> bindings,
-                 const PushConstants& pushConstants) {
-  bindProgram(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()),
-              std::as_bytes(std::span(&pushConstants, 1)));
+requires(
+    std::is_standard_layout_v<PushConstants>&& std::is_trivially_destructible_v<PushConstants> &&
+    !std::is_convertible_v<const PushConstants&,
+                           std::span<const std::byte>>) void bind_program(VkCommandBuffer cmd, const Program& program,
+                                                                          std::initializer_list<Descriptor> bindings,
+                                                                          const PushConstants& push_constants) {
+  bind_program(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()),
+               std::as_bytes(std::span(&push_constants, 1)));
 }
 
 // Binds the pipeline, pushes one descriptor per binding and the push constants, and dispatches
-// groupsX * groupsY * groupsZ workgroups. Preconditions (std::invalid_argument otherwise, nothing
-// recorded): one descriptor per binding, pushConstants.size() == program.pushConstantSize(). The
+// groups_x * groups_y * groups_z workgroups. Preconditions (std::invalid_argument otherwise, nothing
+// recorded): one descriptor per binding, push_constants.size() == program.pushConstantSize(). The
 // resources are in the layouts given and synchronized by the caller (the barrier helpers of
 // commands.h); cmd is recording, outside a render pass.
-void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ,
-              std::span<const Descriptor> bindings, std::span<const std::byte> pushConstants = {});
+void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groups_x, uint32_t groups_y, uint32_t groups_z,
+              std::span<const Descriptor> bindings, std::span<const std::byte> push_constants = {});
 
-inline void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY,
-                     uint32_t groupsZ, std::initializer_list<Descriptor> bindings = {},
-                     std::span<const std::byte> pushConstants = {}) {
-  dispatch(cmd, program, groupsX, groupsY, groupsZ, std::span<const Descriptor>(bindings.begin(), bindings.size()),
-           pushConstants);
+inline void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groups_x, uint32_t groups_y,
+                     uint32_t groups_z, std::initializer_list<Descriptor> bindings = {},
+                     std::span<const std::byte> push_constants = {}) {
+  dispatch(cmd, program, groups_x, groups_y, groups_z, std::span<const Descriptor>(bindings.begin(), bindings.size()),
+           push_constants);
 }
 
 // Push constants given as one struct (its bytes, padding included, must match the shader's block).
 // Standard layout rather than trivially copyable: GLM_FORCE_CTOR_INIT (msm::scene) gives glm types
 // user-provided copies, yet their bytes are all there is to them.
 template <class PushConstants>
-  requires(std::is_standard_layout_v<PushConstants> && std::is_trivially_destructible_v<PushConstants> &&
-           !std::is_convertible_v<const PushConstants&, std::span<const std::byte>>)
-void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groupsX, uint32_t groupsY, uint32_t groupsZ,
-              std::initializer_list<Descriptor> bindings, const PushConstants& pushConstants) {
-  dispatch(cmd, program, groupsX, groupsY, groupsZ, bindings, std::as_bytes(std::span(&pushConstants, 1)));
+requires(std::is_standard_layout_v<PushConstants>&& std::is_trivially_destructible_v<PushConstants> &&
+         !std::is_convertible_v<const PushConstants&,
+                                std::span<const std::byte>>) void dispatch(VkCommandBuffer cmd, const Program& program,
+                                                                           uint32_t groups_x, uint32_t groups_y,
+                                                                           uint32_t groups_z,
+                                                                           std::initializer_list<Descriptor> bindings,
+                                                                           const PushConstants& push_constants) {
+  dispatch(cmd, program, groups_x, groups_y, groups_z, bindings, std::as_bytes(std::span(&push_constants, 1)));
 }
 
-// Workgroups needed for `threads` invocations with `localSize` per group: ceil(threads / localSize).
-constexpr uint32_t groupCount(uint32_t threads, uint32_t localSize) { return (threads + localSize - 1) / localSize; }
+// Workgroups needed for `threads` invocations with `local_size` per group: ceil(threads / local_size).
+constexpr uint32_t group_count(uint32_t threads, uint32_t local_size) {
+  return (threads + local_size - 1) / local_size;
+}
 
 } // namespace msm::vk

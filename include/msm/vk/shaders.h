@@ -34,13 +34,13 @@ struct EmbeddedShader {
 // Registers shaders (static storage, outliving this object) for target `target`; unregisters them
 // on destruction (a shared library being unloaded).
 class ShaderRegistration {
-public:
+ public:
   ShaderRegistration(std::string_view target, std::span<const EmbeddedShader> shaders);
   ~ShaderRegistration();
   ShaderRegistration(const ShaderRegistration&) = delete;
   ShaderRegistration& operator=(const ShaderRegistration&) = delete;
 
-private:
+ private:
   std::span<const EmbeddedShader> shaders_;
 };
 

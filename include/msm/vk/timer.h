@@ -25,27 +25,27 @@ class Context;
 
 struct TimerScope {
   std::string name;
-  uint32_t depth = 0; // nesting level: 0 for outermost scopes
-  double startMs = 0; // from the first timestamp of the recording
-  double endMs = 0;
-  double ms() const { return endMs - startMs; }
+  uint32_t depth = 0;  // nesting level: 0 for outermost scopes
+  double start_ms = 0; // from the first timestamp of the recording
+  double end_ms = 0;
+  double ms() const { return end_ms - start_ms; }
 };
 
 struct TimerResults {
-  std::vector<TimerScope> scopes; // in begin() order
-  double total(std::string_view name) const;       // sum over the scopes with this name; 0 if none
-  std::size_t count(std::string_view name) const;  // how many scopes had this name
+  std::vector<TimerScope> scopes;                             // in begin() order
+  double total(std::string_view name) const;                  // sum over the scopes with this name; 0 if none
+  std::size_t count(std::string_view name) const;             // how many scopes had this name
   std::vector<std::pair<std::string, double>> totals() const; // per name, in order of first begin()
 };
 
 class GpuTimer {
-public:
-  // Room for reserveScopes scopes per recording; more grow the query storage (new pools).
-  explicit GpuTimer(const Context& ctx, uint32_t reserveScopes = 32);
+ public:
+  // Room for reserve_scopes scopes per recording; more grow the query storage (new pools).
+  explicit GpuTimer(const Context& ctx, uint32_t reserve_scopes = 32);
   GpuTimer(GpuTimer&&) noexcept = default;
   GpuTimer& operator=(GpuTimer&&) noexcept = default;
 
-  // False when the queue family has no timestamps (timestampValidBits == 0): then begin/end record
+  // False when the queue family has no timestamps (timestamp_valid_bits == 0): then begin/end record
   // nothing and read() returns no scopes.
   bool supported() const noexcept { return supported_; }
 
@@ -55,26 +55,27 @@ public:
   // Precondition: reset(cmd) was called since the last read(). A begin() beyond the reserved scopes
   // creates a query pool; without hostQueryReset it is reset in cmd, so that begin() must then be
   // outside a render pass too.
-  void begin(VkCommandBuffer cmd, std::string_view name, VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
+  void begin(VkCommandBuffer cmd, std::string_view name,
+             VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
   // Ends the innermost open scope (std::logic_error if none is open).
   void end(VkCommandBuffer cmd, VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT);
   // Precondition: every scope ended (std::logic_error otherwise) and the command buffer completed
   // (std::runtime_error if its timestamps are not available: it was not submitted or waited for).
   TimerResults read();
 
-private:
+ private:
   struct Record {
     std::string name;
-    uint32_t depth, beginQuery, endQuery;
+    uint32_t depth, begin_query, end_query;
   };
-  uint32_t nextQuery(VkCommandBuffer cmd);
-  void addPool(VkCommandBuffer cmd);
+  uint32_t next_query(VkCommandBuffer cmd);
+  void add_pool(VkCommandBuffer cmd);
 
   VkDevice device_ = VK_NULL_HANDLE;
   bool supported_ = false;
   bool hostQueryReset_ = false;
   double msPerTick_ = 0;
-  uint64_t mask_ = 0; // timestampValidBits low bits
+  uint64_t mask_ = 0; // timestamp_valid_bits low bits
   uint32_t poolSize_ = 0;
   std::vector<Unique<VkQueryPool, vkDestroyQueryPool>> pools_;
   uint32_t used_ = 0;

@@ -10,7 +10,7 @@ layout(push_constant) uniform Push {
   uint count;      // entries in inputs and outputs
 } pc;
 
-// msm_fma (shared.h) is exact on every device: createProgram specializes msm_fused_fma to the
+// msm_fma (shared.h) is exact on every device: create_program specializes msm_fused_fma to the
 // Context's probe of fma(), so this runs the emulation where fma() is not fused (lavapipe).
 #include "kernels.h"
 

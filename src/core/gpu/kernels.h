@@ -10,86 +10,86 @@
 // 16-byte members, stride 48) matches the C++ struct.
 #ifndef MSM_GPU_KERNELS_H
 #define MSM_GPU_KERNELS_H
-#include "msm/shared.h"
+#include "msm/baselines.h"
+#include "msm/bias.h"
+#include "msm/blocker.h"
 #include "msm/config.h"
+#include "msm/hamburger4.h"
+#include "msm/hamburger6.h"
+#include "msm/hausdorff4.h"
 #include "msm/moments.h"
+#include "msm/nonlinear.h"
 #include "msm/quantize.h"
 #include "msm/roots.h"
-#include "msm/bias.h"
-#include "msm/hamburger4.h"
-#include "msm/hausdorff4.h"
+#include "msm/shared.h"
 #include "msm/three_moments.h"
-#include "msm/hamburger6.h"
-#include "msm/blocker.h"
 #include "msm/trigonometric.h"
-#include "msm/nonlinear.h"
-#include "msm/baselines.h"
 
 MSM_BEGIN
 
 struct KernelIO {
-    vec4 a;
-    vec4 b;
-    uvec4 u;
+  vec4 a;
+  vec4 b;
+  uvec4 u;
 };
 
 // Function ids; 'arguments -> results' in KernelIO terms. b4 = four moments, b6 = Moments6(a.xyz,
 // b.xyz), nl = NonLinearMoments(a.x, a.y, a.z, a.w).
 // shared.h
-const int MSM_K_FMA = 0;                // a.xyz -> a.x = msm_fma(a.x, a.y, a.z)
-const int MSM_K_SATURATE = 1;           // a.x -> a.x
+const int MSM_K_FMA = 0;      // a.xyz -> a.x = msm_fma(a.x, a.y, a.z)
+const int MSM_K_SATURATE = 1; // a.x -> a.x
 // moments.h
-const int MSM_K_MOMENTS4 = 2;           // a.x = z -> a
-const int MSM_K_MOMENTS6 = 3;           // a.x = z -> a.xyz odd, b.xyz even
-const int MSM_K_TRIG_MOMENTS = 4;       // a.x = z -> a
-const int MSM_K_UNIT_TO_SIGNED = 5;     // a -> a
+const int MSM_K_MOMENTS4 = 2;       // a.x = z -> a
+const int MSM_K_MOMENTS6 = 3;       // a.x = z -> a.xyz odd, b.xyz even
+const int MSM_K_TRIG_MOMENTS = 4;   // a.x = z -> a
+const int MSM_K_UNIT_TO_SIGNED = 5; // a -> a
 // quantize.h
-const int MSM_K_THETA4 = 6;             // a -> a
-const int MSM_K_THETA4_INVERSE = 7;     // a -> a
-const int MSM_K_THETA4_STAR = 8;        // a -> a
-const int MSM_K_THETA4_STAR_INVERSE = 9; // a -> a
-const int MSM_K_THETA6_STAR = 10;       // b6 -> a.xyz, b.xyz
+const int MSM_K_THETA4 = 6;               // a -> a
+const int MSM_K_THETA4_INVERSE = 7;       // a -> a
+const int MSM_K_THETA4_STAR = 8;          // a -> a
+const int MSM_K_THETA4_STAR_INVERSE = 9;  // a -> a
+const int MSM_K_THETA6_STAR = 10;         // b6 -> a.xyz, b.xyz
 const int MSM_K_THETA6_STAR_INVERSE = 11; // b6 -> a.xyz, b.xyz
-const int MSM_K_THETA2 = 12;            // a.xy -> a.xy
-const int MSM_K_THETA2_INVERSE = 13;    // a.xy -> a.xy
-const int MSM_K_PACK_UNORM16 = 14;      // a -> u.xy
-const int MSM_K_UNPACK_UNORM16 = 15;    // u.xy -> a
-const int MSM_K_PACK_UNORM10 = 16;      // a.xyz -> u.x
-const int MSM_K_UNPACK_UNORM10 = 17;    // u.x -> a.xyz
-const int MSM_K_QUANTIZE6_UNORM16 = 18; // b6 -> a.xyz, b.xyz (round trip)
-const int MSM_K_QUANTIZE6_UNORM10 = 19; // b6 -> a.xyz, b.xyz (round trip)
+const int MSM_K_THETA2 = 12;              // a.xy -> a.xy
+const int MSM_K_THETA2_INVERSE = 13;      // a.xy -> a.xy
+const int MSM_K_PACK_UNORM16 = 14;        // a -> u.xy
+const int MSM_K_UNPACK_UNORM16 = 15;      // u.xy -> a
+const int MSM_K_PACK_UNORM10 = 16;        // a.xyz -> u.x
+const int MSM_K_UNPACK_UNORM10 = 17;      // u.x -> a.xyz
+const int MSM_K_QUANTIZE6_UNORM16 = 18;   // b6 -> a.xyz, b.xyz (round trip)
+const int MSM_K_QUANTIZE6_UNORM10 = 19;   // b6 -> a.xyz, b.xyz (round trip)
 // bias.h
-const int MSM_K_APPLY_BIAS = 20;        // a, representation u.x -> a
-const int MSM_K_APPLY_BIAS6 = 21;       // b6, representation u.x -> a.xyz, b.xyz
+const int MSM_K_APPLY_BIAS = 20;  // a, representation u.x -> a
+const int MSM_K_APPLY_BIAS6 = 21; // b6, representation u.x -> a.xyz, b.xyz
 // roots.h, hamburger6.h
-const int MSM_K_SOLVE_QUADRATIC = 22;   // a.xyz = c -> a.xy
-const int MSM_K_CUBIC_ROOTS = 23;       // a = q -> a.xyz
+const int MSM_K_SOLVE_QUADRATIC = 22; // a.xyz = c -> a.xy
+const int MSM_K_CUBIC_ROOTS = 23;     // a = q -> a.xyz
 // hamburger4.h, hausdorff4.h, three_moments.h
-const int MSM_K_HAMBURGER4_BOUNDS = 24; // a = b4, b.x = zf -> a.xy
+const int MSM_K_HAMBURGER4_BOUNDS = 24;    // a = b4, b.x = zf -> a.xy
 const int MSM_K_HAMBURGER4_CANONICAL = 25; // a = b4, b.x = zf -> a.xyz nodes, b.xyz weights
-const int MSM_K_HAUSDORFF4 = 26;        // a = b4, b.xyz = (zf, lo, hi) -> a.x
-const int MSM_K_TWO_DEPTHS = 27;        // a.xyz = (b1, b2, b3) -> a = (z, w)
+const int MSM_K_HAUSDORFF4 = 26;           // a = b4, b.xyz = (zf, lo, hi) -> a.x
+const int MSM_K_TWO_DEPTHS = 27;           // a.xyz = (b1, b2, b3) -> a = (z, w)
 // hamburger6.h
-const int MSM_K_HAMBURGER6_BOUNDS = 28; // b6, a.w = zf -> a.xy
-const int MSM_K_HAMBURGER6_BLEND = 29;  // b6, a.w = zf, b.w = beta -> a.x
+const int MSM_K_HAMBURGER6_BOUNDS = 28;    // b6, a.w = zf -> a.xy
+const int MSM_K_HAMBURGER6_BLEND = 29;     // b6, a.w = zf, b.w = beta -> a.x
 const int MSM_K_HAMBURGER6_CANONICAL = 30; // b6, a.w = zf -> a nodes, b weights
 // blocker.h
-const int MSM_K_BLOCKER4 = 31;          // a = b4, b.x = zf -> a.xy = (depth, shadow)
-const int MSM_K_BLOCKER4_UPPER = 32;    // a = b4, b.xyz = (zf, delta1, delta2) -> a.xy
-const int MSM_K_BLOCKER6 = 33;          // b6, a.w = zf -> a.xy
-const int MSM_K_BLOCKER6_UPPER = 34;    // b6, a.w = zf, u.xy = bits of (delta1, delta2) -> a.xy
+const int MSM_K_BLOCKER4 = 31;       // a = b4, b.x = zf -> a.xy = (depth, shadow)
+const int MSM_K_BLOCKER4_UPPER = 32; // a = b4, b.xyz = (zf, delta1, delta2) -> a.xy
+const int MSM_K_BLOCKER6 = 33;       // b6, a.w = zf -> a.xy
+const int MSM_K_BLOCKER6_UPPER = 34; // b6, a.w = zf, u.xy = bits of (delta1, delta2) -> a.xy
 // trigonometric.h
-const int MSM_K_TRIG_BOUNDS = 35;       // a = trigonometric moments, b.x = zf -> a.xy
+const int MSM_K_TRIG_BOUNDS = 35; // a = trigonometric moments, b.x = zf -> a.xy
 // nonlinear.h
-const int MSM_K_NL_FROM_MOMENTS = 36;   // a = b4 -> a = nl (Φ)
-const int MSM_K_NL_MOMENTS_FROM = 37;   // a = nl -> a = b4 (Φ⁻¹)
-const int MSM_K_NL_PSI4 = 38;           // a.x = ξ4 -> a.x = Ψ4
-const int MSM_K_NL_PSI4_INVERSE = 39;   // a.x = Ψ4 -> a.x = ξ4
-const int MSM_K_NL_PACK64 = 40;         // a = nl -> u.xy
-const int MSM_K_NL_UNPACK64 = 41;       // u.xy -> a = nl
-const int MSM_K_NL_PACK32 = 42;         // a = nl -> u.x
-const int MSM_K_NL_UNPACK32 = 43;       // u.x -> a = nl
-const int MSM_K_NL_SHADOW = 44;         // a = nl, b.x = zf -> a.x (HPG Algorithm 3)
+const int MSM_K_NL_FROM_MOMENTS = 36; // a = b4 -> a = nl (Φ)
+const int MSM_K_NL_MOMENTS_FROM = 37; // a = nl -> a = b4 (Φ⁻¹)
+const int MSM_K_NL_PSI4 = 38;         // a.x = ξ4 -> a.x = Ψ4
+const int MSM_K_NL_PSI4_INVERSE = 39; // a.x = Ψ4 -> a.x = ξ4
+const int MSM_K_NL_PACK64 = 40;       // a = nl -> u.xy
+const int MSM_K_NL_UNPACK64 = 41;     // u.xy -> a = nl
+const int MSM_K_NL_PACK32 = 42;       // a = nl -> u.x
+const int MSM_K_NL_UNPACK32 = 43;     // u.x -> a = nl
+const int MSM_K_NL_SHADOW = 44;       // a = nl, b.x = zf -> a.x (HPG Algorithm 3)
 // baselines.h
 const int MSM_K_VSM_SHADOW = 45;        // a.xy = b, a.z = zf -> a.x
 const int MSM_K_VSM_SHADOW_THETA2 = 46; // a.xy = q, a.z = zf -> a.x
@@ -107,102 +107,100 @@ const int MSM_K_OVERDARKEN = 56;        // a.xy = (shadow, factor) -> a.x
 const int MSM_K_COUNT = 57;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
-MSM_FN KernelIO msm_kernel_result6(Moments6 m) {
-    return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u));
-}
+MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
 MSM_FN KernelIO msm_kernel_result_nl(NonLinearMoments m) {
-    return KernelIO(vec4(m.y1, m.y2, m.v2, m.xi4), vec4(0.0f), uvec4(0u));
+  return KernelIO(vec4(m.y1, m.y2, m.v2, m.xi4), vec4(0.0f), uvec4(0u));
 }
 MSM_FN KernelIO msm_kernel_result_blocker(BlockerResult o) {
-    return KernelIO(vec4(o.depth, o.shadow, 0.0f, 0.0f), vec4(0.0f), uvec4(0u));
+  return KernelIO(vec4(o.depth, o.shadow, 0.0f, 0.0f), vec4(0.0f), uvec4(0u));
 }
 
 MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
-    KernelIO r = KernelIO(vec4(0.0f), vec4(0.0f), uvec4(0u));
-    Moments6 b6 = Moments6(vec3(x.a), vec3(x.b));
-    NonLinearMoments nl = NonLinearMoments(x.a[0], x.a[1], x.a[2], x.a[3]);
-    switch (function) {
-    case MSM_K_FMA: r.a[0] = msm_fma(x.a[0], x.a[1], x.a[2]); break;
-    case MSM_K_SATURATE: r.a[0] = msm_saturate(x.a[0]); break;
-    case MSM_K_MOMENTS4: r.a = msm_moments4(x.a[0]); break;
-    case MSM_K_MOMENTS6: r = msm_kernel_result6(msm_moments6(x.a[0])); break;
-    case MSM_K_TRIG_MOMENTS: r.a = msm_trig_moments(x.a[0]); break;
-    case MSM_K_UNIT_TO_SIGNED: r.a = msm_unit_to_signed_moments(x.a); break;
-    case MSM_K_THETA4: r.a = msm_theta4(x.a); break;
-    case MSM_K_THETA4_INVERSE: r.a = msm_theta4_inverse(x.a); break;
-    case MSM_K_THETA4_STAR: r.a = msm_theta4_star(x.a); break;
-    case MSM_K_THETA4_STAR_INVERSE: r.a = msm_theta4_star_inverse(x.a); break;
-    case MSM_K_THETA6_STAR: r = msm_kernel_result6(msm_theta6_star(b6)); break;
-    case MSM_K_THETA6_STAR_INVERSE: r = msm_kernel_result6(msm_theta6_star_inverse(b6)); break;
-    case MSM_K_THETA2: r.a = vec4(msm_theta2(vec2(x.a)), 0.0f, 0.0f); break;
-    case MSM_K_THETA2_INVERSE: r.a = vec4(msm_theta2_inverse(vec2(x.a)), 0.0f, 0.0f); break;
-    case MSM_K_PACK_UNORM16: r.u = uvec4(msm_pack_unorm16x4(x.a), 0u, 0u); break;
-    case MSM_K_UNPACK_UNORM16: r.a = msm_unpack_unorm16x4(uvec2(x.u)); break;
-    case MSM_K_PACK_UNORM10: r.u = uvec4(msm_pack_unorm10x3(vec3(x.a)), 0u, 0u, 0u); break;
-    case MSM_K_UNPACK_UNORM10: r.a = vec4(msm_unpack_unorm10x3(x.u[0]), 0.0f); break;
-    case MSM_K_QUANTIZE6_UNORM16: r = msm_kernel_result6(msm_quantize_unorm16(b6)); break;
-    case MSM_K_QUANTIZE6_UNORM10: r = msm_kernel_result6(msm_quantize_unorm10(b6)); break;
-    case MSM_K_APPLY_BIAS: r.a = msm_apply_bias(x.a, msm_moment_bias(int(x.u[0]))); break;
-    case MSM_K_APPLY_BIAS6: r = msm_kernel_result6(msm_apply_bias6(b6, msm_moment_bias6(int(x.u[0])))); break;
-    case MSM_K_SOLVE_QUADRATIC: r.a = vec4(msm_solve_quadratic(vec3(x.a)), 0.0f, 0.0f); break;
-    case MSM_K_CUBIC_ROOTS: r.a = vec4(msm_cubic_roots(x.a), 0.0f); break;
-    case MSM_K_HAMBURGER4_BOUNDS: r.a = vec4(msm_hamburger4_bounds(x.a, x.b[0]), 0.0f, 0.0f); break;
-    case MSM_K_HAMBURGER4_CANONICAL: {
-        Canonical4 c = msm_hamburger4_canonical(x.a, x.b[0]);
-        r.a = vec4(c.z, 0.0f);
-        r.b = vec4(c.w, 0.0f);
-        break;
-    }
-    case MSM_K_HAUSDORFF4: r.a[0] = msm_hausdorff4_lower(x.a, x.b[0], x.b[1], x.b[2]); break;
-    case MSM_K_TWO_DEPTHS: {
-        TwoDepths t = msm_two_depths_from_three_moments(vec3(x.a));
-        r.a = vec4(t.z, t.w);
-        break;
-    }
-    case MSM_K_HAMBURGER6_BOUNDS: r.a = vec4(msm_hamburger6_bounds(b6, x.a[3]), 0.0f, 0.0f); break;
-    case MSM_K_HAMBURGER6_BLEND: r.a[0] = msm_hamburger6_blend(b6, x.a[3], x.b[3]); break;
-    case MSM_K_HAMBURGER6_CANONICAL: {
-        Canonical6 c = msm_hamburger6_canonical(b6, x.a[3]);
-        r.a = c.z;
-        r.b = c.w;
-        break;
-    }
-    case MSM_K_BLOCKER4: r = msm_kernel_result_blocker(msm_blocker4(x.a, x.b[0])); break;
-    case MSM_K_BLOCKER4_UPPER: r = msm_kernel_result_blocker(msm_blocker4_upper(x.a, x.b[0], x.b[1], x.b[2])); break;
-    case MSM_K_BLOCKER6: r = msm_kernel_result_blocker(msm_blocker6(b6, x.a[3])); break;
-    case MSM_K_BLOCKER6_UPPER:
-        r = msm_kernel_result_blocker(msm_blocker6_upper(b6, x.a[3], uintBitsToFloat(x.u[0]), uintBitsToFloat(x.u[1])));
-        break;
-    case MSM_K_TRIG_BOUNDS: r.a = vec4(msm_trig_bounds(x.a, x.b[0]), 0.0f, 0.0f); break;
-    case MSM_K_NL_FROM_MOMENTS: r = msm_kernel_result_nl(msm_nl_from_moments(x.a)); break;
-    case MSM_K_NL_MOMENTS_FROM: r.a = msm_nl_moments_from(nl); break;
-    case MSM_K_NL_PSI4: r.a[0] = msm_nl_psi4(x.a[0]); break;
-    case MSM_K_NL_PSI4_INVERSE: r.a[0] = msm_nl_psi4_inverse(x.a[0]); break;
-    case MSM_K_NL_PACK64: r.u = uvec4(msm_nl_pack64(nl), 0u, 0u); break;
-    case MSM_K_NL_UNPACK64: r = msm_kernel_result_nl(msm_nl_unpack64(uvec2(x.u))); break;
-    case MSM_K_NL_PACK32: r.u = uvec4(msm_nl_pack32(nl), 0u, 0u, 0u); break;
-    case MSM_K_NL_UNPACK32: r = msm_kernel_result_nl(msm_nl_unpack32(x.u[0])); break;
-    case MSM_K_NL_SHADOW: r.a[0] = msm_nl_shadow(nl, x.b[0]); break;
-    case MSM_K_VSM_SHADOW: r.a[0] = msm_vsm_shadow(vec2(x.a), x.a[2]); break;
-    case MSM_K_VSM_SHADOW_THETA2: r.a[0] = msm_vsm_shadow_theta2(vec2(x.a), x.a[2]); break;
-    case MSM_K_ESM_MOMENT: r.a[0] = msm_esm_moment(x.a[0], x.a[1]); break;
-    case MSM_K_ESM_SHADOW: r.a[0] = msm_esm_shadow(x.a[0], x.a[1], x.a[2]); break;
-    case MSM_K_ESM_LOG_MIX: r.a[0] = msm_esm_log_mix(x.a[0], x.a[1], x.a[2]); break;
-    case MSM_K_EVSM2_MOMENTS: r.a = vec4(msm_evsm2_moments(x.a[0], x.a[1]), 0.0f, 0.0f); break;
-    case MSM_K_EVSM2_SHADOW: r.a[0] = msm_evsm2_shadow(vec2(x.a), x.b[0], x.b[1], x.b[2]); break;
-    case MSM_K_EVSM4_MOMENTS: r.a = msm_evsm4_moments(x.a[0], x.a[1], x.a[2]); break;
-    case MSM_K_EVSM4_SHADOW: r.a[0] = msm_evsm4_shadow(x.a, x.b[0], x.b[1], x.b[2], x.b[3]); break;
-    case MSM_K_CSM_BASIS: r.a = msm_csm_basis_texel(x.a[0], int(x.u[0])); break;
-    case MSM_K_CSM_SHADOW: {
-        CsmParams p = CsmParams(int(x.u[0]), uintBitsToFloat(x.u[1]), uintBitsToFloat(x.u[2]), 0.0f);
-        CsmMoments m = CsmMoments(mat4(x.a, x.b, vec4(0.0f), vec4(0.0f)), mat4(0.0f));
-        r.a[0] = msm_csm_shadow(m, uintBitsToFloat(x.u[3]), p);
-        break;
-    }
-    case MSM_K_OVERDARKEN: r.a[0] = msm_overdarken(x.a[0], x.a[1]); break;
-    default: break;
-    }
-    return r;
+  KernelIO r = KernelIO(vec4(0.0f), vec4(0.0f), uvec4(0u));
+  Moments6 b6 = Moments6(vec3(x.a), vec3(x.b));
+  NonLinearMoments nl = NonLinearMoments(x.a[0], x.a[1], x.a[2], x.a[3]);
+  switch (function) {
+  case MSM_K_FMA: r.a[0] = msm_fma(x.a[0], x.a[1], x.a[2]); break;
+  case MSM_K_SATURATE: r.a[0] = msm_saturate(x.a[0]); break;
+  case MSM_K_MOMENTS4: r.a = msm_moments4(x.a[0]); break;
+  case MSM_K_MOMENTS6: r = msm_kernel_result6(msm_moments6(x.a[0])); break;
+  case MSM_K_TRIG_MOMENTS: r.a = msm_trig_moments(x.a[0]); break;
+  case MSM_K_UNIT_TO_SIGNED: r.a = msm_unit_to_signed_moments(x.a); break;
+  case MSM_K_THETA4: r.a = msm_theta4(x.a); break;
+  case MSM_K_THETA4_INVERSE: r.a = msm_theta4_inverse(x.a); break;
+  case MSM_K_THETA4_STAR: r.a = msm_theta4_star(x.a); break;
+  case MSM_K_THETA4_STAR_INVERSE: r.a = msm_theta4_star_inverse(x.a); break;
+  case MSM_K_THETA6_STAR: r = msm_kernel_result6(msm_theta6_star(b6)); break;
+  case MSM_K_THETA6_STAR_INVERSE: r = msm_kernel_result6(msm_theta6_star_inverse(b6)); break;
+  case MSM_K_THETA2: r.a = vec4(msm_theta2(vec2(x.a)), 0.0f, 0.0f); break;
+  case MSM_K_THETA2_INVERSE: r.a = vec4(msm_theta2_inverse(vec2(x.a)), 0.0f, 0.0f); break;
+  case MSM_K_PACK_UNORM16: r.u = uvec4(msm_pack_unorm16x4(x.a), 0u, 0u); break;
+  case MSM_K_UNPACK_UNORM16: r.a = msm_unpack_unorm16x4(uvec2(x.u)); break;
+  case MSM_K_PACK_UNORM10: r.u = uvec4(msm_pack_unorm10x3(vec3(x.a)), 0u, 0u, 0u); break;
+  case MSM_K_UNPACK_UNORM10: r.a = vec4(msm_unpack_unorm10x3(x.u[0]), 0.0f); break;
+  case MSM_K_QUANTIZE6_UNORM16: r = msm_kernel_result6(msm_quantize_unorm16(b6)); break;
+  case MSM_K_QUANTIZE6_UNORM10: r = msm_kernel_result6(msm_quantize_unorm10(b6)); break;
+  case MSM_K_APPLY_BIAS: r.a = msm_apply_bias(x.a, msm_moment_bias(int(x.u[0]))); break;
+  case MSM_K_APPLY_BIAS6: r = msm_kernel_result6(msm_apply_bias6(b6, msm_moment_bias6(int(x.u[0])))); break;
+  case MSM_K_SOLVE_QUADRATIC: r.a = vec4(msm_solve_quadratic(vec3(x.a)), 0.0f, 0.0f); break;
+  case MSM_K_CUBIC_ROOTS: r.a = vec4(msm_cubic_roots(x.a), 0.0f); break;
+  case MSM_K_HAMBURGER4_BOUNDS: r.a = vec4(msm_hamburger4_bounds(x.a, x.b[0]), 0.0f, 0.0f); break;
+  case MSM_K_HAMBURGER4_CANONICAL: {
+    Canonical4 c = msm_hamburger4_canonical(x.a, x.b[0]);
+    r.a = vec4(c.z, 0.0f);
+    r.b = vec4(c.w, 0.0f);
+    break;
+  }
+  case MSM_K_HAUSDORFF4: r.a[0] = msm_hausdorff4_lower(x.a, x.b[0], x.b[1], x.b[2]); break;
+  case MSM_K_TWO_DEPTHS: {
+    TwoDepths t = msm_two_depths_from_three_moments(vec3(x.a));
+    r.a = vec4(t.z, t.w);
+    break;
+  }
+  case MSM_K_HAMBURGER6_BOUNDS: r.a = vec4(msm_hamburger6_bounds(b6, x.a[3]), 0.0f, 0.0f); break;
+  case MSM_K_HAMBURGER6_BLEND: r.a[0] = msm_hamburger6_blend(b6, x.a[3], x.b[3]); break;
+  case MSM_K_HAMBURGER6_CANONICAL: {
+    Canonical6 c = msm_hamburger6_canonical(b6, x.a[3]);
+    r.a = c.z;
+    r.b = c.w;
+    break;
+  }
+  case MSM_K_BLOCKER4: r = msm_kernel_result_blocker(msm_blocker4(x.a, x.b[0])); break;
+  case MSM_K_BLOCKER4_UPPER: r = msm_kernel_result_blocker(msm_blocker4_upper(x.a, x.b[0], x.b[1], x.b[2])); break;
+  case MSM_K_BLOCKER6: r = msm_kernel_result_blocker(msm_blocker6(b6, x.a[3])); break;
+  case MSM_K_BLOCKER6_UPPER:
+    r = msm_kernel_result_blocker(msm_blocker6_upper(b6, x.a[3], uintBitsToFloat(x.u[0]), uintBitsToFloat(x.u[1])));
+    break;
+  case MSM_K_TRIG_BOUNDS: r.a = vec4(msm_trig_bounds(x.a, x.b[0]), 0.0f, 0.0f); break;
+  case MSM_K_NL_FROM_MOMENTS: r = msm_kernel_result_nl(msm_nl_from_moments(x.a)); break;
+  case MSM_K_NL_MOMENTS_FROM: r.a = msm_nl_moments_from(nl); break;
+  case MSM_K_NL_PSI4: r.a[0] = msm_nl_psi4(x.a[0]); break;
+  case MSM_K_NL_PSI4_INVERSE: r.a[0] = msm_nl_psi4_inverse(x.a[0]); break;
+  case MSM_K_NL_PACK64: r.u = uvec4(msm_nl_pack64(nl), 0u, 0u); break;
+  case MSM_K_NL_UNPACK64: r = msm_kernel_result_nl(msm_nl_unpack64(uvec2(x.u))); break;
+  case MSM_K_NL_PACK32: r.u = uvec4(msm_nl_pack32(nl), 0u, 0u, 0u); break;
+  case MSM_K_NL_UNPACK32: r = msm_kernel_result_nl(msm_nl_unpack32(x.u[0])); break;
+  case MSM_K_NL_SHADOW: r.a[0] = msm_nl_shadow(nl, x.b[0]); break;
+  case MSM_K_VSM_SHADOW: r.a[0] = msm_vsm_shadow(vec2(x.a), x.a[2]); break;
+  case MSM_K_VSM_SHADOW_THETA2: r.a[0] = msm_vsm_shadow_theta2(vec2(x.a), x.a[2]); break;
+  case MSM_K_ESM_MOMENT: r.a[0] = msm_esm_moment(x.a[0], x.a[1]); break;
+  case MSM_K_ESM_SHADOW: r.a[0] = msm_esm_shadow(x.a[0], x.a[1], x.a[2]); break;
+  case MSM_K_ESM_LOG_MIX: r.a[0] = msm_esm_log_mix(x.a[0], x.a[1], x.a[2]); break;
+  case MSM_K_EVSM2_MOMENTS: r.a = vec4(msm_evsm2_moments(x.a[0], x.a[1]), 0.0f, 0.0f); break;
+  case MSM_K_EVSM2_SHADOW: r.a[0] = msm_evsm2_shadow(vec2(x.a), x.b[0], x.b[1], x.b[2]); break;
+  case MSM_K_EVSM4_MOMENTS: r.a = msm_evsm4_moments(x.a[0], x.a[1], x.a[2]); break;
+  case MSM_K_EVSM4_SHADOW: r.a[0] = msm_evsm4_shadow(x.a, x.b[0], x.b[1], x.b[2], x.b[3]); break;
+  case MSM_K_CSM_BASIS: r.a = msm_csm_basis_texel(x.a[0], int(x.u[0])); break;
+  case MSM_K_CSM_SHADOW: {
+    CsmParams p = CsmParams(int(x.u[0]), uintBitsToFloat(x.u[1]), uintBitsToFloat(x.u[2]), 0.0f);
+    CsmMoments m = CsmMoments(mat4(x.a, x.b, vec4(0.0f), vec4(0.0f)), mat4(0.0f));
+    r.a[0] = msm_csm_shadow(m, uintBitsToFloat(x.u[3]), p);
+    break;
+  }
+  case MSM_K_OVERDARKEN: r.a[0] = msm_overdarken(x.a[0], x.a[1]); break;
+  default: break;
+  }
+  return r;
 }
 
 MSM_END

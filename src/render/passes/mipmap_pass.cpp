@@ -23,18 +23,18 @@ void MipmapPass::execute(FrameContext& f) const {
     int32_t size = t.config.shadow_size;
     uint32_t levels = t.mip_levels;
     if (levels == 1) {
-      vk::pipelineBarrier(f.cmd, vk::imageBarrier(image, color, compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                                  VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, 1));
+      vk::pipeline_barrier(f.cmd, vk::image_barrier(image, color, compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                                    VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                                                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, 1));
       continue;
     }
     VkImageMemoryBarrier2 start[2] = {
-        vk::imageBarrier(image, color, compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL, transfer,
-                         VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 0, 1),
-        vk::imageBarrier(image, color, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED, transfer,
-                         VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, levels - 1)};
-    vk::pipelineBarrier(f.cmd, {}, {}, start);
+        vk::image_barrier(image, color, compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL,
+                          transfer, VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, 0, 1),
+        vk::image_barrier(image, color, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED, transfer,
+                          VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, levels - 1)};
+    vk::pipeline_barrier(f.cmd, {}, {}, start);
     for (uint32_t mip = 1; mip < levels; ++mip) {
       int32_t src = std::max(size >> (mip - 1), 1), dst = std::max(size >> mip, 1);
       VkImageBlit2 region{.sType = VK_STRUCTURE_TYPE_IMAGE_BLIT_2,
@@ -51,17 +51,16 @@ void MipmapPass::execute(FrameContext& f) const {
                             .pRegions = &region,
                             .filter = VK_FILTER_LINEAR};
       vkCmdBlitImage2(f.cmd, &blit);
-      vk::pipelineBarrier(f.cmd, vk::imageBarrier(image, color, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, transfer,
-                                                  VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                                  mip, 1));
+      vk::pipeline_barrier(f.cmd, vk::image_barrier(image, color, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                    VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, transfer,
+                                                    VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                                    mip, 1));
     }
-    vk::pipelineBarrier(f.cmd, vk::imageBarrier(image, color, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT |
-                                                VK_ACCESS_2_TRANSFER_READ_BIT,
-                                                VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                                VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, levels));
+    vk::pipeline_barrier(
+        f.cmd,
+        vk::image_barrier(image, color, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
+                          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, levels));
   }
 }
 

@@ -26,7 +26,7 @@ struct FrameContext {
   vk::GpuTimer& timer;
   const FrameTargets& targets;
   const GpuScene& scene;
-  const vk::Buffer& uniforms; // FrameUniforms
+  const vk::Buffer& uniforms;  // FrameUniforms
   const vk::Image& blue_noise; // 64 layers of 64² RG8 (blue_noise.h)
   glm::vec3 camera_position;
   // The colour channel whose moment images resolve, translucent, blur and mips work on
@@ -36,12 +36,12 @@ struct FrameContext {
 
 // Scene -> shadow_depth (D16, MSAA), left SHADER_READ_ONLY for compute and fragment reads.
 class ShadowDepthPass {
-public:
+ public:
   static const PassDecl& decl();
   ShadowDepthPass(const vk::Context& ctx, int msaa);
   void execute(FrameContext& f) const;
 
-private:
+ private:
   vk::Program program_;
 };
 
@@ -49,12 +49,12 @@ private:
 // coloured translucency the opaque moments of channel 0 are then copied to the other channels
 // (the same opaque occluders; only the translucent blend differs), in the same timer scope.
 class MomentResolvePass {
-public:
+ public:
   static const PassDecl& decl();
   MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg);
   void execute(FrameContext& f) const;
 
-private:
+ private:
   vk::Program program_;
 };
 
@@ -62,25 +62,25 @@ private:
 // encoding (HPG 2017 §4); visible to transfer, compute and fragment reads. One per technique,
 // MSAA and filter radius (specialization constants).
 class OnePassFilterPass {
-public:
+ public:
   static const PassDecl& decl();
   OnePassFilterPass(const vk::Context& ctx, const Technique& technique, int msaa, int taps);
   void execute(FrameContext& f) const;
 
-private:
+ private:
   vk::Program program_;
 };
 
 // Translucent objects -> blended into moments mip 0 (GENERAL, as colour attachments), back to
 // front (JCGT §3); after the resolve, before the blur. Visible to compute and transfer.
 class TranslucentPass {
-public:
+ public:
   static const PassDecl& decl();
   TranslucentPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg,
                   const std::array<int, 2>& formats);
   void execute(FrameContext& f) const;
 
-private:
+ private:
   vk::Program program_;
 };
 
@@ -88,54 +88,54 @@ private:
 // summed-area tables of the soft shadows (JCGT §4.2, msm::soft::SatBuilder), one per moment
 // image, visible to fragment reads.
 class SatPass {
-public:
+ public:
   static const PassDecl& decl();
   explicit SatPass(const vk::Context& ctx);
   void execute(FrameContext& f, int max_kernel_texels) const;
 
-private:
+ private:
   std::unique_ptr<soft::SatBuilder> builder_;
 };
 
 // moments mip 0 -> blur_temp -> moments mip 0 (GENERAL), visible to transfer, compute, fragment.
 class BlurPass {
-public:
+ public:
   static const PassDecl& decl();
   explicit BlurPass(const vk::Context& ctx);
   void execute(FrameContext& f) const;
 
-private:
+ private:
   vk::Program program_;
 };
 
 // moments mip 0 -> mips 1.. by linear blits (GENERAL), visible to fragment reads.
 class MipmapPass {
-public:
+ public:
   static const PassDecl& decl();
   void execute(FrameContext& f) const;
 };
 
 // Scene + shadow_depth or moments -> color (sRGB) and shadow_buffer, left TRANSFER_SRC.
 class ShadingPass {
-public:
+ public:
   static const PassDecl& decl();
   ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg, bool coloured);
   void execute(FrameContext& f) const;
 
-private:
+ private:
   vk::Program program_, translucent_program_; // opaque; translucent objects blended over it
   bool depth_based_, nonlinear_, soft_;
 };
 
 // Scope guard for the timer scope of a pass.
 class PassScope {
-public:
+ public:
   PassScope(FrameContext& f, const PassDecl& decl) : f_(f) { f_.timer.begin(f_.cmd, decl.name); }
   ~PassScope() { f_.timer.end(f_.cmd); }
   PassScope(const PassScope&) = delete;
   PassScope& operator=(const PassScope&) = delete;
 
-private:
+ private:
   FrameContext& f_;
 };
 

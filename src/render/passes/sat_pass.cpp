@@ -18,11 +18,12 @@ void SatPass::execute(FrameContext& f, int max_kernel_texels) const {
     moments.push_back(&t.moments[size_t(i)]);
     tables.push_back(&t.sat_tables[size_t(i)]);
   }
-  builder_->record(f.cmd, moments, tables, max_kernel_texels, soft::SatBuilder::Scheme::RowsThenColumns, nullptr,
+  builder_->record(f.cmd, moments, tables, max_kernel_texels, soft::SatBuilder::Scheme::rows_then_columns, nullptr,
                    VK_IMAGE_LAYOUT_GENERAL);
-  vk::pipelineBarrier(f.cmd, vk::memoryBarrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                               VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT));
+  vk::pipeline_barrier(f.cmd,
+                       vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                          VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                          VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_READ_BIT));
 }
 
 } // namespace msm::render

@@ -8,45 +8,42 @@ const PassDecl& ShadowDepthPass::decl() {
 }
 
 ShadowDepthPass::ShadowDepthPass(const vk::Context& ctx, int msaa)
-    : program_(vk::createGraphicsProgram(ctx, {.name = "shadow_depth",
-                                               .vertexShader = "shadow_depth.vert",
-                                               .bindings = {vk::Binding::UniformBuffer},
-                                               .vertexStride = sizeof(Vertex),
-                                               .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}},
-                                               .depthFormat = VK_FORMAT_D16_UNORM,
-                                               .samples = VkSampleCountFlagBits(msaa),
-                                               // casters in front of the fitted near plane still cast
-                                               .depthClamp = true})) {}
+    : program_(vk::create_graphics_program(ctx, {.name = "shadow_depth",
+                                                 .vertex_shader = "shadow_depth.vert",
+                                                 .bindings = {vk::Binding::uniform_buffer},
+                                                 .vertex_stride = sizeof(Vertex),
+                                                 .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}},
+                                                 .depth_format = VK_FORMAT_D16_UNORM,
+                                                 .samples = VkSampleCountFlagBits(msaa),
+                                                 // casters in front of the fitted near plane still cast
+                                                 .depth_clamp = true})) {}
 
 void ShadowDepthPass::execute(FrameContext& f) const {
   PassScope scope(f, decl());
   const vk::Image& depth = f.targets.shadow_depth;
-  vk::pipelineBarrier(f.cmd, vk::imageBarrier(depth.handle(), depth.aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0,
-                                              VK_IMAGE_LAYOUT_UNDEFINED,
-                                              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                                                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
-                                                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
-                                              VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL));
-  vk::beginRendering(f.cmd, extent(depth), {}, vk::DepthAttachment{depth.view(), 1.0f});
-  vk::setViewportScissor(f.cmd, extent(depth));
+  vk::pipeline_barrier(
+      f.cmd, vk::image_barrier(
+                 depth.handle(), depth.aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED,
+                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
+                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL));
+  vk::begin_rendering(f.cmd, extent(depth), {}, vk::DepthAttachment{depth.view(), 1.0f});
+  vk::set_viewport_scissor(f.cmd, extent(depth));
   vkCmdSetCullMode(f.cmd, VK_CULL_MODE_NONE); // both sides cast: thin walls, planes, open meshes
-  vk::bindProgram(f.cmd, program_, {vk::Descriptor(f.uniforms)});
+  vk::bind_program(f.cmd, program_, {vk::Descriptor(f.uniforms)});
   VkDeviceSize offset = 0;
   VkBuffer vertices = f.scene.vertices.handle();
   vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
   vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
   for (const Draw& d : f.scene.draws) vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
   vkCmdEndRendering(f.cmd);
-  vk::pipelineBarrier(f.cmd, vk::imageBarrier(depth.handle(), depth.aspect(),
-                                              VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                                              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
-                                              VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                                              VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
-                                                  VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
-                                                  VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-                                              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
-                                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
+  vk::pipeline_barrier(
+      f.cmd, vk::image_barrier(depth.handle(), depth.aspect(), VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                               VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
+                                   VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
+                               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
 }
 
 } // namespace msm::render

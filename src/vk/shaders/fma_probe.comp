@@ -1,6 +1,6 @@
 // Whether this device's fma() is the fused multiply-add (one rounding): msm::vk::Context runs it
 // once at creation on cases where a * b + c rounded once, rounded twice (a * b, then + c) and
-// computed in double and then rounded to float all differ (context.cpp, probeFusedFma), and compares
+// computed in double and then rounded to float all differ (context.cpp, probe_fused_fma), and compares
 // with std::fma. Each case is evaluated twice, as msm_fma (shared.h) uses fma(): in plain code, and
 // consumed by a `precise` variable (SPIR-V NoContraction), which a driver may lower differently.
 // The inputs come from the buffer, so neither glslc nor the driver can fold them.

@@ -1,5 +1,5 @@
 // dst[i] = msm_fma(a, b, c) for src[i] = (a, b, c, unused): shared.h's msm_fma on the device, with
-// the specialization constant msm_fused_fma that createProgram sets (the native fma() where the
+// the specialization constant msm_fused_fma that create_program sets (the native fma() where the
 // Context found it fused, else the exact emulation), against std::fma (vk_test.cpp).
 #version 460
 #extension GL_GOOGLE_include_directive : require
