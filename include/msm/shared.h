@@ -39,9 +39,22 @@ using uint = std::uint32_t;
 #define MSM_CPP 0
 #endif
 
+// `precise` (SPIR-V NoContraction): no contraction into fma and no reassociation of the operation
+// whose result it qualifies. Nothing in C++, whose build has -ffp-contract=off instead.
+#if MSM_CPP
+#define MSM_PRECISE
+#else
+#define MSM_PRECISE precise
+#endif
+
+// The error-free transformations (TwoSum, TwoProduct, double-float) that msm_fma's emulation and
+// trigonometric.h build on; they need only the macros above.
+#include "msm/eft.h"
+
 MSM_BEGIN
 
 const float MSM_PI = 3.14159265358979323846f;
+const float MSM_TWO_PI = 6.28318530717958647692f;
 
 // a * b + c with one rounding: exact differences such as b2 - b1² in nearly singular Hankel
 // matrices. GLM's fma is an unfused a * b + c, so the C++ side calls std::fma (correctly rounded).
@@ -59,14 +72,6 @@ const float MSM_PI = 3.14159265358979323846f;
 // keep their own constant_ids below 2000.
 #define MSM_SPEC_FUSED_FMA_ID 2000
 
-// `precise` (SPIR-V NoContraction): no contraction into fma and no reassociation of the operation
-// whose result it qualifies. Nothing in C++, whose build has -ffp-contract=off instead.
-#if MSM_CPP
-#define MSM_PRECISE
-#else
-#define MSM_PRECISE precise
-#endif
-
 // a * b + c correctly rounded (to nearest, ties to even: what std::fma and a fused fma() give)
 // from float additions and multiplications, each rounded once: Boldo & Melquiond's emulated FMA
 // ("Emulation of FMA and correctly rounded sums: proved algorithms using rounding to odd", IEEE
@@ -82,25 +87,14 @@ const float MSM_PI = 3.14159265358979323846f;
 // std::fma (gpu_math_test.cpp: EmulatedFmaIsCorrectlyRounded; vk_test.cpp: on the device).
 // Its C++ build is exact only without contraction (-ffp-contract=off): C++ code calls msm_fma.
 MSM_FN float msm_fma_emulated(float a, float b, float c) {
-  MSM_PRECISE float ta = 4097.0f * a;
-  MSM_PRECISE float tb = 4097.0f * b;
-  MSM_PRECISE float ah = ta - (ta - a);
-  MSM_PRECISE float bh = tb - (tb - b);
-  MSM_PRECISE float al = a - ah;
-  MSM_PRECISE float bl = b - bh;
-  MSM_PRECISE float p = a * b;
-  MSM_PRECISE float e = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
-  MSM_PRECISE float s = c + p;
-  MSM_PRECISE float sc = s - c;
-  MSM_PRECISE float t = (c - (s - sc)) + (p - sc);
-  MSM_PRECISE float v = t + e;
-  MSM_PRECISE float ve = v - t;
-  MSM_PRECISE float w = (t - (v - ve)) + (e - ve);
-  int bits = floatBitsToInt(v);
+  vec2 pe = msm_two_product(a, b);   // p + e = a * b
+  vec2 st = msm_two_sum(c, pe.x);    // s + t = c + p
+  vec2 vw = msm_two_sum(st.y, pe.y); // v + w = t + e
+  int bits = floatBitsToInt(vw.x);
   // Rounded to odd: an inexact v with an even last bit moves to its neighbor on w's side (v != 0
   // here: t + e rounds to 0 only if it is 0). Sign-magnitude: +1 is away from zero.
-  if (w != 0.0f && (bits & 1) == 0) bits += (w > 0.0f) == (v > 0.0f) ? 1 : -1;
-  MSM_PRECISE float r = s + intBitsToFloat(bits);
+  if (vw.y != 0.0f && (bits & 1) == 0) bits += (vw.y > 0.0f) == (vw.x > 0.0f) ? 1 : -1;
+  MSM_PRECISE float r = st.x + intBitsToFloat(bits);
   return r;
 }
 

@@ -75,15 +75,6 @@
 #define MSM_TRIGONOMETRIC_H
 #include "msm/shared.h"
 
-// The error-free transformations below need IEEE rounding of every operation, without
-// contraction into fused multiply-adds or reassociation: GLSL's `precise`; in C++ the project
-// compiles with -ffp-contract=off (no -ffast-math).
-#ifdef __cplusplus
-#define MSM_TRIG_PRECISE
-#else
-#define MSM_TRIG_PRECISE precise
-#endif
-
 MSM_BEGIN
 
 // Default bias strength toward the uniform distribution (all four trigonometric moments zero,
@@ -102,7 +93,6 @@ const int MSM_TRIG_SCAN = 8;
 const float MSM_TRIG_MIN_BRACKET = 1.0e-5f;
 // Floor of the pivots of T: far below α, so it only acts on unbiased boundary moments.
 const float MSM_TRIG_MIN_PIVOT = 1.0e-10f;
-const float MSM_TRIG_TWO_PI = 6.28318530717958647692f;
 
 // b' = (1 - α) b + α b*, b* = 0 (the uniform distribution on [0,1]).
 MSM_FN vec4 msm_trig_bias(vec4 b, float alpha) { return (1.0f - alpha) * b; }
@@ -120,52 +110,13 @@ MSM_FN vec2 msm_trig_csqrt(vec2 z) {
   float o = 0.5f * z.y / t;
   return z.x >= 0.0f ? vec2(t, o) : vec2(abs(o), z.y < 0.0f ? -t : t);
 }
-// clamp(x, 0, 1) that maps NaN (rounding noise of inputs outside the moment space) to 0.
-MSM_FN float msm_trig_clamp01(float x) { return x > 0.0f ? min(x, 1.0f) : 0.0f; }
 // Angle of z in [0, 2π).
 MSM_FN float msm_trig_arg(vec2 z) {
   float a = atan(z.y, z.x);
-  return a < 0.0f ? a + MSM_TRIG_TWO_PI : a;
+  return a < 0.0f ? a + MSM_TWO_PI : a;
 }
 
-// --- double-float numbers vec2(hi, lo), value hi + lo (Knuth, Dekker) ---
-MSM_FN vec2 msm_trig_two_sum(float a, float b) {
-  MSM_TRIG_PRECISE float s = a + b;
-  MSM_TRIG_PRECISE float v = s - a;
-  MSM_TRIG_PRECISE float e = (a - (s - v)) + (b - v);
-  return vec2(s, e);
-}
-MSM_FN vec2 msm_trig_quick_two_sum(float a, float b) { // |a| >= |b|
-  MSM_TRIG_PRECISE float s = a + b;
-  MSM_TRIG_PRECISE float e = b - (s - a);
-  return vec2(s, e);
-}
-MSM_FN vec2 msm_trig_split(float a) {
-  MSM_TRIG_PRECISE float c = 4097.0f * a;
-  MSM_TRIG_PRECISE float hi = c - (c - a);
-  MSM_TRIG_PRECISE float lo = a - hi;
-  return vec2(hi, lo);
-}
-MSM_FN vec2 msm_trig_two_prod(float a, float b) {
-  vec2 sa = msm_trig_split(a), sb = msm_trig_split(b);
-  MSM_TRIG_PRECISE float p = a * b;
-  MSM_TRIG_PRECISE float e = ((sa.x * sb.x - p) + sa.x * sb.y + sa.y * sb.x) + sa.y * sb.y;
-  return vec2(p, e);
-}
-MSM_FN vec2 msm_trig_df_add(vec2 a, vec2 b) {
-  vec2 s = msm_trig_two_sum(a.x, b.x);
-  MSM_TRIG_PRECISE float lo = s.y + (a.y + b.y);
-  return msm_trig_quick_two_sum(s.x, lo);
-}
-MSM_FN vec2 msm_trig_df_mul(vec2 a, vec2 b) {
-  vec2 p = msm_trig_two_prod(a.x, b.x);
-  MSM_TRIG_PRECISE float lo = p.y + (a.x * b.y + a.y * b.x);
-  return msm_trig_quick_two_sum(p.x, lo);
-}
-// a + b c + d e for floats, in double-float.
-MSM_FN vec2 msm_trig_df_sum_prod2(float a, float b, float c, float d, float e) {
-  return msm_trig_df_add(msm_trig_df_add(vec2(a, 0.0f), msm_trig_two_prod(b, c)), msm_trig_two_prod(d, e));
-}
+// Double-float arithmetic: msm_df_* and msm_two_product of msm/eft.h (through shared.h).
 
 // T = L D Lᴴ for T = [[1, c1, c2], [c̄1, 1, c1], [c̄2, c̄1, 1]]: L unit lower triangular with
 // entries l10 = c̄1, l20 = c̄2, l21; D = diag(1, d1, d2). For nearly singular T (1-2 Diracs) the
@@ -182,12 +133,12 @@ struct TrigLdl {
 
 MSM_FN TrigLdl msm_trig_ldl(vec4 b) {
   float x1 = b[1], y1 = b[0], x2 = b[3], y2 = b[2];
-  vec2 d1 = msm_trig_df_sum_prod2(1.0f, -x1, x1, -y1, y1); // 1 - |c1|²
-  vec2 nr = msm_trig_df_sum_prod2(x1, -x2, x1, -y2, y1);   // Re(c̄1 - c̄2 c1)
-  vec2 ni = msm_trig_df_sum_prod2(-y1, -x2, y1, y2, x1);   // Im(c̄1 - c̄2 c1)
-  vec2 a = msm_trig_df_sum_prod2(1.0f, -x2, x2, -y2, y2);  // 1 - |c2|²
-  vec2 n2 = msm_trig_df_add(msm_trig_df_mul(nr, nr), msm_trig_df_mul(ni, ni));
-  vec2 det = msm_trig_df_add(msm_trig_df_mul(a, d1), -n2); // (1 - |c2|²) d1 - |n|²
+  vec2 d1 = msm_df_sum_prod2(1.0f, -x1, x1, -y1, y1); // 1 - |c1|²
+  vec2 nr = msm_df_sum_prod2(x1, -x2, x1, -y2, y1);   // Re(c̄1 - c̄2 c1)
+  vec2 ni = msm_df_sum_prod2(-y1, -x2, y1, y2, x1);   // Im(c̄1 - c̄2 c1)
+  vec2 a = msm_df_sum_prod2(1.0f, -x2, x2, -y2, y2);  // 1 - |c2|²
+  vec2 n2 = msm_df_add(msm_df_mul(nr, nr), msm_df_mul(ni, ni));
+  vec2 det = msm_df_add(msm_df_mul(a, d1), -n2); // (1 - |c2|²) d1 - |n|²
   // Pivots >= the smallest eigenvalue of T (>= α for biased moments); the floor only keeps
   // unbiased boundary moments (a missing bias) from dividing by zero.
   float pivot1 = max(d1.x + d1.y, MSM_TRIG_MIN_PIVOT);
@@ -204,8 +155,8 @@ struct TrigForward {
 MSM_FN TrigForward msm_trig_forward(TrigLdl f, vec2 w) {
   vec2 y1 = msm_trig_conj(w) - msm_trig_conj(f.c1);
   // w̄² - c̄2 cancels down to ~|w - atom| for w near a nearly Dirac atom: double-float.
-  vec2 re = msm_trig_df_sum_prod2(-f.c2.x, w.x, w.x, -w.y, w.y);
-  vec2 im = msm_trig_df_sum_prod2(f.c2.y, -2.0f * w.x, w.y, 0.0f, 0.0f);
+  vec2 re = msm_df_sum_prod2(-f.c2.x, w.x, w.x, -w.y, w.y);
+  vec2 im = msm_df_sum_prod2(f.c2.y, -2.0f * w.x, w.y, 0.0f, 0.0f);
   vec2 y2 = vec2(re.x + re.y, im.x + im.y) - msm_trig_cmul(f.l21, y1);
   return TrigForward(y1, y2);
 }
@@ -305,7 +256,7 @@ MSM_FN vec2 msm_trig_stationarity(TrigArcMoments m, vec2 e0, vec2 e1, vec2 u, bo
 // inf μ(open arc from e0 counterclockwise to e1) over the measures with the factorized moments,
 // for the arc length L = arg(e1 / e0) in (0, 2π] (L = 2π: the circle without e0).
 MSM_FN float msm_trig_lower_arc(TrigLdl f, vec2 e0, vec2 e1, float L) {
-  if (L >= MSM_TRIG_TWO_PI) return msm_trig_clamp01(1.0f - msm_trig_christoffel(f, e0));
+  if (L >= MSM_TWO_PI) return msm_saturate(1.0f - msm_trig_christoffel(f, e0));
   vec2 tp = msm_trig_canonical_atoms(f, e1, e0); // σ_end, angles from e0
   vec2 t0 = msm_trig_canonical_atoms(f, e0, e0); // σ_start
   bool p1 = tp.x > 0.0f && tp.x<L, p2 = tp.y> 0.0f && tp.y < L;
@@ -328,7 +279,7 @@ MSM_FN float msm_trig_lower_arc(TrigLdl f, vec2 e0, vec2 e1, float L) {
   // minimum of f lies at an end of the bracket, and the fallback for a degenerate bracket
   // (t = s up to the rounding of the atoms) or atom counts that differ (rounding at an arc end).
   float best = min(g_end, g_start);
-  if (two != two0 || !(s > t + MSM_TRIG_MIN_BRACKET)) return msm_trig_clamp01(best);
+  if (two != two0 || !(s > t + MSM_TRIG_MIN_BRACKET)) return msm_saturate(best);
   // g has the sign of f'. Scan for its first change from - to + (the minimum of f), which is
   // more robust than the signs at the ends alone: g vanishes at an end where an atom meets
   // another one (a nearly Dirac distribution), and rounding may flip its sign there.
@@ -349,7 +300,7 @@ MSM_FN float msm_trig_lower_arc(TrigLdl f, vec2 e0, vec2 e1, float L) {
     }
     x_prev = x, g_prev = g;
   }
-  if (!found) return msm_trig_clamp01(best);
+  if (!found) return msm_saturate(best);
   // Safeguarded Newton on g in [lo, hi], g(lo) < 0 < g(hi), from the regula falsi point:
   // Newton steps where they stay inside the bracket, bisection otherwise (g need not be
   // monotone in the bracket). Ends when a step is below 2e-6 rad: the error of f is second
@@ -371,14 +322,14 @@ MSM_FN float msm_trig_lower_arc(TrigLdl f, vec2 e0, vec2 e1, float L) {
   vec2 v = msm_trig_fourth_atom(m, u);
   float shadow = msm_trig_atom_weight(f.c1, f.c2, u, e0, e1, v);
   if (two) shadow += msm_trig_atom_weight(f.c1, f.c2, v, e0, e1, u);
-  return msm_trig_clamp01(min(best, shadow));
+  return msm_saturate(min(best, shadow));
 }
 
 // Sharp lower bound of Z(z < zf): inf μ(open arc (0, 2π zf)).
 MSM_FN float msm_trig_lower_from_ldl(TrigLdl f, float zf) {
   if (zf <= 0.0f) return 0.0f;
   if (zf > 1.0f) return 1.0f;
-  float phi = MSM_TRIG_TWO_PI * zf;
+  float phi = MSM_TWO_PI * zf;
   return msm_trig_lower_arc(f, vec2(1.0f, 0.0f), msm_trig_cis(phi), phi);
 }
 
@@ -386,8 +337,8 @@ MSM_FN float msm_trig_lower_from_ldl(TrigLdl f, float zf) {
 MSM_FN float msm_trig_upper_from_ldl(TrigLdl f, float zf) {
   if (zf < 0.0f) return 0.0f;
   if (zf >= 1.0f) return 1.0f;
-  float phi = MSM_TRIG_TWO_PI * zf;
-  return msm_trig_clamp01(1.0f - msm_trig_lower_arc(f, msm_trig_cis(phi), vec2(1.0f, 0.0f), MSM_TRIG_TWO_PI - phi));
+  float phi = MSM_TWO_PI * zf;
+  return msm_saturate(1.0f - msm_trig_lower_arc(f, msm_trig_cis(phi), vec2(1.0f, 0.0f), MSM_TWO_PI - phi));
 }
 
 // Sharp lower bound of Z(z < zf) for biased trigonometric moments b (see top of file).

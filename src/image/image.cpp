@@ -1,5 +1,7 @@
 #include "msm/image/image.h"
 
+#include "msm/shading.h"
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -133,9 +135,7 @@ Image tone_map(const Image& image, const ToneMap& tone) {
     switch (tone.curve) {
     case ToneCurve::clamp: break;
     case ToneCurve::reinhard: x = std::isinf(x) ? 1.0f : x / (1.0f + x); break;
-    case ToneCurve::aces:
-      x = std::isinf(x) ? 1.0f : std::clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
-      break;
+    case ToneCurve::aces: x = std::isinf(x) ? 1.0f : msm_aces(x); break;
     }
     px[i] = x;
   }

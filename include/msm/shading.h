@@ -1,0 +1,39 @@
+// The look of every image msm makes, defined once for the renderer's shaders, the ray tracer's
+// radiance and the tools: Lambertian surfaces lit by directional lights plus a constant ambient
+// term, Narkowicz's ACES fit as the tone curve, and the sky colour of pixels without a surface.
+//   radiance = albedo (Σ_l E_l max(n·l_l, 0) V_l / π + ambient)
+// with E_l the irradiance of light l on a surface facing it, V_l its visibility (per colour
+// channel for coloured translucent shadows) and ambient MSM_AMBIENT (an irradiance factor, so
+// that shadowed surfaces keep a little of their albedo).
+#ifndef MSM_SHADING_H
+#define MSM_SHADING_H
+#include "msm/shared.h"
+
+MSM_BEGIN
+
+const float MSM_AMBIENT = 0.03f;
+// Linear RGB radiance of pixels where the camera sees no surface.
+const vec3 MSM_SKY_RADIANCE = vec3(0.55f, 0.65f, 0.8f);
+
+// Reflected-irradiance term of one directional light: E max(n·l, 0) V / π (the 1/π of the
+// Lambertian BRDF; the albedo multiplies the sum over lights in msm_surface_radiance).
+MSM_FN vec3 msm_direct_light(vec3 irradiance, float n_dot_l, vec3 visibility) {
+  return irradiance * (max(n_dot_l, 0.0f) * visibility / MSM_PI);
+}
+
+// Outgoing radiance of a Lambertian surface from the summed direct terms and the ambient factor.
+MSM_FN vec3 msm_surface_radiance(vec3 albedo, vec3 direct, float ambient) { return albedo * (direct + ambient); }
+
+// Narkowicz 2015 fit of the ACES filmic curve, x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14),
+// clamped to [0, 1]; applied after the exposure. Precondition: x >= 0 and finite (callers map NaN,
+// negative and infinite values first where they can occur).
+MSM_FN float msm_aces(float x) {
+  return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+}
+MSM_FN vec3 msm_aces(vec3 x) {
+  return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), vec3(0.0f), vec3(1.0f));
+}
+
+MSM_END
+
+#endif // MSM_SHADING_H
