@@ -18,10 +18,19 @@ if(MSM_SANITIZE)
 endif()
 install(TARGETS msm_compile_options EXPORT msmTargets)
 
+# Test support (tests/support: the Vulkan test fixture) and the one place of test data
+# (tests/data, and the Debian packages' models found by configured paths): for test targets only,
+# never installed.
+set(MSM_GLMARK2_MODELS_DIR /usr/share/glmark2/models CACHE PATH "glmark2-data's models (the bunny of the import tests)")
+add_library(msm_test_support INTERFACE)
+target_include_directories(msm_test_support INTERFACE ${PROJECT_SOURCE_DIR}/tests/support)
+target_compile_definitions(msm_test_support INTERFACE MSM_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
+  MSM_GLMARK2_MODELS_DIR="${MSM_GLMARK2_MODELS_DIR}")
+
 # msm_add_test(NAME SOURCES... LIBS ...): one GoogleTest executable, its tests registered with CTest.
 function(msm_add_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main msm_compile_options)
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main msm_compile_options msm_test_support)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 900)
 endfunction()

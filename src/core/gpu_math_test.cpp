@@ -31,7 +31,7 @@
 #include "gpu/kernels.h"
 #include "test_distributions.h"
 
-#include "msm/vk/test_support.h"
+#include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
 #include <gtest/gtest.h>

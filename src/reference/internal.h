@@ -12,28 +12,14 @@
 #include <glm/glm.hpp>
 
 #include "msm/reference/reference.h"
+#include "msm/util/random.h"
 
 namespace msm::reference::detail {
 
 // ---- Random numbers --------------------------------------------------------------------------
 
-inline std::uint64_t splitmix64(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-// SplitMix64: small, fast, statistically fine for sampling; one per pixel.
-class Rng {
- public:
-  explicit Rng(std::uint64_t seed) : state_(seed) {}
-  std::uint64_t next() { return splitmix64(state_); }
-  double uniform() { return double(next() >> 11) * 0x1.0p-53; } // [0, 1)
-
- private:
-  std::uint64_t state_;
-};
+// One generator per pixel (msm/util/random.h).
+using Rng = util::SplitMix64;
 
 // The generator of pixel (x, y): depends on nothing but these (not on threads or order).
 Rng pixel_rng(std::uint64_t seed, int x, int y, Effect effect);

@@ -16,6 +16,7 @@
 #include <tbb/task_arena.h>
 
 #include "internal.h"
+#include "msm/shading.h"
 
 namespace msm::reference {
 
@@ -84,27 +85,6 @@ void validate(const Settings& s) {
   check_angle("light height", s.light_height_deg);
 }
 
-glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, float visibility) {
-  return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>)+kAmbient * albedo;
-}
-
-glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, glm::vec3 visibility) {
-  // Channel by channel exactly the scalar formula (same operations in the same order).
-  return albedo * irradiance * (std::max(0.0f, n_dot_l) * visibility / std::numbers::pi_v<float>)+kAmbient * albedo;
-}
-
-LightFrame LightFrame::of(const scene::Scene& scene) {
-  const glm::dmat4 inv = glm::inverse(glm::dmat4(scene.light_view_projection()));
-  LightFrame f;
-  f.towards_light = glm::normalize(glm::dvec3(scene.light.towards_light));
-  // Orthographic: a unit step of clip x (y) moves by inv[0] (inv[1]) in world space.
-  const glm::dvec3 cx(inv[0]), cy(inv[1]);
-  f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
-  f.x_axis = glm::normalize(cx);
-  f.y_axis = glm::normalize(cy);
-  return f;
-}
-
 // ---- Rendering ---------------------------------------------------------------------------------
 
 namespace {
@@ -148,7 +128,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   result.build_seconds = seconds_since(start);
 
   EffectContext ctx{
-      tracer, settings, LightFrame::of(scene), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
+      tracer, settings, scene.light_frame(), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
   ctx.towards_light = ctx.frame.towards_light;
   ctx.texel_x = ctx.frame.x_axis * (ctx.frame.extent.x / settings.shadow_size);
   ctx.texel_y = ctx.frame.y_axis * (ctx.frame.extent.y / settings.shadow_size);
@@ -156,7 +136,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   ctx.light_x = glm::normalize(ctx.frame.x_axis - glm::dot(ctx.frame.x_axis, ctx.towards_light) * ctx.towards_light);
   ctx.light_y = glm::cross(ctx.towards_light, ctx.light_x);
   if (glm::dot(ctx.light_y, ctx.frame.y_axis) < 0.0) ctx.light_y = -ctx.light_y;
-  const double extent = settings.light_extent_deg.value_or(scene.light.angular_extent_deg);
+  const double extent = settings.light_extent_deg.value_or(scene.light().angular_extent_deg);
   if (!(std::isfinite(extent) && extent >= 0.0 && extent < 90.0))
     throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", extent));
   result.light_extent_deg = extent;
@@ -187,7 +167,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     const glm::dvec4 q = inv_vp * glm::dvec4(nx, ny, depth, 1.0);
     return glm::dvec3(q) / q.w;
   };
-  const glm::dvec3 irradiance(scene.light.irradiance);
+  const glm::dvec3 irradiance(scene.light().irradiance);
 
   std::vector<double> row_sum(H, 0.0);
   std::vector<std::size_t> row_background(H, 0);
@@ -248,10 +228,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         // effect gives a visibility per channel (translucent).
         glm::dvec3 n = tracer.shading_normal(hit);
         if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-        const glm::vec3 colour = e.rgb ? shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                               float(glm::dot(n, ctx.towards_light)), rgb)
-                                       : shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                               float(glm::dot(n, ctx.towards_light)), float(e.value));
+        const glm::vec3 direct = msm_direct_light(glm::vec3(irradiance), float(glm::dot(n, ctx.towards_light)), rgb);
+        const glm::vec3 colour = msm_surface_radiance(tracer.material(hit).albedo, direct, MSM_AMBIENT);
         c[0] = colour.r;
         c[1] = colour.g;
         c[2] = colour.b;

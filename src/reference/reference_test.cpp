@@ -260,7 +260,7 @@ TEST(reference_filtered, EdgeProfileMatchesTheKernel) {
     const Scene scene = make_scene(
         camera, light_json(pc.towards), ground_and_half_plane(h),
         R"("shadow_map": {"framing": "explicit", "center": [0, 0.5, 0], "extent": [6, 8], "depth_range": [-5, 5]}, )");
-    const LightFrame frame = LightFrame::of(scene);
+    const LightFrame frame = scene.light_frame();
     EXPECT_NEAR(frame.extent.x, 6.0, 1e-5);
     EXPECT_NEAR(frame.extent.y, 8.0, 1e-5);
     Settings s;
@@ -310,12 +310,16 @@ TEST(reference_filtered, EdgeProfileMatchesTheKernel) {
 }
 
 TEST(reference_filtered, KernelSamplingHasTheKernelsDistribution) {
-  // FilterKernel::sample maps uniform u to offsets with CDF cdf(); cdf matches the test's own.
+  // FilterKernel::sample maps uniform u to offsets with CDF cdf(); cdf matches the test's own,
+  // computed in double from the Gaussian. The kernel's weights are the renderer's floats
+  // (msm/filter.h): they sum to 1 and follow the double Gaussian within float rounding (each
+  // weight within 1 ulp, 6e-8 relative, of its double value).
   const FilterKernel k(9, 2.4);
   double total = 0.0;
   for (double w : k.weights()) total += w;
-  EXPECT_NEAR(total, 1.0, 1e-15);
-  for (double s = -6.0; s <= 6.0; s += 0.37) EXPECT_NEAR(k.cdf(s), kernel_cdf(s, 9, 2.4), 1e-14);
+  EXPECT_NEAR(total, 1.0, 1e-7);
+  for (double s = -6.0; s <= 6.0; s += 0.37)
+    EXPECT_NEAR(k.cdf(s), kernel_cdf(s, 9, 2.4), 1e-7 * kernel_cdf(s, 9, 2.4) + 1e-15);
   // Empirical CDF of 2^16 evenly spaced u against cdf(): Kolmogorov distance ~ 1 / 2^16.
   std::vector<double> samples;
   const int n = 1 << 16;
@@ -340,7 +344,7 @@ struct DiscScene {
   Scene scene;
   CameraSpec camera; // the scene's camera, for the test's own camera model
   explicit DiscScene(double extent_deg) : scene(msm::scene::builtin_scene("disc")) {
-    scene.light.angular_extent_deg = float(extent_deg);
+    scene.lights[0].angular_extent_deg = float(extent_deg);
     const msm::scene::Camera& c = scene.camera;
     camera = CameraSpec{glm::dvec3(c.position), glm::dvec3(c.target), glm::dvec3(c.up), double(c.fov_y_deg)};
   }
@@ -407,8 +411,8 @@ TEST(reference_soft, BuiltinDiscSceneHasTheAnalyticGeometry) {
   EXPECT_NEAR(occluder.bounds.min.y, disc.center_height - 0.5 * disc.thickness, 1e-6);
   EXPECT_NEAR(occluder.bounds.max.y, disc.center_height + 0.5 * disc.thickness, 1e-6);
   EXPECT_EQ(occluder.mesh.triangle_count(), 4u * 1024u);
-  EXPECT_EQ(scene.light.towards_light, glm::vec3(0.0f, 1.0f, 0.0f));
-  EXPECT_EQ(scene.light.angular_extent_deg, 10.0f);
+  EXPECT_EQ(scene.light().towards_light, glm::vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(scene.light().angular_extent_deg, 10.0f);
   EXPECT_GT(scene.camera.position.y, 0.0f);
   EXPECT_LT(scene.camera.position.y, occluder.bounds.min.y);
 }

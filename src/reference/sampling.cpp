@@ -8,12 +8,9 @@ namespace msm::reference::detail {
 
 Rng pixel_rng(std::uint64_t seed, int x, int y, Effect effect) {
   // Hash the seed, the pixel and the effect into an independent-looking stream per pixel.
-  std::uint64_t s = seed;
-  std::uint64_t h = splitmix64(s);
-  s = h ^ (std::uint64_t(std::uint32_t(x)) | (std::uint64_t(std::uint32_t(y)) << 32));
-  h = splitmix64(s);
-  s = h ^ (0xD1B54A32D192ED03ull * (std::uint64_t(effect) + 1));
-  return Rng(splitmix64(s));
+  std::uint64_t h = Rng(seed).next();
+  h = Rng(h ^ (std::uint64_t(std::uint32_t(x)) | (std::uint64_t(std::uint32_t(y)) << 32))).next();
+  return Rng(Rng(h ^ (0xD1B54A32D192ED03ull * (std::uint64_t(effect) + 1))).next());
 }
 
 SampleSet::SampleSet(Sampler sampler, int count) : sampler_(sampler), count_(count), grid_(0) {

@@ -1,5 +1,6 @@
 // Blue noise by void-and-cluster (Ulichney 1993), its cache file and its spectral measures.
 #include "msm/render/blue_noise.h"
+#include "msm/util/random.h"
 
 #include "msm/image/image.h"
 #include "msm/image/io.h"
@@ -29,30 +30,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// ---- Random numbers: SplitMix64 (Steele, Lea, Flood 2014), identical on every platform ---------
-
-std::uint64_t mix64(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
-class SplitMix64 {
- public:
-  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
-  std::uint64_t next() { return mix64(state_ += 0x9e3779b97f4a7c15ull); }
-  // Uniform in [0, bound) without modulo bias (bound > 0).
-  std::uint64_t below(std::uint64_t bound) {
-    const std::uint64_t threshold = (0 - bound) % bound; // 2^64 mod bound
-    for (;;) {
-      const std::uint64_t r = next();
-      if (r >= threshold) return r % bound;
-    }
-  }
-
- private:
-  std::uint64_t state_;
-};
+using util::mix64;
+using util::SplitMix64;
 
 // The seed of run `index` (texture t, channel c: index t * channels + c) of a set.
 std::uint64_t derived_seed(std::uint64_t seed, std::uint64_t index) {

@@ -250,8 +250,8 @@ TEST(BlueNoiseMeasures, CropOfALargerTextureDoesNotTile) {
 // ---- A published texture as reference ------------------------------------------------------------
 
 TEST(BlueNoiseMeasures, ComparableToPublishedTexture) {
-  const fs::path file = fs::path(MSM_BLUE_NOISE_DATA_DIR) / "n8ao_blue_noise_128_rgba.png";
-  if (!fs::exists(file)) GTEST_SKIP() << "reference texture missing: " << file;
+  const fs::path file = fs::path(MSM_TEST_DATA_DIR) / "blue_noise" / "n8ao_blue_noise_128_rgba.png";
+  ASSERT_TRUE(fs::exists(file)) << "the committed reference texture is missing: " << file;
   const msm::image::Image image = msm::image::read_png(file);
   ASSERT_EQ(image.width(), 128);
   ASSERT_EQ(image.height(), 128);

@@ -32,7 +32,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
   std::vector<Vertex> vertex_data;
   std::vector<uint32_t> index_data;
   std::map<std::filesystem::path, int> texture_index;
-  glm::vec3 travel = scene.light.travel();
+  glm::vec3 travel = scene.light().travel();
   std::vector<std::pair<float, Draw>> translucent_by_depth;
   for (const scene::Object& object : scene.objects) {
     const scene::Mesh& mesh = object.mesh;
@@ -91,6 +91,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
   vk::upload_buffer(ctx, indices, std::as_bytes(std::span(index_data)));
   const std::uint8_t white_texel[4] = {255, 255, 255, 255};
   white = upload_rgba8(ctx, 1, 1, white_texel);
+  white_array = vk::create_image_view(ctx, white.handle(), white.format(), VK_IMAGE_ASPECT_COLOR_BIT,
+                                      VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, 1, 0, 1);
   texture_sampler = vk::create_sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
 }
 

@@ -37,6 +37,7 @@ struct GpuScene {
   std::vector<vk::Image> textures;         // RGBA8 sRGB
   std::vector<vk::Image> opacity_textures; // R8 UNORM: the alpha channel, or the red one where alpha is all 1
   vk::Image white;                         // 1x1, for draws without a texture
+  vk::ImageView white_array;               // the same as a one-layer array (unused array bindings)
   vk::Sampler texture_sampler;             // linear, repeat
 
   GpuScene(const vk::Context& ctx, const scene::Scene& scene);

@@ -8,7 +8,7 @@
 #include "msm/nonlinear.h"
 #include "msm/render/frame.h"
 #include "msm/techniques.h"
-#include "msm/vk/test_support.h"
+#include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
 #include <fmt/format.h>
@@ -89,9 +89,11 @@ const std::map<std::string, SceneRenders>& renders(const vk::Context& ctx) {
     RenderResult pcf = renderer.render(small("pcf"));
     r.pcf = visibility(pcf);
     r.mask = background(pcf);
-    for (const Technique& t : techniques()) // soft shadows are checked in soft_shadow_test.cpp
+    for (const Technique* tp : rendered_techniques()) { // soft shadows are checked in soft_shadow_test.cpp
+      const Technique& t = *tp;
       if (t.id != MSM_TECH_PCF && !msm_technique_is_area_light(t.id))
         r.visibility[std::string(t.name)] = visibility(renderer.render(small(std::string(t.name))));
+    }
   }
   return all;
 }
@@ -105,7 +107,8 @@ TEST_F(RenderTest, EveryTechniqueIsWithinItsBoundOfPcfOnEveryScene) {
   std::string table = fmt::format("{:<24}", "MAE / leaking / >3%");
   for (const auto& [scene, r] : renders(ctx())) table += fmt::format(" | {:^24}", scene);
   fmt::print("{}\n", table);
-  for (const Technique& t : techniques()) {
+  for (const Technique* tp : rendered_techniques()) {
+    const Technique& t = *tp;
     if (t.id == MSM_TECH_PCF || msm_technique_is_area_light(t.id)) continue;
     std::string name(t.name);
     ASSERT_TRUE(kBounds.count(name)) << name << " has no bound";
@@ -163,10 +166,10 @@ TEST_F(RenderTest, ResolvedMomentsEqualTheCpuComputationOnTheSameDepths) {
       s.shadow_size = 128;
       Intermediates in;
       renderer.render(s, &in);
-      const Technique& t = find_technique(name);
-      glm::vec4 params = default_params(t);
+      const Technique& t = find_rendered_technique(name);
+      glm::vec4 params = t.default_params();
       ASSERT_EQ(in.depth_samples.size(), size_t(128 * 128 * msaa));
-      bool unorm = t.formats[0] == VK_FORMAT_R16G16B16A16_UNORM || t.formats[0] == VK_FORMAT_R16G16_UNORM;
+      bool unorm = t.formats[0] == TexelFormat::rgba16_unorm || t.formats[0] == TexelFormat::rg16_unorm;
       int channels = in.moments.channels();
       double worst = 0;
       int distinct_depths = 0;
@@ -244,7 +247,8 @@ TEST_F(RenderTest, FlatReceiverFacingTheLightIsLit) {
                                                             height, height / 2),
                                                 ".", "flat");
     Renderer renderer(ctx(), scene);
-    for (const Technique& t : techniques()) {
+    for (const Technique* tp : rendered_techniques()) {
+      const Technique& t = *tp;
       if (msm_technique_is_depth_based(t.id) || msm_technique_is_area_light(t.id)) continue;
       image::Image v = visibility(renderer.render(small(std::string(t.name))));
       double darkest = 1.0;
@@ -264,11 +268,8 @@ TEST_F(RenderTest, BlurNeverSpreadsNaN) {
       sizeof(ImagePassPush));
   FrameUniforms u{};
   u.kernel = glm::ivec4(taps, 1, radius, 0);
-  std::vector<float> w(taps);
-  float sum = 0;
   for (int k = 0; k < taps; ++k)
-    sum += w[size_t(k)] = std::exp(-float((k - radius) * (k - radius)) / (2 * 2.4f * 2.4f));
-  for (int k = 0; k < taps; ++k) u.filter_weights[k / 4][k % 4] = w[size_t(k)] / sum;
+    u.filter_weights[k / 4][k % 4] = msm_gaussian_weight(k, taps, MSM_FILTER_DEFAULT_SIGMA);
   vk::Buffer uniforms = vk::create_buffer(ctx(), sizeof(u), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host);
   std::memcpy(uniforms.data(), &u, sizeof(u));
   std::vector<float> texels(size_t(n * n * 4));
@@ -320,8 +321,8 @@ TEST_F(RenderTest, BlurNeverSpreadsNaN) {
         double expected = 0;
         for (int j = 0; j < taps; ++j)
           for (int i = 0; i < taps; ++i)
-            expected +=
-                double(w[size_t(i)] / sum) * (w[size_t(j)] / sum) * at(texels, x + i - radius, y + j - radius, c);
+            expected += double(u.filter_weights[i / 4][i % 4]) * u.filter_weights[j / 4][j % 4] *
+                        at(texels, x + i - radius, y + j - radius, c);
         EXPECT_NEAR(v, expected, 1e-5) << x << "," << y;
       }
 }
@@ -335,7 +336,7 @@ TEST_F(RenderTest, ParametersReachTheShaders) {
   RenderSettings dark = small("vsm-32");
   dark.overdarken = 0.8f;
   RenderSettings loose = small("vsm-32");
-  loose.params = default_params(find_technique("vsm-32")) + glm::vec4(0.0f, 0.0f, 0.0f, 0.01f);
+  loose.params = find_rendered_technique("vsm-32").default_params() + glm::vec4(0.0f, 0.0f, 0.0f, 0.01f);
   image::Image darker = visibility(renderer.render(dark)), brighter = visibility(renderer.render(loose));
   int darkened = 0, brightened = 0;
   for (size_t i = 0; i < base.pixels().size(); ++i) {
@@ -365,7 +366,7 @@ TEST_F(RenderTest, OnePassFilterEqualsTheThreePassFilter) {
       s.one_pass = true;
       renderer.render(s, &one);
       ASSERT_EQ(one.moments.width(), 200);
-      bool unorm = find_technique(name).formats[0] != VK_FORMAT_R32G32B32A32_SFLOAT;
+      bool unorm = find_rendered_technique(name).formats[0] != TexelFormat::rgba32_float;
       double worst = 0;
       for (size_t i = 0; i < one.moments.pixels().size(); ++i)
         worst = std::max(worst, double(std::abs(one.moments.pixels()[i] - three.filtered.pixels()[i])));
@@ -388,11 +389,9 @@ TEST_F(RenderTest, OnePassFilterEqualsTheThreePassFilter) {
 TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
   Renderer renderer(ctx(), scene::builtin_scene("fence"));
   const int n = 96, taps = 9, radius = 4;
-  std::vector<float> w(taps);
-  double wsum = 0;
-  for (int k = 0; k < taps; ++k) wsum += std::exp(-double((k - radius) * (k - radius)) / (2 * 2.4 * 2.4));
-  for (int k = 0; k < taps; ++k)
-    w[size_t(k)] = float(std::exp(-double((k - radius) * (k - radius)) / (2 * 2.4 * 2.4)) / wsum);
+  RenderSettings kernel_settings; // the default kernel, as the renders below use
+  std::vector<float> w = filter_weights(kernel_settings);
+  ASSERT_EQ(int(w.size()), taps);
   auto cpu_filtered = [&](const Intermediates& in, int msaa) {
     std::vector<glm::vec4> resolved(size_t(n * n)), horizontal(size_t(n * n)), out(size_t(n * n));
     for (int i = 0; i < n * n; ++i) {

@@ -1,31 +1,39 @@
-// The frame: uniforms, the passes in order, readback. Pipelines are built on first use of a
-// technique / MSAA combination and kept.
+// The frame: settings -> configuration -> frame graph (recipes.cpp, frame_graph.h), uniforms of the
+// frame and of its lights, recording, readback. Graphs are rebuilt when the configuration changes;
+// pipelines stay in the program cache.
 #include "msm/render/renderer.h"
 
-#include "frame_targets.h"
+#include "frame_config.h"
+#include "frame_graph.h"
 #include "gpu_scene.h"
+#include "passes/pass.h"
+#include "program_cache.h"
+#include "recipes.h"
+
+#include "msm/filter.h"
+#include "msm/gpu/sat_builder.h"
 #include "msm/render/blue_noise.h"
 #include "msm/render/frame.h"
+#include "msm/sat.h"
 #include "msm/soft.h"
 #include "msm/techniques.h"
-#include "passes/pass.h"
 
 #include <fmt/format.h>
 #include <glm/gtc/packing.hpp>
 
+#include <bit>
 #include <cmath>
 #include <cstring>
-#include <map>
-#include <tuple>
 
 namespace msm::render {
 
-// std140 and the C++ struct agree (frame.h uses vec4/ivec4/mat4 members only).
-static_assert(sizeof(FrameUniforms) == 3 * 64 + 7 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 16);
-static_assert(offsetof(FrameUniforms, kernel) == 3 * 64 + 6 * 16);
-static_assert(offsetof(FrameUniforms, filter_weights) == 3 * 64 + 7 * 16);
-static_assert(offsetof(FrameUniforms, receiver_bias) == sizeof(FrameUniforms) - 16);
-static_assert(sizeof(ObjectPush) == 48 && sizeof(ImagePassPush) == 16);
+// std140/std430 and the C++ structs agree (frame.h uses vec4/ivec4/mat4 members only).
+static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 2 * 16);
+static_assert(offsetof(FrameUniforms, filter_weights) == 64 + 4 * 16);
+static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 16);
+static_assert(sizeof(LightUniforms) == 2 * 64 + 3 * 16);
+static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
+static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
 
 namespace {
 
@@ -41,26 +49,15 @@ std::vector<glm::vec2> standard_sample_offsets(int samples) {
   return out;
 }
 
+// Layer 0 of a readback (layers are tightly packed, layer after layer).
 image::Image to_float_image(std::span<const std::byte> bytes, VkFormat format, int width, int height) {
   int channels = 0;
-  enum { unorm16, half, Float } kind = Float;
+  enum { unorm16, half, single } kind = single;
   switch (format) {
-  case VK_FORMAT_R16G16B16A16_UNORM:
-    channels = 4;
-    kind = unorm16;
-    break;
-  case VK_FORMAT_R16G16_UNORM:
-    channels = 2;
-    kind = unorm16;
-    break;
-  case VK_FORMAT_R16G16B16A16_SFLOAT:
-    channels = 4;
-    kind = half;
-    break;
-  case VK_FORMAT_R16G16_SFLOAT:
-    channels = 2;
-    kind = half;
-    break;
+  case VK_FORMAT_R16G16B16A16_UNORM: channels = 4, kind = unorm16; break;
+  case VK_FORMAT_R16G16_UNORM: channels = 2, kind = unorm16; break;
+  case VK_FORMAT_R16G16B16A16_SFLOAT: channels = 4, kind = half; break;
+  case VK_FORMAT_R16G16_SFLOAT: channels = 2, kind = half; break;
   case VK_FORMAT_R32G32B32A32_SFLOAT: channels = 4; break;
   case VK_FORMAT_R32G32_SFLOAT: channels = 2; break;
   case VK_FORMAT_R32_SFLOAT: channels = 1; break;
@@ -84,31 +81,44 @@ image::Image to_float_image(std::span<const std::byte> bytes, VkFormat format, i
   return out;
 }
 
+bool has_features(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags features) {
+  VkFormatProperties props{};
+  vkGetPhysicalDeviceFormatProperties(ctx.physical_device(), format, &props);
+  return (props.optimalTilingFeatures & features) == features;
+}
+
 } // namespace
+
+std::vector<float> filter_weights(const RenderSettings& s) {
+  std::vector<float> w(size_t(s.filter_size));
+  for (int k = 0; k < s.filter_size; ++k) w[size_t(k)] = msm_gaussian_weight(k, s.filter_size, s.filter_sigma);
+  return w;
+}
 
 struct Renderer::Impl {
   const vk::Context& ctx;
   scene::Scene scene;
   GpuScene gpu;
-  glm::mat4 light_view_projection;
-  vk::Buffer uniforms;
+  vk::Buffer uniforms, lights;
   vk::GpuTimer timer;
-  std::unique_ptr<FrameTargets> targets;
-  std::map<int, std::unique_ptr<ShadowDepthPass>> shadow_passes;
-  std::map<std::tuple<int, int, bool>, std::unique_ptr<MomentResolvePass>> resolve_passes;
-  std::map<std::tuple<int, int, bool, bool>, std::unique_ptr<ShadingPass>> shading_passes;
-  std::map<std::tuple<int, int, bool>, std::unique_ptr<TranslucentPass>> translucent_passes;
-  std::map<std::tuple<int, int, int>, std::unique_ptr<OnePassFilterPass>> one_pass_passes;
   vk::Image noise;
-  std::unique_ptr<BlurPass> blur_pass;
-  std::unique_ptr<SatPass> sat_pass;
+  vk::Sampler point_sampler, linear_sampler;
+  ProgramCache programs;
+  gpu::SatBuilder sat_builder;
   std::unique_ptr<vk::Program> depth_copy;
-  MipmapPass mipmap_pass;
+  FrameConfig config;
+  std::unique_ptr<FrameGraph> graph;
+  std::vector<LightUniforms> light_data;
+  // Fitting a light's frustum visits every vertex: one fit per light direction, kept.
+  std::vector<std::pair<glm::vec3, scene::LightFrame>> frames;
 
   Impl(const vk::Context& c, const scene::Scene& s)
-      : ctx(c), scene(s), gpu(c, s), light_view_projection(s.light_view_projection()),
+      : ctx(c), scene(s), gpu(c, s),
         uniforms(vk::create_buffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
-        timer(c, 32), noise(upload_blue_noise(c)) {}
+        lights(vk::create_buffer(c, sizeof(LightUniforms) * MSM_MAX_LIGHTS, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                 vk::Memory::host)),
+        timer(c, 32), noise(upload_blue_noise(c)), point_sampler(vk::create_sampler(c, VK_FILTER_NEAREST)),
+        linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)), programs(c), sat_builder(c) {}
 
   static vk::Image upload_blue_noise(const vk::Context& ctx) {
     const BlueNoise& n = blue_noise();
@@ -123,52 +133,36 @@ struct Renderer::Impl {
     return image;
   }
 
-  template <class Map, class Key, class Make>
-  auto& cached(Map& map, const Key& key, Make make) {
-    auto it = map.find(key);
-    if (it == map.end()) it = map.emplace(key, make()).first;
-    return *it->second;
+  const scene::LightFrame& light_frame(const scene::DirectionalLight& light) {
+    for (const auto& [towards, frame] : frames)
+      if (towards == light.towards_light) return frame;
+    frames.emplace_back(light.towards_light, scene.light_frame(light)); // depends on the direction only
+    return frames.back().second;
+  }
+
+  const std::vector<scene::DirectionalLight>& lights_of(const RenderSettings& s) const {
+    return s.lights.empty() ? scene.lights : s.lights;
   }
 
   FrameUniforms frame_uniforms(const RenderSettings& s, const Technique& technique) const {
     FrameUniforms u{};
     u.camera_view_projection = scene.camera_view_projection(float(s.width) / float(s.height));
-    u.light_view_projection = light_view_projection;
-    u.light_normal_matrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(light_view_projection))));
-    u.towards_light = glm::vec4(scene.light.towards_light, 0.0f);
-    u.irradiance = glm::vec4(scene.light.irradiance, 0.03f); // ambient factor: as the reference
-    u.technique_params = s.params ? *s.params : default_params(technique);
-    // One shadow-map texel in world units: the light frustum's width over the map size.
-    glm::mat4 inverse = glm::inverse(light_view_projection);
-    float texel = glm::length(glm::vec3(inverse * glm::vec4(2.0f, 0.0f, 0.0f, 0.0f))) / float(s.shadow_size);
-    bool soft = msm_technique_is_soft(technique.id);
+    u.technique_params = s.params ? *s.params : technique.default_params();
+    bool area_light = msm_technique_is_area_light(technique.id);
     float depth_bias = s.resolved_depth_bias();
-    u.shadow_map =
-        glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), s.normal_offset * texel, soft ? 0.0f : depth_bias);
-    if (msm_technique_is_area_light(technique.id)) {
-      // soft.h: texels of reach per unit of [-1,1] depth = tan(θ/2) w_d / w_t.
-      float extent = s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg;
-      float tan_half = std::tan(glm::radians(extent) * 0.5f);
-      float world_per_depth = 0.5f * glm::length(glm::vec3(inverse * glm::vec4(0.0f, 0.0f, 1.0f, 0.0f)));
-      float texel_y = glm::length(glm::vec3(inverse * glm::vec4(0.0f, 2.0f, 0.0f, 0.0f))) / float(s.shadow_size);
+    // The tables' techniques bias in soft.h (u.soft.z); PCSS, like every other, in the fragment depth.
+    u.shadow_map = glm::vec4(float(s.shadow_size), 1.0f / float(s.shadow_size), 0.0f,
+                             msm_technique_is_soft(technique.id) ? 0.0f : depth_bias);
+    if (area_light) {
       // The constant part of msm_soft_depth_bias, in [-1,1] depth.
-      u.soft = glm::vec4(tan_half * world_per_depth / texel, tan_half * world_per_depth / texel_y, 2.0f * depth_bias,
-                         MSM_SOFT_UMBRA_EPSILON);
+      u.soft = glm::vec4(0.0f, 0.0f, 2.0f * depth_bias, MSM_SOFT_UMBRA_EPSILON);
       int kernel = s.resolved_soft_kernel();
-      uint32_t scale = 0xFFFFFFFFu / uint32_t(kernel * kernel);
-      u.soft_kernel = glm::ivec4(kernel, int(scale), 0, 0); // the uint's bits
+      u.soft_kernel = glm::ivec4(kernel, int(msm_sat_scale(kernel * kernel)), 0, 0); // the uint's bits
     }
     u.shading = glm::vec4(s.overdarken, s.exposure, s.translucent_alpha_threshold, 0.0f);
-    u.background = glm::vec4(0.55f, 0.65f, 0.8f, 1.0f);
-    int radius = s.filter_size / 2;
-    u.kernel = glm::ivec4(s.filter_size, s.msaa, radius, 0);
-    double sum = 0;
-    std::vector<double> w(size_t(s.filter_size));
-    for (int k = 0; k < s.filter_size; ++k) {
-      double x = k - radius;
-      sum += w[size_t(k)] = std::exp(-x * x / (2.0 * double(s.filter_sigma) * s.filter_sigma));
-    }
-    for (int k = 0; k < s.filter_size; ++k) u.filter_weights[k / 4][k % 4] = float(w[size_t(k)] / sum);
+    u.kernel = glm::ivec4(s.filter_size, s.msaa, s.filter_size / 2, 0);
+    std::vector<float> weights = filter_weights(s);
+    for (int k = 0; k < s.filter_size; ++k) u.filter_weights[k / 4][k % 4] = weights[size_t(k)];
     std::vector<glm::vec2> offsets =
         ctx.properties().limits.standardSampleLocations ? standard_sample_offsets(s.msaa) : std::vector<glm::vec2>(8);
     bool nonlinear = msm_technique_is_nonlinear(technique.id);
@@ -190,102 +184,129 @@ struct Renderer::Impl {
     // Receiver-plane bias of the filtered techniques (lookup.glsl, msm/bias.h): the kernel's
     // variance per axis in texels², of the normalized Gaussian taps plus the MSAA sample positions
     // (the resolve averages depths taken there; mean of x and y); the lookup adds its own.
-    double kernel_variance = 0;
-    for (int k = 0; k < s.filter_size; ++k) kernel_variance += w[size_t(k)] / sum * double((k - radius) * (k - radius));
+    double kernel_variance = msm_gaussian_variance(s.filter_size, s.filter_sigma);
     for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
     u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
+    u.lights = glm::ivec4(int(lights_of(s).size()), 0, 0, 0);
     return u;
   }
 
-  // Validates, builds what is missing, writes the uniforms.
+  LightUniforms light_uniforms(const RenderSettings& s, const Technique& technique,
+                               const scene::DirectionalLight& light) {
+    const scene::LightFrame& f = light_frame(light);
+    LightUniforms u{};
+    u.view_projection = f.view_projection;
+    u.normal_matrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(f.view_projection))));
+    glm::dvec2 texel = f.texel(s.shadow_size);
+    u.towards_light = glm::vec4(light.towards_light, s.normal_offset * float(texel.x));
+    u.irradiance = glm::vec4(light.irradiance, 0.0f);
+    if (msm_technique_is_area_light(technique.id)) {
+      float extent = s.light_extent_deg ? *s.light_extent_deg : light.angular_extent_deg;
+      float tan_half = std::tan(glm::radians(extent) * 0.5f);
+      // soft.h: texels of reach per unit of [-1,1] depth.
+      vec2 spread = msm_soft_spread(vec2(tan_half), float(0.5 * f.depth_extent), vec2(texel));
+      u.soft = glm::vec4(spread, 0.0f, 0.0f);
+    }
+    return u;
+  }
+
+  // Validates, (re)builds the frame graph where the configuration changed, writes the uniforms.
   const Technique& prepare(const RenderSettings& s) {
     s.validate();
-    const Technique& technique = find_technique(s.technique);
-    VkSampleCountFlagBits samples = VkSampleCountFlagBits(s.msaa);
-    if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, samples))
+    const Technique& technique = find_rendered_technique(s.technique);
+    if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, VkSampleCountFlagBits(s.msaa)))
       throw RenderError(
           fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name, s.msaa));
     if (uint32_t(std::max(s.width, s.height)) > ctx.properties().limits.maxImageDimension2D ||
         uint32_t(s.shadow_size) > ctx.properties().limits.maxImageDimension2D)
       throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
                                     ctx.properties().limits.maxImageDimension2D));
-    bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(technique.id));
+    const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
+    if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
+      throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
+                                    ctx.properties().limits.maxImageArrayLayers));
+    int id = technique.id;
+    bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(id));
     bool translucent =
         s.translucent_occluders && !gpu.translucent.empty() && supports_translucency(technique) && !one_pass;
-    FrameConfig config{&technique,    s.width,   s.height, s.shadow_size, s.msaa,
-                       s.filter_size, s.mipmaps, one_pass, translucent,   translucent && s.coloured_translucency};
-    bool split = config.split_rg();
-    if (!targets || !(targets->config == config)) {
-      targets.reset();
-      targets = std::make_unique<FrameTargets>(ctx, config);
+    FrameConfig c{.technique = &technique,
+                  .width = s.width,
+                  .height = s.height,
+                  .shadow_size = s.shadow_size,
+                  .msaa = s.msaa,
+                  .taps = s.filter_size,
+                  .lights = int(frame_lights.size()),
+                  .one_pass = one_pass,
+                  .translucent = translucent,
+                  .coloured = translucent && s.coloured_translucency,
+                  .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0};
+    // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
+    // the linear maps get a mip chain, where the device can blit their formats.
+    bool can_mip =
+        s.mipmaps && !msm_technique_is_depth_based(id) && !msm_technique_is_nonlinear(id) && !msm_technique_is_soft(id);
+    for (int i = 0; i < c.moment_images(); ++i)
+      can_mip = can_mip && has_features(ctx, c.formats()[size_t(i)],
+                                        VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
+                                            VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
+    c.mip_levels = can_mip ? uint32_t(std::bit_width(uint32_t(s.shadow_size))) : 1u;
+    if (!msm_technique_is_nonlinear(id))
+      for (int i = 0; i < c.moment_images(); ++i)
+        if (!has_features(ctx, c.formats()[size_t(i)], VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+          throw RenderError(fmt::format("{} cannot filter format {} linearly ({})", ctx.info().name,
+                                        int(c.formats()[size_t(i)]), technique.name));
+    if (!graph || !(config == c)) {
+      graph.reset();
+      graph = std::make_unique<FrameGraph>(ctx, recipe(c), std::vector<std::string>{}, frame_outputs(),
+                                           PassResources{programs, sat_builder});
+      config = c;
     }
-    cached(shadow_passes, s.msaa, [&] { return std::make_unique<ShadowDepthPass>(ctx, s.msaa); });
-    if (one_pass) {
-      cached(one_pass_passes, std::tuple(technique.id, s.msaa, s.filter_size),
-             [&] { return std::make_unique<OnePassFilterPass>(ctx, technique, s.msaa, s.filter_size); });
-    } else if (config.moment_images()) {
-      cached(resolve_passes, std::tuple(technique.id, s.msaa, split),
-             [&] { return std::make_unique<MomentResolvePass>(ctx, technique, s.msaa, split); });
-      if (translucent)
-        cached(translucent_passes, std::tuple(technique.id, s.msaa, split),
-               [&] { return std::make_unique<TranslucentPass>(ctx, technique, s.msaa, split, config.formats()); });
-      if (!blur_pass) blur_pass = std::make_unique<BlurPass>(ctx);
-      if (msm_technique_is_soft(technique.id) && !sat_pass) sat_pass = std::make_unique<SatPass>(ctx);
-    }
-    cached(shading_passes, std::tuple(technique.id, s.msaa, split, config.coloured),
-           [&] { return std::make_unique<ShadingPass>(ctx, technique, s.msaa, split, config.coloured); });
     FrameUniforms u = frame_uniforms(s, technique);
     std::memcpy(uniforms.data(), &u, sizeof(u));
+    light_data.clear();
+    for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
+    std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
     return technique;
   }
 
-  // Records the passes; `until_resolve` stops after the moment resolve (intermediates).
-  void record(VkCommandBuffer cmd, const RenderSettings& s, const Technique& technique, bool until_resolve) {
+  void record(VkCommandBuffer cmd, std::optional<std::string_view> stop_after = std::nullopt) {
     timer.reset(cmd);
-    FrameContext f{ctx, cmd, timer, *targets, gpu, uniforms, noise, scene.camera.position};
-    bool split = targets->config.split_rg();
-    const ShadingPass& shading = *shading_passes.at({technique.id, s.msaa, split, targets->config.coloured});
-    shadow_passes.at(s.msaa)->execute(f);
-    if (targets->config.one_pass) {
-      one_pass_passes.at({technique.id, s.msaa, s.filter_size})->execute(f);
-      if (until_resolve) return;
-      mipmap_pass.execute(f);
-    } else if (targets->config.moment_images()) {
-      // One set of moment images per colour channel with coloured translucency: the resolve
-      // writes channel 0 and copies it to the others; the translucent blend uses each channel's
-      // opacity.
-      resolve_passes.at({technique.id, s.msaa, split})->execute(f);
-      if (until_resolve) return;
-      if (msm_technique_is_soft(technique.id)) { // tables instead of blur and mips; no translucency
-        sat_pass->execute(f, s.resolved_soft_kernel() * s.resolved_soft_kernel());
-      } else {
-        for (f.channel = 0; f.channel < targets->config.channels(); ++f.channel) {
-          if (targets->config.translucent) translucent_passes.at({technique.id, s.msaa, split})->execute(f);
-          if (s.filter_size > 1) blur_pass->execute(f);
-          mipmap_pass.execute(f); // also hands the moments over to the shading (layouts)
-        }
-        f.channel = 0;
+    FrameResources resources{gpu,   uniforms,      lights,         light_data,
+                             noise, point_sampler, linear_sampler, scene.camera.position};
+    graph->record(cmd, timer, resources, config, stop_after);
+  }
+
+  // Pass totals (outermost scopes) and, with several lights, each light's share.
+  void read_times(std::vector<PassTime>& passes, std::vector<LightPassTime>* per_light) {
+    vk::TimerResults r = timer.read();
+    for (const vk::TimerScope& scope : r.scopes) {
+      if (scope.depth == 0) {
+        auto it = std::find_if(passes.begin(), passes.end(), [&](const PassTime& p) { return p.name == scope.name; });
+        if (it == passes.end())
+          passes.push_back({scope.name, scope.ms()});
+        else
+          it->ms += scope.ms();
+      } else if (per_light) {
+        size_t hash = scope.name.rfind('#');
+        if (hash != std::string::npos)
+          per_light->push_back({scope.name.substr(0, hash), std::stoi(scope.name.substr(hash + 1)), scope.ms()});
       }
     }
-    if (until_resolve) return;
-    shading.execute(f);
   }
 
-  std::vector<PassTime> read_times() {
-    std::vector<PassTime> out;
-    for (auto& [name, ms] : timer.read().totals()) out.push_back({name, ms});
-    return out;
-  }
-
-  void read_intermediates(const RenderSettings& s, const Technique& technique, Intermediates& out) {
-    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) { record(cmd, s, technique, true); });
+  void read_intermediates(const RenderSettings& s, Intermediates& out) {
+    std::string_view until = config.one_pass                                      ? "one_pass_filter"
+                             : msm_technique_is_depth_based(config.technique->id) ? "shadow_depth"
+                                                                                  : "moment_resolve";
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) { record(cmd, until); });
     timer.read();
     int size = s.shadow_size;
+    const GraphImage& depth = graph->image(kShadowDepth);
+    size_t texels = size_t(size) * size_t(size);
     if (s.msaa == 1) {
       std::vector<std::byte> bytes =
-          vk::readback_image(ctx, targets->shadow_depth, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-      out.depth_samples.resize(size_t(size) * size);
-      for (size_t i = 0; i < out.depth_samples.size(); ++i) {
+          vk::readback_image(ctx, depth.image, graph->layout_after_record(kShadowDepth)); // every layer
+      out.depth_samples.resize(texels);
+      for (size_t i = 0; i < texels; ++i) {
         uint16_t v;
         std::memcpy(&v, bytes.data() + 2 * i, 2);
         out.depth_samples[i] = float(v) / 65535.0f;
@@ -295,26 +316,27 @@ struct Renderer::Impl {
         depth_copy = std::make_unique<vk::Program>(
             vk::create_program(ctx, "depth_samples.comp", {vk::Binding::sampled_image, vk::Binding::storage_buffer},
                                sizeof(ImagePassPush)));
-      size_t count = size_t(size) * size * size_t(s.msaa);
+      size_t count = texels * size_t(s.msaa);
       vk::Buffer buffer =
           vk::create_buffer(ctx, count * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+      VkImageLayout layout = graph->layout_after_record(kShadowDepth);
       vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
         uint32_t groups = vk::group_count(uint32_t(size), 8);
         vk::dispatch(cmd, *depth_copy, groups, groups, 1,
-                     {vk::Descriptor(targets->shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                                     targets->point_sampler),
-                      vk::Descriptor(buffer)},
+                     {vk::Descriptor(depth.layer_views[0], layout, point_sampler), vk::Descriptor(buffer)},
                      ImagePassPush{glm::ivec4(size, size, s.msaa, 0)});
       });
       std::span<const float> mapped = buffer.mapped<const float>();
       out.depth_samples.assign(mapped.begin(), mapped.begin() + std::ptrdiff_t(count));
     }
-    for (int i = 0; i < targets->config.moment_images(); ++i) {
-      std::vector<std::byte> bytes = vk::readback_image(ctx, targets->moments[size_t(i)], VK_IMAGE_LAYOUT_GENERAL);
-      VkFormat format = VkFormat(targets->config.formats()[size_t(i)]);
+    for (int i = 0; i < config.moment_images(); ++i) {
+      std::string name = moment_image(0, i);
+      std::vector<std::byte> bytes =
+          vk::readback_image(ctx, graph->image(name).image, graph->layout_after_record(name));
+      VkFormat format = config.formats()[size_t(i)];
       if (format == VK_FORMAT_R32_UINT) {
-        out.packed.resize(size_t(size) * size);
-        std::memcpy(out.packed.data(), bytes.data(), out.packed.size() * 4);
+        out.packed.resize(texels);
+        std::memcpy(out.packed.data(), bytes.data(), texels * 4);
         continue;
       }
       (i == 0 ? out.moments : out.moments1) = to_float_image(bytes, format, size, size);
@@ -328,28 +350,30 @@ const scene::Scene& Renderer::scene() const noexcept { return impl_->scene; }
 
 RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermediates) {
   Impl& m = *impl_;
-  const Technique& technique = m.prepare(s);
-  if (intermediates) m.read_intermediates(s, technique, *intermediates);
-  vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
+  m.prepare(s);
+  if (intermediates) m.read_intermediates(s, *intermediates);
+  vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd); });
   RenderResult r;
-  r.passes = m.read_times();
+  m.read_times(r.passes, m.config.lights > 1 ? &r.light_passes : nullptr);
   for (const PassTime& p : r.passes) r.total_ms += p.ms;
-  if (intermediates && m.targets->config.moment_images() && m.targets->config.formats()[0] != VK_FORMAT_R32_UINT)
+  const FrameGraph& g = *m.graph;
+  std::string moments0 = moment_image(0, 0);
+  if (intermediates && g.has_image(moments0) && m.config.formats()[0] != VK_FORMAT_R32_UINT)
     intermediates->filtered =
-        to_float_image(vk::readback_image(m.ctx, m.targets->moments[0], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL),
-                       VkFormat(m.targets->config.formats()[0]), s.shadow_size, s.shadow_size);
+        to_float_image(vk::readback_image(m.ctx, g.image(moments0).image, g.layout_after_record(moments0)),
+                       m.config.formats()[0], s.shadow_size, s.shadow_size);
 
-  std::vector<std::byte> color = vk::readback_image(m.ctx, m.targets->color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  std::vector<std::byte> color = vk::readback_image(m.ctx, g.image(kColor).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   r.color = image::Image(s.width, s.height, 3);
   std::span<float> c = r.color.pixels();
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
     for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
 
   std::vector<std::byte> shadow =
-      vk::readback_image(m.ctx, m.targets->shadow_buffer, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+      vk::readback_image(m.ctx, g.image(kShadowBuffer).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   // RGBA32F: visibility per colour channel, coverage. With coloured translucency "visibility" is
   // the mean of the channels (as the ray tracer's), and the channels come along.
-  bool coloured = m.targets->config.coloured;
+  bool coloured = m.config.coloured;
   r.shadow = image::Image(s.width, s.height, {"visibility", "background"});
   if (coloured) r.shadow_rgb = image::Image(s.width, s.height, {"visibility_r", "visibility_g", "visibility_b"});
   std::span<float> v = r.shadow.pixels();
@@ -359,7 +383,7 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
     v[2 * i] = coloured ? (px[0] + px[1] + px[2]) / 3.0f : px[0];
     v[2 * i + 1] = 1.0f - px[3];
     if (coloured)
-      for (size_t c = 0; c < 3; ++c) r.shadow_rgb.pixels()[3 * i + c] = px[c];
+      for (size_t k = 0; k < 3; ++k) r.shadow_rgb.pixels()[3 * i + k] = px[k];
   }
   return r;
 }
@@ -367,12 +391,20 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
 std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {
   if (frames < 1) throw RenderError("time_frames: at least one frame");
   Impl& m = *impl_;
-  const Technique& technique = m.prepare(s);
+  m.prepare(s);
   std::vector<std::vector<PassTime>> out;
   for (int i = 0; i < frames; ++i) {
-    vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd, s, technique, false); });
-    out.push_back(m.read_times());
+    vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd); });
+    out.emplace_back();
+    m.read_times(out.back(), nullptr);
   }
+  return out;
+}
+
+std::vector<std::string> Renderer::frame_passes(const RenderSettings& s) {
+  impl_->prepare(s);
+  std::vector<std::string> out;
+  for (std::string_view name : impl_->graph->pass_names()) out.emplace_back(name);
   return out;
 }
 

@@ -1,6 +1,6 @@
 // Soft shadows in the renderer against the ray-traced area light (msm::reference, effect soft):
 // moment soft shadows with four and six moments (JCGT §4, Kneiphof §4.2, include/msm/soft.h with
-// the integer summed-area tables of msm::soft) and their baselines, naive variance soft shadows and
+// the integer summed-area tables of msm::gpu) and their baselines, naive variance soft shadows and
 // percentage-closer soft shadows with a 15² search. Error figures go to docs/results.md.
 #include "msm/reference/analytic.h"
 #include "msm/reference/reference.h"
@@ -8,7 +8,7 @@
 
 #include "msm/image/compare.h"
 #include "msm/image/metrics.h"
-#include "msm/vk/test_support.h"
+#include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -133,7 +133,7 @@ TEST_F(SoftShadowTest, ModelsAndPillarBeforeBrickWall) {
   for (const char* name : {"models", "pillar_wall"}) {
     scene::Scene scene = scene::builtin_scene(name);
     bool wall = std::string(name) == "pillar_wall";
-    auto m = errors(ctx(), scene, scene.light.angular_extent_deg, kSoftTechniques, wall ? 2048 : 512);
+    auto m = errors(ctx(), scene, scene.light().angular_extent_deg, kSoftTechniques, wall ? 2048 : 512);
     // Measured MAE: models 0.004-0.007, pillar_wall 0.003-0.011 (VSSM the worst on both).
     for (const std::string& t : kSoftTechniques) EXPECT_LT(m[t].mae, 0.015) << name << ", " << t;
     EXPECT_LT(m["mssm4"].mae, m["vssm"].mae) << name;

@@ -51,7 +51,7 @@ class Parser {
     } catch (const json::exception& e) { // parse_error, out_of_range (number overflow), ...
       fail("", fmt::format("malformed JSON: {}", e.what()));
     }
-    keys(root, "", {"msm_scene", "name", "camera", "light", "shadow_map", "materials", "objects"});
+    keys(root, "", {"msm_scene", "name", "camera", "light", "lights", "shadow_map", "materials", "objects"});
     const json* version = find(root, "msm_scene");
     if (!version) fail("/msm_scene", "required key missing (the format version, 1)");
     if (!version->is_number_integer() || version->get<long long>() != 1)
@@ -61,8 +61,18 @@ class Parser {
     if (const json* v = find(root, "name")) s.name = string(*v, "/name");
     if (const json* v = find(root, "camera")) s.camera = camera(*v, "/camera");
     const json* light_json = find(root, "light");
-    if (!light_json) fail("/light", "required key missing");
-    s.light = light(*light_json, "/light");
+    const json* lights_json = find(root, "lights");
+    if (!light_json && !lights_json) fail("/light", "required key missing (or \"lights\": a list of them)");
+    if (light_json && lights_json) fail("/lights", "give either \"light\" or \"lights\", not both");
+    if (light_json) {
+      s.lights = {light(*light_json, "/light")};
+    } else {
+      if (!lights_json->is_array() || lights_json->empty() || lights_json->size() > size_t(kMaxLights))
+        fail("/lights", fmt::format("must be a list of 1 to {} lights", kMaxLights));
+      s.lights.clear();
+      for (size_t i = 0; i < lights_json->size(); ++i)
+        s.lights.push_back(light((*lights_json)[i], fmt::format("/lights/{}", i)));
+    }
     if (const json* v = find(root, "shadow_map")) s.shadow = framing(*v, "/shadow_map");
 
     Material default_material;
@@ -449,7 +459,7 @@ std::size_t Scene::vertex_count() const {
   return n;
 }
 
-glm::mat4 Scene::light_view() const {
+glm::mat4 Scene::light_view(const DirectionalLight& light) const {
   const glm::vec3 d = light.travel();
   const glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
   const Bounds b = bounds();
@@ -458,7 +468,7 @@ glm::mat4 Scene::light_view() const {
   return glm::lookAtRH(c, c + d, up);
 }
 
-glm::mat4 Scene::light_projection() const {
+glm::mat4 Scene::light_projection(const DirectionalLight& light) const {
   if (shadow.mode == ShadowFraming::Mode::given) {
     const glm::vec2 h = 0.5f * shadow.extent;
     return flip_y(glm::orthoRH_ZO(-h.x, h.x, -h.y, h.y, shadow.depth_range.x, shadow.depth_range.y));
@@ -467,7 +477,7 @@ glm::mat4 Scene::light_projection() const {
   if (b.empty()) return flip_y(glm::orthoRH_ZO(-1.0f, 1.0f, -1.0f, 1.0f, -1.0f, 1.0f));
   // Fitted to the vertices (tighter than the bounds' corners): the near plane touches the
   // vertex closest to the light and the far plane the farthest one.
-  const glm::mat4 v = light_view();
+  const glm::mat4 v = light_view(light);
   glm::vec3 lo(1e30f), hi(-1e30f);
   for (const Object& o : objects)
     for (const glm::vec3& q : o.mesh.positions) {
@@ -481,6 +491,20 @@ glm::mat4 Scene::light_projection() const {
   hi += margin;
   // View space looks down -z: distance along the light's travel is -z.
   return flip_y(glm::orthoRH_ZO(lo.x, hi.x, lo.y, hi.y, -hi.z, -lo.z));
+}
+
+LightFrame Scene::light_frame(const DirectionalLight& light) const {
+  LightFrame f;
+  f.view_projection = light_projection(light) * light_view(light);
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(f.view_projection));
+  f.towards_light = glm::normalize(glm::dvec3(light.towards_light));
+  // Orthographic: a unit step of clip x (y, z) moves by inv[0] (inv[1], inv[2]) in world space.
+  const glm::dvec3 cx(inv[0]), cy(inv[1]), cz(inv[2]);
+  f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
+  f.x_axis = glm::normalize(cx);
+  f.y_axis = glm::normalize(cy);
+  f.depth_extent = glm::length(cz);
+  return f;
 }
 
 Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir,

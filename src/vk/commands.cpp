@@ -66,7 +66,8 @@ VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src
 VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 src_stage,
                                     VkAccessFlags2 src_access, VkImageLayout old_layout,
                                     VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
-                                    VkImageLayout new_layout, uint32_t base_mip, uint32_t mip_count) {
+                                    VkImageLayout new_layout, uint32_t base_mip, uint32_t mip_count,
+                                    uint32_t base_layer, uint32_t layer_count) {
   return {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
           .srcStageMask = src_stage,
           .srcAccessMask = src_access,
@@ -77,7 +78,7 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, Vk
           .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
           .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
           .image = image,
-          .subresourceRange = {aspect, base_mip, mip_count, 0, VK_REMAINING_ARRAY_LAYERS}};
+          .subresourceRange = {aspect, base_mip, mip_count, base_layer, layer_count}};
 }
 
 void pipeline_barrier(VkCommandBuffer cmd, std::span<const VkMemoryBarrier2> memory,

@@ -1,6 +1,6 @@
 // Tests of the msm::vk layer on the device MSM_DEVICE picks (lavapipe here), validation on.
 #include "msm/shared.h"
-#include "msm/vk/test_support.h"
+#include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
 #include <gtest/gtest.h>

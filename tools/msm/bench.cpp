@@ -5,6 +5,7 @@
 
 #include "msm/image/io.h"
 #include "msm/techniques.h"
+#include "msm/util/statistics.h"
 
 #include <fmt/core.h>
 
@@ -20,11 +21,7 @@ struct Stats {
   double median = 0, p10 = 0, p90 = 0;
 };
 
-Stats stats(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  auto at = [&](double q) { return v[size_t(q * double(v.size() - 1) + 0.5)]; };
-  return {at(0.5), at(0.1), at(0.9)};
-}
+Stats stats(const std::vector<double>& v) { return {util::median(v), util::quantile(v, 0.1), util::quantile(v, 0.9)}; }
 
 // Sum of the named passes per frame, then statistics over the frames.
 Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const std::vector<std::string>& names) {
@@ -76,7 +73,7 @@ void add_bench(CLI::App& app) {
     if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
     std::vector<std::string> names = opt->techniques;
     if (names.empty())
-      for (const render::Technique& t : render::techniques()) names.emplace_back(t.name);
+      for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     if (std::find(names.begin(), names.end(), "pcf") == names.end()) names.insert(names.begin(), "pcf");
     std::vector<std::pair<int, int>> resolutions;
     for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
@@ -162,7 +159,7 @@ void add_bench(CLI::App& app) {
       const std::string name = entry["technique"];
       for (auto& [key, value] : entry["shading"].items()) {
         value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
-        if (with_pcss && msm_technique_is_area_light(render::find_technique(name).id))
+        if (with_pcss && msm_technique_is_area_light(render::find_rendered_technique(name).id))
           value["ratio_to_pcss"] = per_unit[name]["shading " + key] / per_unit["pcss"]["shading " + key];
       }
       for (auto& [key, value] : entry["shadow_map"].items())

@@ -11,6 +11,8 @@
 #include "msm/image/io.h"
 #include "msm/image/metrics.h"
 #include "msm/reference/reference.h"
+#include "msm/shading.h"
+#include "msm/util/statistics.h"
 
 #include <fmt/core.h>
 
@@ -46,8 +48,7 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
       for (const auto& f : frames)
         for (const render::PassTime& q : f)
           if (q.name == p.name) ms.push_back(q.ms);
-      std::nth_element(ms.begin(), ms.begin() + std::ptrdiff_t(ms.size() / 2), ms.end());
-      p.ms = ms.empty() ? p.ms : ms[ms.size() / 2];
+      if (!ms.empty()) p.ms = util::median(ms);
     }
     results.back().total_ms = 0;
     for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
@@ -77,7 +78,7 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   for (const std::string& p : pass_names) header += fmt::format(" {:>14}", p + " ms");
   fmt::print("\n{} {:>10}\n", header, "total ms");
   for (size_t i = 0; i < results.size(); ++i) {
-    const render::Technique& t = render::find_technique(techniques[i]);
+    const Technique& t = render::find_rendered_technique(techniques[i]);
     image::Metrics m = image::compute_metrics(signals[i], reference, {.mask = &mask});
     std::string line = fmt::format("{:<20} {:>5} {:>8.5f} {:>8.5f} {:>6.2f}%", t.name, t.bits_per_texel, m.mae,
                                    m.light_leaking, 100 * m.share_above_3pct);
@@ -157,7 +158,7 @@ void add_demo(CLI::App& app) {
       compare_techniques(renderer, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
     }
     if (!soft_scene) return;
-    float extent = fs.light_extent_deg ? *fs.light_extent_deg : soft_scene->light.angular_extent_deg;
+    float extent = fs.light_extent_deg ? *fs.light_extent_deg : soft_scene->light().angular_extent_deg;
     fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
                "samples per pixel\n",
                soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, opt->soft_samples);
@@ -173,7 +174,7 @@ void add_demo(CLI::App& app) {
     for (int y = 0; y < truth_rgb.height(); ++y)
       for (int x = 0; x < truth_rgb.width(); ++x)
         if (truth.visibility.at(x, y, 1) > 0.5f)
-          for (int c = 0; c < 3; ++c) truth_rgb.at(x, y, c) = std::array{0.55f, 0.65f, 0.8f}[size_t(c)];
+          for (int c = 0; c < 3; ++c) truth_rgb.at(x, y, c) = MSM_SKY_RADIANCE[c];
     render::Renderer renderer(*ctx, *soft_scene);
     compare_techniques(renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
                        "soft-comparison.png");

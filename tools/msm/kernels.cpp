@@ -59,7 +59,8 @@ void add_kernels(CLI::App& app) {
     fmt::print("{:<26} {:>5}", "exact (PCF)", "");
     for (const Example& e : examples) fmt::print(" {:>6.3f}", cpu::percentage_closer(e.depths, e.weights, e.zf));
     fmt::print("\n");
-    for (const cpu::Technique& t : cpu::techniques()) {
+    for (const Technique& t : techniques()) {
+      if (!t.on_cpu()) continue;
       fmt::print("{:<26} {:>5}", t.name, t.bits_per_texel);
       float worst = 0.0f;
       for (const Example& e : examples) {

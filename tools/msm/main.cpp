@@ -1,13 +1,18 @@
 // msm: the command-line front end of the moment shadow mapping toolkit.
 #include "commands.h"
 
+#include "msm/version.h"
+
 #include <fmt/core.h>
 
 #include <cstdio>
 #include <exception>
 
 int main(int argc, char** argv) {
-  CLI::App app{"msm: moment shadow mapping toolkit (filtered, soft and volumetric shadows)"};
+  CLI::App app{"msm: moment shadow mapping toolkit (filtered, soft and translucent shadows, measured against "
+               "ray-traced ground truth)"};
+  app.set_version_flag("--version",
+                       fmt::format("msm {}.{}.{}", MSM_VERSION_MAJOR, MSM_VERSION_MINOR, MSM_VERSION_PATCH));
   app.require_subcommand(1);
   msm::tool::add_kernels(app);
   msm::tool::add_techniques(app);

@@ -7,6 +7,7 @@
 #endif
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -14,29 +15,37 @@
 namespace msm::tool {
 
 void add_techniques(CLI::App& app) {
+  auto passes = std::make_shared<bool>(false);
   auto* cmd = app.add_subcommand(
-      "techniques",
-      "List the shadow techniques: storage per texel, where they run (renderer, CPU pipeline), parameters");
-  cmd->callback([] {
+      "techniques", "List the shadow techniques of the technique table (msm/cpu/techniques.h): storage per texel, "
+                    "where they run (renderer, CPU pipeline), parameters, and with --passes the passes of each "
+                    "one's frame");
+  cmd->add_flag("--passes", *passes,
+                "Print the passes of each rendered technique's frame in execution order (default settings; "
+                "translucent and coloured variants where the technique blends translucent occluders)");
+  cmd->callback([passes] {
     fmt::print("{:<26} {:>4}  {:<12} {}\n", "technique", "bits", "runs in", "description");
-#if MSM_TOOL_RENDER
-    for (const render::Technique& t : render::techniques()) {
-      bool cpu = false;
-      for (const cpu::Technique& c : cpu::techniques()) cpu = cpu || c.name == t.name;
-      fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, cpu ? "render, cpu" : "render", t.description);
+    for (const Technique& t : techniques()) {
+      std::string where = t.rendered && t.on_cpu() ? "render, cpu" : t.rendered ? "render" : "cpu";
+      fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, where, t.description);
       if (!t.parameters.empty()) {
-        glm::vec4 p = render::default_params(t);
+        glm::vec4 p = t.default_params();
         fmt::print("{:<26} {:>4}  {:<12} --param {},{},{},{} ({})\n", "", "", "", p.x, p.y, p.z, p.w, t.parameters);
       }
+#if MSM_TOOL_RENDER
+      if (*passes && t.rendered) {
+        fmt::print("{:<26} {:>4}  {:<12} passes: {}\n", "", "", "", fmt::join(render::technique_passes(t), " > "));
+        if (render::supports_translucency(t)) {
+          fmt::print("{:<26} {:>4}  {:<12} translucent: {}\n", "", "", "",
+                     fmt::join(render::technique_passes(t, true), " > "));
+          fmt::print("{:<26} {:>4}  {:<12} coloured: {}\n", "", "", "",
+                     fmt::join(render::technique_passes(t, true, true), " > "));
+        }
+      }
+#endif
     }
-    for (const cpu::Technique& t : cpu::techniques()) {
-      bool rendered = false;
-      for (const render::Technique& r : render::techniques()) rendered = rendered || r.name == t.name;
-      if (!rendered) fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, "cpu", t.description);
-    }
-#else
-    for (const cpu::Technique& t : cpu::techniques())
-      fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, "cpu", t.description);
+#if !MSM_TOOL_RENDER
+    if (*passes) throw UsageError("--passes: this msm was built without the renderer (MSM_BUILD_VULKAN=OFF)");
 #endif
   });
 }
@@ -67,23 +76,30 @@ void add_reconstruct(CLI::App& app) {
     for (float w : opt->weights)
       if (!(std::isfinite(w) && w >= 0.0f)) throw UsageError(fmt::format("weight {} is not >= 0", w));
 
-    std::vector<const cpu::Technique*> chosen;
+    std::vector<const Technique*> chosen;
     if (opt->techniques.empty())
-      for (const cpu::Technique& t : cpu::techniques()) chosen.push_back(&t);
-    for (const std::string& name : opt->techniques) chosen.push_back(&cpu::find_technique(name));
+      for (const Technique& t : techniques())
+        if (t.on_cpu()) chosen.push_back(&t);
+    for (const std::string& name : opt->techniques) {
+      const Technique& t = find_technique(name);
+      if (!t.on_cpu())
+        throw UsageError(
+            fmt::format("{} runs in the renderer only (msm render); msm techniques lists where each runs", name));
+      chosen.push_back(&t);
+    }
 
     float reference = cpu::percentage_closer(opt->depths, opt->weights, opt->zf);
     nlohmann::ordered_json out;
     out["zf"] = opt->zf;
     out["pcf"] = std::round(reference * 1e6) / 1e6;
-    for (const cpu::Technique* t : chosen)
+    for (const Technique* t : chosen)
       out["techniques"][std::string(t->name)] = cpu::filtered_shadow(*t, opt->depths, opt->weights, opt->zf);
     if (opt->json) {
       fmt::print("{}\n", out.dump(2));
       return;
     }
     fmt::print("{:<26} {:.4f}\n", "pcf (exact)", reference);
-    for (const cpu::Technique* t : chosen)
+    for (const Technique* t : chosen)
       fmt::print("{:<26} {:.4f}\n", t->name, out["techniques"][std::string(t->name)].get<float>());
   });
 }

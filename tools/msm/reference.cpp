@@ -67,9 +67,10 @@ void add_reference(CLI::App& app) {
   struct Options {
     std::string scene{msm::scene::default_scene_name()};
     std::string effect, out = "out/reference", light_shape = "disc", sampler = "stratified";
-    int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = 9, max_crossings = 64, threads = 0;
+    int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = MSM_FILTER_DEFAULT_TAPS,
+        max_crossings = 64, threads = 0;
     std::uint64_t seed = 1;
-    double filter_sigma = 2.4;
+    double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
     std::optional<double> light_extent, light_width, light_height;
     bool json = false, progress = false;
   };
@@ -84,8 +85,8 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--seed", opt->seed, "Seed of the per-pixel generators (default 1)");
   cmd->add_option("--sampler", opt->sampler, "stratified (default) | independent");
   cmd->add_option("--shadow-size", opt->shadow_size, "filtered: shadow map size in texels (default 1024)");
-  cmd->add_option("--filter-size", opt->filter_size, "filtered: Gaussian taps per axis, odd (default 9)");
-  cmd->add_option("--filter-sigma", opt->filter_sigma, "filtered: Gaussian sigma in texels (default 2.4)");
+  cmd->add_option("--filter-size", opt->filter_size, "filtered: Gaussian taps per axis, odd")->capture_default_str();
+  cmd->add_option("--filter-sigma", opt->filter_sigma, "filtered: Gaussian sigma in texels")->capture_default_str();
   cmd->add_option("--light-extent", opt->light_extent,
                   "soft: angular diameter of the light in degrees (default: the scene's)");
   cmd->add_option("--light-shape", opt->light_shape, "soft: disc (default) | rectangle");

@@ -41,7 +41,7 @@ void add_render(CLI::App& app) {
     finish_frame_options(opt->frame);
     std::vector<std::string> names;
     if (opt->techniques == "all")
-      for (const render::Technique& t : render::techniques()) names.emplace_back(t.name);
+      for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     else
       names = split(opt->techniques);
     if (names.empty()) throw UsageError("--technique: no technique given");

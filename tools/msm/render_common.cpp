@@ -87,8 +87,9 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
   render::RenderSettings s = options.settings;
   s.technique = technique;
   try {
-    const render::Technique& t = render::find_technique(technique);
-    if (s.one_pass && *s.one_pass && (t.formats[0] == 0 || t.formats[1] != 0)) s.one_pass.reset();
+    const Technique& t = render::find_rendered_technique(technique);
+    if (s.one_pass && *s.one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
+      s.one_pass.reset();
   } catch (const render::RenderError&) {
     // validate() reports the unknown name
   }
@@ -130,8 +131,8 @@ void ensure_output_dir(const std::filesystem::path& dir) {
 
 nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, const vk::Context& ctx,
                            const render::RenderResult& result) {
-  const render::Technique& t = render::find_technique(s.technique);
-  glm::vec4 p = s.params ? *s.params : render::default_params(t);
+  const Technique& t = render::find_rendered_technique(s.technique);
+  glm::vec4 p = s.params ? *s.params : t.default_params();
   nlohmann::json passes = nlohmann::json::object();
   for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
   return {{"scene", scene.name},
@@ -160,7 +161,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                                                                            : "bilinear (auto)"},
           {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
           {"frame", s.frame},
-          {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light.angular_extent_deg},
+          {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light().angular_extent_deg},
           {"soft_kernel", s.resolved_soft_kernel()},
           {"translucent_occluders", s.translucent_occluders},
           {"translucent_alpha_threshold", s.translucent_alpha_threshold},

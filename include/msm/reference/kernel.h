@@ -1,10 +1,8 @@
 // msm::reference: the continuous footprint of the renderer's shadow-map filter (PCF), in texels.
 //
-// The renderer filters a shadow map of shadow_size x shadow_size texels with a discrete Gaussian of
-// size x size taps (size odd, radius r = (size - 1) / 2) and samples the result bilinearly. The
-// 2D tap weights are w(i, j) = exp(-(i^2 + j^2) / (2 sigma^2)) normalized to sum 1 over
-// i, j in [-r, r]; they are the product w_i w_j of the normalized 1D weights
-// w_k = exp(-k^2 / (2 sigma^2)) / sum_j exp(-j^2 / (2 sigma^2)). Bilinear sampling spreads each tap
+// The renderer filters a shadow map of shadow_size x shadow_size texels with the discrete Gaussian
+// of msm/filter.h (size x size taps, the product w_i w_j of its normalized 1D weights, computed by
+// msm_gaussian_weight for both) and samples the result bilinearly. Bilinear sampling spreads each tap
 // over a tent (hat) of half-width 1 texel per axis, so the continuous kernel of an offset
 // o = (ox, oy) in texels is
 //     K(o) = k(ox) k(oy),   k(s) = sum_k w_k tent(s - k),   tent(u) = max(0, 1 - |u|),
@@ -16,23 +14,27 @@
 // along light-space y (msm::reference::LightFrame).
 #pragma once
 
+#include "msm/filter.h"
+
 #include <vector>
 
 namespace msm::reference {
 
 class FilterKernel {
  public:
-  // size odd in [1, kMaxSize], sigma finite and > 0 (in texels); else std::invalid_argument.
-  FilterKernel(int size = 9, double sigma = 2.4);
-  static constexpr int kMaxSize = 255;
+  // msm_filter_valid(size, sigma) (size odd in [1, MSM_FILTER_MAX_TAPS], sigma in texels within
+  // [MSM_FILTER_MIN_SIGMA, MSM_FILTER_MAX_SIGMA]); else std::invalid_argument.
+  FilterKernel(int size = MSM_FILTER_DEFAULT_TAPS, double sigma = MSM_FILTER_DEFAULT_SIGMA);
 
   int size() const noexcept { return size_; }
   int radius() const noexcept { return (size_ - 1) / 2; }
   double sigma() const noexcept { return sigma_; }
-  // Normalized 1D weights w_k for k = -radius..radius (index k + radius).
+  // The renderer's 1D weights w_k for k = -radius..radius (index k + radius): msm_gaussian_weight's
+  // floats, which sum to 1 within their rounding (a few 1e-8).
   const std::vector<double>& weights() const noexcept { return weights_; }
 
-  // The 1D marginal k(s) and its cumulative distribution K1(s) = integral of k up to s.
+  // The 1D marginal k(s) and its cumulative distribution K1(s) = integral of k up to s, with the
+  // weights divided by their sum (a density that integrates to 1 in double precision).
   double density(double s) const;
   double cdf(double s) const;
 
@@ -44,7 +46,8 @@ class FilterKernel {
  private:
   int size_;
   double sigma_;
-  std::vector<double> weights_, cumulative_; // cumulative_[i] = sum of weights_[0..i)
+  double total_ = 0.0;                       // sum of weights_
+  std::vector<double> weights_, cumulative_; // cumulative_[i] = sum of weights_[0..i) / total_
 };
 
 } // namespace msm::reference

@@ -76,7 +76,7 @@
 //   visibility_rgb  translucent only (empty for the other effects; an image holds at most 4
 //                channels, so not in `visibility`): "visibility_r", "visibility_g",
 //                "visibility_b" = T_r, T_g, T_b; 1 on background.
-//   radiance     "R", "G", "B" (linear): shade() below at the visible surface, 0 on background;
+//   radiance     "R", "G", "B" (linear): msm/shading.h's radiance at the visible surface, 0 on background;
 //                for translucent with the visibility of each channel (T_r, T_g, T_b) in its
 //                channel. Result::mean_visibility averages "visibility".
 #pragma once
@@ -117,29 +117,10 @@ inline constexpr int kMaxCrossings = 4096;
 inline constexpr int kMaxThreads = 1024;
 inline constexpr double kOffsetScale = 1e-5;      // shadow-ray origin offset, relative
 inline constexpr double kMaxReceiverSlope = 16.0; // |t| / |o_world| on grazing receivers
-inline constexpr float kAmbient = 0.03f;          // ambient term, times the albedo
 
-// The radiance formula shared with the renderer: Lambert shading of the directional light plus a
-// constant ambient term,
-//   albedo * irradiance * max(0, n_dot_l) * visibility / pi + kAmbient * albedo,
-// with albedo the material's constant colour (albedo textures are ignored), n the interpolated
-// vertex normal turned towards the viewer, l = towards_light.
-glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, float visibility);
-// The same formula with a visibility per RGB channel (coloured translucent shadows); for equal
-// channels v it is exactly shade(albedo, irradiance, n_dot_l, v).
-glm::vec3 shade(glm::vec3 albedo, glm::vec3 irradiance, float n_dot_l, glm::vec3 visibility);
-
-// The shadow map's light-space frame, from the inverse of light_projection() * light_view():
-// x_axis / y_axis are the unit world directions of increasing clip x / y (along the map's texel
-// rows / columns; clip y points down the image), extent the frustum's width and height in world
-// units, so that one texel is extent.x / shadow_size along x_axis and extent.y / shadow_size along
-// y_axis. Both axes are orthogonal to towards_light.
-struct LightFrame {
-  glm::dvec3 towards_light{0.0, 1.0, 0.0};
-  glm::dvec3 x_axis{1.0, 0.0, 0.0}, y_axis{0.0, 0.0, 1.0};
-  glm::dvec2 extent{1.0, 1.0};
-  static LightFrame of(const scene::Scene& scene);
-};
+// The shadow map's light-space frame (x_axis, y_axis, extent: one texel is extent / shadow_size
+// along each axis), shared with the renderer: msm::scene::LightFrame of the scene's first light.
+using scene::LightFrame;
 
 struct Progress {
   std::size_t rows_done = 0, rows_total = 0;
@@ -153,9 +134,9 @@ struct Settings {
   std::uint64_t seed = 1;
   Sampler sampler = Sampler::stratified;
   // filtered: the renderer's shadow map and filter.
-  int shadow_size = 1024;    // 1..kMaxShadowSize
-  int filter_size = 9;       // odd, 1..FilterKernel::kMaxSize
-  double filter_sigma = 2.4; // texels, > 0
+  int shadow_size = 1024;                         // 1..kMaxShadowSize
+  int filter_size = MSM_FILTER_DEFAULT_TAPS;      // odd, 1..MSM_FILTER_MAX_TAPS (msm/filter.h)
+  double filter_sigma = MSM_FILTER_DEFAULT_SIGMA; // texels
   // soft: light extent in degrees, in [0, 90). Unset: the scene's angular_extent_deg (the disc's
   // diameter, and the rectangle's width and height unless given).
   std::optional<double> light_extent_deg;

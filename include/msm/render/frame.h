@@ -1,40 +1,47 @@
 // Parameters the renderer's host code hands to its shaders, declared once for both (the
 // Falcor HostDeviceShared idea on top of msm/shared.h). Only vec4, ivec4 and mat4 members, so
 // that std140 (GLSL) and the C++ layout agree without implicit padding; the host checks sizes
-// and offsets with static_asserts (src/render/frame_layout.cpp).
+// and offsets with static_asserts (src/render/renderer.cpp).
 #ifndef MSM_RENDER_FRAME_H
 #define MSM_RENDER_FRAME_H
-#include "msm/shared.h"
+#include "msm/filter.h"
 MSM_BEGIN
 
-// Largest filter (odd number of taps per axis) of the blur and PCF: 63 taps fill 16 vec4s.
-const int MSM_MAX_FILTER_TAPS = 63;
+// The largest number of shadow-casting lights in one frame (the layers of the shadow-map arrays;
+// Vulkan guarantees 256 array layers; the image-based lighting of Kneiphof uses up to 256 lights).
+const int MSM_MAX_LIGHTS = 256;
 
 // The uniform block of every pass of one frame (binding 0 where a pass uses it).
 struct FrameUniforms {
   mat4 camera_view_projection;
-  mat4 light_view_projection; // world -> shadow-map clip space (orthographic)
-  mat4 light_normal_matrix;   // inverse transpose of its 3x3 part (normals -> clip space)
-  vec4 towards_light;         // xyz: unit direction from the scene towards the light
-  vec4 irradiance;            // rgb: irradiance of the light; a: ambient factor
-  vec4 technique_params;      // see msm/techniques.h
-  vec4 shadow_map;            // x: size in texels, y: 1 / size,
-                              // z: normal offset in world units, w: depth bias in [0,1] depth
-  vec4 shading;               // x: over-darkening factor (1 = off), y: exposure,
-                              // z: translucent alpha threshold, w: unused
-  vec4 background;            // rgb: linear colour of pixels without a surface
-  ivec4 kernel;               // x: taps per axis (odd), y: MSAA samples, z: radius, w: unused
-  vec4 filter_weights[16];    // normalized 1D Gaussian weights, tap k at [k / 4][k % 4]
-  ivec4 lookup;               // x: shadow-map lookup (MSM_LOOKUP_*), y: blue-noise layer,
-                              // zw: blue-noise offset in pixels (per frame)
-  vec4 soft;                  // soft shadows: xy: texels of reach per unit of [-1,1] depth
-                              // (soft.h msm_soft_spread), z: constant depth bias, w: ε_u
-  ivec4 soft_kernel;          // x: kernel width W (n_t = W²), y: table scale (uint bits)
-  vec4 sample_offsets[4];     // MSAA sample positions relative to the texel centre, in
-                              // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
-  vec4 receiver_bias;         // receiver-plane bias of the filtered techniques (lookup.glsl):
-                              // x: the kernel's variance per axis in texels² (blur + MSAA),
-                              // y: multiplier of the bias each bound needs (0 = off), zw: unused
+  vec4 technique_params;   // see msm/techniques.h
+  vec4 shadow_map;         // x: size in texels, y: 1 / size, z: unused, w: depth bias in [0,1] depth
+  vec4 shading;            // x: over-darkening factor (1 = off), y: exposure,
+                           // z: translucent alpha threshold, w: unused
+  ivec4 kernel;            // x: taps per axis (odd), y: MSAA samples, z: radius, w: unused
+  vec4 filter_weights[16]; // normalized 1D Gaussian weights (msm/filter.h), tap k at [k / 4][k % 4]
+  ivec4 lookup;            // x: shadow-map lookup (MSM_LOOKUP_*), y: blue-noise layer,
+                           // zw: blue-noise offset in pixels (per frame)
+  vec4 soft;               // soft shadows: xy: unused (per light), z: constant depth bias, w: ε_u
+  ivec4 soft_kernel;       // x: kernel width W (n_t = W²), y: table scale (uint bits)
+  vec4 sample_offsets[4];  // MSAA sample positions relative to the texel centre, in
+                           // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
+  vec4 receiver_bias;      // receiver-plane bias of the filtered techniques (lookup.glsl):
+                           // x: the kernel's variance per axis in texels² (blur + MSAA),
+                           // y: multiplier of the bias each bound needs (0 = off), zw: unused
+  ivec4 lights;            // x: number of lights (layers of the shadow-map arrays), yzw: unused
+};
+
+// One shadow-casting directional light of the frame: its shadow map is layer `index` of every
+// shadow-map array of the frame (a storage buffer of these, binding named by each pipeline).
+struct LightUniforms {
+  mat4 view_projection; // world -> its shadow-map clip space (orthographic, depth in [0,1])
+  mat4 normal_matrix;   // inverse transpose of the 3x3 part (normals -> clip space)
+  vec4 towards_light;   // xyz: unit direction from the scene towards the light,
+                        // w: normal offset in world units (RenderSettings::normal_offset texels)
+  vec4 irradiance;      // rgb: irradiance on a surface facing the light, a: unused
+  vec4 soft;            // soft shadows: xy: texels of reach per unit of [-1,1] depth
+                        // (msm_soft_spread), zw: unused
 };
 
 // How the shading reads a filtered shadow map.
@@ -42,7 +49,7 @@ const int MSM_LOOKUP_BILINEAR = 0; // hardware (tri)linear; for the non-linear m
 const int MSM_LOOKUP_NEAREST = 1;  // the texel under the fragment, mip 0
 const int MSM_LOOKUP_DITHER = 2;   // nearest after a blue-noise offset of up to half a texel (HPG)
 
-// Per draw of the shading pass (push constants).
+// Per draw of the shadow, translucent and shading passes (push constants).
 struct ObjectPush {
   vec4 albedo_opacity; // rgb: albedo (multiplies the texture), a: opacity
   ivec4 flags;         // x: 1 if the albedo texture is used, y: 1 if double-sided,
@@ -50,6 +57,7 @@ struct ObjectPush {
                        // the translucent pass blends (-1: grey, the opacity itself)
   vec4 transmission;   // rgb: transmission colour (the channel's opacity is
                        // opacity (1 - transmission)), a: unused
+  ivec4 light;         // x: the light (shadow-map layer) the shadow and translucent passes draw for
 };
 
 // The compute passes on shadow-map images (push constants).

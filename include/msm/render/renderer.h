@@ -1,21 +1,26 @@
-// msm::render: the headless Vulkan renderer of filtered hard shadows. One frame is four passes
-// (src/render/passes/, each with declared inputs, outputs and a GPU timer scope):
+// msm::render: the headless Vulkan renderer of filtered, soft and translucent shadows. A frame is
+// the recipe of passes of its technique (src/render/recipes.cpp), ordered and synchronized by a
+// frame graph from what each pass declares (src/render/frame_graph.h; docs/architecture.md):
 //
-//   shadow_depth   scene -> 16-bit depth, 1x/4x/8x MSAA, orthographic light frustum
+//   shadow_depth   scene -> 16-bit depth, 1x/4x/8x MSAA, one orthographic light frustum per light
 //   moment_resolve depth samples -> the technique's channels per sample, averaged, in the
 //                  storage basis (compute); skipped by the depth-based techniques
-//   blur           separable Gaussian (taps x taps, sigma in texels) -> moment images; then mips
-//   (or one_pass_filter: resolve + blur in shared memory + storage in one dispatch; HPG 2017)
-//   shading        Lambert + ambient with the technique's shadow, over-darkening, tone mapping,
-//                  sRGB; plus the shadow buffer (visibility of the visible surface per pixel)
+//   translucent    translucent occluders blended into the moments (JCGT §3), where the scene has any
+//   blur, mipmaps  separable Gaussian (msm/filter.h) and a mip chain of the moment images
+//   (one_pass_filter: resolve + blur in shared memory + storage in one dispatch; HPG 2017)
+//   (sat: integer summed-area tables of the soft shadows, instead of blur and mips)
+//   shading        Lambert + ambient with every light's shadow (msm/shading.h), over-darkening, tone
+//                  mapping, sRGB; plus the shadow buffer (visibility of the visible surface per pixel)
 //
-// A technique (msm/techniques.h for the per-texel math) picks its storage formats and its
-// shading shader; everything else is shared, so every technique sees the same depth samples and
-// the same filter kernel. PCF evaluates exactly that kernel (blur then bilinear lookup) on the
-// depth samples, with a receiver plane from the surface normal: it is the reference the filtered
-// techniques approximate.
+// A technique (msm/techniques.h for the per-texel math, msm/cpu/techniques.h for its row of the
+// technique table) picks its storage formats, its recipe and its shading shader; everything else is
+// shared, so every technique sees the same depth samples and the same filter kernel. PCF evaluates
+// exactly that kernel (blur then bilinear lookup) on the depth samples, with a receiver plane from
+// the surface normal: it is the reference the filtered techniques approximate.
 #pragma once
 
+#include "msm/cpu/techniques.h"
+#include "msm/filter.h"
 #include "msm/image/image.h"
 #include "msm/scene/scene.h"
 
@@ -43,29 +48,22 @@ class RenderError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-struct Technique {
-  std::string_view name;
-  std::string_view description;
-  int id;                      // MSM_TECH_* of msm/techniques.h
-  int bits_per_texel;          // of the filtered shadow map (depth-based: bits per depth sample)
-  std::array<int, 2> formats;  // VkFormat of the moment images (0: none)
-  std::string_view parameters; // meaning of the technique_params components it uses
-};
-
-// Every technique of the renderer, in the order of the comparison tables.
-std::span<const Technique> techniques();
-// Throws RenderError listing the valid names.
-const Technique& find_technique(std::string_view name);
+// The renderer's techniques are the rows of the technique table (msm/cpu/techniques.h) with
+// `rendered` set, in the table's order.
+std::vector<const Technique*> rendered_techniques();
+// Throws RenderError listing the valid names for a name the renderer does not have.
+const Technique& find_rendered_technique(std::string_view name);
 // Whether a technique can blend translucent occluders into its map (see RenderSettings).
 bool supports_translucency(const Technique& technique);
-// The papers' parameters of a technique (msm_technique_default_params).
-glm::vec4 default_params(const Technique& technique);
+// The passes of a technique's frame with the default settings (one light, the default filter and
+// mips; translucent occluders and coloured shadows as given), in the order the frame graph runs
+// them (src/render/recipes.cpp); needs no device.
+std::vector<std::string> technique_passes(const Technique& technique, bool translucent = false, bool coloured = false);
 
 // Limits against absurd input (checked by RenderSettings::validate before anything is allocated).
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxImagePixels = 64ll << 20; // 64 Mpixels
 inline constexpr int kMaxShadowSize = 8192;
-inline constexpr int kMaxFilterTaps = 63;     // MSM_MAX_FILTER_TAPS
 inline constexpr int kMaxOnePassTaps = 17;    // radius 8 in one_pass_filter.glsl
 inline constexpr int kDefaultSatKernel = 27;  // JCGT §4.5: a 27² search region
 inline constexpr int kDefaultPcssKernel = 15; // the PCSS baseline's 15² search
@@ -74,21 +72,21 @@ inline constexpr int kMaxPcssKernel = 63;     // 63² taps per pixel and loop
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
   int width = 1280, height = 720;
-  int shadow_size = 1024;            // texels per side of the square shadow map
-  int msaa = 4;                      // samples of the shadow depth pass: 1, 4 or 8
-  int filter_size = 9;               // Gaussian taps per axis (odd, 1..63; 1 = no blur)
-  float filter_sigma = 2.4f;         // in texels
-  bool mipmaps = true;               // mip chain of the moment images (trilinear lookups)
-  std::optional<glm::vec4> params;   // technique parameters (msm/techniques.h); default: the papers'
-  float overdarken = 1.0f;           // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
-  float normal_offset = 0.0f;        // lookup offset along the normal, in shadow-map texels
-  std::optional<float> depth_bias;   // subtracted from the fragment depth ([0,1] units); default:
-                                     // 2e-5 for the depth-based techniques (16-bit depth rounding),
-                                     // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
-                                     // 1e-5 for the filtered ones (the D16 rounding that their
-                                     // moment bias does not cover), 5e-4 for the non-linear ones
-                                     // (HPG §5: 1e-3 in [-1,1] depth)
-  float resolved_depth_bias() const; // depth_bias or the technique's default
+  int shadow_size = 1024;                        // texels per side of the square shadow map
+  int msaa = 4;                                  // samples of the shadow depth pass: 1, 4 or 8
+  int filter_size = MSM_FILTER_DEFAULT_TAPS;     // Gaussian taps per axis (odd, 1..63; 1 = no blur)
+  float filter_sigma = MSM_FILTER_DEFAULT_SIGMA; // in texels (msm/filter.h)
+  bool mipmaps = true;                           // mip chain of the moment images (trilinear lookups)
+  std::optional<glm::vec4> params;               // technique parameters (msm/techniques.h); default: the papers'
+  float overdarken = 1.0f;                       // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
+  float normal_offset = 0.0f;                    // lookup offset along the normal, in shadow-map texels
+  std::optional<float> depth_bias;               // subtracted from the fragment depth ([0,1] units); default:
+                                                 // 2e-5 for the depth-based techniques (16-bit depth rounding),
+                                                 // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
+                                                 // 1e-5 for the filtered ones (the D16 rounding that their
+                                                 // moment bias does not cover), 5e-4 for the non-linear ones
+                                                 // (HPG §5: 1e-3 in [-1,1] depth)
+  float resolved_depth_bias() const;             // depth_bias or the technique's default
   // Receiver-plane bias of the filtered techniques (msm/bias.h): the fragment depth moves towards
   // the light by the spread of the receiver's own depth over the kernel (σ = slope x the kernel's
   // standard deviation, mips included) times what the technique's bound needs on a plane (4MSM: 1,
@@ -127,9 +125,17 @@ struct RenderSettings {
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default
   float translucent_alpha_threshold = 0.01f;
+  // The frame's shadow-casting lights: empty = the scene's (scene::Scene::lights); at most
+  // MSM_MAX_LIGHTS (render/frame.h). Each gets its own shadow map (a layer of the frame's arrays),
+  // fitted to the scene like the scene's lights; the shading sums their contributions.
+  std::vector<scene::DirectionalLight> lights;
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;
 };
+
+// The normalized 1D weights of the blur and PCF (msm/filter.h), tap k at [k]: what the frame's
+// uniforms hold and what the ray tracer's filtered effect samples (reference::FilterKernel).
+std::vector<float> filter_weights(const RenderSettings& settings);
 
 // GPU time of one pass scope, in milliseconds.
 struct PassTime {
@@ -137,14 +143,22 @@ struct PassTime {
   double ms = 0;
 };
 
+// GPU time of one light's share of a pass that works light by light (frames with several lights).
+struct LightPassTime {
+  std::string pass;
+  int light = 0;
+  double ms = 0;
+};
+
 struct RenderResult {
-  image::Image color;           // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
-  image::Image shadow;          // "visibility" (of the light at the visible surface, 0 where the surface
-                                // faces away from the light) and "background" (1 where no surface)
-  image::Image shadow_rgb;      // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
-                                // "visibility" is then their mean, as the ray tracer's); else empty
-  std::vector<PassTime> passes; // in execution order; empty where the queue has no timestamps
-  double total_ms = 0;          // sum of the passes
+  image::Image color;                      // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
+  image::Image shadow;                     // "visibility" (of the light at the visible surface, 0 where the surface
+                                           // faces away from the light) and "background" (1 where no surface)
+  image::Image shadow_rgb;                 // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
+                                           // "visibility" is then their mean, as the ray tracer's); else empty
+  std::vector<PassTime> passes;            // in execution order; empty where the queue has no timestamps
+  double total_ms = 0;                     // sum of the passes
+  std::vector<LightPassTime> light_passes; // several lights: each light's share of the passes
 };
 
 // What tests compare against the CPU: the depth samples and the resolved moment image (before
@@ -173,6 +187,9 @@ class Renderer {
   // `frames` frames with the same settings, nothing read back: the per-pass times of each (for
   // msm bench). Precondition: frames >= 1.
   std::vector<std::vector<PassTime>> time_frames(const RenderSettings& settings, int frames);
+
+  // The passes of the frame these settings make, in the order the frame graph runs them.
+  std::vector<std::string> frame_passes(const RenderSettings& settings);
 
   const scene::Scene& scene() const noexcept;
 

@@ -121,6 +121,7 @@ namespace msm::scene {
 inline constexpr int kMaxSegments = 4096; // any one segment/ring/step/bar count
 inline constexpr std::size_t kMaxPrimitiveTriangles = 4'000'000;
 inline constexpr float kMaxSize = 1e6f; // any primitive dimension / |translate|
+inline constexpr int kMaxLights = 256;  // render/frame.h MSM_MAX_LIGHTS: the layers of a shadow-map array
 
 class SceneError : public std::runtime_error {
  public:
@@ -237,26 +238,50 @@ struct ShadowFraming {
   glm::vec2 depth_range{-1.0f, 1.0f};
 };
 
+// The orthographic shadow-map frustum of one directional light with the scene's framing: the one
+// definition the renderer (its light uniforms) and the ray tracer (kernel offsets, light axes)
+// derive their light-space quantities from.
+struct LightFrame {
+  glm::mat4 view_projection{1.0f}; // world -> clip: x, y in [-1, 1] (y down the map), depth in [0, 1]
+  glm::dvec3 towards_light{0.0, 1.0, 0.0};
+  // Unit world directions of increasing clip x / y (along the map's texel rows / columns; clip y
+  // points down the image); both orthogonal to towards_light.
+  glm::dvec3 x_axis{1.0, 0.0, 0.0}, y_axis{0.0, 0.0, 1.0};
+  glm::dvec2 extent{1.0, 1.0}; // the frustum's width and height in world units
+  double depth_extent = 1.0;   // world distance from depth 0 to depth 1
+  // One texel of a shadow map of shadow_size² texels, in world units along x_axis and y_axis.
+  glm::dvec2 texel(int shadow_size) const { return extent / double(shadow_size); }
+};
+
 struct Scene {
   std::string name;
   std::filesystem::path source; // the scene file, or "builtin:<name>"
   std::vector<Material> materials;
   std::vector<Object> objects;
   Camera camera;
-  DirectionalLight light;
+  // Shadow-casting directional lights, at least one (the JSON's "light", or 1..kMaxLights of
+  // "lights"). The ray tracer's effects use the first: light().
+  std::vector<DirectionalLight> lights{DirectionalLight{}};
   ShadowFraming shadow;
+
+  const DirectionalLight& light() const { return lights.front(); }
 
   Bounds bounds() const;
   std::size_t triangle_count() const;
   std::size_t vertex_count() const;
-  // Light view (right-handed, looking along travel()) and orthographic projection, with the
-  // shadow framing applied: for "fit", the orthographic box is fitted to the scene's vertices
-  // in light space (plus a 1e-5 relative margin): every vertex maps into x,y in [-1,1] and depth
-  // in [0,1], depth 0 at the vertex closest to the light, 1 at the farthest. O(vertices) per
-  // call: cache the result. Vulkan clip conventions.
-  glm::mat4 light_view() const;
-  glm::mat4 light_projection() const;
-  glm::mat4 light_view_projection() const { return light_projection() * light_view(); }
+  // Light view (right-handed, looking along travel()) and orthographic projection of lights[index],
+  // with the shadow framing applied: for "fit", the orthographic box is fitted to the scene's
+  // vertices in light space (plus a 1e-5 relative margin): every vertex maps into x,y in [-1,1] and
+  // depth in [0,1], depth 0 at the vertex closest to the light, 1 at the farthest. O(vertices) per
+  // call: cache the result. Vulkan clip conventions. Precondition: index < lights.size().
+  glm::mat4 light_view(std::size_t index = 0) const { return light_view(lights.at(index)); }
+  glm::mat4 light_projection(std::size_t index = 0) const { return light_projection(lights.at(index)); }
+  glm::mat4 light_view_projection(std::size_t index = 0) const { return light_projection(index) * light_view(index); }
+  LightFrame light_frame(std::size_t index = 0) const { return light_frame(lights.at(index)); }
+  // The same for any light (e.g. the renderer's per-frame lights), with the scene's framing.
+  glm::mat4 light_view(const DirectionalLight& light) const;
+  glm::mat4 light_projection(const DirectionalLight& light) const;
+  LightFrame light_frame(const DirectionalLight& light) const;
   glm::mat4 camera_view_projection(float aspect) const { return camera.projection(aspect) * camera.view(); }
 };
 

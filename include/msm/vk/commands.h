@@ -25,12 +25,13 @@ VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src
                                       VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                       VkDeviceSize offset = 0, VkDeviceSize size = VK_WHOLE_SIZE);
 
-// Covers mips [base_mip, base_mip + mip_count) of all layers.
+// Covers mips [base_mip, base_mip + mip_count) of layers [base_layer, base_layer + layer_count).
 VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 src_stage,
                                     VkAccessFlags2 src_access, VkImageLayout old_layout,
                                     VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                     VkImageLayout new_layout, uint32_t base_mip = 0,
-                                    uint32_t mip_count = VK_REMAINING_MIP_LEVELS);
+                                    uint32_t mip_count = VK_REMAINING_MIP_LEVELS, uint32_t base_layer = 0,
+                                    uint32_t layer_count = VK_REMAINING_ARRAY_LAYERS);
 
 // vkCmdPipelineBarrier2 with any mix of barriers.
 void pipeline_barrier(VkCommandBuffer cmd, std::span<const VkMemoryBarrier2> memory,

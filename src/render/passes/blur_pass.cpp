@@ -1,48 +1,60 @@
 #include "pass.h"
 
+#include <fmt/format.h>
+
 namespace msm::render {
 
-const PassDecl& BlurPass::decl() {
-  static const PassDecl d{"blur", {"moments", "frame.filter_weights"}, {"moments"}};
-  return d;
+void BlurPass::prepare(const PassResources& r) {
+  program_ = &r.programs.compute("blur.comp",
+                                 {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
+                                 sizeof(ImagePassPush));
 }
 
-BlurPass::BlurPass(const vk::Context& ctx)
-    : program_(vk::create_program(ctx, "blur.comp",
-                                  {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
-                                  sizeof(ImagePassPush))) {}
+namespace {
+std::string temp_name(int channel, int i) { return fmt::format("blur_temp{}.{}", i, channel); }
+} // namespace
 
-void BlurPass::execute(FrameContext& f) const {
-  PassScope scope(f, decl());
-  const FrameTargets& t = f.targets;
-  int size = t.config.shadow_size;
-  uint32_t groups = vk::group_count(uint32_t(size), 8);
-  VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
-  for (int i = 0; i < t.config.moment_images(); ++i) {
-    VkImageView moments = t.moment_mip0(f.channel, i);
-    const vk::Image& temp = t.blur_temp[size_t(i)];
-    vk::pipeline_barrier(f.cmd, vk::image_barrier(temp.handle(), VK_IMAGE_ASPECT_COLOR_BIT,
-                                                  VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED,
-                                                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
-    vk::dispatch(f.cmd, program_, groups, groups, 1,
-                 {vk::Descriptor(f.uniforms), vk::Descriptor(moments, general, t.point_sampler), vk::Descriptor(temp)},
-                 ImagePassPush{glm::ivec4(size, size, 0, 0)});
-    vk::pipeline_barrier(
-        f.cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                  VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
-                                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                  VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
-    vk::dispatch(
-        f.cmd, program_, groups, groups, 1,
-        {vk::Descriptor(f.uniforms), vk::Descriptor(temp, general, t.point_sampler), vk::Descriptor(moments, general)},
-        ImagePassPush{glm::ivec4(size, size, 1, 0)});
+void BlurPass::reflect(PassBuilder& b) const {
+  for (int i = 0; i < config_.moment_images(); ++i) {
+    b.modify(moment_image(channel_, i), use::compute_general());
+    // Between the two directions, in float: one layer, reused light after light.
+    b.scratch(temp_name(channel_, i), {.format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                       .width = uint32_t(config_.shadow_size),
+                                       .height = uint32_t(config_.shadow_size),
+                                       .extra_usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
   }
-  vk::pipeline_barrier(f.cmd,
-                       vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                          VK_PIPELINE_STAGE_2_TRANSFER_BIT | VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
-                                              VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
-                                          VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
+}
+
+void BlurPass::execute(const PassContext& c) const {
+  int size = config_.shadow_size;
+  uint32_t groups = vk::group_count(uint32_t(size), 8);
+  constexpr VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
+  constexpr VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  for (int l = 0; l < config_.lights; ++l) {
+    c.begin_light(name(), l);
+    for (int i = 0; i < config_.moment_images(); ++i) {
+      VkImageView moments = c.image(moment_image(channel_, i)).layer_mip0_views[size_t(l)];
+      const GraphImage& temp = c.image(temp_name(channel_, i));
+      // The scratch image's earlier contents (the previous light's) are not needed.
+      vk::pipeline_barrier(c.cmd, vk::image_barrier(temp.image.handle(), VK_IMAGE_ASPECT_COLOR_BIT, compute,
+                                                    VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                                    compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
+      vk::dispatch(c.cmd, *program_, groups, groups, 1,
+                   {vk::Descriptor(c.frame.uniforms), vk::Descriptor(moments, general, c.frame.point_sampler),
+                    vk::Descriptor(temp.layer_views[0], general)},
+                   ImagePassPush{glm::ivec4(size, size, 0, 0)});
+      vk::pipeline_barrier(
+          c.cmd,
+          vk::memory_barrier(compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
+                             compute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
+      vk::dispatch(c.cmd, *program_, groups, groups, 1,
+                   {vk::Descriptor(c.frame.uniforms),
+                    vk::Descriptor(temp.layer_views[0], general, c.frame.point_sampler),
+                    vk::Descriptor(moments, general)},
+                   ImagePassPush{glm::ivec4(size, size, 1, 0)});
+    }
+    c.end_light();
+  }
 }
 
 } // namespace msm::render

@@ -1,142 +1,158 @@
-// The passes of a frame. Each declares what it reads and writes (PassDecl, apart from execute)
-// and records itself inside a GPU timer scope of its name; the renderer composes them. A pass
-// leaves its outputs in the layout and with the barrier its consumers need (stated per pass).
+// The passes a frame is composed of (recipes.cpp picks them per technique). Each declares in
+// reflect() what it creates, reads and modifies (frame_graph.h) and records only its own work in
+// execute(); the frame graph places the barriers between passes. A pass that works per light loops
+// over the layers of its images (one per light), each light in a timer scope of its own when the
+// frame has several.
 #pragma once
 
-#include "../frame_targets.h"
+#include "../frame_config.h"
+#include "../frame_graph.h"
 #include "../gpu_scene.h"
+#include "../program_cache.h"
 
-#include "msm/soft/sat_builder.h"
+#include "msm/gpu/sat_builder.h"
 
 #include <memory>
 #include <string_view>
-#include <vector>
 
 namespace msm::render {
 
-struct PassDecl {
-  std::string_view name; // also the GPU timer scope
-  std::vector<std::string_view> inputs, outputs;
-};
-
-// What execute() records with.
-struct FrameContext {
-  const vk::Context& ctx;
-  VkCommandBuffer cmd;
-  vk::GpuTimer& timer;
-  const FrameTargets& targets;
-  const GpuScene& scene;
-  const vk::Buffer& uniforms;  // FrameUniforms
-  const vk::Image& blue_noise; // 64 layers of 64² RG8 (blue_noise.h)
-  glm::vec3 camera_position;
-  // The colour channel whose moment images resolve, translucent, blur and mips work on
-  // (FrameTargets::moment_image; always 0 unless the frame has coloured translucency).
-  int channel = 0;
-};
-
-// Scene -> shadow_depth (D16, MSAA), left SHADER_READ_ONLY for compute and fragment reads.
-class ShadowDepthPass {
+// Scene -> shadow_depth (D16, MSAA, one layer per light): orthographic depth, depth clamp, both faces.
+class ShadowDepthPass : public Pass {
  public:
-  static const PassDecl& decl();
-  ShadowDepthPass(const vk::Context& ctx, int msaa);
-  void execute(FrameContext& f) const;
+  explicit ShadowDepthPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "shadow_depth"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  vk::Program program_;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
 };
 
-// shadow_depth -> moments[0..1] mip 0 (GENERAL), visible to compute and fragment reads. With
-// coloured translucency the opaque moments of channel 0 are then copied to the other channels
-// (the same opaque occluders; only the translucent blend differs), in the same timer scope.
-class MomentResolvePass {
+// shadow_depth -> moment images (mip 0) of channel 0: per sample msm_technique_generate, averaged,
+// in the storage basis (compute).
+class MomentResolvePass : public Pass {
  public:
-  static const PassDecl& decl();
-  MomentResolvePass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg);
-  void execute(FrameContext& f) const;
+  explicit MomentResolvePass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "moment_resolve"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  vk::Program program_;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
 };
 
-// shadow_depth -> moments mip 0 (GENERAL) in one dispatch: resolve, Gaussian in shared memory,
-// encoding (HPG 2017 §4); visible to transfer, compute and fragment reads. One per technique,
-// MSAA and filter radius (specialization constants).
-class OnePassFilterPass {
+// Coloured translucency: the moment images of channel 0 (the opaque occluders) copied to the green
+// and blue channels' images, which the translucent pass then blends differently.
+class ChannelCopyPass : public Pass {
  public:
-  static const PassDecl& decl();
-  OnePassFilterPass(const vk::Context& ctx, const Technique& technique, int msaa, int taps);
-  void execute(FrameContext& f) const;
+  explicit ChannelCopyPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "channel_copy"; }
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  vk::Program program_;
+  FrameConfig config_;
 };
 
-// Translucent objects -> blended into moments mip 0 (GENERAL, as colour attachments), back to
-// front (JCGT §3); after the resolve, before the blur. Visible to compute and transfer.
-class TranslucentPass {
+// shadow_depth -> moment images (mip 0) in one dispatch: resolve, Gaussian in shared memory,
+// encoding (HPG 2017 §4). One pipeline per technique, MSAA and filter radius.
+class OnePassFilterPass : public Pass {
  public:
-  static const PassDecl& decl();
-  TranslucentPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg,
-                  const std::array<int, 2>& formats);
-  void execute(FrameContext& f) const;
+  explicit OnePassFilterPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "one_pass_filter"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  vk::Program program_;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
 };
 
-// moments mip 0 (unfiltered Θ4*, Θ6* or (z, z²)) -> sat_tables (GENERAL): the 32-bit integer
-// summed-area tables of the soft shadows (JCGT §4.2, msm::soft::SatBuilder), one per moment
-// image, visible to fragment reads.
-class SatPass {
+// Translucent objects blended into the moment images (mip 0) of one colour channel, back to front
+// (JCGT §3), with the opaque depth samples as the occlusion of each fragment.
+class TranslucentPass : public Pass {
  public:
-  static const PassDecl& decl();
-  explicit SatPass(const vk::Context& ctx);
-  void execute(FrameContext& f, int max_kernel_texels) const;
+  TranslucentPass(const FrameConfig& config, int channel) : config_(config), channel_(channel) {}
+  std::string_view name() const override { return "translucent"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  std::unique_ptr<soft::SatBuilder> builder_;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+  int channel_;
 };
 
-// moments mip 0 -> blur_temp -> moments mip 0 (GENERAL), visible to transfer, compute, fragment.
-class BlurPass {
+// Moment images (mip 0) of one channel -> separable Gaussian (msm/filter.h) in place, through a
+// float scratch image.
+class BlurPass : public Pass {
  public:
-  static const PassDecl& decl();
-  explicit BlurPass(const vk::Context& ctx);
-  void execute(FrameContext& f) const;
+  BlurPass(const FrameConfig& config, int channel) : config_(config), channel_(channel) {}
+  std::string_view name() const override { return "blur"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  vk::Program program_;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+  int channel_;
 };
 
-// moments mip 0 -> mips 1.. by linear blits (GENERAL), visible to fragment reads.
-class MipmapPass {
+// Moment images of one channel: mips 1.. by linear blits of the previous mip (averages of moments
+// are moments).
+class MipmapPass : public Pass {
  public:
-  static const PassDecl& decl();
-  void execute(FrameContext& f) const;
-};
-
-// Scene + shadow_depth or moments -> color (sRGB) and shadow_buffer, left TRANSFER_SRC.
-class ShadingPass {
- public:
-  static const PassDecl& decl();
-  ShadingPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg, bool coloured);
-  void execute(FrameContext& f) const;
+  MipmapPass(const FrameConfig& config, int channel) : config_(config), channel_(channel) {}
+  std::string_view name() const override { return "mipmaps"; }
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  vk::Program program_, translucent_program_; // opaque; translucent objects blended over it
-  bool depth_based_, nonlinear_, soft_;
+  FrameConfig config_;
+  int channel_;
 };
 
-// Scope guard for the timer scope of a pass.
-class PassScope {
+// Moment images (unfiltered Θ4*, Θ6* or (z, z²)) -> 32-bit integer summed-area tables of the soft
+// shadows (JCGT §4.2, msm::gpu::SatBuilder, rows then columns), one per moment image.
+class SatPass : public Pass {
  public:
-  PassScope(FrameContext& f, const PassDecl& decl) : f_(f) { f_.timer.begin(f_.cmd, decl.name); }
-  ~PassScope() { f_.timer.end(f_.cmd); }
-  PassScope(const PassScope&) = delete;
-  PassScope& operator=(const PassScope&) = delete;
+  explicit SatPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "sat"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
 
  private:
-  FrameContext& f_;
+  const gpu::SatBuilder* builder_ = nullptr; // the renderer's (its pipelines outlive a configuration)
+  FrameConfig config_;
 };
+
+// Scene + shadow_depth, moment images or tables -> color (sRGB) and shadow_buffer: Lambert + ambient
+// with every light's shadow (msm/shading.h), over-darkening, ACES; translucent surfaces blended over.
+class ShadingPass : public Pass {
+ public:
+  explicit ShadingPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "shading"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr; // opaque; translucent over it
+  FrameConfig config_;
+};
+
+// The images every shadow-map pass creates.
+ImageSpec moment_image_spec(const FrameConfig& config, int i);
+// Binds the scene's vertex and index buffers (every graphics pass draws the scene).
+void bind_scene(VkCommandBuffer cmd, const GpuScene& scene);
 
 } // namespace msm::render

@@ -2,48 +2,55 @@
 
 namespace msm::render {
 
-const PassDecl& ShadowDepthPass::decl() {
-  static const PassDecl d{"shadow_depth", {"scene", "frame.light_view_projection"}, {"shadow_depth"}};
-  return d;
+void bind_scene(VkCommandBuffer cmd, const GpuScene& scene) {
+  VkDeviceSize offset = 0;
+  VkBuffer vertices = scene.vertices.handle();
+  vkCmdBindVertexBuffers(cmd, 0, 1, &vertices, &offset);
+  vkCmdBindIndexBuffer(cmd, scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
 }
 
-ShadowDepthPass::ShadowDepthPass(const vk::Context& ctx, int msaa)
-    : program_(vk::create_graphics_program(ctx, {.name = "shadow_depth",
-                                                 .vertex_shader = "shadow_depth.vert",
-                                                 .bindings = {vk::Binding::uniform_buffer},
-                                                 .vertex_stride = sizeof(Vertex),
-                                                 .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}},
-                                                 .depth_format = VK_FORMAT_D16_UNORM,
-                                                 .samples = VkSampleCountFlagBits(msaa),
-                                                 // casters in front of the fitted near plane still cast
-                                                 .depth_clamp = true})) {}
+void ShadowDepthPass::prepare(const PassResources& r) {
+  const FrameConfig& config = config_;
+  program_ = &r.programs.graphics({.name = "shadow_depth",
+                                   .vertex_shader = "shadow_depth.vert",
+                                   .bindings = {vk::Binding::uniform_buffer, vk::Binding::storage_buffer},
+                                   .push_constant_size = sizeof(ObjectPush),
+                                   .vertex_stride = sizeof(Vertex),
+                                   .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}},
+                                   .depth_format = VK_FORMAT_D16_UNORM,
+                                   .samples = VkSampleCountFlagBits(config.msaa),
+                                   // casters in front of the fitted near plane still cast
+                                   .depth_clamp = true});
+}
 
-void ShadowDepthPass::execute(FrameContext& f) const {
-  PassScope scope(f, decl());
-  const vk::Image& depth = f.targets.shadow_depth;
-  vk::pipeline_barrier(
-      f.cmd, vk::image_barrier(
-                 depth.handle(), depth.aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                 VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT,
-                 VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL));
-  vk::begin_rendering(f.cmd, extent(depth), {}, vk::DepthAttachment{depth.view(), 1.0f});
-  vk::set_viewport_scissor(f.cmd, extent(depth));
-  vkCmdSetCullMode(f.cmd, VK_CULL_MODE_NONE); // both sides cast: thin walls, planes, open meshes
-  vk::bind_program(f.cmd, program_, {vk::Descriptor(f.uniforms)});
-  VkDeviceSize offset = 0;
-  VkBuffer vertices = f.scene.vertices.handle();
-  vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
-  vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-  for (const Draw& d : f.scene.draws) vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
-  vkCmdEndRendering(f.cmd);
-  vk::pipeline_barrier(
-      f.cmd, vk::image_barrier(depth.handle(), depth.aspect(), VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-                               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-                               VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
-                                   VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-                               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT,
-                               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
+void ShadowDepthPass::reflect(PassBuilder& b) const {
+  // Single-sampled depth is read back by copy (Renderer::Intermediates), MSAA depth by a shader.
+  b.create(kShadowDepth,
+           {.format = VK_FORMAT_D16_UNORM,
+            .width = uint32_t(config_.shadow_size),
+            .height = uint32_t(config_.shadow_size),
+            .layers = uint32_t(config_.lights),
+            .samples = VkSampleCountFlagBits(config_.msaa),
+            .extra_usage = VkImageUsageFlags(config_.msaa == 1 ? VK_IMAGE_USAGE_TRANSFER_SRC_BIT : 0)},
+           use::depth_attachment());
+}
+
+void ShadowDepthPass::execute(const PassContext& c) const {
+  const GraphImage& depth = c.image(kShadowDepth);
+  VkExtent2D size{uint32_t(config_.shadow_size), uint32_t(config_.shadow_size)};
+  for (int l = 0; l < config_.lights; ++l) {
+    c.begin_light(name(), l);
+    vk::begin_rendering(c.cmd, size, {}, vk::DepthAttachment{depth.layer_views[size_t(l)], 1.0f});
+    vk::set_viewport_scissor(c.cmd, size);
+    vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE); // both sides cast: thin walls, planes, open meshes
+    bind_scene(c.cmd, c.frame.scene);
+    ObjectPush push{};
+    push.light.x = l;
+    vk::bind_program(c.cmd, *program_, {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.frame.lights)}, push);
+    for (const Draw& d : c.frame.scene.draws) vkCmdDrawIndexed(c.cmd, d.index_count, 1, d.first_index, 0, 0);
+    vkCmdEndRendering(c.cmd);
+    c.end_light();
+  }
 }
 
 } // namespace msm::render

@@ -2,77 +2,84 @@
 
 #include "msm/techniques.h"
 
+#include <algorithm>
+
 namespace msm::render {
-
-const PassDecl& TranslucentPass::decl() {
-  static const PassDecl d{"translucent", {"scene.translucent", "shadow_depth", "moments"}, {"moments"}};
-  return d;
-}
-
 namespace {
 
-vk::GraphicsDesc translucent_desc(const Technique& technique, int msaa, bool split_rg,
-                                  const std::array<int, 2>& formats) {
-  std::string fragment =
-      std::string(split_rg ? "translucent_moments2" : "translucent_moments") + (msaa == 1 ? "_1x.frag" : ".frag");
-  vk::GraphicsDesc d{.name = std::string("translucent ") + std::string(technique.name),
+vk::GraphicsDesc translucent_desc(const FrameConfig& config) {
+  bool split_rg = config.split_rg();
+  std::string fragment = std::string(split_rg ? "translucent_moments2" : "translucent_moments") +
+                         (config.msaa == 1 ? "_1x.frag" : ".frag");
+  vk::GraphicsDesc d{.name = std::string("translucent ") + std::string(config.technique->name),
                      .vertex_shader = "translucent.vert",
                      .fragment_shader = fragment,
-                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image},
+                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
+                                  vk::Binding::storage_buffer},
                      .push_constant_size = sizeof(ObjectPush),
                      .vertex_stride = sizeof(Vertex),
                      .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
                                     {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
-                     .color_formats = {VkFormat(formats[0])},
+                     .color_formats = {config.formats()[0]},
                      .alpha_blend = true,
-                     .constants = {{0, uint32_t(technique.id)}, {3, split_rg ? 1u : 0u}}};
-  if (split_rg) d.color_formats.push_back(VkFormat(formats[1]));
+                     .constants = {{0, uint32_t(config.technique->id)}, {3, split_rg ? 1u : 0u}}};
+  if (split_rg) d.color_formats.push_back(config.formats()[1]);
   return d;
 }
 
 } // namespace
 
-TranslucentPass::TranslucentPass(const vk::Context& ctx, const Technique& technique, int msaa, bool split_rg,
-                                 const std::array<int, 2>& formats)
-    : program_(vk::create_graphics_program(ctx, translucent_desc(technique, msaa, split_rg, formats))) {}
+void TranslucentPass::prepare(const PassResources& r) { program_ = &r.programs.graphics(translucent_desc(config_)); }
 
-void TranslucentPass::execute(FrameContext& f) const {
-  PassScope scope(f, decl());
-  const FrameTargets& t = f.targets;
-  constexpr VkPipelineStageFlags2 color = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-  constexpr VkAccessFlags2 color_rw = VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-  vk::pipeline_barrier(f.cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                                 VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, color, color_rw));
-  std::vector<vk::ColorAttachment> targets;
-  for (int i = 0; i < t.config.moment_images(); ++i)
-    targets.push_back({.view = t.moment_mip0(f.channel, i), .load = true, .layout = VK_IMAGE_LAYOUT_GENERAL});
-  VkExtent2D size{uint32_t(t.config.shadow_size), uint32_t(t.config.shadow_size)};
-  vk::begin_rendering(f.cmd, size, targets);
-  vk::set_viewport_scissor(f.cmd, size);
-  vkCmdSetCullMode(f.cmd, VK_CULL_MODE_NONE);
-  VkDeviceSize offset = 0;
-  VkBuffer vertices = f.scene.vertices.handle();
-  vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
-  vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-  vk::Descriptor depth(t.shadow_depth.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, t.point_sampler);
-  for (const Draw& d : f.scene.translucent) {
-    ObjectPush push = d.push;
-    push.flags.w = t.config.coloured ? f.channel : -1; // the channel whose opacity to blend
-    const vk::Image& opacity =
-        d.opacity_texture >= 0 ? f.scene.opacity_textures[size_t(d.opacity_texture)] : f.scene.white;
-    vk::bind_program(f.cmd, program_,
-                     {vk::Descriptor(f.uniforms),
-                      vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler),
-                      depth},
-                     push);
-    vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
+void TranslucentPass::reflect(PassBuilder& b) const {
+  b.read(kShadowDepth, use::sampled(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT));
+  for (int i = 0; i < config_.moment_images(); ++i)
+    b.modify(moment_image(channel_, i), use::color_attachment_general());
+}
+
+void TranslucentPass::execute(const PassContext& c) const {
+  const GraphImage& depth = c.image(kShadowDepth);
+  VkExtent2D size{uint32_t(config_.shadow_size), uint32_t(config_.shadow_size)};
+  const GpuScene& scene = c.frame.scene;
+  for (int l = 0; l < config_.lights; ++l) {
+    c.begin_light(name(), l);
+    std::vector<vk::ColorAttachment> targets;
+    for (int i = 0; i < config_.moment_images(); ++i)
+      targets.push_back({.view = c.image(moment_image(channel_, i)).layer_mip0_views[size_t(l)],
+                         .load = true,
+                         .layout = VK_IMAGE_LAYOUT_GENERAL});
+    vk::begin_rendering(c.cmd, size, targets);
+    vk::set_viewport_scissor(c.cmd, size);
+    vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
+    bind_scene(c.cmd, scene);
+    vk::Descriptor depth_samples(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                 c.frame.point_sampler);
+    // Back to front along this light's travel (the scene sorted them, and each one's triangles, for
+    // its first light; the objects are re-sorted here for the others).
+    std::vector<const Draw*> order;
+    for (const Draw& d : scene.translucent) order.push_back(&d);
+    if (l > 0) {
+      glm::vec3 travel = -glm::vec3(c.frame.light_data[size_t(l)].towards_light);
+      std::stable_sort(order.begin(), order.end(), [&](const Draw* a, const Draw* b) {
+        return glm::dot(a->center, travel) > glm::dot(b->center, travel);
+      });
+    }
+    for (const Draw* d : order) {
+      ObjectPush push = d->push;
+      push.flags.w = config_.coloured ? channel_ : -1; // the channel whose opacity to blend
+      push.light.x = l;
+      const vk::Image& opacity =
+          d->opacity_texture >= 0 ? scene.opacity_textures[size_t(d->opacity_texture)] : scene.white;
+      vk::bind_program(c.cmd, *program_,
+                       {vk::Descriptor(c.frame.uniforms),
+                        vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler),
+                        depth_samples, vk::Descriptor(c.frame.lights)},
+                       push);
+      vkCmdDrawIndexed(c.cmd, d->index_count, 1, d->first_index, 0, 0);
+    }
+    vkCmdEndRendering(c.cmd);
+    c.end_light();
   }
-  vkCmdEndRendering(f.cmd);
-  vk::pipeline_barrier(f.cmd, vk::memory_barrier(color, VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT,
-                                                 VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT |
-                                                     VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
-                                                     VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-                                                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_TRANSFER_READ_BIT));
 }
 
 } // namespace msm::render

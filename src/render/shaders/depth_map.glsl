@@ -1,18 +1,29 @@
 // The shadow pass's depth map as the compute and fragment shaders read it: multisampled, or
 // single-sampled where the including file defines MSM_SINGLE_SAMPLE (a sampler2DMS cannot take a
-// one-sample image). The including file defines MSM_DEPTH_BINDING.
+// one-sample image). The including file defines MSM_DEPTH_BINDING, and MSM_DEPTH_LAYERED where it
+// reads the whole array (one layer per light; layer `shadow_layer`) instead of one light's layer.
+#ifdef MSM_DEPTH_LAYERED
+#ifdef MSM_SINGLE_SAMPLE
+layout(binding = MSM_DEPTH_BINDING) uniform sampler2DArray depth_map;
+#else
+layout(binding = MSM_DEPTH_BINDING) uniform sampler2DMSArray depth_map;
+#endif
+#define MSM_DEPTH_TEXEL(p) ivec3(p, shadow_layer)
+#else
 #ifdef MSM_SINGLE_SAMPLE
 layout(binding = MSM_DEPTH_BINDING) uniform sampler2D depth_map;
 #else
 layout(binding = MSM_DEPTH_BINDING) uniform sampler2DMS depth_map;
 #endif
+#define MSM_DEPTH_TEXEL(p) (p)
+#endif
 
 // Depth of sample s of texel p (sample 0 where single-sampled).
 float depth_sample(ivec2 p, int s) {
 #ifdef MSM_SINGLE_SAMPLE
-  return texelFetch(depth_map, p, 0).x;
+  return texelFetch(depth_map, MSM_DEPTH_TEXEL(p), 0).x;
 #else
-  return texelFetch(depth_map, p, s).x;
+  return texelFetch(depth_map, MSM_DEPTH_TEXEL(p), s).x;
 #endif
 }
 

@@ -1,7 +1,13 @@
-// Shared by the renderer's shaders: the frame's uniform block and the shading helpers.
+// Shared by the renderer's shaders: the frame's uniform block, the lights and the shading helpers.
 #include "msm/render/frame.h"
 
 layout(std140, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+
+// The frame's lights (FrameUniforms::lights.x of them), at the binding the including shader
+// names with MSM_LIGHT_BINDING (every pipeline's bindings are positional).
+#ifdef MSM_LIGHT_BINDING
+layout(std430, binding = MSM_LIGHT_BINDING) readonly buffer LightBlock { LightUniforms lights[]; };
+#endif
 
 // The technique (MSM_TECH_*, msm/techniques.h): a specialization constant, so that each pipeline
 // compiles one technique's path only.

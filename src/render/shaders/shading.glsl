@@ -1,8 +1,19 @@
-// Forward shading (Lambert + constant ambient) with the technique's shadow, tone mapping and
-// sRGB output, plus the shadow buffer (visibility of the visible surface) for error measurement.
-// The including shader defines shadow_intensity() for its family of techniques.
+// Forward shading (Lambert + constant ambient, msm/shading.h) with the technique's shadow of every
+// light of the frame, tone mapping and sRGB output, plus the shadow buffer (visibility of the
+// visible surface) for error measurement. The including shader defines shadow_intensity() for its
+// family of techniques; it reads layer `shadow_layer` of the shadow-map arrays (the light being
+// evaluated).
+#include "msm/shading.h"
 #include "msm/techniques.h"
+#define MSM_LIGHT_BINDING 10
 #include "frame.glsl"
+
+// The light whose shadow map the lookups read: its layer of the frame's shadow-map arrays. Frames
+// with one light specialize it to the constant 0 (kOneLight): lavapipe fetches from a constant
+// layer several times faster than from a variable one.
+layout(constant_id = 4) const bool kOneLight = false;
+int current_layer = 0;
+#define shadow_layer (kOneLight ? 0 : current_layer)
 
 layout(binding = 1) uniform sampler2D albedo_texture;
 layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
@@ -22,6 +33,9 @@ struct ShadowLookup {
   vec2 t;
   float z;
   vec2 depth_per_texel;
+  // Screen-space derivatives of t (texels per pixel), taken in uniform control flow: filtered lookups
+  // pick their mip from them (implicit derivatives inside the branches below would be undefined).
+  vec2 dt_dx, dt_dy;
 };
 
 float shadow_intensity(ShadowLookup s);
@@ -30,48 +44,65 @@ float shadow_intensity(ShadowLookup s);
 vec3 shadow_intensity_rgb(ShadowLookup s);
 #endif
 
-// Narkowicz's fit of the ACES filmic curve (as msm::image::ToneCurve::aces).
-vec3 tone_map(vec3 x) { return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f); }
+
+// Visibility of light l at the surface (0 where the surface faces away from it: its own shadow),
+// per colour channel.
+vec3 light_visibility(int l, vec3 n, float n_dot_l) {
+  current_layer = l;
+  // Normal offset: more at grazing light, where depth varies fastest across a texel.
+  vec3 p = world_position + n * (lights[l].towards_light.w * (1.0f - n_dot_l));
+  vec4 clip = lights[l].view_projection * vec4(p, 1.0f);
+  ShadowLookup s;
+  s.t = (clip.xy * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
+  s.dt_dx = dFdx(s.t);
+  s.dt_dy = dFdy(s.t);
+  if (n_dot_l <= 0.0f) return vec3(0.0f);
+  vec3 nc = mat3(lights[l].normal_matrix) * n;
+  s.z = clip.z - frame.shadow_map.w;
+  // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
+  float slope_limit = 0.02f; // per texel: grazing planes would otherwise reach any depth
+  s.depth_per_texel = abs(nc.z) > 1e-6f
+                          ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
+                          : vec2(0.0f);
+  bool inside = all(greaterThanEqual(clip.xy, vec2(-1.0f))) && all(lessThanEqual(clip.xy, vec2(1.0f))) &&
+                clip.z <= 1.0f;
+#ifdef MSM_COLOURED_SHADOWS
+  vec3 shadow = inside ? shadow_intensity_rgb(s) : vec3(0.0f);
+#else
+  vec3 shadow = vec3(inside ? shadow_intensity(s) : 0.0f);
+#endif
+  if (frame.shading.x < 1.0f)
+    shadow = vec3(msm_overdarken(shadow.x, frame.shading.x), msm_overdarken(shadow.y, frame.shading.x),
+                  msm_overdarken(shadow.z, frame.shading.x));
+  return 1.0f - shadow;
+}
 
 void main() {
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n; // only double-sided materials show back faces (culling)
-  vec3 l = frame.towards_light.xyz;
-  float n_dot_l = dot(n, l);
 
-  vec3 visibility = vec3(0.0f); // surfaces turned away from the light are in their own shadow
-  if (n_dot_l > 0.0f) {
-    // Normal offset: more at grazing light, where depth varies fastest across a texel.
-    vec3 p = world_position + n * (frame.shadow_map.z * (1.0f - n_dot_l));
-    vec4 clip = frame.light_view_projection * vec4(p, 1.0f);
-    vec3 nc = mat3(frame.light_normal_matrix) * n;
-    ShadowLookup s;
-    s.t = (clip.xy * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
-    s.z = clip.z - frame.shadow_map.w;
-    // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
-    float slope_limit = 0.02f; // per texel: grazing planes would otherwise reach any depth
-    s.depth_per_texel = abs(nc.z) > 1e-6f
-                            ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
-                            : vec2(0.0f);
-    bool inside = all(greaterThanEqual(clip.xy, vec2(-1.0f))) && all(lessThanEqual(clip.xy, vec2(1.0f))) &&
-                  clip.z <= 1.0f;
-#ifdef MSM_COLOURED_SHADOWS
-    vec3 shadow = inside ? shadow_intensity_rgb(s) : vec3(0.0f);
-#else
-    vec3 shadow = vec3(inside ? shadow_intensity(s) : 0.0f);
-#endif
-    if (frame.shading.x < 1.0f)
-      shadow = vec3(msm_overdarken(shadow.x, frame.shading.x), msm_overdarken(shadow.y, frame.shading.x),
-                    msm_overdarken(shadow.z, frame.shading.x));
-    visibility = 1.0f - shadow;
+  // The shadow buffer holds the visibility of the direct light: with one light its visibility,
+  // with several the mean weighted by the irradiance each one brings (luminance of E max(n·l, 0)).
+  vec3 direct = vec3(0.0f), weighted = vec3(0.0f), first = vec3(0.0f);
+  float weight_sum = 0.0f;
+  int light_count = kOneLight ? 1 : frame.lights.x;
+  for (int l = 0; l < light_count; ++l) {
+    float n_dot_l = dot(n, lights[l].towards_light.xyz);
+    vec3 visibility = light_visibility(l, n, n_dot_l);
+    direct += msm_direct_light(lights[l].irradiance.rgb, n_dot_l, visibility);
+    float w = dot(lights[l].irradiance.rgb, vec3(0.2126f, 0.7152f, 0.0722f)) * max(n_dot_l, 0.0f);
+    weighted += w * visibility;
+    weight_sum += w;
+    if (l == 0) first = visibility;
   }
+  vec3 visibility = light_count == 1 ? first : (weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f));
 
   vec3 albedo = object.albedo_opacity.rgb;
   if (object.flags.x != 0) albedo *= texture(albedo_texture, texcoord).rgb;
-  vec3 radiance = albedo * (frame.irradiance.rgb * (max(n_dot_l, 0.0f) * visibility / MSM_PI) + frame.irradiance.a);
+  vec3 radiance = msm_surface_radiance(albedo, direct, MSM_AMBIENT);
   // Alpha: the surface's opacity (translucent objects blend over the opaque image).
   float opacity = object.albedo_opacity.a;
   if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
-  out_color = vec4(tone_map(radiance * frame.shading.y), opacity);
+  out_color = vec4(msm_aces(radiance * frame.shading.y), opacity);
   out_shadow = vec4(visibility, 1.0f);
 }

@@ -5,6 +5,7 @@
 #include "msm/soft.h"
 #include "shading.glsl"
 #define MSM_DEPTH_BINDING 2
+#define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
 
 vec2 sample_offset(int k) {
@@ -38,7 +39,7 @@ float texel_occlusion(ivec2 i, ShadowLookup s) { return texel_blockers(i, s).x /
 float pcss_shadow(ShadowLookup s) {
   ivec2 map = ivec2(int(frame.shadow_map.x));
   int width = frame.soft_kernel.x, samples = frame.kernel.y;
-  vec2 spread = vec2(frame.soft.x, frame.soft.y);
+  vec2 spread = vec2(lights[shadow_layer].soft.x, lights[shadow_layer].soft.y);
   float zf = msm_signed_depth(s.z);
   vec2 position = s.t + 0.5f; // texel i covers [i, i + 1) in soft.h
   SatRect r = msm_soft_search_rect(position, msm_soft_search_half_width(spread, zf, -1.0f, width), map);

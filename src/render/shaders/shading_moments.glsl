@@ -1,40 +1,43 @@
-// Shading with the linear filtered techniques: the blurred (and mip-mapped) moment images, read
+// Shading with the linear filtered techniques: the blurred (and mip-mapped) moment images (arrays
+// with one layer per light), read
 // with hardware bilinear/trilinear filtering, at the nearest texel or dithered, then
 // reconstructed by the shared technique code; with coloured translucency (shading_moments_rgb.frag
 // defines MSM_COLOURED_SHADOWS) once per colour channel. A separate shader, not a specialization
 // constant: lavapipe compiled the three reconstructions even where the constant disabled them,
 // tripling the pipeline build time of every linear technique.
-layout(binding = 2) uniform sampler2D moments0;
-layout(binding = 3) uniform sampler2D moments1; // second half of 6MSM; else moments0 again
+layout(binding = 2) uniform sampler2DArray moments0;
+layout(binding = 3) uniform sampler2DArray moments1; // second half of 6MSM; else moments0 again
 // Coloured translucency: the green and blue channels' moment images (bound to moments0/1 where the
 // frame has none; only shading_moments_rgb.frag reads them).
-layout(binding = 6) uniform sampler2D moments0_g;
-layout(binding = 7) uniform sampler2D moments1_g;
-layout(binding = 8) uniform sampler2D moments0_b;
-layout(binding = 9) uniform sampler2D moments1_b;
+layout(binding = 6) uniform sampler2DArray moments0_g;
+layout(binding = 7) uniform sampler2DArray moments1_g;
+layout(binding = 8) uniform sampler2DArray moments0_b;
+layout(binding = 9) uniform sampler2DArray moments1_b;
 #include "shading.glsl"
 #include "lookup.glsl"
 
 // The shadow intensity from one set of moment images (one colour channel's, or the only one).
-float shadow_from(sampler2D first, sampler2D second_image, ShadowLookup s) {
+float shadow_from(sampler2DArray first, sampler2DArray second_image, ShadowLookup s) {
   bool six = msm_technique_is_six_moments(kTechnique);
   bool second = six || kSplitRG;
   MsmTexel texel = MsmTexel(vec4(0.0f), vec4(0.0f));
+  vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
+  vec2 duv_dx = s.dt_dx * frame.shadow_map.y, duv_dy = s.dt_dy * frame.shadow_map.y;
   if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
-    vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
-    s.z -= receiver_plane_bias(s, textureQueryLod(first, uv).x);
+    // The mip the lookup reads (textureQueryLod's x, from the same derivatives).
+    float lod = log2(max(length(s.dt_dx), length(s.dt_dy)));
+    s.z -= receiver_plane_bias(s, clamp(lod, 0.0f, float(textureQueryLevels(first) - 1)));
   } else {
     s.z -= receiver_plane_bias(s, 0.0f);
   }
   float zf = s.z;
   if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
-    vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
-    texel.a = texture(first, uv);
-    if (second) texel.b = texture(second_image, uv);
+    texel.a = textureGrad(first, vec3(uv, shadow_layer), duv_dx, duv_dy);
+    if (second) texel.b = textureGrad(second_image, vec3(uv, shadow_layer), duv_dx, duv_dy);
   } else {
     ivec2 i = lookup_texel(s.t);
-    texel.a = texelFetch(first, i, 0);
-    if (second) texel.b = texelFetch(second_image, i, 0);
+    texel.a = texelFetch(first, ivec3(i, shadow_layer), 0);
+    if (second) texel.b = texelFetch(second_image, ivec3(i, shadow_layer), 0);
     zf = receiver_depth_at(s, i);
   }
   if (kSplitRG) texel = MsmTexel(vec4(texel.a.x, texel.a.y, texel.b.x, texel.b.y), vec4(0.0f));

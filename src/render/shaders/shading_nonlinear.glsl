@@ -3,19 +3,19 @@
 // true bilinear lookup decodes four, converts each back to moments (Eq. 4), interpolates those
 // and applies Φ again.
 #ifdef MSM_NL32
-layout(binding = 2) uniform usampler2D moments0;
+layout(binding = 2) uniform usampler2DArray moments0;
 #else
-layout(binding = 2) uniform sampler2D moments0;
+layout(binding = 2) uniform sampler2DArray moments0;
 #endif
-layout(binding = 3) uniform sampler2D unused_second_image; // the shading layout of every filtered technique
+layout(binding = 3) uniform sampler2DArray unused_second_image; // the shading layout of every filtered technique
 #include "shading.glsl"
 #include "lookup.glsl"
 
 NonLinearMoments decode(ivec2 i) {
 #ifdef MSM_NL32
-  return msm_nl_unpack32(texelFetch(moments0, i, 0).x);
+  return msm_nl_unpack32(texelFetch(moments0, ivec3(i, shadow_layer), 0).x);
 #else
-  return msm_nl64_decode(texelFetch(moments0, i, 0));
+  return msm_nl64_decode(texelFetch(moments0, ivec3(i, shadow_layer), 0));
 #endif
 }
 

@@ -7,12 +7,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "msm/soft.h"
-layout(binding = 2) uniform usampler2D sat_table;
-layout(binding = 3) uniform usampler2D sat_table1; // six moments: b4, b6; else the first again
+layout(binding = 2) uniform usampler2DArray sat_table;
+layout(binding = 3) uniform usampler2DArray sat_table1; // six moments: b4, b6; else the first again
 #include "shading.glsl"
 
-uvec4 table(int x, int y) { return x < 0 || y < 0 ? uvec4(0u) : texelFetch(sat_table, ivec2(x, y), 0); }
-uvec4 table1(int x, int y) { return x < 0 || y < 0 ? uvec4(0u) : texelFetch(sat_table1, ivec2(x, y), 0); }
+uvec4 table(int x, int y) { return x < 0 || y < 0 ? uvec4(0u) : texelFetch(sat_table, ivec3(x, y, shadow_layer), 0); }
+uvec4 table1(int x, int y) { return x < 0 || y < 0 ? uvec4(0u) : texelFetch(sat_table1, ivec3(x, y, shadow_layer), 0); }
 
 SatValues6 rect_sum6(SatRect r) {
   return SatValues6(msm_sat_rect_sum(table(r.hi.x, r.hi.y), table(r.lo.x - 1, r.hi.y), table(r.hi.x, r.lo.y - 1),
@@ -25,7 +25,7 @@ float shadow_intensity(ShadowLookup s) {
   ivec2 map = ivec2(int(frame.shadow_map.x));
   int width = frame.soft_kernel.x;
   uint scale = uint(frame.soft_kernel.y);
-  vec2 spread = vec2(frame.soft.x, frame.soft.y);
+  vec2 spread = vec2(lights[shadow_layer].soft.x, lights[shadow_layer].soft.y);
   vec4 params = frame.technique_params;
   float zf = msm_signed_depth(s.z);
   vec2 position = s.t + 0.5f; // texel i covers [i, i + 1) in sat.h / soft.h

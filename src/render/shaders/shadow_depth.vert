@@ -1,8 +1,11 @@
-// Shadow depth pass: positions into the light's orthographic clip space; no fragment stage.
+// Shadow depth pass: positions into the light's orthographic clip space; no fragment stage. One
+// draw per light, into its layer of the depth array (ObjectPush::light).
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#define MSM_LIGHT_BINDING 1
 #include "frame.glsl"
 
 layout(location = 0) in vec3 position;
+layout(push_constant) uniform Push { ObjectPush object; };
 
-void main() { gl_Position = frame.light_view_projection * vec4(position, 1.0f); }
+void main() { gl_Position = lights[object.light.x].view_projection * vec4(position, 1.0f); }

@@ -1,14 +1,16 @@
 // Translucent occluders into the moment shadow map: light clip space, and the texture coordinate
-// of the opacity texture.
+// of the opacity texture. One draw per light and object, into the light's layer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#define MSM_LIGHT_BINDING 3
 #include "frame.glsl"
 
 layout(location = 0) in vec3 position;
 layout(location = 2) in vec2 uv;
 layout(location = 0) out vec2 texcoord;
+layout(push_constant) uniform Push { ObjectPush object; };
 
 void main() {
   texcoord = uv;
-  gl_Position = frame.light_view_projection * vec4(position, 1.0f);
+  gl_Position = lights[object.light.x].view_projection * vec4(position, 1.0f);
 }

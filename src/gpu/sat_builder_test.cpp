@@ -1,4 +1,4 @@
-// msm::soft::SatBuilder on the Vulkan device (MSM_DEVICE; lavapipe here), validation and
+// msm::gpu::SatBuilder on the Vulkan device (MSM_DEVICE; lavapipe here), validation and
 // synchronization validation on (VulkanTest: any message fails):
 //  - both schemes (rows then columns; JCGT Appendix C blocks) produce exactly build_sat_cpu's
 //    table, bitwise, for float and UNORM16 moment images, two- and four-channel formats, sizes
@@ -8,9 +8,9 @@
 //  - the six-moment overload (two images, RGBA32F + RG32F) fills both tables;
 //  - the shared queries (sat.h's 4- and 16-lookup queries, soft.h's whole per-pixel flow) in a
 //    shader (shaders/test/sat_queries.comp, via soft_flow.h) agree with the same code on the CPU.
+#include "msm/gpu/sat_builder.h"
 #include "msm/quantize.h"
-#include "msm/soft/sat_builder.h"
-#include "msm/vk/test_support.h"
+#include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
 #include <gtest/gtest.h>
@@ -37,7 +37,7 @@ inline uvec4 sat_fetch(int x, int y) {
 namespace {
 
 using namespace msm;
-using msm::soft::SatBuilder;
+using msm::gpu::SatBuilder;
 using Scheme = SatBuilder::Scheme;
 
 class SatBuilderTest : public vk::test::VulkanTest {};
@@ -147,7 +147,7 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
     std::vector<vec4> m = random_moments(rng, c.width, c.height);
     vk::Image moments = moment_image(ctx(), c.format, c.width, c.height);
     std::vector<vec4> seen = upload(ctx(), moments, m);
-    std::vector<uvec4> cpu = soft::build_sat_cpu(seen, c.width, c.height, c.nt);
+    std::vector<uvec4> cpu = gpu::build_sat_cpu(seen, c.width, c.height, c.nt);
     ASSERT_EQ(cpu, reference_table(seen, c.width, c.height, c.nt)) << c.width << "x" << c.height;
     for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
       if (scheme == Scheme::rows_then_columns && !c.rows_then_columns) continue;
@@ -193,11 +193,11 @@ TEST_F(SatBuilderTest, SixMomentTablesInOneCall) {
   std::vector<vec4> sa = upload(ctx(), ma, a), sb = upload(ctx(), mb, b);
   for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
     vk::Image ta = table_image(ctx(), w, h), tb = table_image(ctx(), w, h);
-    const vk::Image* moments[] = {&ma, &mb};
-    const vk::Image* tables[] = {&ta, &tb};
+    const gpu::SatImage moments[] = {ma, mb};
+    const gpu::SatImage tables[] = {ta, tb};
     vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, tables, nt, scheme); });
-    EXPECT_EQ(read_table(ctx(), ta), soft::build_sat_cpu(sa, w, h, nt));
-    EXPECT_EQ(read_table(ctx(), tb), soft::build_sat_cpu(sb, w, h, nt));
+    EXPECT_EQ(read_table(ctx(), ta), gpu::build_sat_cpu(sa, w, h, nt));
+    EXPECT_EQ(read_table(ctx(), tb), gpu::build_sat_cpu(sb, w, h, nt));
   }
 }
 
@@ -212,7 +212,7 @@ TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
   for (const Case& c : cases) {
     std::vector<vec4> m = random_moments(rng, c.width, c.height);
     vk::Image moments = moment_image(ctx(), c.format, c.width, c.height);
-    std::vector<uvec4> cpu = soft::build_sat_cpu(upload(ctx(), moments, m), c.width, c.height, c.nt);
+    std::vector<uvec4> cpu = gpu::build_sat_cpu(upload(ctx(), moments, m), c.width, c.height, c.nt);
     for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
       vk::Image table = table_image(ctx(), c.width, c.height, VK_FORMAT_R32G32_UINT);
       vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, table, c.nt, scheme); });
@@ -244,7 +244,7 @@ TEST_F(SatBuilderTest, RejectsBadImages) {
     vk::Image rg = table_image(ctx(), 16, 16, VK_FORMAT_R32G32_UINT);
     EXPECT_THROW(builder.record(cmd, moments, rg, 729, Scheme::blocks), std::invalid_argument);
   });
-  EXPECT_THROW(soft::build_sat_cpu(std::vector<vec4>(10), 3, 3, 729), std::invalid_argument);
+  EXPECT_THROW(gpu::build_sat_cpu(std::vector<vec4>(10), 3, 3, 729), std::invalid_argument);
 }
 
 // The queries on the device: sat.h's 4-lookup rectangle sum (bitwise), the nine-region box filter
@@ -277,7 +277,7 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
   for (size_t i = 0; i < m.size(); ++i) m[i] = msm_theta4_star(msm_moments4(depth[i]));
   vk::Image moments = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
   std::vector<vec4> seen = upload(ctx(), moments, m);
-  std::vector<uvec4> cpu = soft::build_sat_cpu(seen, w, h, nt);
+  std::vector<uvec4> cpu = gpu::build_sat_cpu(seen, w, h, nt);
   vk::Image table = table_image(ctx(), w, h);
 
   struct Query {

@@ -1,4 +1,4 @@
-// GPU time of the summed-area table schemes of msm::soft::SatBuilder against a bandwidth bound
+// GPU time of the summed-area table schemes of msm::gpu::SatBuilder against a bandwidth bound
 // (docs/results.md, "Integer summed-area tables"). Not a test: prints a Markdown table.
 //
 //   build-soft/src/soft/msm_sat_timing [sizes...] [--repeat N]    (default sizes 1024 2048, N = 7)
@@ -11,9 +11,9 @@
 // the table, pass 2 reads and writes the table: 64 B per texel. JCGT's bound (App. C) counts one
 // read and one write, 32 B per texel, as a single fused pass would move. Fraction = bound / time.
 // Median of N runs, each its own submission, after one warm-up.
+#include "msm/gpu/sat_builder.h"
 #include "msm/moments.h"
 #include "msm/quantize.h"
-#include "msm/soft/sat_builder.h"
 #include "msm/vk/vk.h"
 
 #include <fmt/core.h>
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
 
   vk::Context ctx;
   fmt::print("device: {}\n\n", ctx.info().describe());
-  soft::SatBuilder builder(ctx);
+  gpu::SatBuilder builder(ctx);
   fmt::print("| size | copy RGBA32F (ms) | copy bandwidth (GB/s) | scheme | time (ms) | bound 64 B/texel (ms) | "
              "fraction | bound 32 B/texel (ms) | fraction |\n|---|---|---|---|---|---|---|---|---|\n");
   for (int n : sizes) {
@@ -97,8 +97,8 @@ int main(int argc, char** argv) {
     const double texels = double(size) * size;
     const double copy_ms = median(copies);
     const double bandwidth = 32.0 * texels / (copy_ms * 1e-3); // bytes per second
-    for (auto scheme : {soft::SatBuilder::Scheme::rows_then_columns, soft::SatBuilder::Scheme::blocks}) {
-      const bool blocks = scheme == soft::SatBuilder::Scheme::blocks;
+    for (auto scheme : {gpu::SatBuilder::Scheme::rows_then_columns, gpu::SatBuilder::Scheme::blocks}) {
+      const bool blocks = scheme == gpu::SatBuilder::Scheme::blocks;
       std::vector<double> times, rows, columns;
       for (int r = 0; r <= repeat; ++r) {
         vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {

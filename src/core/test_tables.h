@@ -1,5 +1,5 @@
 // Integer summed-area tables for the CPU tests of sat.h and soft.h, built with sat.h's
-// quantization and plain uint arithmetic (wrapping modulo 2^32), independently of msm::soft's
+// quantization and plain uint arithmetic (wrapping modulo 2^32), independently of msm::gpu's
 // build_sat_cpu (which sat_builder_test checks against the device and against 64-bit sums).
 #pragma once
 #include "msm/sat.h"

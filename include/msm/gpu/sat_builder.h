@@ -1,9 +1,9 @@
 // Integer summed-area tables of moment shadow maps on the device (JCGT 2017 §4.2, Appendix C),
 // and the same tables on the CPU. The per-texel math (quantization, wrap-around, queries) is
-// include/msm/sat.h, shared with the shaders; the shaders are src/soft/shaders/sat_*.comp.
+// include/msm/sat.h, shared with the shaders; the shaders are src/gpu/shaders/sat_*.comp.
 //
-//   msm::soft::SatBuilder sat(ctx);
-//   sat.record(cmd, moments, table, 27 * 27, msm::soft::SatBuilder::Scheme::Blocks, &timer);
+//   msm::gpu::SatBuilder sat(ctx);
+//   sat.record(cmd, moments, table, 27 * 27, msm::gpu::SatBuilder::Scheme::Blocks, &timer);
 //
 // Six moments (Θ6*, sat.h's msm_sat_split6): two moment images and two tables; record each pair
 // (or use the overload with two pairs, whose passes run side by side).
@@ -20,7 +20,22 @@
 #include <span>
 #include <vector>
 
-namespace msm::soft {
+namespace msm::gpu {
+
+// One layer of an image as the builder reads (moments) or writes (a table) it: the layer's view
+// (mip 0 is what counts) and what the checks and barriers need.
+struct SatImage {
+  VkImage handle = VK_NULL_HANDLE;
+  VkImageView view = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  uint32_t width = 0, height = 0;
+  VkImageUsageFlags usage = 0;
+  uint32_t mips = 1;
+  uint32_t layer = 0;
+  SatImage() = default;
+  SatImage(const vk::Image& image); // NOLINT(google-explicit-constructor): a one-layer image as it is
+  SatImage(const vk::Image& image, VkImageView layer_view, uint32_t layer);
+};
 
 class SatBuilder {
  public:
@@ -49,19 +64,19 @@ class SatBuilder {
   //    (SHADER_STORAGE_WRITE): the caller's barrier makes that visible to its readers.
   //  - timer: if given, scopes as listed with the schemes (reset() is the caller's).
   // Throws std::invalid_argument for other formats, mismatched sizes or max_kernel_texels < 1.
-  void record(VkCommandBuffer cmd, const vk::Image& moments, const vk::Image& table, int max_kernel_texels,
-              Scheme scheme, vk::GpuTimer* timer = nullptr,
-              VkImageLayout moments_layout = VK_IMAGE_LAYOUT_GENERAL) const;
+  void record(VkCommandBuffer cmd, const SatImage& moments, const SatImage& table, int max_kernel_texels, Scheme scheme,
+              vk::GpuTimer* timer = nullptr, VkImageLayout moments_layout = VK_IMAGE_LAYOUT_GENERAL) const;
 
-  // Several images (e.g. the two of six moments) at once: each pass is dispatched for every pair
-  // before the barrier that separates the passes. Preconditions as above, per pair.
-  void record(VkCommandBuffer cmd, std::span<const vk::Image* const> moments, std::span<const vk::Image* const> tables,
+  // Several images (e.g. the two of six moments, or the layers of one light each) at once: each
+  // pass is dispatched for every pair before the barrier that separates the passes. Preconditions
+  // as above, per pair; the tables' barriers cover their own layer only.
+  void record(VkCommandBuffer cmd, std::span<const SatImage> moments, std::span<const SatImage> tables,
               int max_kernel_texels, Scheme scheme, vk::GpuTimer* timer = nullptr,
               VkImageLayout moments_layout = VK_IMAGE_LAYOUT_GENERAL) const;
 
  private:
-  vk::Program rows_, columns_, blockRows_, blockColumns_;
-  vk::Program rowsRg_, columnsRg_, blockRowsRg_, blockColumnsRg_; // RG32_UINT tables
+  vk::Program rows_, columns_, block_rows_, block_columns_;
+  vk::Program rows_rg_, columns_rg_, block_rows_rg_, block_columns_rg_; // RG32_UINT tables
   vk::Sampler sampler_;
 };
 
@@ -71,4 +86,4 @@ class SatBuilder {
 // decodes them) is bitwise equal. Precondition: moments.size() == width * height.
 std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int width, int height, int max_kernel_texels);
 
-} // namespace msm::soft
+} // namespace msm::gpu

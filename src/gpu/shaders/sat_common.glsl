@@ -4,7 +4,7 @@
 #define SAT_COMMON_GLSL
 #include "msm/sat.h"
 
-// msm::soft::SatBuilder's SatPush (sat_builder.cpp), 16 bytes.
+// msm::gpu::SatBuilder's SatPush (sat_builder.cpp), 16 bytes.
 layout(push_constant) uniform Push {
   ivec2 size;   // of the moment image and the table
   uint scale;   // msm_sat_scale(max_kernel_texels)

@@ -1,0 +1,160 @@
+#include "msm/gpu/sat_builder.h"
+
+#include "msm/sat.h"
+#include "msm/vk/commands.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace msm::gpu {
+
+namespace {
+
+// The push constants of every sat_*.comp (shaders/sat_common.glsl).
+struct SatPush {
+  glm::ivec2 size;
+  uint32_t scale;
+  uint32_t flags; // 1: UNORM16 texels, 2: two channels (RG)
+};
+static_assert(sizeof(SatPush) == 16, "SatPush must match the shaders' push constant block");
+
+bool unorm16_format(VkFormat format) {
+  return format == VK_FORMAT_R16G16B16A16_UNORM || format == VK_FORMAT_R16G16_UNORM;
+}
+bool float_format(VkFormat format) {
+  return format == VK_FORMAT_R32G32B32A32_SFLOAT || format == VK_FORMAT_R32G32_SFLOAT;
+}
+bool two_channels(VkFormat format) { return format == VK_FORMAT_R32G32_SFLOAT || format == VK_FORMAT_R16G16_UNORM; }
+
+void check(const SatImage& moments, const SatImage& table, int max_kernel_texels) {
+  const char* where = "msm::gpu::SatBuilder::record: ";
+  if (!moments.handle || !table.handle || !moments.view || !table.view)
+    throw std::invalid_argument(std::string(where) + "null image");
+  if (!unorm16_format(moments.format) && !float_format(moments.format))
+    throw std::invalid_argument(std::string(where) +
+                                "moments must be RGBA32_SFLOAT, RG32_SFLOAT, RGBA16_UNORM or RG16_UNORM");
+  if (!(moments.usage & VK_IMAGE_USAGE_SAMPLED_BIT))
+    throw std::invalid_argument(std::string(where) + "moments need SAMPLED usage");
+  if (table.format != VK_FORMAT_R32G32B32A32_UINT &&
+      !(table.format == VK_FORMAT_R32G32_UINT && two_channels(moments.format)))
+    throw std::invalid_argument(std::string(where) + "the table must be RGBA32_UINT (or RG32_UINT for RG moments)");
+  if (!(table.usage & VK_IMAGE_USAGE_STORAGE_BIT) || table.mips != 1)
+    throw std::invalid_argument(std::string(where) + "the table needs STORAGE usage and one mip");
+  if (moments.width != table.width || moments.height != table.height)
+    throw std::invalid_argument(std::string(where) + "moments and table differ in size");
+  if (max_kernel_texels < 1) throw std::invalid_argument(std::string(where) + "max_kernel_texels < 1");
+}
+
+} // namespace
+
+SatImage::SatImage(const vk::Image& image)
+    : handle(image.handle()), view(image.view()), format(image.format()), width(image.width()), height(image.height()),
+      usage(image.desc().usage), mips(image.desc().mip_levels) {
+  if (image && image.desc().layers != 1)
+    throw std::invalid_argument("msm::gpu::SatImage: an array image needs a layer view");
+}
+
+SatImage::SatImage(const vk::Image& image, VkImageView layer_view, uint32_t layer_index)
+    : handle(image.handle()), view(layer_view), format(image.format()), width(image.width()), height(image.height()),
+      usage(image.desc().usage), mips(image.desc().mip_levels), layer(layer_index) {}
+
+SatBuilder::SatBuilder(const vk::Context& ctx)
+    : rows_(vk::create_program(ctx, "sat_rows.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
+                               sizeof(SatPush))),
+      columns_(vk::create_program(ctx, "sat_columns.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      block_rows_(vk::create_program(ctx, "sat_block_rows.comp",
+                                     {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
+      block_columns_(vk::create_program(ctx, "sat_block_columns.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      rows_rg_(vk::create_program(ctx, "sat_rows_rg.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
+                                  sizeof(SatPush))),
+      columns_rg_(vk::create_program(ctx, "sat_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      block_rows_rg_(vk::create_program(ctx, "sat_block_rows_rg.comp",
+                                        {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
+      block_columns_rg_(
+          vk::create_program(ctx, "sat_block_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      sampler_(vk::create_sampler(ctx, VK_FILTER_NEAREST)) {}
+
+void SatBuilder::record(VkCommandBuffer cmd, const SatImage& moments, const SatImage& table, int max_kernel_texels,
+                        Scheme scheme, vk::GpuTimer* timer, VkImageLayout moments_layout) const {
+  record(cmd, std::span(&moments, 1), std::span(&table, 1), max_kernel_texels, scheme, timer, moments_layout);
+}
+
+void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, std::span<const SatImage> tables,
+                        int max_kernel_texels, Scheme scheme, vk::GpuTimer* timer, VkImageLayout moments_layout) const {
+  if (moments.size() != tables.size())
+    throw std::invalid_argument("msm::gpu::SatBuilder::record: as many tables as moment images");
+  for (size_t i = 0; i < moments.size(); ++i) check(moments[i], tables[i], max_kernel_texels);
+  if (moments.empty()) return;
+  const uint32_t scale = msm_sat_scale(max_kernel_texels);
+  const VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
+  auto push = [&](size_t i) {
+    const SatImage& m = moments[i];
+    bool two = two_channels(m.format);
+    return SatPush{glm::ivec2(int(m.width), int(m.height)), scale,
+                   (unorm16_format(m.format) ? 1u : 0u) | (two ? 2u : 0u)};
+  };
+  // The program of each pass for table i: the table's format is part of the shader.
+  auto program = [&](size_t i, const vk::Program& rgba, const vk::Program& rg) -> const vk::Program& {
+    return tables[i].format == VK_FORMAT_R32G32_UINT ? rg : rgba;
+  };
+
+  // Discard the tables' contents (UNDEFINED), after every earlier access to them.
+  for (const SatImage& table : tables)
+    vk::pipeline_barrier(cmd, vk::image_barrier(table.handle, VK_IMAGE_ASPECT_COLOR_BIT,
+                                                VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                                VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                                VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general, 0, 1, table.layer, 1));
+  // Pass 1 writes every texel; pass 2 reads and rewrites them in place.
+  const VkMemoryBarrier2 between =
+      vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                         VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                         VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
+
+  if (scheme == Scheme::rows_then_columns) {
+    if (timer) timer->begin(cmd, "sat_rows");
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, program(i, rows_, rows_rg_), vk::group_count(moments[i].height, 64), 1, 1,
+                   {vk::Descriptor(moments[i].view, moments_layout, sampler_), vk::Descriptor(tables[i].view, general)},
+                   push(i));
+    if (timer) timer->end(cmd);
+    vk::pipeline_barrier(cmd, between);
+    if (timer) timer->begin(cmd, "sat_columns");
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, program(i, columns_, columns_rg_), vk::group_count(moments[i].width, 64), 1, 1,
+                   {vk::Descriptor(tables[i].view, general)}, push(i));
+    if (timer) timer->end(cmd);
+  } else {
+    if (timer) timer->begin(cmd, "sat_blocks");
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, program(i, block_rows_, block_rows_rg_), vk::group_count(moments[i].height, 8), 1, 1,
+                   {vk::Descriptor(moments[i].view, moments_layout, sampler_), vk::Descriptor(tables[i].view, general)},
+                   push(i));
+    vk::pipeline_barrier(cmd, between);
+    for (size_t i = 0; i < moments.size(); ++i)
+      vk::dispatch(cmd, program(i, block_columns_, block_columns_rg_), vk::group_count(moments[i].width, 8), 1, 1,
+                   {vk::Descriptor(tables[i].view, general)}, push(i));
+    if (timer) timer->end(cmd);
+  }
+}
+
+std::vector<glm::uvec4> build_sat_cpu(std::span<const glm::vec4> moments, int width, int height,
+                                      int max_kernel_texels) {
+  if (width < 0 || height < 0 || moments.size() != size_t(width) * size_t(height))
+    throw std::invalid_argument("msm::gpu::build_sat_cpu: moments.size() != width * height");
+  const uint32_t scale = msm_sat_scale(max_kernel_texels);
+  std::vector<glm::uvec4> table(moments.size());
+  for (int y = 0; y < height; ++y) {
+    glm::uvec4 sum(0u);
+    for (int x = 0; x < width; ++x) {
+      size_t i = size_t(y) * size_t(width) + size_t(x);
+      sum += msm_sat_quantize(moments[i], scale); // wraps modulo 2^32, as on the device
+      table[i] = sum;
+    }
+  }
+  for (int y = 1; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      table[size_t(y) * size_t(width) + size_t(x)] += table[size_t(y - 1) * size_t(width) + size_t(x)];
+  return table;
+}
+
+} // namespace msm::gpu

@@ -1,0 +1,47 @@
+// What a frame is made of: the configuration that picks the recipe (recipes.cpp) and sizes the
+// images of the frame graph. A new configuration builds a new graph; pipelines stay cached.
+#pragma once
+
+#include "msm/render/renderer.h"
+
+#include <vulkan/vulkan.h>
+
+#include <array>
+#include <string>
+
+namespace msm::render {
+
+struct FrameConfig {
+  const Technique* technique = nullptr;
+  int width = 0, height = 0, shadow_size = 0, msaa = 1, taps = 1;
+  int lights = 1;          // shadow-casting lights: layers of every shadow-map image
+  uint32_t mip_levels = 1; // of the filtered moment images (1: no mips)
+  bool one_pass = false;   // one_pass_filter instead of moment_resolve + blur
+  // Translucent occluders are blended into the map (JCGT §3): a four-channel technique then
+  // stores its moments as two RG images, because the blend factor is the fragment's alpha.
+  bool translucent = false;
+  // Coloured translucent shadows (JCGT §3): one set of moment images per colour channel, each
+  // blended with the channel's opacity α (1 − transmission colour); only with translucent.
+  bool coloured = false;
+  int soft_kernel = 0; // soft techniques: the tables' largest kernel width W (n_t = W²)
+  bool operator==(const FrameConfig&) const = default;
+
+  bool split_rg() const;                            // translucent and four channels in one image
+  std::array<VkFormat, 2> formats() const;          // of the moment images as allocated
+  int moment_images() const;                        // 0 (depth-based), 1 or 2 (6MSM, split_rg)
+  int channels() const { return coloured ? 3 : 1; } // sets of moment images
+};
+
+VkFormat vk_format(TexelFormat format);
+
+// Names of the frame's images (the frame graph's resources).
+inline constexpr const char* kShadowDepth = "shadow_depth";
+inline constexpr const char* kColor = "color";
+inline constexpr const char* kShadowBuffer = "shadow_buffer";
+inline constexpr const char* kCameraDepth = "camera_depth";
+// Moment image i (0 or 1) of colour channel c (0 = the only one, or red; 1 green; 2 blue).
+std::string moment_image(int channel, int i);
+// Summed-area table of moment image i (soft shadows).
+std::string sat_table(int i);
+
+} // namespace msm::render

@@ -1,0 +1,56 @@
+#include "recipes.h"
+
+#include "passes/pass.h"
+
+#include "msm/techniques.h"
+
+namespace msm::render {
+
+std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
+  std::vector<std::unique_ptr<Pass>> passes;
+  passes.push_back(std::make_unique<ShadowDepthPass>(c));
+  int id = c.technique->id;
+  if (msm_technique_is_depth_based(id)) {
+    // plain, pcf, pcss read the depth map itself.
+  } else if (c.one_pass) { // HPG 2017: resolve, blur and encoding in one dispatch
+    passes.push_back(std::make_unique<OnePassFilterPass>(c));
+    if (c.mip_levels > 1) passes.push_back(std::make_unique<MipmapPass>(c, 0));
+  } else if (msm_technique_is_soft(id)) { // tables instead of blur and mips
+    passes.push_back(std::make_unique<MomentResolvePass>(c));
+    passes.push_back(std::make_unique<SatPass>(c));
+  } else {
+    passes.push_back(std::make_unique<MomentResolvePass>(c));
+    // Coloured translucency: every channel starts from the same opaque moments.
+    if (c.channels() > 1) passes.push_back(std::make_unique<ChannelCopyPass>(c));
+    for (int channel = 0; channel < c.channels(); ++channel) {
+      if (c.translucent) passes.push_back(std::make_unique<TranslucentPass>(c, channel));
+      if (c.taps > 1) passes.push_back(std::make_unique<BlurPass>(c, channel));
+      if (c.mip_levels > 1) passes.push_back(std::make_unique<MipmapPass>(c, channel));
+    }
+  }
+  passes.push_back(std::make_unique<ShadingPass>(c));
+  return passes;
+}
+
+std::vector<std::string> frame_outputs() { return {kColor, kShadowBuffer}; }
+
+std::vector<std::string> technique_passes(const Technique& technique, bool translucent, bool coloured) {
+  RenderSettings defaults;
+  FrameConfig c;
+  c.technique = &technique;
+  c.width = defaults.width;
+  c.height = defaults.height;
+  c.shadow_size = defaults.shadow_size;
+  c.msaa = defaults.msaa;
+  c.taps = defaults.filter_size;
+  c.one_pass = msm_technique_is_nonlinear(technique.id);
+  c.mip_levels = defaults.mipmaps && !c.one_pass && !msm_technique_is_soft(technique.id) ? 11 : 1;
+  c.translucent = translucent && supports_translucency(technique);
+  c.coloured = c.translucent && coloured;
+  std::vector<std::unique_ptr<Pass>> passes = recipe(c);
+  std::vector<std::string> names;
+  for (size_t i : order_passes(passes, {}, frame_outputs())) names.emplace_back(passes[i]->name());
+  return names;
+}
+
+} // namespace msm::render

@@ -1,0 +1,20 @@
+// A technique is a recipe of passes: the list below, built from the frame's configuration, is
+// all that distinguishes one technique's frame from another's. The frame graph orders the passes
+// and connects them by the images they declare (frame_graph.h).
+#pragma once
+
+#include "frame_config.h"
+#include "frame_graph.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace msm::render {
+
+std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& config);
+
+// The images the frame hands back (left ready for a transfer after the frame).
+std::vector<std::string> frame_outputs();
+
+} // namespace msm::render

@@ -1,0 +1,113 @@
+// The renderer's view of the technique table (msm/cpu/techniques.h) and the validation of its
+// settings.
+#include "msm/render/renderer.h"
+#include "msm/techniques.h"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <stdexcept>
+#include <vector>
+
+namespace msm::render {
+std::vector<const Technique*> rendered_techniques() {
+  std::vector<const Technique*> out;
+  for (const Technique& t : techniques())
+    if (t.rendered) out.push_back(&t);
+  return out;
+}
+
+const Technique& find_rendered_technique(std::string_view name) {
+  std::string valid;
+  for (const Technique* t : rendered_techniques()) {
+    if (t->name == name) return *t;
+    valid += (valid.empty() ? "" : ", ") + std::string(t->name);
+  }
+  throw RenderError(fmt::format("unknown technique '{}'; valid: {}", name, valid));
+}
+
+bool supports_translucency(const Technique& t) {
+  return !msm_technique_is_depth_based(t.id) && !msm_technique_is_nonlinear(t.id) && !msm_technique_is_soft(t.id) &&
+         t.formats[1] == TexelFormat::none;
+}
+
+int RenderSettings::resolved_soft_kernel() const {
+  if (soft_kernel != 0) return soft_kernel;
+  return find_rendered_technique(technique).id == MSM_TECH_PCSS ? kDefaultPcssKernel : kDefaultSatKernel;
+}
+
+float RenderSettings::resolved_depth_bias() const {
+  if (depth_bias) return *depth_bias;
+  int id = find_rendered_technique(technique).id;
+  // Soft shadows: the 32-bit tables keep ~22 bits of a 27² kernel's moments, plus the moment
+  // bias: 1e-3 in [-1,1] depth (JCGT §4.4's constant part). PCSS gets the same constant: its
+  // receiver planes are exact for planar receivers only, and across a 15-texel kernel curved ones
+  // (the models scene's knots) would shadow themselves (MAE 0.018 at 2e-5, 0.006 at 5e-4).
+  if (msm_technique_is_area_light(id)) return 5e-4f;
+  // Depth-based: 16-bit depth rounding (a step is 1.5e-5). Filtered: the moments come from the
+  // rounded D16 depths, the fragment's depth is a float: a receiver lit straight down is compared
+  // against its own texels up to half a step (7.6e-6) too far, which the float techniques' tiny
+  // moment bias (3e-7) does not absorb (msm-hamburger-128 read bare ground as shadowed).
+  // Non-linear maps: HPG §5 uses a constant 1e-3 in [-1,1] depth for all results; it is half a
+  // bin of msm-nl32's 10-bit depths (1/1023), which otherwise shadow a flat receiver facing the
+  // light wherever its depth rounds towards the light.
+  if (msm_technique_is_nonlinear(id)) return 5e-4f;
+  return msm_technique_is_depth_based(id) ? 2e-5f : 1e-5f;
+}
+
+void RenderSettings::validate() const {
+  find_rendered_technique(technique);
+  auto range = [](std::string_view what, long long v, long long lo, long long hi) {
+    if (v < lo || v > hi) throw RenderError(fmt::format("{} = {} is outside [{}, {}]", what, v, lo, hi));
+  };
+  range("width", width, 1, kMaxImageSide);
+  range("height", height, 1, kMaxImageSide);
+  if (static_cast<long long>(width) * height > kMaxImagePixels)
+    throw RenderError(fmt::format("{} x {} pixels is more than the {} allowed", width, height, kMaxImagePixels));
+  range("shadow size", shadow_size, 16, kMaxShadowSize);
+  if (msaa != 1 && msaa != 4 && msaa != 8) throw RenderError(fmt::format("msaa = {}: use 1, 4 or 8", msaa));
+  range("filter size", filter_size, 1, MSM_FILTER_MAX_TAPS);
+  if (filter_size % 2 == 0) throw RenderError(fmt::format("filter size = {} must be odd", filter_size));
+  auto finite = [](std::string_view what, float v, float lo, float hi) {
+    if (!std::isfinite(v) || v < lo || v > hi)
+      throw RenderError(fmt::format("{} = {} is outside [{}, {}]", what, v, lo, hi));
+  };
+  finite("filter sigma", filter_sigma, MSM_FILTER_MIN_SIGMA, MSM_FILTER_MAX_SIGMA);
+  finite("over-darkening factor", overdarken, 0.5f, 1.0f);
+  finite("normal offset", normal_offset, 0.0f, 100.0f);
+  finite("exposure", exposure, 1e-6f, 1e6f);
+  if (depth_bias) finite("depth bias", *depth_bias, -1.0f, 1.0f);
+  const Technique& t = find_rendered_technique(technique);
+  bool nonlinear = msm_technique_is_nonlinear(t.id);
+  if (one_pass && !*one_pass && nonlinear)
+    throw RenderError(fmt::format("{} needs the one-pass filter (it stores Φ of the filtered moments)", technique));
+  bool uses_one_pass = one_pass.value_or(nonlinear);
+  if (uses_one_pass && msm_technique_is_soft(t.id))
+    throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
+  if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
+  if (soft_kernel != 0) {
+    if (t.id == MSM_TECH_PCSS)
+      range("soft kernel", soft_kernel, 3, kMaxPcssKernel);
+    else
+      range("soft kernel", soft_kernel, 3, 255);
+  }
+  if (uses_one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
+    throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
+  if (uses_one_pass && filter_size > kMaxOnePassTaps)
+    throw RenderError(
+        fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size, kMaxOnePassTaps));
+  if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
+  finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
+  if (params) {
+    for (int i = 0; i < 4; ++i)
+      if (!std::isfinite((*params)[i])) throw RenderError("technique parameters must be finite");
+    const glm::vec4& p = *params;
+    // The blocker estimators divide by δ1 + (blocker mass) and VSSM by the variance.
+    if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
+      throw RenderError(
+          fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
+    if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
+      throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
+  }
+}
+
+} // namespace msm::render
