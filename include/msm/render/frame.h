@@ -10,6 +10,11 @@ MSM_BEGIN
 // Largest filter (odd number of taps per axis) of the blur and PCF: 63 taps fill 16 vec4s.
 const int MSM_MAX_FILTER_TAPS = 63;
 
+// The receiver plane's depth slope per texel ([0,1] depth, along each axis of the map) is clamped
+// to this: grazing planes would otherwise reach any depth. The shading and the ray-traced filtered
+// reference clamp alike.
+const float MSM_MAX_RECEIVER_DEPTH_SLOPE = 0.02f;
+
 // The uniform block of every pass of one frame (binding 0 where a pass uses it).
 struct FrameUniforms {
   mat4 camera_view_projection;
@@ -49,7 +54,8 @@ struct ObjectPush {
                        // z: 1 if the opacity texture is used, w: the colour channel
                        // the translucent pass blends (-1: grey, the opacity itself)
   vec4 transmission;   // rgb: transmission colour (the channel's opacity is
-                       // opacity (1 - transmission)), a: unused
+                       // opacity (1 - transmission)), a: alpha cutoff of alpha-tested
+                       // surfaces (0: none; alpha_test.glsl)
 };
 
 // The compute passes on shadow-map images (push constants).

@@ -43,6 +43,7 @@ class ShadowDepthPass {
 
  private:
   vk::Program program_;
+  vk::Program masked_program_; // alpha-tested draws: a fragment stage that discards the cut-outs
 };
 
 // shadow_depth -> moments[0..1] mip 0 (GENERAL), visible to compute and fragment reads. With

@@ -16,7 +16,19 @@ ShadowDepthPass::ShadowDepthPass(const vk::Context& ctx, int msaa)
                                                  .depth_format = VK_FORMAT_D16_UNORM,
                                                  .samples = VkSampleCountFlagBits(msaa),
                                                  // casters in front of the fitted near plane still cast
-                                                 .depth_clamp = true})) {}
+                                                 .depth_clamp = true})),
+      masked_program_(
+          vk::create_graphics_program(ctx, {.name = "shadow_depth (alpha-tested)",
+                                            .vertex_shader = "shadow_depth_masked.vert",
+                                            .fragment_shader = "shadow_depth_masked.frag",
+                                            .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image},
+                                            .push_constant_size = sizeof(ObjectPush),
+                                            .vertex_stride = sizeof(Vertex),
+                                            .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                                                           {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+                                            .depth_format = VK_FORMAT_D16_UNORM,
+                                            .samples = VkSampleCountFlagBits(msaa),
+                                            .depth_clamp = true})) {}
 
 void ShadowDepthPass::execute(FrameContext& f) const {
   PassScope scope(f, decl());
@@ -30,12 +42,27 @@ void ShadowDepthPass::execute(FrameContext& f) const {
   vk::begin_rendering(f.cmd, extent(depth), {}, vk::DepthAttachment{depth.view(), 1.0f});
   vk::set_viewport_scissor(f.cmd, extent(depth));
   vkCmdSetCullMode(f.cmd, VK_CULL_MODE_NONE); // both sides cast: thin walls, planes, open meshes
-  vk::bind_program(f.cmd, program_, {vk::Descriptor(f.uniforms)});
   VkDeviceSize offset = 0;
   VkBuffer vertices = f.scene.vertices.handle();
   vkCmdBindVertexBuffers(f.cmd, 0, 1, &vertices, &offset);
   vkCmdBindIndexBuffer(f.cmd, f.scene.indices.handle(), 0, VK_INDEX_TYPE_UINT32);
-  for (const Draw& d : f.scene.draws) vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
+  const vk::Program* bound = nullptr;
+  for (const Draw& d : f.scene.draws) {
+    if (d.masked) { // its own opacity texture and cutoff
+      const vk::Image& opacity =
+          d.opacity_texture >= 0 ? f.scene.opacity_textures[size_t(d.opacity_texture)] : f.scene.white;
+      vk::bind_program(
+          f.cmd, masked_program_,
+          {vk::Descriptor(f.uniforms),
+           vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, f.scene.texture_sampler)},
+          d.push);
+      bound = &masked_program_;
+    } else if (bound != &program_) {
+      vk::bind_program(f.cmd, program_, {vk::Descriptor(f.uniforms)});
+      bound = &program_;
+    }
+    vkCmdDrawIndexed(f.cmd, d.index_count, 1, d.first_index, 0, 0);
+  }
   vkCmdEndRendering(f.cmd);
   vk::pipeline_barrier(
       f.cmd, vk::image_barrier(depth.handle(), depth.aspect(), VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,

@@ -33,7 +33,10 @@ vec3 shadow_intensity_rgb(ShadowLookup s);
 // Narkowicz's fit of the ACES filmic curve (as msm::image::ToneCurve::aces).
 vec3 tone_map(vec3 x) { return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f); }
 
+#include "alpha_test.glsl"
+
 void main() {
+  if (!alpha_test_passes(object, opacity_texture, texcoord)) discard; // cut-outs (alpha mask)
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n; // only double-sided materials show back faces (culling)
   vec3 l = frame.towards_light.xyz;
@@ -49,7 +52,7 @@ void main() {
     s.t = (clip.xy * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
     s.z = clip.z - frame.shadow_map.w;
     // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
-    float slope_limit = 0.02f; // per texel: grazing planes would otherwise reach any depth
+    float slope_limit = MSM_MAX_RECEIVER_DEPTH_SLOPE;
     s.depth_per_texel = abs(nc.z) > 1e-6f
                             ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
                             : vec2(0.0f);
