@@ -100,6 +100,7 @@ LightFrame LightFrame::of(const scene::Scene& scene) {
   // Orthographic: a unit step of clip x (y) moves by inv[0] (inv[1]) in world space.
   const glm::dvec3 cx(inv[0]), cy(inv[1]);
   f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
+  f.depth_range = glm::length(glm::dvec3(inv[2]));
   f.x_axis = glm::normalize(cx);
   f.y_axis = glm::normalize(cy);
   return f;
@@ -179,6 +180,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const bool coloured = settings.effect == Effect::translucent;
   if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
   result.radiance = image::Image(W, H, 3);
+  result.surface = image::Image(W, H, {"n_dot_l", "object"});
+  for (std::size_t i = 0; i < result.surface.pixel_count(); ++i) result.surface.pixels()[2 * i + 1] = -1.0f;
   result.samples = mc ? settings.samples : 1;
 
   // Camera: unproject NDC depth 0 and 1 with the inverse of the rasterizer's matrix.
@@ -199,6 +202,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const int channels = result.visibility.channels();
   float* vis = result.visibility.pixels().data();
   float* rad = result.radiance.pixels().data();
+  float* surf = result.surface.pixels().data();
   float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
   const auto trace_start = std::chrono::steady_clock::now();
 
@@ -215,9 +219,14 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         SurfaceHit hit;
         ++row_rays;
         // The visible surface is the closest opaque one: translucent surfaces (opacity
-        // < 1) are looked through, as the renderer's shadow buffer does.
+        // < 1) are looked through, as the renderer's shadow buffer does, and so are the back
+        // faces of single-sided materials, which the rasterizer culls.
         bool found = tracer.closest(near, dir, length, hit);
-        for (int crossed = 0; found && tracer.material(hit).translucent() && crossed < kMaxCrossings; ++crossed) {
+        const auto hidden = [&](const SurfaceHit& h) {
+          const scene::Material& m = tracer.material(h);
+          return m.translucent() || (!m.double_sided && glm::dot(h.normal, dir) > 0.0);
+        };
+        for (int crossed = 0; found && hidden(hit) && crossed < kMaxCrossings; ++crossed) {
           const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
           found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
           ++row_rays;
@@ -248,10 +257,13 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         // effect gives a visibility per channel (translucent).
         glm::dvec3 n = tracer.shading_normal(hit);
         if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-        const glm::vec3 colour = e.rgb ? shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                               float(glm::dot(n, ctx.towards_light)), rgb)
-                                       : shade(tracer.material(hit).albedo, glm::vec3(irradiance),
-                                               float(glm::dot(n, ctx.towards_light)), float(e.value));
+        const float n_dot_l = float(glm::dot(n, ctx.towards_light));
+        const glm::vec3 albedo = tracer.albedo(hit);
+        const glm::vec3 colour = e.rgb ? shade(albedo, glm::vec3(irradiance), n_dot_l, rgb)
+                                       : shade(albedo, glm::vec3(irradiance), n_dot_l, float(e.value));
+        float* q = surf + (std::size_t(y) * W + x) * 2;
+        q[0] = n_dot_l;
+        q[1] = float(hit.object);
         c[0] = colour.r;
         c[1] = colour.g;
         c[2] = colour.b;
