@@ -80,6 +80,42 @@ TEST(GltfImport, TextureCoordinatesRightSideUp) {
   EXPECT_EQ(o.uvs[vertex_at(o, {0, 0, 0})], glm::vec2(0, 1));
 }
 
+// KHR_texture_transform on the base colour texture, as engines apply it (translation * rotation *
+// scale, the rotation turning u away from v; Assimp's own baking puts v off where there is a
+// rotation): offset (0.25, 0.5), rotation 90 degrees, scale (0.5, 0.25) map (u, v) to
+// (0.25 + 0.25 v, 0.5 - 0.5 u). Offset and scale alone: (0.5 + 0.5 u, 0.5 v).
+TEST(GltfImport, TextureTransform) {
+  TempDir dir;
+  for (const bool rotated : {true, false}) {
+    SCOPED_TRACE(rotated);
+    GltfModel model;
+    model.textures = {corners_texture()};
+    GltfMaterial m{.name = "t", .texture = 0};
+    if (rotated) {
+      m.uv_offset = {0.25f, 0.5f};
+      m.uv_rotation = 1.5707963267948966f;
+      m.uv_scale = {0.5f, 0.25f};
+    } else {
+      m.uv_offset = {0.5f, 0.0f};
+      m.uv_scale = {0.5f, 0.5f};
+    }
+    model.materials = {m};
+    model.primitives.push_back(quad({0, 1, 0}, {1, 0, 0}, {0, -1, 0}, {0, 0, 1}, 0));
+    write_gltf(dir.path() / "t.gltf", model);
+    const Mesh g = import_mesh(dir.path() / "t.gltf");
+    const std::pair<glm::vec3, glm::vec2> expected[] = {
+        {{0, 1, 0}, rotated ? glm::vec2(0.25f, 0.5f) : glm::vec2(0.5f, 0.0f)}, // uv (0, 0)
+        {{1, 1, 0}, rotated ? glm::vec2(0.25f, 0.0f) : glm::vec2(1.0f, 0.0f)}, // uv (1, 0)
+        {{1, 0, 0}, rotated ? glm::vec2(0.5f, 0.0f) : glm::vec2(1.0f, 0.5f)},  // uv (1, 1)
+        {{0, 0, 0}, rotated ? glm::vec2(0.5f, 0.5f) : glm::vec2(0.5f, 0.5f)}}; // uv (0, 1)
+    for (const auto& [p, uv] : expected) {
+      const glm::vec2 got = g.uvs[vertex_at(g, p)];
+      EXPECT_NEAR(got.x, uv.x, 1e-6f) << p.x << ", " << p.y;
+      EXPECT_NEAR(got.y, uv.y, 1e-6f) << p.x << ", " << p.y;
+    }
+  }
+}
+
 // The primitives follow the same convention: the box's front face and the cylinder's side show
 // the picture's top row at their top.
 TEST(GltfImport, PrimitivesTextureCoordinatesRightSideUp) {

@@ -140,6 +140,32 @@ Material convert_material(const aiScene& s, const aiMaterial& m, const std::file
   return out;
 }
 
+// KHR_texture_transform of a glTF material's base colour texture, as the matrix its specification
+// applies to texture coordinates: translation * rotation * scale. Assimp 5.2 hands the extension
+// out converted to its v-up convention (aiUVTransform: rotation negated, translation moved so that
+// it rotates about the centre, v flipped; FlipUVs then negates rotation and translation.y again);
+// that is undone here, because Assimp's own TransformUVCoords step puts v off by up to the scale
+// where there is a rotation. Identity for other formats (their UV transforms are not read) and
+// without the extension.
+glm::mat3 gltf_texture_transform(const aiMaterial& m) {
+  aiString alpha_mode;
+  aiUVTransform t;
+  if (m.Get(AI_MATKEY_GLTF_ALPHAMODE, alpha_mode) != AI_SUCCESS) return glm::mat3(1.0f);
+  if (m.Get(AI_MATKEY_UVTRANSFORM(aiTextureType_BASE_COLOR, 0), t) != AI_SUCCESS &&
+      m.Get(AI_MATKEY_UVTRANSFORM(aiTextureType_DIFFUSE, 0), t) != AI_SUCCESS)
+    return glm::mat3(1.0f);
+  const double rotation = double(t.mRotation), c = std::cos(rotation), s = std::sin(rotation);
+  const glm::dvec2 scale(t.mScaling.x, t.mScaling.y);
+  const glm::dvec2 offset(double(t.mTranslation.x) - 0.5 * scale.x * (1.0 - c + s),
+                          1.0 - scale.y + 0.5 * scale.y * (s + c - 1.0) + double(t.mTranslation.y));
+  // Columns (cos, -sin) scale.x, (sin, cos) scale.y, offset: u turns away from v, so that the
+  // Khronos TextureTransformTest sample's arrows point at their "correct" marks (the draft text of
+  // the extension printed the other sign).
+  return glm::mat3(glm::vec3(float(c * scale.x), float(-s * scale.x), 0.0f),
+                   glm::vec3(float(s * scale.y), float(c * scale.y), 0.0f),
+                   glm::vec3(float(offset.x), float(offset.y), 1.0f));
+}
+
 bool same_material(const std::optional<Material>& a, const std::optional<Material>& b) {
   if (!a || !b) return !a && !b;
   return a->albedo == b->albedo && a->albedo_texture == b->albedo_texture && a->opacity == b->opacity &&
@@ -158,7 +184,7 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
   // FlipUVs: Assimp hands out v up (OpenGL), msm and Vulkan sample with v down (row 0 on top).
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
                          aiProcess_GenSmoothNormals | aiProcess_SortByPType | aiProcess_ValidateDataStructure |
-                         aiProcess_TransformUVCoords | aiProcess_FlipUVs;
+                         aiProcess_FlipUVs;
   const aiScene* s = importer.ReadFile(file.string(), flags);
   if (!s || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !s->mRootNode)
     throw SceneError(file.string(), "", fmt::format("Assimp cannot read the mesh: {}", importer.GetErrorString()));
@@ -188,6 +214,9 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
       else
         parts.push_back(std::move(part));
     }
+    const glm::mat3 uv_matrix = am->mMaterialIndex < s->mNumMaterials
+                                    ? gltf_texture_transform(*s->mMaterials[am->mMaterialIndex])
+                                    : glm::mat3(1.0f);
     Mesh& m = parts[it->second].mesh;
     const auto base = static_cast<std::uint32_t>(m.positions.size());
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
@@ -195,7 +224,8 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
       m.positions.emplace_back(p.x, p.y, p.z);
       m.normals.push_back(am->mNormals ? glm::vec3(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z)
                                        : glm::vec3(0.0f));
-      m.uvs.push_back(am->mTextureCoords[0] ? glm::vec2(am->mTextureCoords[0][v].x, am->mTextureCoords[0][v].y)
+      m.uvs.push_back(am->mTextureCoords[0] ? glm::vec2(uv_matrix * glm::vec3(am->mTextureCoords[0][v].x,
+                                                                              am->mTextureCoords[0][v].y, 1.0f))
                                             : glm::vec2(0.0f));
     }
     for (unsigned f = 0; f < am->mNumFaces; ++f) {

@@ -1,6 +1,7 @@
 // Test support: a minimal glTF 2.0 writer (see gltf_writer.h).
 #include "gltf_writer.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
@@ -125,17 +126,24 @@ void write_gltf(const std::filesystem::path& file, const GltfModel& model, bool 
     textures.push_back({{"source", i}, {"sampler", 0}});
   }
   json materials = json::array();
-  bool transmission = false;
+  std::vector<std::string> used;
   for (const GltfMaterial& m : model.materials) {
     json pbr = {{"baseColorFactor", {m.base_color.r, m.base_color.g, m.base_color.b, m.base_color.a}},
                 {"metallicFactor", 0.0}};
     if (m.texture >= 0) pbr["baseColorTexture"] = {{"index", m.texture}};
+    if (m.texture >= 0 && (m.uv_offset != glm::vec2(0.0f) || m.uv_scale != glm::vec2(1.0f) || m.uv_rotation != 0.0f)) {
+      pbr["baseColorTexture"]["extensions"] = {{"KHR_texture_transform",
+                                                {{"offset", {m.uv_offset.x, m.uv_offset.y}},
+                                                 {"scale", {m.uv_scale.x, m.uv_scale.y}},
+                                                 {"rotation", m.uv_rotation}}}};
+      used.push_back("KHR_texture_transform");
+    }
     json mat = {{"pbrMetallicRoughness", pbr}, {"alphaMode", m.alpha_mode}, {"doubleSided", m.double_sided}};
     if (!m.name.empty()) mat["name"] = m.name;
     if (m.alpha_mode == "MASK") mat["alphaCutoff"] = m.alpha_cutoff;
     if (m.transmission > 0.0f) {
       mat["extensions"] = {{"KHR_materials_transmission", {{"transmissionFactor", m.transmission}}}};
-      transmission = true;
+      used.push_back("KHR_materials_transmission");
     }
     materials.push_back(mat);
   }
@@ -148,7 +156,9 @@ void write_gltf(const std::filesystem::path& file, const GltfModel& model, bool 
       {"meshes", {{{"primitives", primitives}}}},
       {"accessors", accessors},
       {"bufferViews", buffer.views}};
-  if (transmission) root["extensionsUsed"] = {"KHR_materials_transmission"};
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  if (!used.empty()) root["extensionsUsed"] = used;
   if (!materials.empty()) root["materials"] = materials;
   if (!images.empty()) {
     root["images"] = images;

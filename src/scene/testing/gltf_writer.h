@@ -26,6 +26,9 @@ struct GltfMaterial {
   float alpha_cutoff = 0.5f;
   bool double_sided = false;
   float transmission = 0.0f; // KHR_materials_transmission's factor (0: not written)
+  // KHR_texture_transform of the base colour texture (written where it is not the identity).
+  glm::vec2 uv_offset{0.0f}, uv_scale{1.0f};
+  float uv_rotation = 0.0f;
 };
 
 struct GltfPrimitive {
