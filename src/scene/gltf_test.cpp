@@ -287,6 +287,23 @@ TEST(GltfImport, KhronosSamples) {
   }
 }
 
+// Formats without materials (OFF, PLY, OBJ without .mtl): Assimp invents one; the part keeps the
+// scene's default material.
+TEST(GltfImport, FormatsWithoutMaterialsKeepTheDefault) {
+  TempDir dir;
+  std::ofstream(dir.path() / "t.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::ofstream(dir.path() / "t.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                         "property float y\nproperty float z\nelement face 1\n"
+                                         "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"
+                                         "0 1 0\n3 0 1 2\n";
+  std::ofstream(dir.path() / "t.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  for (const char* name : {"t.off", "t.ply", "t.obj"}) {
+    const std::vector<ModelPart> parts = import_model(dir.path() / name);
+    ASSERT_EQ(parts.size(), 1u) << name;
+    EXPECT_FALSE(parts[0].material.has_value()) << name;
+  }
+}
+
 // glmark2-data's Stanford bunny: one part, no material of its own (the scene's default).
 TEST(GltfImport, BunnyHasNoMaterial) {
   const fs::path bunny = fs::path(MSM_GLMARK2_MODELS_DIR) / "bunny.obj";

@@ -203,8 +203,11 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
         const aiMaterial& material = *s->mMaterials[am->mMaterialIndex];
         aiString name;
         material.Get(AI_MATKEY_NAME, name);
+        // Formats without materials get one from Assimp, named AI_DEFAULT_MATERIAL_NAME or unnamed
+        // (OFF, PLY): those parts keep the scene's default material.
         if (name.length > 0) part.name = name.C_Str();
-        if (part.name != AI_DEFAULT_MATERIAL_NAME) part.material = convert_material(*s, material, file, decoded);
+        if (name.length > 0 && part.name != AI_DEFAULT_MATERIAL_NAME)
+          part.material = convert_material(*s, material, file, decoded);
       }
       const auto same = std::find_if(parts.begin(), parts.end(), [&](const ModelPart& p) {
         return p.name == part.name && same_material(p.material, part.material);
