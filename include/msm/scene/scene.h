@@ -50,6 +50,8 @@
 //                                          fraction (opacity alpha) the fraction that passes, per
 //                                          channel; per-channel opacity alpha*(1 - transmission_color)
 //                                          (coloured shadows; see Material::channel_opacity)
+//   "alpha_cutoff": c in [0,1]             alpha testing (glTF alphaMode MASK): present where the
+//                                          opacity reaches c, a cut-out elsewhere (Material::alpha_cutoff)
 //   "double_sided": false
 // }
 // Texture paths are relative to the scene file; they must exist when the scene is loaded but are
@@ -59,7 +61,9 @@
 //   "name": "wall",                        default "object<i>"; used in error messages
 //   "mesh": "models/bunny.obj"             file relative to the scene file (glTF 2.0 .gltf/.glb,
 //                                          OBJ, PLY, OFF and whatever else Assimp reads); node
-//                                          transforms are applied, normals generated if missing
+//                                          transforms are applied, normals generated if missing;
+//                                          without "material", one object "<name>/<material>" per
+//                                          material of the file (import_model; scenes/README.md)
 //   | "primitive": { "type": ..., parameters },  exactly one of "mesh" / "primitive"
 //   "transform": {
 //     "translate": [x,y,z],
@@ -95,8 +99,8 @@
 // Errors: every problem throws SceneError naming the file, the JSON pointer (and the object's
 // name) and what is wrong: malformed JSON, unknown keys/primitive/scene names, missing or
 // unreadable meshes/textures, NaN/infinite positions, meshes with only degenerate triangles,
-// scale <= 0, fov outside (0,180), opacity, albedo or transmission_color outside [0,1], absurd
-// sizes or segment counts.
+// scale <= 0, fov outside (0,180), absurd camera near/far, opacity, albedo, alpha_cutoff or
+// transmission_color outside [0,1], absurd sizes or segment counts.
 // Degenerate (zero-area) triangles in otherwise valid meshes are dropped silently.
 //
 // Clip-space conventions (camera and light matrices): Vulkan: x right, y DOWN in NDC (an image
