@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
@@ -161,6 +162,7 @@ TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, i
   // The nearest surface inside the view frustum: clip each triangle to it in clip space (w is the
   // view depth) and keep the smallest w of the clipped polygon. Surfaces hidden behind others count
   // too: the bound is meant for the closest surface the camera shows, which is never hidden.
+  const glm::dmat4 camera_inverse = glm::inverse(camera_vp);
   double nearest = std::numeric_limits<double>::infinity();
   glm::dvec3 nearest_point(0.0);
   std::vector<glm::dvec4> poly, next;
@@ -193,7 +195,7 @@ TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, i
       for (const glm::dvec4& p : poly)
         if (p.w < nearest) {
           nearest = p.w;
-          const glm::dvec4 world = glm::inverse(camera_vp) * p;
+          const glm::dvec4 world = camera_inverse * p;
           nearest_point = glm::dvec3(world) / world.w;
         }
     }
