@@ -18,14 +18,16 @@ if(MSM_SANITIZE)
 endif()
 install(TARGETS msm_compile_options EXPORT msmTargets)
 
-# Test support (tests/support: the Vulkan test fixture) and the one place of test data
-# (tests/data, and the Debian packages' models found by configured paths): for test targets only,
-# never installed.
-set(MSM_GLMARK2_MODELS_DIR /usr/share/glmark2/models CACHE PATH "glmark2-data's models (the bunny of the import tests)")
+# Test support (tests/support: the Vulkan test fixture, the glTF writer) and the one place of test
+# data: tests/data, and the real models no one here wrote, from Debian packages that
+# scripts/bootstrap.sh installs, by configured paths (a test whose model is missing fails, it does
+# not skip). For test targets only, never installed.
+set(MSM_ASSIMP_MODELS_DIR /usr/share/assimp/models CACHE PATH "assimp-testmodels' models (glTF samples)")
+set(MSM_GLMARK2_MODELS_DIR /usr/share/glmark2/models CACHE PATH "glmark2-data's models (the bunny)")
 add_library(msm_test_support INTERFACE)
 target_include_directories(msm_test_support INTERFACE ${PROJECT_SOURCE_DIR}/tests/support)
 target_compile_definitions(msm_test_support INTERFACE MSM_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
-  MSM_GLMARK2_MODELS_DIR="${MSM_GLMARK2_MODELS_DIR}")
+  MSM_ASSIMP_MODELS_DIR="${MSM_ASSIMP_MODELS_DIR}" MSM_GLMARK2_MODELS_DIR="${MSM_GLMARK2_MODELS_DIR}")
 
 # msm_add_test(NAME SOURCES... LIBS ...): one GoogleTest executable, its tests registered with CTest.
 function(msm_add_test name)

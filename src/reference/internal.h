@@ -62,6 +62,7 @@ struct SurfaceHit {
   double scale = 1.0;     // max(|p|_inf, |vertex coordinates|_inf of the triangle)
   std::uint32_t object = 0, triangle = 0;
   float u = 0.0f, v = 0.0f; // Embree barycentrics (of vertices 1 and 2)
+  glm::dvec3 incoming{0.0}; // unit direction of the ray that found it
 };
 
 // Offset of a shadow-ray origin: eps = kOffsetScale * scale along the normal's side facing `towards`.
@@ -102,13 +103,30 @@ class Tracer {
   // Interpolated vertex normal at a hit (unit).
   glm::dvec3 shading_normal(const SurfaceHit& hit) const;
   const scene::Material& material(const SurfaceHit& hit) const;
+  // The opacity alpha at a hit (constant times texture or noise); 1 for alpha-tested materials
+  // (their hits are where the surface exists).
   double opacity(const SurfaceHit& hit) const;
+  // The albedo at a hit: the material's constant times its texture (decoded from sRGB to linear,
+  // then bilinear with repeat: what the renderer's sRGB texture with a linear sampler gives).
+  glm::vec3 albedo(const SurfaceHit& hit) const;
+  // Whether an alpha-tested object exists at barycentrics (u, v) of a triangle: opacity >= the
+  // material's alpha_cutoff (always true for other materials). Hits where it does not are
+  // skipped by every query (Embree filter functions).
+  bool solid(std::uint32_t object, std::uint32_t triangle, float u, float v) const;
 
   struct Impl; // Embree device and scene
 
  private:
+  glm::vec2 uv(std::uint32_t object, std::uint32_t triangle, float u, float v) const;
+  double texture_opacity(std::uint32_t object, std::uint32_t triangle, float u, float v) const;
+
+  struct LinearImage { // an albedo texture in linear RGB
+    int width = 0, height = 0;
+    std::vector<glm::vec3> texels;
+  };
   const scene::Scene& scene_;
   std::vector<scene::OpacityImage> opacity_images_; // per material (width 0: none)
+  std::vector<LinearImage> albedo_images_;          // per material (width 0: none)
   std::unique_ptr<Impl> impl_;
 };
 

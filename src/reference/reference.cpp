@@ -159,6 +159,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const bool coloured = settings.effect == Effect::translucent;
   if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
   result.radiance = image::Image(W, H, 3);
+  result.surface = image::Image(W, H, {"n_dot_l", "object"});
+  for (std::size_t i = 0; i < result.surface.pixel_count(); ++i) result.surface.pixels()[2 * i + 1] = -1.0f;
   result.samples = mc ? settings.samples : 1;
 
   // Camera: unproject NDC depth 0 and 1 with the inverse of the rasterizer's matrix.
@@ -179,6 +181,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const int channels = result.visibility.channels();
   float* vis = result.visibility.pixels().data();
   float* rad = result.radiance.pixels().data();
+  float* surf = result.surface.pixels().data();
   float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
   const auto trace_start = std::chrono::steady_clock::now();
 
@@ -195,9 +198,14 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         SurfaceHit hit;
         ++row_rays;
         // The visible surface is the closest opaque one: translucent surfaces (opacity
-        // < 1) are looked through, as the renderer's shadow buffer does.
+        // < 1) are looked through, as the renderer's shadow buffer does, and so are the back
+        // faces of single-sided materials, which the rasterizer culls.
         bool found = tracer.closest(near, dir, length, hit);
-        for (int crossed = 0; found && tracer.material(hit).translucent() && crossed < kMaxCrossings; ++crossed) {
+        const auto hidden = [&](const SurfaceHit& h) {
+          const scene::Material& m = tracer.material(h);
+          return m.translucent() || (!m.double_sided && glm::dot(h.normal, dir) > 0.0);
+        };
+        for (int crossed = 0; found && hidden(hit) && crossed < kMaxCrossings; ++crossed) {
           const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
           found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
           ++row_rays;
@@ -228,8 +236,12 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         // effect gives a visibility per channel (translucent).
         glm::dvec3 n = tracer.shading_normal(hit);
         if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-        const glm::vec3 direct = msm_direct_light(glm::vec3(irradiance), float(glm::dot(n, ctx.towards_light)), rgb);
-        const glm::vec3 colour = msm_surface_radiance(tracer.material(hit).albedo, direct, MSM_AMBIENT);
+        const float n_dot_l = float(glm::dot(n, ctx.towards_light));
+        const glm::vec3 direct = msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);
+        const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), direct, MSM_AMBIENT);
+        float* q = surf + (std::size_t(y) * W + x) * 2;
+        q[0] = n_dot_l;
+        q[1] = float(hit.object);
         c[0] = colour.r;
         c[1] = colour.g;
         c[2] = colour.b;

@@ -86,11 +86,11 @@ glm::dvec3 ground_point(const CameraSpec& c, int x, int y, int W, int H) {
 }
 
 // The ground (20 x 20, albedo 0.5) and a half-plane occluder covering x < 0 at height h.
-std::string ground_and_half_plane(double h) {
+std::string ground_and_half_plane(double h, bool double_sided = false) {
   return R"({"name": "ground", "primitive": {"type": "plane", "size": [20, 20]}, "material": {"albedo": [0.5, 0.5, 0.5]}},
               {"name": "half", "primitive": {"type": "plane", "size": [10, 20]},
-               "transform": {"translate": [-5, )" +
-         num(h) + R"(, 0]}})";
+               "material": {"double_sided": )" +
+         std::string(double_sided ? "true" : "false") + R"(}, "transform": {"translate": [-5, )" + num(h) + R"(, 0]}})";
 }
 
 // ---- The filter kernel, independently: k(s) = sum_k w_k tent(s - k), CDF per tap ---------------
@@ -133,7 +133,8 @@ void expect_invalid(F&& f, const std::string& fragment) {
 // Every pixel of a ground plane under a half-plane occluder (x < 0 at height 1) against the exact
 // shadow edge x = -h Lx / Ly; only pixels whose centre lies within 1e-5 of the edge (or 1e-3 of a
 // plane's rim) are skipped. Also: background where the ray misses, the occluder's back face seen
-// from below (visible to the light from its upper side, unlit on the viewer's side), and the
+// from below (double-sided: visible to the light from its upper side, unlit on the viewer's side;
+// single-sided: culled as the rasterizer culls it, the ray goes on to the background), and the
 // radiance formula.
 TEST(reference_hard, HalfPlaneEdgeIsExactPerPixel) {
   const double h = 1.0, inf = std::numeric_limits<double>::infinity();
@@ -142,12 +143,13 @@ TEST(reference_hard, HalfPlaneEdgeIsExactPerPixel) {
     // Below the occluder, looking down and to the side, so that the edge runs diagonally
     // across the image; the top rows see the occluder from below, or nothing.
     const CameraSpec camera{{0.3, 0.6, 1.5}, {-0.6, 0.0, -0.5}};
-    const Scene scene = make_scene(camera, light_json(towards), ground_and_half_plane(h));
+    const Scene scene = make_scene(camera, light_json(towards), ground_and_half_plane(h, true));
     Settings s;
     s.effect = Effect::hard;
     s.width = 160;
     s.height = 120;
     const Result r = render(scene, s);
+    const Result culled = render(make_scene(camera, light_json(towards), ground_and_half_plane(h, false)), s);
     ASSERT_EQ(r.visibility.channel_names(), (std::vector<std::string>{"visibility", "background"}));
     ASSERT_EQ(r.radiance.channels(), 3);
     const double edge_x = -h * towards.x / towards.y;
@@ -182,9 +184,11 @@ TEST(reference_hard, HalfPlaneEdgeIsExactPerPixel) {
         if (occluder) { // seen from below: nothing above it; n faces the viewer, n.l < 0
           ASSERT_EQ(v, 1.0f) << x << "," << y;
           ASSERT_NEAR(r.radiance.at(x, y, 0), 0.03 * 0.8, 1e-7);
+          ASSERT_EQ(channel(culled.visibility, "background", x, y), 1.0f) << "single-sided: culled";
           ++underside;
           continue;
         }
+        ASSERT_EQ(channel(culled.visibility, "visibility", x, y), v) << x << "," << y;
         if (std::abs(pg.x - edge_x) < 1e-5) {
           ++skipped;
           continue;

@@ -10,12 +10,18 @@
 #include <fmt/format.h>
 
 #include "internal.h"
+#include "msm/image/image.h"
 
 namespace msm::reference::detail {
 
 struct Tracer::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  struct Masked { // user data of an alpha-tested geometry's filter function
+    const Tracer* tracer;
+    std::uint32_t object;
+  };
+  std::vector<Masked> masked; // reserved up front: the geometries keep pointers into it
   std::mutex error_mutex;
   std::string error;
 
@@ -38,6 +44,11 @@ void on_embree_error(void* user, RTCError code, const char* message) {
   impl->error = fmt::format("{} (code {})", message ? message : "", int(code));
 }
 
+const scene::Material& material_of(const scene::Scene& scene, std::size_t object) {
+  const std::uint32_t m = scene.objects[object].material;
+  return scene.materials.at(m < scene.materials.size() ? m : 0);
+}
+
 RTCRay make_ray(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) {
   RTCRay ray{};
   ray.org_x = float(origin.x);
@@ -55,10 +66,32 @@ RTCRay make_ray(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) {
   return ray;
 }
 
+// Alpha testing: hits on the holes of an alpha-tested object are rejected (for closest hits and
+// occlusion alike).
+void mask_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* masked = static_cast<const Tracer::Impl::Masked*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const unsigned triangle = RTCHitN_primID(args->hit, args->N, i);
+    const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+    if (!masked->tracer->solid(masked->object, triangle, u, v)) args->valid[i] = 0;
+  }
+}
+
 } // namespace
 
 Tracer::Tracer(const scene::Scene& scene) : scene_(scene), impl_(std::make_unique<Impl>()) {
-  for (const scene::Material& m : scene.materials) opacity_images_.push_back(scene::opacity_image(m));
+  for (const scene::Material& m : scene.materials) {
+    opacity_images_.push_back(scene::opacity_image(m));
+    const scene::Image texels = scene::albedo_image(m);
+    LinearImage& albedo = albedo_images_.emplace_back();
+    albedo.width = texels.width;
+    albedo.height = texels.height;
+    for (std::size_t i = 0; i + 3 < texels.rgba.size(); i += 4)
+      albedo.texels.emplace_back(image::srgb_to_linear(texels.rgba[i] / 255.0f),
+                                 image::srgb_to_linear(texels.rgba[i + 1] / 255.0f),
+                                 image::srgb_to_linear(texels.rgba[i + 2] / 255.0f));
+  }
   // Refuse non-finite vertices (possible in scenes not built by the loader).
   for (const scene::Object& o : scene.objects)
     for (std::size_t i = 0; i < o.mesh.positions.size(); ++i) {
@@ -78,6 +111,7 @@ Tracer::Tracer(const scene::Scene& scene) : scene_(scene), impl_(std::make_uniqu
   rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
   impl_->check("scene creation");
+  impl_->masked.reserve(scene.objects.size());
 
   for (std::size_t id = 0; id < scene.objects.size(); ++id) {
     const scene::Mesh& mesh = scene.objects[id].mesh;
@@ -102,6 +136,12 @@ Tracer::Tracer(const scene::Scene& scene) : scene_(scene), impl_(std::make_uniqu
       vertices[3 * i + 2] = mesh.positions[i].z;
     }
     for (std::size_t i = 0; i < mesh.indices.size(); ++i) indices[i] = mesh.indices[i];
+    if (material_of(scene, id).masked()) {
+      impl_->masked.push_back({this, std::uint32_t(id)});
+      rtcSetGeometryUserData(geom, &impl_->masked.back());
+      rtcSetGeometryIntersectFilterFunction(geom, mask_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, mask_filter);
+    }
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(impl_->scene, geom, unsigned(id));
     rtcReleaseGeometry(geom);
@@ -124,6 +164,7 @@ bool Tracer::closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfa
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
   hit.object = rh.hit.geomID;
+  hit.incoming = dir;
   hit.triangle = rh.hit.primID;
   hit.u = rh.hit.u;
   hit.v = rh.hit.v;
@@ -190,25 +231,44 @@ glm::dvec3 Tracer::shading_normal(const SurfaceHit& hit) const {
   return len > 1e-12 ? n / len : hit.normal;
 }
 
-double Tracer::opacity(const SurfaceHit& hit) const {
-  const scene::Material& m = material(hit);
-  double alpha = m.opacity;
-  const std::uint32_t index = scene_.objects[hit.object].material;
-  if (index < opacity_images_.size() && opacity_images_[index].width > 0) {
-    const scene::Mesh& mesh = scene_.objects[hit.object].mesh;
-    if (mesh.uvs.size() == mesh.positions.size()) {
-      const std::uint32_t* tri = &mesh.indices[3 * std::size_t(hit.triangle)];
-      const float u = hit.u, v = hit.v;
-      const glm::vec2 uv = (1.0f - u - v) * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
-      alpha *= double(opacity_images_[index].sample(uv));
-    }
-  }
+glm::vec2 Tracer::uv(std::uint32_t object, std::uint32_t triangle, float u, float v) const {
+  const scene::Mesh& mesh = scene_.objects[object].mesh;
+  if (mesh.uvs.size() != mesh.positions.size()) return glm::vec2(0.0f);
+  const std::uint32_t* tri = &mesh.indices[3 * std::size_t(triangle)];
+  return (1.0f - u - v) * mesh.uvs[tri[0]] + u * mesh.uvs[tri[1]] + v * mesh.uvs[tri[2]];
+}
+
+double Tracer::texture_opacity(std::uint32_t object, std::uint32_t triangle, float u, float v) const {
+  const std::uint32_t index = scene_.objects[object].material;
+  double alpha = material_of(scene_, object).opacity;
+  if (index < opacity_images_.size() && opacity_images_[index].width > 0)
+    alpha *= double(opacity_images_[index].sample(uv(object, triangle, u, v)));
   return alpha;
 }
 
-const scene::Material& Tracer::material(const SurfaceHit& hit) const {
-  const std::uint32_t m = scene_.objects[hit.object].material;
-  return scene_.materials.at(m < scene_.materials.size() ? m : 0);
+double Tracer::opacity(const SurfaceHit& hit) const {
+  if (material(hit).masked()) return 1.0;
+  return texture_opacity(hit.object, hit.triangle, hit.u, hit.v);
 }
+
+bool Tracer::solid(std::uint32_t object, std::uint32_t triangle, float u, float v) const {
+  const scene::Material& m = material_of(scene_, object);
+  // In float, as the renderer's shaders compare.
+  return !m.masked() || float(texture_opacity(object, triangle, u, v)) >= *m.alpha_cutoff;
+}
+
+glm::vec3 Tracer::albedo(const SurfaceHit& hit) const {
+  const std::uint32_t index = scene_.objects[hit.object].material;
+  glm::vec3 a = material(hit).albedo;
+  if (index < albedo_images_.size() && albedo_images_[index].width > 0) {
+    const LinearImage& image = albedo_images_[index];
+    a *= scene::sample_bilinear_repeat<glm::vec3>(
+        image.width, image.height, uv(hit.object, hit.triangle, hit.u, hit.v),
+        [&](int i, int j) { return image.texels[std::size_t(j) * std::size_t(image.width) + std::size_t(i)]; });
+  }
+  return a;
+}
+
+const scene::Material& Tracer::material(const SurfaceHit& hit) const { return material_of(scene_, hit.object); }
 
 } // namespace msm::reference::detail

@@ -56,10 +56,10 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
       for (int k = 0; k < 3; ++k) index_data.push_back(base + mesh.indices[3 * t + uint32_t(k)]);
     draw.index_count = uint32_t(mesh.indices.size());
     draw.center = object.bounds.center();
-    if (!material.albedo_texture.empty()) {
+    if (!material.albedo_texture.empty()) { // a file, or "<mesh file>#<index>" for embedded ones
       auto [it, inserted] = texture_index.try_emplace(material.albedo_texture, int(textures.size()));
       if (inserted) {
-        scene::Image texels = scene::load_texture(material.albedo_texture);
+        scene::Image texels = scene::albedo_image(material);
         textures.push_back(upload_rgba8(ctx, texels.width, texels.height, texels.rgba));
       }
       draw.texture = it->second;
@@ -75,7 +75,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
     draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);
     draw.push.flags =
         glm::ivec4(draw.texture >= 0 ? 1 : 0, material.double_sided ? 1 : 0, draw.opacity_texture >= 0 ? 1 : 0, -1);
-    draw.push.transmission = glm::vec4(material.transmission_color, 0.0f);
+    draw.masked = material.masked();
+    draw.push.transmission = glm::vec4(material.transmission_color, material.alpha_cutoff.value_or(0.0f));
     if (!draw.index_count) continue;
     if (is_translucent)
       translucent_by_depth.emplace_back(glm::dot(draw.center, travel), draw);

@@ -24,18 +24,19 @@ struct Draw {
   int opacity_texture = -1; // into GpuScene::opacity_textures, -1: none
   ObjectPush push{};        // albedo, opacity, flags (z: 1 if the opacity texture is used)
   bool double_sided = false;
+  bool masked = false;    // alpha-tested (push.transmission.w: the cutoff)
   glm::vec3 center{0.0f}; // of the object's bounds (sorting for the camera)
 };
 
 struct GpuScene {
   vk::Buffer vertices, indices;
-  std::vector<Draw> draws; // opaque objects
+  std::vector<Draw> draws; // opaque objects, alpha-tested ones included
   // Objects with opacity < 1 or an opacity texture, sorted far to near along the light's
   // direction of travel, each one's triangles too (JCGT §3: blended back to front into the
   // moment shadow map; the light is fixed, so the order is computed once here).
   std::vector<Draw> translucent;
   std::vector<vk::Image> textures;         // RGBA8 sRGB
-  std::vector<vk::Image> opacity_textures; // R8 UNORM: the alpha channel, or the red one where alpha is all 1
+  std::vector<vk::Image> opacity_textures; // R8 UNORM: scene::opacity_image of the material
   vk::Image white;                         // 1x1, for draws without a texture
   vk::ImageView white_array;               // the same as a one-layer array (unused array bindings)
   vk::Sampler texture_sampler;             // linear, repeat

@@ -48,9 +48,11 @@ RenderSettings soft_settings(const std::string& technique, int width, int height
 }
 
 // Error of each technique's visibility against the ray-traced area light (background excluded).
-std::map<std::string, image::Metrics> errors(const vk::Context& ctx, const scene::Scene& scene, float extent_deg,
+// The map is fitted to the whole scene ("fit_scene"): these tests size kernels in texels of it.
+std::map<std::string, image::Metrics> errors(const vk::Context& ctx, scene::Scene scene, float extent_deg,
                                              const std::vector<std::string>& techniques, int shadow_size = 512,
                                              int width = 240, int height = 135) {
+  scene.shadow.mode = scene::ShadowFraming::Mode::fit_scene;
   reference::Result truth = area_light_truth(scene, width, height, extent_deg);
   image::Image mask = truth.visibility.channel("background");
   Renderer renderer(ctx, scene);
@@ -183,6 +185,7 @@ scene::Scene plank_scene() {
   return scene::load_scene_json(R"({ "msm_scene": 1, "name": "plank",
       "camera": { "position": [0, 6, -1.5], "target": [0, 0, -1.5], "up": [0, 0, -1], "fov_y_deg": 40 },
       "light": { "towards_light": [0, 0.70710678, 0.70710678], "angular_extent_deg": 6 },
+      "shadow_map": { "framing": "fit_scene" },
       "objects": [
         { "name": "ground", "primitive": { "type": "plane", "size": [9, 9] }, "transform": { "translate": [0, 0, -1.5] } },
         { "name": "plank", "primitive": { "type": "box", "size": [6.3246, 0.02, 1.0] },

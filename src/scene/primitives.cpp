@@ -76,7 +76,9 @@ void add_box(Mesh& m, glm::vec3 lo, glm::vec3 hi) {
     const glm::vec3 pu = f.u * glm::dot(glm::abs(f.u), h);
     const glm::vec3 pv = f.v * glm::dot(glm::abs(f.v), h);
     const auto base = static_cast<std::uint32_t>(m.positions.size());
-    for (const glm::vec2& k : corners) add_vertex(m, c + pn + k.x * pu + k.y * pv, f.n, 0.5f * (k + 1.0f));
+    // v runs down the face (against f.v, its "up"): the picture upright (uv convention in scene.h).
+    for (const glm::vec2& k : corners)
+      add_vertex(m, c + pn + k.x * pu + k.y * pv, f.n, glm::vec2(0.5f * (k.x + 1.0f), 0.5f * (1.0f - k.y)));
     add_tri(m, base, base + 1, base + 2);
     add_tri(m, base, base + 2, base + 3);
   }
@@ -186,7 +188,7 @@ Mesh make_cylinder(float radius, float height, int segments, bool caps) {
   add_grid(m, segments, 1, [&](int i, int j, glm::vec3& p, glm::vec3& n, glm::vec2& uv) {
     n = ring(i);
     p = radius * n + glm::vec3(0.0f, j == 0 ? -h : h, 0.0f);
-    uv = {float(i) / segments, float(j)};
+    uv = {float(i) / segments, float(1 - j)}; // v down: row 0 of the picture at the top
   });
   if (caps) {
     for (float side : {-1.0f, 1.0f}) {

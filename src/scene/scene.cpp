@@ -90,8 +90,7 @@ class Parser {
     const json* objs = find(root, "objects");
     if (!objs) fail("/objects", "required key missing");
     if (!objs->is_array() || objs->empty()) fail("/objects", "must be a non-empty array");
-    for (std::size_t i = 0; i < objs->size(); ++i)
-      s.objects.push_back(object((*objs)[i], fmt::format("/objects/{}", i), i, s));
+    for (std::size_t i = 0; i < objs->size(); ++i) object((*objs)[i], fmt::format("/objects/{}", i), i, s);
     return s;
   }
 
@@ -173,9 +172,14 @@ class Parser {
     if (const json* v = find(j, "target")) c.target = vec<3>(*v, ptr + "/target");
     if (const json* v = find(j, "up")) c.up = direction(*v, ptr + "/up");
     if (const json* v = find(j, "fov_y_deg")) c.fov_y_deg = number_in(*v, ptr + "/fov_y_deg", 0.0f, 180.0f, true, true);
-    if (const json* v = find(j, "near")) c.near = number_in(*v, ptr + "/near", 0.0f, kMaxSize, true, false);
-    if (const json* v = find(j, "far")) c.far = number_in(*v, ptr + "/far", 0.0f, 1e30f, true, false);
+    if (const json* v = find(j, "near")) c.near = number_in(*v, ptr + "/near", kMinCameraNear, kMaxSize, false, false);
+    if (const json* v = find(j, "far"))
+      c.far = number_in(*v, ptr + "/far", kMinCameraNear, kMaxCameraFar, false, false);
     if (!(c.far > c.near)) fail(ptr + "/far", "must be greater than near");
+    if (double(c.far) / double(c.near) > kMaxCameraDepthRatio)
+      fail(ptr + "/far", fmt::format("far / near = {:g} is more than {:g}: the camera's depth buffer would not "
+                                     "separate surfaces (raise near or lower far)",
+                                     double(c.far) / double(c.near), kMaxCameraDepthRatio));
     const glm::vec3 view = c.target - c.position;
     if (!(glm::length(view) > 0.0f)) fail(ptr + "/target", "must differ from position");
     if (!(glm::length(glm::cross(glm::normalize(view), c.up)) > 1e-4f))
@@ -202,12 +206,14 @@ class Parser {
     keys(j, ptr, {"framing", "center", "extent", "depth_range"});
     ShadowFraming f;
     const std::string mode = find(j, "framing") ? string(*find(j, "framing"), ptr + "/framing") : "fit";
-    if (mode == "fit") {
+    if (mode == "fit" || mode == "fit_scene") {
+      if (mode == "fit_scene") f.mode = ShadowFraming::Mode::fit_scene;
       for (const char* k : {"center", "extent", "depth_range"})
         if (find(j, k)) fail(ptr + "/" + k, "only allowed with \"framing\": \"explicit\"");
       return f;
     }
-    if (mode != "explicit") fail(ptr + "/framing", fmt::format("unknown framing '{}' (fit, explicit)", mode));
+    if (mode != "explicit")
+      fail(ptr + "/framing", fmt::format("unknown framing '{}' (fit, fit_scene, explicit)", mode));
     f.mode = ShadowFraming::Mode::given;
     for (const char* k : {"center", "extent", "depth_range"})
       if (!find(j, k)) fail(ptr + "/" + k, "required with \"framing\": \"explicit\"");
@@ -231,7 +237,7 @@ class Parser {
   Material material(const json& j, const std::string& ptr) const {
     keys(j, ptr,
          {"albedo", "albedo_texture", "opacity", "opacity_texture", "opacity_noise", "transmission_color",
-          "double_sided"});
+          "alpha_cutoff", "double_sided"});
     Material m;
     if (const json* v = find(j, "albedo")) {
       m.albedo = vec<3>(*v, ptr + "/albedo");
@@ -261,6 +267,11 @@ class Parser {
       if (!v->is_array() || v->size() != 3) fail(q, "must be an array of 3 numbers (r, g, b)");
       for (int c = 0; c < 3; ++c)
         m.transmission_color[c] = number_in((*v)[c], fmt::format("{}/{}", q, c), 0.0f, 1.0f, false, false);
+    }
+    if (const json* v = find(j, "alpha_cutoff")) {
+      m.alpha_cutoff = number_in(*v, ptr + "/alpha_cutoff", 0.0f, 1.0f, false, false);
+      if (glm::any(glm::greaterThan(m.transmission_color, glm::vec3(0.0f))))
+        fail(ptr + "/alpha_cutoff", "an alpha-tested material is opaque: no transmission_color with it");
     }
     if (const json* v = find(j, "double_sided")) m.double_sided = boolean(*v, ptr + "/double_sided");
     return m;
@@ -369,54 +380,75 @@ class Parser {
                      type));
   }
 
-  Object object(const json& j, const std::string& ptr, std::size_t index, Scene& s) const {
-    Object o;
-    o.name = fmt::format("object{}", index);
+  // One JSON object: one Object, or for a mesh file with several materials and no "material"
+  // key one Object per material of the file ("<name>/<material>").
+  void object(const json& j, const std::string& ptr, std::size_t index, Scene& s) const {
+    std::string name = fmt::format("object{}", index);
     if (j.is_object())
-      if (const json* v = find(j, "name")) o.name = string(*v, ptr + "/name");
+      if (const json* v = find(j, "name")) name = string(*v, ptr + "/name");
     try {
       keys(j, ptr, {"name", "mesh", "primitive", "transform", "material"});
       const json* mesh = find(j, "mesh");
       const json* prim = find(j, "primitive");
       if (!mesh == !prim) fail(ptr, "needs exactly one of \"mesh\" (a file) and \"primitive\"");
+      Object o;
+      o.name = name;
       if (const json* v = find(j, "transform")) o.transform = transform(*v, ptr + "/transform");
-      if (const json* v = find(j, "material")) {
-        if (v->is_string()) {
-          const auto it = named_.find(v->get<std::string>());
-          if (it == named_.end()) fail(ptr + "/material", fmt::format("unknown material '{}'", v->get<std::string>()));
+      const json* material_json = find(j, "material");
+      if (material_json) {
+        if (material_json->is_string()) {
+          const auto it = named_.find(material_json->get<std::string>());
+          if (it == named_.end())
+            fail(ptr + "/material", fmt::format("unknown material '{}'", material_json->get<std::string>()));
           o.material = it->second;
         } else {
           o.material = static_cast<std::uint32_t>(s.materials.size());
-          s.materials.push_back(material(*v, ptr + "/material"));
+          s.materials.push_back(material(*material_json, ptr + "/material"));
         }
       }
-      Mesh m;
-      if (mesh) {
-        o.mesh_file = existing_file(string(*mesh, ptr + "/mesh"), ptr + "/mesh", "mesh");
-        try {
-          m = import_mesh(o.mesh_file);
-        } catch (const SceneError& e) {
-          fail(ptr + "/mesh", fmt::format("{} ({})", e.problem(), o.mesh_file.string()));
-        }
-      } else {
-        m = primitive(*prim, ptr + "/primitive", o.primitive);
+      if (!mesh) {
+        Mesh m = primitive(*prim, ptr + "/primitive", o.primitive);
+        add_object(std::move(o), std::move(m), ptr, s);
+        return;
       }
-      // To world space. Scale > 0, so the winding is kept; normals by the inverse transpose.
-      const glm::mat4 mm = o.transform.matrix();
-      for (std::size_t v = 0; v < m.positions.size(); ++v) {
-        m.positions[v] = glm::vec3(mm * glm::vec4(m.positions[v], 1.0f));
-        m.normals[v] = glm::normalize(o.transform.rotate * (m.normals[v] / o.transform.scale));
-      }
+      o.mesh_file = existing_file(string(*mesh, ptr + "/mesh"), ptr + "/mesh", "mesh");
+      std::vector<ModelPart> parts;
       try {
-        detail::finalize_mesh(m, "");
-      } catch (const SceneError& e) { fail(ptr, "after the transform: " + e.problem()); }
-      o.mesh = std::move(m);
-      o.bounds = o.mesh.bounds();
+        if (material_json) {
+          parts.push_back({"", import_mesh(o.mesh_file), std::nullopt});
+        } else {
+          parts = import_model(o.mesh_file);
+        }
+      } catch (const SceneError& e) { fail(ptr + "/mesh", fmt::format("{} ({})", e.problem(), o.mesh_file.string())); }
+      for (ModelPart& part : parts) {
+        Object p = o;
+        if (parts.size() > 1) p.name = fmt::format("{}/{}", name, part.name);
+        if (part.material) {
+          p.material = static_cast<std::uint32_t>(s.materials.size());
+          s.materials.push_back(std::move(*part.material));
+          s.materials.back().name = fmt::format("{}/{}", name, s.materials.back().name);
+        }
+        add_object(std::move(p), std::move(part.mesh), ptr, s);
+      }
     } catch (const SceneError& e) {
       // Name the object in the location.
-      throw SceneError(e.file(), fmt::format("{} (object '{}')", e.where(), o.name), e.problem());
+      throw SceneError(e.file(), fmt::format("{} (object '{}')", e.where(), name), e.problem());
     }
-    return o;
+  }
+
+  // To world space. Scale > 0, so the winding is kept; normals by the inverse transpose.
+  void add_object(Object o, Mesh m, const std::string& ptr, Scene& s) const {
+    const glm::mat4 mm = o.transform.matrix();
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      m.positions[v] = glm::vec3(mm * glm::vec4(m.positions[v], 1.0f));
+      m.normals[v] = glm::normalize(o.transform.rotate * (m.normals[v] / o.transform.scale));
+    }
+    try {
+      detail::finalize_mesh(m, "");
+    } catch (const SceneError& e) { fail(ptr, "after the transform: " + e.problem()); }
+    o.mesh = std::move(m);
+    o.bounds = o.mesh.bounds();
+    s.objects.push_back(std::move(o));
   }
 
   std::string file_;
@@ -473,24 +505,9 @@ glm::mat4 Scene::light_projection(const DirectionalLight& light) const {
     const glm::vec2 h = 0.5f * shadow.extent;
     return flip_y(glm::orthoRH_ZO(-h.x, h.x, -h.y, h.y, shadow.depth_range.x, shadow.depth_range.y));
   }
-  const Bounds b = bounds();
-  if (b.empty()) return flip_y(glm::orthoRH_ZO(-1.0f, 1.0f, -1.0f, 1.0f, -1.0f, 1.0f));
-  // Fitted to the vertices (tighter than the bounds' corners): the near plane touches the
-  // vertex closest to the light and the far plane the farthest one.
-  const glm::mat4 v = light_view(light);
-  glm::vec3 lo(1e30f), hi(-1e30f);
-  for (const Object& o : objects)
-    for (const glm::vec3& q : o.mesh.positions) {
-      const glm::vec3 p(v * glm::vec4(q, 1.0f));
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-    }
-  // A tiny margin keeps rounding from pushing vertices out; depth 0 stays at the closest point.
-  const float margin = 1e-5f * glm::length(b.size()) + 1e-6f;
-  lo -= margin;
-  hi += margin;
+  const LightBox b = fit_light_frustum(*this, light_view(light), shadow.mode == ShadowFraming::Mode::fit);
   // View space looks down -z: distance along the light's travel is -z.
-  return flip_y(glm::orthoRH_ZO(lo.x, hi.x, lo.y, hi.y, -hi.z, -lo.z));
+  return flip_y(glm::orthoRH_ZO(b.lo.x, b.hi.x, b.lo.y, b.hi.y, -b.hi.z, -b.lo.z));
 }
 
 LightFrame Scene::light_frame(const DirectionalLight& light) const {

@@ -15,9 +15,10 @@ namespace msm::tool {
 
 void add_compare(CLI::App& app) {
   struct Options {
-    std::string reference, test, error_image, mask, channel;
+    std::string reference, test, error_image, mask, mask_channel, channel;
     std::string signal = "visibility";
     double range = 0.1;
+    std::optional<double> mask_above, mask_below;
     bool json = false;
   };
   auto opt = std::make_shared<Options>();
@@ -27,7 +28,16 @@ void add_compare(CLI::App& app) {
   cmd->add_flag("--json", opt->json, "Print JSON");
   cmd->add_option("--error-image", opt->error_image, "Write the false-colour error image (PNG) here");
   cmd->add_option("--range", opt->range, "Difference shown at full colour in the error image (default 0.1)");
-  cmd->add_option("--mask", opt->mask, "Image whose first channel > 0.5 marks pixels to ignore");
+  cmd->add_option("--mask", opt->mask,
+                  "Image marking pixels to ignore: where its mask channel is > 0.5 (or as --mask-above / "
+                  "--mask-below say)");
+  cmd->add_option("--mask-channel", opt->mask_channel,
+                  "Channel of the mask image (default: the first), e.g. background of visibility.exr, n_dot_l or "
+                  "object of surface.exr");
+  cmd->add_option("--mask-above", opt->mask_above, "Ignore pixels where the mask channel is above this");
+  cmd->add_option("--mask-below", opt->mask_below,
+                  "Ignore pixels where the mask channel is below this (e.g. n_dot_l 0.1: the terminator and the "
+                  "background)");
   cmd->add_option("--channel", opt->channel,
                   "Channel to compare (default: the only one, Y of Y+A, else the luminance of R,G,B)");
   cmd->add_option("--signal", opt->signal,
@@ -49,7 +59,21 @@ void add_compare(CLI::App& app) {
       const Image reference = read_image(opt->reference);
       const Image test = read_image(opt->test);
       std::optional<Image> mask;
-      if (!opt->mask.empty()) mask = read_image(opt->mask);
+      if (!opt->mask.empty()) {
+        const Image source = read_image(opt->mask);
+        const Image values = opt->mask_channel.empty() ? source.channel(0) : source.channel(opt->mask_channel);
+        // Without thresholds: ignored where > 0.5, as before.
+        const bool any = opt->mask_above || opt->mask_below;
+        mask = Image(values.width(), values.height(), 1);
+        for (std::size_t i = 0; i < values.pixel_count(); ++i) {
+          const double v = values.pixels()[i];
+          const bool ignored =
+              any ? ((opt->mask_above && v > *opt->mask_above) || (opt->mask_below && v < *opt->mask_below)) : v > 0.5;
+          mask->pixels()[i] = ignored ? 1.0f : 0.0f;
+        }
+      } else if (!opt->mask_channel.empty() || opt->mask_above || opt->mask_below) {
+        throw UsageError("--mask-channel, --mask-above and --mask-below need --mask");
+      }
       options.mask = mask ? &*mask : nullptr;
       metrics = compute_metrics(test, reference, options);
       if (!opt->error_image.empty()) write_error_png(opt->error_image, test, reference, opt->range, options);

@@ -1,6 +1,7 @@
 // `msm reference`: ground truth of a scene's shadows by CPU ray tracing (msm::reference): writes
-// DIR/visibility.exr (the shadow buffer), DIR/radiance.exr and DIR/reference.json (settings,
-// timings, sample count), each atomically. Bad input is a UsageError (exit status 2); scene
+// DIR/visibility.exr (the shadow buffer), DIR/radiance.exr, DIR/surface.exr (n_dot_l and object
+// index, masks for comparisons) and DIR/reference.json (settings, timings, sample count), each
+// atomically. Bad input is a UsageError (exit status 2); scene
 // errors (SceneError) name the file and the problem.
 #include <unistd.h>
 
@@ -128,6 +129,9 @@ void add_reference(CLI::App& app) {
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
     const msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    if (settings.effect == msm::reference::Effect::filtered)
+      if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
+        fmt::print(stderr, "msm reference: {}\n", *w);
     const double load_seconds = seconds_since(start);
     const fs::path out = opt->out;
     prepare_output(out);
@@ -144,6 +148,7 @@ void add_reference(CLI::App& app) {
     try {
       msm::image::write_exr(out / "visibility.exr", result.visibility);
       msm::image::write_exr(out / "radiance.exr", result.radiance);
+      msm::image::write_exr(out / "surface.exr", result.surface);
       // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
       // from an earlier run into the same folder for the other effects.
       if (!result.visibility_rgb.empty()) {
@@ -173,8 +178,10 @@ void add_reference(CLI::App& app) {
     j["rays"] = result.rays;
     j["background_pixels"] = result.background_pixels;
     j["mean_visibility"] = result.mean_visibility;
-    j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}};
-    j["channels"] = {{"visibility", result.visibility.channel_names()}, {"radiance", result.radiance.channel_names()}};
+    j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}, {"surface", "surface.exr"}};
+    j["channels"] = {{"visibility", result.visibility.channel_names()},
+                     {"radiance", result.radiance.channel_names()},
+                     {"surface", result.surface.channel_names()}};
     if (!result.visibility_rgb.empty()) {
       j["files"]["visibility_rgb"] = "visibility_rgb.exr";
       j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();

@@ -47,6 +47,9 @@ void add_render(CLI::App& app) {
     if (names.empty()) throw UsageError("--technique: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    const render::RenderSettings& f = opt->frame.settings;
+    if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
+      fmt::print(stderr, "msm render: {}\n", *w);
     ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);

@@ -9,13 +9,14 @@
 // (Vulkan: y down, depth in [0, 1]): from the unprojection of NDC depth 0 to that of depth 1 with
 // inverse(scene.camera_view_projection(float(W) / H)), in double precision. The closest hit over
 // [near point, far point] that is opaque (not scene::Material::translucent(): no opacity below 1,
-// no opacity texture or noise, no transmission colour) is the visible surface: translucent
-// surfaces are looked through, as in the renderer's shadow buffer. Back faces are surfaces too: the rasterizer
-// culls the back faces of single-sided materials, which shows the same surface as long as meshes
-// are closed (or seen from their front side); for an open single-sided surface seen from behind
-// the two differ, and the reference shows the surface. The hit point p is the intersection of the
-// (double precision) primary ray with the plane of the hit triangle; n is the triangle's
-// geometric normal (not the interpolated one).
+// no opacity texture or noise, no transmission colour) and not a back face of a single-sided
+// material is the visible surface: translucent surfaces are looked through, as in the renderer's
+// shadow buffer, and back faces (the triangle's winding turned away from the camera) of materials
+// that are not double_sided are skipped, as the rasterizer culls them. Alpha-tested materials
+// (scene::Material::alpha_cutoff) exist only where their opacity reaches the cutoff, for every
+// ray (primary, shadow, transmission): their cut-outs are seen through and cast no shadow. The
+// hit point p is the intersection of the (double precision) primary ray with the plane of the hit
+// triangle; n is the triangle's geometric normal (not the interpolated one).
 //
 // Effects (L = scene.light.towards_light, the exact direction towards the light; every shadow
 // ray starts at its point offset by eps along the geometric normal facing the light, with
@@ -25,14 +26,24 @@
 //   hard        V(p) = 1 if the ray p -> L reaches infinity, else 0. One primary ray per pixel
 //               centre, no bias beyond eps, no antialiasing: the renderer's shadow buffer.
 //
-//   filtered    The antialiased hard shadow that a perfectly biased PCF approximates (the
-//               "receiver plane" reference): V(p) = integral of K(o) V_hard(p'(o)) do, with K the
-//               continuous filter kernel of msm/reference/kernel.h (offsets o in shadow-map
-//               texels) and p'(o) the point of the tangent plane of p whose light-space (x, y) is
-//               that of p moved by o: p' = p + o_world + t * travel, o_world = ox * texel_x *
-//               x_axis + oy * texel_y * y_axis (LightFrame), t chosen so that dot(n, p' - p) = 0 and
-//               clamped to |t| <= kMaxReceiverSlope * |o_world| on grazing planes. Estimated with
-//               `samples` stratified offsets.
+//   filtered    What a filtered shadow map means, on any geometry (the renderer's PCF with
+//               perfect depth): with n_s the interpolated normal turned towards the viewer (the
+//               normal the renderer shades with), V(p) = 0 where n_s . L <= 0 (a surface turned
+//               away from the light is in its own shadow, as the renderer has it; sample_count
+//               0 there), else V(p) = integral of K(o) V_o do over the light's shadow-map plane,
+//               K the continuous filter kernel of msm/reference/kernel.h (offsets o in texels)
+//               and V_o the visibility of the light ray through the light-space (x, y) of p
+//               moved by o, at the receiver's depth extrapolated along its plane: 1 unless a
+//               surface lies between the light and q(o) = p + o_world + (s . o) D travel, where
+//               o_world = ox * texel_x * x_axis + oy * texel_y * y_axis (LightFrame), D the map's
+//               depth_range and s the receiver plane's depth per texel (from n_s; each component
+//               clamped to +-MSM_MAX_RECEIVER_DEPTH_SLOPE of msm/render/frame.h, as the renderer
+//               clamps it), except surfaces within kOffsetScale * scale + kReceiverPlaneTolerance
+//               * |o_world| of q(o) along the ray: those are the receiver's own surface, which the
+//               plane models only to that tolerance (without it, a flat face whose interpolated
+//               normal strays by 0.1 degree shadows itself: the "grey" of perfect-depth maps). Every
+//               other surface counts, both faces, the receiver's own too (as in the map).
+//               Estimated with `samples` stratified offsets, one ray each.
 //
 //   soft        Visibility averaged over a directional area light: the fraction of the light
 //               that p sees. The light is a planar emitter at infinity: its directions are
@@ -79,6 +90,11 @@
 //   radiance     "R", "G", "B" (linear): msm/shading.h's radiance at the visible surface, 0 on background;
 //                for translucent with the visibility of each channel (T_r, T_g, T_b) in its
 //                channel. Result::mean_visibility averages "visibility".
+//   surface      "n_dot_l": the cosine of the radiance (msm/shading.h) (interpolated normal turned towards the viewer,
+//                dotted with L; 0 on background), "object": the index into scene.objects of the
+//                visible surface (-1 on background; a mesh with several materials is several
+//                objects). Masks for comparisons: the terminator (n_dot_l near 0), where shadow
+//                maps and ray tracing disagree by design, or one object.
 #pragma once
 
 #include <array>
@@ -115,11 +131,15 @@ inline constexpr int kMaxSamples = 1'000'000;
 inline constexpr int kMaxShadowSize = 65536;
 inline constexpr int kMaxCrossings = 4096;
 inline constexpr int kMaxThreads = 1024;
-inline constexpr double kOffsetScale = 1e-5;      // shadow-ray origin offset, relative
-inline constexpr double kMaxReceiverSlope = 16.0; // |t| / |o_world| on grazing receivers
+inline constexpr double kOffsetScale = 1e-5; // shadow-ray origin offset, relative
+// filtered: surfaces within this times |o_world| of the receiver plane are the receiver itself
+// (the plane's slope is known to about 0.3 degrees: real meshes' interpolated normals stray from
+// their flat faces by this much, 0.11 degrees on the 2CylinderEngine's covers).
+inline constexpr double kReceiverPlaneTolerance = 0.005;
 
 // The shadow map's light-space frame (x_axis, y_axis, extent: one texel is extent / shadow_size
-// along each axis), shared with the renderer: msm::scene::LightFrame of the scene's first light.
+// along each axis; depth_extent the world distance from depth 0 to 1), shared with the renderer:
+// msm::scene::LightFrame of the scene's first light.
 using scene::LightFrame;
 
 struct Progress {
@@ -158,6 +178,7 @@ struct Result {
   image::Image visibility;     // see above for the channels
   image::Image visibility_rgb; // translucent: T_r, T_g, T_b ("visibility_r/_g/_b"); else empty
   image::Image radiance;       // R, G, B
+  image::Image surface;        // n_dot_l, object (see above)
   int samples = 1;             // per covered pixel (1 for hard and translucent)
   double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0; // as used (soft)
   double build_seconds = 0.0;                                                   // Embree scene

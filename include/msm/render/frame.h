@@ -11,6 +11,11 @@ MSM_BEGIN
 // Vulkan guarantees 256 array layers; the image-based lighting of Kneiphof uses up to 256 lights).
 const int MSM_MAX_LIGHTS = 256;
 
+// The receiver plane's depth slope per texel ([0,1] depth, along each axis of the map) is clamped
+// to this: grazing planes would otherwise reach any depth. The shading and the ray-traced filtered
+// reference clamp alike.
+const float MSM_MAX_RECEIVER_DEPTH_SLOPE = 0.02f;
+
 // The uniform block of every pass of one frame (binding 0 where a pass uses it).
 struct FrameUniforms {
   mat4 camera_view_projection;
@@ -56,7 +61,8 @@ struct ObjectPush {
                        // z: 1 if the opacity texture is used, w: the colour channel
                        // the translucent pass blends (-1: grey, the opacity itself)
   vec4 transmission;   // rgb: transmission colour (the channel's opacity is
-                       // opacity (1 - transmission)), a: unused
+                       // opacity (1 - transmission)), a: alpha cutoff of alpha-tested
+                       // surfaces (0: none; alpha_test.glsl)
   ivec4 light;         // x: the light (shadow-map layer) the shadow and translucent passes draw for
 };
 

@@ -17,7 +17,7 @@
 //   "camera": {
 //     "position": [x,y,z], "target": [x,y,z], "up": [0,1,0],
 //     "fov_y_deg": 45,                     vertical field of view, in (0, 180)
-//     "near": 0.1, "far": 1000             0 < near < far
+//     "near": 0.1, "far": 1000             1e-6 <= near < far <= 1e9, far / near <= 1e7
 //   },
 //   "light": {                             ONE directional light
 //     "towards_light": [x,y,z],            REQUIRED direction FROM the scene TOWARDS the light
@@ -26,8 +26,9 @@
 //     "angular_extent_deg": 0              angular diameter of the light, [0, 90); 0 = hard
 //   },
 //   "shadow_map": {
-//     "framing": "fit"                     default: orthographic light frustum fitted to the
-//                                          scene's vertices (near plane through the closest one)
+//     "framing": "fit"                     default: orthographic light frustum fitted to what the
+//                                          camera sees (fit_light_frustum)
+//     | "framing": "fit_scene"             fitted to every vertex of the scene
 //     | "framing": "explicit",
 //       "center": [x,y,z],                 world-space centre of the light frustum
 //       "extent": [w,h],                   full width/height across the light direction, > 0
@@ -49,6 +50,8 @@
 //                                          fraction (opacity alpha) the fraction that passes, per
 //                                          channel; per-channel opacity alpha*(1 - transmission_color)
 //                                          (coloured shadows; see Material::channel_opacity)
+//   "alpha_cutoff": c in [0,1]             alpha testing (glTF alphaMode MASK): present where the
+//                                          opacity reaches c, a cut-out elsewhere (Material::alpha_cutoff)
 //   "double_sided": false
 // }
 // Texture paths are relative to the scene file; they must exist when the scene is loaded but are
@@ -58,7 +61,9 @@
 //   "name": "wall",                        default "object<i>"; used in error messages
 //   "mesh": "models/bunny.obj"             file relative to the scene file (glTF 2.0 .gltf/.glb,
 //                                          OBJ, PLY, OFF and whatever else Assimp reads); node
-//                                          transforms are applied, normals generated if missing
+//                                          transforms are applied, normals generated if missing;
+//                                          without "material", one object "<name>/<material>" per
+//                                          material of the file (import_model; scenes/README.md)
 //   | "primitive": { "type": ..., parameters },  exactly one of "mesh" / "primitive"
 //   "transform": {
 //     "translate": [x,y,z],
@@ -94,8 +99,8 @@
 // Errors: every problem throws SceneError naming the file, the JSON pointer (and the object's
 // name) and what is wrong: malformed JSON, unknown keys/primitive/scene names, missing or
 // unreadable meshes/textures, NaN/infinite positions, meshes with only degenerate triangles,
-// scale <= 0, fov outside (0,180), opacity, albedo or transmission_color outside [0,1], absurd
-// sizes or segment counts.
+// scale <= 0, fov outside (0,180), absurd camera near/far, opacity, albedo, alpha_cutoff or
+// transmission_color outside [0,1], absurd sizes or segment counts.
 // Degenerate (zero-area) triangles in otherwise valid meshes are dropped silently.
 //
 // Clip-space conventions (camera and light matrices): Vulkan: x right, y DOWN in NDC (an image
@@ -107,6 +112,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -122,6 +128,11 @@ inline constexpr int kMaxSegments = 4096; // any one segment/ring/step/bar count
 inline constexpr std::size_t kMaxPrimitiveTriangles = 4'000'000;
 inline constexpr float kMaxSize = 1e6f; // any primitive dimension / |translate|
 inline constexpr int kMaxLights = 256;  // render/frame.h MSM_MAX_LIGHTS: the layers of a shadow-map array
+// Camera depth range: near in [kMinCameraNear, kMaxSize], far <= kMaxCameraFar and far / near <=
+// kMaxCameraDepthRatio (beyond, the float depth buffer cannot tell surfaces apart).
+inline constexpr float kMinCameraNear = 1e-6f;
+inline constexpr float kMaxCameraFar = 1e9f;
+inline constexpr double kMaxCameraDepthRatio = 1e7;
 
 class SceneError : public std::runtime_error {
  public:
@@ -173,13 +184,34 @@ struct SmokeNoise {
   float softness = 0.25f; // width of the noise-to-opacity ramp, (0, 1]
 };
 
+// Decoded texels, always 4 channels RGBA8, row 0 = the top row of the picture (texture coordinate
+// v = 0).
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;
+};
+
+// Texture coordinates everywhere (primitives, imported meshes, renderer, ray tracer): (0, 0) is
+// the top-left corner of the picture, u to the right, v DOWN (glTF's, Vulkan's and Direct3D's
+// convention); formats with v up (OBJ and most others) are flipped on import.
 struct Material {
   std::string name; // key in "materials", or empty for inline ones
   glm::vec3 albedo{0.8f};
-  std::filesystem::path albedo_texture; // absolute or relative to the CWD; empty = none
+  // A file (absolute or relative to the CWD), or for a picture embedded in a mesh file (GLB, data
+  // URI) "<mesh file>#<index>" with the texels in albedo_pixels; empty = none.
+  std::filesystem::path albedo_texture;
+  std::shared_ptr<const Image> albedo_pixels;
   float opacity = 1.0f;
-  std::filesystem::path opacity_texture;
+  std::filesystem::path opacity_texture; // as albedo_texture, embedded ones in opacity_pixels
+  std::shared_ptr<const Image> opacity_pixels;
+  // The opacity texture's alpha channel even where it is 255 everywhere (glTF: the base colour's
+  // alpha); otherwise the alpha channel, or the red one where alpha is all 255 (grey masks).
+  bool opacity_from_alpha = false;
   std::optional<SmokeNoise> opacity_noise; // procedural opacity (instead of opacity_texture)
+  // Alpha testing (glTF alphaMode MASK): where the opacity (constant times texture) is below the
+  // cutoff the surface is absent (a cut-out: no shadow, seen through), elsewhere it is opaque.
+  // Such a material is not translucent, whatever its opacity.
+  std::optional<float> alpha_cutoff;
   bool double_sided = false;
   // Coloured transmission (JCGT 2017, Sec. 3): of the light that meets the covered fraction (the
   // opacity alpha) of this surface, the fraction that passes, per RGB channel, each in [0, 1].
@@ -188,11 +220,13 @@ struct Material {
   // Per-channel opacity at a point of opacity alpha (the constant times texture/noise there):
   // alpha * (1 - transmission_color). Equals vec3(alpha) for the default transmission colour.
   glm::vec3 channel_opacity(float alpha) const { return alpha * (glm::vec3(1.0f) - transmission_color); }
+  bool masked() const { return alpha_cutoff.has_value(); }
   // Lets light through somewhere: an opacity constant below 1, an opacity texture, procedural
-  // noise, or any transmission_color component > 0 (stained glass of opacity 1 still transmits).
+  // noise, or any transmission_color component > 0 (stained glass of opacity 1 still transmits);
+  // never an alpha-tested (masked) material.
   bool translucent() const {
-    return opacity < 1.0f || !opacity_texture.empty() || opacity_noise.has_value() ||
-           glm::any(glm::greaterThan(transmission_color, glm::vec3(0.0f)));
+    return !masked() && (opacity < 1.0f || !opacity_texture.empty() || opacity_noise.has_value() ||
+                         glm::any(glm::greaterThan(transmission_color, glm::vec3(0.0f))));
   }
 };
 
@@ -232,7 +266,8 @@ struct DirectionalLight {
 };
 
 struct ShadowFraming {
-  enum class Mode { fit, given } mode = Mode::fit;
+  // fit: to what the camera sees (fit_light_frustum); fit_scene: to every vertex; given: explicit.
+  enum class Mode { fit, fit_scene, given } mode = Mode::fit;
   glm::vec3 center{0.0f};
   glm::vec2 extent{1.0f};
   glm::vec2 depth_range{-1.0f, 1.0f};
@@ -270,10 +305,9 @@ struct Scene {
   std::size_t triangle_count() const;
   std::size_t vertex_count() const;
   // Light view (right-handed, looking along travel()) and orthographic projection of lights[index],
-  // with the shadow framing applied: for "fit", the orthographic box is fitted to the scene's
-  // vertices in light space (plus a 1e-5 relative margin): every vertex maps into x,y in [-1,1] and
-  // depth in [0,1], depth 0 at the vertex closest to the light, 1 at the farthest. O(vertices) per
-  // call: cache the result. Vulkan clip conventions. Precondition: index < lights.size().
+  // with the shadow framing applied: fit_light_frustum's box for "fit" and "fit_scene", the explicit
+  // box for "explicit". O(vertices) per call: cache the result. Vulkan clip conventions.
+  // Precondition: index < lights.size().
   glm::mat4 light_view(std::size_t index = 0) const { return light_view(lights.at(index)); }
   glm::mat4 light_projection(std::size_t index = 0) const { return light_projection(lights.at(index)); }
   glm::mat4 light_view_projection(std::size_t index = 0) const { return light_projection(index) * light_view(index); }
@@ -284,6 +318,50 @@ struct Scene {
   LightFrame light_frame(const DirectionalLight& light) const;
   glm::mat4 camera_view_projection(float aspect) const { return camera.projection(aspect) * camera.view(); }
 };
+
+// ---- Framing --------------------------------------------------------------------------------
+
+// The widest image (width / height) the "fit" framing serves: the camera's frustum is taken at
+// this aspect, so any narrower image sees only surfaces inside the map.
+inline constexpr float kFitMaxAspect = 2.4f;
+
+// An orthographic box in light view space (as glm::orthoRH_ZO takes it: x in [lo.x, hi.x], y in
+// [lo.y, hi.y], distance along the light's travel in [-hi.z, -lo.z]).
+struct LightBox {
+  glm::vec3 lo{-1.0f}, hi{1.0f};
+  bool visible_only = false; // fitted to the visible part (else to every vertex)
+};
+
+// The "fit" framing. visible_only: x and y span the intersection of the camera's view frustum (at
+// kFitMaxAspect) with the scene's bounds, the part of the scene the camera can see; depth runs from
+// the vertex closest to the light among those over that rectangle (the casters; a caster nearer
+// still is clamped to depth 0 by the renderer and still shadows) to the farthest visible point.
+// Otherwise, or where the frustum misses the bounds, every vertex maps into x, y in [-1, 1] and
+// depth [0, 1] (depth 0 at the vertex closest to the light, 1 at the farthest). A relative margin
+// of 1e-5 of the scene's size keeps rounding from pushing points out.
+LightBox fit_light_frustum(const Scene& scene, const glm::mat4& light_view, bool visible_only);
+
+// How coarse the shadow map is on screen: one texel (the larger of its two sides, in scene units)
+// over the size of a pixel at the nearest surface inside the view frustum (view depth `distance`;
+// pixels per unit there: height / (2 distance tan(fov_y / 2))), for an image of width x height and
+// a map of shadow_size² texels.
+struct TexelCoverage {
+  bool visible = false;           // the camera sees a surface
+  double pixels_per_texel = 0.0;  // screen pixels one texel spans (along a line)
+  double texel_size = 0.0;        // scene units
+  double distance = 0.0;          // view depth of the nearest visible surface
+  glm::vec3 where{0.0f};          // a point of it
+  bool aspect_beyond_fit = false; // "fit" framing and width / height > kFitMaxAspect
+};
+TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size);
+
+// Above this many screen pixels per shadow-map texel the tools warn.
+inline constexpr double kMaxPixelsPerTexel = 8.0;
+
+// The warning the tools print (one call), or none: when a texel spans more than kMaxPixelsPerTexel
+// pixels (naming the cures: a larger map, explicit framing; cascades do not exist yet) or the image
+// is wider than the fit covers.
+std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size);
 
 // Loading. Relative mesh/texture paths resolve against base_dir (the file's directory).
 Scene load_scene_file(const std::filesystem::path& file);
@@ -299,9 +377,23 @@ Scene builtin_scene(std::string_view name);
 // A built-in name, or else a path to a scene file.
 Scene load_scene(std::string_view name_or_path);
 
-// Mesh import through Assimp (node transforms applied, triangulated, normals generated if
-// missing, degenerate triangles dropped). Object space. Throws SceneError.
+// Mesh import through Assimp: node transforms applied (instances repeated), triangulated, texture
+// coordinates flipped to v down where the format has v up, KHR_texture_transform baked into them,
+// normals generated if missing, degenerate triangles dropped. Object space. Throws SceneError.
 Mesh import_mesh(const std::filesystem::path& file);
+
+// The same file as one part per material, each with the file's material (glTF: base colour
+// factor and texture, alphaMode OPAQUE / MASK with alphaCutoff / BLEND, doubleSided,
+// KHR_materials_transmission's factor; other formats: diffuse colour and texture, opacity,
+// two-sidedness; scenes/README.md says what is read). Textures embedded in the file (GLB, data
+// URIs) are decoded here; referenced files must exist. A part without a material of its own
+// (Assimp's default material) has none.
+struct ModelPart {
+  std::string name; // the material's name in the file, or "part<i>"
+  Mesh mesh;        // object space
+  std::optional<Material> material;
+};
+std::vector<ModelPart> import_model(const std::filesystem::path& file);
 
 // Primitive generators (local frames as documented above). Arguments are validated.
 Mesh make_plane(glm::vec2 size, glm::ivec2 subdivisions = {1, 1});
@@ -315,11 +407,10 @@ Mesh make_brick_wall(int rows, int columns, float brick_length, float brick_heig
                      float thickness);
 
 // Minimal lazy texture loading (stb_image), always 4 channels RGBA8.
-struct Image {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> rgba;
-};
 Image load_texture(const std::filesystem::path& file);
+// The albedo texture of a material (its embedded texels, or load_texture of its file); width 0
+// if it has none.
+Image albedo_image(const Material& material);
 
 // The opacity texture of a material (from its file or its procedural noise), as 8-bit values
 // (the alpha channel of the file, or its red channel where alpha is all 255); width 0 if none.
@@ -330,6 +421,21 @@ struct OpacityImage {
   std::vector<std::uint8_t> values;
   float sample(glm::vec2 uv) const; // bilinear with repeat, in [0, 1]; 1 if empty
 };
+
+// Bilinear interpolation with repeat over a width x height grid of texels, texel centres at
+// ((i + 0.5) / width, (j + 0.5) / height), as a Vulkan linear sampler with REPEAT addressing;
+// fetch(i, j) returns texel (i, j) (row j from the top). The one formula the CPU samplers share.
+template <class T, class Fetch>
+T sample_bilinear_repeat(int width, int height, glm::vec2 uv, Fetch&& fetch) {
+  const float x = uv.x * float(width) - 0.5f, y = uv.y * float(height) - 0.5f;
+  const float fx = glm::floor(x), fy = glm::floor(y);
+  const auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+  const int i = int(fx), j = int(fy);
+  const int i0 = wrap(i, width), i1 = wrap(i + 1, width), j0 = wrap(j, height), j1 = wrap(j + 1, height);
+  const float tx = x - fx, ty = y - fy;
+  return (1 - ty) * ((1 - tx) * fetch(i0, j0) + tx * fetch(i1, j0)) +
+         ty * ((1 - tx) * fetch(i0, j1) + tx * fetch(i1, j1));
+}
 OpacityImage opacity_image(const Material& material);
 // 128² procedural smoke: deterministic for its parameters.
 OpacityImage make_smoke_opacity(const SmokeNoise& noise);

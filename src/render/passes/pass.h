@@ -28,6 +28,7 @@ class ShadowDepthPass : public Pass {
 
  private:
   const vk::Program* program_ = nullptr;
+  const vk::Program* masked_program_ = nullptr; // alpha-tested draws: a fragment stage discards cut-outs
   FrameConfig config_;
 };
 

@@ -21,6 +21,18 @@ void ShadowDepthPass::prepare(const PassResources& r) {
                                    .samples = VkSampleCountFlagBits(config.msaa),
                                    // casters in front of the fitted near plane still cast
                                    .depth_clamp = true});
+  masked_program_ = &r.programs.graphics(
+      {.name = "shadow_depth (alpha-tested)",
+       .vertex_shader = "shadow_depth_masked.vert",
+       .fragment_shader = "shadow_depth_masked.frag",
+       .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_buffer},
+       .push_constant_size = sizeof(ObjectPush),
+       .vertex_stride = sizeof(Vertex),
+       .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                      {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+       .depth_format = VK_FORMAT_D16_UNORM,
+       .samples = VkSampleCountFlagBits(config.msaa),
+       .depth_clamp = true});
 }
 
 void ShadowDepthPass::reflect(PassBuilder& b) const {
@@ -44,10 +56,29 @@ void ShadowDepthPass::execute(const PassContext& c) const {
     vk::set_viewport_scissor(c.cmd, size);
     vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE); // both sides cast: thin walls, planes, open meshes
     bind_scene(c.cmd, c.frame.scene);
-    ObjectPush push{};
-    push.light.x = l;
-    vk::bind_program(c.cmd, *program_, {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.frame.lights)}, push);
-    for (const Draw& d : c.frame.scene.draws) vkCmdDrawIndexed(c.cmd, d.index_count, 1, d.first_index, 0, 0);
+    const GpuScene& scene = c.frame.scene;
+    const vk::Program* bound = nullptr;
+    for (const Draw& d : scene.draws) {
+      if (d.masked) { // its own opacity texture and cutoff
+        const vk::Image& opacity =
+            d.opacity_texture >= 0 ? scene.opacity_textures[size_t(d.opacity_texture)] : scene.white;
+        ObjectPush push = d.push;
+        push.light.x = l;
+        vk::bind_program(c.cmd, *masked_program_,
+                         {vk::Descriptor(c.frame.uniforms),
+                          vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                         scene.texture_sampler),
+                          vk::Descriptor(c.frame.lights)},
+                         push);
+        bound = masked_program_;
+      } else if (bound != program_) {
+        ObjectPush push{};
+        push.light.x = l;
+        vk::bind_program(c.cmd, *program_, {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.frame.lights)}, push);
+        bound = program_;
+      }
+      vkCmdDrawIndexed(c.cmd, d.index_count, 1, d.first_index, 0, 0);
+    }
     vkCmdEndRendering(c.cmd);
     c.end_light();
   }

@@ -60,7 +60,7 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l) {
   vec3 nc = mat3(lights[l].normal_matrix) * n;
   s.z = clip.z - frame.shadow_map.w;
   // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
-  float slope_limit = 0.02f; // per texel: grazing planes would otherwise reach any depth
+  float slope_limit = MSM_MAX_RECEIVER_DEPTH_SLOPE; // per texel (frame.h)
   s.depth_per_texel = abs(nc.z) > 1e-6f
                           ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
                           : vec2(0.0f);
@@ -77,7 +77,11 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l) {
   return 1.0f - shadow;
 }
 
+#include "alpha_test.glsl"
+
 void main() {
+  // Cut-outs (alpha mask) are discarded at the end: the lookups' derivatives need the whole quad.
+  bool cut_out = !alpha_test_passes(object, opacity_texture, texcoord);
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n; // only double-sided materials show back faces (culling)
 
@@ -105,4 +109,5 @@ void main() {
   if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
   out_color = vec4(msm_aces(radiance * frame.shading.y), opacity);
   out_shadow = vec4(visibility, 1.0f);
+  if (cut_out) discard;
 }

@@ -1,0 +1,238 @@
+// The shadow map's framing ("fit": what the camera sees) and the check that its texels are not
+// too coarse for the image (shadow_framing_warning).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "msm/scene/scene.h"
+
+namespace msm::scene {
+namespace {
+
+// A plane n . p + d >= 0 (inside).
+struct Plane {
+  glm::dvec3 n;
+  double d;
+  double at(const glm::dvec3& p) const { return glm::dot(n, p) + d; }
+};
+
+struct Edge {
+  glm::dvec3 a, b;
+};
+
+// A convex polyhedron given by its corners, edges and inward planes (a box or a frustum).
+struct Hull {
+  std::vector<glm::dvec3> corners;
+  std::vector<Edge> edges;
+  std::vector<Plane> planes;
+  bool contains(const glm::dvec3& p, double tolerance) const {
+    for (const Plane& plane : planes)
+      if (plane.at(p) < -tolerance) return false;
+    return true;
+  }
+};
+
+// The 8 corners (index bit 0: x, bit 1: y, bit 2: z) of a box-like solid, their 12 edges and its
+// 6 inward planes.
+Hull hull_of_corners(const std::array<glm::dvec3, 8>& c) {
+  Hull h;
+  h.corners.assign(c.begin(), c.end());
+  for (int i = 0; i < 8; ++i)
+    for (int bit = 1; bit < 8; bit <<= 1)
+      if (!(i & bit)) h.edges.push_back({c[i], c[i | bit]});
+  const glm::dvec3 centre = 0.125 * (c[0] + c[1] + c[2] + c[3] + c[4] + c[5] + c[6] + c[7]);
+  // Each face: the 4 corners with one index bit fixed; its plane from three of them.
+  for (int bit = 1; bit < 8; bit <<= 1)
+    for (int value : {0, bit}) {
+      std::vector<glm::dvec3> face;
+      for (int i = 0; i < 8; ++i)
+        if ((i & bit) == value) face.push_back(c[i]);
+      glm::dvec3 n = glm::cross(face[1] - face[0], face[2] - face[0]);
+      if (glm::length(n) == 0.0) n = glm::cross(face[3] - face[0], face[2] - face[0]);
+      n = glm::normalize(n);
+      Plane p{n, -glm::dot(n, face[0])};
+      if (p.at(centre) < 0.0) p = {-n, -p.d};
+      h.planes.push_back(p);
+    }
+  return h;
+}
+
+// Corners of the intersection of two convex hulls: the corners of each inside the other and the
+// points where an edge of one crosses a face plane of the other inside both.
+std::vector<glm::dvec3> intersection_corners(const Hull& a, const Hull& b, double tolerance) {
+  std::vector<glm::dvec3> out;
+  for (const auto& [one, other] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
+    for (const glm::dvec3& p : one->corners)
+      if (other->contains(p, tolerance)) out.push_back(p);
+    for (const Edge& e : one->edges)
+      for (const Plane& plane : other->planes) {
+        const double da = plane.at(e.a), db = plane.at(e.b);
+        if ((da < 0.0) == (db < 0.0) || da == db) continue;
+        const glm::dvec3 p = e.a + (da / (da - db)) * (e.b - e.a);
+        if (a.contains(p, tolerance) && b.contains(p, tolerance)) out.push_back(p);
+      }
+  }
+  return out;
+}
+
+// The camera's view frustum for the widest image the fit serves (kFitMaxAspect).
+Hull camera_frustum(const Camera& camera) {
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(camera.projection(kFitMaxAspect)) * glm::dmat4(camera.view()));
+  std::array<glm::dvec3, 8> c;
+  for (int i = 0; i < 8; ++i) {
+    const glm::dvec4 q = inv * glm::dvec4(i & 1 ? 1.0 : -1.0, i & 2 ? 1.0 : -1.0, i & 4 ? 1.0 : 0.0, 1.0);
+    c[i] = glm::dvec3(q) / q.w;
+  }
+  return hull_of_corners(c);
+}
+
+Hull box_hull(const Bounds& b) {
+  std::array<glm::dvec3, 8> c;
+  for (int i = 0; i < 8; ++i)
+    c[i] = glm::dvec3(i & 1 ? b.max.x : b.min.x, i & 2 ? b.max.y : b.min.y, i & 4 ? b.max.z : b.min.z);
+  return hull_of_corners(c);
+}
+
+} // namespace
+
+LightBox fit_light_frustum(const Scene& scene, const glm::mat4& light_view, bool visible_only) {
+  const Bounds b = scene.bounds();
+  LightBox box;
+  if (b.empty()) return box;
+  const glm::dmat4 v(light_view);
+  const double size = glm::length(glm::dvec3(b.size()));
+  // A tiny margin keeps rounding from pushing points out; depth 0 stays at the closest point.
+  const double margin = 1e-5 * size + 1e-6;
+  auto extend = [](glm::dvec3& l, glm::dvec3& h, const glm::dvec3& p) {
+    l = glm::min(l, p);
+    h = glm::max(h, p);
+  };
+  // Every vertex (tighter than the bounds' corners): near plane at the closest to the light, far
+  // plane at the farthest.
+  glm::dvec3 lo(1e300), hi(-1e300);
+  for (const Object& o : scene.objects)
+    for (const glm::vec3& q : o.mesh.positions) extend(lo, hi, glm::dvec3(v * glm::dvec4(glm::dvec3(q), 1.0)));
+  if (visible_only) {
+    // A flat scene (a plane) has a zero-thickness box: give it the margin so the planes exist.
+    Bounds grown = b;
+    grown.extend(b.min - glm::vec3(float(margin)));
+    grown.extend(b.max + glm::vec3(float(margin)));
+    glm::dvec3 vlo(1e300), vhi(-1e300);
+    for (const glm::dvec3& p : intersection_corners(camera_frustum(scene.camera), box_hull(grown), 1e-9 * size))
+      extend(vlo, vhi, glm::dvec3(v * glm::dvec4(p, 1.0)));
+    // The bounds' box holds empty space (its corners stick out of the geometry in light space):
+    // the visible part is also within the vertices' box.
+    vlo = glm::max(vlo, lo);
+    vhi = glm::min(vhi, hi);
+    box.visible_only = vlo.x <= vhi.x && vlo.y <= vhi.y && vlo.z <= vhi.z;
+    if (box.visible_only) {
+      // Casters: every vertex over the fitted rectangle may shadow it, so the near plane moves up
+      // to the closest of them (view space looks down -z: nearer the light = larger z).
+      for (const Object& o : scene.objects)
+        for (const glm::vec3& q : o.mesh.positions) {
+          const glm::dvec3 p(v * glm::dvec4(glm::dvec3(q), 1.0));
+          if (p.x >= vlo.x - margin && p.x <= vhi.x + margin && p.y >= vlo.y - margin && p.y <= vhi.y + margin)
+            vhi.z = std::max(vhi.z, p.z);
+        }
+      lo = vlo;
+      hi = vhi;
+    }
+  }
+  lo -= margin;
+  hi += margin;
+  box.lo = glm::vec3(lo);
+  box.hi = glm::vec3(hi);
+  return box;
+}
+
+TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size) {
+  TexelCoverage c;
+  if (width <= 0 || height <= 0 || shadow_size <= 0) return c;
+  const glm::dmat4 camera_vp =
+      glm::dmat4(scene.camera.projection(float(width) / float(height))) * glm::dmat4(scene.camera.view());
+  const glm::dmat4 light_vp(scene.light_view_projection());
+  // One texel in world units: the orthographic box's width and height over the map's texels.
+  const glm::dmat4 light_inv = glm::inverse(light_vp);
+  c.texel_size = 2.0 * std::max(glm::length(glm::dvec3(light_inv[0])), glm::length(glm::dvec3(light_inv[1]))) /
+                 double(shadow_size);
+  // The nearest surface inside the view frustum: clip each triangle to it in clip space (w is the
+  // view depth) and keep the smallest w of the clipped polygon. Surfaces hidden behind others count
+  // too: the bound is meant for the closest surface the camera shows, which is never hidden.
+  const glm::dmat4 camera_inverse = glm::inverse(camera_vp);
+  double nearest = std::numeric_limits<double>::infinity();
+  glm::dvec3 nearest_point(0.0);
+  std::vector<glm::dvec4> poly, next;
+  const auto inside = [](const glm::dvec4& p, int plane) {
+    switch (plane) {
+    case 0: return p.w + p.x;
+    case 1: return p.w - p.x;
+    case 2: return p.w + p.y;
+    case 3: return p.w - p.y;
+    case 4: return p.z;
+    default: return p.w - p.z;
+    }
+  };
+  for (const Object& o : scene.objects) {
+    const Mesh& m = o.mesh;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      poly.clear();
+      for (int k = 0; k < 3; ++k)
+        poly.push_back(camera_vp * glm::dvec4(glm::dvec3(m.positions[m.indices[3 * t + std::size_t(k)]]), 1.0));
+      for (int plane = 0; plane < 6 && !poly.empty(); ++plane) {
+        next.clear();
+        for (std::size_t i = 0; i < poly.size(); ++i) {
+          const glm::dvec4 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+          const double da = inside(a, plane), db = inside(b, plane);
+          if (da >= 0.0) next.push_back(a);
+          if ((da >= 0.0) != (db >= 0.0)) next.push_back(a + (da / (da - db)) * (b - a));
+        }
+        poly.swap(next);
+      }
+      for (const glm::dvec4& p : poly)
+        if (p.w < nearest) {
+          nearest = p.w;
+          const glm::dvec4 world = camera_inverse * p;
+          nearest_point = glm::dvec3(world) / world.w;
+        }
+    }
+  }
+  if (!std::isfinite(nearest)) return c; // the camera sees nothing
+  c.visible = true;
+  c.distance = nearest;
+  c.where = glm::vec3(nearest_point);
+  // Pixels per world unit across the view direction at view depth w: height / (2 w tan(fov/2)).
+  const double pixels_per_unit =
+      double(height) / (2.0 * nearest * std::tan(double(scene.camera.fov_y_deg) * std::numbers::pi / 360.0));
+  c.pixels_per_texel = c.texel_size * pixels_per_unit;
+  c.aspect_beyond_fit = scene.shadow.mode == ShadowFraming::Mode::fit && double(width) / height > kFitMaxAspect;
+  return c;
+}
+
+std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size) {
+  const TexelCoverage c = shadow_texel_coverage(scene, width, height, shadow_size);
+  std::string text;
+  if (c.pixels_per_texel > kMaxPixelsPerTexel) {
+    const int needed = int(std::min<double>(65536.0, std::ceil(shadow_size * c.pixels_per_texel / kMaxPixelsPerTexel)));
+    text = fmt::format(
+        "warning: one shadow-map texel ({:.3g} scene units) spans {:.1f} screen pixels (more than {:g}) at the nearest "
+        "visible surface, {:.3g} units from the camera: shadows there are blocky or lost. Cures: a larger map "
+        "(--shadow-size {} or more), an explicit framing of what matters (\"shadow_map\": {{\"framing\": "
+        "\"explicit\", ...}}), a camera that sees less of a large scene; cascaded shadow maps would fix it but are "
+        "not implemented.",
+        c.texel_size, c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, needed);
+  }
+  if (c.aspect_beyond_fit) {
+    if (!text.empty()) text += "\n";
+    text += fmt::format("warning: the image ({}x{}) is wider than the {:g}:1 the shadow map's fit covers: surfaces at "
+                        "its left and right edges may lie outside the map (unshadowed). Cure: an explicit framing.",
+                        width, height, kFitMaxAspect);
+  }
+  if (text.empty()) return std::nullopt;
+  return text;
+}
+
+} // namespace msm::scene

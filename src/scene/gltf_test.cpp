@@ -1,0 +1,314 @@
+// glTF as engines use it: per-primitive materials, texture coordinates right side up, alpha
+// modes, textures in files, data URIs and GLB, KHR_materials_transmission; and real models from
+// Debian packages (assimp-testmodels, glmark2-data), found through CMake-configured paths.
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "msm/test/gltf_writer.h"
+#include "msm/scene/scene.h"
+
+namespace fs = std::filesystem;
+using namespace msm::scene;
+using msm::scene::testing::GltfMaterial;
+using msm::scene::testing::GltfModel;
+using msm::scene::testing::GltfTexture;
+using msm::scene::testing::quad;
+using msm::scene::testing::write_gltf;
+
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device rd;
+    path_ = fs::temp_directory_path() / ("msm_gltf_test_" + std::to_string(rd()) + std::to_string(rd()));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// 2x2 texels, all different: red top-left, green top-right, blue bottom-left, white bottom-right
+// (alpha 255, 0, 255, 0 in that order: the right column is transparent).
+GltfTexture corners_texture() { return {2, 2, {255, 0, 0, 255, 0, 255, 0, 0, 0, 0, 255, 255, 255, 255, 255, 0}}; }
+
+std::string scene_json(const std::string& mesh, const std::string& material = "") {
+  return R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"name": "m", "mesh": ")" + mesh +
+         "\"" + (material.empty() ? "" : R"(, "material": )" + material) + "}]}";
+}
+
+Scene load(const TempDir& dir, const std::string& json) {
+  return load_scene_json(json, dir.path(), (dir.path() / "s.json").string());
+}
+
+// The vertex of an object at a position (exactly as written).
+std::size_t vertex_at(const Mesh& m, glm::vec3 p) {
+  for (std::size_t i = 0; i < m.positions.size(); ++i)
+    if (glm::length(m.positions[i] - p) < 1e-6f) return i;
+  ADD_FAILURE() << "no vertex at " << p.x << ", " << p.y << ", " << p.z;
+  return 0;
+}
+
+} // namespace
+
+// glTF's texture coordinates are msm's (v down, row 0 on top): imported unchanged, although
+// Assimp flips them on the way in. OBJ's v points up: imported as 1 - v.
+TEST(GltfImport, TextureCoordinatesRightSideUp) {
+  TempDir dir;
+  GltfModel model;
+  model.primitives.push_back(quad({0, 1, 0}, {1, 0, 0}, {0, -1, 0}, {0, 0, 1}));
+  write_gltf(dir.path() / "quad.gltf", model);
+  const Mesh g = import_mesh(dir.path() / "quad.gltf");
+  EXPECT_EQ(g.uvs[vertex_at(g, {0, 1, 0})], glm::vec2(0, 0)); // top-left of the quad: top-left texel
+  EXPECT_EQ(g.uvs[vertex_at(g, {1, 1, 0})], glm::vec2(1, 0));
+  EXPECT_EQ(g.uvs[vertex_at(g, {0, 0, 0})], glm::vec2(0, 1));
+
+  std::ofstream(dir.path() / "quad.obj") << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+                                         << "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+  const Mesh o = import_mesh(dir.path() / "quad.obj");
+  EXPECT_EQ(o.uvs[vertex_at(o, {0, 1, 0})], glm::vec2(0, 0)); // OBJ (0, 1): top-left in OBJ's convention
+  EXPECT_EQ(o.uvs[vertex_at(o, {0, 0, 0})], glm::vec2(0, 1));
+}
+
+// KHR_texture_transform on the base colour texture, as engines apply it (translation * rotation *
+// scale, the rotation turning u away from v; Assimp's own baking puts v off where there is a
+// rotation): offset (0.25, 0.5), rotation 90 degrees, scale (0.5, 0.25) map (u, v) to
+// (0.25 + 0.25 v, 0.5 - 0.5 u). Offset and scale alone: (0.5 + 0.5 u, 0.5 v).
+TEST(GltfImport, TextureTransform) {
+  TempDir dir;
+  for (const bool rotated : {true, false}) {
+    SCOPED_TRACE(rotated);
+    GltfModel model;
+    model.textures = {corners_texture()};
+    GltfMaterial m{.name = "t", .texture = 0};
+    if (rotated) {
+      m.uv_offset = {0.25f, 0.5f};
+      m.uv_rotation = 1.5707963267948966f;
+      m.uv_scale = {0.5f, 0.25f};
+    } else {
+      m.uv_offset = {0.5f, 0.0f};
+      m.uv_scale = {0.5f, 0.5f};
+    }
+    model.materials = {m};
+    model.primitives.push_back(quad({0, 1, 0}, {1, 0, 0}, {0, -1, 0}, {0, 0, 1}, 0));
+    write_gltf(dir.path() / "t.gltf", model);
+    const Mesh g = import_mesh(dir.path() / "t.gltf");
+    const std::pair<glm::vec3, glm::vec2> expected[] = {
+        {{0, 1, 0}, rotated ? glm::vec2(0.25f, 0.5f) : glm::vec2(0.5f, 0.0f)}, // uv (0, 0)
+        {{1, 1, 0}, rotated ? glm::vec2(0.25f, 0.0f) : glm::vec2(1.0f, 0.0f)}, // uv (1, 0)
+        {{1, 0, 0}, rotated ? glm::vec2(0.5f, 0.0f) : glm::vec2(1.0f, 0.5f)},  // uv (1, 1)
+        {{0, 0, 0}, rotated ? glm::vec2(0.5f, 0.5f) : glm::vec2(0.5f, 0.5f)}}; // uv (0, 1)
+    for (const auto& [p, uv] : expected) {
+      const glm::vec2 got = g.uvs[vertex_at(g, p)];
+      EXPECT_NEAR(got.x, uv.x, 1e-6f) << p.x << ", " << p.y;
+      EXPECT_NEAR(got.y, uv.y, 1e-6f) << p.x << ", " << p.y;
+    }
+  }
+}
+
+// The primitives follow the same convention: the box's front face and the cylinder's side show
+// the picture's top row at their top.
+TEST(GltfImport, PrimitivesTextureCoordinatesRightSideUp) {
+  const Mesh box = make_box(glm::vec3(2.0f));
+  EXPECT_EQ(box.uvs[vertex_at(box, {-1, 1, 1})].y, 0.0f); // front face: seen from +z, top edge v = 0
+  const Mesh cylinder = make_cylinder(1.0f, 2.0f, 8, false);
+  EXPECT_EQ(cylinder.uvs[vertex_at(cylinder, {1, 1, 0})].y, 0.0f);
+  EXPECT_EQ(cylinder.uvs[vertex_at(cylinder, {1, -1, 0})].y, 1.0f);
+}
+
+// One mesh, two primitives of different materials: two objects, each with its own material.
+TEST(GltfImport, TwoMaterialsOnOneMesh) {
+  TempDir dir;
+  GltfModel model;
+  model.materials = {{.name = "red", .base_color = {1, 0, 0, 1}}, {.name = "blue", .base_color = {0, 0, 1, 1}}};
+  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
+  model.primitives.push_back(quad({2, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1));
+  write_gltf(dir.path() / "two.gltf", model);
+  const Scene s = load(dir, scene_json("two.gltf"));
+  ASSERT_EQ(s.objects.size(), 2u);
+  for (const Object& o : s.objects) {
+    const Material& m = s.materials.at(o.material);
+    const bool red = o.bounds.max.x < 1.5f;
+    EXPECT_EQ(o.name, red ? "m/red" : "m/blue");
+    EXPECT_EQ(m.name, red ? "m/red" : "m/blue");
+    EXPECT_EQ(m.albedo, red ? glm::vec3(1, 0, 0) : glm::vec3(0, 0, 1));
+    EXPECT_EQ(o.mesh.triangle_count(), 2u);
+    EXPECT_FALSE(m.translucent());
+  }
+  // A material given in the scene replaces the file's: one object, as before.
+  const Scene one = load(dir, scene_json("two.gltf", R"({"albedo": [0, 1, 0]})"));
+  ASSERT_EQ(one.objects.size(), 1u);
+  EXPECT_EQ(one.objects[0].name, "m");
+  EXPECT_EQ(one.objects[0].mesh.triangle_count(), 4u);
+  EXPECT_EQ(one.materials.at(one.objects[0].material).albedo, glm::vec3(0, 1, 0));
+}
+
+// Alpha modes: MASK is alpha-tested with the base colour's alpha (texture included), BLEND is a
+// translucent occluder, OPAQUE ignores alpha; double-sidedness and transmission are read.
+TEST(GltfImport, AlphaModesAndTransmission) {
+  TempDir dir;
+  GltfModel model;
+  model.textures = {corners_texture()};
+  model.materials = {{.name = "mask",
+                      .base_color = {1, 1, 1, 0.9f},
+                      .texture = 0,
+                      .alpha_mode = "MASK",
+                      .alpha_cutoff = 0.3f,
+                      .double_sided = true},
+                     {.name = "blend", .base_color = {1, 1, 1, 0.5f}, .alpha_mode = "BLEND"},
+                     {.name = "opaque", .base_color = {0.5f, 0.5f, 0.5f, 0.2f}, .texture = 0},
+                     {.name = "glass", .base_color = {1, 0.5f, 0.25f, 1}, .transmission = 0.8f}};
+  for (int i = 0; i < 4; ++i) model.primitives.push_back(quad({2.0f * i, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, i));
+  write_gltf(dir.path() / "alpha.gltf", model);
+  const Scene s = load(dir, scene_json("alpha.gltf"));
+  ASSERT_EQ(s.objects.size(), 4u);
+  auto material = [&](const std::string& name) -> const Material& {
+    for (const Object& o : s.objects)
+      if (o.name == "m/" + name) return s.materials.at(o.material);
+    throw std::runtime_error("no object m/" + name);
+  };
+  const Material& mask = material("mask");
+  ASSERT_TRUE(mask.masked());
+  EXPECT_FLOAT_EQ(*mask.alpha_cutoff, 0.3f);
+  EXPECT_FLOAT_EQ(mask.opacity, 0.9f);
+  EXPECT_TRUE(mask.opacity_from_alpha);
+  EXPECT_EQ(mask.opacity_texture, mask.albedo_texture);
+  EXPECT_TRUE(mask.double_sided);
+  EXPECT_FALSE(mask.translucent());
+  // The opacity is the texture's alpha: opaque left column, transparent right column.
+  const OpacityImage alpha = opacity_image(mask);
+  ASSERT_EQ(alpha.width, 2);
+  EXPECT_EQ(alpha.values, (std::vector<std::uint8_t>{255, 0, 255, 0}));
+
+  const Material& blend = material("blend");
+  EXPECT_FALSE(blend.masked());
+  EXPECT_TRUE(blend.translucent());
+  EXPECT_FLOAT_EQ(blend.opacity, 0.5f);
+
+  const Material& opaque = material("opaque");
+  EXPECT_FALSE(opaque.translucent());
+  EXPECT_FALSE(opaque.masked());
+  EXPECT_EQ(opaque.opacity, 1.0f);
+  EXPECT_TRUE(opaque.opacity_texture.empty());
+
+  const Material& glass = material("glass");
+  EXPECT_TRUE(glass.translucent());
+  EXPECT_NEAR(glass.transmission_color.r, 0.8f, 1e-6f);
+  EXPECT_NEAR(glass.transmission_color.g, 0.4f, 1e-6f);
+  EXPECT_NEAR(glass.transmission_color.b, 0.2f, 1e-6f);
+}
+
+// Textures as data URIs, as files beside the .gltf, and inside a GLB: the same texels, the row
+// order of the picture kept (row 0 on top).
+TEST(GltfImport, EmbeddedAndExternalTextures) {
+  TempDir dir;
+  GltfModel model;
+  model.textures = {corners_texture()};
+  model.materials = {{.name = "t", .texture = 0}};
+  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
+  write_gltf(dir.path() / "data.gltf", model);
+  write_gltf(dir.path() / "files.gltf", model, true);
+  write_gltf(dir.path() / "binary.glb", model);
+  for (const std::string name : {"data.gltf", "files.gltf", "binary.glb"}) {
+    SCOPED_TRACE(name);
+    const Scene s = load(dir, scene_json(name));
+    ASSERT_EQ(s.objects.size(), 1u);
+    const Material& m = s.materials.at(s.objects[0].material);
+    const bool embedded = name != "files.gltf";
+    EXPECT_EQ(m.albedo_pixels != nullptr, embedded);
+    if (embedded)
+      EXPECT_EQ(m.albedo_texture.string(), (dir.path() / name).string() + "#0");
+    else
+      EXPECT_EQ(m.albedo_texture, dir.path() / "files_0.png");
+    const Image texels = albedo_image(m);
+    ASSERT_EQ(texels.width, 2);
+    ASSERT_EQ(texels.height, 2);
+    EXPECT_EQ(texels.rgba, corners_texture().rgba);
+  }
+  // A missing texture file is an error naming it.
+  fs::remove(dir.path() / "files_0.png");
+  try {
+    load(dir, scene_json("files.gltf"));
+    ADD_FAILURE() << "no error for a missing texture";
+  } catch (const SceneError& e) { EXPECT_NE(std::string(e.what()).find("files_0.png"), std::string::npos); }
+}
+
+// The JSON schema has alpha testing too.
+TEST(GltfImport, AlphaCutoffInJson) {
+  TempDir dir;
+  const Scene s =
+      load(dir, R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"primitive": {"type": "box"},
+               "material": {"opacity": 0.7, "alpha_cutoff": 0.5}}]})");
+  const Material& m = s.materials.at(s.objects[0].material);
+  ASSERT_TRUE(m.masked());
+  EXPECT_FALSE(m.translucent());
+  EXPECT_THROW(load(dir, R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"primitive":
+                            {"type": "box"}, "material": {"alpha_cutoff": 1.5}}]})"),
+               SceneError);
+}
+
+// Khronos samples from Debian's assimp-testmodels: the 2CylinderEngine (a GLB of many parts,
+// node transforms and instances), BoxTextured as .gltf with a file, as .glb with the texture
+// inside, and with a data URI. Fails when the package is missing (scripts/bootstrap.sh).
+TEST(GltfImport, KhronosSamples) {
+  const fs::path root = fs::path(MSM_ASSIMP_MODELS_DIR) / "glTF2";
+  const fs::path engine = root / "2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+  ASSERT_TRUE(fs::exists(engine)) << engine << " is missing: install assimp-testmodels (scripts/bootstrap.sh)";
+  const std::string json = R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"name": "engine",
+                               "mesh": ")" +
+                           engine.string() + "\"}]}";
+  const Scene s = load_scene_json(json, ".", "engine.json");
+  EXPECT_EQ(s.triangle_count(), 110336u);
+  EXPECT_GE(s.objects.size(), 2u); // one per material of the file
+  for (const Object& o : s.objects) EXPECT_NE(o.material, 0u) << o.name << ": the file's material is used";
+
+  Image first;
+  for (const char* sample : {"BoxTextured-glTF/BoxTextured.gltf", "BoxTextured-glTF-Binary/BoxTextured.glb",
+                             "BoxTextured-glTF-Embedded/BoxTextured.gltf"}) {
+    SCOPED_TRACE(sample);
+    const std::vector<ModelPart> parts = import_model(root / sample);
+    ASSERT_EQ(parts.size(), 1u);
+    ASSERT_TRUE(parts[0].material.has_value());
+    const Image texels = albedo_image(*parts[0].material);
+    ASSERT_GT(texels.width, 0);
+    if (first.width == 0) first = texels;
+    EXPECT_EQ(texels.rgba, first.rgba); // the same picture, wherever it is stored
+    EXPECT_EQ(parts[0].mesh.triangle_count(), 12u);
+  }
+}
+
+// Formats without materials (OFF, PLY, OBJ without .mtl): Assimp invents one; the part keeps the
+// scene's default material.
+TEST(GltfImport, FormatsWithoutMaterialsKeepTheDefault) {
+  TempDir dir;
+  std::ofstream(dir.path() / "t.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  std::ofstream(dir.path() / "t.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                         "property float y\nproperty float z\nelement face 1\n"
+                                         "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n"
+                                         "0 1 0\n3 0 1 2\n";
+  std::ofstream(dir.path() / "t.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  for (const char* name : {"t.off", "t.ply", "t.obj"}) {
+    const std::vector<ModelPart> parts = import_model(dir.path() / name);
+    ASSERT_EQ(parts.size(), 1u) << name;
+    EXPECT_FALSE(parts[0].material.has_value()) << name;
+  }
+}
+
+// glmark2-data's Stanford bunny: one part, no material of its own (the scene's default).
+TEST(GltfImport, BunnyHasNoMaterial) {
+  const fs::path bunny = fs::path(MSM_GLMARK2_MODELS_DIR) / "bunny.obj";
+  ASSERT_TRUE(fs::exists(bunny)) << bunny << " is missing: install glmark2-data (scripts/bootstrap.sh)";
+  const std::vector<ModelPart> parts = import_model(bunny);
+  ASSERT_EQ(parts.size(), 1u);
+  EXPECT_FALSE(parts[0].material.has_value());
+}
