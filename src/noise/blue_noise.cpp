@@ -1,4 +1,4 @@
-// The renderer's blue-noise set: the texels embed_blue_noise generated at build time.
+// The renderer's blue-noise set: the texels msm_embed_blue_noise generated at build time.
 #include "msm/noise/blue_noise.h"
 
 #include "embedded_set.h"

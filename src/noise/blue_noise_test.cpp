@@ -269,7 +269,7 @@ TEST(BlueNoiseMeasures, ComparableToPublishedTexture) {
 // ---- The renderer's set ----------------------------------------------------------------------------
 
 TEST(BlueNoiseSet, EmbeddedSetIsAFreshGenerationBitForBit) {
-  // Generated at build time by embed_blue_noise from BlueNoiseParams{}; the generator here is the
+  // Generated at build time by msm_embed_blue_noise from BlueNoiseParams{}; the generator here is the
   // same code, so a stale or mis-embedded set (other parameters, a truncated or reordered array)
   // differs.
   const BlueNoise& noise = blue_noise();

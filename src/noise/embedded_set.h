@@ -1,5 +1,5 @@
 // The renderer's blue-noise set as embedded data: declared here, defined in the source file that
-// embed_blue_noise writes at build time (<build>/src/noise/generated/blue_noise_set.cpp).
+// msm_embed_blue_noise writes at build time (<build>/src/noise/generated/blue_noise_set.cpp).
 #pragma once
 
 #include <cstddef>

@@ -59,7 +59,7 @@ BlueNoise generate_blue_noise(int size, int count, int channels, double sigma, s
 // ---- The renderer's set ------------------------------------------------------------------------
 
 // The parameters of the renderer's set. The build generates it from these (src/noise,
-// embed_blue_noise), so changing them here changes the embedded set at the next build.
+// msm_embed_blue_noise), so changing them here changes the embedded set at the next build.
 struct BlueNoiseParams {
   int size = 64;
   int count = 64;
