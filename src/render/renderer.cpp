@@ -12,7 +12,7 @@
 
 #include "msm/filter.h"
 #include "msm/gpu/sat_builder.h"
-#include "msm/render/blue_noise.h"
+#include "msm/noise/blue_noise.h"
 #include "msm/render/frame.h"
 #include "msm/sat.h"
 #include "msm/soft.h"
@@ -121,7 +121,7 @@ struct Renderer::Impl {
         linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)), programs(c), sat_builder(c) {}
 
   static vk::Image upload_blue_noise(const vk::Context& ctx) {
-    const BlueNoise& n = blue_noise();
+    const msm::noise::BlueNoise& n = msm::noise::blue_noise();
     if (n.size != 64 || n.channels != 2) throw RenderError("blue noise: expected 64² textures with two channels");
     vk::Image image = vk::create_image(ctx, {.width = 64,
                                              .height = 64,
@@ -176,7 +176,8 @@ struct Renderer::Impl {
     h ^= h >> 15;
     h *= 2246822519u;
     h ^= h >> 13;
-    u.lookup = glm::ivec4(lookup, int(h % uint32_t(blue_noise().count)), int((h >> 8) & 63u), int((h >> 16) & 63u));
+    u.lookup = glm::ivec4(lookup, int(h % uint32_t(msm::noise::blue_noise().count)), int((h >> 8) & 63u),
+                          int((h >> 16) & 63u));
     for (size_t i = 0; i < offsets.size(); ++i) {
       u.sample_offsets[i / 2][int(2 * (i % 2))] = offsets[i].x;
       u.sample_offsets[i / 2][int(2 * (i % 2) + 1)] = offsets[i].y;
