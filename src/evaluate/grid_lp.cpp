@@ -20,7 +20,10 @@ GridBasis::GridBasis(std::span<const double> grid, std::span<const std::function
       throw std::invalid_argument("GridBasis: grid points must be finite and strictly increasing");
   if (functions.empty() || rows_ > kMaxRows)
     throw std::invalid_argument(fmt::format("{}: a basis needs 1 to {} functions", name, kMaxRows - 1));
-  if (n_ < rows_) throw SingularBasis(fmt::format("{}: {} functions on a grid of only {} points", name, rows_ - 1, n_));
+  if (n_ < rows_)
+    throw SingularBasis(fmt::format("{}: {} functions and the constant are linearly dependent on a grid of only {} "
+                                    "points (a singular moment space)",
+                                    name, rows_ - 1, n_));
 
   using Real = long double;
   using Matrix = Eigen::Matrix<Real, Eigen::Dynamic, Eigen::Dynamic>;
