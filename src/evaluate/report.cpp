@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <span>
 
@@ -63,10 +64,24 @@ std::vector<std::size_t> ranking_order(const RunResult& run) {
   return order;
 }
 
+// The population that ranks and the histogram count: the LP candidates with the most common number
+// of functions (4 where that ties: the paper's histogram is of its four-function sets), singular
+// ones left out.
+int reference_m(const RunResult& run) {
+  std::map<int, int> count;
+  for (std::size_t i = 0; i < run.results.size(); ++i)
+    if (run.candidates[i].technique == Technique::lp && !run.results[i].singular) ++count[run.candidates[i].m()];
+  int best = 4;
+  for (const auto& [m, n] : count)
+    if (n > (count.contains(best) ? count[best] : 0)) best = m;
+  return best;
+}
+
 std::vector<double> lp_errors(const RunResult& run) {
+  const int m = reference_m(run);
   std::vector<double> errors;
   for (std::size_t i = 0; i < run.results.size(); ++i)
-    if (run.candidates[i].technique == Technique::lp && !run.results[i].singular)
+    if (run.candidates[i].technique == Technique::lp && run.candidates[i].m() == m && !run.results[i].singular)
       errors.push_back(run.results[i].error());
   std::sort(errors.begin(), errors.end());
   return errors;
@@ -102,13 +117,20 @@ void write_histogram(const fs::path& file, const std::vector<double>& errors, co
   const int width = 1000, height = 560, left = 80, right = 30, top = 70, bottom = 70;
   const int plot_w = width - left - right, plot_h = height - top - bottom;
   image::Image img(width, height, 3, 1.0f);
-  double hi = 0.0;
-  for (double e : errors) hi = std::max(hi, e);
-  for (const HistogramMark& m : marks) hi = std::max(hi, m.error);
-  hi = hi > 0.0 ? hi * 1.04 : 0.01;
+  // The range of the candidates and the marks, except marks at 0 (PCF), which sit at the left edge
+  // with an arrow when the range does not reach down to them.
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (double e : errors) lo = std::min(lo, e), hi = std::max(hi, e);
+  for (const HistogramMark& m : marks)
+    if (m.error > 0.0) lo = std::min(lo, m.error), hi = std::max(hi, m.error);
+  if (!(hi > 0.0)) lo = 0.0, hi = 0.01;
+  const double margin = 0.04 * (hi - lo) + 1e-6;
+  lo = std::max(0.0, lo - margin);
+  hi += margin;
+  const auto to_x = [&](double e) { return left + int(std::lround((e - lo) / (hi - lo) * plot_w)); };
   const int bins = 80;
   std::vector<int> counts(bins, 0);
-  for (double e : errors) counts[std::clamp(int(e / hi * bins), 0, bins - 1)]++;
+  for (double e : errors) counts[std::clamp(int((e - lo) / (hi - lo) * bins), 0, bins - 1)]++;
   const int most = std::max(1, *std::max_element(counts.begin(), counts.end()));
   const glm::vec3 ink(0.0f), bar(0.18f, 0.36f, 0.62f), grid_colour(0.85f), mark_colour(0.75f, 0.08f, 0.05f);
 
@@ -123,7 +145,7 @@ void write_histogram(const fs::path& file, const std::vector<double>& errors, co
   for (int k = 0; k <= 8; ++k) {
     const int x = left + int(std::lround(double(k) / 8.0 * plot_w));
     fill(img, x, top + plot_h, x + 1, top + plot_h + 6, ink);
-    const std::string label = percent(hi * k / 8.0);
+    const std::string label = percent(lo + (hi - lo) * k / 8.0);
     text(img, x - image::text_width(label, 2) / 2, top + plot_h + 12, label, ink, 2);
   }
   const std::string x_label = "mean error against PCF (L1 irradiance error / total radiant power)";
@@ -141,9 +163,10 @@ void write_histogram(const fs::path& file, const std::vector<double>& errors, co
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.error < b.error; });
   std::vector<int> row_end(6, -1000);
   for (const HistogramMark& m : sorted) {
-    const int x = left + int(std::lround(m.error / hi * plot_w));
+    const bool off_scale = m.error < lo;
+    const int x = off_scale ? left : to_x(m.error);
     fill(img, x - 1, top, x + 1, top + plot_h, mark_colour);
-    const std::string label = fmt::format("{} {}", m.label, percent(m.error));
+    const std::string label = fmt::format("{}{} {}", off_scale ? "<- " : "", m.label, percent(m.error));
     const int w = image::text_width(label, 2);
     int row = 0;
     while (row + 1 < int(row_end.size()) && row_end[row] > x + 4) ++row;
@@ -217,20 +240,18 @@ json summary(const RunResult& run, const RunSettings& settings) {
   for (std::size_t k = 0; k < std::min<std::size_t>(20, order.size()); ++k) best.push_back(entry(order[k]));
   j["best"] = best;
 
-  std::int64_t singular = 0, failures = 0, fallbacks = 0, lps_total = 0;
+  std::int64_t singular = 0, failures = 0, fallbacks = 0, lps_total = 0, lp_total = 0;
+  for (std::size_t i = 0; i < run.results.size(); ++i) lp_total += run.candidates[i].technique == Technique::lp ? 1 : 0;
   for (const CandidateResult& r : run.results) {
     singular += r.singular ? 1 : 0;
     failures += r.failures();
     fallbacks += r.fallbacks();
     lps_total += r.lps();
   }
-  j["candidates"] = {{"total", run.candidates.size()},
-                     {"lp", errors.size() + std::size_t(singular)},
-                     {"singular", singular},
-                     {"resumed_from_checkpoint", run.resumed},
-                     {"lp_glpk_fallbacks", fallbacks},
-                     {"lp_failures", failures},
-                     {"lps", lps_total}};
+  j["candidates"] = {
+      {"total", run.candidates.size()}, {"lp", lp_total},          {"ranked_m", reference_m(run)},
+      {"ranked", errors.size()},        {"singular", singular},    {"resumed_from_checkpoint", run.resumed},
+      {"lp_glpk_fallbacks", fallbacks}, {"lp_failures", failures}, {"lps", lps_total}};
   if (!errors.empty())
     j["candidates"]["lp_error"] = {
         {"best", errors.front()}, {"median", errors[errors.size() / 2]}, {"worst", errors.back()}};
@@ -271,8 +292,8 @@ json summary(const RunResult& run, const RunSettings& settings) {
         {"hours_on_16_cores", core_hours / 16},
         {"hours_on_128_cores", core_hours / 128},
         {"hours_on_1024_cores", core_hours / 1024}};
-    if (lps_total > 0 && errors.size() > 0) {
-      const double lps_per_candidate = double(lps_total) / double(errors.size() + std::size_t(singular));
+    if (lps_total > 0 && lp_total > 0) {
+      const double lps_per_candidate = double(lps_total) / double(lp_total);
       j["projection"]["all4_this_stack_core_hours"] = lps_per_candidate * 66045.0 / per_core / 3600.0;
     }
   }
@@ -326,8 +347,9 @@ void write_report(const RunResult& run, const RunSettings& settings, const fs::p
            {"PCF", "pcf"}, {"VSM", "vsm"}, {"ESM", "esm"}, {"MSM", "power4"}, {"TMSM", "trig4"}})
     if (const CandidateResult* r = find_named(run, name); r && !r->singular) marks.push_back({label, r->error()});
   write_histogram(dir / "histogram.png", errors, marks,
-                  fmt::format("{} LP candidates on {} scene(s), {}x{} shadow maps, {}-point depth grid", errors.size(),
-                              run.scene_names.size(), settings.stack.size, settings.stack.size, settings.stack.grid));
+                  fmt::format("{} sets of {} functions, {} scene(s), {}x{} maps, {}-point grid", errors.size(),
+                              reference_m(run), run.scene_names.size(), settings.stack.size, settings.stack.size,
+                              settings.stack.grid));
 
   write_text(dir / "summary.json", summary(run, settings).dump(2) + "\n");
 }

@@ -65,19 +65,21 @@ void print_summary(const RunResult& run, const nlohmann::json& s, const std::str
                st["scene"].get<std::string>(), st["fragments"].get<long long>(),
                st["counted_fragments"].get<long long>(), st["lit_fragments"].get<long long>(),
                st["max_layers"].get<long long>());
-  const auto row = [](const nlohmann::json& e) {
+  const long long ranked = s["candidates"]["ranked"].get<long long>();
+  const int ranked_m = s["candidates"]["ranked_m"].get<int>();
+  const auto row = [&](const nlohmann::json& e) {
     const std::string error =
         e["error"].is_null() ? "singular" : fmt::format("{:.4f}%", 100.0 * e["error"].get<double>());
     std::string name = e["name"].get<std::string>();
     if (!e["aliases"].empty()) name += " (" + e["aliases"][0].get<std::string>() + ")";
-    const std::string rank =
-        e.contains("lp_rank")
-            ? fmt::format("LP rank {}, top {:.1f}%", e["lp_rank"].get<long long>(), e["lp_percentile"].get<double>())
-            : "";
-    fmt::print("  {:<44} {:>10}  {}\n", name, error, rank);
+    const std::string rank = e.contains("lp_rank")
+                                 ? fmt::format("rank {} of {} (top {:.1f}%)", e["lp_rank"].get<long long>(), ranked,
+                                               e["lp_percentile"].get<double>())
+                                 : "";
+    fmt::print("  {:<50} {:>9}  {}\n", name, error, rank);
   };
   if (!s["named"].empty()) {
-    fmt::print("named:\n");
+    fmt::print("named (ranked among the {} sets of {} functions):\n", ranked, ranked_m);
     for (const auto& e : s["named"]) row(e);
   }
   fmt::print("best:\n");

@@ -4,9 +4,12 @@
 //                  worst fragment, fragments, LPs solved, LP failures, simplex pivots, cold starts.
 //                  Deterministic: the same bits for any thread or rank count (no timings in it).
 //   ranking.csv    every candidate by error (ties by index; singular bases last), with its rank
-//                  among the LP candidates and the share of them that do better.
-//   histogram.png  2015 Fig. 4: how many LP candidates fall into each error interval, with PCF, VSM,
-//                  ESM, MSM (power4) and TMSM (trig4) marked where the run has them.
+//                  among the ranked population and the share of it that does better. The ranked
+//                  population is the LP candidates with the most common number of functions (4
+//                  where that ties, as the paper's four-function sets): power2 or a closed form
+//                  gets the place it would take among the four-function sets.
+//   histogram.png  2015 Fig. 4: how many of the ranked population fall into each error interval,
+//                  with PCF, VSM, ESM, MSM (power4) and TMSM (trig4) marked where the run has them.
 //   summary.json   settings, stacks, the named techniques, the best candidates, timings, LP
 //                  throughput per core and rank, and the projected time of the paper's evaluation.
 #pragma once
