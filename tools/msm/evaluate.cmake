@@ -101,3 +101,12 @@ if(MSM_BUILD_TESTS)
     set_tests_properties(msm_cli_evaluate_${name}_message PROPERTIES PASS_REGULAR_EXPRESSION "${message}")
   endforeach()
 endif()
+
+# An imported mesh (glmark2-data's bunny, installed by scripts/bootstrap.sh).
+if(MSM_BUILD_TESTS AND EXISTS /usr/share/glmark2/models/bunny.obj)
+  add_test(NAME msm_cli_evaluate_imported_mesh
+    COMMAND msm evaluate --scene ${PROJECT_SOURCE_DIR}/tests/data/evaluate_bunny.json --size 48 --grid 257
+      --candidates power4,trig4,hamburger4 --fresh --out ${CMAKE_CURRENT_BINARY_DIR}/evaluate-tests/bunny)
+  set_tests_properties(msm_cli_evaluate_imported_mesh PROPERTIES
+    PASS_REGULAR_EXPRESSION "3 candidates \\(0 from the checkpoint\\) on 1 scene.*evaluate_bunny.json: [0-9]+ fragments \\([0-9]+ receive light")
+endif()
