@@ -10,6 +10,7 @@ packages=(
   libassimp-dev libembree-dev libopenexr-dev libstb-dev libtbb-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin  # MPI ranks of msm evaluate (Open MPI)
   glmark2-data  # real meshes for the import tests (the bunny, 9 MB)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
 )

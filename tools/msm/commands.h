@@ -5,6 +5,7 @@
 namespace msm::tool {
 
 void add_demo(CLI::App& app);
+void add_evaluate(CLI::App& app);
 void add_kernels(CLI::App& app);
 void add_bench(CLI::App& app);
 void add_techniques(CLI::App& app);

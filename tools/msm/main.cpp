@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   msm::tool::add_scenes(app);
 #endif
   msm::tool::add_reference(app);
+  msm::tool::add_evaluate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) { return app.exit(e); } catch (const std::exception& e) {
