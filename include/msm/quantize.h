@@ -70,9 +70,14 @@ MSM_FN Moments6 msm_theta6_star_inverse(Moments6 q) {
 // ---- Fixed-point storage: round to nearest, as Vulkan's UNORM conversion does ----
 // At an exact tie (x * 65535 = k + 1/2) GLM rounds away from zero and a device may round to even:
 // the two builds can then differ by one step, which the GPU tests accept at ties only.
+// NaN is stored as 0, as Vulkan converts NaN to UNORM (and packUnorm's clamp, and the float to
+// integer conversion after it, leave NaN undefined in GLSL and in C++): msm_saturate first. Every
+// moment representation decodes code 0 to a vector outside the moment space (D1 < 0), which the
+// reconstructions read as lit (hamburger4.h), like NaN moments themselves.
 // Four values in [0,1] as 16-bit UNORM (RGBA16_UNORM texel = two uints).
 MSM_FN uvec2 msm_pack_unorm16x4(vec4 v) {
-  return uvec2(packUnorm2x16(vec2(v[0], v[1])), packUnorm2x16(vec2(v[2], v[3])));
+  return uvec2(packUnorm2x16(vec2(msm_saturate(v[0]), msm_saturate(v[1]))),
+               packUnorm2x16(vec2(msm_saturate(v[2]), msm_saturate(v[3]))));
 }
 MSM_FN vec4 msm_unpack_unorm16x4(uvec2 p) {
   vec2 a = unpackUnorm2x16(p.x);
@@ -81,11 +86,13 @@ MSM_FN vec4 msm_unpack_unorm16x4(uvec2 p) {
 }
 // Round-trip through 16-bit UNORM storage (what a texture write then read does).
 MSM_FN vec4 msm_quantize_unorm16(vec4 v) { return msm_unpack_unorm16x4(msm_pack_unorm16x4(v)); }
-MSM_FN vec2 msm_quantize_unorm16x2(vec2 v) { return unpackUnorm2x16(packUnorm2x16(v)); }
+MSM_FN vec2 msm_quantize_unorm16x2(vec2 v) {
+  return unpackUnorm2x16(packUnorm2x16(vec2(msm_saturate(v[0]), msm_saturate(v[1]))));
+}
 
 // Three values in [0,1] as 10-bit UNORM in the RGB channels of A2B10G10R10_UNORM (R lowest).
 MSM_FN uint msm_pack_unorm10x3(vec3 v) {
-  uvec3 q = uvec3(round(clamp(v, vec3(0.0f), vec3(1.0f)) * 1023.0f));
+  uvec3 q = uvec3(round(vec3(msm_saturate(v[0]), msm_saturate(v[1]), msm_saturate(v[2])) * 1023.0f));
   return q.x | (q.y << 10u) | (q.z << 20u);
 }
 MSM_FN vec3 msm_unpack_unorm10x3(uint p) {
