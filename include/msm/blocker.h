@@ -32,10 +32,10 @@ struct BlockerResult {
 };
 
 // d clamped to the depth range [-1, 1], and NaN to -1; a receiver in front of the range (zf < -1)
-// keeps its own depth (no blocker lies in front of it), so the result never exceeds zf. Selects,
-// not clamp(): GLSL leaves clamp() of NaN undefined.
+// keeps its own depth (no blocker lies in front of it; -inf is kept at -MSM_ROOT_LIMIT), so the
+// result never exceeds zf. Selects, not clamp(): GLSL leaves clamp() of NaN undefined.
 MSM_FN float msm_blocker_depth_in_range(float d, float zf) {
-  return d > -1.0f ? (d < 1.0f ? d : 1.0f) : (zf < -1.0f ? zf : -1.0f);
+  return d > -1.0f ? (d < 1.0f ? d : 1.0f) : (zf < -1.0f ? msm_at_least(zf, -MSM_ROOT_LIMIT) : -1.0f);
 }
 
 // JCGT Eq. (4) on a canonical distribution given as up to four nodes with weights; unused

@@ -140,10 +140,13 @@ struct Canonical4 {
 };
 
 MSM_FN Canonical4 msm_hamburger4_canonical(vec4 b, float zf) {
+  // Invalid input (see msm_hamburger4_roots): no atom besides zf, every weight 0.
+  if (!(msm_hamburger4_valid(b) && msm_receiver_in_range(zf)))
+    return Canonical4(vec3(zf, MSM_ROOT_LIMIT, MSM_ROOT_LIMIT), vec3(0.0f));
   Hamburger4Roots r = msm_hamburger4_roots(b, zf);
   float b1 = b[0], b2 = b[1];
   float z2 = r.z2, z3 = r.z3;
-  // Coincident nodes (invalid input: both roots at MSM_ROOT_LIMIT) get weight 0, not 0/0.
+  // Coincident nodes (a double root) get weight 0, not 0/0.
   float d1 = (z2 - zf) * (z2 - z3), d2 = (z3 - zf) * (z3 - z2);
   float w1 = d1 != 0.0f ? (b2 - b1 * (zf + z3) + zf * z3) / d1 : 0.0f;
   float w2 = d2 != 0.0f ? (b2 - b1 * (zf + z2) + zf * z2) / d2 : 0.0f;

@@ -287,7 +287,10 @@ MSM_FN vec2 msm_hamburger6_merged_pair(Moments6 b, float zf, float za, float zb,
   float w = msm_hamburger6_weighted_sum(b, z, ones);
   float s = msm_hamburger6_weighted_sum(b, z, depths);
   float mid = 0.5f * (za + zb);
-  return vec2(w, (w > 0.0f) ? clamp(s / w, za, zb) : mid);
+  // s / w clamped to [za, zb] by selects (NaN goes to mid): clamp() of NaN differs between GLM and
+  // devices.
+  float m = (w > 0.0f) ? s / w : mid;
+  return vec2(w, m >= za ? (m <= zb ? m : zb) : (m < za ? za : mid));
 }
 
 // A pair of roots closer than MSM_MERGE_ROOTS6 is returned as one atom: position and combined
@@ -301,6 +304,9 @@ MSM_FN vec2 msm_hamburger6_merged_pair(Moments6 b, float zf, float za, float zb,
 // the two roots, which is itself ill-conditioned. If all three roots lie within the tolerance
 // (invalid input only) the lower pair is merged.
 MSM_FN Canonical6 msm_hamburger6_canonical(Moments6 b, float zf) {
+  // Invalid input (see msm_hamburger6_roots): no atom besides zf, every weight 0.
+  if (!(msm_hamburger6_valid(b) && msm_receiver_in_range(zf)))
+    return Canonical6(vec4(zf, MSM_ROOT_LIMIT, MSM_ROOT_LIMIT, MSM_ROOT_LIMIT), vec4(0.0f));
   Hamburger6Roots r = msm_hamburger6_roots(b, zf);
   float z1 = r.z[0], z2 = r.z[1], z3 = r.z[2];
   float w0 = msm_hamburger6_w0(r, zf);
