@@ -16,38 +16,40 @@
 
 MSM_BEGIN
 
-// How many unit roundoffs (2^-24) of the terms of s1 and s2 below count as their noise: the input
-// moments carry about one rounding each (filtered float moments a few), the evaluation three or
-// four more.
-const float MSM_HAUSDORFF_NOISE = 4.0f;
+// How many unit roundoffs (2^-24) of the sum of the magnitudes of the terms of s0, s1, s2 and V
+// below count as their noise: one. The sum assumes every term's rounding aligned, a worst case
+// of the input's own rounding (measured errors of s2 were a quarter of it). Four cost 0.04 on the
+// HPG §3.2 pair ½δ(0.915) + ½δ(1) at the far end (K6 of `msm kernels`: 0.455 against a sharp
+// 0.499, 0.487 with one), and no edge class needed more (edges_test).
+const float MSM_HAUSDORFF_NOISE = 1.0f;
 
-// The four-atom branch, written so that every quantity it divides by is a sum of non-negative
-// terms. With g(z) = (z - lo)(hi - z) >= 0 on [lo, hi], the measure ν = g μ of the optimal
-// μ = w_lo δ(lo) + w_0 δ(zf) + w_x δ(x) + w_hi δ(hi) has atoms at zf and x only (g vanishes at the
-// ends), and its moments come from b0..b4:
+// The four-atom branch. With g(z) = (z - lo)(hi - z) >= 0 on [lo, hi], the measure ν = g μ of the
+// optimal μ = w_lo δ(lo) + w_0 δ(zf) + w_x δ(x) + w_hi δ(hi) has atoms at zf and x only (g vanishes
+// at the ends), and its moments come from b0..b4:
 //   s0 = E[g], s1 = E[g (z - zf)] = c (x - zf), s2 = E[g (z - zf)²] = c (x - zf)²,
-// c the ν-weight of x: x - zf = s2 / s1, c = s1² / s2 <= s0 (Cauchy-Schwarz). Eliminating w_hi and
-// w_0 with b0, b1 gives L = Z(z < zf) of μ = w_lo + [x < zf] w_x as
-//   L (hi - lo)(zf - lo) = P + corr,    P = E[(hi - z)(zf - z)] = b2 - (hi + zf) b1 + hi zf,
-//   x >= zf (s1 >= 0): corr = s1² / (s1 (zf - lo) + s2)              (= c (x - zf) / (x - lo)),
-//   x <  zf (s1 <  0): corr = c + c (zf - lo) |s1| / (|s1| (hi - zf) + s2)  (= c + c (zf - lo) / (hi - x)).
-// P / ((hi - lo)(zf - lo)) alone is E[p] for the quadratic p through (lo, 1), (zf, 0), (hi, 0),
-// which lies below the indicator of z < zf on [lo, hi]: a lower bound by itself (the two-moment
-// bound that knows the interval); corr >= 0 sharpens it, and corr = 0 where ν has no mass
-// besides zf. Why this form: the former Lagrange weights of {lo, zf, x, hi} divided by x - zf and
-// by E[(z-lo)(z-hi)(z-zf)] = -s1, both 0 when μ lives on {lo, zf, hi} (an occluder at the near end
-// biased towards ½δ(lo) + ½δ(hi), alone or beside a receiver): 0/0 = NaN, which max() kept on the
-// CPU and msm_saturate turned into "lit". And for a receiver on a cluster of nearly equal depths,
-// s1 and s2 are rounding noise: x came out just below zf with c ~ s0, counting the whole cluster
-// as shadow (0.98 against a sharp bound of 0.27).
-// Rounding. s1 and s2 are differences of terms up to ~|b| each; below MSM_HAUSDORFF_NOISE unit
-// roundoffs of those terms (tol1, tol2) their values, and the sign of s1 (which side of zf x lies
-// on), are noise. corr grows with |s1| and shrinks with s2 in both branches, so |s1| is reduced by
-// tol1 and s2 raised to at least tol2: the bound of the vector within rounding that allows the
-// least shadow, i.e. the light side (a lower bound for every vector the rounding could have come
-// from). c is capped at s0 (ν's weight at x is at most all of ν) and P is left as it is (its own rounding moves the result by
-// ~2^-24 / (zf - lo), which is the conditioning of the problem: mass at lo and at zf are told apart
-// by zf - lo).
+// c the ν-weight of x: x - zf = s2 / s1, c = s1² / s2, and V = s0 s2 - s1² >= 0 (Cauchy-Schwarz;
+// s0² times ν's variance, 0 when ν is one atom). Eliminating w_hi and w_0 with b0, b1 gives
+// L = Z(z < zf) of μ = w_lo + [x < zf] w_x as
+//   L (hi - lo) = (hi - b1) - t - V / ((zf - lo) d),
+//   x >= zf (s1 >= 0): d = s1 (zf - lo) + s2, t = s0 s1 / d,
+//   x <  zf (s1 <  0): d = s2,                t = -c |s1| / (|s1| (hi - zf) + s2), c = s0 - V / s2.
+// (Written as L (hi - lo)(zf - lo) = P + corr with P = E[(hi - z)(zf - z)], the quadratic bound
+// that knows the interval, P and corr are each ~s0 and cancel to V / d where ν has no spread:
+// divided by zf - lo, their rounding made a receiver 2.7e-5 behind an occluder at the near end
+// read 0.420 for 0.432. Here only V, which is 0 there, is divided by zf - lo.) Every divisor is
+// a sum of non-negative terms. Why not the former Lagrange weights of {lo, zf, x = E[z r] / E[r]}:
+// they divided by x - zf and by E[(z-lo)(z-hi)(z-zf)] = -s1, both 0 when μ lives on {lo, zf, hi}
+// (an occluder at the near end biased towards ½δ(lo) + ½δ(hi), alone or beside a receiver): 0/0 =
+// NaN, which max() kept on the CPU and msm_saturate turned into "lit"; and for a receiver on a
+// cluster of nearly equal depths s1 and s2 are rounding noise: x came out just below zf with c ~
+// s0, counting the whole cluster as shadow (0.98 against a sharp bound of 0.27).
+// Rounding. s0, s1, s2 and V are differences of terms up to ~|b| each; below MSM_HAUSDORFF_NOISE
+// unit roundoffs of the sum of those terms' magnitudes (tol0, tol1, tol2, tolv) their values, and
+// the sign of s1 (which side of zf x lies on), are noise. Resolved to the light side, the bound of
+// the vector within rounding that allows the least shadow: |s1| within tol1 of 0 takes x >= zf
+// with s1 >= 0, s2 at least tol2, and V at least tolv (a larger V spreads ν and lowers L; t stays
+// within what c <= s0 allows). Beyond rounding, negative s0, s2 or V mean that no distribution on
+// [lo, hi] has these moments (below).
 MSM_FN float msm_hausdorff4_four_atoms(vec4 b, float zf, float lo, float hi) {
   float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];
   float noise = MSM_HAUSDORFF_NOISE * MSM_FLOAT_ROUNDING;
@@ -62,7 +64,6 @@ MSM_FN float msm_hausdorff4_four_atoms(vec4 b, float zf, float lo, float hi) {
   float f1 = e1 + zf, f2 = e2 + zf * e1, f3 = e3 + zf * e2, f4 = zf * e3;
   float s2 = -(b4 - f1 * b3 + f2 * b2 - f3 * b1 + f4);
   float tol2 = noise * (abs(b4) + abs(f1 * b3) + abs(f2 * b2) + abs(f3 * b1) + abs(f4));
-  // V = s0 s2 - s1² >= 0 (Cauchy-Schwarz for ν): s0² times ν's variance about its mean.
   float v = s0 * s2 - s1 * s1;
   float tolv = noise * (abs(s0 * s2) + s1 * s1) + abs(s0) * tol2 + abs(s2) * tol0 + 2.0f * abs(s1) * tol1;
   // Outside the moment space of [lo, hi] beyond rounding: s0, s2 or V negative (mass beyond the
@@ -73,18 +74,10 @@ MSM_FN float msm_hausdorff4_four_atoms(vec4 b, float zf, float lo, float hi) {
   if (s0 < -tol0 || s2 < -tol2 || v < -tolv) return -1.0f;
   s0 = msm_at_least(s0, 0.0f);
   s2 = msm_at_least(s2, tol2);
-  // Light side: the largest V within rounding (a larger V spreads ν and lowers the bound).
-  v = msm_at_least(v, tolv);
-  // L (hi - lo) = (hi - b1) - t - V / ((zf - lo) d), both branches:
-  //   x >= zf: d = s1 (zf - lo) + s2, t = s0 s1 / d;
-  //   x <  zf: d = s2, t = -c |s1| / (|s1| (hi - zf) + s2), c = s0 - V / s2 (= s1² / s2 <= s0).
-  // This is P + corr above rearranged with P = (zf - lo)(hi - b1) - s0: s0 and corr, each ~s0 and
-  // cancelling to V / d where ν has no spread, no longer meet, and only V (which is 0 there) is
-  // divided by zf - lo. Written as P + corr, a receiver 2.7e-5 behind an occluder at the near end
-  // read 0.420 for 0.432 (float rounding of P and corr, ~5e-7, over 2 (zf - lo) = 5.4e-5).
+  v = msm_at_least(v, tolv); // the light side (above)
   float t = 0.0f, d = s2;
   if (s1 < -tol1) {
-    float c = s0 - v / s2;
+    float c = msm_at_least(s0 - v / s2, 0.0f);
     t = -c * (-s1) / (-s1 * (hi - zf) + s2);
   } else {
     float a = msm_at_least(s1, 0.0f);

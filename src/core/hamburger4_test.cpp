@@ -141,8 +141,8 @@ TEST(Hamburger4, CanonicalDistributionHasTheInputMoments) {
 // The LP of the 2015 paper on a grid, solved exactly (GLPK's rational re-solve): minimizing over
 // distributions on the grid only, its optimum is >= the sharp bound over the whole domain and
 // approaches it as the grid resolves the optimal atoms. So: never float > LP beyond float error
-// (1e-3), and equality up to the grid: measured max 2.1e-5 (Hamburger, wide grid) and 2.0e-3
-// (Hausdorff, 1e-3 spacing on [0,1]); bounds p90 1e-4, max 5e-3. Few cases: an exact LP takes
+// (1e-3), and equality up to the grid: measured max 2.1e-5 (Hamburger, wide grid) and 4.7e-5
+// (Hausdorff, 1e-3 spacing on [0,1]; 2.0e-3 before its four-atom branch was rewritten); bounds p90 1e-4, max 5e-3. Few cases: an exact LP takes
 // 0.2-0.7 s.
 void check_against_lp(const std::vector<double>& grid, bool hausdorff, int cases, uint64_t seed) {
   std::mt19937_64 rng(seed);
