@@ -551,7 +551,7 @@ TEST(Edges, SatBiasTargetIsMeasuredAfterTheTransform) {
 // The pivot floor of Hamburger 4MSM (hamburger4.h): where D2 rounds to <= 0 the bound is that of
 // the vector with D2 raised to one rounding of b4, not the two-atom limit (the old floor 1e-12).
 //  - The case: a surface at 0.950902 ([0,1] float, 2015 bias), a receiver 3.5e-6 behind
-//    it. The sharp bound of the exactly biased vector is 0.0044; the two-atom limit read 0.917.
+//    it. The sharp bound of the exactly biased vector is 0.0044; the two-atom limit read 0.909.
 //    The floor must read no more than that sharp bound (+1e-3): the light side.
 //  - Self-shadowing: with the filtered techniques' depth bias (1e-5 in [0,1] depth) a flat
 //    receiver on a single surface reads at most the bias's α/2 = 1e-6 plus rounding (1e-5).
@@ -572,7 +572,7 @@ TEST(Edges, PivotFloorIsTheLightSide) {
   ASSERT_TRUE(sharp.ok);
   float result = msm_hamburger4_lower(msm_apply_bias(test::moments4f(surface), unit), zf);
   std::printf("[edges] surface at 0.950902, receiver 3.5e-6 behind: %.4f, sharp bound of the exactly biased vector "
-              "%.4f (two-atom limit before: 0.917)\n",
+              "%.4f (two-atom limit before: 0.909)\n",
               result, sharp.lower);
   EXPECT_LE(result, sharp.lower + 1e-3);
   for (int rep : {MSM_REP_UNIT_FLOAT, MSM_REP_SIGNED_FLOAT}) {
