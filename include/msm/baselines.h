@@ -71,11 +71,12 @@ MSM_FN vec2 msm_vsm_moments(float z) { return vec2(z, z * z); }
 // Reconstruction from b = E(z, z²).
 MSM_FN float msm_vsm_shadow(vec2 b, float zf, float min_variance) {
   float mean = b[0];
-  if (zf <= mean) return 0.0f;
-  float variance = max(b[1] - mean * mean, min_variance);
+  if (!(zf > mean)) return 0.0f; // NaN reads lit, as in every moment technique
+  float variance = b[1] - mean * mean;
+  variance = variance > min_variance ? variance : min_variance; // a select: no NaN reaches max()
   float d = zf - mean;
   // d²/(σ² + d²) = 1 - σ²/(σ² + d²), without the cancellation for small shadows.
-  return (d * d) / (variance + d * d);
+  return msm_saturate((d * d) / (variance + d * d));
 }
 MSM_FN float msm_vsm_shadow(vec2 b, float zf) { return msm_vsm_shadow(b, zf, MSM_VSM_MIN_VARIANCE_FLOAT); }
 

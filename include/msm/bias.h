@@ -4,6 +4,7 @@
 #ifndef MSM_BIAS_H
 #define MSM_BIAS_H
 #include "msm/config.h"
+#include "msm/hamburger4.h"
 #include "msm/moments.h"
 #include "msm/shared.h"
 
@@ -35,8 +36,13 @@ MSM_FN MomentBias4 msm_moment_bias(int representation) {
   if (representation == MSM_REP_UNIT_THETA4) return MomentBias4(MSM_ALPHA_UNIT_16BIT, MSM_BSTAR_UNIT);
   if (representation == MSM_REP_SIGNED_FLOAT) return MomentBias4(MSM_ALPHA_SIGNED_FLOAT, MSM_BSTAR_SIGNED_FLOAT);
   if (representation == MSM_REP_SIGNED_THETA4) return MomentBias4(MSM_ALPHA_SIGNED_16BIT, MSM_BSTAR_SIGNED_16BIT);
-  // Summed-area tables store Θ4* moments at ~22 bits: the float b* with the stronger α.
-  return MomentBias4(MSM_ALPHA_SAT_INT32, MSM_BSTAR_SIGNED_FLOAT);
+  // Summed-area tables store Θ4* moments at ~22.5 bits. Their rounding happens after Θ4*, as for
+  // 16-bit Θ4* storage, so b* is the one measured after Θ4* (JCGT §2.5; App. D.4 and the authors'
+  // Convert4MomentOptimizedToCanonical use 0.628 with α = 6e-7). With the float b* (0.375), 509 of
+  // 40000 biased one-texel queries of single depths were not positive definite, 147 with 0.628
+  // (edges_test, SatBiasTargetIsMeasuredAfterTheTransform); α = 6e-7 stays the paper's, the rest
+  // is what hamburger4.h's D2 floor is for.
+  return MomentBias4(MSM_ALPHA_SAT_INT32, MSM_BSTAR_SIGNED_16BIT);
 }
 
 MSM_FN MomentBias6 msm_moment_bias6(int representation) {
@@ -79,6 +85,15 @@ MSM_FN float msm_receiver_depth_sigma(vec2 depth_per_texel, float kernel_varianc
 MSM_FN float msm_receiver_plane_bias_negative_warp(float sigma, float c) { return 0.5f * c * sigma * sigma; }
 
 MSM_FN vec4 msm_apply_bias(vec4 b, float alpha, vec4 bstar) { return mix(b, bstar, alpha); }
+
+// b with b4 raised so that the last LDLᵀ pivot D2 = b4 - b2² - L21² D1 (hamburger4.h) is at least
+// min_d2: adding to b4 adds the same to D2 and leaves b0..b3 alone, and a larger D2 only lowers
+// the lower bound (HPG §3.2), so this is the light side of a vector whose D2 the storage rounded
+// away. For the 2015 θ4 16-bit representation (MSM_MIN_D2_UNIT_16BIT, config.h); every other
+// representation relies on its bias and on hamburger4.h's float floor.
+MSM_FN vec4 msm_raise_d2(vec4 b, float min_d2) {
+  return vec4(b[0], b[1], b[2], b[3] + msm_at_least(min_d2 - msm_hankel3_ldl(b).D2, 0.0f));
+}
 MSM_FN vec4 msm_apply_bias(vec4 b, MomentBias4 bias) { return mix(b, bias.bstar, bias.alpha); }
 MSM_FN Moments6 msm_apply_bias6(Moments6 b, MomentBias6 bias) { return msm_moments6_mix(b, bias.bstar, bias.alpha); }
 

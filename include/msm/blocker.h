@@ -6,7 +6,12 @@
 // (2015 Prop. 8), up to the bias in both cases (blocker_test measures how far). Hence:
 //  - b are the BIASED moments (bias.h), as everywhere;
 //  - zf is the UNBIASED fragment depth (no depth bias added), so that a receiver surface at zf
-//    is the known third surface of Prop. 8.
+//    is the known third surface of Prop. 8;
+//  - depths are in [-1,1] (JCGT §2.3, as soft.h uses them), and the average blocker depth is
+//    clamped to that range, as the authors' Compute4MomentAverageBlockerDepth does: a root of the
+//    canonical distribution may lie below -1 (the Hamburger problem knows no depth range, and the
+//    bias puts weight ~α there), and it pulled the average down to -2.33 (edges_test), which
+//    widened the penumbra beyond any blocker in the map.
 #ifndef MSM_BLOCKER_H
 #define MSM_BLOCKER_H
 #include "msm/config.h"
@@ -26,6 +31,13 @@ struct BlockerResult {
   float shadow;
 };
 
+// d clamped to the depth range [-1, 1], and NaN to -1; a receiver in front of the range (zf < -1)
+// keeps its own depth (no blocker lies in front of it; -inf is kept at -MSM_ROOT_LIMIT), so the
+// result never exceeds zf. Selects, not clamp(): GLSL leaves clamp() of NaN undefined.
+MSM_FN float msm_blocker_depth_in_range(float d, float zf) {
+  return d > -1.0f ? (d < 1.0f ? d : 1.0f) : (zf < -1.0f ? msm_at_least(zf, -MSM_ROOT_LIMIT) : -1.0f);
+}
+
 // JCGT Eq. (4) on a canonical distribution given as up to four nodes with weights; unused
 // nodes carry weight 0. z[0] = zf, the other nodes count where z[l] < zf:
 // (ε zf + Σ w[l] z[l]) / (ε + Σ w[l]). ε > 0 keeps the quotient defined when nothing occludes
@@ -42,7 +54,8 @@ MSM_FN BlockerResult msm_blocker_from_canonical(vec4 z, vec4 w, float epsilon) {
     weight_sum += occludes;
     depth_sum += occludes * z[l];
   }
-  return BlockerResult((epsilon * zf + depth_sum) / (epsilon + weight_sum), msm_saturate(weight_sum));
+  return BlockerResult(msm_blocker_depth_in_range((epsilon * zf + depth_sum) / (epsilon + weight_sum), zf),
+                       msm_saturate(weight_sum));
 }
 
 // Kneiphof Eq. (19), the upper-bound variant: the average over all nodes z[l] <= zf INCLUDING
@@ -65,7 +78,7 @@ MSM_FN BlockerResult msm_blocker_upper_from_canonical(vec4 z, vec4 w, float delt
     depth_sum += below * z[l];
     shadow += (z[l] < zf) ? wl : 0.0f;
   }
-  return BlockerResult(depth_sum / weight_sum, msm_saturate(shadow));
+  return BlockerResult(msm_blocker_depth_in_range(depth_sum / weight_sum, zf), msm_saturate(shadow));
 }
 
 // Four moments b = (b1, b2, b3, b4): three nodes (zf, z2, z3) from msm_hamburger4_canonical.

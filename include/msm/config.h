@@ -16,17 +16,26 @@ const float MSM_ALPHA_UNIT_16BIT = 3.0e-5f;
 const float MSM_ALPHA_SIGNED_FLOAT = 3.0e-7f;
 // JCGT: [-1,1] depth, 16-bit Θ4*: b* = (1,0,0.628,0,0.628) (optimal after Θ4*) with 6e-5.
 const float MSM_ALPHA_SIGNED_16BIT = 6.0e-5f;
-// JCGT §4.2: 32-bit integer summed-area tables keep ~22.4 bits for 28² kernels: 6e-7.
+// JCGT §4.2, App. D.4: 32-bit integer summed-area tables keep ~22.4 bits for 28² kernels: 6e-7,
+// towards the b* measured after Θ4* (MSM_BSTAR_SIGNED_16BIT), since the tables store Θ4* moments.
 const float MSM_ALPHA_SAT_INT32 = 6.0e-7f;
 // JCGT §5.4.3: six moments in 10-bit (64 bits per texel), 16-bit (96) and float (192).
 const float MSM_ALPHA6_10BIT = 4.0e-3f;
 const float MSM_ALPHA6_16BIT = 8.0e-5f;
 const float MSM_ALPHA6_FLOAT = 5.0e-6f;
 
+// 2015 θ4 16-bit storage: its b* = ½δ0 + ½δ1 has D2(b*) = 0, so α protects only the variance,
+// and 16-bit rounding moves D2 (the last LDLᵀ pivot of the Hankel matrix) by 2.1e-7 (median) to
+// 3e-6 (p99) for one to three depths: 9% of single depths leave the moment space, where the
+// bound approached the two-atom limit and read up to 0.83 darker than PCF. bias.h raises D2 of
+// that representation to at least this (msm_raise_d2): 0.04 darker at most, for 10% more mean
+// error against float storage (edges_test; 1e-7 left 0.15, 1e-6 cost 24%).
+const float MSM_MIN_D2_UNIT_16BIT = 5.0e-7f;
+
 // Biasing targets b* (without b0 = 1).
 const vec4 MSM_BSTAR_UNIT = vec4(0.5f, 0.5f, 0.5f, 0.5f);             // ½δ0 + ½δ1 on [0,1]
 const vec4 MSM_BSTAR_SIGNED_FLOAT = vec4(0.0f, 0.375f, 0.0f, 0.375f); // JCGT §2.5 worst case
-const vec4 MSM_BSTAR_SIGNED_16BIT = vec4(0.0f, 0.628f, 0.0f, 0.628f); // JCGT §2.5 after Θ4*
+const vec4 MSM_BSTAR_SIGNED_16BIT = vec4(0.0f, 0.628f, 0.0f, 0.628f); // JCGT §2.5 after Θ4* (16-bit, SAT)
 // JCGT §5.4.3, six moments b* = (1, 0, 0.5566, 0, 0.489, 0, 0.47869382): the odd moments
 // (b1, b3, b5) of b* are zero, the even ones (b2, b4, b6) are these.
 const vec3 MSM_BSTAR6_EVEN = vec3(0.5566f, 0.489f, 0.47869382f);

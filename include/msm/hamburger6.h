@@ -106,7 +106,19 @@ struct Hamburger6Roots {
   vec3 z;
 };
 
+// A vector that some biased texel can have: finite, with variance above MSM_MIN_PIVOT6_1 (biased
+// six-moment vectors have D1 >= 2.8e-6, see below; a NaN texel stored as UNORM code 0 decodes to
+// D1 = -1.02).
+MSM_FN bool msm_hamburger6_valid(Moments6 b) {
+  return msm_is_finite4(vec4(b.odd, b.even[0])) && msm_is_finite(b.even[1]) && msm_is_finite(b.even[2]) &&
+         msm_fma(-b.odd[0], b.odd[0], b.even[0]) > MSM_MIN_PIVOT6_1;
+}
+
+// Invalid input (msm_hamburger6_valid false) or a receiver out of range (msm_receiver_in_range,
+// roots.h) comes back as q = 0 and all roots at +MSM_ROOT_LIMIT: the bounds then read 0 (lit),
+// or 1 behind everything, and w0 = 0, as in hamburger4.h.
 MSM_FN Hamburger6Roots msm_hamburger6_roots(Moments6 b, float zf) {
+  if (!(msm_hamburger6_valid(b) && msm_receiver_in_range(zf))) return Hamburger6Roots(vec4(0.0f), vec3(MSM_ROOT_LIMIT));
   float b1 = b.odd[0], b3 = b.odd[1], b5 = b.odd[2];
   float b2 = b.even[0], b4 = b.even[1], b6 = b.even[2];
   // B = L D Lᵀ, L unit lower triangular with first column (1, b1, b2, b3),
@@ -116,16 +128,19 @@ MSM_FN Hamburger6Roots msm_hamburger6_roots(Moments6 b, float zf) {
   // the float LDLᵀ written out plainly this cuts the error against JCGT Alg. 1 (m = 6) from p99
   // 2e-5 / max 5e-2 to p99 6e-6 / max 4e-3 (hamburger6_test). The pivots are floored (below)
   // for unbiased or otherwise invalid input only: biased float moments keep D1 >= 2.8e-6,
-  // D2 >= 7.9e-7, D3 >= 3.0e-8 (measured over flat receivers and 1-3 Diracs in [-1,1]).
-  float D1 = max(msm_fma(-b1, b1, b2), MSM_MIN_PIVOT6_1);
+  // D2 >= 7.9e-7, D3 >= 3.0e-8 (measured over flat receivers and 1-3 Diracs in [-1,1]), and no
+  // biased vector of a six-moment storage path was found outside the moment space (edges_test),
+  // so the rounding floor of hamburger4.h's D2 is not needed here. msm_at_least, not max(): no
+  // NaN reaches a max().
+  float D1 = msm_at_least(msm_fma(-b1, b1, b2), MSM_MIN_PIVOT6_1);
   float L21D1 = msm_fma(-b1, b2, b3);
   float L31D1 = msm_fma(-b1, b3, b4);
   float L21 = L21D1 / D1;
   float L31 = L31D1 / D1;
-  float D2 = max(msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)), MSM_MIN_PIVOT6_2);
+  float D2 = msm_at_least(msm_fma(-L21, L21D1, msm_fma(-b2, b2, b4)), MSM_MIN_PIVOT6_2);
   float L32D2 = msm_fma(-L21, L31D1, msm_fma(-b2, b3, b5));
   float L32 = L32D2 / D2;
-  float D3 = max(msm_fma(-L32, L32D2, msm_fma(-L31, L31D1, msm_fma(-b3, b3, b6))), MSM_MIN_PIVOT6_3);
+  float D3 = msm_at_least(msm_fma(-L32, L32D2, msm_fma(-L31, L31D1, msm_fma(-b3, b3, b6))), MSM_MIN_PIVOT6_3);
   // Forward substitution L y = (1, zf, zf², zf³) (y0 = 1), scaling by D⁻¹, back substitution.
   float y1 = zf - b1;
   float y2 = msm_fma(-L21, y1, msm_fma(zf, zf, -b2));
@@ -142,10 +157,14 @@ MSM_FN Hamburger6Roots msm_hamburger6_roots(Moments6 b, float zf) {
 }
 
 // Weight of zf in the canonical representation: w0 = 1 / (pᵀ B⁻¹ p) = 1 / Σ q[j] zf^j with
-// p = (1, zf, zf², zf³) (2015 supplementary, Proposition 10; as msm_hamburger4_w0).
+// p = (1, zf, zf², zf³) (2015 supplementary, Proposition 10; as msm_hamburger4_w0). pᵀ B⁻¹ p >= 1
+// for positive definite B; just below 1 (rounding) gives 1, a non-positive or NaN value (garbage
+// moments, or invalid input with q = 0) gives 0, so that lower <= lower + β w0 <= upper for any
+// input (garbage moments gave w0 < 0 and upper < lower in 19% of random vectors before).
 MSM_FN float msm_hamburger6_w0(Hamburger6Roots r, float zf) {
   vec4 q = r.q;
-  return 1.0f / (q[0] + zf * (q[1] + zf * (q[2] + zf * q[3])));
+  float s = q[0] + zf * (q[1] + zf * (q[2] + zf * q[3]));
+  return s >= 1.0f ? 1.0f / s : (s > 0.0f ? 1.0f : 0.0f);
 }
 
 // Σ v[l] w[l] over the canonical distribution Σ w[l] δ(z[l]), z = zf and the three roots in any
@@ -205,6 +224,7 @@ MSM_FN float msm_hamburger6_weighted_sum(Moments6 b, vec4 z, vec4 v) {
 // basis multiplies by z[0], z[1], z[2] only, so a root far away (up to ±MSM_ROOT_LIMIT, see
 // msm_cubic_roots) never scales a coefficient.
 MSM_FN float msm_hamburger6_lower_from_roots(Moments6 b, float zf, Hamburger6Roots r) {
+  if (!msm_receiver_in_range(zf)) return msm_receiver_out_of_range_shadow(msm_hamburger6_valid(b), zf);
   vec4 z = (abs(r.z[0]) > abs(r.z[2])) ? vec4(zf, r.z[1], r.z[2], r.z[0]) : vec4(zf, r.z[1], r.z[0], r.z[2]);
   vec4 v = vec4(0.0f, (z[1] < zf) ? 1.0f : 0.0f, (z[2] < zf) ? 1.0f : 0.0f, (z[3] < zf) ? 1.0f : 0.0f);
   return msm_saturate(msm_hamburger6_weighted_sum(b, z, v));
@@ -267,7 +287,10 @@ MSM_FN vec2 msm_hamburger6_merged_pair(Moments6 b, float zf, float za, float zb,
   float w = msm_hamburger6_weighted_sum(b, z, ones);
   float s = msm_hamburger6_weighted_sum(b, z, depths);
   float mid = 0.5f * (za + zb);
-  return vec2(w, (w > 0.0f) ? clamp(s / w, za, zb) : mid);
+  // s / w clamped to [za, zb] by selects (NaN goes to mid): clamp() of NaN differs between GLM and
+  // devices.
+  float m = (w > 0.0f) ? s / w : mid;
+  return vec2(w, m >= za ? (m <= zb ? m : zb) : (m < za ? za : mid));
 }
 
 // A pair of roots closer than MSM_MERGE_ROOTS6 is returned as one atom: position and combined
@@ -281,6 +304,9 @@ MSM_FN vec2 msm_hamburger6_merged_pair(Moments6 b, float zf, float za, float zb,
 // the two roots, which is itself ill-conditioned. If all three roots lie within the tolerance
 // (invalid input only) the lower pair is merged.
 MSM_FN Canonical6 msm_hamburger6_canonical(Moments6 b, float zf) {
+  // Invalid input (see msm_hamburger6_roots): no atom besides zf, every weight 0.
+  if (!(msm_hamburger6_valid(b) && msm_receiver_in_range(zf)))
+    return Canonical6(vec4(zf, MSM_ROOT_LIMIT, MSM_ROOT_LIMIT, MSM_ROOT_LIMIT), vec4(0.0f));
   Hamburger6Roots r = msm_hamburger6_roots(b, zf);
   float z1 = r.z[0], z2 = r.z[1], z3 = r.z[2];
   float w0 = msm_hamburger6_w0(r, zf);

@@ -52,7 +52,16 @@ struct NonLinearMoments {
 // depth of weight ~α (the one the bias adds) is ill conditioned and may leave [-1,1] by ~0.02
 // (nonlinear_test measures these). So the result is clamped: y to [-1,1], ξ4 to >= 0. Both
 // clamps only touch values that rounding produced.
+// Non-finite moments (a NaN texel) become MSM_NL_FAR, all depth at the far plane y = 1: it reads
+// as lit (0) for every receiver up to the far plane, unquantized, at 64 bits and at 32 bits alike
+// (32 bits store y = 1 in the last depth bin, whose centre is 1 - 1/1023), as NaN moments read in
+// every other representation (hamburger4.h). Before, the 64/32-bit round trip of NaN stored
+// codes 0 (y1 = y2 = -1) and read 1.
+const NonLinearMoments MSM_NL_FAR = NonLinearMoments(1.0f, 1.0f, 0.0f, 0.0f);
+MSM_FN bool msm_nl_is_finite(NonLinearMoments m) { return msm_is_finite4(vec4(m.y1, m.y2, m.v2, m.xi4)); }
+
 MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
+  if (!msm_is_finite4(b)) return MSM_NL_FAR;
   // Steps 1-5: the two depths and the weight of the larger one.
   TwoDepths two = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
   // Steps 6-7: third diagonal entry of the LDLᵀ factorization of the Hankel matrix (Eq. (3)),
@@ -61,7 +70,9 @@ MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
   // multiplies and subtractions (max 4e-8 instead of 2.3e-7 against double on the same float
   // moments), which matters because ξ4 is ~1e-7 for the most common texel, a single surface.
   float xi4 = msm_hankel3_ldl(b).D2;
-  return NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, max(xi4, 0.0f));
+  NonLinearMoments m =
+      NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, msm_at_least(xi4, 0.0f));
+  return msm_nl_is_finite(m) ? m : MSM_NL_FAR; // finite but overflowing garbage
 }
 
 // Φ of filtered, unbiased float moments: applies the float bias of [-1,1] depth first.
@@ -98,6 +109,7 @@ MSM_FN float msm_nl_psi4_inverse(float psi4) {
 
 // ---- 64 bits: four 16-bit UNORM (HPG §3.3) ----
 MSM_FN uvec2 msm_nl_pack64(NonLinearMoments m) {
+  m = msm_nl_is_finite(m) ? m : MSM_NL_FAR;
   return msm_pack_unorm16x4(vec4(0.5f * m.y1 + 0.5f, 0.5f * m.y2 + 0.5f, m.v2, msm_nl_psi4(m.xi4)));
 }
 MSM_FN NonLinearMoments msm_nl_unpack64(uvec2 p) {
@@ -148,6 +160,7 @@ MSM_FN uint msm_nl_psi4_encode6(float psi4) {
 }
 
 MSM_FN uint msm_nl_pack32(NonLinearMoments m) {
+  m = msm_nl_is_finite(m) ? m : MSM_NL_FAR;
   uint t1 = msm_nl_depth10_encode(m.y1);
   uint t2 = msm_nl_depth10_encode(m.y2);
   uint pair = msm_nl_fold_depths(uvec2(min(t1, t2), max(t1, t2)));
@@ -175,10 +188,11 @@ MSM_FN NonLinearMoments msm_nl_quantize32(NonLinearMoments m) { return msm_nl_un
 // far inside float range.
 const float MSM_NL_XI4_SHADING_MIN = 1.0e-12f;
 MSM_FN float msm_nl_shadow(NonLinearMoments m, float zf) {
+  if (!msm_nl_is_finite(m)) return 0.0f; // as MSM_NL_FAR, and no NaN reaches the max() below
   float y1 = m.y1;
   float y2 = max(m.y2, y1 + MSM_NL_TOLERANCE);
   float v2 = clamp(m.v2, MSM_NL_TOLERANCE, 1.0f - MSM_NL_TOLERANCE);
-  if (zf <= y1) return 0.0f;
+  if (!(zf > y1)) return 0.0f; // NaN zf reads lit too
   // Shift and scale depths so that y1 = 0, y2 = 1; ξ4 scales with the fourth power.
   float inv_range = 1.0f / (y2 - y1);
   float zf1 = (zf - y1) * inv_range; // z'f in (0, 1] when zf <= y2

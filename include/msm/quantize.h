@@ -23,7 +23,16 @@ const mat4 MSM_THETA4_INV =
 const vec4 MSM_THETA4_OFFSET = vec4(0.0359558848f, 0.0f, 0.0f, 0.0f);
 
 MSM_FN vec4 msm_theta4(vec4 b) { return MSM_THETA4 * b + MSM_THETA4_OFFSET; }
-MSM_FN vec4 msm_theta4_inverse(vec4 q) { return MSM_THETA4_INV * (q - MSM_THETA4_OFFSET); }
+// The inverse is written out, in a fixed order and `precise`, so that every device rounds it as the
+// CPU build does: a shader's mat4 * vec4 may sum in any order and contract into fma, and the
+// one-ulp differences that left in the moments moved Hausdorff 4MSM by up to 0.6 for receivers
+// within 1e-4 of the near end, where the bound is that steep (gpu_math_test, technique_shadow4).
+MSM_FN vec4 msm_theta4_inverse(vec4 q) {
+  vec4 d = q - MSM_THETA4_OFFSET;
+  MSM_PRECISE vec4 b =
+      ((MSM_THETA4_INV[0] * d[0] + MSM_THETA4_INV[1] * d[1]) + MSM_THETA4_INV[2] * d[2]) + MSM_THETA4_INV[3] * d[3];
+  return b;
+}
 
 // ---- 2015 θ2 for VSM on [0,1] depth: (b1, 4 b1 - 4 b2) ----
 MSM_FN vec2 msm_theta2(vec2 b) { return vec2(b.x, 4.0f * (b.x - b.y)); }
@@ -37,11 +46,13 @@ MSM_FN vec4 msm_theta4_star(vec4 b) {
   return vec4(1.5f * b[0] - 2.0f * b[2] + 0.5f, 4.0f * b[1] - 4.0f * b[3],
               0.5f * MSM_SQRT3 * b[0] - (2.0f / 9.0f) * MSM_SQRT3 * b[2] + 0.5f, 0.5f * b[1] + 0.5f * b[3]);
 }
-// Inverse blocks: odd [[-1/3, √3], [-3/4, 3√3/4]], even [[1/8, 1], [-1/8, 1]].
+// Inverse blocks: odd [[-1/3, √3], [-3/4, 3√3/4]], even [[1/8, 1], [-1/8, 1]]; `precise` as
+// msm_theta4_inverse, so that devices do not contract the products into fma.
 MSM_FN vec4 msm_theta4_star_inverse(vec4 q) {
   float q1 = q[0] - 0.5f, q3 = q[2] - 0.5f;
-  return vec4(-(1.0f / 3.0f) * q1 + MSM_SQRT3 * q3, 0.125f * q[1] + q[3], -0.75f * q1 + 0.75f * MSM_SQRT3 * q3,
-              -0.125f * q[1] + q[3]);
+  MSM_PRECISE vec4 b = vec4(-(1.0f / 3.0f) * q1 + MSM_SQRT3 * q3, 0.125f * q[1] + q[3],
+                            -0.75f * q1 + 0.75f * MSM_SQRT3 * q3, -0.125f * q[1] + q[3]);
+  return b;
 }
 
 // ---- JCGT Θ6* for [-1,1] depth (odd and even moments transformed apart) ----
@@ -62,17 +73,27 @@ const mat3 MSM_THETA6_EVEN_INV =
 MSM_FN Moments6 msm_theta6_star(Moments6 b) {
   return Moments6(MSM_THETA6_ODD * b.odd + MSM_THETA6_ODD_OFFSET, MSM_THETA6_EVEN * b.even + MSM_THETA6_EVEN_OFFSET);
 }
+// Written out and `precise` as msm_theta4_inverse: the same rounding on every device.
+MSM_FN vec3 msm_theta6_block_inverse(mat3 m, vec3 q) {
+  MSM_PRECISE vec3 b = (m[0] * q[0] + m[1] * q[1]) + m[2] * q[2];
+  return b;
+}
 MSM_FN Moments6 msm_theta6_star_inverse(Moments6 q) {
-  return Moments6(MSM_THETA6_ODD_INV * (q.odd - MSM_THETA6_ODD_OFFSET),
-                  MSM_THETA6_EVEN_INV * (q.even - MSM_THETA6_EVEN_OFFSET));
+  return Moments6(msm_theta6_block_inverse(MSM_THETA6_ODD_INV, q.odd - MSM_THETA6_ODD_OFFSET),
+                  msm_theta6_block_inverse(MSM_THETA6_EVEN_INV, q.even - MSM_THETA6_EVEN_OFFSET));
 }
 
 // ---- Fixed-point storage: round to nearest, as Vulkan's UNORM conversion does ----
 // At an exact tie (x * 65535 = k + 1/2) GLM rounds away from zero and a device may round to even:
 // the two builds can then differ by one step, which the GPU tests accept at ties only.
+// NaN is stored as 0, as Vulkan converts NaN to UNORM (and packUnorm's clamp, and the float to
+// integer conversion after it, leave NaN undefined in GLSL and in C++): msm_saturate first. Every
+// moment representation decodes code 0 to a vector outside the moment space (D1 < 0), which the
+// reconstructions read as lit (hamburger4.h), like NaN moments themselves.
 // Four values in [0,1] as 16-bit UNORM (RGBA16_UNORM texel = two uints).
 MSM_FN uvec2 msm_pack_unorm16x4(vec4 v) {
-  return uvec2(packUnorm2x16(vec2(v[0], v[1])), packUnorm2x16(vec2(v[2], v[3])));
+  return uvec2(packUnorm2x16(vec2(msm_saturate(v[0]), msm_saturate(v[1]))),
+               packUnorm2x16(vec2(msm_saturate(v[2]), msm_saturate(v[3]))));
 }
 MSM_FN vec4 msm_unpack_unorm16x4(uvec2 p) {
   vec2 a = unpackUnorm2x16(p.x);
@@ -81,11 +102,13 @@ MSM_FN vec4 msm_unpack_unorm16x4(uvec2 p) {
 }
 // Round-trip through 16-bit UNORM storage (what a texture write then read does).
 MSM_FN vec4 msm_quantize_unorm16(vec4 v) { return msm_unpack_unorm16x4(msm_pack_unorm16x4(v)); }
-MSM_FN vec2 msm_quantize_unorm16x2(vec2 v) { return unpackUnorm2x16(packUnorm2x16(v)); }
+MSM_FN vec2 msm_quantize_unorm16x2(vec2 v) {
+  return unpackUnorm2x16(packUnorm2x16(vec2(msm_saturate(v[0]), msm_saturate(v[1]))));
+}
 
 // Three values in [0,1] as 10-bit UNORM in the RGB channels of A2B10G10R10_UNORM (R lowest).
 MSM_FN uint msm_pack_unorm10x3(vec3 v) {
-  uvec3 q = uvec3(round(clamp(v, vec3(0.0f), vec3(1.0f)) * 1023.0f));
+  uvec3 q = uvec3(round(vec3(msm_saturate(v[0]), msm_saturate(v[1]), msm_saturate(v[2])) * 1023.0f));
   return q.x | (q.y << 10u) | (q.z << 20u);
 }
 MSM_FN vec3 msm_unpack_unorm10x3(uint p) {

@@ -10,6 +10,25 @@ MSM_BEGIN
 
 const float MSM_ROOT_LIMIT = 1.0e8f;
 
+// Largest finite float. A value x is finite iff |x| <= MSM_FLT_MAX: the comparison is false for
+// NaN and ±inf, on the CPU and on a device alike (GLSL's isnan/isinf may be folded away).
+const float MSM_FLT_MAX = 3.40282347e38f;
+MSM_FN bool msm_is_finite(float x) { return abs(x) <= MSM_FLT_MAX; }
+MSM_FN bool msm_is_finite4(vec4 v) {
+  return msm_is_finite(v[0]) && msm_is_finite(v[1]) && msm_is_finite(v[2]) && msm_is_finite(v[3]);
+}
+
+// x where x > lo, else lo; NaN goes to lo. Floors values that may be NaN: GLSL leaves max() with
+// a NaN operand undefined (GLM and std::max return whichever operand their comparison picks), and
+// a NaN that survived a max() would make the CPU and a device disagree.
+MSM_FN float msm_at_least(float x, float lo) { return x > lo ? x : lo; }
+
+// Receivers at |zf| >= MSM_ROOT_LIMIT (or NaN) lie beyond every depth: the reconstructions return 1
+// for zf >= MSM_ROOT_LIMIT and valid moments, else 0 (zf² would overflow their solves, and their
+// closed forms use roots clamped to that limit).
+MSM_FN bool msm_receiver_in_range(float zf) { return abs(zf) < MSM_ROOT_LIMIT; }
+MSM_FN float msm_receiver_out_of_range_shadow(bool valid, float zf) { return (valid && zf > 0.0f) ? 1.0f : 0.0f; }
+
 // x clamped to [-MSM_ROOT_LIMIT, MSM_ROOT_LIMIT]; NaN goes to -MSM_ROOT_LIMIT.
 MSM_FN float msm_clamp_root(float x) {
   return x > -MSM_ROOT_LIMIT ? (x < MSM_ROOT_LIMIT ? x : MSM_ROOT_LIMIT) : -MSM_ROOT_LIMIT;

@@ -108,7 +108,8 @@ MSM_FN SatRect msm_soft_search_rect(vec2 center, vec2 half_width, ivec2 size) {
 // ---- Moments from the tables ----
 // Averages from sat.h are Θ4* (Θ6*) moments in [0,1]; Θ is affine, so the inverse of the average
 // is the average of the moments. Biasing (bias.h): four moments with MSM_REP_SAT_INT32 (JCGT §4.2:
-// α = 6e-7 at ~22.4 bits). Six moments: no paper gives α for integer tables. Scaling the 16-bit
+// α = 6e-7 at ~22.4 bits, towards the b* measured after Θ4*, (0, 0.628, 0, 0.628), as the
+// tables round Θ4* moments: JCGT §2.5, App. D.4). Six moments: no paper gives α for integer tables. Scaling the 16-bit
 // values by the precision gained predicts it: 4 moments 6e-5 · 2^-(22.4-16) = 7.1e-7 (JCGT's 6e-7),
 // 6 moments 8e-5 · 2^-6.4 = 9.5e-7, below float's 5e-6, whose own rounding then dominates: the
 // float bias MSM_REP6_FLOAT (soft_test checks it on single depths and flat receivers).

@@ -158,8 +158,11 @@ MSM_FN float msm_technique_shadow_4moments(int t, vec4 stored, float unit_zf, fl
     return msm_hamburger4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_UNIT), unit_zf);
   if (t == MSM_TECH_HAMBURGER_128)
     return msm_hamburger4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_SIGNED_FLOAT), zf);
+  // 2015 θ4 16-bit: D2 raised to the representation's floor (config.h, MSM_MIN_D2_UNIT_16BIT).
   if (t == MSM_TECH_HAMBURGER_64_THETA4)
-    return msm_hamburger4_lower(msm_apply_bias(msm_theta4_inverse(stored), alpha, MSM_BSTAR_UNIT), unit_zf);
+    return msm_hamburger4_lower(
+        msm_raise_d2(msm_apply_bias(msm_theta4_inverse(stored), alpha, MSM_BSTAR_UNIT), MSM_MIN_D2_UNIT_16BIT),
+        unit_zf);
   if (t == MSM_TECH_HAMBURGER_64)
     return msm_hamburger4_lower(msm_apply_bias(msm_theta4_star_inverse(stored), alpha, MSM_BSTAR_SIGNED_16BIT), zf);
   if (t == MSM_TECH_HAUSDORFF_128_UNIT)
@@ -167,7 +170,9 @@ MSM_FN float msm_technique_shadow_4moments(int t, vec4 stored, float unit_zf, fl
   if (t == MSM_TECH_HAUSDORFF_128)
     return msm_hausdorff4_lower(msm_apply_bias(stored, alpha, MSM_BSTAR_SIGNED_FLOAT), zf, -1.0f, 1.0f);
   if (t == MSM_TECH_HAUSDORFF_64_THETA4)
-    return msm_hausdorff4_lower(msm_apply_bias(msm_theta4_inverse(stored), alpha, MSM_BSTAR_UNIT), unit_zf, 0.0f, 1.0f);
+    return msm_hausdorff4_lower(
+        msm_raise_d2(msm_apply_bias(msm_theta4_inverse(stored), alpha, MSM_BSTAR_UNIT), MSM_MIN_D2_UNIT_16BIT), unit_zf,
+        0.0f, 1.0f);
   // MSM_TECH_HAUSDORFF_64
   return msm_hausdorff4_lower(msm_apply_bias(msm_theta4_star_inverse(stored), alpha, MSM_BSTAR_SIGNED_16BIT), zf, -1.0f,
                               1.0f);

@@ -38,7 +38,9 @@ float uniform_float(std::mt19937_64& rng, float lo, float hi) {
 
 test::Distribution diracs(std::vector<double> z, std::vector<double> w) { return test::Distribution{z, w}; }
 
-// JCGT Eq. (4) on a discrete distribution, in double: the blockers are the depths below zf.
+// JCGT Eq. (4) on a discrete distribution, in double: the blockers are the depths below zf. The
+// average is then clamped to the depth range [-1, 1] as the authors' code does (a receiver in
+// front of the range keeps its own depth), which is what blocker.h promises.
 struct Reference {
   double depth, shadow;
 };
@@ -49,7 +51,8 @@ Reference equation4(const std::vector<double>& z, const std::vector<double>& w, 
       weight += w[l];
       depth += w[l] * z[l];
     }
-  return {(epsilon * zf + depth) / (epsilon + weight), weight};
+  double average = (epsilon * zf + depth) / (epsilon + weight);
+  return {average > -1.0 ? std::min(average, 1.0) : std::min(zf, -1.0), weight};
 }
 
 // JCGT §4.3: one occluder at z1 < zf with weight w1 and the receiver at zf (the UNBIASED fragment

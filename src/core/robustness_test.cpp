@@ -88,8 +88,10 @@ TEST(Robustness, EveryRepresentationStaysFiniteAndInRange) {
     float ref_signed = msm_hamburger4_lower(msm_apply_bias(bs, msm_moment_bias(MSM_REP_SIGNED_FLOAT)), zf);
     unitf.add(ref_unit, ref_unit);
 
-    vec4 lu =
-        msm_apply_bias(msm_theta4_inverse(msm_quantize_unorm16(msm_theta4(bu))), msm_moment_bias(MSM_REP_UNIT_THETA4));
+    // As the technique reads it: biased, D2 raised to the representation's floor (bias.h).
+    vec4 lu = msm_raise_d2(
+        msm_apply_bias(msm_theta4_inverse(msm_quantize_unorm16(msm_theta4(bu))), msm_moment_bias(MSM_REP_UNIT_THETA4)),
+        MSM_MIN_D2_UNIT_16BIT);
     theta4.add(msm_hamburger4_lower(lu, zu), ref_unit);
     hausdorff.add(msm_hausdorff4_lower(lu, zu, 0.0f, 1.0f),
                   msm_hausdorff4_lower(msm_apply_bias(bu, msm_moment_bias(MSM_REP_UNIT_FLOAT)), zu, 0.0f, 1.0f));

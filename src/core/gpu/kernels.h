@@ -22,6 +22,8 @@
 #include "msm/quantize.h"
 #include "msm/roots.h"
 #include "msm/shared.h"
+#include "msm/soft.h"
+#include "msm/techniques.h"
 #include "msm/three_moments.h"
 #include "msm/trigonometric.h"
 
@@ -104,7 +106,14 @@ const int MSM_K_CSM_BASIS = 54;         // a.x = z, u.x = texel -> a
 const int MSM_K_CSM_SHADOW = 55;        // a, b = texels 0, 1 (terms 1..4); u = (terms, bits of damping,
                                         // scale, zf); offset 0 -> a.x
 const int MSM_K_OVERDARKEN = 56;        // a.xy = (shadow, factor) -> a.x
-const int MSM_K_COUNT = 57;
+// techniques.h, soft.h, bias.h: whole reconstructions from stored texels (issue 19's edge classes)
+const int MSM_K_TECHNIQUE_SHADOW4 = 57; // a = stored texel, b.x = unit zf, u.x = technique id -> a.x
+const int MSM_K_SOFT4 = 58;    // a = Θ4* average, b.xy = (zf, depth bias), u.x = 1 for Eq. (19) -> a.xyz = (depth,
+                               // blocker shadow, shadow)
+const int MSM_K_SOFT6 = 59;    // a.xyz, b.xyz = Θ6* average (odd, even), a.w = zf, b.w = depth bias, u.x as above
+                               // -> a.xyz
+const int MSM_K_RAISE_D2 = 60; // a = b4, b.x = min D2 -> a
+const int MSM_K_COUNT = 61;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
 MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
@@ -198,6 +207,24 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
     break;
   }
   case MSM_K_OVERDARKEN: r.a[0] = msm_overdarken(x.a[0], x.a[1]); break;
+  case MSM_K_TECHNIQUE_SHADOW4: {
+    int t = int(x.u[0]);
+    r.a[0] = msm_technique_shadow(t, MsmTexel(x.a, vec4(0.0f)), x.b[0], msm_technique_default_params(t));
+    break;
+  }
+  case MSM_K_SOFT4: {
+    vec4 params = msm_technique_default_params(x.u[0] == 1u ? MSM_TECH_MSSM6 : MSM_TECH_MSSM4);
+    BlockerResult o = msm_soft_blocker4_select(x.a, x.b[0], params);
+    r.a = vec4(o.depth, o.shadow, msm_soft_shadow4(x.a, x.b[0] - x.b[1], MSM_SOFT_UMBRA_EPSILON), 0.0f);
+    break;
+  }
+  case MSM_K_SOFT6: {
+    vec4 params = msm_technique_default_params(x.u[0] == 1u ? MSM_TECH_MSSM6 : MSM_TECH_MSSM4);
+    BlockerResult o = msm_soft_blocker6_select(b6, x.a[3], params);
+    r.a = vec4(o.depth, o.shadow, msm_soft_shadow6(b6, x.a[3] - x.b[3], MSM_SOFT_UMBRA_EPSILON), 0.0f);
+    break;
+  }
+  case MSM_K_RAISE_D2: r.a = msm_raise_d2(x.a, x.b[0]); break;
   default: break;
   }
   return r;
