@@ -11,6 +11,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # MPI ranks of msm evaluate (Open MPI)
+  clang-format clang-tidy  # .ci/check-format (clang-format 14) and .ci/tidy
   glmark2-data  # real meshes for the import tests (the bunny, 9 MB)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
 )

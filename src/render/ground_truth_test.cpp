@@ -12,6 +12,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <map>
 
 namespace msm::render {
@@ -21,6 +23,38 @@ namespace {
 const std::vector<std::string> kHardShadowScenes = {"fence", "railing", "stair", "column"};
 
 class GroundTruthTest : public vk::test::VulkanTest {};
+
+// MAE of each technique against the filtered ground truth per scene (in the order of
+// kHardShadowScenes), measured on lavapipe after issues 12, 13 and 19: the table of
+// docs/results.md, "Renderer: every technique against PCF and the ray-traced ground truth".
+const std::map<std::string, std::array<double, 4>> kMeasuredMae = {
+    {"plain", {0.0279, 0.0920, 0.0295, 0.0057}},
+    {"pcf", {0.0014, 0.0052, 0.0013, 0.0005}},
+    {"vsm-32", {0.0127, 0.0325, 0.0148, 0.0008}},
+    {"vsm-64", {0.0127, 0.0323, 0.0140, 0.0007}},
+    {"esm-32", {0.0203, 0.0488, 0.0219, 0.0016}},
+    {"evsm2-32", {0.0154, 0.0380, 0.0163, 0.0009}},
+    {"evsm2-64", {0.0249, 0.0504, 0.0238, 0.0024}},
+    {"evsm4-64", {0.0105, 0.0348, 0.0145, 0.0008}},
+    {"evsm4-128", {0.0105, 0.0304, 0.0127, 0.0011}},
+    {"msm-hamburger-128-unit", {0.0083, 0.0261, 0.0122, 0.0022}},
+    {"msm-hamburger-128", {0.0112, 0.0238, 0.0159, 0.0122}},
+    {"msm-hamburger-64-theta4", {0.0086, 0.0336, 0.0140, 0.0012}},
+    {"msm-hamburger-64", {0.0087, 0.0351, 0.0144, 0.0011}},
+    {"msm-hausdorff-128-unit", {0.0085, 0.0261, 0.0123, 0.0022}},
+    {"msm-hausdorff-128", {0.0113, 0.0238, 0.0160, 0.0122}},
+    {"msm-hausdorff-64-theta4", {0.0086, 0.0300, 0.0127, 0.0012}},
+    {"msm-hausdorff-64", {0.0086, 0.0307, 0.0127, 0.0012}},
+    {"tmsm-128", {0.0098, 0.0242, 0.0144, 0.0083}},
+    {"msm6-192", {0.0093, 0.0261, 0.0136, 0.0070}},
+    {"msm6-96", {0.0086, 0.0310, 0.0129, 0.0021}},
+    {"msm-nl64", {0.0095, 0.0305, 0.0148, 0.0051}},
+    {"msm-nl32", {0.0098, 0.0313, 0.0152, 0.0058}},
+};
+
+// The bound: 1.5x the measured MAE, and at least the measured MAE plus 0.002 (two references of
+// different seeds differ by MAE 0.0019-0.0021: the Monte Carlo noise of 256 samples per pixel).
+double mae_bound(double measured) { return std::max(1.5 * measured, measured + 0.002); }
 
 constexpr int kWidth = 200, kHeight = 112, kShadowSize = 512;
 
@@ -87,14 +121,15 @@ TEST_F(GroundTruthTest, RasterizerAndRayTracerSeeTheSameSurfaces) {
 // depth of the occluder's surface instead of its exact silhouette) plus Monte Carlo noise (256
 // samples: standard error <= 0.03 at a penumbra, 0 outside).
 TEST_F(GroundTruthTest, PcfAgreesWithTheRayTracedFilteredShadow) {
-  for (const std::string& name : kHardShadowScenes) {
+  for (std::size_t i = 0; i < kHardShadowScenes.size(); ++i) {
+    const std::string& name = kHardShadowScenes[i];
     scene::Scene scene = scene::builtin_scene(name);
     Renderer renderer(ctx(), scene);
     RenderResult pcf = renderer.render(settings("pcf"));
     reference::Result truth = ground_truth(scene, reference::Effect::filtered);
     image::Image mask = truth.visibility.channel("background");
     image::Tolerances tolerances;
-    tolerances.max_mae = 0.012;
+    tolerances.max_mae = mae_bound(kMeasuredMae.at("pcf")[i]);
     // Pixels off by more than 10%: at most 0.01% since the ground truth takes the renderer's
     // receiver plane and its rule for surfaces turned away from the light (measured; up to 2.5% on
     // the terminators of the stair and the column before).
@@ -112,12 +147,11 @@ TEST_F(GroundTruthTest, PcfAgreesWithTheRayTracedFilteredShadow) {
 }
 
 // Every technique against the ground truth: MAE and light leaking per scene (the table of
-// docs/results.md). The bound is loose (0.07; 0.12 for the unfiltered plain shadow map, measured
-// 0.091 on the railing): it catches a technique that is wrong everywhere; the renderer tests
-// bound each technique against PCF more tightly.
+// docs/results.md), each MAE within mae_bound of its measured value.
 TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
   std::map<std::string, std::map<std::string, image::Metrics>> table;
-  for (const std::string& name : kHardShadowScenes) {
+  for (std::size_t i = 0; i < kHardShadowScenes.size(); ++i) {
+    const std::string& name = kHardShadowScenes[i];
     scene::Scene scene = scene::builtin_scene(name);
     Renderer renderer(ctx(), scene);
     reference::Result truth = ground_truth(scene, reference::Effect::filtered);
@@ -128,7 +162,8 @@ TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
       if (msm_technique_is_area_light(t.id)) continue; // against the area light: soft_shadow_test.cpp
       image::Metrics m = image::compute_metrics(
           renderer.render(settings(std::string(t.name))).shadow.channel("visibility"), reference, {.mask = &mask});
-      EXPECT_LT(m.mae, t.name == "plain" ? 0.12 : 0.07) << name << ", " << t.name;
+      ASSERT_TRUE(kMeasuredMae.count(std::string(t.name))) << t.name << " has no measured error";
+      EXPECT_LE(m.mae, mae_bound(kMeasuredMae.at(std::string(t.name))[i])) << name << ", " << t.name;
       EXPECT_EQ(m.non_finite, 0u);
       table[std::string(t.name)][name] = m;
     }

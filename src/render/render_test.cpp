@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -43,36 +44,47 @@ RenderSettings small(std::string technique) {
 image::Image visibility(const RenderResult& r) { return r.shadow.channel("visibility"); }
 image::Image background(const RenderResult& r) { return r.shadow.channel("background"); }
 
-// Upper bounds on the error against PCF over the four built-in scenes at the settings of small():
-// the measured worst case (docs/results.md, "Renderer against PCF") with a margin of about 1.5x
-// for driver differences. They catch broken reconstructions, kernels or storage (which give
-// errors of 0.05 and more everywhere), not the fine orderings, which the next test checks.
-struct Bound {
+// The error of each technique against PCF on each built-in scene at the settings of small(), as
+// measured on lavapipe after issues 12, 13 and 19 (docs/results.md, "Renderer: every technique
+// against PCF and the ray-traced ground truth", the table "Against PCF"): MAE and the share of
+// pixels more than 3% off, per scene in the order of kHardShadowScenes.
+struct Measured {
   double mae, share_above_3pct;
 };
-const std::map<std::string, Bound> kBounds = {
-    {"plain", {0.14, 0.45}}, // unfiltered: differs in every penumbra
-    {"vsm-32", {0.06, 0.44}},
-    {"vsm-64", {0.06, 0.44}},
-    {"esm-32", {0.085, 0.45}},
-    {"evsm2-32", {0.07, 0.45}},
-    {"evsm2-64", {0.09, 0.46}},
-    {"evsm4-64", {0.065, 0.44}},
-    {"evsm4-128", {0.06, 0.44}},
-    {"msm-hamburger-128-unit", {0.052, 0.44}},
-    {"msm-hamburger-128", {0.052, 0.41}},
-    {"msm-hamburger-64-theta4", {0.065, 0.44}},
-    {"msm-hamburger-64", {0.066, 0.44}},
-    {"msm-hausdorff-128-unit", {0.052, 0.44}},
-    {"msm-hausdorff-128", {0.052, 0.41}},
-    {"msm-hausdorff-64-theta4", {0.057, 0.44}},
-    {"msm-hausdorff-64", {0.058, 0.44}},
-    {"tmsm-128", {0.05, 0.44}},
-    {"msm6-192", {0.052, 0.44}},
-    {"msm6-96", {0.059, 0.44}},
-    {"msm-nl64", {0.05, 0.41}},
-    {"msm-nl32", {0.055, 0.41}}, // dithered lookups
+const std::map<std::string, std::array<Measured, 4>> kMeasuredAgainstPcf = {
+    {"plain", {{{0.0282, 0.111}, {0.0924, 0.292}, {0.0291, 0.142}, {0.0055, 0.027}}}},
+    {"vsm-32", {{{0.0126, 0.082}, {0.0326, 0.278}, {0.0149, 0.115}, {0.0004, 0.003}}}},
+    {"vsm-64", {{{0.0125, 0.082}, {0.0325, 0.278}, {0.0140, 0.109}, {0.0003, 0.002}}}},
+    {"esm-32", {{{0.0201, 0.099}, {0.0493, 0.291}, {0.0219, 0.132}, {0.0015, 0.017}}}},
+    {"evsm2-32", {{{0.0153, 0.090}, {0.0383, 0.284}, {0.0163, 0.113}, {0.0006, 0.004}}}},
+    {"evsm2-64", {{{0.0248, 0.110}, {0.0510, 0.301}, {0.0239, 0.132}, {0.0023, 0.023}}}},
+    {"evsm4-64", {{{0.0104, 0.080}, {0.0351, 0.283}, {0.0145, 0.105}, {0.0005, 0.003}}}},
+    {"evsm4-128", {{{0.0105, 0.077}, {0.0306, 0.283}, {0.0127, 0.102}, {0.0007, 0.002}}}},
+    {"msm-hamburger-128-unit", {{{0.0083, 0.067}, {0.0262, 0.280}, {0.0122, 0.098}, {0.0019, 0.010}}}},
+    {"msm-hamburger-128", {{{0.0112, 0.070}, {0.0237, 0.269}, {0.0158, 0.083}, {0.0120, 0.010}}}},
+    {"msm-hamburger-64-theta4", {{{0.0086, 0.067}, {0.0339, 0.281}, {0.0140, 0.104}, {0.0009, 0.007}}}},
+    {"msm-hamburger-64", {{{0.0087, 0.067}, {0.0353, 0.282}, {0.0144, 0.105}, {0.0009, 0.007}}}},
+    {"msm-hausdorff-128-unit", {{{0.0084, 0.068}, {0.0262, 0.280}, {0.0122, 0.098}, {0.0019, 0.010}}}},
+    {"msm-hausdorff-128", {{{0.0112, 0.070}, {0.0237, 0.269}, {0.0159, 0.083}, {0.0120, 0.010}}}},
+    {"msm-hausdorff-64-theta4", {{{0.0086, 0.067}, {0.0301, 0.279}, {0.0127, 0.099}, {0.0010, 0.007}}}},
+    {"msm-hausdorff-64", {{{0.0086, 0.067}, {0.0308, 0.279}, {0.0127, 0.100}, {0.0009, 0.007}}}},
+    {"tmsm-128", {{{0.0097, 0.070}, {0.0243, 0.279}, {0.0142, 0.091}, {0.0081, 0.010}}}},
+    {"msm6-192", {{{0.0091, 0.072}, {0.0262, 0.281}, {0.0135, 0.098}, {0.0068, 0.011}}}},
+    {"msm6-96", {{{0.0085, 0.067}, {0.0311, 0.279}, {0.0129, 0.100}, {0.0019, 0.010}}}},
+    {"msm-nl64", {{{0.0094, 0.083}, {0.0308, 0.282}, {0.0148, 0.105}, {0.0050, 0.021}}}},
+    {"msm-nl32", {{{0.0098, 0.083}, {0.0315, 0.283}, {0.0153, 0.108}, {0.0057, 0.021}}}},
 };
+
+// The bound: 1.5x the measured value, and at least the measured value plus 0.001 in MAE and 0.5
+// points of share (the table's rounding, and room for another driver's rasterization). A broken
+// reconstruction, kernel or storage path moves a small value by far more; the orderings of the
+// papers are checked by the next test.
+image::Tolerances bound_of(const Measured& m) {
+  image::Tolerances t;
+  t.max_mae = std::max(1.5 * m.mae, m.mae + 0.001);
+  t.max_share_above_3pct = std::max(1.5 * m.share_above_3pct, m.share_above_3pct + 0.005);
+  return t;
+}
 
 struct SceneRenders {
   image::Image pcf, mask;
@@ -105,19 +117,18 @@ image::Metrics against_pcf(const vk::Context& ctx, const std::string& scene, con
 
 TEST_F(RenderTest, EveryTechniqueIsWithinItsBoundOfPcfOnEveryScene) {
   std::string table = fmt::format("{:<24}", "MAE / leaking / >3%");
-  for (const auto& [scene, r] : renders(ctx())) table += fmt::format(" | {:^24}", scene);
+  for (const std::string& scene : kHardShadowScenes) table += fmt::format(" | {:^24}", scene);
   fmt::print("{}\n", table);
   for (const Technique* tp : rendered_techniques()) {
     const Technique& t = *tp;
     if (t.id == MSM_TECH_PCF || msm_technique_is_area_light(t.id)) continue;
     std::string name(t.name);
-    ASSERT_TRUE(kBounds.count(name)) << name << " has no bound";
-    const Bound& bound = kBounds.at(name);
+    ASSERT_TRUE(kMeasuredAgainstPcf.count(name)) << name << " has no measured error";
     std::string row = fmt::format("{:<24}", name);
-    for (const auto& [scene, r] : renders(ctx())) {
-      image::Tolerances tolerances;
-      tolerances.max_mae = bound.mae;
-      tolerances.max_share_above_3pct = bound.share_above_3pct;
+    for (std::size_t i = 0; i < kHardShadowScenes.size(); ++i) {
+      const std::string& scene = kHardShadowScenes[i];
+      const SceneRenders& r = renders(ctx()).at(scene);
+      const image::Tolerances tolerances = bound_of(kMeasuredAgainstPcf.at(name)[i]);
       image::CompareResult c = image::compare(
           r.visibility.at(name), r.pcf, tolerances,
           {.metrics = {.mask = &r.mask}, .failure_dir = fmt::format("test-failures/render/{}-{}", scene, name)});

@@ -15,6 +15,7 @@
 
 #include <glm/glm.hpp>
 
+#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
@@ -68,10 +69,26 @@ std::map<std::string, image::Metrics> errors(const vk::Context& ctx, scene::Scen
   return out;
 }
 
+// The MAE of each soft technique against the ray-traced area light, per scene and light size, as
+// measured on lavapipe (docs/results.md, "Soft shadows in the renderer"): the column and the fence
+// under 3°, the models (5°) and the pillar before the brick wall (4°) under their own lights.
+const std::map<std::string, std::map<std::string, double>> kMeasuredSoftMae = {
+    {"column", {{"mssm4", 0.0015}, {"mssm6", 0.0008}, {"vssm", 0.0030}, {"pcss", 0.0014}}},
+    {"fence", {{"mssm4", 0.0063}, {"mssm6", 0.0054}, {"vssm", 0.0100}, {"pcss", 0.0076}}},
+    {"models", {{"mssm4", 0.0050}, {"mssm6", 0.0041}, {"vssm", 0.0071}, {"pcss", 0.0059}}},
+    {"pillar_wall", {{"mssm4", 0.0078}, {"mssm6", 0.0061}, {"vssm", 0.0111}, {"pcss", 0.0033}}},
+};
+
+// The bound: 1.5x the measured MAE, and at least +0.002 (the reference's Monte Carlo noise).
+void expect_near_measured(const std::string& scene, const std::string& technique, double mae) {
+  const double measured = kMeasuredSoftMae.at(scene).at(technique);
+  EXPECT_LE(mae, std::max(1.5 * measured, measured + 0.002))
+      << scene << ", " << technique << " (measured " << measured << ")";
+}
+
 // On the column (JCGT Fig. 11: a long shadow, so its penumbra grows from contact to wide) and the
 // fence, lit by a disc light of 3 degrees: every soft technique is closer to the ray-traced soft
-// shadow than the hard shadows, and within a stated bound (measured at 240x135 with a 512² map:
-// MAE <= 0.0025 on the column, <= 0.011 on the fence; the bound leaves a 2x margin on the worst).
+// shadow than the hard shadows, and within the bound of its measured error.
 TEST_F(SoftShadowTest, CloserToTheAreaLightThanHardShadows) {
   for (const char* name : {"column", "fence"}) {
     std::vector<std::string> techniques = kSoftTechniques;
@@ -81,7 +98,7 @@ TEST_F(SoftShadowTest, CloserToTheAreaLightThanHardShadows) {
     for (const std::string& t : kSoftTechniques) {
       EXPECT_LT(m[t].mae, m["msm-hamburger-64"].mae) << name << ", " << t;
       EXPECT_LT(m[t].mae, m["pcf"].mae) << name << ", " << t;
-      EXPECT_LT(m[t].mae, 0.02) << name << ", " << t;
+      expect_near_measured(name, t, m[t].mae);
     }
   }
 }
@@ -136,8 +153,7 @@ TEST_F(SoftShadowTest, ModelsAndPillarBeforeBrickWall) {
     scene::Scene scene = scene::builtin_scene(name);
     bool wall = std::string(name) == "pillar_wall";
     auto m = errors(ctx(), scene, scene.light().angular_extent_deg, kSoftTechniques, wall ? 2048 : 512);
-    // Measured MAE: models 0.004-0.007, pillar_wall 0.003-0.011 (VSSM the worst on both).
-    for (const std::string& t : kSoftTechniques) EXPECT_LT(m[t].mae, 0.015) << name << ", " << t;
+    for (const std::string& t : kSoftTechniques) expect_near_measured(name, t, m[t].mae);
     EXPECT_LT(m["mssm4"].mae, m["vssm"].mae) << name;
     EXPECT_LT(m["mssm6"].mae, m["vssm"].mae) << name;
   }

@@ -8,8 +8,8 @@
 
 #include <gtest/gtest.h>
 
-#include "msm/test/gltf_writer.h"
 #include "msm/scene/scene.h"
+#include "msm/test/gltf_writer.h"
 
 namespace fs = std::filesystem;
 using namespace msm::scene;

@@ -64,12 +64,12 @@ void ShadowDepthPass::execute(const PassContext& c) const {
             d.opacity_texture >= 0 ? scene.opacity_textures[size_t(d.opacity_texture)] : scene.white;
         ObjectPush push = d.push;
         push.light.x = l;
-        vk::bind_program(c.cmd, *masked_program_,
-                         {vk::Descriptor(c.frame.uniforms),
-                          vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                                         scene.texture_sampler),
-                          vk::Descriptor(c.frame.lights)},
-                         push);
+        vk::bind_program(
+            c.cmd, *masked_program_,
+            {vk::Descriptor(c.frame.uniforms),
+             vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler),
+             vk::Descriptor(c.frame.lights)},
+            push);
         bound = masked_program_;
       } else if (bound != program_) {
         ObjectPush push{};
