@@ -49,6 +49,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace {
@@ -897,7 +898,10 @@ std::vector<KernelIO> run_kernels(vk::Context& ctx, const vk::Program& program, 
   VkDeviceSize size = in.size() * sizeof(KernelIO);
   vk::Buffer src = vk::create_buffer(ctx, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
   vk::Buffer dst = vk::create_buffer(ctx, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
-  std::memcpy(src.data(), in.data(), size);
+  // glm's vectors are standard-layout floats with a user-written copy constructor (so not
+  // TriviallyCopyable to the standard); their bytes are exactly what the shader reads.
+  static_assert(std::is_standard_layout_v<KernelIO> && sizeof(KernelIO) == 48);
+  std::memcpy(src.data(), in.data(), size); // NOLINT(bugprone-undefined-memory-manipulation): see above
   std::memset(dst.data(), 0xFF, size); // NaN everywhere: an output the shader did not write shows
   struct Push {
     int32_t function;

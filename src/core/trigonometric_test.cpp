@@ -78,6 +78,7 @@ TEST(Trigonometric, EqualsLinearProgram) {
     // The upper bound's reference is the LP's lower bound for the mirrored distribution
     // z' = 1 - z (moments (-b1, b2, -b3, b4), exact): sup Z(z <= zf) = 1 - inf Z'(z' < 1 - zf).
     std::vector<double> mirrored_grid;
+    mirrored_grid.reserve(grid.size());
     for (double z : grid) mirrored_grid.push_back(1.0 - z);
     std::reverse(mirrored_grid.begin(), mirrored_grid.end());
     std::vector<double> bm = {-bd[0], bd[1], -bd[2], bd[3]};
@@ -223,7 +224,7 @@ TEST(Trigonometric, DegenerateInputsAreFinite) {
   inputs.push_back(vec4(0.0f, 1.5f, 0.0f, 0.0f));
   std::vector<float> depths = {-0.5f, 0.0f, 1e-7f, 1e-3f, 0.25f, 0.3f, 0.5f, 0.999f, 1.0f - 1e-7f, 1.0f, 1.5f};
   for (float alpha : {0.0f, MSM_TRIG_ALPHA_DEFAULT, 1e-3f})
-    for (vec4 raw : inputs)
+    for (const vec4& raw : inputs)
       for (float zf : depths) {
         vec4 b = msm_trig_bias(raw, alpha);
         float lower = msm_trig_lower(b, zf), upper = msm_trig_upper(b, zf);

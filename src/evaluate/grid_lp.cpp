@@ -101,9 +101,10 @@ GridLp::GridLp(const GridBasis& basis)
   // kPerturbation, jittered by a fixed low-discrepancy sequence so that no two points weigh the
   // same), added to every moment vector: the perturbed moments lie inside the moment cone of the
   // working set, where no vertex is degenerate.
+  const int coarse_points = (n_ - 1) / stride_ + 1; // i = 0, stride_, ... <= n_ - 1
   for (int i = 0, count = 0; i < n_; i += stride_, ++count) {
     const double jitter = 0.5 + std::fmod(0.6180339887498949 * double(count + 1), 1.0);
-    const double weight = kPerturbation * jitter / double((n_ - 1) / stride_ + 1);
+    const double weight = kPerturbation * jitter / double(coarse_points);
     for (int j = 0; j < r_; ++j) perturbation_[j] += weight / scale_[i] * basis_.row(j)[i];
   }
 }

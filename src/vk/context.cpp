@@ -376,11 +376,11 @@ Context::Context(const ContextOptions& options) {
     if (validation_) {
       auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
           vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
-      destroyMessenger_ = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+      destroy_messenger_ = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
           vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
-      setObjectName_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
+      set_object_name_ = reinterpret_cast<PFN_vkSetDebugUtilsObjectNameEXT>(
           vkGetInstanceProcAddr(instance_, "vkSetDebugUtilsObjectNameEXT"));
-      if (!create || !destroyMessenger_) throw std::runtime_error("msm::vk: VK_EXT_debug_utils entry points missing");
+      if (!create || !destroy_messenger_) throw std::runtime_error("msm::vk: VK_EXT_debug_utils entry points missing");
       MSM_VK_CHECK(create(instance_, &messenger_info, nullptr, &messenger_));
     }
 
@@ -400,14 +400,14 @@ Context::Context(const ContextOptions& options) {
       source = "MSM_DEVICE";
     }
     const Candidate& chosen = candidates[select(candidates, selector, source)];
-    physicalDevice_ = chosen.device;
+    physical_device_ = chosen.device;
     info_ = chosen.info;
-    queueFamily_ = chosen.queue_family;
-    timestampValidBits_ = chosen.timestamp_valid_bits;
-    vkGetPhysicalDeviceProperties(physicalDevice_, &properties_);
-    vkGetPhysicalDeviceMemoryProperties(physicalDevice_, &memory_);
+    queue_family_ = chosen.queue_family;
+    timestamp_valid_bits_ = chosen.timestamp_valid_bits;
+    vkGetPhysicalDeviceProperties(physical_device_, &properties_);
+    vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_);
 
-    features_ = pick_features(physicalDevice_);
+    features_ = pick_features(physical_device_);
     DeviceFeatures chain = features_;
     chain.v11.pNext = &chain.v12;
     chain.v12.pNext = &chain.v13;
@@ -415,7 +415,7 @@ Context::Context(const ContextOptions& options) {
         .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &chain.v11, .features = chain.core};
     float priority = 1.0f;
     VkDeviceQueueCreateInfo queue_info{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
-                                       .queueFamilyIndex = queueFamily_,
+                                       .queueFamilyIndex = queue_family_,
                                        .queueCount = 1,
                                        .pQueuePriorities = &priority};
     const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
@@ -425,34 +425,34 @@ Context::Context(const ContextOptions& options) {
                                    .pQueueCreateInfos = &queue_info,
                                    .enabledExtensionCount = 1,
                                    .ppEnabledExtensionNames = device_extensions};
-    MSM_VK_CHECK(vkCreateDevice(physicalDevice_, &device_info, nullptr, &device_));
-    vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+    MSM_VK_CHECK(vkCreateDevice(physical_device_, &device_info, nullptr, &device_));
+    vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 
-    pushDescriptorSet_ =
+    push_descriptor_set_ =
         reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetKHR"));
-    pushDescriptorSetWithTemplate_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetWithTemplateKHR>(
+    push_descriptor_set_with_template_ = reinterpret_cast<PFN_vkCmdPushDescriptorSetWithTemplateKHR>(
         vkGetDeviceProcAddr(device_, "vkCmdPushDescriptorSetWithTemplateKHR"));
-    if (!pushDescriptorSet_ || !pushDescriptorSetWithTemplate_)
+    if (!push_descriptor_set_ || !push_descriptor_set_with_template_)
       throw std::runtime_error("msm::vk: VK_KHR_push_descriptor entry points missing");
 
     VkCommandPoolCreateInfo pool_info{.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
                                       .flags = VK_COMMAND_POOL_CREATE_TRANSIENT_BIT,
-                                      .queueFamilyIndex = queueFamily_};
-    MSM_VK_CHECK(vkCreateCommandPool(device_, &pool_info, nullptr, &commandPool_));
+                                      .queueFamilyIndex = queue_family_};
+    MSM_VK_CHECK(vkCreateCommandPool(device_, &pool_info, nullptr, &command_pool_));
 
-    fusedFma_ = probe_fused_fma();
+    fused_fma_ = probe_fused_fma();
     ContextOptions::FmaMode fma_mode = options.fma_mode;
     if (fma_mode == ContextOptions::FmaMode::probe && env_flag("MSM_FORCE_EMULATED_FMA"))
       fma_mode = ContextOptions::FmaMode::emulated;
-    useNativeFma_ =
-        fma_mode == ContextOptions::FmaMode::native || (fma_mode == ContextOptions::FmaMode::probe && fusedFma_);
+    use_native_fma_ =
+        fma_mode == ContextOptions::FmaMode::native || (fma_mode == ContextOptions::FmaMode::probe && fused_fma_);
 
     if (options.verbose)
       std::fprintf(stderr, "msm::vk: device %u: %s; validation %s; fma() %s, msm_fma %s\n", info_.index,
                    info_.describe().c_str(), validation_ ? (sync_validation ? "on (+synchronization)" : "on") : "off",
-                   fusedFma_ ? "fused" : "NOT fused",
-                   useNativeFma_ ? (fusedFma_ ? "native" : "native (forced, NOT exact)")
-                                 : (fusedFma_ ? "emulated (forced)" : "emulated"));
+                   fused_fma_ ? "fused" : "NOT fused",
+                   use_native_fma_ ? (fused_fma_ ? "native" : "native (forced, NOT exact)")
+                                   : (fused_fma_ ? "emulated (forced)" : "emulated"));
   } catch (...) {
     destroy();
     throw;
@@ -464,12 +464,12 @@ Context::~Context() { destroy(); }
 void Context::destroy() noexcept {
   if (device_) {
     vkDeviceWaitIdle(device_); // nothing to do about a failure in a destructor; destruction goes on
-    if (commandPool_) vkDestroyCommandPool(device_, commandPool_, nullptr);
+    if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
     vkDestroyDevice(device_, nullptr); // the layer reports objects still alive here, into *log_
   }
-  if (messenger_) destroyMessenger_(instance_, messenger_, nullptr);
+  if (messenger_) destroy_messenger_(instance_, messenger_, nullptr);
   if (instance_) vkDestroyInstance(instance_, nullptr);
-  commandPool_ = VK_NULL_HANDLE;
+  command_pool_ = VK_NULL_HANDLE;
   device_ = VK_NULL_HANDLE;
   messenger_ = VK_NULL_HANDLE;
   instance_ = VK_NULL_HANDLE;
@@ -510,12 +510,12 @@ bool Context::probe_fused_fma() const {
 }
 
 void Context::set_object_name(VkObjectType type, uint64_t handle, const std::string& name) const {
-  if (!setObjectName_ || !handle) return;
+  if (!set_object_name_ || !handle) return;
   VkDebugUtilsObjectNameInfoEXT info{.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT,
                                      .objectType = type,
                                      .objectHandle = handle,
                                      .pObjectName = name.c_str()};
-  MSM_VK_CHECK(setObjectName_(device_, &info));
+  MSM_VK_CHECK(set_object_name_(device_, &info));
 }
 
 } // namespace msm::vk

@@ -71,6 +71,7 @@ Program create_graphics_program(const Context& ctx, const GraphicsDesc& desc) {
   VkVertexInputBindingDescription vertex_binding{
       .binding = 0, .stride = desc.vertex_stride, .inputRate = VK_VERTEX_INPUT_RATE_VERTEX};
   std::vector<VkVertexInputAttributeDescription> attributes;
+  attributes.reserve(desc.attributes.size());
   for (const VertexAttribute& a : desc.attributes)
     attributes.push_back({.location = a.location, .binding = 0, .format = a.format, .offset = a.offset});
   VkPipelineVertexInputStateCreateInfo vertex_input{.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,

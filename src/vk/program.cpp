@@ -57,10 +57,10 @@ Program create_program_layout(const Context& ctx, std::string_view name, std::sp
   Program p;
   p.name_ = name;
   p.bindings_.assign(bindings.begin(), bindings.end());
-  p.pushConstantSize_ = push_constant_size;
-  p.pushDescriptors_ = ctx.cmd_push_descriptor_set_with_template();
+  p.push_constant_size_ = push_constant_size;
+  p.push_descriptors_ = ctx.cmd_push_descriptor_set_with_template();
   p.stages_ = stages;
-  p.bindPoint_ = bind_point;
+  p.bind_point_ = bind_point;
 
   std::vector<VkDescriptorSetLayoutBinding> layout_bindings;
   std::vector<VkDescriptorUpdateTemplateEntry> entries;
@@ -81,11 +81,11 @@ Program create_program_layout(const Context& ctx, std::string_view name, std::sp
                                          .pBindings = layout_bindings.data()};
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     MSM_VK_CHECK(vkCreateDescriptorSetLayout(device, &info, nullptr, &set_layout));
-    p.setLayout_ = {device, set_layout};
+    p.set_layout_ = {device, set_layout};
   }
 
   VkPushConstantRange range{stages, 0, push_constant_size};
-  VkDescriptorSetLayout set_layout = p.setLayout_;
+  VkDescriptorSetLayout set_layout = p.set_layout_;
   VkPipelineLayoutCreateInfo layout_info{.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
                                          .setLayoutCount = set_layout ? 1u : 0u,
                                          .pSetLayouts = &set_layout,
@@ -152,11 +152,11 @@ void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groups_x, ui
   if (bindings.size() != program.bindings_.size())
     throw std::invalid_argument(fmt::format("msm::vk::dispatch({}): {} descriptors given, the program has {} bindings",
                                             program.name_, bindings.size(), program.bindings_.size()));
-  if (push_constants.size() != program.pushConstantSize_)
+  if (push_constants.size() != program.push_constant_size_)
     throw std::invalid_argument(fmt::format("msm::vk::dispatch({}): {} bytes of push constants given, the program "
                                             "takes {}",
-                                            program.name_, push_constants.size(), program.pushConstantSize_));
-  if (program.bindPoint_ != VK_PIPELINE_BIND_POINT_COMPUTE)
+                                            program.name_, push_constants.size(), program.push_constant_size_));
+  if (program.bind_point_ != VK_PIPELINE_BIND_POINT_COMPUTE)
     throw std::invalid_argument(fmt::format("msm::vk::dispatch({}): not a compute program", program.name_));
   bind_program(cmd, program, bindings, push_constants);
   vkCmdDispatch(cmd, groups_x, groups_y, groups_z);
@@ -168,12 +168,12 @@ void bind_program(VkCommandBuffer cmd, const Program& program, std::span<const D
     throw std::invalid_argument(fmt::format("msm::vk::bind_program({}): {} descriptors given, the program has {} "
                                             "bindings",
                                             program.name_, bindings.size(), program.bindings_.size()));
-  if (push_constants.size() != program.pushConstantSize_)
+  if (push_constants.size() != program.push_constant_size_)
     throw std::invalid_argument(fmt::format("msm::vk::bind_program({}): {} bytes of push constants given, the program "
                                             "takes {}",
-                                            program.name_, push_constants.size(), program.pushConstantSize_));
-  vkCmdBindPipeline(cmd, program.bindPoint_, program.pipeline_);
-  if (!bindings.empty()) program.pushDescriptors_(cmd, program.template_, program.layout_, 0, bindings.data());
+                                            program.name_, push_constants.size(), program.push_constant_size_));
+  vkCmdBindPipeline(cmd, program.bind_point_, program.pipeline_);
+  if (!bindings.empty()) program.push_descriptors_(cmd, program.template_, program.layout_, 0, bindings.data());
   if (!push_constants.empty())
     vkCmdPushConstants(cmd, program.layout_, program.stages_, 0, uint32_t(push_constants.size()),
                        push_constants.data());

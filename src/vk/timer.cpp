@@ -35,26 +35,27 @@ std::vector<std::pair<std::string, double>> TimerResults::totals() const {
 
 GpuTimer::GpuTimer(const Context& ctx, uint32_t reserve_scopes)
     : device_(ctx.device()), supported_(ctx.timestamp_valid_bits() > 0),
-      hostQueryReset_(ctx.features().v12.hostQueryReset),
-      msPerTick_(double(ctx.properties().limits.timestampPeriod) * 1e-6),
+      host_query_reset_(ctx.features().v12.hostQueryReset),
+      ms_per_tick_(double(ctx.properties().limits.timestampPeriod) * 1e-6),
       mask_(ctx.timestamp_valid_bits() >= 64 ? ~0ull : (1ull << ctx.timestamp_valid_bits()) - 1),
-      poolSize_(2 * std::max(reserve_scopes, 1u)) {
+      pool_size_(2 * std::max(reserve_scopes, 1u)) {
   if (supported_) add_pool(VK_NULL_HANDLE); // reset by reset(cmd) before first use
 }
 
 void GpuTimer::add_pool(VkCommandBuffer cmd) {
-  VkQueryPoolCreateInfo info{
-      .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO, .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = poolSize_};
+  VkQueryPoolCreateInfo info{.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+                             .queryType = VK_QUERY_TYPE_TIMESTAMP,
+                             .queryCount = pool_size_};
   VkQueryPool pool = VK_NULL_HANDLE;
   MSM_VK_CHECK(vkCreateQueryPool(device_, &info, nullptr, &pool));
   pools_.emplace_back(device_, pool);
   // A pool added while recording must be reset before its first query; a fresh pool is not in use
   // on the device, so a host reset (no render-pass restriction) is safe.
   if (cmd == VK_NULL_HANDLE) return;
-  if (hostQueryReset_)
-    vkResetQueryPool(device_, pool, 0, poolSize_);
+  if (host_query_reset_)
+    vkResetQueryPool(device_, pool, 0, pool_size_);
   else
-    vkCmdResetQueryPool(cmd, pool, 0, poolSize_);
+    vkCmdResetQueryPool(cmd, pool, 0, pool_size_);
 }
 
 void GpuTimer::reset(VkCommandBuffer cmd) {
@@ -62,11 +63,11 @@ void GpuTimer::reset(VkCommandBuffer cmd) {
   open_.clear();
   used_ = 0;
   recording_ = true;
-  for (const auto& pool : pools_) vkCmdResetQueryPool(cmd, pool, 0, poolSize_);
+  for (const auto& pool : pools_) vkCmdResetQueryPool(cmd, pool, 0, pool_size_);
 }
 
 uint32_t GpuTimer::next_query(VkCommandBuffer cmd) {
-  if (used_ == pools_.size() * poolSize_) add_pool(cmd);
+  if (used_ == pools_.size() * pool_size_) add_pool(cmd);
   return used_++;
 }
 
@@ -75,7 +76,7 @@ void GpuTimer::begin(VkCommandBuffer cmd, std::string_view name, VkPipelineStage
   Record record{std::string(name), uint32_t(open_.size()), 0, 0};
   if (supported_) {
     record.begin_query = next_query(cmd);
-    vkCmdWriteTimestamp2(cmd, stage, pools_[record.begin_query / poolSize_], record.begin_query % poolSize_);
+    vkCmdWriteTimestamp2(cmd, stage, pools_[record.begin_query / pool_size_], record.begin_query % pool_size_);
   }
   open_.push_back(records_.size());
   records_.push_back(std::move(record));
@@ -87,7 +88,7 @@ void GpuTimer::end(VkCommandBuffer cmd, VkPipelineStageFlags2 stage) {
   open_.pop_back();
   if (supported_) {
     record.end_query = next_query(cmd);
-    vkCmdWriteTimestamp2(cmd, stage, pools_[record.end_query / poolSize_], record.end_query % poolSize_);
+    vkCmdWriteTimestamp2(cmd, stage, pools_[record.end_query / pool_size_], record.end_query % pool_size_);
   }
 }
 
@@ -100,10 +101,10 @@ TimerResults GpuTimer::read() {
   if (!supported_ || records_.empty()) return results;
 
   std::vector<uint64_t> ticks(used_);
-  for (uint32_t first = 0; first < used_; first += poolSize_) {
-    uint32_t n = std::min(poolSize_, used_ - first);
+  for (uint32_t first = 0; first < used_; first += pool_size_) {
+    uint32_t n = std::min(pool_size_, used_ - first);
     // No WAIT_BIT: a command buffer that was never submitted would block forever.
-    VkResult r = vkGetQueryPoolResults(device_, pools_[first / poolSize_], 0, n, n * sizeof(uint64_t), &ticks[first],
+    VkResult r = vkGetQueryPoolResults(device_, pools_[first / pool_size_], 0, n, n * sizeof(uint64_t), &ticks[first],
                                        sizeof(uint64_t), VK_QUERY_RESULT_64_BIT);
     if (r == VK_NOT_READY)
       throw std::runtime_error("msm::vk::GpuTimer::read: timestamps not available; submit the command buffer and "
@@ -112,7 +113,7 @@ TimerResults GpuTimer::read() {
   }
   // Differences modulo 2^timestamp_valid_bits: the counter may wrap between two timestamps.
   uint64_t origin = ticks[records_.front().begin_query];
-  auto ms = [&](uint32_t query) { return double((ticks[query] - origin) & mask_) * msPerTick_; };
+  auto ms = [&](uint32_t query) { return double((ticks[query] - origin) & mask_) * ms_per_tick_; };
   for (const Record& record : records_)
     results.scopes.push_back({record.name, record.depth, ms(record.begin_query), ms(record.end_query)});
   return results;

@@ -95,37 +95,37 @@ class Context {
   Context& operator=(const Context&) = delete;
 
   VkInstance instance() const noexcept { return instance_; }
-  VkPhysicalDevice physical_device() const noexcept { return physicalDevice_; }
+  VkPhysicalDevice physical_device() const noexcept { return physical_device_; }
   VkDevice device() const noexcept { return device_; }
   VkQueue queue() const noexcept { return queue_; }
-  uint32_t queue_family() const noexcept { return queueFamily_; }
-  VkCommandPool command_pool() const noexcept { return commandPool_; }
+  uint32_t queue_family() const noexcept { return queue_family_; }
+  VkCommandPool command_pool() const noexcept { return command_pool_; }
 
   const DeviceInfo& info() const noexcept { return info_; }
   const DeviceFeatures& features() const noexcept { return features_; }
   const VkPhysicalDeviceProperties& properties() const noexcept { return properties_; }
   const VkPhysicalDeviceMemoryProperties& memory_properties() const noexcept { return memory_; }
   // Of the queue's family: 0 means no timestamps (GpuTimer then measures nothing).
-  uint32_t timestamp_valid_bits() const noexcept { return timestampValidBits_; }
+  uint32_t timestamp_valid_bits() const noexcept { return timestamp_valid_bits_; }
 
   // Whether the device's GLSL fma() is the fused multiply-add (one rounding), as found at creation
   // by the probe shader fma_probe.comp: on cases where one rounding, two roundings and a double
   // evaluation all differ, fused only if every case is rounded once. NVIDIA and AMD GPUs: fused;
   // lavapipe (llvmpipe): a * b, then + c.
-  bool fused_fma() const noexcept { return fusedFma_; }
+  bool fused_fma() const noexcept { return fused_fma_; }
   // The value of the shared headers' specialization constant msm_fused_fma (shared.h,
   // MSM_SPEC_FUSED_FMA_ID) in every pipeline created from this Context: fused_fma(), unless
   // ContextOptions::fma_mode (or MSM_FORCE_EMULATED_FMA) says otherwise.
-  bool use_native_fma() const noexcept { return useNativeFma_; }
+  bool use_native_fma() const noexcept { return use_native_fma_; }
 
   bool validation_enabled() const noexcept { return validation_; }
   ValidationLog& validation() const noexcept { return *log_; }
   std::shared_ptr<ValidationLog> validation_log() const noexcept { return log_; }
 
   // VK_KHR_push_descriptor entry points (device-level, loaded at creation).
-  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const noexcept { return pushDescriptorSet_; }
+  PFN_vkCmdPushDescriptorSetKHR cmd_push_descriptor_set() const noexcept { return push_descriptor_set_; }
   PFN_vkCmdPushDescriptorSetWithTemplateKHR cmd_push_descriptor_set_with_template() const noexcept {
-    return pushDescriptorSetWithTemplate_;
+    return push_descriptor_set_with_template_;
   }
   // Names an object in validation messages and debuggers; a no-op without validation.
   void set_object_name(VkObjectType type, uint64_t handle, const std::string& name) const;
@@ -141,23 +141,23 @@ class Context {
   std::shared_ptr<ValidationLog> log_ = std::make_shared<ValidationLog>();
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-  VkPhysicalDevice physicalDevice_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
-  VkCommandPool commandPool_ = VK_NULL_HANDLE;
-  uint32_t queueFamily_ = 0;
-  uint32_t timestampValidBits_ = 0;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  uint32_t timestamp_valid_bits_ = 0;
   bool validation_ = false;
-  bool fusedFma_ = true;
-  bool useNativeFma_ = true;
+  bool fused_fma_ = true;
+  bool use_native_fma_ = true;
   DeviceInfo info_;
   DeviceFeatures features_;
   VkPhysicalDeviceProperties properties_{};
   VkPhysicalDeviceMemoryProperties memory_{};
-  PFN_vkCmdPushDescriptorSetKHR pushDescriptorSet_ = nullptr;
-  PFN_vkCmdPushDescriptorSetWithTemplateKHR pushDescriptorSetWithTemplate_ = nullptr;
-  PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;
-  PFN_vkDestroyDebugUtilsMessengerEXT destroyMessenger_ = nullptr;
+  PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR push_descriptor_set_with_template_ = nullptr;
+  PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
+  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger_ = nullptr;
 };
 
 } // namespace msm::vk

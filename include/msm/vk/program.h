@@ -58,11 +58,11 @@ class Program {
  public:
   VkPipeline pipeline() const noexcept { return pipeline_; }
   VkPipelineLayout layout() const noexcept { return layout_; }
-  VkPipelineBindPoint bind_point() const noexcept { return bindPoint_; }
-  VkShaderStageFlags stages() const noexcept { return stages_; }           // of the descriptors and push constants
-  VkDescriptorSetLayout set_layout() const noexcept { return setLayout_; } // null without bindings
+  VkPipelineBindPoint bind_point() const noexcept { return bind_point_; }
+  VkShaderStageFlags stages() const noexcept { return stages_; }            // of the descriptors and push constants
+  VkDescriptorSetLayout set_layout() const noexcept { return set_layout_; } // null without bindings
   std::span<const Binding> bindings() const noexcept { return bindings_; }
-  uint32_t push_constant_size() const noexcept { return pushConstantSize_; }
+  uint32_t push_constant_size() const noexcept { return push_constant_size_; }
   const std::string& name() const noexcept { return name_; }
   explicit operator bool() const noexcept { return bool(pipeline_); }
 
@@ -77,12 +77,12 @@ class Program {
   friend Program create_graphics_program(const Context&, const GraphicsDesc&);
   std::string name_;
   std::vector<Binding> bindings_;
-  uint32_t pushConstantSize_ = 0;
-  PFN_vkCmdPushDescriptorSetWithTemplateKHR pushDescriptors_ = nullptr;
+  uint32_t push_constant_size_ = 0;
+  PFN_vkCmdPushDescriptorSetWithTemplateKHR push_descriptors_ = nullptr;
   VkShaderStageFlags stages_ = VK_SHADER_STAGE_COMPUTE_BIT;
-  VkPipelineBindPoint bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
+  VkPipelineBindPoint bind_point_ = VK_PIPELINE_BIND_POINT_COMPUTE;
   // Declaration order is creation order; destruction runs in reverse.
-  Unique<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout> setLayout_;
+  Unique<VkDescriptorSetLayout, vkDestroyDescriptorSetLayout> set_layout_;
   Unique<VkPipelineLayout, vkDestroyPipelineLayout> layout_;
   Unique<VkDescriptorUpdateTemplate, vkDestroyDescriptorUpdateTemplate> template_;
   Unique<VkPipeline, vkDestroyPipeline> pipeline_;

@@ -73,10 +73,10 @@ class GpuTimer {
 
   VkDevice device_ = VK_NULL_HANDLE;
   bool supported_ = false;
-  bool hostQueryReset_ = false;
-  double msPerTick_ = 0;
+  bool host_query_reset_ = false;
+  double ms_per_tick_ = 0;
   uint64_t mask_ = 0; // timestamp_valid_bits low bits
-  uint32_t poolSize_ = 0;
+  uint32_t pool_size_ = 0;
   std::vector<Unique<VkQueryPool, vkDestroyQueryPool>> pools_;
   uint32_t used_ = 0;
   bool recording_ = false;
