@@ -12,6 +12,7 @@
 #include "msm/image/io.h"
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
+#include "msm/test/temp_dir.h"
 
 namespace {
 
@@ -19,22 +20,7 @@ namespace fs = std::filesystem;
 using namespace msm::reference;
 using msm::image::Image;
 
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("msm_reference_content_" + std::to_string(rd()) + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using msm::test::TempDir;
 
 msm::scene::Scene load(const std::string& json, const fs::path& dir = ".") {
   return msm::scene::load_scene_json(json, dir, "content.json");
@@ -58,7 +44,7 @@ Settings filtered(int width, int height) {
 TEST(reference_filtered, FlatFaceWithStrayNormalsIsLit) {
   for (const double degrees : {0.1, 2.0}) {
     SCOPED_TRACE(degrees);
-    TempDir dir;
+    TempDir dir("msm_reference_content");
     const double a = degrees * 3.141592653589793 / 180.0;
     std::ofstream(dir.path() / "ground.obj") << "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
                                              << "vn 0 " << std::cos(a) << " " << std::sin(a) << "\n"
@@ -124,7 +110,7 @@ TEST(reference_surface, NDotLAndObjectChannels) {
 // the ground, light straight down: the ground under the left half is shadowed, under the hole lit,
 // in the hard and the translucent effects; the camera above sees the ground through the hole.
 TEST(reference_masked, CutOutsCastNoShadowAndAreSeenThrough) {
-  TempDir dir;
+  TempDir dir("msm_reference_content");
   Image alpha(8, 8, 1);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x) alpha.at(x, y) = x < 4 ? 1.0f : 0.0f;

@@ -10,6 +10,7 @@
 
 #include "msm/scene/scene.h"
 #include "msm/test/gltf_writer.h"
+#include "msm/test/temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace msm::scene;
@@ -21,22 +22,7 @@ using msm::scene::testing::write_gltf;
 
 namespace {
 
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("msm_gltf_test_" + std::to_string(rd()) + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using msm::test::TempDir;
 
 // 2x2 texels, all different: red top-left, green top-right, blue bottom-left, white bottom-right
 // (alpha 255, 0, 255, 0 in that order: the right column is transparent).
@@ -64,7 +50,7 @@ std::size_t vertex_at(const Mesh& m, glm::vec3 p) {
 // glTF's texture coordinates are msm's (v down, row 0 on top): imported unchanged, although
 // Assimp flips them on the way in. OBJ's v points up: imported as 1 - v.
 TEST(GltfImport, TextureCoordinatesRightSideUp) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   GltfModel model;
   model.primitives.push_back(quad({0, 1, 0}, {1, 0, 0}, {0, -1, 0}, {0, 0, 1}));
   write_gltf(dir.path() / "quad.gltf", model);
@@ -85,7 +71,7 @@ TEST(GltfImport, TextureCoordinatesRightSideUp) {
 // rotation): offset (0.25, 0.5), rotation 90 degrees, scale (0.5, 0.25) map (u, v) to
 // (0.25 + 0.25 v, 0.5 - 0.5 u). Offset and scale alone: (0.5 + 0.5 u, 0.5 v).
 TEST(GltfImport, TextureTransform) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   for (const bool rotated : {true, false}) {
     SCOPED_TRACE(rotated);
     GltfModel model;
@@ -128,7 +114,7 @@ TEST(GltfImport, PrimitivesTextureCoordinatesRightSideUp) {
 
 // One mesh, two primitives of different materials: two objects, each with its own material.
 TEST(GltfImport, TwoMaterialsOnOneMesh) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   GltfModel model;
   model.materials = {{.name = "red", .base_color = {1, 0, 0, 1}}, {.name = "blue", .base_color = {0, 0, 1, 1}}};
   model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
@@ -156,7 +142,7 @@ TEST(GltfImport, TwoMaterialsOnOneMesh) {
 // Alpha modes: MASK is alpha-tested with the base colour's alpha (texture included), BLEND is a
 // translucent occluder, OPAQUE ignores alpha; double-sidedness and transmission are read.
 TEST(GltfImport, AlphaModesAndTransmission) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   GltfModel model;
   model.textures = {corners_texture()};
   model.materials = {{.name = "mask",
@@ -211,7 +197,7 @@ TEST(GltfImport, AlphaModesAndTransmission) {
 // Textures as data URIs, as files beside the .gltf, and inside a GLB: the same texels, the row
 // order of the picture kept (row 0 on top).
 TEST(GltfImport, EmbeddedAndExternalTextures) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   GltfModel model;
   model.textures = {corners_texture()};
   model.materials = {{.name = "t", .texture = 0}};
@@ -245,7 +231,7 @@ TEST(GltfImport, EmbeddedAndExternalTextures) {
 
 // The JSON schema has alpha testing too.
 TEST(GltfImport, AlphaCutoffInJson) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   const Scene s =
       load(dir, R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"primitive": {"type": "box"},
                "material": {"opacity": 0.7, "alpha_cutoff": 0.5}}]})");
@@ -290,7 +276,7 @@ TEST(GltfImport, KhronosSamples) {
 // Formats without materials (OFF, PLY, OBJ without .mtl): Assimp invents one; the part keeps the
 // scene's default material.
 TEST(GltfImport, FormatsWithoutMaterialsKeepTheDefault) {
-  TempDir dir;
+  TempDir dir("msm_gltf_test");
   std::ofstream(dir.path() / "t.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
   std::ofstream(dir.path() / "t.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
                                          "property float y\nproperty float z\nelement face 1\n"

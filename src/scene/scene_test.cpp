@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "msm/scene/scene.h"
+#include "msm/test/temp_dir.h"
 
 namespace fs = std::filesystem;
 using namespace msm::scene;
@@ -20,27 +21,7 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 // A fresh temporary directory per test.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device rd;
-    path_ = fs::temp_directory_path() / ("msm_scene_test_" + std::to_string(rd()) + std::to_string(rd()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  const fs::path& path() const { return path_; }
-  fs::path write(const std::string& name, const std::string& text) const {
-    const fs::path p = path_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-
- private:
-  fs::path path_;
-};
+using msm::test::TempDir;
 
 double signed_volume(const Mesh& m) {
   double v = 0.0;
@@ -454,7 +435,7 @@ TEST(Primitives, TransformsApply) {
 // Assimp import
 
 TEST(Import, ObjPlyOffGltf) {
-  TempDir dir;
+  TempDir dir("msm_scene_test");
   // OBJ: a quad (2 triangles) and a triangle, no normals.
   const fs::path obj = dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 3 0 0\nv 2 1 0\n"
                                           "f 1 2 3 4\nf 5 6 7\n");
@@ -529,7 +510,7 @@ TEST(Import, RealModel) {
 // Textures
 
 TEST(Textures, PathRecordedAndLoadedLazily) {
-  TempDir dir;
+  TempDir dir("msm_scene_test");
   dir.write("t.ppm", std::string("P6\n2 1\n255\n") + std::string("\xff\x00\x00\x00\x80\xff", 6));
   const Scene s = load_scene_json(
       scene_with_object(
@@ -604,7 +585,7 @@ TEST(Materials, TransmissionColor) {
 // Bad input: a SceneError naming the file, the location and the problem.
 
 TEST(Errors, Files) {
-  TempDir dir;
+  TempDir dir("msm_scene_test");
   expect_error([&] { load_scene_file(dir.path() / "missing.json"); }, {"missing.json", "does not exist"});
   expect_error([&] { load_scene_file(dir.path()); }, {"not a regular file"});
   const fs::path bad = dir.write("bad.json", R"({"msm_scene": 1, "objects": [ )");
@@ -679,7 +660,7 @@ TEST(Errors, Values) {
 }
 
 TEST(Errors, Meshes) {
-  TempDir dir;
+  TempDir dir("msm_scene_test");
   auto load = [&](const std::string& object_json) {
     load_scene_file(dir.write("s.json", scene_with_object(object_json)));
   };
