@@ -4,6 +4,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
+#include <string>
 #include <system_error>
 
 #include <assimp/GltfMaterial.h>
@@ -176,6 +178,26 @@ bool same_material(const std::optional<Material>& a, const std::optional<Materia
 
 } // namespace
 
+// Debian's Assimp is built with ASSIMP_BUILD_DEBUG: an internal assertion (a truncated PLY trips
+// one in TriangulateProcess) prints and aborts the process, and this version has no handler to
+// install. The definition of Assimp::aiAssertViolation below interposes the library's (ELF symbol
+// interposition: the executable's definition wins over the shared library's exported one): the
+// assertion becomes an exception, which Importer::ReadFile swallows (or we catch), and the import
+// fails with a SceneError naming the file.
+namespace {
+thread_local std::string assimp_assertion; // the last assertion of this thread's import
+} // namespace
+} // namespace msm::scene
+
+namespace Assimp {
+void aiAssertViolation(const char* expression, const char* file, int line) {
+  msm::scene::assimp_assertion = fmt::format("{} ({}:{})", expression, file, line);
+  throw std::runtime_error("Assimp's internal check failed: " + msm::scene::assimp_assertion);
+}
+} // namespace Assimp
+
+namespace msm::scene {
+
 std::vector<ModelPart> import_model(const std::filesystem::path& file) {
   check_regular_file(file, "mesh");
   Assimp::Importer importer;
@@ -185,7 +207,17 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
                          aiProcess_GenSmoothNormals | aiProcess_SortByPType | aiProcess_ValidateDataStructure |
                          aiProcess_FlipUVs;
-  const aiScene* s = importer.ReadFile(file.string(), flags);
+  assimp_assertion.clear();
+  const aiScene* s = nullptr;
+  try {
+    s = importer.ReadFile(file.string(), flags);
+  } catch (const std::exception&) {
+    s = nullptr; // an assertion (above) that ReadFile let through
+  }
+  if (!assimp_assertion.empty())
+    throw SceneError(file.string(), "",
+                     fmt::format("Assimp cannot read the mesh (truncated or corrupt?): its internal check {} failed",
+                                 assimp_assertion));
   if (!s || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !s->mRootNode)
     throw SceneError(file.string(), "", fmt::format("Assimp cannot read the mesh: {}", importer.GetErrorString()));
   // One part per distinct material: Assimp repeats a glTF material for every mesh that uses it.

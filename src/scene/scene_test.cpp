@@ -506,6 +506,23 @@ TEST(Import, RealModel) {
   EXPECT_GE(double(consistent), 0.999 * double(m.triangle_count()));
 }
 
+// A truncated PLY (issue 19: the first 40000 bytes of assimp-testmodels' Wuson.ply) trips an
+// assertion inside Assimp, which Debian's build turns into abort(): the import must fail with a
+// SceneError naming the file instead (import.cpp interposes Assimp's assertion handler).
+TEST(Import, TruncatedPlyIsAnErrorNotAnAbort) {
+  const fs::path wuson = fs::path(MSM_ASSIMP_MODELS_DIR) / "PLY" / "Wuson.ply";
+  ASSERT_TRUE(fs::exists(wuson)) << wuson << " is missing (install assimp-testmodels: scripts/bootstrap.sh does)";
+  std::ifstream in(wuson, std::ios::binary);
+  std::string head(40000, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  ASSERT_EQ(in.gcount(), 40000);
+  TempDir dir("msm_scene_test");
+  const fs::path truncated = dir.write("truncated.ply", head);
+  expect_error([&] { (void)import_mesh(truncated); }, {"truncated.ply", "truncated or corrupt"});
+  // The importer still works afterwards.
+  EXPECT_GT(import_mesh(wuson).triangle_count(), 0u);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Textures
 
