@@ -902,7 +902,7 @@ std::vector<KernelIO> run_kernels(vk::Context& ctx, const vk::Program& program, 
   // TriviallyCopyable to the standard); their bytes are exactly what the shader reads.
   static_assert(std::is_standard_layout_v<KernelIO> && sizeof(KernelIO) == 48);
   std::memcpy(src.data(), in.data(), size); // NOLINT(bugprone-undefined-memory-manipulation): see above
-  std::memset(dst.data(), 0xFF, size); // NaN everywhere: an output the shader did not write shows
+  std::memset(dst.data(), 0xFF, size);      // NaN everywhere: an output the shader did not write shows
   struct Push {
     int32_t function;
     uint32_t count;

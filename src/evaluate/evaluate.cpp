@@ -28,6 +28,7 @@ std::vector<double> unit_grid(int n) {
 GridBasis prepare_basis(const Candidate& candidate, int grid_points) {
   if (candidate.technique != Technique::lp) throw std::invalid_argument("prepare_basis: not an LP candidate");
   std::vector<std::function<double(double)>> functions;
+  functions.reserve(candidate.functions.size());
   for (int f : candidate.functions) functions.emplace_back(candidate_functions()[f].value);
   return GridBasis(unit_grid(grid_points), functions, candidate.name);
 }
@@ -54,6 +55,7 @@ std::optional<double> glpk_bound(const Candidate& candidate, const std::vector<d
   const int n = int(grid.size());
   if (cutoff >= n) return 1.0; // every grid point counts
   std::vector<std::function<double(double)>> functions;
+  functions.reserve(candidate.functions.size());
   for (int f : candidate.functions) functions.emplace_back(candidate_functions()[f].value);
   const oracle::Basis basis = oracle::custom_basis(candidate.name, functions);
   std::vector<double> b(functions.size(), 0.0);

@@ -21,6 +21,7 @@ namespace {
 
 std::vector<std::function<double(double)>> functions_of(const std::vector<int>& indices) {
   std::vector<std::function<double(double)>> f;
+  f.reserve(indices.size());
   for (int i : indices) f.emplace_back(candidate_functions()[i].value);
   return f;
 }

@@ -191,6 +191,7 @@ std::vector<char> Stack::serialize() const {
   w.put_vector(indices);
   w.put_vector(weights);
   std::vector<PackedFragment> packed;
+  packed.reserve(fragments.size());
   for (const Fragment& f : fragments)
     packed.push_back({f.texel, f.layer, f.cutoff, f.counted ? 1 : 0, f.receiver, f.pcf});
   w.put_vector(packed);

@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 namespace msm {
@@ -263,15 +264,17 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
   const int w = 128, h = 96, width = 27, nt = width * width;
   const uint scale = msm_sat_scale(nt);
   // Receiver at z = 0.6 with a slope along x, occluders: random rectangles at -0.8 .. 0.4.
-  std::vector<float> depth(size_t(w * h));
+  const int centre = w / 2; // the receiver's slope pivots on the middle column
+  const auto at = [w](int x, int y) { return size_t(y) * size_t(w) + size_t(x); };
+  std::vector<float> depth(size_t(w) * size_t(h));
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) depth[size_t(y * w + x)] = 0.6f + 0.001f * float(x - w / 2);
+    for (int x = 0; x < w; ++x) depth[at(x, y)] = 0.6f + 0.001f * float(x - centre);
   for (int k = 0; k < 25; ++k) { // the first five large enough to hold umbrae
     int x0 = int(unit(rng) * w), y0 = int(unit(rng) * h), x1 = x0 + 2 + int(unit(rng) * (k < 5 ? 60 : 30)),
         y1 = y0 + 2 + int(unit(rng) * (k < 5 ? 50 : 20));
     float z = -0.8f + 1.2f * unit(rng);
     for (int y = y0; y < std::min(y1, h); ++y)
-      for (int x = x0; x < std::min(x1, w); ++x) depth[size_t(y * w + x)] = std::min(depth[size_t(y * w + x)], z);
+      for (int x = x0; x < std::min(x1, w); ++x) depth[at(x, y)] = std::min(depth[at(x, y)], z);
   }
   std::vector<vec4> m(depth.size());
   for (size_t i = 0; i < m.size(); ++i) m[i] = msm_theta4_star(msm_moments4(depth[i]));
@@ -298,13 +301,15 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
     vec2 lo(unit(rng) * (float(w) - extent.x), unit(rng) * (float(h) - extent.y));
     int px = int(unit(rng) * w), py = int(unit(rng) * h);
     q.region = vec4(lo, lo + extent);
-    q.fragment = vec4(float(px) + 0.5f, float(py) + 0.5f, 0.6f + 0.001f * float(px - w / 2), 0.001f);
+    q.fragment = vec4(float(px) + 0.5f, float(py) + 0.5f, 0.6f + 0.001f * float(px - centre), 0.001f);
   }
   vk::Buffer query_buffer =
       vk::create_buffer(ctx(), sizeof(Query) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
   vk::Buffer result_buffer =
       vk::create_buffer(ctx(), sizeof(SoftFlow) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
-  std::memcpy(query_buffer.data(), queries.data(), sizeof(Query) * count);
+  static_assert(std::is_standard_layout_v<Query>); // glm vectors: see gpu_math_test.cpp's KernelIO
+  std::memcpy(query_buffer.data(), queries.data(),
+              sizeof(Query) * count); // NOLINT(bugprone-undefined-memory-manipulation)
   vk::Program program = vk::create_program(
       ctx(), "sat_queries.comp", {vk::Binding::storage_image, vk::Binding::storage_buffer, vk::Binding::storage_buffer},
       sizeof(Push));

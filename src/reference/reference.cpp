@@ -79,7 +79,7 @@ void validate(const Settings& s) {
   check_range("shadow map size", s.shadow_size, 1, kMaxShadowSize);
   check_range("max crossings", s.max_crossings, 1, kMaxCrossings);
   check_range("threads", s.threads, 0, kMaxThreads);
-  FilterKernel(s.filter_size, s.filter_sigma); // throws for a bad size or sigma
+  [[maybe_unused]] const FilterKernel kernel(s.filter_size, s.filter_sigma); // throws for a bad size or sigma
   check_angle("light extent", s.light_extent_deg);
   check_angle("light width", s.light_width_deg);
   check_angle("light height", s.light_height_deg);

@@ -327,6 +327,7 @@ TEST(reference_filtered, KernelSamplingHasTheKernelsDistribution) {
   // Empirical CDF of 2^16 evenly spaced u against cdf(): Kolmogorov distance ~ 1 / 2^16.
   std::vector<double> samples;
   const int n = 1 << 16;
+  samples.reserve(n);
   for (int i = 0; i < n; ++i) samples.push_back(k.sample((i + 0.5) / n));
   std::sort(samples.begin(), samples.end());
   double worst = 0.0;

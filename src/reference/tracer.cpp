@@ -254,7 +254,7 @@ double Tracer::opacity(const SurfaceHit& hit) const {
 bool Tracer::solid(std::uint32_t object, std::uint32_t triangle, float u, float v) const {
   const scene::Material& m = material_of(scene_, object);
   // In float, as the renderer's shaders compare.
-  return !m.masked() || float(texture_opacity(object, triangle, u, v)) >= *m.alpha_cutoff;
+  return !m.alpha_cutoff || float(texture_opacity(object, triangle, u, v)) >= *m.alpha_cutoff; // masked()
 }
 
 glm::vec3 Tracer::albedo(const SurfaceHit& hit) const {

@@ -227,7 +227,7 @@ class Parser {
 
   fs::path existing_file(const std::string& rel, const std::string& ptr, const char* what) const {
     if (rel.empty()) fail(ptr, "empty path");
-    const fs::path p = (base_ / fs::path(rel)).lexically_normal();
+    fs::path p = (base_ / fs::path(rel)).lexically_normal();
     std::error_code ec;
     if (!fs::is_regular_file(p, ec))
       fail(ptr, fmt::format("{} file '{}' does not exist or is not a file", what, p.string()));

@@ -44,6 +44,7 @@ void TranslucentPass::execute(const PassContext& c) const {
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     std::vector<vk::ColorAttachment> targets;
+    targets.reserve(size_t(config_.moment_images()));
     for (int i = 0; i < config_.moment_images(); ++i)
       targets.push_back({.view = c.image(moment_image(channel_, i)).layer_mip0_views[size_t(l)],
                          .load = true,
@@ -57,6 +58,7 @@ void TranslucentPass::execute(const PassContext& c) const {
     // Back to front along this light's travel (the scene sorted them, and each one's triangles, for
     // its first light; the objects are re-sorted here for the others).
     std::vector<const Draw*> order;
+    order.reserve(scene.translucent.size());
     for (const Draw& d : scene.translucent) order.push_back(&d);
     if (l > 0) {
       glm::vec3 travel = -glm::vec3(c.frame.light_data[size_t(l)].towards_light);
