@@ -4,7 +4,7 @@ BUILD_TYPE ?= RelWithDebInfo
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test bench clean
+.PHONY: all deps configure build demo test sanitize bench clean
 
 all: build
 
@@ -23,8 +23,19 @@ demo: build
 test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --timeout 900
 
+# The suite again under AddressSanitizer and UndefinedBehaviorSanitizer, halting on the first
+# report (CI runs it after `make test`). Leak checking is off: the Khronos validation layer leaks.
+SANITIZE_DIR ?= build-sanitize
+sanitize: deps
+	@cmake -S . -B $(SANITIZE_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMSM_SANITIZE=address,undefined \
+		-DMSM_BUILD_BENCHMARKS=OFF "-DCMAKE_CXX_FLAGS=-fno-sanitize-recover=all" $(CMAKE_FLAGS) \
+		> $(SANITIZE_DIR).configure.log 2>&1 || (cat $(SANITIZE_DIR).configure.log; exit 1)
+	@cmake --build $(SANITIZE_DIR) -j $(JOBS)
+	@cd $(SANITIZE_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+		ctest --output-on-failure -j $(JOBS) --timeout 1800
+
 bench: build
 	@$(BUILD_DIR)/bench/msm_bench_cpu --benchmark_min_time=0.2
 
 clean:
-	rm -rf $(BUILD_DIR) $(BUILD_DIR).configure.log
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).configure.log $(SANITIZE_DIR) $(SANITIZE_DIR).configure.log
