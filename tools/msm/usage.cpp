@@ -1,9 +1,12 @@
 #include "usage.h"
 
+#include "msm/util/spelling.h"
+
 #include <fmt/core.h>
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace msm::tool {
 
@@ -18,15 +21,64 @@ const char* exit_status_help() {
          "  128+n  killed by signal n";
 }
 
+namespace {
+
+std::string suggestion(const std::vector<std::string>& near, const std::string& prefix) {
+  if (near.empty()) return "";
+  std::string s = " (did you mean " + prefix + near[0];
+  for (size_t i = 1; i < near.size(); ++i) s += (i + 1 == near.size() ? " or " : ", ") + prefix + near[i];
+  return s + "?)";
+}
+
+// What the parser left unmatched in one (sub)command, each with the nearest valid name: options
+// against the command's long option names, a word against its subcommands' names. A word just
+// after an unknown option is taken as that option's value and not reported again.
+std::vector<std::string> unknown_items(const CLI::App& app) {
+  std::vector<std::string> lines;
+  bool after_option = false;
+  for (const std::string& item : app.remaining(false)) {
+    if (item.size() > 1 && item[0] == '-') {
+      std::string name = item.substr(item.find_first_not_of('-'));
+      name = name.substr(0, name.find('='));
+      std::vector<std::string> names;
+      for (const CLI::Option* o : app.get_options())
+        for (const std::string& l : o->get_lnames()) names.push_back(l);
+      lines.push_back(fmt::format("unknown option '{}'{}", item, suggestion(util::nearest_names(name, names), "--")));
+      after_option = true;
+      continue;
+    }
+    if (!app.get_subcommands({}).empty()) {
+      std::vector<std::string> names;
+      for (const CLI::App* sub : app.get_subcommands({})) names.push_back(sub->get_name());
+      lines.push_back(fmt::format("unknown command '{}'{}", item, suggestion(util::nearest_names(item, names), "")));
+      break; // what follows belonged to that command
+    }
+    if (!after_option) lines.push_back(fmt::format("unexpected argument '{}'", item));
+    after_option = false;
+  }
+  return lines;
+}
+
+} // namespace
+
 int report_parse_error(CLI::App& app, const CLI::ParseError& error) {
   if (error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(error); // help, version
   // The subcommand that rejected it: the innermost one the parser had entered.
   std::string command = "msm";
+  std::vector<std::string> unknown = unknown_items(app);
   for (const CLI::App* sub = &app; !sub->get_subcommands().empty();) {
     sub = sub->get_subcommands().front();
     command += " " + sub->get_name();
+    std::vector<std::string> more = unknown_items(*sub);
+    unknown.insert(unknown.end(), more.begin(), more.end());
   }
-  fmt::print(stderr, "{}: error: {}\nRun '{} --help' for the usage.\n", command, error.what(), command);
+  for (const std::string& line : unknown) fmt::print(stderr, "{}: error: {}\n", command, line);
+  // The parser's own message, unless it only restates the unknown items ("not expected") or
+  // follows from a mistyped command ("a subcommand is required").
+  bool restated = dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr ||
+                  (dynamic_cast<const CLI::RequiredError*>(&error) != nullptr && app.get_subcommands().empty());
+  if (unknown.empty() || !restated) fmt::print(stderr, "{}: error: {}\n", command, error.what());
+  fmt::print(stderr, "Run '{} --help' for the usage.\n", command);
   return kExitUsage;
 }
 
