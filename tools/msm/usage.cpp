@@ -5,6 +5,7 @@
 #include <fmt/core.h>
 
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,7 +13,7 @@ namespace msm::tool {
 
 const char* exit_status_help() {
   return "Exit status:\n"
-         "  0    success (also --help and --version)\n"
+         "  0    success (also --help, --version and msm help)\n"
          "  1    the command line was not understood: an unknown command or option, a missing or malformed "
          "value (the message names it)\n"
          "  2    the command failed: a bad value or input file, no Vulkan device, output not writable (nothing "
@@ -60,6 +61,29 @@ std::vector<std::string> unknown_items(const CLI::App& app) {
 }
 
 } // namespace
+
+void add_help(CLI::App& app) {
+  auto command = std::make_shared<std::string>();
+  auto* cmd = app.add_subcommand("help", "Print the help of msm, or of one command (msm help render)");
+  cmd->add_option("COMMAND", *command, "The command");
+  cmd->callback([&app, command] {
+    if (command->empty()) {
+      // Not app.help(): with `help` parsed, it would print the help of `help`.
+      fmt::print("{}", app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal));
+      return;
+    }
+    std::vector<std::string> names;
+    for (CLI::App* sub : app.get_subcommands({})) {
+      if (sub->get_name() == *command) {
+        fmt::print("{}", sub->help(app.get_name()));
+        return;
+      }
+      names.push_back(sub->get_name());
+    }
+    throw CLI::ValidationError(
+        fmt::format("unknown command '{}'{}", *command, suggestion(util::nearest_names(*command, names), "")));
+  });
+}
 
 int report_parse_error(CLI::App& app, const CLI::ParseError& error) {
   if (error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(error); // help, version

@@ -11,6 +11,10 @@ constexpr int kExitFailure = 2; // the command ran and failed: bad value or file
 // The footer of `msm --help`: the exit statuses.
 const char* exit_status_help();
 
+// `msm help [COMMAND]`: the help of msm or of one command (stdout, exit 0); an unknown command is
+// a usage error naming the nearest.
+void add_help(CLI::App& app);
+
 // Prints why the parser rejected the command line (naming the subcommand) and returns the exit
 // status: 0 for --help and --version (CLI11 signals them as errors too), else kExitUsage.
 int report_parse_error(CLI::App& app, const CLI::ParseError& error);
