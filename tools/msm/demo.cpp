@@ -128,16 +128,18 @@ void add_demo(CLI::App& app) {
                                          "mssm6, vssm, pcss) against the ray-traced area light; print the errors and "
                                          "the time per pass");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
-  cmd->add_option("--techniques", opt->techniques, "Techniques to compare (the first is the reference)")
+  cmd->add_option("--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
       ->delimiter(',');
   cmd->add_option("--soft-scene", opt->soft_scene, "Scene of the soft-shadow part")->capture_default_str();
-  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques (empty: skip the soft part)")
+  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques or aliases (empty: skip the soft part)")
       ->delimiter(',');
   cmd->add_option("--soft-samples", opt->soft_samples, "Ray-traced samples per pixel of the area-light reference")
       ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
+    opt->techniques = canonical_technique_names(opt->techniques);
+    opt->soft_techniques = canonical_technique_names(opt->soft_techniques);
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
     if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
     validate_techniques(opt->frame, opt->techniques);

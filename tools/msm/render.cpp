@@ -33,7 +33,7 @@ void add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
                                            "EXR and JSON per technique)");
   cmd->add_option("--technique,-t", opt->techniques,
-                  "Technique, comma-separated list, or 'all' (msm techniques lists them)")
+                  "Technique or alias, comma-separated list, or 'all' (msm techniques lists them)")
       ->capture_default_str();
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   add_frame_options(cmd, opt->frame);
@@ -43,7 +43,7 @@ void add_render(CLI::App& app) {
     if (opt->techniques == "all")
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     else
-      names = split(opt->techniques);
+      names = canonical_technique_names(split(opt->techniques));
     if (names.empty()) throw UsageError("--technique: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);

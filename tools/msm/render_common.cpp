@@ -96,6 +96,11 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
   return s;
 }
 
+std::vector<std::string> canonical_technique_names(std::vector<std::string> names) {
+  for (std::string& name : names) name = std::string(canonical_technique_name(name));
+  return names;
+}
+
 void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques) {
   for (const std::string& name : techniques) {
     try {

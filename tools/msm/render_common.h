@@ -35,6 +35,10 @@ void finish_frame_options(FrameOptions& options);
 // moment image (the depth-based ones and 6MSM keep their own pipeline).
 render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique);
 
+// The table's names for technique names and aliases (msm = msm-hamburger-64, ...): outputs and
+// tables are named by the table's name whichever was typed.
+std::vector<std::string> canonical_technique_names(std::vector<std::string> names);
+
 // Every technique's settings are valid, before anything is loaded or created (UsageError naming
 // the first problem otherwise).
 void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques);
