@@ -131,15 +131,18 @@ void add_demo(CLI::App& app) {
   cmd->add_option("--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
       ->delimiter(',');
   cmd->add_option("--soft-scene", opt->soft_scene, "Scene of the soft-shadow part")->capture_default_str();
-  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques or aliases (empty: skip the soft part)")
+  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques or aliases (\"\": skip the soft part)")
       ->delimiter(',');
   cmd->add_option("--soft-samples", opt->soft_samples, "Ray-traced samples per pixel of the area-light reference")
       ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
-    opt->techniques = canonical_technique_names(opt->techniques);
-    opt->soft_techniques = canonical_technique_names(opt->soft_techniques);
+    // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
+    for (auto* list : {&opt->techniques, &opt->soft_techniques}) {
+      std::erase(*list, std::string());
+      *list = canonical_technique_names(*list);
+    }
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
     if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
     validate_techniques(opt->frame, opt->techniques);
@@ -159,7 +162,10 @@ void add_demo(CLI::App& app) {
                  ctx->info().name);
       compare_techniques(renderer, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
     }
-    if (!soft_scene) return;
+    if (!soft_scene) {
+      fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
+      return;
+    }
     float extent = fs.light_extent_deg ? *fs.light_extent_deg : soft_scene->light().angular_extent_deg;
     fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
                "samples per pixel\n",
