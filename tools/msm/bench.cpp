@@ -95,6 +95,7 @@ void add_bench(CLI::App& app) {
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
+    check_on_device(renderer, opt->frame, names); // before the first frame, not after some
     const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve",  "translucent", "blur",
                                                     "mipmaps",      "one_pass_filter", "sat"};
 

@@ -152,16 +152,23 @@ void add_demo(CLI::App& app) {
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::optional<scene::Scene> soft_scene;
     if (!opt->soft_techniques.empty()) soft_scene = load_scene_or_fail(soft.scene);
-    ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
-    const render::RenderSettings& fs = opt->frame.settings;
-    {
-      render::Renderer renderer(*ctx, scene);
-      fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
-                 scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
-                 ctx->info().name);
-      compare_techniques(renderer, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
+    // Both parts' renderers first: what the device cannot do is refused before the output
+    // directory exists (the first renderer is released before the soft part).
+    std::optional<render::Renderer> hard, soft_renderer;
+    hard.emplace(*ctx, scene);
+    check_on_device(*hard, opt->frame, opt->techniques);
+    if (soft_scene) {
+      soft_renderer.emplace(*ctx, *soft_scene);
+      check_on_device(*soft_renderer, soft, opt->soft_techniques);
     }
+    ensure_output_dir(opt->out);
+    const render::RenderSettings& fs = opt->frame.settings;
+    fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
+               scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
+               ctx->info().name);
+    compare_techniques(*hard, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
+    hard.reset();
     if (!soft_scene) {
       fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
       return;
@@ -183,8 +190,7 @@ void add_demo(CLI::App& app) {
       for (int x = 0; x < truth_rgb.width(); ++x)
         if (truth.visibility.at(x, y, 1) > 0.5f)
           for (int c = 0; c < 3; ++c) truth_rgb.at(x, y, c) = MSM_SKY_RADIANCE[c];
-    render::Renderer renderer(*ctx, *soft_scene);
-    compare_techniques(renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
+    compare_techniques(*soft_renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
                        "soft-comparison.png");
   });
 }

@@ -50,11 +50,13 @@ void add_render(CLI::App& app) {
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);
-    ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     fmt::print(stderr, "msm render: scene '{}', {} triangles, {}x{}, shadow map {}², on {}\n", scene.name,
                scene.triangle_count(), f.width, f.height, f.shadow_size, ctx->info().name);
     render::Renderer renderer(*ctx, scene);
+    // What the device cannot do is refused before the output directory exists.
+    check_on_device(renderer, opt->frame, names);
+    ensure_output_dir(opt->out);
     for (size_t i = 0; i < names.size(); ++i) {
       render::RenderSettings s = settings_for(opt->frame, names[i]);
       render::RenderResult result;

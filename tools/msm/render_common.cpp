@@ -109,6 +109,15 @@ void validate_techniques(const FrameOptions& options, const std::vector<std::str
   }
 }
 
+void check_on_device(const render::Renderer& renderer, const FrameOptions& options,
+                     const std::vector<std::string>& techniques) {
+  for (const std::string& name : techniques) {
+    try {
+      renderer.check(settings_for(options, name));
+    } catch (const render::RenderError& e) { throw UsageError(e.what()); }
+  }
+}
+
 std::unique_ptr<vk::Context> open_device(const std::string& device) {
   vk::ContextOptions options;
   options.device = device;

@@ -43,6 +43,11 @@ std::vector<std::string> canonical_technique_names(std::vector<std::string> name
 // the first problem otherwise).
 void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques);
 
+// The device can render every technique's settings (Renderer::check), before any output exists:
+// UsageError naming the first problem (an MSAA count the device lacks, an image too large).
+void check_on_device(const render::Renderer& renderer, const FrameOptions& options,
+                     const std::vector<std::string>& techniques);
+
 // The Vulkan context (validation with MSM_VALIDATION=1); a failure is a UsageError naming devices.
 std::unique_ptr<vk::Context> open_device(const std::string& device);
 // A built-in scene or a scene file; SceneError becomes a UsageError with the loader's message.
