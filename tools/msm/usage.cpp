@@ -99,9 +99,12 @@ int report_parse_error(CLI::App& app, const CLI::ParseError& error) {
   for (const std::string& line : unknown) fmt::print(stderr, "{}: error: {}\n", command, line);
   // The parser's own message, unless it only restates the unknown items ("not expected") or
   // follows from a mistyped command ("a subcommand is required").
-  bool restated = dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr ||
-                  (dynamic_cast<const CLI::RequiredError*>(&error) != nullptr && app.get_subcommands().empty());
-  if (unknown.empty() || !restated) fmt::print(stderr, "{}: error: {}\n", command, error.what());
+  bool no_command = dynamic_cast<const CLI::RequiredError*>(&error) != nullptr && app.get_subcommands().empty();
+  bool restated = dynamic_cast<const CLI::ExtrasError*>(&error) != nullptr || no_command;
+  if (unknown.empty() && no_command)
+    fmt::print(stderr, "msm: error: no command given ('msm help' lists them)\n");
+  else if (unknown.empty() || !restated)
+    fmt::print(stderr, "{}: error: {}\n", command, error.what());
   fmt::print(stderr, "Run '{} --help' for the usage.\n", command);
   return kExitUsage;
 }
