@@ -2,9 +2,11 @@
 
 #include "msm/msm.h"
 #include "msm/techniques.h"
+#include "msm/util/spelling.h"
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace msm {
 namespace {
@@ -397,19 +399,54 @@ constexpr Technique kTechniques[] = {
      nullptr},
 };
 
+// One short name per family, for its recommended storage: the JCGT 2017 64-bit MSM, the 2015
+// comparison's 32-bit VSM and ESM, EVSM4 at 64 bits (JCGT Fig. 4a), the HPG 2017 64-bit map, 6MSM
+// in 96 bits (JCGT §5.4.3), moment soft shadows with four moments.
+constexpr TechniqueAlias kAliases[] = {
+    {"msm", "msm-hamburger-64"}, {"vsm", "vsm-32"},   {"esm", "esm-32"}, {"evsm", "evsm4-64"},
+    {"msm-nl", "msm-nl64"},      {"msm6", "msm6-96"}, {"mssm", "mssm4"},
+};
+
 } // namespace
 
 std::span<const Technique> techniques() { return kTechniques; }
 
+std::span<const TechniqueAlias> technique_aliases() { return kAliases; }
+
+std::string_view canonical_technique_name(std::string_view name) {
+  for (const TechniqueAlias& a : kAliases)
+    if (a.alias == name) return a.technique;
+  return name;
+}
+
+std::string technique_alias_list(std::string_view technique) {
+  std::string out;
+  for (const TechniqueAlias& a : kAliases)
+    if (a.technique == technique) out += (out.empty() ? "" : ", ") + std::string(a.alias);
+  return out;
+}
+
+std::string technique_suggestion(std::string_view unknown, std::span<const std::string_view> names) {
+  std::vector<std::string> candidates(names.begin(), names.end());
+  for (const TechniqueAlias& a : kAliases)
+    for (std::string_view n : names)
+      if (a.technique == n) candidates.emplace_back(a.alias);
+  return util::did_you_mean(unknown, candidates);
+}
+
 glm::vec4 Technique::default_params() const { return id >= 0 ? msm_technique_default_params(id) : glm::vec4(0.0f); }
 
 const Technique& find_technique(std::string_view name) {
+  std::string_view canonical = canonical_technique_name(name);
   std::string valid;
+  std::vector<std::string_view> names;
   for (const Technique& t : kTechniques) {
-    if (t.name == name) return t;
+    if (t.name == canonical) return t;
     valid += (valid.empty() ? "" : ", ") + std::string(t.name);
+    names.push_back(t.name);
   }
-  throw std::invalid_argument("unknown technique '" + std::string(name) + "'; valid: " + valid);
+  throw std::invalid_argument("unknown technique '" + std::string(name) + "'" + technique_suggestion(name, names) +
+                              "; valid: " + valid + " (aliases: msm techniques)");
 }
 
 const Technique& technique_by_id(int id) {

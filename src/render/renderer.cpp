@@ -211,10 +211,9 @@ struct Renderer::Impl {
     return u;
   }
 
-  // Validates, (re)builds the frame graph where the configuration changed, writes the uniforms.
-  const Technique& prepare(const RenderSettings& s) {
+  // The settings are valid and this device can render them (RenderError naming what it lacks).
+  void check(const RenderSettings& s) const {
     s.validate();
-    const Technique& technique = find_rendered_technique(s.technique);
     if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, VkSampleCountFlagBits(s.msaa)))
       throw RenderError(
           fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name, s.msaa));
@@ -226,6 +225,13 @@ struct Renderer::Impl {
     if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
       throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
                                     ctx.properties().limits.maxImageArrayLayers));
+  }
+
+  // Validates, (re)builds the frame graph where the configuration changed, writes the uniforms.
+  const Technique& prepare(const RenderSettings& s) {
+    check(s);
+    const Technique& technique = find_rendered_technique(s.technique);
+    const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
     int id = technique.id;
     bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(id));
     bool translucent =
@@ -348,6 +354,7 @@ struct Renderer::Impl {
 Renderer::Renderer(const vk::Context& ctx, const scene::Scene& scene) : impl_(std::make_unique<Impl>(ctx, scene)) {}
 Renderer::~Renderer() = default;
 const scene::Scene& Renderer::scene() const noexcept { return impl_->scene; }
+void Renderer::check(const RenderSettings& s) const { impl_->check(s); }
 
 RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermediates) {
   Impl& m = *impl_;

@@ -17,12 +17,16 @@ std::vector<const Technique*> rendered_techniques() {
 }
 
 const Technique& find_rendered_technique(std::string_view name) {
+  std::string_view canonical = canonical_technique_name(name);
   std::string valid;
+  std::vector<std::string_view> names;
   for (const Technique* t : rendered_techniques()) {
-    if (t->name == name) return *t;
+    if (t->name == canonical) return *t;
     valid += (valid.empty() ? "" : ", ") + std::string(t->name);
+    names.push_back(t->name);
   }
-  throw RenderError(fmt::format("unknown technique '{}'; valid: {}", name, valid));
+  throw RenderError(fmt::format("unknown technique '{}'{}; valid: {} (aliases: msm techniques)", name,
+                                technique_suggestion(name, names), valid));
 }
 
 bool supports_translucency(const Technique& t) {

@@ -55,7 +55,7 @@ void add_bench(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
                                           "pixel, shadow map per texel)");
-  cmd->add_option("--techniques", opt->techniques, "Techniques (default: all)")->delimiter(',');
+  cmd->add_option("--techniques", opt->techniques, "Techniques or aliases (default: all)")->delimiter(',');
   cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")
       ->delimiter(',')
       ->capture_default_str();
@@ -71,7 +71,7 @@ void add_bench(CLI::App& app) {
     finish_frame_options(opt->frame);
     if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
     if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
-    std::vector<std::string> names = opt->techniques;
+    std::vector<std::string> names = canonical_technique_names(opt->techniques);
     if (names.empty())
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     if (std::find(names.begin(), names.end(), "pcf") == names.end()) names.insert(names.begin(), "pcf");
@@ -95,6 +95,7 @@ void add_bench(CLI::App& app) {
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
+    check_on_device(renderer, opt->frame, names); // before the first frame, not after some
     const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve",  "translucent", "blur",
                                                     "mipmaps",      "one_pass_filter", "sat"};
 

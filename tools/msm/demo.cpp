@@ -128,16 +128,21 @@ void add_demo(CLI::App& app) {
                                          "mssm6, vssm, pcss) against the ray-traced area light; print the errors and "
                                          "the time per pass");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
-  cmd->add_option("--techniques", opt->techniques, "Techniques to compare (the first is the reference)")
+  cmd->add_option("--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
       ->delimiter(',');
   cmd->add_option("--soft-scene", opt->soft_scene, "Scene of the soft-shadow part")->capture_default_str();
-  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques (empty: skip the soft part)")
+  cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques or aliases (\"\": skip the soft part)")
       ->delimiter(',');
   cmd->add_option("--soft-samples", opt->soft_samples, "Ray-traced samples per pixel of the area-light reference")
       ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
+    // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
+    for (auto* list : {&opt->techniques, &opt->soft_techniques}) {
+      std::erase(*list, std::string());
+      *list = canonical_technique_names(*list);
+    }
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
     if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
     validate_techniques(opt->frame, opt->techniques);
@@ -147,17 +152,27 @@ void add_demo(CLI::App& app) {
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::optional<scene::Scene> soft_scene;
     if (!opt->soft_techniques.empty()) soft_scene = load_scene_or_fail(soft.scene);
-    ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
-    const render::RenderSettings& fs = opt->frame.settings;
-    {
-      render::Renderer renderer(*ctx, scene);
-      fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
-                 scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
-                 ctx->info().name);
-      compare_techniques(renderer, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
+    // Both parts' renderers first: what the device cannot do is refused before the output
+    // directory exists (the first renderer is released before the soft part).
+    std::optional<render::Renderer> hard, soft_renderer;
+    hard.emplace(*ctx, scene);
+    check_on_device(*hard, opt->frame, opt->techniques);
+    if (soft_scene) {
+      soft_renderer.emplace(*ctx, *soft_scene);
+      check_on_device(*soft_renderer, soft, opt->soft_techniques);
     }
-    if (!soft_scene) return;
+    ensure_output_dir(opt->out);
+    const render::RenderSettings& fs = opt->frame.settings;
+    fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
+               scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
+               ctx->info().name);
+    compare_techniques(*hard, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
+    hard.reset();
+    if (!soft_scene) {
+      fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
+      return;
+    }
     float extent = fs.light_extent_deg ? *fs.light_extent_deg : soft_scene->light().angular_extent_deg;
     fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
                "samples per pixel\n",
@@ -175,8 +190,7 @@ void add_demo(CLI::App& app) {
       for (int x = 0; x < truth_rgb.width(); ++x)
         if (truth.visibility.at(x, y, 1) > 0.5f)
           for (int c = 0; c < 3; ++c) truth_rgb.at(x, y, c) = MSM_SKY_RADIANCE[c];
-    render::Renderer renderer(*ctx, *soft_scene);
-    compare_techniques(renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
+    compare_techniques(*soft_renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
                        "soft-comparison.png");
   });
 }

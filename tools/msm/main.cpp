@@ -1,5 +1,6 @@
 // msm: the command-line front end of the moment shadow mapping toolkit.
 #include "commands.h"
+#include "usage.h"
 
 #include "msm/version.h"
 
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version",
                        fmt::format("msm {}.{}.{}", MSM_VERSION_MAJOR, MSM_VERSION_MINOR, MSM_VERSION_PATCH));
   app.require_subcommand(1);
+  app.footer(msm::tool::exit_status_help()); // before the subcommands: each inherits it
   msm::tool::add_kernels(app);
   msm::tool::add_techniques(app);
   msm::tool::add_reconstruct(app);
@@ -26,11 +28,12 @@ int main(int argc, char** argv) {
 #endif
   msm::tool::add_reference(app);
   msm::tool::add_evaluate(app);
+  msm::tool::add_help(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) { return app.exit(e); } catch (const std::exception& e) {
+  } catch (const CLI::ParseError& e) { return msm::tool::report_parse_error(app, e); } catch (const std::exception& e) {
     fmt::print(stderr, "msm: error: {}\n", e.what());
-    return 2;
+    return msm::tool::kExitFailure;
   }
   return 0;
 }

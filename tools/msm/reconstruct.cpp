@@ -28,6 +28,8 @@ void add_techniques(CLI::App& app) {
     for (const Technique& t : techniques()) {
       std::string where = t.rendered && t.on_cpu() ? "render, cpu" : t.rendered ? "render" : "cpu";
       fmt::print("{:<26} {:>4}  {:<12} {}\n", t.name, t.bits_per_texel, where, t.description);
+      if (std::string aliases = technique_alias_list(t.name); !aliases.empty())
+        fmt::print("{:<26} {:>4}  {:<12} alias: {}\n", "", "", "", aliases);
       if (!t.parameters.empty()) {
         glm::vec4 p = t.default_params();
         fmt::print("{:<26} {:>4}  {:<12} --param {},{},{},{} ({})\n", "", "", "", p.x, p.y, p.z, p.w, t.parameters);
@@ -63,7 +65,7 @@ void add_reconstruct(CLI::App& app) {
   cmd->add_option("--depths", opt->depths, "Occluder depths in the kernel, in [0,1]")->required()->delimiter(',');
   cmd->add_option("--weights", opt->weights, "Filter weights (default: equal)")->delimiter(',');
   cmd->add_option("--zf", opt->zf, "Fragment depth in [0,1]")->required();
-  cmd->add_option("--technique", opt->techniques, "Techniques to run (default: all)")->delimiter(',');
+  cmd->add_option("--technique,-t", opt->techniques, "Techniques or aliases to run (default: all)")->delimiter(',');
   cmd->add_flag("--json", opt->json, "Print JSON");
   cmd->callback([opt] {
     auto finite_unit = [](float x) { return std::isfinite(x) && x >= 0.0f && x <= 1.0f; };

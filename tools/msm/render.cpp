@@ -3,8 +3,8 @@
 
 #include <fmt/core.h>
 
+#include <chrono>
 #include <cstdio>
-#include <unistd.h>
 
 namespace msm::tool {
 namespace {
@@ -33,7 +33,7 @@ void add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
                                            "EXR and JSON per technique)");
   cmd->add_option("--technique,-t", opt->techniques,
-                  "Technique, comma-separated list, or 'all' (msm techniques lists them)")
+                  "Technique or alias, comma-separated list, or 'all' (msm techniques lists them)")
       ->capture_default_str();
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   add_frame_options(cmd, opt->frame);
@@ -43,29 +43,34 @@ void add_render(CLI::App& app) {
     if (opt->techniques == "all")
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     else
-      names = split(opt->techniques);
+      names = canonical_technique_names(split(opt->techniques));
     if (names.empty()) throw UsageError("--technique: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);
-    ensure_output_dir(opt->out);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
+    fmt::print(stderr, "msm render: scene '{}', {} triangles, {}x{}, shadow map {}², on {}\n", scene.name,
+               scene.triangle_count(), f.width, f.height, f.shadow_size, ctx->info().name);
     render::Renderer renderer(*ctx, scene);
-    bool tty = isatty(fileno(stderr));
+    // What the device cannot do is refused before the output directory exists.
+    check_on_device(renderer, opt->frame, names);
+    ensure_output_dir(opt->out);
     for (size_t i = 0; i < names.size(); ++i) {
       render::RenderSettings s = settings_for(opt->frame, names[i]);
       render::RenderResult result;
+      // GPU time is the frame's passes (timestamps); wall time adds recording, read-back and the files.
+      auto start = std::chrono::steady_clock::now();
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
       write_render(opt->out, names[i], result, render_json(s, scene, *ctx, result));
-      if (names.size() > 1 || tty || !result.shadow_rgb.empty())
-        fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU -> {}/{}.png{}\n", i + 1, names.size(), names[i],
-                   result.total_ms, opt->out, names[i],
-                   result.shadow_rgb.empty() ? ""
-                                             : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]));
+      double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU {:8.0f} ms wall -> {}/{}.png{}\n", i + 1, names.size(),
+                 names[i], result.total_ms, wall_ms, opt->out, names[i],
+                 result.shadow_rgb.empty() ? ""
+                                           : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]));
     }
   });
 }

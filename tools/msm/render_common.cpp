@@ -96,10 +96,24 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
   return s;
 }
 
+std::vector<std::string> canonical_technique_names(std::vector<std::string> names) {
+  for (std::string& name : names) name = std::string(canonical_technique_name(name));
+  return names;
+}
+
 void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques) {
   for (const std::string& name : techniques) {
     try {
       settings_for(options, name).validate();
+    } catch (const render::RenderError& e) { throw UsageError(e.what()); }
+  }
+}
+
+void check_on_device(const render::Renderer& renderer, const FrameOptions& options,
+                     const std::vector<std::string>& techniques) {
+  for (const std::string& name : techniques) {
+    try {
+      renderer.check(settings_for(options, name));
     } catch (const render::RenderError& e) { throw UsageError(e.what()); }
   }
 }

@@ -35,9 +35,18 @@ void finish_frame_options(FrameOptions& options);
 // moment image (the depth-based ones and 6MSM keep their own pipeline).
 render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique);
 
+// The table's names for technique names and aliases (msm = msm-hamburger-64, ...): outputs and
+// tables are named by the table's name whichever was typed.
+std::vector<std::string> canonical_technique_names(std::vector<std::string> names);
+
 // Every technique's settings are valid, before anything is loaded or created (UsageError naming
 // the first problem otherwise).
 void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques);
+
+// The device can render every technique's settings (Renderer::check), before any output exists:
+// UsageError naming the first problem (an MSAA count the device lacks, an image too large).
+void check_on_device(const render::Renderer& renderer, const FrameOptions& options,
+                     const std::vector<std::string>& techniques);
 
 // The Vulkan context (validation with MSM_VALIDATION=1); a failure is a UsageError naming devices.
 std::unique_ptr<vk::Context> open_device(const std::string& device);

@@ -12,6 +12,7 @@
 #pragma once
 #include <array>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include <glm/vec4.hpp>
@@ -61,7 +62,23 @@ struct Technique {
 
 // Every technique, in the order of the comparison tables.
 std::span<const Technique> techniques();
-// The technique of that name; throws std::invalid_argument listing the valid names if unknown.
+
+// Short names for the variant one reaches for first (`msm` = the 64-bit MSM of JCGT 2017),
+// accepted wherever a technique name is; outputs are named by the table's name.
+struct TechniqueAlias {
+  std::string_view alias;
+  std::string_view technique;
+};
+std::span<const TechniqueAlias> technique_aliases();
+// The table's name for an alias; any other name unchanged (the lookup reports it if unknown).
+std::string_view canonical_technique_name(std::string_view name);
+// The aliases of one technique, comma-separated ("" if none).
+std::string technique_alias_list(std::string_view technique);
+// " (did you mean ...?)" for an unknown name: the nearest of the given names and the aliases.
+std::string technique_suggestion(std::string_view unknown, std::span<const std::string_view> names);
+
+// The technique of that name or alias; throws std::invalid_argument listing the valid names (and
+// the nearest) if unknown.
 const Technique& find_technique(std::string_view name);
 // The technique of an MSM_TECH_* id; throws std::invalid_argument if none has it.
 const Technique& technique_by_id(int id);

@@ -181,6 +181,11 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
+  // What render() checks first: the settings are valid and this device supports them (MSAA
+  // count, image sizes, light layers); RenderError naming the problem otherwise. Lets a tool
+  // refuse before it creates any output.
+  void check(const RenderSettings& settings) const;
+
   // One frame, submitted and waited for, images read back.
   RenderResult render(const RenderSettings& settings, Intermediates* intermediates = nullptr);
 

@@ -1,0 +1,22 @@
+// msm's exit statuses and how a command line the parser rejects is reported: one documented set
+// (README.md, the footer of `msm --help`) instead of CLI11's own codes (104 to 114).
+#pragma once
+#include <CLI/CLI.hpp>
+
+namespace msm::tool {
+
+constexpr int kExitUsage = 1;   // the command line was not understood (parser: unknown, missing, malformed)
+constexpr int kExitFailure = 2; // the command ran and failed: bad value or file, no device, cannot write
+
+// The footer of `msm --help`: the exit statuses.
+const char* exit_status_help();
+
+// `msm help [COMMAND]`: the help of msm or of one command (stdout, exit 0); an unknown command is
+// a usage error naming the nearest.
+void add_help(CLI::App& app);
+
+// Prints why the parser rejected the command line (naming the subcommand) and returns the exit
+// status: 0 for --help and --version (CLI11 signals them as errors too), else kExitUsage.
+int report_parse_error(CLI::App& app, const CLI::ParseError& error);
+
+} // namespace msm::tool
