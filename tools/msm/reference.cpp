@@ -20,6 +20,7 @@
 #include "msm/image/io.h"
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
+#include "msm/util/limits.h"
 
 namespace msm::tool {
 namespace {
@@ -132,6 +133,12 @@ void add_reference(CLI::App& app) {
     if (settings.effect == msm::reference::Effect::filtered)
       if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
         fmt::print(stderr, "msm reference: {}\n", *w);
+    // The same limits as msm render's, before the output directory or anything large exists.
+    try {
+      msm::reference::check_limits(settings, scene.triangle_count());
+    } catch (const msm::limits::LimitError& e) {
+      throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
+    }
     const double load_seconds = seconds_since(start);
     const fs::path out = opt->out;
     prepare_output(out);

@@ -2,6 +2,7 @@
 
 #include "msm/image/io.h"
 #include "msm/techniques.h"
+#include "msm/util/limits.h"
 
 #include <fmt/format.h>
 
@@ -106,6 +107,14 @@ void validate_techniques(const FrameOptions& options, const std::vector<std::str
     try {
       settings_for(options, name).validate();
     } catch (const render::RenderError& e) { throw UsageError(e.what()); }
+  }
+}
+
+void check_limits(const FrameOptions& options, const scene::Scene& scene, const std::vector<std::string>& techniques) {
+  for (const std::string& name : techniques) {
+    try {
+      render::check_limits(settings_for(options, name), scene.triangle_count(), scene.lights.size());
+    } catch (const limits::LimitError& e) { throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what())); }
   }
 }
 
