@@ -1,7 +1,7 @@
 // `msm reference`: ground truth of a scene's shadows by CPU ray tracing (msm::reference): writes
 // DIR/visibility.exr (the shadow buffer), DIR/radiance.exr, DIR/surface.exr (n_dot_l and object
-// index, masks for comparisons) and DIR/reference.json (settings, timings, sample count), each
-// atomically. Bad input is a UsageError (exit status 2); scene
+// index, masks for comparisons) and DIR/reference.json (settings, timings, sample count), all or
+// none (msm::image::FileSet). Bad input is a UsageError (exit status 2); scene
 // errors (SceneError) name the file and the problem.
 #include <unistd.h>
 
@@ -152,18 +152,18 @@ void add_reference(CLI::App& app) {
       throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
     }
     const auto write_start = std::chrono::steady_clock::now();
+    // All the files or none (a full disk, a failed rename): temporaries first, renamed together.
+    msm::image::FileSet files;
     try {
-      msm::image::write_exr(out / "visibility.exr", result.visibility);
-      msm::image::write_exr(out / "radiance.exr", result.radiance);
-      msm::image::write_exr(out / "surface.exr", result.surface);
+      files.add_exr(out / "visibility.exr", result.visibility);
+      files.add_exr(out / "radiance.exr", result.radiance);
+      files.add_exr(out / "surface.exr", result.surface);
       // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
       // from an earlier run into the same folder for the other effects.
-      if (!result.visibility_rgb.empty()) {
-        msm::image::write_exr(out / "visibility_rgb.exr", result.visibility_rgb);
-      } else {
-        std::error_code ec;
-        fs::remove(out / "visibility_rgb.exr", ec);
-      }
+      if (!result.visibility_rgb.empty())
+        files.add_exr(out / "visibility_rgb.exr", result.visibility_rgb);
+      else
+        files.remove(out / "visibility_rgb.exr");
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
 
     nlohmann::ordered_json j;
@@ -200,8 +200,8 @@ void add_reference(CLI::App& app) {
                     {"total", seconds_since(start)}};
     const std::string text = j.dump(2) + "\n";
     try {
-      msm::image::write_file_atomic(out / "reference.json",
-                                    {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+      files.add(out / "reference.json", {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+      files.commit();
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
     if (opt->json)
       fmt::print("{}", text);

@@ -197,12 +197,16 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json) {
   try {
-    image::write_png(dir / (stem + ".png"), result.color);
-    image::write_exr(dir / (stem + ".exr"), result.shadow);
-    if (!result.shadow_rgb.empty()) image::write_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
+    image::FileSet files;
+    files.add_png(dir / (stem + ".png"), result.color);
+    files.add_exr(dir / (stem + ".exr"), result.shadow);
+    if (!result.shadow_rgb.empty())
+      files.add_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
+    else
+      files.remove(dir / (stem + "-rgb.exr")); // no stale copy of an earlier coloured render
     std::string text = json.dump(2) + "\n";
-    image::write_file_atomic(dir / (stem + ".json"),
-                             std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    files.add(dir / (stem + ".json"), std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    files.commit();
   } catch (const image::ImageError& e) { throw UsageError(e.what()); }
 }
 

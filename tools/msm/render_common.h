@@ -65,8 +65,8 @@ void ensure_output_dir(const std::filesystem::path& dir);
 nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, const vk::Context& ctx,
                            const render::RenderResult& result);
 
-// <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>.json; each
-// written to a temporary name and renamed.
+// <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>-rgb.exr (coloured
+// shadows only), <dir>/<stem>.json: all or none (image::FileSet: temporaries, then renamed together).
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json);
 
