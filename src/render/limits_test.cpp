@@ -4,11 +4,13 @@
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 #include "msm/util/limits.h"
+#include "msm/util/progress.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 namespace msm {
 namespace {
@@ -85,6 +87,29 @@ TEST(Limits, TheEnvironmentOverridesEachLimit) {
   EXPECT_EQ(limits::max_bytes(), limits::kMaxBytes);
   ::unsetenv("MSM_MAX_TRIANGLES");
   ::unsetenv("MSM_MAX_MEMORY_MB");
+}
+
+// Progress lines for a log: nothing from a short run; from a long one a line per tenth once it has
+// run two seconds, each tenth once, and the last line at the end.
+TEST(ProgressLines, ShortRunsAreQuietLongRunsGetATenthPerLine) {
+  util::ProgressLines quick("msm reference: ");
+  for (std::size_t done = 1; done <= 100; ++done) EXPECT_FALSE(quick.next(done, 100, 0.01 * double(done)));
+
+  util::ProgressLines slow("msm reference: ");
+  std::vector<std::string> lines;
+  for (std::size_t done = 1; done <= 100; ++done)
+    for (int repeat = 0; repeat < 2; ++repeat) // a report repeated prints nothing more
+      if (auto line = slow.next(done, 100, 0.1 * double(done))) lines.push_back(*line);
+  ASSERT_EQ(lines.size(), 9u); // 20%, 30%, ..., 100%: the first tenth came before 2 s
+  EXPECT_EQ(lines.front(), "msm reference:  20% (20 of 100), 2.0 s, 8.0 s left");
+  EXPECT_EQ(lines.back(), "msm reference: 100% (100 of 100), 10.0 s, 0.0 s left");
+
+  // Reports coarser than a tenth (a few rows of a tall image at a time): one line per report.
+  util::ProgressLines coarse("x ");
+  EXPECT_FALSE(coarse.next(0, 3, 5.0));
+  EXPECT_EQ(coarse.next(1, 3, 6.0).value_or(""), "x  33% (1 of 3), 6.0 s, 12.0 s left");
+  EXPECT_TRUE(coarse.next(3, 3, 9.0));
+  EXPECT_FALSE(coarse.next(3, 3, 9.0));
 }
 
 } // namespace

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -21,6 +22,7 @@
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
 #include "msm/util/limits.h"
+#include "msm/util/progress.h"
 
 namespace msm::tool {
 namespace {
@@ -98,7 +100,9 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
   cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
-  cmd->add_flag("--progress", opt->progress, "Progress bar on stderr (default: when stderr is a terminal)");
+  cmd->add_flag("--progress", opt->progress,
+                "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth of the "
+                "rows once the run has taken 2 s)");
   cmd->callback([opt] {
     const auto start = std::chrono::steady_clock::now();
     Settings settings;
@@ -143,7 +147,15 @@ void add_reference(CLI::App& app) {
     const fs::path out = opt->out;
     prepare_output(out);
     ProgressBar bar;
-    if (opt->progress || ::isatty(::fileno(stderr))) settings.progress = bar;
+    if (opt->progress || ::isatty(::fileno(stderr))) {
+      settings.progress = bar;
+    } else {
+      // A log (stderr redirected): a line per tenth once the run has taken a few seconds.
+      settings.progress = [lines = std::make_shared<msm::util::ProgressLines>("msm reference: ", " rows")](
+                              const msm::reference::Progress& p) {
+        if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
+      };
+    }
 
     msm::reference::Result result;
     try {

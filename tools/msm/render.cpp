@@ -63,6 +63,8 @@ void add_render(CLI::App& app) {
       render::RenderResult result;
       // GPU time is the frame's passes (timestamps); wall time adds recording, read-back and the files.
       auto start = std::chrono::steady_clock::now();
+      // One technique can take long (a large shadow map on a CPU device): say what is running.
+      if (names.size() == 1) fmt::print(stderr, "msm render: rendering {} ...\n", names[i]);
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
