@@ -21,7 +21,7 @@
 namespace msm::limits {
 
 // 32 M triangles: ~8 GB of ray tracer (kTracerBytesPerTriangle) or ~4 GB of renderer, within
-// kMaxBytes; the largest model of the test data has 0.6 M.
+// kMaxBytes; the largest built-in scene (models) has 28,674.
 inline constexpr std::uint64_t kMaxTriangles = 32'000'000;
 // 12 GiB: leaves 4 GB of a 16 GB machine to the system and the scene's own copy.
 inline constexpr std::uint64_t kMaxBytes = 12ull << 30;
