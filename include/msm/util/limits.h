@@ -3,8 +3,8 @@
 // before anything large is allocated so that absurd input ends in a message naming the limit and
 // the value, not in std::bad_alloc after gigabytes (or the machine swapping).
 //
-// The defaults keep what works today on a 16-32 GB machine working: the largest render of the
-// heaviest render tried, `msm render --scene fence -t msm6-192 --shadow-size 8192`, takes
+// The defaults keep what works today on a 16-32 GB machine working: the heaviest render tried,
+// `msm render --scene fence -t msm6-192 --shadow-size 8192`, takes
 // 4.9 GB (lavapipe, where device memory is host memory) and is estimated at 4.9 GB; a 4096²
 // reference is estimated at 1.6 GB. MSM_MAX_TRIANGLES and MSM_MAX_MEMORY_MB (environment) raise
 // or lower them for a larger or smaller machine.
@@ -26,12 +26,12 @@ inline constexpr std::uint64_t kMaxTriangles = 32'000'000;
 // 12 GiB: leaves 4 GB of a 16 GB machine to the system and the scene's own copy.
 inline constexpr std::uint64_t kMaxBytes = 12ull << 30;
 
-// The renderer per triangle: positions, normals, uvs (32 B per vertex, ~1.5 vertices per triangle
-// in the imported meshes) and 12 B of indices, once in the staging copy and once on the device.
+// The renderer per triangle: positions, normals, uvs (32 B per vertex; 1.5 vertices per triangle
+// assumed, between a closed mesh's ~0.5 and a triangle soup's 3) and 12 B of indices, once in the
+// staging copy and once on the device.
 inline constexpr std::uint64_t kRendererBytesPerTriangle = 2 * (48 + 12);
-// The ray tracer per triangle: Embree's BVH (~100 B per triangle for its default quality, see
-// Embree's documentation of rtcCommitScene memory) plus the tracer's own vertex, index and
-// per-triangle material data (~150 B).
+// The ray tracer per triangle: Embree's BVH (an estimate of ~100 B per triangle at its default
+// quality, not measured here) plus the tracer's own vertex, index and per-triangle data (~150 B).
 inline constexpr std::uint64_t kTracerBytesPerTriangle = 256;
 // Renderer per camera pixel: the colour, depth and shadow images on the device, their read-back
 // (host) copies and the PNG/EXR encoders' buffers.
