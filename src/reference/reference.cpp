@@ -87,15 +87,16 @@ void validate(const Settings& s) {
 }
 
 std::uint64_t estimated_bytes(const Settings& s, std::uint64_t triangles) {
-  return triangles * limits::kTracerBytesPerTriangle +
-         std::uint64_t(s.width) * std::uint64_t(s.height) * limits::kTracerBytesPerPixel;
+  const std::uint64_t per_pixel =
+      s.effect == Effect::translucent ? limits::kTracerBytesPerPixelTranslucent : limits::kTracerBytesPerPixel;
+  return triangles * limits::kTracerBytesPerTriangle + std::uint64_t(s.width) * std::uint64_t(s.height) * per_pixel;
 }
 
 void check_limits(const Settings& s, std::uint64_t triangles) {
   limits::check_triangles(triangles);
-  limits::check_bytes(
-      fmt::format("a {}x{} reference of {} triangles", s.width, s.height, limits::with_commas(triangles)),
-      estimated_bytes(s, triangles));
+  limits::check_bytes(fmt::format("a {}x{} {} reference of {} triangles", s.width, s.height, to_string(s.effect),
+                                  limits::with_commas(triangles)),
+                      estimated_bytes(s, triangles));
 }
 
 // ---- Rendering ---------------------------------------------------------------------------------

@@ -4,10 +4,10 @@
 // the value, not in std::bad_alloc after gigabytes (or the machine swapping).
 //
 // The defaults keep what works today on a 16-32 GB machine working: the heaviest render tried,
-// `msm render --scene fence -t msm6-192 --shadow-size 8192`, takes
-// 4.9 GB (lavapipe, where device memory is host memory) and is estimated at 4.9 GB; a 4096²
-// reference is estimated at 1.6 GB. MSM_MAX_TRIANGLES and MSM_MAX_MEMORY_MB (environment) raise
-// or lower them for a larger or smaller machine.
+// `msm render --scene fence -t msm6-192 --shadow-size 8192`, takes 4.9 GB (lavapipe, where device
+// memory is host memory) and is estimated at 4.9 GB; a 16384² hard reference is estimated at
+// 10.0 GiB (allowed), a 16384² translucent one at 13.0 GiB (refused). MSM_MAX_TRIANGLES and
+// MSM_MAX_MEMORY_MB (environment) raise or lower them for a larger or smaller machine.
 #pragma once
 
 #include <fmt/format.h>
@@ -20,25 +20,28 @@
 
 namespace msm::limits {
 
-// 32 M triangles: ~8 GB of ray tracer (kTracerBytesPerTriangle) or ~4 GB of renderer, within
-// kMaxBytes; the largest built-in scene (models) has 28,674.
+// 32 M triangles: ~8 GB of renderer or ray tracer (k*BytesPerTriangle), within kMaxBytes; the
+// largest built-in scene (models) has 28,674.
 inline constexpr std::uint64_t kMaxTriangles = 32'000'000;
 // 12 GiB: leaves 4 GB of a 16 GB machine to the system and the scene's own copy.
 inline constexpr std::uint64_t kMaxBytes = 12ull << 30;
 
-// The renderer per triangle: positions, normals, uvs (32 B per vertex; 1.5 vertices per triangle
-// assumed, between a closed mesh's ~0.5 and a triangle soup's 3) and 12 B of indices, once in the
-// staging copy and once on the device.
-inline constexpr std::uint64_t kRendererBytesPerTriangle = 2 * (48 + 12);
-// The ray tracer per triangle: Embree's BVH (an estimate of ~100 B per triangle at its default
-// quality, not measured here) plus the tracer's own vertex, index and per-triangle data (~150 B).
+// The renderer per triangle, process and device together: measured 193 B (lavapipe, a
+// 4,000,000-triangle plane of 0.5 vertices per triangle, resident set over a 14-triangle scene:
+// the scene, its staging and device copies); meshes with more vertices per triangle (up to 3 for
+// a soup of 32-B vertices) need more, hence the headroom.
+inline constexpr std::uint64_t kRendererBytesPerTriangle = 256;
+// The ray tracer per triangle: measured 141 B in the same way (the scene, Embree's BVH at its
+// default quality, the tracer's own vertex, index and per-triangle data); headroom as above.
 inline constexpr std::uint64_t kTracerBytesPerTriangle = 256;
-// Renderer per camera pixel: the colour, depth and shadow images on the device, their read-back
-// (host) copies and the PNG/EXR encoders' buffers.
-inline constexpr std::uint64_t kRendererBytesPerPixel = 64;
-// Ray tracer per pixel: visibility (2 floats), visibility_rgb (3), radiance (3), surface (2), and
-// the EXR writer's copy of each.
-inline constexpr std::uint64_t kTracerBytesPerPixel = 96;
+// Renderer per camera pixel: measured 72 B (lavapipe, pcf at 4096², resident set over 16²: the
+// colour, depth and shadow images, their read-back copies, the PNG/EXR encoders), with headroom.
+inline constexpr std::uint64_t kRendererBytesPerPixel = 96;
+// Ray tracer per pixel: the images as floats (visibility 2, radiance 3, surface 2; translucent adds
+// visibility_rgb 3) and the EXR encoder's copy of the largest (3 floats): 40 B, 52 B translucent.
+// Measured: 28 B for hard at 4096² (the encoded files are compressed).
+inline constexpr std::uint64_t kTracerBytesPerPixel = 40;
+inline constexpr std::uint64_t kTracerBytesPerPixelTranslucent = 52;
 // Shadow-map depth: 32-bit depth per MSAA sample.
 inline constexpr std::uint64_t kDepthBytesPerSample = 4;
 
