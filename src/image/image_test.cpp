@@ -404,3 +404,54 @@ TEST_F(ImageTest, CompareDumpsActualReferenceAndErrorOnFailure) {
   nan_test.at(0, 0) = std::nanf("");
   EXPECT_FALSE(compare(nan_test, ref).passed);
 }
+
+// A file set appears whole or not at all: a failure at the second rename (its target is a
+// non-empty directory) leaves the first target as it was (absent, or its old bytes) and no
+// temporary or backup file; a set never committed leaves nothing.
+TEST_F(ImageTest, FileSetIsAllOrNothing) {
+  const std::string bytes = "{}\n";
+  const std::span<const std::uint8_t> json(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+  fs::create_directories(dir / "b.png" / "inside");
+  {
+    FileSet set;
+    set.add_exr(dir / "a.exr", ramp(4, 4, {"Y"}));
+    set.add_png(dir / "b.png", ramp(4, 4, {"Y"}));
+    set.add(dir / "c.json", json);
+    EXPECT_THROW(set.commit(), ImageError);
+  }
+  EXPECT_EQ(entries(), (std::vector<std::string>{"b.png"}));
+
+  write_exr(dir / "a.exr", ramp(2, 2, {"Y"}));
+  const std::string old_bytes = slurp(dir / "a.exr");
+  {
+    FileSet set;
+    set.add_exr(dir / "a.exr", ramp(8, 8, {"Y"}));
+    set.add_png(dir / "b.png", ramp(8, 8, {"Y"}));
+    try {
+      set.commit();
+      ADD_FAILURE() << "the rename over a directory succeeded";
+    } catch (const ImageError& e) {
+      EXPECT_EQ(e.path(), dir / "b.png");
+      EXPECT_NE(e.reason().find("none of the set's files was written"), std::string::npos) << e.reason();
+    }
+  }
+  EXPECT_EQ(slurp(dir / "a.exr"), old_bytes);
+  EXPECT_EQ(entries(), (std::vector<std::string>{"a.exr", "b.png"}));
+
+  {
+    FileSet set; // never committed
+    set.add(dir / "c.json", json);
+  }
+  EXPECT_EQ(entries(), (std::vector<std::string>{"a.exr", "b.png"}));
+
+  fs::remove_all(dir / "b.png");
+  spit(dir / "stale.exr", "old");
+  FileSet set;
+  set.add_exr(dir / "a.exr", ramp(8, 8, {"Y"}));
+  set.add_png(dir / "b.png", ramp(8, 8, {"Y"}));
+  set.remove(dir / "stale.exr");
+  set.remove(dir / "never-there.exr");
+  set.commit();
+  EXPECT_TRUE(read_exr(dir / "a.exr") == ramp(8, 8, {"Y"}));
+  EXPECT_EQ(entries(), (std::vector<std::string>{"a.exr", "b.png"}));
+}

@@ -214,7 +214,11 @@ void require_image(const fs::path& path, const Image& image) {
 
 // ---- Atomic write ----------------------------------------------------------------------------
 
-void write_file_atomic(const fs::path& path, std::span<const std::uint8_t> bytes) {
+namespace {
+
+// Writes bytes to a fresh temporary file next to path, flushed to disk; returns its name. On
+// failure the temporary file is removed and ImageError names path.
+fs::path write_temporary(const fs::path& path, std::span<const std::uint8_t> bytes) {
   if (path.empty() || !path.has_filename()) throw ImageError(path, "not a file path");
   static std::atomic<unsigned> counter{0};
   const fs::path dir = path.parent_path();
@@ -240,12 +244,77 @@ void write_file_atomic(const fs::path& path, std::span<const std::uint8_t> bytes
   int rc = ::close(fd);
   fd = -1;
   if (rc != 0) fail("cannot close", errno);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) fail("cannot rename the temporary file over the target", errno);
+  return tmp;
+}
+
+} // namespace
+
+void write_file_atomic(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  const fs::path tmp = write_temporary(path, bytes);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw ImageError(path, "cannot rename the temporary file over the target: " + errno_text(err));
+  }
+}
+
+// ---- File sets -------------------------------------------------------------------------------
+
+FileSet::~FileSet() {
+  for (const Pending& p : pending_)
+    if (!p.tmp.empty()) ::unlink(p.tmp.c_str());
+}
+
+void FileSet::add(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  pending_.push_back({path, write_temporary(path, bytes)});
+}
+
+void FileSet::add_png(const fs::path& path, const Image& image) { add(path, encode_png(path, image)); }
+void FileSet::add_exr(const fs::path& path, const Image& image) { add(path, encode_exr(path, image)); }
+void FileSet::remove(const fs::path& path) { pending_.push_back({path, {}}); }
+
+void FileSet::commit() {
+  // An existing target is kept under a hard link until every rename has succeeded, so that a
+  // failed rename can put the set back as it was.
+  struct Done {
+    fs::path target, backup;
+  };
+  std::vector<Done> done;
+  auto roll_back = [&] {
+    for (auto it = done.rbegin(); it != done.rend(); ++it) {
+      if (!it->backup.empty())
+        ::rename(it->backup.c_str(), it->target.c_str());
+      else
+        ::unlink(it->target.c_str());
+    }
+  };
+  for (std::size_t i = 0; i < pending_.size(); ++i) {
+    Pending& p = pending_[i];
+    fs::path backup = p.target;
+    backup.replace_filename(fmt::format(".{}.old.{}", p.target.filename().string(), ::getpid()));
+    ::unlink(backup.c_str());
+    const bool existed = ::link(p.target.c_str(), backup.c_str()) == 0;
+    const bool ok = p.tmp.empty() ? (::unlink(p.target.c_str()) == 0 || errno == ENOENT)
+                                  : ::rename(p.tmp.c_str(), p.target.c_str()) == 0;
+    if (!ok) {
+      const int err = errno;
+      if (existed) ::unlink(backup.c_str());
+      roll_back();
+      throw ImageError(p.target, (p.tmp.empty() ? "cannot remove the stale file: "
+                                                : "cannot rename the temporary file over the target: ") +
+                                     errno_text(err) + " (none of the set's files was written)");
+    }
+    p.tmp.clear();
+    done.push_back({p.target, existed ? backup : fs::path()});
+  }
+  for (const Done& d : done)
+    if (!d.backup.empty()) ::unlink(d.backup.c_str());
+  pending_.clear();
 }
 
 // ---- PNG -------------------------------------------------------------------------------------
 
-void write_png(const fs::path& path, const Image& image) {
+std::vector<std::uint8_t> encode_png(const fs::path& path, const Image& image) {
   require_image(path, image);
   const int n = image.channels();
   const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
@@ -262,8 +331,10 @@ void write_png(const fs::path& path, const Image& image) {
   std::vector<std::uint8_t> encoded;
   if (!stbi_write_png_to_func(append_bytes, &encoded, image.width(), image.height(), n, data.data(), image.width() * n))
     throw ImageError(path, "PNG encoding failed");
-  write_file_atomic(path, encoded);
+  return encoded;
 }
+
+void write_png(const fs::path& path, const Image& image) { write_file_atomic(path, encode_png(path, image)); }
 
 Image read_png(const fs::path& path) {
   auto bytes = read_file(path);
@@ -273,7 +344,7 @@ Image read_png(const fs::path& path) {
 
 // ---- EXR -------------------------------------------------------------------------------------
 
-void write_exr(const fs::path& path, const Image& image) {
+std::vector<std::uint8_t> encode_exr(const fs::path& path, const Image& image) {
   require_image(path, image);
   MemoryOStream stream;
   try {
@@ -292,8 +363,10 @@ void write_exr(const fs::path& path, const Image& image) {
     file.setFrameBuffer(fb);
     file.writePixels(image.height());
   } catch (const std::exception& e) { throw ImageError(path, std::string("EXR encoding failed: ") + e.what()); }
-  write_file_atomic(path, stream.bytes);
+  return std::move(stream.bytes);
 }
+
+void write_exr(const fs::path& path, const Image& image) { write_file_atomic(path, encode_exr(path, image)); }
 
 Image read_exr(const fs::path& path) {
   auto bytes = read_file(path);

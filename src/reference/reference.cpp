@@ -17,6 +17,7 @@
 
 #include "internal.h"
 #include "msm/shading.h"
+#include "msm/util/limits.h"
 
 namespace msm::reference {
 
@@ -85,6 +86,19 @@ void validate(const Settings& s) {
   check_angle("light height", s.light_height_deg);
 }
 
+std::uint64_t estimated_bytes(const Settings& s, std::uint64_t triangles) {
+  const std::uint64_t per_pixel =
+      s.effect == Effect::translucent ? limits::kTracerBytesPerPixelTranslucent : limits::kTracerBytesPerPixel;
+  return triangles * limits::kTracerBytesPerTriangle + std::uint64_t(s.width) * std::uint64_t(s.height) * per_pixel;
+}
+
+void check_limits(const Settings& s, std::uint64_t triangles) {
+  limits::check_triangles(triangles);
+  limits::check_bytes(fmt::format("a {}x{} {} reference of {} triangles", s.width, s.height, to_string(s.effect),
+                                  limits::with_commas(triangles)),
+                      estimated_bytes(s, triangles));
+}
+
 // ---- Rendering ---------------------------------------------------------------------------------
 
 namespace {
@@ -111,6 +125,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings);
 
 Result render(const scene::Scene& scene, const Settings& settings) {
   validate(settings);
+  check_limits(settings, scene.triangle_count());
   if (settings.threads == 0) return render_in_arena(scene, settings);
   tbb::task_arena arena(settings.threads);
   return arena.execute([&] { return render_in_arena(scene, settings); });

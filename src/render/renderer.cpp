@@ -17,6 +17,7 @@
 #include "msm/sat.h"
 #include "msm/soft.h"
 #include "msm/techniques.h"
+#include "msm/util/limits.h"
 
 #include <fmt/format.h>
 #include <glm/gtc/packing.hpp>
@@ -214,6 +215,9 @@ struct Renderer::Impl {
   // The settings are valid and this device can render them (RenderError naming what it lacks).
   void check(const RenderSettings& s) const {
     s.validate();
+    try {
+      check_limits(s, scene.triangle_count(), scene.lights.size());
+    } catch (const limits::LimitError& e) { throw RenderError(e.what()); }
     if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, VkSampleCountFlagBits(s.msaa)))
       throw RenderError(
           fmt::format("{} cannot render 16-bit depth with {}x MSAA; use --msaa 1 or 4", ctx.info().name, s.msaa));

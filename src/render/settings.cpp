@@ -2,6 +2,7 @@
 // settings.
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
+#include "msm/util/limits.h"
 
 #include <cmath>
 #include <fmt/format.h>
@@ -112,6 +113,43 @@ void RenderSettings::validate() const {
     if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
       throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
   }
+}
+
+namespace {
+
+std::uint64_t texel_bytes(TexelFormat f) {
+  switch (f) {
+  case TexelFormat::none: return 0;
+  case TexelFormat::r32_float:
+  case TexelFormat::rg16_unorm:
+  case TexelFormat::rg16_float:
+  case TexelFormat::r32_uint: return 4;
+  case TexelFormat::rg32_float:
+  case TexelFormat::rgba16_unorm:
+  case TexelFormat::rgba16_float: return 8;
+  case TexelFormat::rgba32_float: return 16;
+  }
+  return 16;
+}
+
+} // namespace
+
+std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights) {
+  const Technique& t = find_rendered_technique(s.technique);
+  const std::uint64_t moment_bytes = texel_bytes(t.formats[0]) + texel_bytes(t.formats[1]);
+  const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
+  return triangles * limits::kRendererBytesPerTriangle +
+         std::uint64_t(s.width) * std::uint64_t(s.height) * limits::kRendererBytesPerPixel +
+         limits::shadow_map_bytes(std::uint64_t(s.shadow_size), lights, std::uint64_t(s.msaa), moment_bytes, s.mipmaps,
+                                  s.coloured_translucency ? 3 : 1);
+}
+
+void check_limits(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights) {
+  limits::check_triangles(triangles);
+  const std::size_t lights = s.lights.empty() ? scene_lights : s.lights.size();
+  limits::check_bytes(fmt::format("rendering {} at {}x{} with a {}² shadow map ({}x MSAA, {} light{})", s.technique,
+                                  s.width, s.height, s.shadow_size, s.msaa, lights, lights == 1 ? "" : "s"),
+                      estimated_bytes(s, triangles, scene_lights));
 }
 
 } // namespace msm::render

@@ -57,8 +57,14 @@ const char* result_name(VkResult result) noexcept {
 }
 
 void throw_error(VkResult result, const char* call, std::source_location where) {
-  throw Error(result, fmt::format("{} failed: {} at {}:{} ({})", call, result_name(result), where.file_name(),
-                                  where.line(), where.function_name()));
+  // What a user can act on first; the call and its place for a bug report.
+  const char* meaning = result == VK_ERROR_DEVICE_LOST ? "the device was lost (a driver timeout or reset, or a GPU "
+                                                         "fault; what was not yet written is lost): "
+                        : result == VK_ERROR_OUT_OF_DEVICE_MEMORY ? "the device is out of memory: "
+                        : result == VK_ERROR_OUT_OF_HOST_MEMORY   ? "out of host memory: "
+                                                                  : "";
+  throw Error(result, fmt::format("{}{} failed: {} at {}:{} ({})", meaning, call, result_name(result),
+                                  where.file_name(), where.line(), where.function_name()));
 }
 
 } // namespace msm::vk

@@ -55,8 +55,24 @@ VkDeviceMemory allocate(const Context& ctx, const VkMemoryRequirements& requirem
       .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
       .allocationSize = requirements.size,
       .memoryTypeIndex = select_memory_type(ctx.memory_properties(), requirements.memoryTypeBits, required, preferred)};
+  // Out of memory is the one failure bad input provokes (a huge image or shadow map): the message
+  // names the size and the heap, and an allocation larger than the heap is refused before the
+  // driver sees it (what drivers do with one differs; the validation layer calls it an error).
+  const VkPhysicalDeviceMemoryProperties& props = ctx.memory_properties();
+  const VkMemoryHeap& heap = props.memoryHeaps[props.memoryTypes[info.memoryTypeIndex].heapIndex];
+  auto out_of_memory = [&](VkResult result) {
+    return Error(
+        result,
+        fmt::format("{}: {:.1f} MiB asked of a heap of {:.1f} MiB on {} (lower the image or "
+                    "shadow-map size, the MSAA samples or the lights)",
+                    result == VK_ERROR_OUT_OF_HOST_MEMORY ? "out of host memory" : "the device is out of memory",
+                    double(requirements.size) / double(1 << 20), double(heap.size) / double(1 << 20), ctx.info().name));
+  };
+  if (requirements.size > heap.size) throw out_of_memory(VK_ERROR_OUT_OF_DEVICE_MEMORY);
   VkDeviceMemory memory = VK_NULL_HANDLE;
-  MSM_VK_CHECK(vkAllocateMemory(ctx.device(), &info, nullptr, &memory));
+  const VkResult result = vkAllocateMemory(ctx.device(), &info, nullptr, &memory);
+  if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) throw out_of_memory(result);
+  MSM_VK_CHECK(result);
   return memory;
 }
 
@@ -218,6 +234,28 @@ Image create_image(const Context& ctx, const ImageDesc& desc) {
                          .usage = desc.usage,
                          .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
                          .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED};
+  // An image beyond the device's largest resource (lavapipe: 4 GiB) is refused as out of memory
+  // before vkCreateImage, which would be invalid usage (mips counted as a third more).
+  uint32_t texel_bytes = 0;
+  try {
+    texel_bytes = format_size(desc.format);
+  } catch (const std::invalid_argument&) {
+    // a format outside the table: left to the driver
+  }
+  VkImageFormatProperties limits{};
+  if (texel_bytes &&
+      vkGetPhysicalDeviceImageFormatProperties(ctx.physical_device(), desc.format, VK_IMAGE_TYPE_2D,
+                                               VK_IMAGE_TILING_OPTIMAL, desc.usage, 0, &limits) == VK_SUCCESS) {
+    const double bytes = double(desc.width) * desc.height * desc.layers * double(desc.samples) * texel_bytes *
+                         (desc.mip_levels > 1 ? 4.0 / 3.0 : 1.0);
+    if (bytes > double(limits.maxResourceSize))
+      throw Error(VK_ERROR_OUT_OF_DEVICE_MEMORY,
+                  fmt::format("the device is out of memory: a {}x{} image of {} layers needs {:.1f} MiB, {} allows "
+                              "{:.1f} MiB per image (lower the image or shadow-map size, the MSAA samples or the "
+                              "lights)",
+                              desc.width, desc.height, desc.layers, bytes / double(1 << 20), ctx.info().name,
+                              double(limits.maxResourceSize) / double(1 << 20)));
+  }
   Image result;
   VkImage image = VK_NULL_HANDLE;
   MSM_VK_CHECK(vkCreateImage(device, &info, nullptr, &image));

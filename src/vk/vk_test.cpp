@@ -53,6 +53,7 @@ TEST(ErrorTest, CheckThrowsWithResultNameAndCallSite) {
     std::string what = e.what();
     EXPECT_NE(what.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << what;
     EXPECT_NE(what.find("vk_test.cpp"), std::string::npos) << what;
+    EXPECT_EQ(what.rfind("the device was lost", 0), 0u) << what; // what a user can act on, first
   }
   EXPECT_NO_THROW(MSM_VK_CHECK(VK_SUCCESS));
   EXPECT_STREQ(result_name(VK_ERROR_OUT_OF_DEVICE_MEMORY), "VK_ERROR_OUT_OF_DEVICE_MEMORY");
@@ -487,6 +488,33 @@ TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
     timer.end(cmd);
   });
   EXPECT_EQ(timer.read().scopes.size(), 1u);
+}
+
+// An allocation larger than the device's heap (a 2D array of RGBA32F 8192² layers, 1 GiB each,
+// one more than the heap holds) is an Error naming the size and the heap, not an abort or a
+// driver's undefined behaviour; the device stays usable.
+TEST_F(VkLayerTest, AllocationLargerThanTheHeapIsAnError) {
+  const VkPhysicalDeviceMemoryProperties& props = ctx().memory_properties();
+  VkDeviceSize largest = 0;
+  for (uint32_t i = 0; i < props.memoryHeapCount; ++i) largest = std::max(largest, props.memoryHeaps[i].size);
+  const uint32_t layers = uint32_t(largest >> 30) + 1;
+  if (layers > ctx().properties().limits.maxImageArrayLayers) GTEST_SKIP() << "the heap exceeds the largest image";
+  try {
+    create_image(ctx(), {.width = 8192,
+                         .height = 8192,
+                         .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                         .usage = VK_IMAGE_USAGE_SAMPLED_BIT,
+                         .layers = layers});
+    FAIL() << "an image larger than every heap was allocated";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.result(), VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("the device is out of memory: ", 0), 0u) << what;
+    EXPECT_NE(what.find(" MiB asked of a heap of "), std::string::npos) << what;
+  }
+  EXPECT_NO_THROW(create_image(
+      ctx(),
+      {.width = 16, .height = 16, .format = VK_FORMAT_R32G32B32A32_SFLOAT, .usage = VK_IMAGE_USAGE_SAMPLED_BIT}));
 }
 
 TEST_F(VkLayerTest, ArgumentErrorsThrowBeforeAnythingIsRecorded) {

@@ -12,6 +12,7 @@
 #include "msm/image/metrics.h"
 #include "msm/reference/reference.h"
 #include "msm/shading.h"
+#include "msm/util/progress.h"
 #include "msm/util/statistics.h"
 
 #include <fmt/core.h>
@@ -20,6 +21,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <unistd.h>
 
@@ -183,6 +185,10 @@ void add_demo(CLI::App& app) {
     rs.height = fs.height;
     rs.samples = opt->soft_samples;
     rs.light_extent_deg = extent;
+    rs.progress = [lines = std::make_shared<util::ProgressLines>("msm demo: ray tracing ", " rows")](
+                      const reference::Progress& p) {
+      if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
+    };
     reference::Result truth = reference::render(*soft_scene, rs);
     // The renderer's look: ACES after the exposure, its sky colour where no surface is.
     image::Image truth_rgb = image::tone_map(truth.radiance, {std::log2(fs.exposure), image::ToneCurve::aces});

@@ -18,6 +18,7 @@
 #include "msm/evaluate/mpi.h"
 #include "msm/evaluate/report.h"
 #include "msm/evaluate/run.h"
+#include "msm/util/progress.h"
 
 namespace msm::tool {
 namespace {
@@ -119,7 +120,9 @@ void add_evaluate(CLI::App& app) {
   cmd->add_option("--threads", opt->threads, "Threads per rank (default: the cores divided among the ranks)");
   cmd->add_flag("--solve-lit", opt->solve_lit, "Also send fully lit fragments through the LP (their bound is 0)");
   cmd->add_flag("--fresh", opt->fresh, "Discard an existing checkpoint in --out instead of resuming from it");
-  cmd->add_flag("--progress", opt->progress, "Progress bar on stderr (default: when stderr is a terminal)");
+  cmd->add_flag("--progress", opt->progress,
+                "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth once the "
+                "run has taken 2 s)");
   cmd->add_flag("--json", opt->json, "Print summary.json to stdout instead of the text summary");
   cmd->add_flag("--functions", opt->list_functions, "List the 37 candidate functions and exit");
   cmd->add_option("--stop-after", opt->stop_after, "Testing: end abruptly after N candidates of this rank")->group("");
@@ -147,7 +150,14 @@ void add_evaluate(CLI::App& app) {
     const int rank = comm->rank(), size = comm->size();
     ProgressBar bar(rank, size);
     std::function<void(const Progress&)> progress;
-    if (rank == 0 && (opt->progress || ::isatty(::fileno(stderr)))) progress = bar;
+    if (rank == 0 && (opt->progress || ::isatty(::fileno(stderr))))
+      progress = bar;
+    else if (rank == 0) // a log: a line per tenth once the run has taken 2 s
+      progress = [lines =
+                      std::make_shared<msm::util::ProgressLines>("msm evaluate: ", " candidates")](const Progress& p) {
+        if (auto line = lines->next(std::size_t(p.done), std::size_t(p.total), p.seconds))
+          fmt::print(stderr, "{}\n", *line);
+      };
     try {
       const RunResult run = run_evaluation(settings, *comm, progress);
       if (rank == 0) {

@@ -1,7 +1,7 @@
 // `msm reference`: ground truth of a scene's shadows by CPU ray tracing (msm::reference): writes
 // DIR/visibility.exr (the shadow buffer), DIR/radiance.exr, DIR/surface.exr (n_dot_l and object
-// index, masks for comparisons) and DIR/reference.json (settings, timings, sample count), each
-// atomically. Bad input is a UsageError (exit status 2); scene
+// index, masks for comparisons) and DIR/reference.json (settings, timings, sample count), all or
+// none (msm::image::FileSet). Bad input is a UsageError (exit status 2); scene
 // errors (SceneError) name the file and the problem.
 #include <unistd.h>
 
@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -20,6 +21,8 @@
 #include "msm/image/io.h"
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
+#include "msm/util/limits.h"
+#include "msm/util/progress.h"
 
 namespace msm::tool {
 namespace {
@@ -97,7 +100,9 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
   cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
-  cmd->add_flag("--progress", opt->progress, "Progress bar on stderr (default: when stderr is a terminal)");
+  cmd->add_flag("--progress", opt->progress,
+                "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth of the "
+                "rows once the run has taken 2 s)");
   cmd->callback([opt] {
     const auto start = std::chrono::steady_clock::now();
     Settings settings;
@@ -132,11 +137,25 @@ void add_reference(CLI::App& app) {
     if (settings.effect == msm::reference::Effect::filtered)
       if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
         fmt::print(stderr, "msm reference: {}\n", *w);
+    // The same limits as msm render's, before the output directory or anything large exists.
+    try {
+      msm::reference::check_limits(settings, scene.triangle_count());
+    } catch (const msm::limits::LimitError& e) {
+      throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
+    }
     const double load_seconds = seconds_since(start);
     const fs::path out = opt->out;
     prepare_output(out);
     ProgressBar bar;
-    if (opt->progress || ::isatty(::fileno(stderr))) settings.progress = bar;
+    if (opt->progress || ::isatty(::fileno(stderr))) {
+      settings.progress = bar;
+    } else {
+      // A log (stderr redirected): a line per tenth once the run has taken a few seconds.
+      settings.progress = [lines = std::make_shared<msm::util::ProgressLines>("msm reference: ", " rows")](
+                              const msm::reference::Progress& p) {
+        if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
+      };
+    }
 
     msm::reference::Result result;
     try {
@@ -145,18 +164,18 @@ void add_reference(CLI::App& app) {
       throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
     }
     const auto write_start = std::chrono::steady_clock::now();
+    // All the files or none (a full disk, a failed rename): temporaries first, renamed together.
+    msm::image::FileSet files;
     try {
-      msm::image::write_exr(out / "visibility.exr", result.visibility);
-      msm::image::write_exr(out / "radiance.exr", result.radiance);
-      msm::image::write_exr(out / "surface.exr", result.surface);
+      files.add_exr(out / "visibility.exr", result.visibility);
+      files.add_exr(out / "radiance.exr", result.radiance);
+      files.add_exr(out / "surface.exr", result.surface);
       // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
       // from an earlier run into the same folder for the other effects.
-      if (!result.visibility_rgb.empty()) {
-        msm::image::write_exr(out / "visibility_rgb.exr", result.visibility_rgb);
-      } else {
-        std::error_code ec;
-        fs::remove(out / "visibility_rgb.exr", ec);
-      }
+      if (!result.visibility_rgb.empty())
+        files.add_exr(out / "visibility_rgb.exr", result.visibility_rgb);
+      else
+        files.remove(out / "visibility_rgb.exr");
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
 
     nlohmann::ordered_json j;
@@ -193,8 +212,8 @@ void add_reference(CLI::App& app) {
                     {"total", seconds_since(start)}};
     const std::string text = j.dump(2) + "\n";
     try {
-      msm::image::write_file_atomic(out / "reference.json",
-                                    {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+      files.add(out / "reference.json", {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+      files.commit();
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
     if (opt->json)
       fmt::print("{}", text);

@@ -50,6 +50,7 @@ void add_render(CLI::App& app) {
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);
+    check_limits(opt->frame, scene, names);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     fmt::print(stderr, "msm render: scene '{}', {} triangles, {}x{}, shadow map {}², on {}\n", scene.name,
                scene.triangle_count(), f.width, f.height, f.shadow_size, ctx->info().name);
@@ -62,6 +63,8 @@ void add_render(CLI::App& app) {
       render::RenderResult result;
       // GPU time is the frame's passes (timestamps); wall time adds recording, read-back and the files.
       auto start = std::chrono::steady_clock::now();
+      // One technique can take long (a large shadow map on a CPU device): say what is running.
+      if (names.size() == 1) fmt::print(stderr, "msm render: rendering {} ...\n", names[i]);
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }

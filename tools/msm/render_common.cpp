@@ -2,6 +2,7 @@
 
 #include "msm/image/io.h"
 #include "msm/techniques.h"
+#include "msm/util/limits.h"
 
 #include <fmt/format.h>
 
@@ -109,6 +110,14 @@ void validate_techniques(const FrameOptions& options, const std::vector<std::str
   }
 }
 
+void check_limits(const FrameOptions& options, const scene::Scene& scene, const std::vector<std::string>& techniques) {
+  for (const std::string& name : techniques) {
+    try {
+      render::check_limits(settings_for(options, name), scene.triangle_count(), scene.lights.size());
+    } catch (const limits::LimitError& e) { throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what())); }
+  }
+}
+
 void check_on_device(const render::Renderer& renderer, const FrameOptions& options,
                      const std::vector<std::string>& techniques) {
   for (const std::string& name : techniques) {
@@ -188,12 +197,16 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json) {
   try {
-    image::write_png(dir / (stem + ".png"), result.color);
-    image::write_exr(dir / (stem + ".exr"), result.shadow);
-    if (!result.shadow_rgb.empty()) image::write_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
+    image::FileSet files;
+    files.add_png(dir / (stem + ".png"), result.color);
+    files.add_exr(dir / (stem + ".exr"), result.shadow);
+    if (!result.shadow_rgb.empty())
+      files.add_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
+    else
+      files.remove(dir / (stem + "-rgb.exr")); // no stale copy of an earlier coloured render
     std::string text = json.dump(2) + "\n";
-    image::write_file_atomic(dir / (stem + ".json"),
-                             std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    files.add(dir / (stem + ".json"), std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    files.commit();
   } catch (const image::ImageError& e) { throw UsageError(e.what()); }
 }
 

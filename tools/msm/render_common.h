@@ -43,6 +43,11 @@ std::vector<std::string> canonical_technique_names(std::vector<std::string> name
 // the first problem otherwise).
 void validate_techniques(const FrameOptions& options, const std::vector<std::string>& techniques);
 
+// The scene's triangles and every technique's memory estimate are within the limits shared with
+// msm reference (msm/util/limits.h), before the device or the output exists: UsageError naming the
+// scene, the value and the limit otherwise.
+void check_limits(const FrameOptions& options, const scene::Scene& scene, const std::vector<std::string>& techniques);
+
 // The device can render every technique's settings (Renderer::check), before any output exists:
 // UsageError naming the first problem (an MSAA count the device lacks, an image too large).
 void check_on_device(const render::Renderer& renderer, const FrameOptions& options,
@@ -60,8 +65,8 @@ void ensure_output_dir(const std::filesystem::path& dir);
 nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, const vk::Context& ctx,
                            const render::RenderResult& result);
 
-// <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>.json; each
-// written to a temporary name and renamed.
+// <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>-rgb.exr (coloured
+// shadows only), <dir>/<stem>.json: all or none (image::FileSet: temporaries, then renamed together).
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json);
 

@@ -9,7 +9,10 @@
 
 #include "msm/image/image.h"
 
+#include <cstdint>
 #include <filesystem>
+#include <span>
+#include <vector>
 
 namespace msm::image {
 
@@ -37,5 +40,33 @@ void write_image(const std::filesystem::path& path, const Image& image);
 
 // The atomic write used by the above, for any bytes.
 void write_file_atomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
+// The encoded files of write_png and write_exr (path: for the messages).
+std::vector<std::uint8_t> encode_png(const std::filesystem::path& path, const Image& image);
+std::vector<std::uint8_t> encode_exr(const std::filesystem::path& path, const Image& image);
+
+// Files that appear together or not at all (a render's PNG, EXR and JSON; a reference's EXRs and
+// JSON): each add writes a complete temporary file next to its target (a full disk fails here,
+// before any target changes), commit renames them all over their targets. A failed rename puts
+// the targets renamed before it back (an overwritten file from a hard link kept until the end) and
+// throws ImageError; a set destroyed without commit removes its temporary files.
+class FileSet {
+ public:
+  FileSet() = default;
+  FileSet(const FileSet&) = delete;
+  FileSet& operator=(const FileSet&) = delete;
+  ~FileSet();
+  void add(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
+  void add_png(const std::filesystem::path& path, const Image& image);
+  void add_exr(const std::filesystem::path& path, const Image& image);
+  // A stale file of an earlier run, removed at commit with the others' renames.
+  void remove(const std::filesystem::path& path);
+  void commit();
+
+ private:
+  struct Pending {
+    std::filesystem::path target, tmp; // tmp empty: remove target
+  };
+  std::vector<Pending> pending_;
+};
 
 } // namespace msm::image

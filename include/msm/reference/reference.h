@@ -173,6 +173,12 @@ struct Settings {
 
 // Throws std::invalid_argument naming the setting and its allowed range.
 void validate(const Settings& settings);
+// What render() would allocate for a scene of `triangles` triangles: the tracer's BVH and the
+// per-pixel images (the model and its constants: msm/util/limits.h).
+std::uint64_t estimated_bytes(const Settings& settings, std::uint64_t triangles);
+// limits::LimitError when the scene or the estimate exceeds its limit (the same limits as the
+// renderer's); render() checks it first.
+void check_limits(const Settings& settings, std::uint64_t triangles);
 
 struct Result {
   image::Image visibility;     // see above for the channels

@@ -133,6 +133,14 @@ struct RenderSettings {
   void validate() const;
 };
 
+// What a render of these settings would allocate, host and device together (the model and its
+// constants: msm/util/limits.h), for a scene of `triangles` triangles; the frame's lights are
+// s.lights or the scene's `scene_lights`.
+std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights);
+// limits::LimitError (msm/util/limits.h) when the scene or the estimate exceeds its limit; the
+// message names the technique, the sizes and the limit.
+void check_limits(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights);
+
 // The normalized 1D weights of the blur and PCF (msm/filter.h), tap k at [k]: what the frame's
 // uniforms hold and what the ray tracer's filtered effect samples (reference::FilterKernel).
 std::vector<float> filter_weights(const RenderSettings& settings);

@@ -1,0 +1,118 @@
+// The limits shared by msm render and msm reference (msm/util/limits.h): what works today stays
+// within them, absurd input is refused with the value and the limit named, and the renderer and the
+// ray tracer refuse the same scene the same way. No device needed: the estimates are arithmetic.
+#include "msm/reference/reference.h"
+#include "msm/render/renderer.h"
+#include "msm/util/limits.h"
+#include "msm/util/progress.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace msm {
+namespace {
+
+render::RenderSettings heaviest_working_render() {
+  render::RenderSettings s; // 1280x720, 4x MSAA, mipmaps: the defaults of msm render
+  s.technique = "msm6-192";
+  s.shadow_size = 8192;
+  return s;
+}
+
+std::string limit_message(auto&& f) {
+  try {
+    f();
+  } catch (const limits::LimitError& e) { return e.what(); }
+  return "";
+}
+
+TEST(Limits, TheHeaviestRenderTriedStaysWithinTheDefaults) {
+  // `msm render --scene fence -t msm6-192 --shadow-size 8192` peaks at 4.9 GB on lavapipe (device
+  // memory is host memory there; docs/results.md): the estimate must be of that order (within 25%)
+  // and within the limit, or the limit refuses what works.
+  const std::uint64_t bytes = render::estimated_bytes(heaviest_working_render(), 410, 1);
+  EXPECT_GT(double(bytes), 0.75 * 4.9e9);
+  EXPECT_LT(double(bytes), 1.25 * 4.9e9);
+  EXPECT_LT(bytes, limits::kMaxBytes);
+  EXPECT_NO_THROW(render::check_limits(heaviest_working_render(), 410, 1));
+}
+
+TEST(Limits, ShadowMemoryGrowsWithTexelsLightsAndColourChannels) {
+  render::RenderSettings s = heaviest_working_render();
+  s.width = s.height = 1; // the shadow maps alone
+  const double base = double(render::estimated_bytes(s, 0, 1));
+  EXPECT_NEAR(double(render::estimated_bytes(s, 0, 4)) / base, 4.0, 1e-6);
+  s.shadow_size = 4096;
+  EXPECT_NEAR(base / double(render::estimated_bytes(s, 0, 1)), 4.0, 1e-6);
+  s.shadow_size = 8192;
+  s.coloured_translucency = true;
+  EXPECT_GT(double(render::estimated_bytes(s, 0, 1)), 2.0 * base); // three moment maps, one depth
+}
+
+TEST(Limits, RenderAndReferenceRefuseTheSameScene) {
+  const std::uint64_t triangles = 160'000'000;
+  reference::Settings ref;
+  const std::string a = limit_message([&] { reference::check_limits(ref, triangles); });
+  const std::string b = limit_message([&] { render::check_limits(render::RenderSettings{}, triangles, 1); });
+  EXPECT_EQ(a, "the scene has 160,000,000 triangles; the limit is 32,000,000 (MSM_MAX_TRIANGLES raises it)");
+  EXPECT_EQ(a, b);
+  EXPECT_NO_THROW(reference::check_limits(ref, limits::kMaxTriangles / 4));
+}
+
+TEST(Limits, HugeReferencesAreRefusedBeforeAllocation) {
+  reference::Settings s;
+  s.width = s.height = 16384;
+  s.effect = reference::Effect::translucent; // four images, one of them RGB
+  const std::string m = limit_message([&] { reference::check_limits(s, 410); });
+  EXPECT_NE(m.find("a 16384x16384 translucent reference of 410 triangles needs about 13.0 GiB; the limit is 12.0 GiB"),
+            std::string::npos)
+      << m;
+  s.effect = reference::Effect::hard; // 28 B per pixel measured at 4096², 40 B estimated: allowed
+  EXPECT_NO_THROW(reference::check_limits(s, 410));
+  EXPECT_GT(reference::estimated_bytes(s, 410), std::uint64_t(28) * 16384 * 16384);
+}
+
+TEST(Limits, TheEnvironmentOverridesEachLimit) {
+  ::setenv("MSM_MAX_TRIANGLES", "1000", 1);
+  ::setenv("MSM_MAX_MEMORY_MB", "1", 1);
+  EXPECT_EQ(limits::max_triangles(), 1000u);
+  EXPECT_EQ(limits::max_bytes(), 1u << 20);
+  EXPECT_NE(limit_message([] { limits::check_triangles(1001); }), "");
+  EXPECT_EQ(limit_message([] { limits::check_triangles(1000); }), "");
+  // Not a positive integer: the default, not a limit of zero.
+  ::setenv("MSM_MAX_TRIANGLES", "lots", 1);
+  ::setenv("MSM_MAX_MEMORY_MB", "0", 1);
+  EXPECT_EQ(limits::max_triangles(), limits::kMaxTriangles);
+  EXPECT_EQ(limits::max_bytes(), limits::kMaxBytes);
+  ::unsetenv("MSM_MAX_TRIANGLES");
+  ::unsetenv("MSM_MAX_MEMORY_MB");
+}
+
+// Progress lines for a log: nothing from a short run; from a long one a line per tenth once it has
+// run two seconds, each tenth once, and the last line at the end.
+TEST(ProgressLines, ShortRunsAreQuietLongRunsGetATenthPerLine) {
+  util::ProgressLines quick("msm reference: ");
+  for (std::size_t done = 1; done <= 100; ++done) EXPECT_FALSE(quick.next(done, 100, 0.01 * double(done)));
+
+  util::ProgressLines slow("msm reference: ");
+  std::vector<std::string> lines;
+  for (std::size_t done = 1; done <= 100; ++done)
+    for (int repeat = 0; repeat < 2; ++repeat) // a report repeated prints nothing more
+      if (auto line = slow.next(done, 100, 0.1 * double(done))) lines.push_back(*line);
+  ASSERT_EQ(lines.size(), 9u); // 20%, 30%, ..., 100%: the first tenth came before 2 s
+  EXPECT_EQ(lines.front(), "msm reference:  20% (20 of 100), 2.0 s, 8.0 s left");
+  EXPECT_EQ(lines.back(), "msm reference: 100% (100 of 100), 10.0 s, 0.0 s left");
+
+  // Reports coarser than a tenth (a few rows of a tall image at a time): one line per report.
+  util::ProgressLines coarse("x ");
+  EXPECT_FALSE(coarse.next(0, 3, 5.0));
+  EXPECT_EQ(coarse.next(1, 3, 6.0).value_or(""), "x  33% (1 of 3), 6.0 s, 12.0 s left");
+  EXPECT_TRUE(coarse.next(3, 3, 9.0));
+  EXPECT_FALSE(coarse.next(3, 3, 9.0));
+}
+
+} // namespace
+} // namespace msm
