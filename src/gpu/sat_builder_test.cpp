@@ -308,8 +308,8 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
   vk::Buffer result_buffer =
       vk::create_buffer(ctx(), sizeof(SoftFlow) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
   static_assert(std::is_standard_layout_v<Query>); // glm vectors: see gpu_math_test.cpp's KernelIO
-  std::memcpy(query_buffer.data(), queries.data(),
-              sizeof(Query) * count); // NOLINT(bugprone-undefined-memory-manipulation)
+  // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, asserted above
+  std::memcpy(query_buffer.data(), queries.data(), sizeof(Query) * count);
   vk::Program program = vk::create_program(
       ctx(), "sat_queries.comp", {vk::Binding::storage_image, vk::Binding::storage_buffer, vk::Binding::storage_buffer},
       sizeof(Push));

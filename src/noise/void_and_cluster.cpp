@@ -135,10 +135,10 @@ std::vector<std::uint32_t> void_and_cluster_ranks(int size, double sigma, std::u
     const int cluster = extreme(field.energy(), on, 1, true);
     on[std::size_t(cluster)] = 0;
     field.splat(cluster, false);
-    const int void_ = extreme(field.energy(), on, 0, false);
-    on[std::size_t(void_)] = 1;
-    field.splat(void_, true);
-    if (void_ == cluster) break;
+    const int largest_void = extreme(field.energy(), on, 0, false);
+    on[std::size_t(largest_void)] = 1;
+    field.splat(largest_void, true);
+    if (largest_void == cluster) break;
   }
   const std::vector<std::uint8_t> prototype = on;
 
@@ -158,10 +158,10 @@ std::vector<std::uint32_t> void_and_cluster_ranks(int size, double sigma, std::u
   const int half = n / 2;
   int r = m;
   for (; r < half; ++r) {
-    const int void_ = extreme(field.energy(), on, 0, false);
-    on[std::size_t(void_)] = 1;
-    field.splat(void_, true);
-    rank[std::size_t(void_)] = std::uint32_t(r);
+    const int largest_void = extreme(field.energy(), on, 0, false);
+    on[std::size_t(largest_void)] = 1;
+    field.splat(largest_void, true);
+    rank[std::size_t(largest_void)] = std::uint32_t(r);
   }
   // Phase 3: the empty pixels are now the minority: energy of the empty pixels, and the
   // tightest cluster of empty pixels is filled; ranks n/2 .. n-1.

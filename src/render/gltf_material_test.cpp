@@ -31,15 +31,15 @@ class GltfMaterialTest : public vk::test::VulkanTest {
   void SetUp() override {
     VulkanTest::SetUp();
     std::random_device rd;
-    dir_ = fs::temp_directory_path() / fmt::format("msm_gltf_material_test_{}{}", rd(), rd());
-    fs::create_directories(dir_);
+    dir = fs::temp_directory_path() / fmt::format("msm_gltf_material_test_{}{}", rd(), rd());
+    fs::create_directories(dir);
   }
   void TearDown() override {
     std::error_code ec;
-    fs::remove_all(dir_, ec);
+    fs::remove_all(dir, ec);
     VulkanTest::TearDown();
   }
-  fs::path dir_;
+  fs::path dir;
 };
 
 // 8 x 8 texels in four 4 x 4 quadrants: red top-left, green top-right, blue bottom-left, white
@@ -94,12 +94,12 @@ TEST_F(GltfMaterialTest, TexturesRightWayUpInRendererAndRayTracer) {
   model.primitives.push_back(quad({0.75f, 0.5f, 0}, {0.5f, 0, 0}, {0, -1, 0}, {0, 0, 1}, 1));
   for (const char* file : {"picture.gltf", "picture.glb"}) {
     SCOPED_TRACE(file);
-    write_gltf(dir_ / file, model);
+    write_gltf(dir / file, model);
     const std::string json = fmt::format(R"({{"msm_scene": 1,
         "camera": {{"position": [0, 0, 3], "target": [0, 0, 0], "fov_y_deg": 60}},
         "light": {{"towards_light": [0, 0, 1]}}, "objects": [{{"name": "q", "mesh": "{}"}}]}})",
                                          file);
-    const scene::Scene s = scene::load_scene_json(json, dir_, "picture.json");
+    const scene::Scene s = scene::load_scene_json(json, dir, "picture.json");
     ASSERT_EQ(s.objects.size(), 2u);
     Renderer renderer(ctx(), s);
     RenderSettings rs;
@@ -142,13 +142,13 @@ TEST_F(GltfMaterialTest, MaskCutOutsCastTheirShadowInEveryTechnique) {
   model.materials = {
       {.name = "cutout", .texture = 0, .alpha_mode = "MASK", .alpha_cutoff = 0.5f, .double_sided = true}};
   model.primitives.push_back(quad({-0.5f, 0.5f, -0.5f}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, 0));
-  write_gltf(dir_ / "cutout.glb", model);
+  write_gltf(dir / "cutout.glb", model);
   const scene::Scene s = scene::load_scene_json(R"({"msm_scene": 1,
       "camera": {"position": [0.3, 0.3, 2.2], "target": [0, 0, -0.2], "fov_y_deg": 50},
       "light": {"towards_light": [0, 1, 0]},
       "objects": [{"name": "ground", "primitive": {"type": "plane", "size": [3, 3]}},
                   {"name": "cutout", "mesh": "cutout.glb"}]})",
-                                                dir_, "cutout.json");
+                                                dir, "cutout.json");
   ASSERT_TRUE(s.materials.at(s.objects[1].material).masked());
   reference::Settings ts;
   ts.effect = reference::Effect::filtered;

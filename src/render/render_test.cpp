@@ -282,7 +282,7 @@ TEST_F(RenderTest, BlurNeverSpreadsNaN) {
   for (int k = 0; k < taps; ++k)
     u.filter_weights[k / 4][k % 4] = msm_gaussian_weight(k, taps, MSM_FILTER_DEFAULT_SIGMA);
   vk::Buffer uniforms = vk::create_buffer(ctx(), sizeof(u), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host);
-  std::memcpy(uniforms.data(), &u, sizeof(u));
+  std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation): renderer.cpp
   std::vector<float> texels(size_t(n * n * 4));
   for (size_t i = 0; i < texels.size(); ++i) texels[i] = float((i * 7919) % 1000) / 1000.0f;
   for (int c = 0; c < 4; ++c) texels[size_t((10 * n + 10) * 4 + c)] = NAN;

@@ -25,6 +25,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 namespace msm::render {
 
@@ -272,9 +273,13 @@ struct Renderer::Impl {
       config = c;
     }
     FrameUniforms u = frame_uniforms(s, technique);
-    std::memcpy(uniforms.data(), &u, sizeof(u));
+    // glm's types are standard-layout with user-written copies (not TriviallyCopyable to the
+    // standard); their bytes are the std140/std430 layout the shaders read (frame.h).
+    static_assert(std::is_standard_layout_v<FrameUniforms> && std::is_standard_layout_v<LightUniforms>);
+    std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation)
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
+    // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
     return technique;
   }

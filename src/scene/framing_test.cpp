@@ -51,13 +51,13 @@ TEST(Framing, FitCoversWhatTheCameraSees) {
       for (std::size_t t = 0; t < o.mesh.triangle_count(); ++t) {
         const glm::vec3 a = o.mesh.positions[o.mesh.indices[3 * t]], b = o.mesh.positions[o.mesh.indices[3 * t + 1]],
                         c = o.mesh.positions[o.mesh.indices[3 * t + 2]];
-        constexpr int kSteps = 16;
-        for (int i = 0; i <= kSteps; ++i)
-          for (int j = 0; i + j <= kSteps; ++j) {
-            const glm::vec3 p = a + (float(i) / kSteps) * (b - a) + (float(j) / kSteps) * (c - a);
+        constexpr int steps = 16;
+        for (int i = 0; i <= steps; ++i)
+          for (int j = 0; i + j <= steps; ++j) {
+            const glm::vec3 p = a + (float(i) / steps) * (b - a) + (float(j) / steps) * (c - a);
             const glm::vec4 q = light * glm::vec4(p, 1.0f);
             const bool over_map = std::abs(q.x) <= 1.0f && std::abs(q.y) <= 1.0f;
-            if (over_map && (i + j == 0 || i == kSteps || j == kSteps)) {
+            if (over_map && (i + j == 0 || i == steps || j == steps)) {
               EXPECT_GE(q.z, -1e-6f) << "a caster over the map in front of the near plane";
             }
             if (!in_view(camera, p)) continue;

@@ -549,7 +549,7 @@ TEST_F(VkLayerTest, BuffersRoundTripAtOffsets) {
     upload_buffer(ctx(), buffer, std::as_bytes(std::span(words)), 1024);
     EXPECT_EQ(readback_buffer<uint32_t>(ctx(), buffer, words.size(), 1024), words);
     Buffer moved = std::move(buffer); // move-only handles: the moved-from one owns nothing
-    EXPECT_FALSE(buffer);
+    EXPECT_FALSE(buffer);             // NOLINT(bugprone-use-after-move): the moved-from state is what is tested
     EXPECT_EQ(readback_buffer<uint32_t>(ctx(), moved, 4, 1024 + 8),
               std::vector<uint32_t>(words.begin() + 2, words.begin() + 6));
   }
@@ -601,7 +601,7 @@ TEST_F(VkLayerTest, ImagesWithMipsLayersSamplesAndViews) {
       ctx(), {.width = 4, .height = 4, .format = VK_FORMAT_R8G8B8A8_UNORM, .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
   EXPECT_EQ(plain.view(), VK_NULL_HANDLE);
   plain = std::move(depth);
-  EXPECT_FALSE(depth);
+  EXPECT_FALSE(depth); // NOLINT(bugprone-use-after-move): the moved-from state is what is tested
   EXPECT_EQ(plain.format(), VK_FORMAT_D32_SFLOAT);
 }
 

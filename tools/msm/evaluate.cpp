@@ -4,6 +4,7 @@
 // checkpoint in DIR/checkpoint to resume from. Runs alone (threads) or under mpirun (ranks).
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
@@ -41,7 +42,7 @@ class ProgressBar {
   ProgressBar(int rank, int size) : rank_(rank), size_(size) {}
   void operator()(const Progress& p) {
     const double fraction = p.total ? double(p.done) / double(p.total) : 1.0;
-    const int width = 30, filled = int(fraction * width + 0.5);
+    const int width = 30, filled = int(std::lround(fraction * width));
     const double left = fraction > 0.0 ? p.seconds * (1.0 - fraction) / fraction : 0.0;
     fmt::print(stderr, "\rmsm evaluate [{}{}] {:3.0f}%  {}/{} candidates{}  {:.1f} s, {:.1f} s left ",
                std::string(filled, '#'), std::string(width - filled, ' '), 100.0 * fraction, p.done, p.total,

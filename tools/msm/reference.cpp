@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -56,7 +57,7 @@ class ProgressBar {
  public:
   void operator()(const msm::reference::Progress& p) {
     const double fraction = p.rows_total ? double(p.rows_done) / double(p.rows_total) : 1.0;
-    const int width = 40, filled = int(fraction * width + 0.5);
+    const int width = 40, filled = int(std::lround(fraction * width));
     const double eta = fraction > 0.0 ? p.seconds * (1.0 - fraction) / fraction : 0.0;
     fmt::print(stderr, "\rmsm reference [{}{}] {:3.0f}%  {:.1f} s, {:.1f} s left ", std::string(filled, '#'),
                std::string(width - filled, ' '), 100.0 * fraction, p.seconds, eta);

@@ -27,7 +27,7 @@ class TempDir {
   const std::filesystem::path& path() const { return path_; }
   // Writes `text` to the file `name` in the directory and returns its path.
   std::filesystem::path write(const std::string& name, const std::string& text) const {
-    const std::filesystem::path p = path_ / name;
+    std::filesystem::path p = path_ / name;
     std::ofstream(p, std::ios::binary) << text;
     return p;
   }
