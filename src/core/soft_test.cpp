@@ -260,7 +260,8 @@ TEST(SoftShadows, SixMomentBlockerDepthMatchesTheExactMean) {
         apart = true;
         for (float other : z) apart = apart && std::abs(other - zk) >= 0.05f;
       } while (!apart);
-      int nk = 15 + int(unit(rng) * float(left / 2 - 15));
+      const int half = left / 2; // whole texels
+      int nk = 15 + int(unit(rng) * float(half - 15));
       z.push_back(zk);
       n.push_back(nk);
       left -= nk;
@@ -382,7 +383,8 @@ TEST(SoftShadows, SixMomentUpperBoundBlockerDepth) {
       std::vector<int> n;
       for (int k = 0; k < occluders; ++k) {
         z.push_back(-1.0f + (zf - 0.1f + 1.0f) * unit(rng));
-        n.push_back(15 + int(unit(rng) * float(left / 2 - 15)));
+        const int half = left / 2; // whole texels
+        n.push_back(15 + int(unit(rng) * float(half - 15)));
         left -= n.back();
       }
       z.push_back(zf);

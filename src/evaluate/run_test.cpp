@@ -32,7 +32,7 @@ RunSettings small(const fs::path& out, int threads) {
 }
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("msm-evaluate-run-test-" + name);
+  fs::path dir = fs::temp_directory_path() / ("msm-evaluate-run-test-" + name);
   fs::remove_all(dir);
   return dir;
 }

@@ -222,8 +222,8 @@ fs::path write_temporary(const fs::path& path, std::span<const std::uint8_t> byt
   if (path.empty() || !path.has_filename()) throw ImageError(path, "not a file path");
   static std::atomic<unsigned> counter{0};
   const fs::path dir = path.parent_path();
-  const fs::path tmp = (dir.empty() ? fs::path(".") : dir) /
-                       fmt::format(".{}.tmp.{}.{}", path.filename().string(), ::getpid(), counter++);
+  fs::path tmp = (dir.empty() ? fs::path(".") : dir) /
+                 fmt::format(".{}.tmp.{}.{}", path.filename().string(), ::getpid(), counter++);
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   if (fd < 0) throw ImageError(path, "cannot create temporary file " + tmp.string() + ": " + errno_text(errno));
   auto fail = [&](const std::string& what, int err) {

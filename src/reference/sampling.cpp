@@ -26,8 +26,9 @@ glm::dvec2 SampleSet::point(int i, Rng& rng) const {
   if (i < grid_ * grid_) {
     // Jittered cell (i mod m, i div m) of the m x m grid.
     const double inv = 1.0 / grid_;
-    return {std::min((i % grid_ + a) * inv, std::nextafter(1.0, 0.0)),
-            std::min((i / grid_ + b) * inv, std::nextafter(1.0, 0.0))};
+    const int column = i % grid_, row = i / grid_;
+    return {std::min((column + a) * inv, std::nextafter(1.0, 0.0)),
+            std::min((row + b) * inv, std::nextafter(1.0, 0.0))};
   }
   return {a, b};
 }

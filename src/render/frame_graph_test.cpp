@@ -112,7 +112,9 @@ RenderSettings small(std::string technique) {
 // equal A. Per-light pass times are reported.
 TEST_F(MultiLightTest, EachLightCastsItsOwnShadow) {
   scene::Scene scene = scene::builtin_scene("fence");
-  scene::DirectionalLight a = scene.light(), b = a;
+  // NOLINTNEXTLINE(performance-unnecessary-copy-initialization): a value, not a view into the scene
+  const scene::DirectionalLight a = scene.light();
+  scene::DirectionalLight b = a;
   b.towards_light = glm::normalize(glm::vec3(-0.6f, 0.7f, -0.4f));
   scene::DirectionalLight a_off = a, b_off = b;
   a_off.irradiance = b_off.irradiance = glm::vec3(0.0f);
