@@ -1,4 +1,6 @@
-// MPI ranks (mpi.h). Compiled with MSM_HAVE_MPI when CMake found MPI, else the stubs at the end.
+// MPI ranks (mpi.h). Compiled with MSM_HAVE_MPI when CMake found MPI; without it, the end of the
+// file says so: mpi_supported() is false, mpi_world() refuses with the reason, and there are no
+// other ranks to abort.
 #include "msm/evaluate/mpi.h"
 
 #include <algorithm>
