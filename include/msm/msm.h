@@ -15,6 +15,7 @@
 #include "msm/quantize.h"
 #include "msm/roots.h"
 #include "msm/sat.h"
+#include "msm/scattering.h"
 #include "msm/shading.h"
 #include "msm/shared.h"
 #include "msm/soft.h"

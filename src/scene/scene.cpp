@@ -51,7 +51,7 @@ class Parser {
     } catch (const json::exception& e) { // parse_error, out_of_range (number overflow), ...
       fail("", fmt::format("malformed JSON: {}", e.what()));
     }
-    keys(root, "", {"msm_scene", "name", "camera", "light", "lights", "shadow_map", "materials", "objects"});
+    keys(root, "", {"msm_scene", "name", "camera", "light", "lights", "shadow_map", "medium", "materials", "objects"});
     const json* version = find(root, "msm_scene");
     if (!version) fail("/msm_scene", "required key missing (the format version, 1)");
     if (!version->is_number_integer() || version->get<long long>() != 1)
@@ -74,6 +74,7 @@ class Parser {
         s.lights.push_back(light((*lights_json)[i], fmt::format("/lights/{}", i)));
     }
     if (const json* v = find(root, "shadow_map")) s.shadow = framing(*v, "/shadow_map");
+    if (const json* v = find(root, "medium")) s.medium = medium(*v, "/medium");
 
     Material default_material;
     default_material.name = "default";
@@ -200,6 +201,27 @@ class Parser {
     if (const json* v = find(j, "angular_extent_deg"))
       l.angular_extent_deg = number_in(*v, ptr + "/angular_extent_deg", 0.0f, 90.0f, false, true);
     return l;
+  }
+
+  Medium medium(const json& j, const std::string& ptr) const {
+    keys(j, ptr, {"extinction", "scattering_albedo", "phase", "g"});
+    Medium m;
+    const json* extinction = find(j, "extinction");
+    if (!extinction) fail(ptr + "/extinction", "required key missing (the extinction coefficient σt, per scene unit)");
+    m.extinction = number_in(*extinction, ptr + "/extinction", 0.0f, kMaxSize, true, false);
+    if (const json* v = find(j, "scattering_albedo"))
+      m.scattering_albedo = number_in(*v, ptr + "/scattering_albedo", 0.0f, 1.0f, false, false);
+    const std::string phase = find(j, "phase") ? string(*find(j, "phase"), ptr + "/phase") : "isotropic";
+    if (phase == "henyey_greenstein") {
+      const json* g = find(j, "g");
+      if (!g) fail(ptr + "/g", "required key missing (the Henyey-Greenstein asymmetry, in (-1, 1))");
+      m.g = number_in(*g, ptr + "/g", -1.0f, 1.0f, true, true);
+    } else if (phase == "isotropic") {
+      if (find(j, "g")) fail(ptr + "/g", "only allowed with \"phase\": \"henyey_greenstein\"");
+    } else {
+      fail(ptr + "/phase", fmt::format("unknown phase function \"{}\" (isotropic, henyey_greenstein)", phase));
+    }
+    return m;
   }
 
   ShadowFraming framing(const json& j, const std::string& ptr) const {

@@ -700,3 +700,40 @@ TEST(Errors, Meshes) {
   load_scene_file(dir.write("ok.json", scene_with_object(R"({"mesh": "mixed.obj"})")));
   EXPECT_EQ(load_scene_file(dir.path() / "ok.json").triangle_count(), 1u);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Participating medium
+
+TEST(Medium, ParsedWithDefaultsAndPhase) {
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  EXPECT_FALSE(load_scene_json(scene_with_object(box), fs::current_path(), "t").medium.has_value());
+  const Scene iso =
+      load_scene_json(scene_with_object(box, R"("medium": {"extinction": 0.25},)"), fs::current_path(), "t");
+  ASSERT_TRUE(iso.medium.has_value());
+  EXPECT_EQ(iso.medium->extinction, 0.25f);
+  EXPECT_EQ(iso.medium->scattering_albedo, 1.0f);
+  EXPECT_EQ(iso.medium->g, 0.0f);
+  const Scene hg = load_scene_json(
+      scene_with_object(
+          box, R"("medium": {"extinction": 2, "scattering_albedo": 0.5, "phase": "henyey_greenstein", "g": -0.3},)"),
+      fs::current_path(), "t");
+  EXPECT_EQ(hg.medium->scattering_albedo, 0.5f);
+  EXPECT_EQ(hg.medium->g, -0.3f);
+}
+
+TEST(Medium, BadValuesNameTheirPointer) {
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  const auto with = [&](const std::string& medium) { return scene_with_object(box, R"("medium": )" + medium + ","); };
+  expect_json_error(with("{}"), {"/medium/extinction", "required"});
+  expect_json_error(with(R"({"extinction": 0})"), {"/medium/extinction", "(0,"});
+  expect_json_error(with(R"({"extinction": -1})"), {"/medium/extinction"});
+  expect_json_error(with(R"({"extinction": 1e30})"), {"/medium/extinction"});
+  expect_json_error(with(R"({"extinction": "thick"})"), {"/medium/extinction", "number"});
+  expect_json_error(with(R"({"extinction": 1, "scattering_albedo": 1.5})"), {"/medium/scattering_albedo"});
+  expect_json_error(with(R"({"extinction": 1, "phase": "rayleigh"})"), {"/medium/phase", "unknown phase"});
+  expect_json_error(with(R"({"extinction": 1, "g": 0.5})"), {"/medium/g", "henyey_greenstein"});
+  expect_json_error(with(R"({"extinction": 1, "phase": "henyey_greenstein"})"), {"/medium/g", "required"});
+  expect_json_error(with(R"({"extinction": 1, "phase": "henyey_greenstein", "g": 1})"), {"/medium/g", "(-1, 1)"});
+  expect_json_error(with(R"({"extinction": 1, "phase": "henyey_greenstein", "g": -1})"), {"/medium/g"});
+  expect_json_error(with(R"({"extinction": 1, "density": 1})"), {"/medium/density", "unknown key"});
+}

@@ -35,6 +35,13 @@
 //       "depth_range": [n,f]               signed distances from center along the direction of
 //                                          travel (-towards_light), n < f; depth 0 at n, 1 at f
 //   },
+//   "medium": {                            a homogeneous participating medium filling the scene, lit
+//                                          by the light(s): single scattering (include/msm/scattering.h)
+//     "extinction": 0.1,                   REQUIRED σt in 1/scene units, in (0, 1e6]
+//     "scattering_albedo": 1,              ρ in [0, 1]: scattering coefficient σs = ρ σt
+//     "phase": "isotropic"                 default
+//     | "phase": "henyey_greenstein", "g": 0.5   asymmetry g in (-1, 1) (> 0 scatters forwards)
+//   },
 //   "materials": { "name": <material>, ... },   named materials that objects may refer to
 //   "objects": [ <object>, ... ]           REQUIRED, at least one
 // }
@@ -265,6 +272,15 @@ struct DirectionalLight {
   glm::vec3 travel() const { return -towards_light; }
 };
 
+// A homogeneous medium (JCGT 2017 §5.1.1): extinction σt, scattering albedo ρ and a Henyey–
+// Greenstein phase function of asymmetry g (g = 0: isotropic). Lit by the scene's light(s) with
+// their irradiance E_l.
+struct Medium {
+  float extinction = 0.1f;        // σt > 0, per scene unit
+  float scattering_albedo = 1.0f; // ρ in [0, 1]
+  float g = 0.0f;                 // in (-1, 1)
+};
+
 struct ShadowFraming {
   // fit: to what the camera sees (fit_light_frustum); fit_scene: to every vertex; given: explicit.
   enum class Mode { fit, fit_scene, given } mode = Mode::fit;
@@ -298,6 +314,7 @@ struct Scene {
   // "lights"). The ray tracer's effects use the first: light().
   std::vector<DirectionalLight> lights{DirectionalLight{}};
   ShadowFraming shadow;
+  std::optional<Medium> medium; // the JSON's "medium"; none: clear air
 
   const DirectionalLight& light() const { return lights.front(); }
 
