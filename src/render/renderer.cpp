@@ -30,9 +30,9 @@
 namespace msm::render {
 
 // std140/std430 and the C++ structs agree (frame.h uses vec4/ivec4/mat4 members only).
-static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 2 * 16);
+static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 3 * 16);
 static_assert(offsetof(FrameUniforms, filter_weights) == 64 + 4 * 16);
-static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 16);
+static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 32);
 static_assert(sizeof(LightUniforms) == 2 * 64 + 3 * 16);
 static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
 static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
@@ -191,6 +191,7 @@ struct Renderer::Impl {
     for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
     u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
     u.lights = glm::ivec4(int(lights_of(s).size()), 0, 0, 0);
+    u.camera_viewport = glm::vec4(float(s.width), float(s.height), 0.0f, 0.0f);
     return u;
   }
 

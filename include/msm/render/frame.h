@@ -35,6 +35,7 @@ struct FrameUniforms {
                            // x: the kernel's variance per axis in texels² (blur + MSAA),
                            // y: multiplier of the bias each bound needs (0 = off), zw: unused
   ivec4 lights;            // x: number of lights (layers of the shadow-map arrays), yzw: unused
+  vec4 camera_viewport;    // xy: the camera image's size in pixels (msm_surface_footprint), zw: unused
 };
 
 // One shadow-casting directional light of the frame: its shadow map is layer `index` of every

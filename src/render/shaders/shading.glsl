@@ -3,6 +3,7 @@
 // visible surface) for error measurement. The including shader defines shadow_intensity() for its
 // family of techniques; it reads layer `shadow_layer` of the shadow-map arrays (the light being
 // evaluated).
+#include "msm/footprint.h"
 #include "msm/shading.h"
 #include "msm/techniques.h"
 #define MSM_LIGHT_BINDING 10
@@ -33,8 +34,9 @@ struct ShadowLookup {
   vec2 t;
   float z;
   vec2 depth_per_texel;
-  // Screen-space derivatives of t (texels per pixel), taken in uniform control flow: filtered lookups
-  // pick their mip from them (implicit derivatives inside the branches below would be undefined).
+  // Texels per pixel of t along screen x and y (the pixel's footprint on the surface, msm/footprint.h):
+  // filtered lookups pick their mip from them. Not dFdx/dFdy: lavapipe's derivatives spike along the
+  // edges of the slivers it clips large triangles into, and coarse mips show there as dark dashes.
   vec2 dt_dx, dt_dy;
 };
 
@@ -47,15 +49,16 @@ vec3 shadow_intensity_rgb(ShadowLookup s);
 
 // Visibility of light l at the surface (0 where the surface faces away from it: its own shadow),
 // per colour channel.
-vec3 light_visibility(int l, vec3 n, float n_dot_l) {
+vec3 light_visibility(int l, vec3 n, float n_dot_l, MsmFootprint pixel) {
   current_layer = l;
   // Normal offset: more at grazing light, where depth varies fastest across a texel.
   vec3 p = world_position + n * (lights[l].towards_light.w * (1.0f - n_dot_l));
   vec4 clip = lights[l].view_projection * vec4(p, 1.0f);
   ShadowLookup s;
   s.t = (clip.xy * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
-  s.dt_dx = dFdx(s.t);
-  s.dt_dy = dFdy(s.t);
+  float texels_per_clip_unit = 0.5f * frame.shadow_map.x;
+  s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
+  s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
   if (n_dot_l <= 0.0f) return vec3(0.0f);
   vec3 nc = mat3(lights[l].normal_matrix) * n;
   s.z = clip.z - frame.shadow_map.w;
@@ -90,9 +93,10 @@ void main() {
   vec3 direct = vec3(0.0f), weighted = vec3(0.0f), first = vec3(0.0f);
   float weight_sum = 0.0f;
   int light_count = kOneLight ? 1 : frame.lights.x;
+  MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
   for (int l = 0; l < light_count; ++l) {
     float n_dot_l = dot(n, lights[l].towards_light.xyz);
-    vec3 visibility = light_visibility(l, n, n_dot_l);
+    vec3 visibility = light_visibility(l, n, n_dot_l, pixel);
     direct += msm_direct_light(lights[l].irradiance.rgb, n_dot_l, visibility);
     float w = dot(lights[l].irradiance.rgb, vec3(0.2126f, 0.7152f, 0.0722f)) * max(n_dot_l, 0.0f);
     weighted += w * visibility;
