@@ -45,8 +45,8 @@ MSM_FN float msm_transmittance_integral(float extinction, float a, float b) {
 // The radiance at the camera of a ray of length s ending on a surface of radiance L_s, given the
 // visible fraction of its in-scattering (1 everywhere lit, 0 everywhere shadowed):
 //   exp(−σt s) L_s + f E_l visible_fraction ∫₀ˢ exp(−σt t) dt.
-MSM_FN vec3 msm_scattered_radiance(vec3 surface_radiance, vec3 irradiance, float extinction, float phase_term,
-                                   float s, float visible_fraction) {
+MSM_FN vec3 msm_scattered_radiance(vec3 surface_radiance, vec3 irradiance, float extinction, float phase_term, float s,
+                                   float visible_fraction) {
   return exp(-extinction * s) * surface_radiance +
          (phase_term * visible_fraction * msm_transmittance_integral(extinction, 0.0f, s)) * irradiance;
 }
