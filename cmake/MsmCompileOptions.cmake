@@ -24,10 +24,13 @@ install(TARGETS msm_compile_options EXPORT msmTargets)
 # not skip). For test targets only, never installed.
 set(MSM_ASSIMP_MODELS_DIR /usr/share/assimp/models CACHE PATH "assimp-testmodels' models (glTF samples)")
 set(MSM_GLMARK2_MODELS_DIR /usr/share/glmark2/models CACHE PATH "glmark2-data's models (the bunny)")
+set(MSM_STUDIOLIGHTS_DIR /usr/share/blender/datafiles/studiolights/world
+  CACHE PATH "blender-data's CC0 equirectangular HDR light probes")
 add_library(msm_test_support INTERFACE)
 target_include_directories(msm_test_support INTERFACE ${PROJECT_SOURCE_DIR}/tests/support)
 target_compile_definitions(msm_test_support INTERFACE MSM_TEST_DATA_DIR="${PROJECT_SOURCE_DIR}/tests/data"
-  MSM_ASSIMP_MODELS_DIR="${MSM_ASSIMP_MODELS_DIR}" MSM_GLMARK2_MODELS_DIR="${MSM_GLMARK2_MODELS_DIR}")
+  MSM_ASSIMP_MODELS_DIR="${MSM_ASSIMP_MODELS_DIR}" MSM_GLMARK2_MODELS_DIR="${MSM_GLMARK2_MODELS_DIR}"
+  MSM_STUDIOLIGHTS_DIR="${MSM_STUDIOLIGHTS_DIR}")
 
 # msm_add_test(NAME SOURCES... LIBS ...): one GoogleTest executable, its tests registered with CTest.
 function(msm_add_test name)

@@ -24,6 +24,10 @@ MSM_FN vec3 msm_direct_light(vec3 irradiance, float n_dot_l, vec3 visibility) {
 // Outgoing radiance of a Lambertian surface from the summed direct terms and the ambient factor.
 MSM_FN vec3 msm_surface_radiance(vec3 albedo, vec3 direct, float ambient) { return albedo * (direct + ambient); }
 
+// Relative luminance (CIE Y) of linear Rec. 709 / sRGB: weights lights and colours wherever one
+// number has to stand for a colour (the shadow buffer of several lights, metrics, light probes).
+MSM_FN float msm_luminance(vec3 rgb) { return dot(rgb, vec3(0.2126f, 0.7152f, 0.0722f)); }
+
 // Narkowicz 2015 fit of the ACES filmic curve, x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14),
 // clamped to [0, 1]; applied after the exposure. Precondition: x >= 0 and finite (callers map NaN,
 // negative and infinite values first where they can occur).

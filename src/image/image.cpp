@@ -117,7 +117,7 @@ std::uint8_t linear_to_srgb8(float x) {
   return static_cast<std::uint8_t>(std::lround(255.0 * double(linear_to_srgb(x))));
 }
 
-float luminance(float r, float g, float b) { return 0.2126f * r + 0.7152f * g + 0.0722f * b; }
+float luminance(float r, float g, float b) { return msm::msm_luminance(glm::vec3(r, g, b)); }
 
 Image tone_map(const Image& image, const ToneMap& tone) {
   Image out = image;

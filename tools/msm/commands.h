@@ -11,6 +11,7 @@ void add_bench(CLI::App& app);
 void add_techniques(CLI::App& app);
 void add_reconstruct(CLI::App& app);
 void add_compare(CLI::App& app);
+void add_probe(CLI::App& app);
 void add_reference(CLI::App& app);
 void add_render(CLI::App& app);
 void add_scenes(CLI::App& app);

@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   msm::tool::add_render(app);
   msm::tool::add_scenes(app);
 #endif
+  msm::tool::add_probe(app);
   msm::tool::add_reference(app);
   msm::tool::add_evaluate(app);
   msm::tool::add_help(app);

@@ -98,7 +98,7 @@ void main() {
     float n_dot_l = dot(n, lights[l].towards_light.xyz);
     vec3 visibility = light_visibility(l, n, n_dot_l, pixel);
     direct += msm_direct_light(lights[l].irradiance.rgb, n_dot_l, visibility);
-    float w = dot(lights[l].irradiance.rgb, vec3(0.2126f, 0.7152f, 0.0722f)) * max(n_dot_l, 0.0f);
+    float w = msm_luminance(lights[l].irradiance.rgb) * max(n_dot_l, 0.0f);
     weighted += w * visibility;
     weight_sum += w;
     if (l == 0) first = visibility;

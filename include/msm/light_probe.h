@@ -1,0 +1,145 @@
+// Light probes as cube maps and the area lights a median cut makes of them (Kneiphof, "Real-Time
+// Image-Based Lighting of Dynamic Scenes with Moment Soft Shadow Mapping", 2017, §4.1), written
+// once for the device and the CPU reference.
+//
+// Cube-map conventions are Vulkan's (spec, "Cube Map Face Selection"): faces +X, −X, +Y, −Y, +Z,
+// −Z are layers 0..5; on a face, u = s_c / |m_a| and v = t_c / |m_a| in [−1, 1], with texel row 0
+// at v = −1 (image rows run along +v). A texel (i, j) of an m x m face has its centre at
+// u = (2 i + 1) / m − 1, v = (2 j + 1) / m − 1.
+#ifndef MSM_LIGHT_PROBE_H
+#define MSM_LIGHT_PROBE_H
+#include "msm/shading.h"
+
+MSM_BEGIN
+
+// The unnormalized direction through (u, v) of a face: the point of the face's plane at distance 1
+// from the centre (|result| = sqrt(1 + u² + v²)).
+MSM_FN vec3 msm_cube_direction(int face, float u, float v) {
+  if (face == 0) return vec3(1.0f, -v, -u);
+  if (face == 1) return vec3(-1.0f, -v, u);
+  if (face == 2) return vec3(u, 1.0f, v);
+  if (face == 3) return vec3(u, -1.0f, -v);
+  if (face == 4) return vec3(u, -v, 1.0f);
+  return vec3(-u, -v, -1.0f);
+}
+
+// The world directions of increasing u and of increasing v on a face (∂ msm_cube_direction / ∂u, ∂v).
+MSM_FN vec3 msm_cube_u_axis(int face) {
+  if (face == 0) return vec3(0.0f, 0.0f, -1.0f);
+  if (face == 1) return vec3(0.0f, 0.0f, 1.0f);
+  if (face == 5) return vec3(-1.0f, 0.0f, 0.0f);
+  return vec3(1.0f, 0.0f, 0.0f);
+}
+MSM_FN vec3 msm_cube_v_axis(int face) {
+  if (face == 2) return vec3(0.0f, 0.0f, 1.0f);
+  if (face == 3) return vec3(0.0f, 0.0f, -1.0f);
+  return vec3(0.0f, -1.0f, 0.0f);
+}
+
+// Face and face coordinates of a direction (the inverse of msm_cube_direction up to scale). Ties
+// between faces go to the lower layer. Precondition: d != 0.
+struct MsmCubeCoord {
+  int face;
+  vec2 uv;
+};
+MSM_FN MsmCubeCoord msm_cube_coord(vec3 d) {
+  vec3 a = abs(d);
+  if (a.x >= a.y && a.x >= a.z)
+    return d.x >= 0.0f ? MsmCubeCoord(0, vec2(-d.z, -d.y) / a.x) : MsmCubeCoord(1, vec2(d.z, -d.y) / a.x);
+  if (a.y >= a.z) return d.y >= 0.0f ? MsmCubeCoord(2, vec2(d.x, d.z) / a.y) : MsmCubeCoord(3, vec2(d.x, -d.z) / a.y);
+  return d.z >= 0.0f ? MsmCubeCoord(4, vec2(d.x, -d.y) / a.z) : MsmCubeCoord(5, vec2(-d.x, -d.y) / a.z);
+}
+
+// The solid angle a texel at (u, v) of an m x m face subtends, to first order: the density
+// (1 + u² + v²)^(−3/2) (Kneiphof Eq. 8 with the sign of the exponent the extracted text lost; see
+// ERRATA.md) times the texel's area 4 / m² on the face. Summed over the six faces: 4π.
+MSM_FN float msm_cube_texel_weight(float u, float v, float m) {
+  float r2 = 1.0f + u * u + v * v;
+  return 4.0f / (m * m * r2 * sqrt(r2));
+}
+
+// CIE XYZ of linear Rec. 709 RGB (Y = msm_luminance): the median cut splits by luminance and its
+// tables keep X, Y, Z (Kneiphof §5: Y is the luminance, X and Z carry the colour back).
+MSM_FN vec3 msm_rgb_to_xyz(vec3 c) {
+  return vec3(dot(c, vec3(0.4124f, 0.3576f, 0.1805f)), msm_luminance(c), dot(c, vec3(0.0193f, 0.1192f, 0.9505f)));
+}
+MSM_FN vec3 msm_xyz_to_rgb(vec3 c) {
+  return vec3(dot(c, vec3(3.2406f, -1.5372f, -0.4986f)), dot(c, vec3(-0.9689f, 1.8758f, 0.0415f)),
+              dot(c, vec3(0.0557f, -0.2040f, 1.0570f)));
+}
+
+// Sums over the texels of one region of one face, each texel weighted by its solid angle
+// (msm_cube_texel_weight): xyz = Σ w L_XYZ (so y is the region's illuminance from luminance and
+// xyz its irradiance M_e of Eq. 11, in XYZ), and the luminance-weighted first and second moments
+// of the face coordinates, Σ w Y (u, v) and Σ w Y (u², v²).
+struct MsmRegionSums {
+  vec3 xyz;
+  vec2 first;
+  vec2 second;
+};
+
+// A circular area light made from a region (Kneiphof §4.1.2–4.1.3).
+struct MsmAreaLight {
+  vec3 direction;        // unit, from the scene towards the light: the luminance-weighted centroid (Eq. 9)
+  vec3 x_axis, y_axis;   // unit, orthogonal to direction: the face's u and v axes projected (§4.1.2)
+  vec2 half_extent;      // half extents along x_axis / y_axis as tangents of angles
+  float cone_half_angle; // α_A of the circular light of the same solid angle as the rectangle
+  vec3 irradiance;       // M_e (Eq. 11), linear RGB: irradiance on a surface facing the light
+};
+
+// The area light of a region of `face` from its sums (precondition: sums.xyz.y > 0). The centroid
+// (μ_u, μ_v) and variances σ² = E[u²] − μ² give half extents d = sqrt(3 σ²) (the uniform
+// distribution of the same variance; ERRATA.md corrects the text's σ² = d / 3) on the face plane.
+// The paper scales them by the length of the projected face axis; here they are also divided by
+// the distance of the centroid's point of the face plane from the centre, so that they are
+// tangents of angles wherever on the face the region lies. The circular light has the area of
+// the rectangle: π tan² α = 4 t_x t_y.
+MSM_FN MsmAreaLight msm_area_light_from_region(int face, MsmRegionSums sums) {
+  float total = sums.xyz.y;
+  vec2 mean = sums.first / total;
+  vec2 variance = max(sums.second / total - mean * mean, vec2(0.0f));
+  vec2 d = sqrt(3.0f * variance);
+  vec3 p = msm_cube_direction(face, mean.x, mean.y);
+  float distance = length(p);
+  vec3 z = p / distance;
+  vec3 x = msm_cube_u_axis(face), y = msm_cube_v_axis(face);
+  x -= z * dot(x, z);
+  y -= z * dot(y, z);
+  float x_length = length(x), y_length = length(y);
+  vec2 t = d * vec2(x_length, y_length) / distance;
+  float cone = atan(sqrt(4.0f * t.x * t.y / MSM_PI));
+  return MsmAreaLight(z, x / x_length, y / y_length, t, cone, max(msm_xyz_to_rgb(sums.xyz), vec3(0.0f)));
+}
+
+// ∫ over the cone of half-angle α around a light direction of max(cos, 0) dω, divided by the
+// cone's π sin² α: the factor that replaces max(n·l, 0) for a uniform circular light, where
+// cos_angle = n·l for the cone's axis l. Eq. (15) of the paper, π sin² α cos, holds while the whole
+// cone is above the receiver's horizon (cos_angle >= sin α); below it, this is the exact integral
+// over the part of the cone above the horizon (the form factor of a sphere or disc light, as in
+// Lagarde and de Rousiers, "Moving Frostbite to PBR", 2014, §4.7.2), not the paper's formula,
+// which would go negative; at cos_angle <= −sin α the light is below the horizon and it is 0.
+MSM_FN float msm_cone_cosine(float cos_angle, float cone_half_angle) {
+  float sin_a = sin(cone_half_angle);
+  float sin2 = sin_a * sin_a;
+  float c = clamp(cos_angle, -1.0f, 1.0f);
+  if (c >= sin_a || sin2 <= 1e-8f) return max(c, 0.0f);
+  if (c <= -sin_a) return 0.0f;
+  float s = sqrt(max(1.0f - c * c, 0.0f));
+  float x = sqrt(max(1.0f / sin2 - 1.0f, 0.0f)); // cot α
+  float y = clamp(-x * c / s, -1.0f, 1.0f);
+  float s_sqrt_y = s * sqrt(max(1.0f - y * y, 0.0f));
+  float integral = (c * acos(y) - x * s_sqrt_y) * sin2 + atan(s_sqrt_y / x);
+  return max(integral, 0.0f) / (MSM_PI * sin2);
+}
+
+// Outgoing radiance factor of Eq. (18): a diffuse surface of albedo ρ under the light reflects
+// ρ / π · (irradiance on a facing surface) · msm_cone_cosine; that irradiance is L_e^A π sin² α with
+// L_e^A = M_e / (2π (1 − cos α)) (Eq. 17), i.e. M_e (1 + cos α) / 2 — Eq. (18)'s fraction
+// (1 − cos² α) / (2 (1 − cos α)) without its 0/0 at α = 0.
+MSM_FN vec3 msm_area_light_facing_irradiance(MsmAreaLight light) {
+  return light.irradiance * (0.5f * (1.0f + cos(light.cone_half_angle)));
+}
+
+MSM_END
+
+#endif // MSM_LIGHT_PROBE_H
