@@ -252,4 +252,18 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
   return lights;
 }
 
+CubeMap sky_probe(int size) {
+  return make_sky_sun_probe(size, glm::vec3(0.3f, 0.45f, 0.8f), glm::vec3(4000.0f, 3600.0f, 3000.0f),
+                            glm::vec3(0.4f, 0.6f, -0.3f), glm::radians(0.27f));
+}
+
+std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
+                                            float intensity) {
+  CubeMap cube = probe == "sky" ? sky_probe(size) : load_equirect_probe(probe, size, rotation_deg);
+  for (auto& face : cube.faces)
+    for (glm::vec3& t : face) t *= intensity;
+  const ProbeTables tables(cube);
+  return area_lights(tables, median_cut(tables, count));
+}
+
 } // namespace msm::probe

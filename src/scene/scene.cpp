@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "internal.h"
+#include "msm/probe/probe.h"
 
 namespace msm::scene {
 namespace {
@@ -51,7 +52,8 @@ class Parser {
     } catch (const json::exception& e) { // parse_error, out_of_range (number overflow), ...
       fail("", fmt::format("malformed JSON: {}", e.what()));
     }
-    keys(root, "", {"msm_scene", "name", "camera", "light", "lights", "shadow_map", "medium", "materials", "objects"});
+    keys(root, "",
+         {"msm_scene", "name", "camera", "light", "lights", "shadow_map", "medium", "probe", "materials", "objects"});
     const json* version = find(root, "msm_scene");
     if (!version) fail("/msm_scene", "required key missing (the format version, 1)");
     if (!version->is_number_integer() || version->get<long long>() != 1)
@@ -62,9 +64,13 @@ class Parser {
     if (const json* v = find(root, "camera")) s.camera = camera(*v, "/camera");
     const json* light_json = find(root, "light");
     const json* lights_json = find(root, "lights");
-    if (!light_json && !lights_json) fail("/light", "required key missing (or \"lights\": a list of them)");
+    const json* probe_json = find(root, "probe");
+    if (!light_json && !lights_json && !probe_json)
+      fail("/light", "required key missing (or \"lights\": a list of them, or a \"probe\")");
     if (light_json && lights_json) fail("/lights", "give either \"light\" or \"lights\", not both");
-    if (light_json) {
+    if (!light_json && !lights_json) {
+      s.lights.clear();
+    } else if (light_json) {
       s.lights = {light(*light_json, "/light")};
     } else {
       if (!lights_json->is_array() || lights_json->empty() || lights_json->size() > size_t(kMaxLights))
@@ -75,6 +81,7 @@ class Parser {
     }
     if (const json* v = find(root, "shadow_map")) s.shadow = framing(*v, "/shadow_map");
     if (const json* v = find(root, "medium")) s.medium = medium(*v, "/medium");
+    if (probe_json) probe_lighting(*probe_json, "/probe", s);
 
     Material default_material;
     default_material.name = "default";
@@ -201,6 +208,44 @@ class Parser {
     if (const json* v = find(j, "angular_extent_deg"))
       l.angular_extent_deg = number_in(*v, ptr + "/angular_extent_deg", 0.0f, 90.0f, false, true);
     return l;
+  }
+
+  // The probe's area lights (msm::probe: cube map, median cut, Kneiphof §4.1), appended to s.lights
+  // as discs of the light's cone with the irradiance a facing surface receives (Eq. 18).
+  void probe_lighting(const json& j, const std::string& ptr, Scene& s) const {
+    keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size"});
+    ProbeLighting p;
+    const json* file = find(j, "file");
+    if (!file) fail(ptr + "/file", "required key missing (an equirectangular EXR, or \"sky\")");
+    const std::string name = string(*file, ptr + "/file");
+    p.file = name == "sky" ? fs::path("sky") : existing_file(name, ptr + "/file", "light probe");
+    if (const json* v = find(j, "lights")) p.lights = integer(*v, ptr + "/lights");
+    if (p.lights < 6 || p.lights > 256)
+      fail(ptr + "/lights", "must be in [6, 256] (one region per cube face at least)");
+    if (s.lights.size() + std::size_t(p.lights) > std::size_t(kMaxLights))
+      fail(ptr + "/lights", fmt::format("{} directional lights and {} of the probe exceed {} lights", s.lights.size(),
+                                        p.lights, kMaxLights));
+    if (const json* v = find(j, "intensity")) p.intensity = number_in(*v, ptr + "/intensity", 0.0f, 1e6f, false, false);
+    if (const json* v = find(j, "rotation_deg"))
+      p.rotation_deg = number_in(*v, ptr + "/rotation_deg", -360.0f, 360.0f, false, false);
+    if (const json* v = find(j, "size")) p.size = integer(*v, ptr + "/size");
+    if (p.size < 1 || p.size > 1024) fail(ptr + "/size", "must be in [1, 1024]");
+    std::vector<msm::MsmAreaLight> lights;
+    try {
+      lights = msm::probe::probe_area_lights(p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights, p.rotation_deg,
+                                        p.intensity);
+    } catch (const msm::probe::ProbeError& e) { fail(ptr + "/file", e.what()); }
+    p.first_light = s.lights.size();
+    for (const msm::MsmAreaLight& a : lights) {
+      DirectionalLight l;
+      l.towards_light = a.direction;
+      l.irradiance = msm::msm_area_light_facing_irradiance(a);
+      // Discs below 90° across (the renderer's and the ray tracer's limit on angular_extent_deg).
+      l.angular_extent_deg = std::min(2.0f * glm::degrees(a.cone_half_angle), 89.0f);
+      s.lights.push_back(l);
+    }
+    if (s.lights.empty()) fail(ptr + "/file", "the probe has no light (every texel is black)");
+    s.probe = p;
   }
 
   Medium medium(const json& j, const std::string& ptr) const {

@@ -76,7 +76,7 @@ void expect_json_error(const std::string& json, std::initializer_list<std::strin
 TEST(BuiltinScenes, NamesAndDefault) {
   const auto names = builtin_scene_names();
   EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke", "models", "pillar_wall",
-                                             "disc", "glass"}));
+                                             "disc", "glass", "sky_probe"}));
   EXPECT_EQ(default_scene_name(), "fence");
 }
 
@@ -736,4 +736,46 @@ TEST(Medium, BadValuesNameTheirPointer) {
   expect_json_error(with(R"({"extinction": 1, "phase": "henyey_greenstein", "g": 1})"), {"/medium/g", "(-1, 1)"});
   expect_json_error(with(R"({"extinction": 1, "phase": "henyey_greenstein", "g": -1})"), {"/medium/g"});
   expect_json_error(with(R"({"extinction": 1, "density": 1})"), {"/medium/density", "unknown key"});
+}
+
+// ---------------------------------------------------------------------------------------------
+// Image-based lighting: a probe's area lights
+
+TEST(Probe, LightsFollowTheDirectionalOnes) {
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  const std::string studio = std::string(MSM_STUDIOLIGHTS_DIR) + "/studio.exr";
+  // A probe alone: its lights only.
+  const Scene alone = load_scene_json(R"({"msm_scene": 1, "probe": {"file": ")" + studio +
+                                          R"(", "lights": 8, "size": 16}, "objects": [)" + box + "]}",
+                                      fs::current_path(), "t");
+  ASSERT_TRUE(alone.probe.has_value());
+  EXPECT_EQ(alone.lights.size(), 8u);
+  EXPECT_EQ(alone.probe->first_light, 0u);
+  // Beside a directional light: it stays first.
+  const Scene both =
+      load_scene_json(scene_with_object(box, R"("probe": {"file": "sky", "lights": 6, "size": 8, "intensity": 2},)"),
+                      fs::current_path(), "t");
+  ASSERT_EQ(both.lights.size(), 7u);
+  EXPECT_EQ(both.probe->first_light, 1u);
+  EXPECT_EQ(both.lights[0].towards_light, glm::vec3(0, 1, 0));
+  for (std::size_t k = 1; k < both.lights.size(); ++k) {
+    EXPECT_NEAR(glm::length(both.lights[k].towards_light), 1.0f, 1e-5f);
+    EXPECT_GE(both.lights[k].angular_extent_deg, 0.0f);
+    EXPECT_LT(both.lights[k].angular_extent_deg, 90.0f);
+  }
+}
+
+TEST(Probe, BadValuesNameTheirPointer) {
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  const auto with = [&](const std::string& probe) { return scene_with_object(box, R"("probe": )" + probe + ","); };
+  expect_json_error(with("{}"), {"/probe/file", "required"});
+  expect_json_error(with(R"({"file": "none.exr"})"), {"/probe/file", "does not exist"});
+  expect_json_error(with(R"({"file": "sky", "lights": 5})"), {"/probe/lights", "[6, 256]"});
+  expect_json_error(with(R"({"file": "sky", "lights": 256})"), {"/probe/lights", "exceed 256"});
+  expect_json_error(with(R"({"file": "sky", "size": 0})"), {"/probe/size"});
+  expect_json_error(with(R"({"file": "sky", "intensity": -1})"), {"/probe/intensity"});
+  expect_json_error(with(R"({"file": "sky", "spin": 1})"), {"/probe/spin", "unknown key"});
+  const std::string license = std::string(MSM_STUDIOLIGHTS_DIR) + "/license.txt";
+  expect_json_error(with(R"({"file": ")" + license + R"("})"), {"/probe/file", "not an EXR"});
+  expect_json_error(R"({"msm_scene": 1, "objects": [)" + box + "]}", {"/light", "\"probe\""});
 }

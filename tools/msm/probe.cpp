@@ -61,10 +61,7 @@ void make_parent(const std::string& path) {
 void run(const ProbeOptions& o) {
   probe::CubeMap cube;
   try {
-    cube = o.probe == "sky"
-               ? probe::make_sky_sun_probe(o.size, glm::vec3(0.3f, 0.45f, 0.8f), glm::vec3(4000.0f, 3600.0f, 3000.0f),
-                                           glm::vec3(0.4f, 0.6f, -0.3f), glm::radians(0.27f))
-               : probe::load_equirect_probe(o.probe, o.size, o.rotation_deg);
+    cube = o.probe == "sky" ? probe::sky_probe(o.size) : probe::load_equirect_probe(o.probe, o.size, o.rotation_deg);
   } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
   for (auto& face : cube.faces)
     for (glm::vec3& t : face) t *= o.intensity;

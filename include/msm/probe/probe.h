@@ -89,4 +89,14 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count);
 // The area lights of the regions (msm_area_light_from_region), regions without energy skipped.
 std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vector<Region>& regions);
 
+// The whole CPU pipeline: the probe (an equirectangular EXR, or "sky" for make_sky_sun_probe's
+// default sky: see sky_probe) as a cube map of size², scaled by intensity, cut into `count`
+// regions, and their area lights.
+std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg = 0.0f,
+                                            float intensity = 1.0f);
+// The procedural sky of `msm probe sky` and of scenes with "file": "sky": a blue sky of radiance
+// (0.3, 0.45, 0.8) and a sun disc of radius 0.27° and radiance (4000, 3600, 3000) towards
+// (0.4, 0.6, −0.3), about a third of the sky's irradiance on a horizontal surface.
+CubeMap sky_probe(int size);
+
 } // namespace msm::probe

@@ -19,6 +19,16 @@
 //     "fov_y_deg": 45,                     vertical field of view, in (0, 180)
 //     "near": 0.1, "far": 1000             1e-6 <= near < far <= 1e9, far / near <= 1e7
 //   },
+//   "probe": {                             image-based lighting (Kneiphof 2017): a light probe split
+//                                          by the median cut into area lights, added after "light" /
+//                                          "lights" (which become optional); msm::probe
+//     "file": "studio.exr" | "sky",        REQUIRED equirectangular EXR (relative to the scene file),
+//                                          or the procedural sky with a sun ("msm probe sky")
+//     "lights": 32,                        area lights, 6..256 (all lights together <= kMaxLights)
+//     "intensity": 1,                      radiance scale, [0, 1e6]
+//     "rotation_deg": 0,                   about +Y, counter-clockwise seen from above
+//     "size": 128                          cube-map face size, 1..1024
+//   },
 //   "light": {                             ONE directional light
 //     "towards_light": [x,y,z],            REQUIRED direction FROM the scene TOWARDS the light
 //                                          (normalized on load; the light travels along -this)
@@ -281,6 +291,16 @@ struct Medium {
   float g = 0.0f;                 // in (-1, 1)
 };
 
+// Image-based lighting: the probe the scene's area lights were made from (Scene::lights holds them).
+struct ProbeLighting {
+  std::filesystem::path file; // "sky": the procedural sky
+  int lights = 32;
+  float intensity = 1.0f;
+  float rotation_deg = 0.0f;
+  int size = 128;
+  std::size_t first_light = 0; // index of its first light in Scene::lights
+};
+
 struct ShadowFraming {
   // fit: to what the camera sees (fit_light_frustum); fit_scene: to every vertex; given: explicit.
   enum class Mode { fit, fit_scene, given } mode = Mode::fit;
@@ -314,7 +334,8 @@ struct Scene {
   // "lights"). The ray tracer's effects use the first: light().
   std::vector<DirectionalLight> lights{DirectionalLight{}};
   ShadowFraming shadow;
-  std::optional<Medium> medium; // the JSON's "medium"; none: clear air
+  std::optional<Medium> medium;       // the JSON's "medium"; none: clear air
+  std::optional<ProbeLighting> probe; // the JSON's "probe"; its lights follow the directional ones
 
   const DirectionalLight& light() const { return lights.front(); }
 
