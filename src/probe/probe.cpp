@@ -253,7 +253,7 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
 }
 
 CubeMap sky_probe(int size) {
-  return make_sky_sun_probe(size, glm::vec3(0.3f, 0.45f, 0.8f), glm::vec3(4000.0f, 3600.0f, 3000.0f),
+  return make_sky_sun_probe(size, glm::vec3(0.15f, 0.22f, 0.4f), glm::vec3(40000.0f, 36000.0f, 30000.0f),
                             glm::vec3(0.4f, 0.6f, -0.3f), glm::radians(0.27f));
 }
 

@@ -232,8 +232,8 @@ class Parser {
     if (p.size < 1 || p.size > 1024) fail(ptr + "/size", "must be in [1, 1024]");
     std::vector<msm::MsmAreaLight> lights;
     try {
-      lights = msm::probe::probe_area_lights(p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights, p.rotation_deg,
-                                        p.intensity);
+      lights = msm::probe::probe_area_lights(p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights,
+                                             p.rotation_deg, p.intensity);
     } catch (const msm::probe::ProbeError& e) { fail(ptr + "/file", e.what()); }
     p.first_light = s.lights.size();
     for (const msm::MsmAreaLight& a : lights) {

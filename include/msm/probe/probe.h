@@ -95,8 +95,9 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg = 0.0f,
                                             float intensity = 1.0f);
 // The procedural sky of `msm probe sky` and of scenes with "file": "sky": a blue sky of radiance
-// (0.3, 0.45, 0.8) and a sun disc of radius 0.27° and radiance (4000, 3600, 3000) towards
-// (0.4, 0.6, −0.3), about a third of the sky's irradiance on a horizontal surface.
+// (0.15, 0.22, 0.4) all around and a sun disc of radius 0.27° and radiance (40000, 36000, 30000)
+// towards (0.4, 0.6, −0.3): on a horizontal surface the sun brings about four times the sky's
+// luminance, as on a clear day.
 CubeMap sky_probe(int size);
 
 } // namespace msm::probe
