@@ -126,7 +126,8 @@ void Viewer::fly(float dt) {
     set_light_direction({std::cos(a) * t.x - std::sin(a) * t.z, t.y, std::sin(a) * t.x + std::cos(a) * t.z});
   }
   // The split-screen divider: dragged outside the panel.
-  if (!split_technique.empty()) {
+  if (!split_technique.empty() || (show_truth && truth_image)) {
+    const char* right_name = show_truth && truth_image ? "error against the ground truth" : split_technique.c_str();
     float w = io.DisplaySize.x, x = divider * w;
     bool near = std::abs(io.MousePos.x - x) < 6.0f && !io.WantCaptureMouse;
     if (near && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) dragging_divider = true;
@@ -137,7 +138,7 @@ void Viewer::fly(float dt) {
     draw->AddLine(ImVec2(x, 0), ImVec2(x, io.DisplaySize.y), colour, 2.0f);
     draw->AddText(ImVec2(x - 8 - ImGui::CalcTextSize(view.settings.technique.c_str()).x, io.DisplaySize.y - 24),
                   IM_COL32_WHITE, view.settings.technique.c_str());
-    draw->AddText(ImVec2(x + 8, io.DisplaySize.y - 24), IM_COL32_WHITE, split_technique.c_str());
+    draw->AddText(ImVec2(x + 8, io.DisplaySize.y - 24), IM_COL32_WHITE, right_name);
   }
 }
 
@@ -218,7 +219,7 @@ void Viewer::panel() {
     ImGui::SliderFloat("exposure", &s.exposure, 0.1f, 4.0f);
   }
 
-  if (ImGui::CollapsingHeader("Light and camera", ImGuiTreeNodeFlags_DefaultOpen)) {
+  if (ImGui::CollapsingHeader("Light and camera")) {
     glm::vec3 t = light_direction();
     float azimuth = glm::degrees(std::atan2(t.z, t.x)), elevation = glm::degrees(std::asin(std::clamp(t.y, -1.f, 1.f)));
     bool a = ImGui::SliderFloat("light azimuth", &azimuth, -180.0f, 180.0f);
@@ -249,6 +250,22 @@ void Viewer::panel() {
     ImGui::PlotLines("##history", gpu_history.data(), int(gpu_history.size()), int(history_next), nullptr, 0.0f,
                      top * 1.1f + 1e-3f, ImVec2(0, 50));
     if (!frame_ms.empty()) ImGui::Text("frame %.1f ms (wall)", frame_ms.back());
+  }
+
+  if (ImGui::CollapsingHeader("Ground truth", ImGuiTreeNodeFlags_DefaultOpen)) {
+    ImGui::SliderInt("samples", &truth_samples, 1, 256, "%d", ImGuiSliderFlags_Logarithmic);
+    if (truth.running()) {
+      ImGui::ProgressBar(truth.progress(), ImVec2(-1, 0));
+    } else if (ImGui::Button("ray trace this view")) {
+      start_truth(truth_samples);
+    }
+    if (!truth.error().empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", truth.error().c_str());
+    if (truth_metrics) {
+      ImGui::Text("%s: MAE %.4f", truth_technique.c_str(), truth_metrics->mae);
+      ImGui::Text("leaking %.4f, over-darkening %.4f", truth_metrics->light_leaking, truth_metrics->over_darkening);
+      ImGui::Checkbox("error image right of the divider", &show_truth);
+      if (show_truth) ImGui::TextDisabled("red: too bright (leaking), blue: too dark");
+    }
   }
 
   if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
@@ -344,6 +361,16 @@ void Viewer::step_script() {
       wait_frames = long(number(x[0]));
     } else if (a.verb == "close") {
       glfwSetWindowShouldClose(window, GLFW_TRUE);
+    } else if (a.verb == "ground-truth") {
+      start_truth(int(number(x[0])));
+    } else if (a.verb == "wait-ground-truth") {
+      if (truth.running()) {
+        --script_next; // again next frame
+        return;
+      }
+      if (!truth.error().empty()) throw ViewerError(fmt::format("{}: ground truth: {}", a.where, truth.error()));
+    } else if (a.verb == "show-truth") {
+      show_truth = x[0] == "on";
     } else if (a.verb == "quit") {
       quit = true;
     }

@@ -20,10 +20,24 @@ struct Verb {
   int min_args, max_args; // -1: rest of the line
 };
 
-constexpr Verb kVerbs[] = {{"technique", 1, 1},  {"set", 2, -1},       {"camera", 6, 6},        {"light", 3, 3},
-                           {"split", 1, 1},      {"divider", 1, 1},    {"load-view", 1, 1},     {"save-view", 1, 1},
-                           {"screenshot", 1, 1}, {"panel-mask", 1, 1}, {"resize", 2, 2},        {"frames", 1, 1},
-                           {"close", 0, 0},      {"quit", 0, 0},       {"each-technique", 0, 0}};
+constexpr Verb kVerbs[] = {{"technique", 1, 1},
+                           {"set", 2, -1},
+                           {"camera", 6, 6},
+                           {"light", 3, 3},
+                           {"split", 1, 1},
+                           {"divider", 1, 1},
+                           {"load-view", 1, 1},
+                           {"save-view", 1, 1},
+                           {"screenshot", 1, 1},
+                           {"panel-mask", 1, 1},
+                           {"resize", 2, 2},
+                           {"frames", 1, 1},
+                           {"close", 0, 0},
+                           {"quit", 0, 0},
+                           {"each-technique", 0, 0},
+                           {"ground-truth", 1, 1},
+                           {"wait-ground-truth", 0, 0},
+                           {"show-truth", 1, 1}};
 
 double parse_number(const std::string& where, const std::string& text) {
   double v = 0;
@@ -56,6 +70,13 @@ void check(const Action& a) {
       if (v != std::floor(v) || v < 64 || v > 8192)
         throw ScriptError(fmt::format("{}: resize {} {}: sizes are integers in [64, 8192]", w, a.args[0], a.args[1]));
     }
+  } else if (a.verb == "ground-truth") {
+    double v = parse_number(w, a.args[0]);
+    if (v != std::floor(v) || v < 1 || v > 65536)
+      throw ScriptError(fmt::format("{}: ground-truth {}: samples are an integer in [1, 65536]", w, a.args[0]));
+  } else if (a.verb == "show-truth") {
+    if (a.args[0] != "on" && a.args[0] != "off")
+      throw ScriptError(fmt::format("{}: show-truth {}: on or off", w, a.args[0]));
   } else if (a.verb == "frames") {
     double v = parse_number(w, a.args[0]);
     if (v != std::floor(v) || v < 0 || v > 100000)

@@ -2,6 +2,7 @@
 #include "viewer_state.h"
 
 #include "msm/image/io.h"
+#include "msm/techniques.h"
 #include "msm/vk/commands.h"
 #include "msm/vk/context.h"
 #include "msm/vk/resources.h"
@@ -68,6 +69,7 @@ Viewer::~Viewer() {
   if (imgui_glfw) ImGui_ImplGlfw_Shutdown();
   if (imgui_context) ImGui::DestroyContext();
   descriptor_pool.reset();
+  truth_image = {};
   left.reset();
   right.reset();
   screenshot_buffer = {};
@@ -222,10 +224,13 @@ void Viewer::frame() {
   panel();
   ImGui::Render();
 
+  if (std::optional<reference::Result> r = truth.take()) finish_truth(*r);
   render::Renderer::DeviceFrame a = render_side(*left, view.settings, true);
   good_settings = view.settings;
   render::Renderer::DeviceFrame b;
-  if (!split_technique.empty()) {
+  if (show_truth && truth_image) {
+    b.color = &truth_image;
+  } else if (!split_technique.empty()) {
     if (!right) right = std::make_unique<render::Renderer>(*ctx, scene);
     b = render_side(*right, split_settings(), false);
   }
@@ -260,6 +265,9 @@ void Viewer::frame() {
   MSM_VK_CHECK(vkResetFences(ctx->device(), 1, &f));
   if (capture) write_screenshot(extent);
   ++frames;
+  if (truth.running())
+    frame_ms_during_truth.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   frame_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
 }
 
@@ -368,6 +376,60 @@ void Viewer::write_panel_mask(const std::string& path) {
     files.commit();
   } catch (const image::ImageError& e) { throw ViewerError(fmt::format("{}: {}", script_where, e.what())); }
   note(fmt::format("panel-mask: {} (panel {},{} to {},{})", path, x0, y0, x1, y1));
+}
+
+void Viewer::start_truth(int samples) {
+  if (truth.running()) return;
+  scene::Scene s = scene;
+  s.camera = *view.camera;
+  truth_camera = *view.camera;
+  size_t n = std::min<size_t>(frame_ms.size(), 10);
+  frame_ms_before_truth = 0;
+  for (size_t i = frame_ms.size() - n; i < frame_ms.size(); ++i) frame_ms_before_truth += frame_ms[i] / double(n);
+  frame_ms_during_truth.clear();
+  try {
+    truth.start(std::move(s), view.settings, samples);
+  } catch (const std::exception& e) {
+    error = e.what();
+    if (script) throw ViewerError(fmt::format("{}: {}", script_where, e.what()));
+    return;
+  }
+  note(fmt::format("ground truth: started ({} samples per pixel, {}x{})", samples, view.settings.width,
+                   view.settings.height));
+}
+
+// The technique's shadow buffer of the same view against the truth: metrics over the covered
+// pixels and the false-colour error image (msm/image/metrics.h), uploaded for the right side.
+void Viewer::finish_truth(const reference::Result& t) {
+  render::RenderSettings s = truth.settings();
+  left->set_camera(truth_camera);
+  render::RenderResult r = left->render(s);
+  image::Image background = t.visibility.channel("background");
+  image::MetricOptions options;
+  options.channel = "visibility";
+  options.mask = &background;
+  truth_metrics = image::compute_metrics(r.shadow, t.visibility, options);
+  truth_technique = s.technique;
+  image::Image error_rgb = image::error_image(r.shadow, t.visibility, 0.1, options);
+  std::vector<std::uint8_t> rgb = image::to_srgb8(error_rgb);
+  std::vector<std::uint8_t> rgba(error_rgb.pixel_count() * 4, 255);
+  for (size_t i = 0; i < error_rgb.pixel_count(); ++i)
+    for (size_t k = 0; k < 3; ++k) rgba[4 * i + k] = rgb[3 * i + k];
+  truth_image = vk::create_image(*ctx, {.width = uint32_t(s.width),
+                                        .height = uint32_t(s.height),
+                                        .format = VK_FORMAT_R8G8B8A8_SRGB,
+                                        .usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+  vk::upload_image(*ctx, truth_image, std::as_bytes(std::span(rgba)), VK_IMAGE_LAYOUT_UNDEFINED,
+                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+  show_truth = true;
+  double during = 0;
+  for (double ms : frame_ms_during_truth) during += ms / double(frame_ms_during_truth.size());
+  note(fmt::format("ground truth: {} against {} {} samples: MAE {:.5f}, light leaking {:.5f}, over-darkening {:.5f} "
+                   "({:.1f} s; frame {:.0f} ms before, {:.0f} ms while tracing, {} frames)",
+                   s.technique, t.samples,
+                   msm_technique_is_area_light(render::find_rendered_technique(s.technique).id) ? "soft" : "filtered",
+                   truth_metrics->mae, truth_metrics->light_leaking, truth_metrics->over_darkening, truth.seconds(),
+                   frame_ms_before_truth, during, frame_ms_during_truth.size()));
 }
 
 void Viewer::push_times(const render::Renderer::DeviceFrame& a) {

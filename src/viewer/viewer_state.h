@@ -2,6 +2,9 @@
 // (panel.cpp). Every change the panel makes goes through the same members a script action sets.
 #pragma once
 
+#include "ground_truth.h"
+
+#include "msm/image/metrics.h"
 #include "msm/render/renderer.h"
 #include "msm/viewer/viewer.h"
 #include "msm/vk/common.h"
@@ -49,6 +52,8 @@ struct Viewer {
   void write_panel_mask(const std::string& path);
   void push_times(const render::Renderer::DeviceFrame& a);
   void note(const std::string& text); // stdout and the panel's status line
+  void start_truth(int samples);
+  void finish_truth(const reference::Result& truth);
 
   // panel.cpp
   void panel();
@@ -102,6 +107,19 @@ struct Viewer {
   std::string view_path = "msm-view.json";
   std::string screenshot_path; // non-empty: captured this frame
   int screenshot_count = 0;
+
+  // The ray-traced ground truth of the view (on demand, in the background) and the technique's
+  // false-colour error against it, shown right of the divider.
+  GroundTruth truth;
+  int truth_samples = 16;
+  scene::Camera truth_camera;
+  bool show_truth = false;
+  vk::Image truth_image;
+  std::optional<image::Metrics> truth_metrics;
+  std::string truth_technique;
+  std::vector<double> frame_ms_during_truth;
+  double frame_ms_before_truth = 0;
+  bool wait_truth = false;
 
   std::optional<std::vector<Action>> script;
   size_t script_next = 0;

@@ -13,6 +13,9 @@
 //   save-view FILE            the current view (what `msm render --view FILE` renders)
 //   screenshot FILE           the window's contents, panel included, as PNG (atomic)
 //   panel-mask FILE           EXR, channel "outside": 1 outside the panel, 0 on it (for msm compare --mask)
+//   ground-truth N            start the ray-traced ground truth of the view, N samples per pixel (background)
+//   wait-ground-truth         wait for it: its MAE, and the error image right of the divider
+//   show-truth on|off         the error image right of the divider (instead of a split technique)
 //   resize W H                resize the window; the swapchain follows
 //   frames N                  let N frames pass
 //   close                     close the window as its close button does
