@@ -74,6 +74,40 @@ void Viewer::set_split(const std::string& name) {
   if (!split_technique.empty()) render::find_rendered_technique(split_technique);
 }
 
+void Viewer::set_scene(const std::string& name, bool keep_view) {
+  scene::Scene loaded = scene::load_scene(name);
+  MSM_VK_CHECK(vkDeviceWaitIdle(ctx->device()));
+  right.reset();
+  left.reset();
+  scene = std::move(loaded);
+  left = std::make_unique<render::Renderer>(*ctx, scene);
+  view.scene = name;
+  if (!keep_view) {
+    view.camera = scene.camera;
+    view.settings.lights.clear();
+  }
+  std::error_code ec;
+  scene_time.reset();
+  if (std::filesystem::is_regular_file(name, ec)) scene_time = std::filesystem::last_write_time(name, ec);
+  note(fmt::format("scene: {} ({} triangles)", name, scene.triangle_count()));
+}
+
+void Viewer::reload_if_changed() {
+  auto now = std::chrono::steady_clock::now();
+  if (!scene_time || now - scene_checked < std::chrono::seconds(1)) return;
+  scene_checked = now;
+  std::error_code ec;
+  auto time = std::filesystem::last_write_time(view.scene, ec);
+  if (ec || time == *scene_time) return;
+  try {
+    set_scene(view.scene, true);
+    error.clear();
+  } catch (const scene::SceneError& e) {
+    scene_time = time; // reported once; the next save is tried again
+    error = e.what();
+  }
+}
+
 void Viewer::save_view_file(const std::string& path) {
   save_view(path, view);
   note(fmt::format("view saved: {}", path));
@@ -154,6 +188,16 @@ void Viewer::panel() {
   ImGui::Text("%s, %d triangles, %dx%d", scene.name.c_str(), int(scene.triangle_count()), s.width, s.height);
   if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", error.c_str());
 
+  std::string scene_name = view.scene;
+  std::vector<std::string> scenes = scene::builtin_scene_names();
+  if (std::find(scenes.begin(), scenes.end(), scene_name) == scenes.end()) scenes.push_back(scene_name);
+  if (choose("scene", scene_name, scenes)) try {
+      set_scene(scene_name, false);
+    } catch (const scene::SceneError& e) { error = e.what(); }
+  ImGui::SameLine();
+  if (ImGui::Button("reload")) try {
+      set_scene(view.scene, true);
+    } catch (const scene::SceneError& e) { error = e.what(); }
   std::string technique = s.technique;
   if (choose("technique", technique, technique_names())) {
     set_technique(technique);
@@ -361,6 +405,10 @@ void Viewer::step_script() {
       wait_frames = long(number(x[0]));
     } else if (a.verb == "close") {
       glfwSetWindowShouldClose(window, GLFW_TRUE);
+    } else if (a.verb == "scene") {
+      set_scene(x[0], false);
+    } else if (a.verb == "reload") {
+      set_scene(view.scene, true);
     } else if (a.verb == "ground-truth") {
       start_truth(int(number(x[0])));
     } else if (a.verb == "wait-ground-truth") {
@@ -374,6 +422,8 @@ void Viewer::step_script() {
     } else if (a.verb == "quit") {
       quit = true;
     }
+  } catch (const scene::SceneError& e) {
+    throw ViewerError(fmt::format("{}: {}", a.where, e.what()));
   } catch (const ViewError& e) {
     throw ViewerError(fmt::format("{}: {}", a.where, e.what()));
   } catch (const render::RenderError& e) { throw ViewerError(fmt::format("{}: {}", a.where, e.what())); }

@@ -37,7 +37,9 @@ constexpr Verb kVerbs[] = {{"technique", 1, 1},
                            {"each-technique", 0, 0},
                            {"ground-truth", 1, 1},
                            {"wait-ground-truth", 0, 0},
-                           {"show-truth", 1, 1}};
+                           {"show-truth", 1, 1},
+                           {"scene", 1, 1},
+                           {"reload", 0, 0}};
 
 double parse_number(const std::string& where, const std::string& text) {
   double v = 0;

@@ -16,11 +16,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 
 namespace msm::viewer {
 namespace {
@@ -85,6 +87,8 @@ Viewer::~Viewer() {
 void Viewer::load() {
   scene = load_view_scene(view);
   if (!view.camera) view.camera = scene.camera;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(view.scene, ec)) scene_time = std::filesystem::last_write_time(view.scene, ec);
   good_settings = view.settings;
 }
 
@@ -450,14 +454,18 @@ void Viewer::run() {
     glfwPollEvents();
     if (script) step_script();
     if (quit) break;
+    reload_if_changed();
     frame();
   }
   if (ctx) MSM_VK_CHECK(vkDeviceWaitIdle(ctx->device()));
   if (script && frames > 0) {
     double sum = 0;
     for (double ms : frame_ms) sum += ms;
-    note(fmt::format("{} frames, {:.1f} ms per frame on average ({}x{}, {})", frames, sum / double(frame_ms.size()),
-                     view.settings.width, view.settings.height, ctx->info().name));
+    std::vector<double> sorted = frame_ms;
+    std::sort(sorted.begin(), sorted.end());
+    note(fmt::format("{} frames, {:.1f} ms per frame on average, median {:.1f} ms ({}x{}, {})", frames,
+                     sum / double(frame_ms.size()), sorted[sorted.size() / 2], view.settings.width,
+                     view.settings.height, ctx->info().name));
   }
 }
 

@@ -15,6 +15,7 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -64,12 +65,18 @@ struct Viewer {
   void set_split(const std::string& name); // empty: off
   void set_light_direction(glm::vec3 towards);
   void save_view_file(const std::string& path);
+  // Another scene (its camera and lights), or the same file again (the view kept); SceneError
+  // leaves everything as it was.
+  void set_scene(const std::string& name, bool keep_view);
+  void reload_if_changed(); // a scene file whose modification time changed
   void copy_command();
   glm::vec3 light_direction() const;
 
   View view;
   render::RenderSettings good_settings; // the last settings that rendered
   scene::Scene scene;
+  std::optional<std::filesystem::file_time_type> scene_time; // of a scene file
+  std::chrono::steady_clock::time_point scene_checked;
   std::string split_technique; // empty: no split screen
   float divider = 0.5f;
   bool dragging_divider = false;

@@ -5,6 +5,8 @@
 //   each-technique            every technique of the table in turn, one frame each
 //   set KEY VALUE             a render setting of the view file (view_file.h: setting_keys()); VALUE
 //                             is JSON (5, 0.1, true, [0,0,0,3e-5], null) or a bare word ("nearest")
+//   scene NAME|FILE           another scene (its camera and lights)
+//   reload                    the scene file again (the view kept)
 //   camera PX PY PZ TX TY TZ  camera position and target
 //   light X Y Z               direction towards the (first) light
 //   split NAME | off          split screen: this technique right of the divider
