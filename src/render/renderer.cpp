@@ -414,6 +414,11 @@ Renderer::DeviceFrame Renderer::render_on_device(const RenderSettings& s) {
   m.read_times(f.passes, nullptr);
   for (const PassTime& p : f.passes) f.total_ms += p.ms;
   f.color = &m.graph->image(kColor).image;
+  std::string moments0 = moment_image(0, 0);
+  if (m.graph->has_image(moments0) && m.config.formats()[0] != VK_FORMAT_R32_UINT) {
+    f.moments = &m.graph->image(moments0).image;
+    f.moments_layout = uint32_t(m.graph->layout_after_record(moments0));
+  }
   return f;
 }
 

@@ -283,6 +283,8 @@ void Viewer::panel() {
     }
   }
 
+  ImGui::Checkbox("moment map (first image, first light) in the corner", &show_map);
+
   if (ImGui::CollapsingHeader("GPU time", ImGuiTreeNodeFlags_DefaultOpen)) {
     double total = 0;
     for (const render::PassTime& p : passes) {
@@ -419,6 +421,8 @@ void Viewer::step_script() {
       if (!truth.error().empty()) throw ViewerError(fmt::format("{}: ground truth: {}", a.where, truth.error()));
     } else if (a.verb == "show-truth") {
       show_truth = x[0] == "on";
+    } else if (a.verb == "show-map") {
+      show_map = x[0] == "on";
     } else if (a.verb == "quit") {
       quit = true;
     }

@@ -39,7 +39,8 @@ constexpr Verb kVerbs[] = {{"technique", 1, 1},
                            {"wait-ground-truth", 0, 0},
                            {"show-truth", 1, 1},
                            {"scene", 1, 1},
-                           {"reload", 0, 0}};
+                           {"reload", 0, 0},
+                           {"show-map", 1, 1}};
 
 double parse_number(const std::string& where, const std::string& text) {
   double v = 0;
@@ -76,9 +77,9 @@ void check(const Action& a) {
     double v = parse_number(w, a.args[0]);
     if (v != std::floor(v) || v < 1 || v > 65536)
       throw ScriptError(fmt::format("{}: ground-truth {}: samples are an integer in [1, 65536]", w, a.args[0]));
-  } else if (a.verb == "show-truth") {
+  } else if (a.verb == "show-truth" || a.verb == "show-map") {
     if (a.args[0] != "on" && a.args[0] != "off")
-      throw ScriptError(fmt::format("{}: show-truth {}: on or off", w, a.args[0]));
+      throw ScriptError(fmt::format("{}: {} {}: on or off", w, a.verb, a.args[0]));
   } else if (a.verb == "frames") {
     double v = parse_number(w, a.args[0]);
     if (v != std::floor(v) || v < 0 || v > 100000)

@@ -307,6 +307,7 @@ void Viewer::record(uint32_t index, const render::Renderer::DeviceFrame& a, cons
   };
   blit(*a.color, 0, split_x);
   if (b.color) blit(*b.color, split_x, w);
+  if (show_map) blit_moments(a, target, extent);
 
   VkImageMemoryBarrier2 to_color = vk::image_barrier(
       target, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
@@ -342,6 +343,41 @@ void Viewer::record(uint32_t index, const render::Renderer::DeviceFrame& a, cons
   vk::pipeline_barrier(cmd, vk::image_barrier(target, VK_IMAGE_ASPECT_COLOR_BIT, last_stage, last_access, last,
                                               VK_PIPELINE_STAGE_2_NONE, 0, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR));
   MSM_VK_CHECK(vkEndCommandBuffer(cmd));
+}
+
+// The left technique's first moment image (mip 0 of the first light), as a picture in the bottom
+// right corner: transitioned for the blit and back to where the renderer left it.
+void Viewer::blit_moments(const render::Renderer::DeviceFrame& a, VkImage target, VkExtent2D extent) {
+  if (!a.moments) return;
+  auto layout = VkImageLayout(a.moments_layout);
+  VkFormatProperties props{};
+  vkGetPhysicalDeviceFormatProperties(ctx->physical_device(), a.moments->format(), &props);
+  if (layout == VK_IMAGE_LAYOUT_UNDEFINED || !(props.optimalTilingFeatures & VK_FORMAT_FEATURE_BLIT_SRC_BIT)) return;
+  VkImage image = a.moments->handle();
+  // The map's own transition, and the frame's blit before this one's writes over the same pixels.
+  VkImageMemoryBarrier2 barriers[] = {
+      vk::image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                        VK_ACCESS_2_MEMORY_WRITE_BIT, layout, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                        VK_ACCESS_2_TRANSFER_READ_BIT, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL),
+      vk::image_barrier(target, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                        VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                        VK_PIPELINE_STAGE_2_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL)};
+  vk::pipeline_barrier(cmd, {}, {}, barriers);
+  int32_t size = std::min<int32_t>(256, int32_t(std::min(extent.width, extent.height)) * 2 / 5);
+  int32_t x0 = int32_t(extent.width) - size - 8, y0 = int32_t(extent.height) - size - 40;
+  if (size > 16 && x0 >= 0 && y0 >= 0) {
+    int32_t sw = int32_t(a.moments->width()), sh = int32_t(a.moments->height());
+    VkImageBlit region{.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                       .srcOffsets = {{0, 0, 0}, {sw, sh, 1}},
+                       .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                       .dstOffsets = {{x0, y0, 0}, {x0 + size, y0 + size, 1}}};
+    vkCmdBlitImage(cmd, image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, target, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                   &region, VK_FILTER_LINEAR);
+  }
+  vk::pipeline_barrier(cmd, vk::image_barrier(image, VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_TRANSFER_BIT, 0,
+                                              VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                              VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, layout));
 }
 
 void Viewer::write_screenshot(VkExtent2D extent) {

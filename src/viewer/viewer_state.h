@@ -49,6 +49,7 @@ struct Viewer {
               bool capture);
   render::Renderer::DeviceFrame render_side(render::Renderer& r, render::RenderSettings s, bool is_left);
   render::RenderSettings split_settings() const;
+  void blit_moments(const render::Renderer::DeviceFrame& a, VkImage target, VkExtent2D extent);
   void write_screenshot(VkExtent2D extent);
   void write_panel_mask(const std::string& path);
   void push_times(const render::Renderer::DeviceFrame& a);
@@ -121,6 +122,7 @@ struct Viewer {
   int truth_samples = 16;
   scene::Camera truth_camera;
   bool show_truth = false;
+  bool show_map = false; // the left technique's moment image in a corner
   vk::Image truth_image;
   std::optional<image::Metrics> truth_metrics;
   std::string truth_technique;

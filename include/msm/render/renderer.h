@@ -203,6 +203,11 @@ class Renderer {
   // until the next frame or destruction) and the pass times. The same frame as render().
   struct DeviceFrame {
     const vk::Image* color = nullptr;
+    // The first moment image (all lights' layers, all mips; none for the depth-based and the
+    // packed 32-bit techniques) and the VkImageLayout it is left in (renderer.h includes no
+    // Vulkan header): to show the map, a viewer transitions it and back.
+    const vk::Image* moments = nullptr;
+    std::uint32_t moments_layout = 0;
     std::vector<PassTime> passes;
     double total_ms = 0;
   };

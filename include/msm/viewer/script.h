@@ -18,6 +18,7 @@
 //   ground-truth N            start the ray-traced ground truth of the view, N samples per pixel (background)
 //   wait-ground-truth         wait for it: its MAE, and the error image right of the divider
 //   show-truth on|off         the error image right of the divider (instead of a split technique)
+//   show-map on|off           the left technique's first moment image in the bottom right corner
 //   resize W H                resize the window; the swapchain follows
 //   frames N                  let N frames pass
 //   close                     close the window as its close button does
