@@ -423,7 +423,11 @@ Renderer::DeviceFrame Renderer::render_on_device(const RenderSettings& s) {
 }
 
 void Renderer::set_camera(const scene::Camera& camera) {
-  impl_->scene.camera = camera;
+  scene::Camera& c = impl_->scene.camera;
+  if (c.position == camera.position && c.target == camera.target && c.up == camera.up &&
+      c.fov_y_deg == camera.fov_y_deg && c.near == camera.near && c.far == camera.far)
+    return;
+  c = camera;
   impl_->frames.clear(); // the fitted light frusta depend on the camera
 }
 

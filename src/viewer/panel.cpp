@@ -307,6 +307,9 @@ void Viewer::panel() {
     }
     if (!truth.error().empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", truth.error().c_str());
     if (truth_metrics) {
+      const scene::Camera& c = *view.camera;
+      if (c.position != truth_camera.position || c.target != truth_camera.target)
+        ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "of an earlier view (the camera moved)");
       ImGui::Text("%s: MAE %.4f", truth_technique.c_str(), truth_metrics->mae);
       ImGui::Text("leaking %.4f, over-darkening %.4f", truth_metrics->light_leaking, truth_metrics->over_darkening);
       ImGui::Checkbox("error image right of the divider", &show_truth);
