@@ -7,7 +7,13 @@
 
 namespace msm::viewer {
 
+namespace {
+// Thrown from the progress callback to stop the tracer (TBB cancels the loop and rethrows it).
+struct Cancelled {};
+} // namespace
+
 GroundTruth::~GroundTruth() {
+  cancel_ = true;
   if (worker_.joinable()) worker_.join();
 }
 
@@ -32,6 +38,7 @@ void GroundTruth::start(scene::Scene scene, const render::RenderSettings& s, int
   // One thread: the device (lavapipe: the CPU) keeps the others, the frame time stays close.
   rs.threads = 1;
   rs.progress = [this](const reference::Progress& p) {
+    if (cancel_) throw Cancelled{};
     rows_total_ = std::max<std::size_t>(p.rows_total, 1);
     rows_done_ = p.rows_done;
   };
@@ -45,7 +52,9 @@ void GroundTruth::start(scene::Scene scene, const render::RenderSettings& s, int
     std::string error;
     try {
       r = reference::render(scene, rs);
-    } catch (const std::exception& e) { error = e.what(); }
+    } catch (const std::exception& e) { error = e.what(); } catch (const Cancelled&) {
+      error = "cancelled";
+    }
     std::lock_guard lock(mutex_);
     result_ = std::move(r);
     error_ = error;

@@ -17,7 +17,7 @@ namespace msm::viewer {
 class GroundTruth {
  public:
   GroundTruth() = default;
-  ~GroundTruth(); // waits for a running computation (the tracer cannot be interrupted)
+  ~GroundTruth(); // cancels a running computation (at its next progress report) and waits for it
   GroundTruth(const GroundTruth&) = delete;
   GroundTruth& operator=(const GroundTruth&) = delete;
 
@@ -34,7 +34,7 @@ class GroundTruth {
 
  private:
   std::thread worker_;
-  std::atomic<bool> running_{false};
+  std::atomic<bool> running_{false}, cancel_{false};
   std::atomic<std::size_t> rows_done_{0}, rows_total_{1};
   std::mutex mutex_;
   std::optional<reference::Result> result_;
