@@ -189,9 +189,13 @@ render::Renderer::DeviceFrame Viewer::render_side(render::Renderer& r, render::R
   } catch (const render::RenderError& e) {
     error = e.what();
     if (script) throw ViewerError(fmt::format("{}: {}", script_where, e.what()));
-    if (is_left) view.settings = good_settings;
-    s = is_left ? view.settings : split_settings();
-    return r.render_on_device(s);
+    if (!is_left) { // settings the left technique takes but the right one refuses: no split
+      error = fmt::format("{} (split screen off)", e.what());
+      split_technique.clear();
+      return {};
+    }
+    view.settings = good_settings;
+    return r.render_on_device(view.settings);
   }
 }
 
