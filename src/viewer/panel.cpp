@@ -154,6 +154,14 @@ void Viewer::fly(float dt) {
       c.target += step;
     }
   }
+  if (!io.WantCaptureMouse && ImGui::IsMouseDragging(ImGuiMouseButton_Middle, 0.0f)) {
+    // The light turns with the mouse: azimuth across, elevation up and down (kept above the horizon).
+    glm::vec3 t = light_direction();
+    float azimuth = std::atan2(t.z, t.x) + io.MouseDelta.x * 0.01f;
+    float elevation = std::clamp(std::asin(std::clamp(t.y, -1.0f, 1.0f)) - io.MouseDelta.y * 0.01f, 0.02f, 1.5707f);
+    set_light_direction(
+        {std::cos(elevation) * std::cos(azimuth), std::sin(elevation), std::cos(elevation) * std::sin(azimuth)});
+  }
   if (animate_light) {
     glm::vec3 t = light_direction();
     float a = glm::radians(light_speed_deg) * dt;
@@ -276,7 +284,8 @@ void Viewer::panel() {
     ImGui::SameLine();
     ImGui::SliderFloat("deg/s", &light_speed_deg, -90.0f, 90.0f);
     ImGui::SliderFloat("fly speed", &fly_speed, 0.05f, 50.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
-    ImGui::TextDisabled("WASD/QE move, right drag looks, wheel: speed");
+    ImGui::TextDisabled("WASD/QE move, right drag looks, wheel: speed;");
+    ImGui::TextDisabled("middle drag turns the light");
     if (ImGui::Button("reset camera and light")) {
       view.camera = scene.camera;
       view.settings.lights.clear();
