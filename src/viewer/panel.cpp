@@ -292,7 +292,7 @@ void Viewer::panel() {
     }
   }
 
-  ImGui::Checkbox("moment map (first image, first light) in the corner", &show_map);
+  ImGui::Checkbox("moment map in the corner", &show_map);
 
   if (ImGui::CollapsingHeader("GPU time", ImGuiTreeNodeFlags_DefaultOpen)) {
     double total = 0;
