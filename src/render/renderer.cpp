@@ -138,6 +138,7 @@ struct Renderer::Impl {
   const scene::LightFrame& light_frame(const scene::DirectionalLight& light) {
     for (const auto& [towards, frame] : frames)
       if (towards == light.towards_light) return frame;
+    if (frames.size() >= 64) frames.clear();                            // a light dragged around in a viewer
     frames.emplace_back(light.towards_light, scene.light_frame(light)); // depends on the direction only
     return frames.back().second;
   }
@@ -404,6 +405,31 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
       for (size_t k = 0; k < 3; ++k) r.shadow_rgb.pixels()[3 * i + k] = px[k];
   }
   return r;
+}
+
+Renderer::DeviceFrame Renderer::render_on_device(const RenderSettings& s) {
+  Impl& m = *impl_;
+  m.prepare(s);
+  vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd); });
+  DeviceFrame f;
+  m.read_times(f.passes, nullptr);
+  for (const PassTime& p : f.passes) f.total_ms += p.ms;
+  f.color = &m.graph->image(kColor).image;
+  std::string moments0 = moment_image(0, 0);
+  if (m.graph->has_image(moments0) && m.config.formats()[0] != VK_FORMAT_R32_UINT) {
+    f.moments = &m.graph->image(moments0).image;
+    f.moments_layout = uint32_t(m.graph->layout_after_record(moments0));
+  }
+  return f;
+}
+
+void Renderer::set_camera(const scene::Camera& camera) {
+  scene::Camera& c = impl_->scene.camera;
+  if (c.position == camera.position && c.target == camera.target && c.up == camera.up &&
+      c.fov_y_deg == camera.fov_y_deg && c.near == camera.near && c.far == camera.far)
+    return;
+  c = camera;
+  impl_->frames.clear(); // the fitted light frusta depend on the camera
 }
 
 std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {

@@ -343,6 +343,12 @@ Context::Context(const ContextOptions& options) {
       }
     }
 
+    for (const std::string& name : options.instance_extensions) {
+      if (!contains(instance_extensions(nullptr), name.c_str()))
+        throw std::runtime_error(fmt::format("msm::vk: the Vulkan instance lacks extension {}", name));
+      extensions.push_back(name.c_str());
+    }
+
     // The messenger is also chained into VkInstanceCreateInfo so that vkCreateInstance and
     // vkDestroyInstance are covered; it keeps a pointer to *log_, which outlives the instance.
     VkDebugUtilsMessengerCreateInfoEXT messenger_info{
@@ -418,13 +424,25 @@ Context::Context(const ContextOptions& options) {
                                        .queueFamilyIndex = queue_family_,
                                        .queueCount = 1,
                                        .pQueuePriorities = &priority};
-    const char* device_extensions[] = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    std::vector<const char*> device_extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+    if (!options.device_extensions.empty()) {
+      uint32_t ext_count = 0;
+      vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &ext_count, nullptr);
+      std::vector<VkExtensionProperties> available(ext_count);
+      vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &ext_count, available.data());
+      available.resize(ext_count);
+      for (const std::string& name : options.device_extensions) {
+        if (!contains(available, name.c_str()))
+          throw std::runtime_error(fmt::format("msm::vk: {} lacks extension {}", info_.name, name));
+        device_extensions.push_back(name.c_str());
+      }
+    }
     VkDeviceCreateInfo device_info{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
                                    .pNext = &features2,
                                    .queueCreateInfoCount = 1,
                                    .pQueueCreateInfos = &queue_info,
-                                   .enabledExtensionCount = 1,
-                                   .ppEnabledExtensionNames = device_extensions};
+                                   .enabledExtensionCount = uint32_t(device_extensions.size()),
+                                   .ppEnabledExtensionNames = device_extensions.data()};
     MSM_VK_CHECK(vkCreateDevice(physical_device_, &device_info, nullptr, &device_));
     vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 

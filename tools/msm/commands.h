@@ -15,6 +15,7 @@ void add_probe(CLI::App& app);
 void add_reference(CLI::App& app);
 void add_render(CLI::App& app);
 void add_scenes(CLI::App& app);
+void add_view(CLI::App& app);
 
 // Thrown by commands for bad input: main prints the message and exits with status 2.
 struct UsageError : std::runtime_error {

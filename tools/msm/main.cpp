@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   msm::tool::add_bench(app);
   msm::tool::add_render(app);
   msm::tool::add_scenes(app);
+  msm::tool::add_view(app);
 #endif
   msm::tool::add_probe(app);
   msm::tool::add_reference(app);

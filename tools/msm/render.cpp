@@ -1,10 +1,13 @@
 // `msm render`: one or more techniques on one scene; `msm scenes`: the built-in scenes.
 #include "render_common.h"
 
+#include "msm/viewer/view_file.h"
+
 #include <fmt/core.h>
 
 #include <chrono>
 #include <cstdio>
+#include <optional>
 
 namespace msm::tool {
 namespace {
@@ -28,6 +31,7 @@ void add_render(CLI::App& app) {
     FrameOptions frame;
     std::string techniques = "msm-hamburger-64";
     std::string out = "msm-render";
+    std::string view; // a view file (msm view)
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
@@ -36,9 +40,29 @@ void add_render(CLI::App& app) {
                   "Technique or alias, comma-separated list, or 'all' (msm techniques lists them)")
       ->capture_default_str();
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
+  cmd->add_option("--view", opt->view,
+                  "A view file of msm view (scene, camera, lights, every setting): renders exactly that view; only "
+                  "-t, -o and --device go with it");
   add_frame_options(cmd, opt->frame);
-  cmd->callback([opt] {
-    finish_frame_options(opt->frame);
+  cmd->callback([opt, cmd] {
+    std::optional<scene::Camera> view_camera;
+    if (!opt->view.empty()) {
+      for (const CLI::Option* o : cmd->get_options()) {
+        const std::vector<std::string>& long_names = o->get_lnames();
+        std::string name = long_names.empty() ? o->get_name() : long_names.front();
+        if (o->count() > 0 && name != "view" && name != "out" && name != "technique" && name != "device")
+          throw UsageError(fmt::format("--view sets the scene and every setting; --{} cannot go with it", name));
+      }
+      try {
+        viewer::View view = viewer::load_view(opt->view);
+        opt->frame.settings = view.settings;
+        opt->frame.scene = view.scene;
+        view_camera = view.camera;
+        if (cmd->count("--technique") == 0) opt->techniques = view.settings.technique;
+      } catch (const viewer::ViewError& e) { throw UsageError(e.what()); }
+    } else {
+      finish_frame_options(opt->frame);
+    }
     std::vector<std::string> names;
     if (opt->techniques == "all")
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
@@ -47,6 +71,7 @@ void add_render(CLI::App& app) {
     if (names.empty()) throw UsageError("--technique: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    if (view_camera) scene.camera = *view_camera;
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);

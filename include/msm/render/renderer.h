@@ -38,7 +38,8 @@
 
 namespace msm::vk {
 class Context;
-}
+class Image;
+} // namespace msm::vk
 
 namespace msm::render {
 
@@ -196,6 +197,24 @@ class Renderer {
 
   // One frame, submitted and waited for, images read back.
   RenderResult render(const RenderSettings& settings, Intermediates* intermediates = nullptr);
+
+  // One frame, submitted and waited for, nothing read back (an interactive viewer blits it): the
+  // colour target (R8G8B8A8_SRGB, settings.width x height, left in TRANSFER_SRC_OPTIMAL, valid
+  // until the next frame or destruction) and the pass times. The same frame as render().
+  struct DeviceFrame {
+    const vk::Image* color = nullptr;
+    // The first moment image (all lights' layers, all mips; none for the depth-based and the
+    // packed 32-bit techniques) and the VkImageLayout it is left in (renderer.h includes no
+    // Vulkan header): to show the map, a viewer transitions it and back.
+    const vk::Image* moments = nullptr;
+    std::uint32_t moments_layout = 0;
+    std::vector<PassTime> passes;
+    double total_ms = 0;
+  };
+  DeviceFrame render_on_device(const RenderSettings& settings);
+
+  // Moves the camera of later frames (the shadow maps' "fit" framing follows it).
+  void set_camera(const scene::Camera& camera);
 
   // `frames` frames with the same settings, nothing read back: the per-pass times of each (for
   // msm bench). Precondition: frames >= 1.

@@ -59,6 +59,10 @@ struct ContextOptions {
   enum class FmaMode { probe, emulated, native };
   FmaMode fma_mode = FmaMode::probe;
   std::string application_name = "msm";
+  // Extra extensions to enable, e.g. a window system's surface extensions (instance) and
+  // VK_KHR_swapchain (device) for a viewer; a missing one fails the creation, naming it.
+  std::vector<std::string> instance_extensions;
+  std::vector<std::string> device_extensions;
 };
 
 struct DeviceInfo {

@@ -1,0 +1,448 @@
+// The viewer's panel, camera fly and script actions: each control and each action calls the same
+// setter, so a script exercises what the panel does.
+#include "viewer_state.h"
+
+#include "msm/techniques.h"
+#include "msm/vk/context.h"
+#include "msm/vk/swapchain.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+
+namespace msm::viewer {
+namespace {
+
+double number(const std::string& text) {
+  double v = 0;
+  std::from_chars(text.data(), text.data() + text.size(), v); // checked by parse_script
+  return v;
+}
+
+// A combo over string choices; true when the selection changed.
+bool choose(const char* label, std::string& value, const std::vector<std::string>& choices) {
+  bool changed = false;
+  if (ImGui::BeginCombo(label, value.c_str())) {
+    for (const std::string& c : choices) {
+      bool selected = c == value;
+      if (ImGui::Selectable(c.c_str(), selected) && !selected) {
+        value = c;
+        changed = true;
+      }
+      if (selected) ImGui::SetItemDefaultFocus();
+    }
+    ImGui::EndCombo();
+  }
+  return changed;
+}
+
+std::vector<std::string> technique_names() {
+  std::vector<std::string> out;
+  for (const Technique* t : render::rendered_techniques()) out.emplace_back(t->name);
+  return out;
+}
+
+// A setting through the view file's setter (the one `set KEY VALUE` uses).
+void set(render::RenderSettings& s, const char* key, const nlohmann::json& value) { apply_setting(s, key, value); }
+
+} // namespace
+
+glm::vec3 Viewer::light_direction() const {
+  return (view.settings.lights.empty() ? scene.lights : view.settings.lights).front().towards_light;
+}
+
+void Viewer::set_light_direction(glm::vec3 towards) {
+  if (view.settings.lights.empty()) view.settings.lights = scene.lights;
+  view.settings.lights.front().towards_light = glm::normalize(towards);
+}
+
+void Viewer::set_technique(const std::string& name) {
+  std::string canonical(canonical_technique_name(name));
+  if (canonical == view.settings.technique) return;
+  set(view.settings, "technique", canonical);
+  view.settings.params.reset(); // another technique's parameters mean something else
+}
+
+void Viewer::set_split(const std::string& name) {
+  split_technique = name.empty() ? "" : std::string(canonical_technique_name(name));
+  if (!split_technique.empty()) render::find_rendered_technique(split_technique);
+}
+
+void Viewer::set_scene(const std::string& name, bool keep_view) {
+  scene::Scene loaded = scene::load_scene(name);
+  MSM_VK_CHECK(vkDeviceWaitIdle(ctx->device()));
+  right.reset();
+  left.reset();
+  scene = std::move(loaded);
+  left = std::make_unique<render::Renderer>(*ctx, scene);
+  view.scene = name;
+  if (!keep_view) {
+    view.camera = scene.camera;
+    view.settings.lights.clear();
+  }
+  std::error_code ec;
+  scene_time.reset();
+  if (std::filesystem::is_regular_file(name, ec)) scene_time = std::filesystem::last_write_time(name, ec);
+  note(fmt::format("scene: {} ({} triangles)", name, scene.triangle_count()));
+}
+
+void Viewer::reload_if_changed() {
+  auto now = std::chrono::steady_clock::now();
+  if (!scene_time || now - scene_checked < std::chrono::seconds(1)) return;
+  scene_checked = now;
+  std::error_code ec;
+  auto time = std::filesystem::last_write_time(view.scene, ec);
+  if (ec || time == *scene_time) return;
+  try {
+    set_scene(view.scene, true);
+    error.clear();
+  } catch (const scene::SceneError& e) {
+    scene_time = time; // reported once; the next save is tried again
+    error = e.what();
+  }
+}
+
+void Viewer::save_view_file(const std::string& path) {
+  save_view(path, view);
+  note(fmt::format("view saved: {}", path));
+}
+
+void Viewer::copy_command() {
+  save_view_file(view_path);
+  std::string command = render_command(view_path);
+  glfwSetClipboardString(window, command.c_str());
+  note(command);
+}
+
+void Viewer::fly(float dt) {
+  ImGuiIO& io = ImGui::GetIO();
+  scene::Camera& c = *view.camera;
+  glm::vec3 up = glm::normalize(c.up);
+  glm::vec3 forward = c.target - c.position;
+  float distance = glm::length(forward);
+  forward /= distance;
+  glm::vec3 right = glm::normalize(glm::cross(forward, up));
+  if (!io.WantCaptureMouse && ImGui::IsMouseDragging(ImGuiMouseButton_Right, 0.0f)) {
+    ImVec2 d = io.MouseDelta;
+    float yaw = -d.x * 0.005f, pitch = -d.y * 0.005f;
+    float elevation = std::asin(std::clamp(glm::dot(forward, up), -1.0f, 1.0f));
+    pitch = std::clamp(elevation + pitch, -1.5f, 1.5f) - elevation;
+    forward = std::cos(yaw) * forward + std::sin(yaw) * glm::cross(up, forward) +
+              (1.0f - std::cos(yaw)) * glm::dot(up, forward) * up;
+    right = glm::normalize(glm::cross(forward, up));
+    forward = std::cos(pitch) * forward + std::sin(pitch) * glm::cross(right, forward);
+    c.target = c.position + distance * glm::normalize(forward);
+  }
+  if (!io.WantCaptureKeyboard) {
+    glm::vec3 move(0.0f);
+    if (ImGui::IsKeyDown(GLFW_KEY_W)) move += forward;
+    if (ImGui::IsKeyDown(GLFW_KEY_S)) move -= forward;
+    if (ImGui::IsKeyDown(GLFW_KEY_D)) move += right;
+    if (ImGui::IsKeyDown(GLFW_KEY_A)) move -= right;
+    if (ImGui::IsKeyDown(GLFW_KEY_E)) move += up;
+    if (ImGui::IsKeyDown(GLFW_KEY_Q)) move -= up;
+    if (glm::length(move) > 0) {
+      float speed = fly_speed * (io.KeyShift ? 4.0f : 1.0f);
+      glm::vec3 step = glm::normalize(move) * speed * dt;
+      c.position += step;
+      c.target += step;
+    }
+  }
+  if (!io.WantCaptureMouse && ImGui::IsMouseDragging(ImGuiMouseButton_Middle, 0.0f)) {
+    // The light turns with the mouse: azimuth across, elevation up and down (kept above the horizon).
+    glm::vec3 t = light_direction();
+    float azimuth = std::atan2(t.z, t.x) + io.MouseDelta.x * 0.01f;
+    float elevation = std::clamp(std::asin(std::clamp(t.y, -1.0f, 1.0f)) - io.MouseDelta.y * 0.01f, 0.02f, 1.5707f);
+    set_light_direction(
+        {std::cos(elevation) * std::cos(azimuth), std::sin(elevation), std::cos(elevation) * std::sin(azimuth)});
+  }
+  if (animate_light) {
+    glm::vec3 t = light_direction();
+    float a = glm::radians(light_speed_deg) * dt;
+    set_light_direction({std::cos(a) * t.x - std::sin(a) * t.z, t.y, std::sin(a) * t.x + std::cos(a) * t.z});
+  }
+  // The split-screen divider: dragged outside the panel.
+  if (!split_technique.empty() || (show_truth && truth_image)) {
+    const char* right_name = show_truth && truth_image ? "error against the ground truth" : split_technique.c_str();
+    float w = io.DisplaySize.x, x = divider * w;
+    bool near = std::abs(io.MousePos.x - x) < 6.0f && !io.WantCaptureMouse;
+    if (near && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) dragging_divider = true;
+    if (!ImGui::IsMouseDown(ImGuiMouseButton_Left)) dragging_divider = false;
+    if (dragging_divider) divider = std::clamp(io.MousePos.x / w, 0.02f, 0.98f);
+    ImDrawList* draw = ImGui::GetBackgroundDrawList();
+    ImU32 colour = near || dragging_divider ? IM_COL32(255, 255, 255, 255) : IM_COL32(200, 200, 200, 200);
+    draw->AddLine(ImVec2(x, 0), ImVec2(x, io.DisplaySize.y), colour, 2.0f);
+    draw->AddText(ImVec2(x - 8 - ImGui::CalcTextSize(view.settings.technique.c_str()).x, io.DisplaySize.y - 24),
+                  IM_COL32_WHITE, view.settings.technique.c_str());
+    draw->AddText(ImVec2(x + 8, io.DisplaySize.y - 24), IM_COL32_WHITE, right_name);
+  }
+}
+
+void Viewer::panel() {
+  ImGuiIO& io = ImGui::GetIO();
+  ImGui::SetNextWindowPos(ImVec2(0, 0));
+  ImGui::SetNextWindowSize(ImVec2(std::min(kPanelWidth, io.DisplaySize.x), io.DisplaySize.y));
+  ImGui::SetNextWindowBgAlpha(0.85f);
+  ImGui::Begin("msm view", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  panel_min = ImGui::GetWindowPos();
+  panel_max = ImVec2(panel_min.x + ImGui::GetWindowSize().x, panel_min.y + ImGui::GetWindowSize().y);
+  render::RenderSettings& s = view.settings;
+  ImGui::Text("%s, %d triangles, %dx%d", scene.name.c_str(), int(scene.triangle_count()), s.width, s.height);
+  if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", error.c_str());
+
+  std::string scene_name = view.scene;
+  std::vector<std::string> scenes = scene::builtin_scene_names();
+  if (std::find(scenes.begin(), scenes.end(), scene_name) == scenes.end()) scenes.push_back(scene_name);
+  if (choose("scene", scene_name, scenes)) try {
+      set_scene(scene_name, false);
+    } catch (const scene::SceneError& e) { error = e.what(); }
+  ImGui::SameLine();
+  if (ImGui::Button("reload")) try {
+      set_scene(view.scene, true);
+    } catch (const scene::SceneError& e) { error = e.what(); }
+  std::string technique = s.technique;
+  if (choose("technique", technique, technique_names())) {
+    set_technique(technique);
+    error.clear();
+  }
+  bool split = !split_technique.empty();
+  if (ImGui::Checkbox("split screen", &split)) set_split(split ? "pcf" : "");
+  if (split) {
+    std::string other = split_technique;
+    if (choose("right side", other, technique_names())) set_split(other);
+    ImGui::SliderFloat("divider", &divider, 0.02f, 0.98f);
+  }
+
+  if (ImGui::CollapsingHeader("Technique settings", ImGuiTreeNodeFlags_DefaultOpen)) {
+    const Technique& t = render::find_rendered_technique(s.technique);
+    bool defaults = !s.params;
+    if (ImGui::Checkbox("papers' parameters", &defaults)) {
+      if (defaults)
+        s.params.reset();
+      else
+        s.params = t.default_params();
+    }
+    if (s.params) {
+      ImGui::InputFloat4("params", &s.params->x, "%.3g");
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%.*s", int(t.parameters.size()), t.parameters.data());
+    } else if (!t.parameters.empty()) {
+      ImGui::TextWrapped("%.*s", int(t.parameters.size()), t.parameters.data());
+    }
+    bool own_bias = s.depth_bias.has_value();
+    if (ImGui::Checkbox("depth bias", &own_bias)) {
+      if (own_bias)
+        s.depth_bias = s.resolved_depth_bias();
+      else
+        s.depth_bias.reset();
+    }
+    if (s.depth_bias) {
+      ImGui::SameLine();
+      ImGui::DragFloat("##depth_bias", &*s.depth_bias, 1e-6f, 0.0f, 0.05f, "%.2e");
+    }
+    int taps = s.filter_size;
+    if (ImGui::SliderInt("kernel taps", &taps, 1, 63)) s.filter_size = taps | 1;
+    ImGui::SliderFloat("sigma", &s.filter_sigma, 0.1f, 16.0f);
+    std::string size = std::to_string(s.shadow_size);
+    if (choose("shadow map", size, {"256", "512", "1024", "2048", "4096"})) s.shadow_size = std::stoi(size);
+    std::string msaa = std::to_string(s.msaa);
+    if (choose("MSAA", msaa, {"1", "4", "8"})) s.msaa = std::stoi(msaa);
+    ImGui::Checkbox("mipmaps", &s.mipmaps);
+    std::string mode = setting_json(s, "filter_mode").get<std::string>();
+    if (choose("filter", mode, {"auto", "one-pass", "three-pass"})) set(s, "filter_mode", mode);
+    std::string lookup = setting_json(s, "lookup").get<std::string>();
+    if (choose("lookup", lookup, {"auto", "bilinear", "nearest", "dither"})) set(s, "lookup", lookup);
+    if (msm_technique_is_soft(t.id) || msm_technique_is_area_light(t.id)) {
+      ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.id == MSM_TECH_PCSS ? render::kMaxPcssKernel : 255);
+      float extent = s.light_extent_deg.value_or(scene.light().angular_extent_deg);
+      if (ImGui::SliderFloat("light extent (deg)", &extent, 0.0f, 20.0f)) s.light_extent_deg = extent;
+    }
+    ImGui::Checkbox("translucent occluders", &s.translucent_occluders);
+    ImGui::Checkbox("coloured translucency", &s.coloured_translucency);
+    ImGui::SliderFloat("alpha threshold", &s.translucent_alpha_threshold, 0.0f, 0.5f);
+    ImGui::SliderFloat("over-darkening", &s.overdarken, 0.5f, 1.0f);
+    ImGui::SliderFloat("normal offset", &s.normal_offset, 0.0f, 4.0f);
+    ImGui::SliderFloat("receiver-plane bias", &s.receiver_plane_bias, 0.0f, 4.0f);
+    ImGui::SliderFloat("exposure", &s.exposure, 0.1f, 4.0f);
+  }
+
+  if (ImGui::CollapsingHeader("Light and camera")) {
+    glm::vec3 t = light_direction();
+    float azimuth = glm::degrees(std::atan2(t.z, t.x)), elevation = glm::degrees(std::asin(std::clamp(t.y, -1.f, 1.f)));
+    bool a = ImGui::SliderFloat("light azimuth", &azimuth, -180.0f, 180.0f);
+    bool e = ImGui::SliderFloat("light elevation", &elevation, 1.0f, 90.0f);
+    if (a || e) {
+      float az = glm::radians(azimuth), el = glm::radians(elevation);
+      set_light_direction({std::cos(el) * std::cos(az), std::sin(el), std::cos(el) * std::sin(az)});
+    }
+    ImGui::Checkbox("animate light", &animate_light);
+    ImGui::SameLine();
+    ImGui::SliderFloat("deg/s", &light_speed_deg, -90.0f, 90.0f);
+    ImGui::SliderFloat("fly speed", &fly_speed, 0.05f, 50.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+    ImGui::TextDisabled("WASD/QE move, right drag looks, wheel: speed;");
+    ImGui::TextDisabled("middle drag turns the light");
+    if (ImGui::Button("reset camera and light")) {
+      view.camera = scene.camera;
+      view.settings.lights.clear();
+    }
+  }
+
+  ImGui::Checkbox("moment map in the corner", &show_map);
+
+  if (ImGui::CollapsingHeader("GPU time", ImGuiTreeNodeFlags_DefaultOpen)) {
+    double total = 0;
+    for (const render::PassTime& p : passes) {
+      ImGui::Text("%-16s %8.3f ms", p.name.c_str(), p.ms);
+      total += p.ms;
+    }
+    ImGui::Text("%-16s %8.3f ms", "total", total);
+    float top = *std::max_element(gpu_history.begin(), gpu_history.end());
+    ImGui::PlotLines("##history", gpu_history.data(), int(gpu_history.size()), int(history_next), nullptr, 0.0f,
+                     top * 1.1f + 1e-3f, ImVec2(0, 50));
+    if (!frame_ms.empty()) ImGui::Text("frame %.1f ms (wall)", frame_ms.back());
+  }
+
+  if (ImGui::CollapsingHeader("Ground truth", ImGuiTreeNodeFlags_DefaultOpen)) {
+    ImGui::SliderInt("samples", &truth_samples, 1, 256, "%d", ImGuiSliderFlags_Logarithmic);
+    if (truth.running()) {
+      ImGui::ProgressBar(truth.progress(), ImVec2(-1, 0));
+    } else if (ImGui::Button("ray trace this view")) {
+      start_truth(truth_samples);
+    }
+    if (!truth.error().empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", truth.error().c_str());
+    if (truth_metrics) {
+      const scene::Camera& c = *view.camera;
+      if (c.position != truth_camera.position || c.target != truth_camera.target)
+        ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "of an earlier view (the camera moved)");
+      ImGui::Text("%s: MAE %.4f", truth_technique.c_str(), truth_metrics->mae);
+      ImGui::Text("leaking %.4f, over-darkening %.4f", truth_metrics->light_leaking, truth_metrics->over_darkening);
+      ImGui::Checkbox("error image right of the divider", &show_truth);
+      if (show_truth) ImGui::TextDisabled("red: too bright (leaking), blue: too dark");
+    }
+  }
+
+  if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (ImGui::Button("screenshot")) screenshot_path = fmt::format("msm-view-{}.png", ++screenshot_count);
+    char path[512];
+    std::snprintf(path, sizeof path, "%s", view_path.c_str());
+    if (ImGui::InputText("view file", path, sizeof path)) view_path = path;
+    if (ImGui::Button("save view")) try {
+        save_view_file(view_path);
+      } catch (const ViewError& e) { error = e.what(); }
+    ImGui::SameLine();
+    if (ImGui::Button("load view")) try {
+        View loaded = load_view(view_path);
+        if (loaded.camera) view.camera = loaded.camera;
+        view.settings = loaded.settings;
+      } catch (const ViewError& e) { error = e.what(); }
+    ImGui::SameLine();
+    if (ImGui::Button("copy the command")) try {
+        copy_command();
+      } catch (const ViewError& e) { error = e.what(); }
+  }
+  if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
+  ImGui::End();
+}
+
+void Viewer::step_script() {
+  if (wait_frames > 0) {
+    --wait_frames;
+    return;
+  }
+  if (pending_resize) {
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window, &w, &h);
+    VkExtent2D e = swapchain->extent();
+    if (w == pending_resize->first && h == pending_resize->second && int(e.width) == w && int(e.height) == h) {
+      note(fmt::format("resize: {}x{}, swapchain recreated (generation {})", w, h, swapchain->generation()));
+      pending_resize.reset();
+    } else if (++resize_tries > 300) {
+      throw ViewerError(
+          fmt::format("{}: the window stayed {}x{} (swapchain {}x{})", script_where, w, h, e.width, e.height));
+    }
+    return;
+  }
+  if (script_next >= script->size()) return; // done: the window stays for the user
+  const Action& a = (*script)[script_next++];
+  script_where = a.where;
+  const std::vector<std::string>& x = a.args;
+  try {
+    if (a.verb == "technique") {
+      set_technique(x[0]);
+      note(fmt::format("technique: {}", view.settings.technique));
+    } else if (a.verb == "each-technique") {
+      // One frame of each, in the table's order (each action runs before a frame).
+      for (const std::string& name : technique_names())
+        script->insert(script->begin() + std::ptrdiff_t(script_next), Action{"technique", {name}, a.line, a.where});
+    } else if (a.verb == "set") {
+      apply_setting(view.settings, x[0], setting_value(x[1]));
+      note(fmt::format("set {} = {}", x[0], setting_json(view.settings, x[0]).dump()));
+    } else if (a.verb == "camera") {
+      view.camera->position = glm::vec3(number(x[0]), number(x[1]), number(x[2]));
+      view.camera->target = glm::vec3(number(x[3]), number(x[4]), number(x[5]));
+    } else if (a.verb == "light") {
+      set_light_direction(glm::vec3(number(x[0]), number(x[1]), number(x[2])));
+    } else if (a.verb == "split") {
+      set_split(x[0] == "off" ? "" : x[0]);
+    } else if (a.verb == "divider") {
+      divider = float(number(x[0]));
+    } else if (a.verb == "load-view") {
+      View loaded = load_view(x[0]);
+      if (loaded.scene != view.scene)
+        throw ViewerError(
+            fmt::format("{}: {} shows scene '{}', the viewer '{}'", a.where, x[0], loaded.scene, view.scene));
+      if (loaded.camera) view.camera = loaded.camera;
+      view.settings = loaded.settings;
+      if (loaded.settings.width != int(swapchain->extent().width) ||
+          loaded.settings.height != int(swapchain->extent().height)) {
+        glfwSetWindowSize(window, loaded.settings.width, loaded.settings.height);
+        pending_resize = {loaded.settings.width, loaded.settings.height};
+        resize_tries = 0;
+      }
+    } else if (a.verb == "save-view") {
+      save_view_file(x[0]);
+    } else if (a.verb == "screenshot") {
+      screenshot_path = x[0];
+    } else if (a.verb == "panel-mask") {
+      write_panel_mask(x[0]);
+    } else if (a.verb == "resize") {
+      int w = int(number(x[0])), h = int(number(x[1]));
+      glfwSetWindowSize(window, w, h);
+      pending_resize = {w, h};
+      resize_tries = 0;
+    } else if (a.verb == "frames") {
+      wait_frames = long(number(x[0]));
+    } else if (a.verb == "close") {
+      glfwSetWindowShouldClose(window, GLFW_TRUE);
+    } else if (a.verb == "scene") {
+      set_scene(x[0], false);
+    } else if (a.verb == "reload") {
+      set_scene(view.scene, true);
+    } else if (a.verb == "ground-truth") {
+      start_truth(int(number(x[0])));
+    } else if (a.verb == "wait-ground-truth") {
+      if (truth.running()) {
+        --script_next; // again next frame
+        return;
+      }
+      if (!truth.error().empty()) throw ViewerError(fmt::format("{}: ground truth: {}", a.where, truth.error()));
+    } else if (a.verb == "show-truth") {
+      show_truth = x[0] == "on";
+    } else if (a.verb == "show-map") {
+      show_map = x[0] == "on";
+    } else if (a.verb == "quit") {
+      quit = true;
+    }
+  } catch (const scene::SceneError& e) {
+    throw ViewerError(fmt::format("{}: {}", a.where, e.what()));
+  } catch (const ViewError& e) {
+    throw ViewerError(fmt::format("{}: {}", a.where, e.what()));
+  } catch (const render::RenderError& e) { throw ViewerError(fmt::format("{}: {}", a.where, e.what())); }
+}
+
+} // namespace msm::viewer

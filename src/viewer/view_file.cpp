@@ -1,0 +1,347 @@
+#include "msm/viewer/view_file.h"
+
+#include "msm/techniques.h"
+#include "msm/util/spelling.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace msm::viewer {
+namespace {
+
+using json = nlohmann::json;
+using Lookup = render::RenderSettings::Lookup;
+
+[[noreturn]] void fail(std::string_view key, std::string_view problem) {
+  throw ViewError(fmt::format("{}: {}", key, problem));
+}
+
+float number(std::string_view key, const json& v) {
+  if (!v.is_number() || !std::isfinite(v.get<double>())) fail(key, fmt::format("expected a number, got {}", v.dump()));
+  return v.get<float>();
+}
+
+int integer(std::string_view key, const json& v) {
+  if (!v.is_number_integer() || v.get<long long>() < -(1ll << 30) || v.get<long long>() > (1ll << 30))
+    fail(key, fmt::format("expected an integer, got {}", v.dump()));
+  return v.get<int>();
+}
+
+bool boolean(std::string_view key, const json& v) {
+  if (!v.is_boolean()) fail(key, fmt::format("expected true or false, got {}", v.dump()));
+  return v.get<bool>();
+}
+
+std::string word(std::string_view key, const json& v) {
+  if (!v.is_string()) fail(key, fmt::format("expected a string, got {}", v.dump()));
+  return v.get<std::string>();
+}
+
+glm::vec3 vec3(std::string_view key, const json& v) {
+  if (!v.is_array() || v.size() != 3) fail(key, fmt::format("expected [x, y, z], got {}", v.dump()));
+  return {number(key, v[0]), number(key, v[1]), number(key, v[2])};
+}
+
+json to_json(glm::vec3 v) { return json::array({v.x, v.y, v.z}); }
+
+// Rejects keys of an object that are not in `known`.
+void check_keys(const json& object, std::string_view where, std::initializer_list<std::string_view> known) {
+  if (!object.is_object()) fail(where, fmt::format("expected an object, got {}", object.dump()));
+  for (const auto& [key, value] : object.items())
+    if (std::find(known.begin(), known.end(), key) == known.end())
+      fail(fmt::format("{}/{}", where, key), "unknown key");
+}
+
+const char* lookup_name(Lookup l) {
+  switch (l) {
+  case Lookup::bilinear: return "bilinear";
+  case Lookup::nearest: return "nearest";
+  case Lookup::dither: return "dither";
+  default: return "auto";
+  }
+}
+
+} // namespace
+
+std::vector<std::string> setting_keys() {
+  return {"technique",
+          "width",
+          "height",
+          "shadow_size",
+          "msaa",
+          "filter_size",
+          "filter_sigma",
+          "mipmaps",
+          "params",
+          "overdarken",
+          "normal_offset",
+          "depth_bias",
+          "receiver_plane_bias",
+          "exposure",
+          "lookup",
+          "filter_mode",
+          "frame",
+          "translucent_occluders",
+          "coloured_translucency",
+          "alpha_threshold",
+          "light_extent_deg",
+          "soft_kernel"};
+}
+
+void apply_setting(render::RenderSettings& s, std::string_view key, const json& v) {
+  if (key == "technique") {
+    std::string name = word(key, v);
+    try {
+      s.technique = std::string(render::find_rendered_technique(canonical_technique_name(name)).name);
+    } catch (const render::RenderError& e) { fail(key, e.what()); }
+  } else if (key == "width")
+    s.width = integer(key, v);
+  else if (key == "height")
+    s.height = integer(key, v);
+  else if (key == "shadow_size")
+    s.shadow_size = integer(key, v);
+  else if (key == "msaa")
+    s.msaa = integer(key, v);
+  else if (key == "filter_size")
+    s.filter_size = integer(key, v);
+  else if (key == "filter_sigma")
+    s.filter_sigma = number(key, v);
+  else if (key == "mipmaps")
+    s.mipmaps = boolean(key, v);
+  else if (key == "params") {
+    if (v.is_null())
+      s.params.reset();
+    else if (!v.is_array() || v.size() != 4)
+      fail(key, fmt::format("expected [x, y, z, w] or null (the technique's defaults), got {}", v.dump()));
+    else
+      s.params = glm::vec4(number(key, v[0]), number(key, v[1]), number(key, v[2]), number(key, v[3]));
+  } else if (key == "overdarken")
+    s.overdarken = number(key, v);
+  else if (key == "normal_offset")
+    s.normal_offset = number(key, v);
+  else if (key == "depth_bias") {
+    if (v.is_null())
+      s.depth_bias.reset();
+    else
+      s.depth_bias = number(key, v);
+  } else if (key == "receiver_plane_bias")
+    s.receiver_plane_bias = number(key, v);
+  else if (key == "exposure")
+    s.exposure = number(key, v);
+  else if (key == "lookup") {
+    std::string l = word(key, v);
+    if (l == "auto")
+      s.lookup = Lookup::automatic;
+    else if (l == "bilinear")
+      s.lookup = Lookup::bilinear;
+    else if (l == "nearest")
+      s.lookup = Lookup::nearest;
+    else if (l == "dither")
+      s.lookup = Lookup::dither;
+    else
+      fail(key, fmt::format("'{}': expected auto, bilinear, nearest or dither", l));
+  } else if (key == "filter_mode") {
+    std::string m = word(key, v);
+    if (m == "auto")
+      s.one_pass.reset();
+    else if (m == "one-pass")
+      s.one_pass = true;
+    else if (m == "three-pass")
+      s.one_pass = false;
+    else
+      fail(key, fmt::format("'{}': expected auto, one-pass or three-pass", m));
+  } else if (key == "frame")
+    s.frame = integer(key, v);
+  else if (key == "translucent_occluders")
+    s.translucent_occluders = boolean(key, v);
+  else if (key == "coloured_translucency")
+    s.coloured_translucency = boolean(key, v);
+  else if (key == "alpha_threshold")
+    s.translucent_alpha_threshold = number(key, v);
+  else if (key == "light_extent_deg") {
+    if (v.is_null())
+      s.light_extent_deg.reset();
+    else
+      s.light_extent_deg = number(key, v);
+  } else if (key == "soft_kernel")
+    s.soft_kernel = integer(key, v);
+  else
+    fail(key, fmt::format("unknown setting{}", util::did_you_mean(key, setting_keys())));
+}
+
+json setting_json(const render::RenderSettings& s, std::string_view key) {
+  if (key == "technique") return s.technique;
+  if (key == "width") return s.width;
+  if (key == "height") return s.height;
+  if (key == "shadow_size") return s.shadow_size;
+  if (key == "msaa") return s.msaa;
+  if (key == "filter_size") return s.filter_size;
+  if (key == "filter_sigma") return s.filter_sigma;
+  if (key == "mipmaps") return s.mipmaps;
+  if (key == "params") return s.params ? json::array({s.params->x, s.params->y, s.params->z, s.params->w}) : json();
+  if (key == "overdarken") return s.overdarken;
+  if (key == "normal_offset") return s.normal_offset;
+  if (key == "depth_bias") return s.depth_bias ? json(*s.depth_bias) : json();
+  if (key == "receiver_plane_bias") return s.receiver_plane_bias;
+  if (key == "exposure") return s.exposure;
+  if (key == "lookup") return lookup_name(s.lookup);
+  if (key == "filter_mode") return !s.one_pass ? "auto" : *s.one_pass ? "one-pass" : "three-pass";
+  if (key == "frame") return s.frame;
+  if (key == "translucent_occluders") return s.translucent_occluders;
+  if (key == "coloured_translucency") return s.coloured_translucency;
+  if (key == "alpha_threshold") return s.translucent_alpha_threshold;
+  if (key == "light_extent_deg") return s.light_extent_deg ? json(*s.light_extent_deg) : json();
+  if (key == "soft_kernel") return s.soft_kernel;
+  fail(key, "unknown setting");
+}
+
+View default_view(const std::string& scene_name, const scene::Scene& scene) {
+  View v;
+  v.scene = scene_name;
+  v.camera = scene.camera;
+  return v;
+}
+
+json view_json(const View& v) {
+  json settings = json::object();
+  for (const std::string& key : setting_keys()) settings[key] = setting_json(v.settings, key);
+  json lights = json::array();
+  for (const scene::DirectionalLight& l : v.settings.lights)
+    lights.push_back({{"towards_light", to_json(l.towards_light)},
+                      {"irradiance", to_json(l.irradiance)},
+                      {"angular_extent_deg", l.angular_extent_deg}});
+  json out = {{"msm_view", 1}, {"scene", v.scene}};
+  if (v.camera)
+    out["camera"] = {{"position", to_json(v.camera->position)},
+                     {"target", to_json(v.camera->target)},
+                     {"up", to_json(v.camera->up)},
+                     {"fov_y_deg", v.camera->fov_y_deg},
+                     {"near", v.camera->near},
+                     {"far", v.camera->far}};
+  out["settings"] = settings;
+  if (!lights.empty()) out["lights"] = lights;
+  return out;
+}
+
+View parse_view(std::string_view text, const std::filesystem::path& file) {
+  const std::string name = file.string();
+  json j;
+  try {
+    j = json::parse(text, nullptr, true, true);
+  } catch (const json::parse_error& e) { throw ViewError(fmt::format("{}: malformed JSON: {}", name, e.what())); }
+  try {
+    check_keys(j, "", {"msm_view", "scene", "camera", "lights", "settings"});
+    if (!j.contains("msm_view") || j["msm_view"] != 1) fail("/msm_view", "required, and only version 1 exists");
+    View v;
+    if (j.contains("scene")) {
+      v.scene = word("/scene", j["scene"]);
+      const std::vector<std::string> builtins = scene::builtin_scene_names();
+      bool builtin = std::find(builtins.begin(), builtins.end(), v.scene) != builtins.end();
+      if (!builtin && std::filesystem::path(v.scene).is_relative())
+        v.scene = (file.parent_path() / v.scene).lexically_normal().string();
+    }
+    if (j.contains("camera")) {
+      const json& c = j["camera"];
+      scene::Camera camera;
+      check_keys(c, "/camera", {"position", "target", "up", "fov_y_deg", "near", "far"});
+      if (c.contains("position")) camera.position = vec3("/camera/position", c["position"]);
+      if (c.contains("target")) camera.target = vec3("/camera/target", c["target"]);
+      if (c.contains("up")) camera.up = vec3("/camera/up", c["up"]);
+      if (c.contains("fov_y_deg")) camera.fov_y_deg = number("/camera/fov_y_deg", c["fov_y_deg"]);
+      if (c.contains("near")) camera.near = number("/camera/near", c["near"]);
+      if (c.contains("far")) camera.far = number("/camera/far", c["far"]);
+      if (!(camera.fov_y_deg > 0 && camera.fov_y_deg < 180)) fail("/camera/fov_y_deg", "outside (0, 180)");
+      if (!(camera.near >= scene::kMinCameraNear && camera.near < camera.far && camera.far <= scene::kMaxCameraFar))
+        fail("/camera/near", "expected 1e-6 <= near < far <= 1e9");
+      if (!(glm::length(camera.position - camera.target) > 0)) fail("/camera/target", "equals the position");
+      if (!(glm::length(glm::cross(camera.target - camera.position, camera.up)) > 0))
+        fail("/camera/up", "parallel to the view direction");
+      v.camera = camera;
+    }
+    if (j.contains("lights")) {
+      const json& lights = j["lights"];
+      if (!lights.is_array() || lights.empty() || lights.size() > size_t(scene::kMaxLights))
+        fail("/lights", fmt::format("expected an array of 1 to {} lights", scene::kMaxLights));
+      std::vector<scene::DirectionalLight> lights_read;
+      for (size_t i = 0; i < lights.size(); ++i) {
+        std::string where = fmt::format("/lights/{}", i);
+        check_keys(lights[i], where, {"towards_light", "irradiance", "angular_extent_deg"});
+        scene::DirectionalLight l;
+        if (!lights[i].contains("towards_light")) fail(where + "/towards_light", "required");
+        glm::vec3 t = vec3(where + "/towards_light", lights[i]["towards_light"]);
+        if (!(glm::length(t) > 0)) fail(where + "/towards_light", "is zero");
+        l.towards_light = glm::normalize(t);
+        if (lights[i].contains("irradiance")) l.irradiance = vec3(where + "/irradiance", lights[i]["irradiance"]);
+        if (lights[i].contains("angular_extent_deg"))
+          l.angular_extent_deg = number(where + "/angular_extent_deg", lights[i]["angular_extent_deg"]);
+        lights_read.push_back(l);
+      }
+      v.settings.lights = lights_read;
+    }
+    if (j.contains("settings")) {
+      const json& s = j["settings"];
+      if (!s.is_object()) fail("/settings", "expected an object");
+      for (const auto& [key, value] : s.items()) {
+        try {
+          apply_setting(v.settings, key, value);
+        } catch (const ViewError& e) { throw ViewError(fmt::format("/settings/{}", e.what())); }
+      }
+      try {
+        v.settings.validate();
+      } catch (const render::RenderError& e) { fail("/settings", e.what()); }
+    }
+    return v;
+  } catch (const ViewError& e) { throw ViewError(fmt::format("{}: {}", name, e.what())); }
+}
+
+View load_view(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ViewError(fmt::format("{}: cannot open the view file", file.string()));
+  std::stringstream text;
+  text << in.rdbuf();
+  return parse_view(text.str(), file);
+}
+
+void save_view(const std::filesystem::path& file, const View& view) {
+  View v = view;
+  const std::vector<std::string> builtins = scene::builtin_scene_names();
+  if (std::find(builtins.begin(), builtins.end(), v.scene) == builtins.end())
+    v.scene = std::filesystem::absolute(v.scene).lexically_normal().string();
+  std::string text = view_json(v).dump(2) + "\n";
+  std::filesystem::path tmp = file;
+  tmp += fmt::format(".tmp{}", ::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(tmp, ec);
+      throw ViewError(fmt::format("{}: cannot write the view file", file.string()));
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw ViewError(fmt::format("{}: cannot write the view file: {}", file.string(), ec.message()));
+  }
+}
+
+scene::Scene load_view_scene(const View& view) {
+  scene::Scene s = scene::load_scene(view.scene);
+  if (view.camera) s.camera = *view.camera;
+  return s;
+}
+
+std::string render_command(const std::filesystem::path& view_file, const std::string& out_dir) {
+  return fmt::format("msm render --view '{}' -o '{}'", view_file.string(), out_dir);
+}
+
+} // namespace msm::viewer

@@ -1,0 +1,153 @@
+// View files and viewer scripts without a window: a view comes back from its JSON exactly (the
+// screenshot test relies on that), and every kind of bad input names the key or the line.
+#include "msm/viewer/script.h"
+#include "msm/viewer/view_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+namespace msm::viewer {
+namespace {
+
+// The message of the ViewError / ScriptError that f throws ("" if none).
+template <class Error, class F>
+std::string error_of(F f) {
+  try {
+    f();
+  } catch (const Error& e) { return e.what(); }
+  return "";
+}
+
+TEST(ViewFile, RoundTripIsExact) {
+  View v;
+  v.scene = "railing";
+  scene::Camera c;
+  c.position = {1.0f / 3.0f, 2.2f, -5.7f};
+  c.target = {0.1f, 0.2f, 0.3f};
+  c.fov_y_deg = 37.5f;
+  c.near = 0.05f;
+  c.far = 321.0f;
+  v.camera = c;
+  scene::DirectionalLight l;
+  l.towards_light = glm::normalize(glm::vec3(0.3f, 0.9f, 0.1f));
+  l.irradiance = {1.0f, 2.0f, 3.0f};
+  v.settings.lights = {l};
+  render::RenderSettings& s = v.settings;
+  s.technique = "vsm-32";
+  s.width = 333;
+  s.height = 222;
+  s.shadow_size = 512;
+  s.msaa = 1;
+  s.filter_size = 5;
+  s.filter_sigma = 1.7f;
+  s.mipmaps = false;
+  s.params = glm::vec4(0.1f, 0.2f, 0.3f, 1e-7f);
+  s.depth_bias = 3e-5f;
+  s.lookup = render::RenderSettings::Lookup::nearest;
+  s.one_pass = false;
+  s.frame = 7;
+  s.coloured_translucency = true;
+  s.light_extent_deg = 2.5f;
+  s.soft_kernel = 11;
+
+  nlohmann::json j = view_json(v);
+  View back = parse_view(j.dump(2), "v.json");
+  EXPECT_EQ(view_json(back), j);
+  ASSERT_TRUE(back.camera);
+  EXPECT_EQ(back.camera->position, c.position); // bit-identical floats, not close ones
+  EXPECT_EQ(back.camera->near, c.near);
+  EXPECT_EQ(back.settings.lights.at(0).towards_light, l.towards_light);
+  EXPECT_EQ(*back.settings.params, *s.params);
+  EXPECT_EQ(*back.settings.depth_bias, *s.depth_bias);
+  EXPECT_EQ(back.settings.lookup, s.lookup);
+  EXPECT_EQ(back.settings.one_pass, s.one_pass);
+  EXPECT_EQ(back.settings.filter_sigma, s.filter_sigma);
+}
+
+TEST(ViewFile, DefaultsStayDefaults) {
+  View v = parse_view(R"({"msm_view": 1})", "v.json");
+  EXPECT_EQ(v.scene, "fence");
+  EXPECT_FALSE(v.camera); // the scene's
+  EXPECT_TRUE(v.settings.lights.empty());
+  EXPECT_FALSE(v.settings.params);
+  EXPECT_FALSE(v.settings.depth_bias);
+}
+
+TEST(ViewFile, RelativeScenePathsFollowTheFile) {
+  View v = parse_view(R"({"msm_view": 1, "scene": "my/scene.json"})", "/data/views/v.json");
+  EXPECT_EQ(v.scene, "/data/views/my/scene.json");
+  EXPECT_EQ(parse_view(R"({"msm_view": 1, "scene": "glass"})", "/data/v.json").scene, "glass");
+}
+
+TEST(ViewFile, BadInputNamesTheKey) {
+  auto bad = [](const std::string& text) { return error_of<ViewError>([&] { parse_view(text, "v.json"); }); };
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"filter_sise": 5}})")
+                .find("v.json: /settings/filter_sise: unknown setting (did you mean filter_size"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"msaa": "four"}})").find("/settings/msaa: expected an integer"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"technique": "nope"}})").find("unknown technique 'nope'"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"filter_size": 8}})").find("filter size = 8 must be odd"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "camera": {"positon": [0, 1, 2]}})").find("/camera/positon: unknown key"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "camera": {"position": [0, 1]}})").find("/camera/position: expected [x, y, z]"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "camera": {"position": [0, 0, 0], "target": [0, 0, 0]}})")
+                .find("/camera/target: equals the position"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "lights": [{"towards_light": [0, 0, 0]}]})").find("/lights/0/towards_light"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"settings": {}})").find("/msm_view: required"), std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1,)").find("v.json: malformed JSON"), std::string::npos);
+  EXPECT_NE(error_of<ViewError>([] { load_view("/nonexistent/v.json"); }).find("cannot open the view file"),
+            std::string::npos);
+}
+
+TEST(ViewFile, SaveIsAtomicAndLoadsBack) {
+  std::filesystem::path dir = std::filesystem::temp_directory_path() / "msm_view_file_test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  View v;
+  v.settings.technique = "pcf";
+  save_view(dir / "v.json", v);
+  EXPECT_EQ(load_view(dir / "v.json").settings.technique, "pcf");
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.is_regular_file();
+  EXPECT_EQ(files, 1); // no temporary left behind
+  EXPECT_NE(error_of<ViewError>([&] { save_view(dir / "missing" / "v.json", v); }).find("cannot write"),
+            std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Script, ParsesActionsAndComments) {
+  std::vector<Action> a = parse_script("# comment\n\ntechnique msm  # trailing\nset params [0, 0, 0, 3e-5]\n"
+                                       "set lookup nearest\nresize 640 360\nquit\n",
+                                       "s.txt");
+  ASSERT_EQ(a.size(), 5u);
+  EXPECT_EQ(a[0].verb, "technique");
+  EXPECT_EQ(a[0].line, 3);
+  EXPECT_EQ(a[1].args.at(1), "[0, 0, 0, 3e-5]"); // the rest of the line
+  EXPECT_EQ(setting_value(a[2].args.at(1)), "nearest");
+  EXPECT_EQ(a[4].where, "s.txt:7");
+}
+
+TEST(Script, BadLinesAreNamed) {
+  auto bad = [](const std::string& text) { return error_of<ScriptError>([&] { parse_script(text, "s.txt"); }); };
+  EXPECT_EQ(bad("quit\nscreenshto a.png\n"), "s.txt:2: unknown action 'screenshto' (did you mean screenshot?)");
+  EXPECT_EQ(bad("technique\n"), "s.txt:1: technique takes 1 argument, got 0");
+  EXPECT_NE(bad("technique nope\n").find("s.txt:1: unknown technique 'nope'"), std::string::npos);
+  EXPECT_NE(bad("frames 1\nset msaa [4]\n").find("s.txt:2: set msaa: expected an integer"), std::string::npos);
+  EXPECT_EQ(bad("camera 0 1 2 3 4 x\n"), "s.txt:1: 'x' is not a number");
+  EXPECT_EQ(bad("resize 10 10\n"), "s.txt:1: resize 10 10: sizes are integers in [64, 8192]");
+  EXPECT_EQ(bad("divider 1.5\n"), "s.txt:1: divider 1.5 is outside (0, 1)");
+  EXPECT_NE(error_of<ScriptError>([] { load_script("/nonexistent/s.txt"); }).find("cannot open the script"),
+            std::string::npos);
+}
+
+} // namespace
+} // namespace msm::viewer
