@@ -4,7 +4,7 @@ BUILD_TYPE ?= RelWithDebInfo
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test sanitize bench clean
+.PHONY: all deps configure build demo test sanitize fuzz bench clean
 
 all: build
 
@@ -34,8 +34,13 @@ sanitize: deps
 	@cd $(SANITIZE_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 		ctest --output-on-failure -j $(JOBS) --timeout 1800
 
+# The libFuzzer targets (tests/fuzz; clang-14, ASan + UBSan, in build-fuzz), FUZZ_SECONDS each.
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@scripts/fuzz.sh $(FUZZ_SECONDS)
+
 bench: build
 	@$(BUILD_DIR)/bench/msm_bench_cpu --benchmark_min_time=0.2
 
 clean:
-	rm -rf $(BUILD_DIR) $(BUILD_DIR).configure.log $(SANITIZE_DIR) $(SANITIZE_DIR).configure.log
+	rm -rf $(BUILD_DIR) $(BUILD_DIR).configure.log $(SANITIZE_DIR) $(SANITIZE_DIR).configure.log build-fuzz build-fuzz.configure.log

@@ -374,11 +374,12 @@ Image read_exr(const fs::path& path) {
   return decode_exr(path, bytes);
 }
 
-Image read_image(const fs::path& path) {
-  auto bytes = read_file(path);
-  if (is_png(bytes)) return decode_png(path, bytes);
-  if (is_exr(bytes)) return decode_exr(path, bytes);
-  throw ImageError(path, bytes.empty() ? "empty file" : "neither a PNG nor an EXR file");
+Image read_image(const fs::path& path) { return decode_image(read_file(path), path); }
+
+Image decode_image(std::span<const std::uint8_t> bytes, const fs::path& name) {
+  if (is_png(bytes)) return decode_png(name, bytes);
+  if (is_exr(bytes)) return decode_exr(name, bytes);
+  throw ImageError(name, bytes.empty() ? "empty file" : "neither a PNG nor an EXR file");
 }
 
 void write_image(const fs::path& path, const Image& image) {
