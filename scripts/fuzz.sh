@@ -30,7 +30,7 @@ for t in "${targets[@]}"; do
   if "$build/tests/fuzz/msm_fuzz_$t" "$build/corpus/$t" "tests/fuzz/corpus/$t" "${dict[@]}" \
     -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -print_final_stats=1 \
     -artifact_prefix="$build/crashes/$t/" > "$build/fuzz-$t.log" 2>&1; then
-    echo "fuzz $t: $(grep -E '^#[0-9]+ +DONE' "$build/fuzz-$t.log" | tail -1) ($(grep -E 'stat::number_of_executed_units' "$build/fuzz-$t.log" | awk '{print $2}') runs, ${seconds} s)"
+    echo "fuzz $t: $(grep -E "^#[0-9]+[[:space:]]+DONE" "$build/fuzz-$t.log" | tail -1) ($(grep -E 'stat::number_of_executed_units' "$build/fuzz-$t.log" | awk '{print $2}') runs, ${seconds} s)"
   else
     failed=1
     echo "fuzz $t: FAILED, reproducer in $build/crashes/$t/:"
