@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # MPI ranks of msm evaluate (Open MPI)
   clang-format clang-tidy  # .ci/check-format (clang-format 14) and .ci/tidy
+  clang-14 libfuzzer-14-dev  # the fuzz targets (make fuzz, tests/fuzz)
   glmark2-data  # real meshes for the import tests (the bunny, 9 MB)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
 )
