@@ -300,6 +300,20 @@ TEST_F(ImageTest, ExrAttributeSizeBeyondTheFileIsRefusedFirst) {
   EXPECT_EQ(read_image(dir / "good.exr"), ramp(4, 3, {"Y"}));
 }
 
+// Found by the image fuzzer (tests/fuzz/crashes/image): stb copies an empty IDAT chunk before
+// the image data from a null buffer (undefined behaviour; UBSan reports it under
+// `make sanitize-cpu`). Empty IDAT chunks are dropped first: the file reads as without them.
+TEST_F(ImageTest, EmptyIdatChunksReadAsWithoutThem) {
+  const Image image = ramp(5, 3, {"R", "G", "B", "A"});
+  write_png(dir / "plain.png", image);
+  std::string png = slurp(dir / "plain.png");
+  const std::size_t idat = png.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  const std::string empty("\0\0\0\0IDAT\x35\xaf\x06\x1e", 12); // length 0, type, CRC
+  spit(dir / "empty_idat.png", png.substr(0, idat - 4) + empty + empty + png.substr(idat - 4));
+  EXPECT_EQ(read_image(dir / "empty_idat.png"), read_image(dir / "plain.png"));
+}
+
 // ---- Metrics ---------------------------------------------------------------------------------
 
 TEST(Metrics, ShiftedStepHasExactErrors) {

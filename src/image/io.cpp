@@ -169,7 +169,33 @@ void append_bytes(void* context, void* data, int size) {
   out->insert(out->end(), p, p + size);
 }
 
+// stb 2.27 copies an empty IDAT chunk that comes before any image data from a null buffer
+// (memcpy(NULL, p, 0): undefined behaviour, a UBSan report; a fuzzer find, tests/fuzz/crashes/
+// image). An empty IDAT chunk carries nothing: the chunks are copied without them (only when there
+// is one) before stb sees the file. A chunk structure that does not fit is left to stb.
+std::vector<std::uint8_t> without_empty_idat(std::span<const std::uint8_t> b) {
+  std::vector<std::uint8_t> out;
+  bool found = false;
+  std::size_t p = 8, copied = 0;
+  while (b.size() - p >= 12) {
+    const std::size_t length =
+        std::size_t(b[p]) << 24 | std::size_t(b[p + 1]) << 16 | std::size_t(b[p + 2]) << 8 | std::size_t(b[p + 3]);
+    if (length > b.size() - p - 12) break;
+    if (length == 0 && std::equal(b.begin() + std::ptrdiff_t(p + 4), b.begin() + std::ptrdiff_t(p + 8), "IDAT")) {
+      found = true;
+      out.insert(out.end(), b.begin() + std::ptrdiff_t(copied), b.begin() + std::ptrdiff_t(p));
+      copied = p + 12;
+    }
+    p += 12 + length;
+  }
+  if (!found) return {};
+  out.insert(out.end(), b.begin() + std::ptrdiff_t(copied), b.end());
+  return out;
+}
+
 Image decode_png(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  const std::vector<std::uint8_t> cleaned = without_empty_idat(bytes);
+  if (!cleaned.empty()) bytes = cleaned;
   if (bytes.size() > std::size_t(INT32_MAX)) throw ImageError(path, "file too large");
   const int len = static_cast<int>(bytes.size());
   int w = 0, h = 0, n = 0;

@@ -606,6 +606,16 @@ TEST(Import, ImpossiblePlyAndOffHeadersAreErrorsNotHangs) {
       dir.write("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
                               "property float y\nproperty float z\nend_headlr\n0 0 0\n1 0 0\n0 1 0\n");
   expect_error([&] { (void)import_mesh(no_end); }, {"no_end.ply", "no end_header", "truncated or corrupt"});
+  const fs::path glued =
+      dir.write("glued.ply", std::string("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                         "property float y\nproperty float z\nend_header\x08") +
+                                 "0 0 0\n1 0 0\n0 1 0\n");
+  expect_error([&] { (void)import_mesh(glued); }, {"glued.ply", "no end_header"});
+  const fs::path binary_line =
+      dir.write("binary_line.ply", std::string("ply\nformat ascii 1.0\nproperty list ucha\0\0\"a\"\n"
+                                               "end_header\n0 0 0\n",
+                                               62));
+  expect_error([&] { (void)import_mesh(binary_line); }, {"binary_line.ply", "line 3 of the PLY header is not text"});
   const fs::path many = dir.write("many.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
                                               "property float x\nproperty float y\nproperty float z\nend_header\n");
   expect_error([&] { (void)import_mesh(many); }, {"many.ply", "48,000,000,000 bytes", "truncated or corrupt"});
