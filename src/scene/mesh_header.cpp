@@ -130,16 +130,13 @@ std::uint64_t off_triangles(const fs::path& file, std::uint64_t size) {
   return faces;
 }
 
-// OBJ: its face lines ("f ...", one triangle or more each).
-std::uint64_t obj_triangles(const fs::path& file, std::uint64_t size) {
-  const std::string text = read_all(file, size);
+// OBJ: its face lines ("f ...", one triangle or more each), read a line at a time.
+std::uint64_t obj_triangles(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
   std::uint64_t faces = 0;
-  for (std::size_t p = 0; p < text.size();) {
-    const std::size_t start = text.find_first_not_of(" \t", p);
-    if (start != std::string::npos && text.compare(start, 2, "f ") == 0) ++faces;
-    const std::size_t next = text.find('\n', p);
-    if (next == std::string::npos) break;
-    p = next + 1;
+  for (std::string line; std::getline(in, line);) {
+    const std::size_t start = line.find_first_not_of(" \t");
+    if (start != std::string::npos && line.compare(start, 2, "f ") == 0) ++faces;
   }
   return faces;
 }
@@ -226,7 +223,7 @@ void check_mesh_header(const std::filesystem::path& file) {
   } else if (extension == ".off") {
     triangles = off_triangles(file, size);
   } else if (extension == ".obj") {
-    triangles = obj_triangles(file, size);
+    triangles = obj_triangles(file);
   } else if (extension == ".gltf") {
     triangles = gltf_triangles(read_all(file, size));
     what = "triangles";
