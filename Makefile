@@ -37,16 +37,17 @@ sanitize: deps
 # The CPU part of the suite under ASan + UBSan, as CI runs it (`.ci/run`; `make sanitize` is all of
 # it, 20 min more): a build without Vulkan, so math, oracles, scene and import, images, the ray
 # tracer, evaluate and the CLI's non-rendering commands (their error paths included) with the
-# fuzz corpora and reproducers; the renderer's lavapipe tests are left out. Leaks are reported
-# here (no validation layer), except Assimp's own (tests/lsan.supp).
+# fuzz corpora and reproducers; the renderer's lavapipe tests are left out. Leak checking is off
+# as in `make sanitize` (not yet tried over Open MPI and Embree); the fuzz runs check leaks.
 SANITIZE_CPU_DIR ?= build-sanitize-cpu
+SANITIZE_CPU_CTEST_ARGS ?=
 sanitize-cpu: deps
 	@cmake -S . -B $(SANITIZE_CPU_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DMSM_SANITIZE=address,undefined \
 		-DMSM_BUILD_VULKAN=OFF -DMSM_BUILD_BENCHMARKS=OFF "-DCMAKE_CXX_FLAGS=-fno-sanitize-recover=all" $(CMAKE_FLAGS) \
 		> $(SANITIZE_CPU_DIR).configure.log 2>&1 || (cat $(SANITIZE_CPU_DIR).configure.log; exit 1)
 	@cmake --build $(SANITIZE_CPU_DIR) -j $(JOBS)
-	@cd $(SANITIZE_CPU_DIR) && ASAN_OPTIONS=abort_on_error=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp \
-		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS) --timeout 1800
+	@cd $(SANITIZE_CPU_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
+		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS) --timeout 1800 $(SANITIZE_CPU_CTEST_ARGS)
 
 # The libFuzzer targets (tests/fuzz; clang-14, ASan + UBSan, in build-fuzz), FUZZ_SECONDS each.
 FUZZ_SECONDS ?= 60
