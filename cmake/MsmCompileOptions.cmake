@@ -16,6 +16,13 @@ if(MSM_SANITIZE)
   target_compile_options(msm_compile_options INTERFACE -fsanitize=${MSM_SANITIZE} -fno-omit-frame-pointer)
   target_link_options(msm_compile_options INTERFACE -fsanitize=${MSM_SANITIZE})
 endif()
+if(MSM_BUILD_FUZZERS)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "MSM_BUILD_FUZZERS needs clang (libFuzzer): CXX=clang++-14")
+  endif()
+  # Coverage feedback from all of msm's code; the fuzz targets link libFuzzer itself.
+  target_compile_options(msm_compile_options INTERFACE -fsanitize=fuzzer-no-link)
+endif()
 install(TARGETS msm_compile_options EXPORT msmTargets)
 
 # Test support (tests/support: the Vulkan test fixture, the glTF writer) and the one place of test

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 
@@ -248,6 +249,69 @@ TEST_F(ImageTest, AbsurdSizesAreRejected) {
   } catch (const ImageError& e) { EXPECT_NE(e.reason().find("70000"), std::string::npos) << e.reason(); }
   EXPECT_THROW(Image(max_side + 1, 1, 1), ImageError);
   EXPECT_NO_THROW(Image(max_side, 1, 1));
+}
+
+// Issue 19: a small file that claims a large image is refused against the memory limit
+// (MSM_MAX_MEMORY_MB, msm/util/limits.h) before the image is allocated, naming the limit.
+TEST_F(ImageTest, ClaimedSizeCheckedAgainstTheMemoryLimit) {
+  write_png(dir / "one.png", Image(1, 1, 4));
+  std::string png = slurp(dir / "one.png");
+  // IHDR width and height 16000 (stb itself refuses more than 2^30 bytes of 8-bit texels).
+  for (std::size_t at : {std::size_t(16), std::size_t(20)})
+    for (int i = 0; i < 4; ++i) png[at + std::size_t(i)] = char((16000u >> (24 - 8 * i)) & 0xff);
+  spit(dir / "claims.png", png);
+  ::setenv("MSM_MAX_MEMORY_MB", "1024", 1);
+  try {
+    read_image(dir / "claims.png");
+    ADD_FAILURE() << "no error";
+  } catch (const ImageError& e) {
+    EXPECT_NE(e.reason().find("16000x16000 image of 4 channels needs about 3.8 GiB; the limit is 1.0 GiB"),
+              std::string::npos)
+        << e.reason();
+  }
+  ::unsetenv("MSM_MAX_MEMORY_MB");
+  // Within the limit the same claim fails as truncated, not as too large.
+  png = slurp(dir / "one.png");
+  png[19] = char(200); // width 200
+  spit(dir / "small_claim.png", png);
+  try {
+    read_image(dir / "small_claim.png");
+    ADD_FAILURE() << "no error";
+  } catch (const ImageError& e) { EXPECT_EQ(e.reason().find("limit"), std::string::npos) << e.reason(); }
+}
+
+// Found by the compare fuzzer (tests/fuzz/crashes/compare): an EXR header attribute whose size
+// field claims 1.9 GB made OpenEXR allocate that before failing; the header is walked first.
+TEST_F(ImageTest, ExrAttributeSizeBeyondTheFileIsRefusedFirst) {
+  write_exr(dir / "good.exr", ramp(4, 3, {"Y"}));
+  std::string exr = slurp(dir / "good.exr");
+  const std::size_t at = exr.find("compression");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t size_field = at + std::string("compression").size() * 2 + 2; // name, type, NULs
+  ASSERT_EQ(exr[size_field], 1);                                                 // compression: one byte
+  exr[size_field + 3] = 0x72;                                                    // 1912602625 bytes claimed
+  spit(dir / "claims.exr", exr);
+  try {
+    read_image(dir / "claims.exr");
+    ADD_FAILURE() << "no error";
+  } catch (const ImageError& e) {
+    EXPECT_NE(e.reason().find("attribute 'compression' claims 1912602625 bytes"), std::string::npos) << e.reason();
+  }
+  EXPECT_EQ(read_image(dir / "good.exr"), ramp(4, 3, {"Y"}));
+}
+
+// Found by the image fuzzer (tests/fuzz/crashes/image): stb copies an empty IDAT chunk before
+// the image data from a null buffer (undefined behaviour; UBSan reports it under
+// `make sanitize-cpu`). Empty IDAT chunks are dropped first: the file reads as without them.
+TEST_F(ImageTest, EmptyIdatChunksReadAsWithoutThem) {
+  const Image image = ramp(5, 3, {"R", "G", "B", "A"});
+  write_png(dir / "plain.png", image);
+  std::string png = slurp(dir / "plain.png");
+  const std::size_t idat = png.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  const std::string empty("\0\0\0\0IDAT\x35\xaf\x06\x1e", 12); // length 0, type, CRC
+  spit(dir / "empty_idat.png", png.substr(0, idat - 4) + empty + empty + png.substr(idat - 4));
+  EXPECT_EQ(read_image(dir / "empty_idat.png"), read_image(dir / "plain.png"));
 }
 
 // ---- Metrics ---------------------------------------------------------------------------------

@@ -6,12 +6,15 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <set>
 
 #include <fcntl.h>
 #include <unistd.h>
 
 #include <fmt/core.h>
+
+#include "msm/util/limits.h"
 
 #include <OpenEXR/Iex.h>
 #include <OpenEXR/ImfChannelList.h>
@@ -71,6 +74,47 @@ void check_size(const fs::path& path, long long width, long long height) {
     throw ImageError(path, fmt::format("image size {}x{} is outside 1..{} per side", width, height, max_side));
 }
 
+// The float image's bytes against msm/util/limits.h (MSM_MAX_MEMORY_MB): a small file claiming a
+// huge size is refused before the allocation.
+void check_memory(const fs::path& path, long long width, long long height, long long channels) {
+  try {
+    limits::check_bytes(fmt::format("a {}x{} image of {} channels", width, height, channels),
+                        std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(channels) * sizeof(float));
+  } catch (const limits::LimitError& e) { throw ImageError(path, e.what()); }
+}
+
+// The attributes of an EXR header (each: name, type, 32-bit size, value) before OpenEXR reads
+// them: OpenEXR 3.1 allocates an attribute's claimed size before reading it (gigabytes for a
+// corrupt size field in a file of a kilobyte).
+void check_exr_header(const fs::path& path, std::span<const std::uint8_t> b) {
+  std::size_t p = 8; // magic and version
+  auto string_at = [&](std::size_t& at) {
+    const auto end = std::find(b.begin() + std::ptrdiff_t(std::min(at, b.size())), b.end(), std::uint8_t(0));
+    if (end == b.end()) throw ImageError(path, "malformed or truncated EXR: header cut short");
+    std::string text(b.begin() + std::ptrdiff_t(at), end);
+    at = std::size_t(end - b.begin()) + 1;
+    return text;
+  };
+  const bool multipart = b.size() > 5 && (b[5] & 0x10) != 0;
+  for (int header = 0;; ++header) {
+    for (;;) {
+      const std::string name = string_at(p);
+      if (name.empty()) break;
+      const std::string type = string_at(p);
+      if (b.size() - p < 4) throw ImageError(path, "malformed or truncated EXR: header cut short");
+      const std::int64_t size = std::int32_t(std::uint32_t(b[p]) | std::uint32_t(b[p + 1]) << 8 |
+                                             std::uint32_t(b[p + 2]) << 16 | std::uint32_t(b[p + 3]) << 24);
+      p += 4;
+      if (size < 0 || std::uint64_t(size) > b.size() - p)
+        throw ImageError(path, fmt::format("malformed or truncated EXR: attribute '{}' claims {} bytes, {} are left",
+                                           name, size, b.size() - p));
+      p += std::size_t(size);
+    }
+    // A multi-part file: headers until an empty one.
+    if (!multipart || (p < b.size() && b[p] == 0)) break;
+  }
+}
+
 bool is_png(std::span<const std::uint8_t> b) {
   static constexpr std::uint8_t sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   return b.size() >= 8 && std::equal(sig, sig + 8, b.begin());
@@ -125,7 +169,33 @@ void append_bytes(void* context, void* data, int size) {
   out->insert(out->end(), p, p + size);
 }
 
+// stb 2.27 copies an empty IDAT chunk that comes before any image data from a null buffer
+// (memcpy(NULL, p, 0): undefined behaviour, a UBSan report; a fuzzer find, tests/fuzz/crashes/
+// image). An empty IDAT chunk carries nothing: the chunks are copied without them (only when there
+// is one) before stb sees the file. A chunk structure that does not fit is left to stb.
+std::vector<std::uint8_t> without_empty_idat(std::span<const std::uint8_t> b) {
+  std::vector<std::uint8_t> out;
+  bool found = false;
+  std::size_t p = 8, copied = 0;
+  while (b.size() - p >= 12) {
+    const std::size_t length =
+        std::size_t(b[p]) << 24 | std::size_t(b[p + 1]) << 16 | std::size_t(b[p + 2]) << 8 | std::size_t(b[p + 3]);
+    if (length > b.size() - p - 12) break;
+    if (length == 0 && std::equal(b.begin() + std::ptrdiff_t(p + 4), b.begin() + std::ptrdiff_t(p + 8), "IDAT")) {
+      found = true;
+      out.insert(out.end(), b.begin() + std::ptrdiff_t(copied), b.begin() + std::ptrdiff_t(p));
+      copied = p + 12;
+    }
+    p += 12 + length;
+  }
+  if (!found) return {};
+  out.insert(out.end(), b.begin() + std::ptrdiff_t(copied), b.end());
+  return out;
+}
+
 Image decode_png(const fs::path& path, std::span<const std::uint8_t> bytes) {
+  const std::vector<std::uint8_t> cleaned = without_empty_idat(bytes);
+  if (!cleaned.empty()) bytes = cleaned;
   if (bytes.size() > std::size_t(INT32_MAX)) throw ImageError(path, "file too large");
   const int len = static_cast<int>(bytes.size());
   int w = 0, h = 0, n = 0;
@@ -133,30 +203,32 @@ Image decode_png(const fs::path& path, std::span<const std::uint8_t> bytes) {
     throw ImageError(path, std::string("not a readable PNG: ") + stbi_failure_reason());
   check_size(path, w, h);
   if (n < 1 || n > 4) throw ImageError(path, fmt::format("{} channels", n));
+  check_memory(path, w, h, n);
   const bool sixteen = stbi_is_16_bit_from_memory(bytes.data(), len) != 0;
-  Image image(w, h, n);
-  auto px = image.pixels();
   const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
+  // Decoded before the float image is allocated: a truncated file claiming a large size fails in
+  // stb first, without a zero-filled buffer of its claimed size.
   auto convert = [&](auto* data, double max) {
     if (!data) throw ImageError(path, std::string("malformed or truncated PNG: ") + stbi_failure_reason());
+    const std::unique_ptr<void, void (*)(void*)> owner(data, stbi_image_free);
+    Image image(w, h, n);
+    auto px = image.pixels();
     for (std::size_t i = 0; i < px.size(); ++i) {
       float v = static_cast<float>(double(data[i]) / max);
       px[i] = int(i % std::size_t(n)) == alpha ? v : srgb_to_linear(v);
     }
-    stbi_image_free(data);
+    return image;
   };
   int rw = 0, rh = 0, rn = 0;
-  if (sixteen)
-    convert(stbi_load_16_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 65535.0);
-  else
-    convert(stbi_load_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 255.0);
-  return image;
+  if (sixteen) return convert(stbi_load_16_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 65535.0);
+  return convert(stbi_load_from_memory(bytes.data(), len, &rw, &rh, &rn, n), 255.0);
 }
 
 // ---- EXR -------------------------------------------------------------------------------------
 
 Image decode_exr(const fs::path& path, std::span<const std::uint8_t> bytes) {
   try {
+    check_exr_header(path, bytes);
     MemoryIStream stream(bytes, path.string());
     Imf::InputFile file(stream);
     const Imf::Header& header = file.header();
@@ -184,6 +256,7 @@ Image decode_exr(const fs::path& path, std::span<const std::uint8_t> bytes) {
         if (std::set<std::string>(known.begin(), known.end()) == have) order = known;
     }
     if (order.empty()) order = names;
+    check_memory(path, w, h, (long long)order.size());
     Image image(int(w), int(h), order);
     if (!file.isComplete()) throw ImageError(path, "truncated EXR (missing pixel data)");
     const std::size_t n = order.size();
@@ -374,11 +447,12 @@ Image read_exr(const fs::path& path) {
   return decode_exr(path, bytes);
 }
 
-Image read_image(const fs::path& path) {
-  auto bytes = read_file(path);
-  if (is_png(bytes)) return decode_png(path, bytes);
-  if (is_exr(bytes)) return decode_exr(path, bytes);
-  throw ImageError(path, bytes.empty() ? "empty file" : "neither a PNG nor an EXR file");
+Image read_image(const fs::path& path) { return decode_image(read_file(path), path); }
+
+Image decode_image(std::span<const std::uint8_t> bytes, const fs::path& name) {
+  if (is_png(bytes)) return decode_png(name, bytes);
+  if (is_exr(bytes)) return decode_exr(name, bytes);
+  throw ImageError(name, bytes.empty() ? "empty file" : "neither a PNG nor an EXR file");
 }
 
 void write_image(const fs::path& path, const Image& image) {

@@ -200,6 +200,7 @@ namespace msm::scene {
 
 std::vector<ModelPart> import_model(const std::filesystem::path& file) {
   check_regular_file(file, "mesh");
+  detail::check_mesh_header(file);
   Assimp::Importer importer;
   // Points and lines are removed; only triangles are kept.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);

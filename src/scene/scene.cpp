@@ -12,6 +12,7 @@
 
 #include "internal.h"
 #include "msm/probe/probe.h"
+#include "msm/util/limits.h"
 
 namespace msm::scene {
 namespace {
@@ -513,6 +514,13 @@ class Parser {
     try {
       detail::finalize_mesh(m, "");
     } catch (const SceneError& e) { fail(ptr, "after the transform: " + e.problem()); }
+    // The scene's running total against the limit (msm/util/limits.h), object by object: 40
+    // spheres of 4M triangles stop at the limit, not in std::bad_alloc after gigabytes.
+    triangles_ += m.triangle_count();
+    if (triangles_ > limits::max_triangles())
+      fail(ptr, fmt::format("the scene has {} triangles up to this object; the limit is {} (MSM_MAX_TRIANGLES "
+                            "raises it)",
+                            limits::with_commas(triangles_), limits::with_commas(limits::max_triangles())));
     o.mesh = std::move(m);
     o.bounds = o.mesh.bounds();
     s.objects.push_back(std::move(o));
@@ -520,6 +528,7 @@ class Parser {
 
   std::string file_;
   fs::path base_;
+  mutable std::uint64_t triangles_ = 0; // of the objects added so far
   std::map<std::string, std::uint32_t> named_;
 };
 

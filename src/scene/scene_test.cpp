@@ -1,12 +1,14 @@
 // Tests of msm::scene: built-in scenes and their JSON files, primitives, transforms, Assimp
 // import, matrices, and clear errors for bad input.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -508,19 +510,117 @@ TEST(Import, RealModel) {
 
 // A truncated PLY (issue 19: the first 40000 bytes of assimp-testmodels' Wuson.ply) trips an
 // assertion inside Assimp, which Debian's build turns into abort(): the import must fail with a
-// SceneError naming the file instead (import.cpp interposes Assimp's assertion handler).
+// SceneError naming the file instead (import.cpp interposes Assimp's assertion handler). Cut at
+// 40000 bytes the header check (mesh_header.cpp) refuses it first; cut at 400000 its vertices are
+// all there and Assimp's assertion trips, as it did at 40000 before the header check.
 TEST(Import, TruncatedPlyIsAnErrorNotAnAbort) {
   const fs::path wuson = fs::path(MSM_ASSIMP_MODELS_DIR) / "PLY" / "Wuson.ply";
   ASSERT_TRUE(fs::exists(wuson)) << wuson << " is missing (install assimp-testmodels: scripts/bootstrap.sh does)";
   std::ifstream in(wuson, std::ios::binary);
-  std::string head(40000, '\0');
+  std::string head(400000, '\0');
   in.read(head.data(), std::streamsize(head.size()));
-  ASSERT_EQ(in.gcount(), 40000);
+  ASSERT_EQ(in.gcount(), 400000);
   TempDir dir("msm_scene_test");
   const fs::path truncated = dir.write("truncated.ply", head);
-  expect_error([&] { (void)import_mesh(truncated); }, {"truncated.ply", "truncated or corrupt"});
+  expect_error([&] { (void)import_mesh(truncated); }, {"truncated.ply", "truncated or corrupt", "internal check"});
+  const fs::path short_file = dir.write("short.ply", head.substr(0, 40000));
+  expect_error([&] { (void)import_mesh(short_file); }, {"short.ply", "at least 186,408 bytes", "truncated or corrupt"});
   // The importer still works afterwards.
   EXPECT_GT(import_mesh(wuson).triangle_count(), 0u);
+}
+
+std::string fmt_vertex(const std::string& prefix, int i) {
+  const double a = 0.001 * i;
+  return (prefix.empty() ? "" : prefix + " ") + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) +
+         " 0\n";
+}
+
+// Mesh files of n triangles (a fan around vertex 0) in the formats whose header or face lines
+// declare their triangle count (mesh_header.cpp).
+std::string fan_obj(int n) {
+  std::string text;
+  for (int i = 0; i <= n + 1; ++i) text += i == 0 ? "v 0 0 0\n" : fmt_vertex("v", i);
+  for (int i = 1; i <= n; ++i) text += "f 1 " + std::to_string(i + 1) + " " + std::to_string(i + 2) + "\n";
+  return text;
+}
+std::string fan_ply(int n) {
+  std::string text = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(n + 2) +
+                     "\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(n) +
+                     "\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n";
+  for (int i = 1; i <= n + 1; ++i) text += fmt_vertex("", i);
+  for (int i = 1; i <= n; ++i) text += "3 0 " + std::to_string(i) + " " + std::to_string(i + 1) + "\n";
+  return text;
+}
+std::string fan_off(int n) {
+  std::string text = "OFF\n" + std::to_string(n + 2) + " " + std::to_string(n) + " 0\n0 0 0\n";
+  for (int i = 1; i <= n + 1; ++i) text += fmt_vertex("", i);
+  for (int i = 1; i <= n; ++i) text += "3 0 " + std::to_string(i) + " " + std::to_string(i + 1) + "\n";
+  return text;
+}
+
+// Issue 19: the total-triangle limit (msm/util/limits.h) is checked from what a mesh file
+// declares, before Assimp imports (and allocates for) it; the same file imports under a limit
+// one higher.
+TEST(Import, TriangleLimitCheckedFromTheFileBeforeImport) {
+  TempDir dir("msm_scene_test");
+  const int n = 1001;
+  const std::vector<fs::path> files = {dir.write("fan.obj", fan_obj(n)), dir.write("fan.ply", fan_ply(n)),
+                                       dir.write("fan.off", fan_off(n))};
+  ::setenv("MSM_MAX_TRIANGLES", "1000", 1);
+  for (const fs::path& file : files)
+    expect_error([&] { (void)import_mesh(file); },
+                 {file.filename().string(), "declares 1,001", "the limit is 1,000", "MSM_MAX_TRIANGLES"});
+  // glTF: a one-triangle mesh shown by 1001 nodes is 1001 triangles after PreTransformVertices.
+  std::string nodes;
+  for (int i = 0; i < n; ++i) nodes += std::string(i ? "," : "") + R"({"mesh":0})";
+  const fs::path gltf =
+      dir.write("instanced.gltf", R"({"asset":{"version":"2.0"},"nodes":[)" + nodes +
+                                      R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+                                      R"("accessors":[{"count":3},{"count":3}]})");
+  expect_error([&] { (void)import_mesh(gltf); }, {"instanced.gltf", "declares 1,001 triangles", "the limit is 1,000"});
+  ::setenv("MSM_MAX_TRIANGLES", "1001", 1);
+  for (const fs::path& file : files) EXPECT_EQ(import_mesh(file).triangle_count(), std::size_t(n)) << file;
+  ::unsetenv("MSM_MAX_TRIANGLES");
+}
+
+// The scene's running total is checked object by object while it loads (issue 19: 40 spheres of
+// 4M triangles ended in std::bad_alloc after 10 GB): loading stops at the object that crosses it.
+TEST(Errors, TriangleLimitStopsTheLoadAtTheObjectThatCrossesIt) {
+  const std::string json = R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [
+    {"name": "a", "primitive": {"type": "sphere", "segments": 64, "rings": 32}},
+    {"name": "b", "primitive": {"type": "sphere", "segments": 64, "rings": 32}},
+    {"name": "c", "primitive": {"type": "sphere", "segments": 64, "rings": 32}}]})";
+  const std::size_t per_sphere = make_sphere(0.5f, 64, 32).triangle_count();
+  ::setenv("MSM_MAX_TRIANGLES", std::to_string(2 * per_sphere + 1).c_str(), 1);
+  expect_json_error(json, {"test.json", "/objects/2", "object 'c'", "the limit is", "MSM_MAX_TRIANGLES"});
+  ::setenv("MSM_MAX_TRIANGLES", std::to_string(3 * per_sphere).c_str(), 1);
+  EXPECT_EQ(load_scene_json(json, fs::current_path(), "test.json").triangle_count(), 3 * per_sphere);
+  ::unsetenv("MSM_MAX_TRIANGLES");
+}
+
+// Found by the mesh fuzzer (tests/fuzz/crashes/mesh_import): Assimp 5.2 reads a PLY header without
+// end_header forever; and headers that declare more than the file holds are truncated files.
+TEST(Import, ImpossiblePlyAndOffHeadersAreErrorsNotHangs) {
+  TempDir dir("msm_scene_test");
+  const fs::path no_end =
+      dir.write("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                              "property float y\nproperty float z\nend_headlr\n0 0 0\n1 0 0\n0 1 0\n");
+  expect_error([&] { (void)import_mesh(no_end); }, {"no_end.ply", "no end_header", "truncated or corrupt"});
+  const fs::path glued =
+      dir.write("glued.ply", std::string("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                         "property float y\nproperty float z\nend_header\x08") +
+                                 "0 0 0\n1 0 0\n0 1 0\n");
+  expect_error([&] { (void)import_mesh(glued); }, {"glued.ply", "no end_header"});
+  const fs::path binary_line =
+      dir.write("binary_line.ply", std::string("ply\nformat ascii 1.0\nproperty list ucha\0\0\"a\"\n"
+                                               "end_header\n0 0 0\n",
+                                               62));
+  expect_error([&] { (void)import_mesh(binary_line); }, {"binary_line.ply", "line 3 of the PLY header is not text"});
+  const fs::path many = dir.write("many.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+                                              "property float x\nproperty float y\nproperty float z\nend_header\n");
+  expect_error([&] { (void)import_mesh(many); }, {"many.ply", "48,000,000,000 bytes", "truncated or corrupt"});
+  const fs::path off = dir.write("many.off", "OFF\n1000000 3 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  expect_error([&] { (void)import_mesh(off); }, {"many.off", "1,000,000 vertices", "truncated or corrupt"});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -684,7 +784,7 @@ TEST(Errors, Meshes) {
   expect_error([&] { load(R"({"name": "m", "mesh": "missing.obj"})"); },
                {"s.json", "/objects/0/mesh", "object 'm'", "missing.obj", "does not exist"});
   dir.write("garbage.ply", "ply\nthis is not a ply file\n\x01\x02\x03");
-  expect_error([&] { load(R"({"mesh": "garbage.ply"})"); }, {"/objects/0/mesh", "garbage.ply", "Assimp cannot read"});
+  expect_error([&] { load(R"({"mesh": "garbage.ply"})"); }, {"/objects/0/mesh", "garbage.ply", "truncated or corrupt"});
   dir.write("empty.obj", "# nothing\n");
   expect_error([&] { load(R"({"mesh": "empty.obj"})"); }, {"/objects/0/mesh", "empty.obj"});
   dir.write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 4\n");

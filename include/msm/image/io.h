@@ -35,6 +35,8 @@ Image read_exr(const std::filesystem::path& path);
 
 // By content (PNG or EXR signature), whatever the extension.
 Image read_image(const std::filesystem::path& path);
+// The same for a file already in memory (name: for the messages only).
+Image decode_image(std::span<const std::uint8_t> bytes, const std::filesystem::path& name);
 // By extension: ".png" or ".exr" (case-insensitive); anything else throws ImageError.
 void write_image(const std::filesystem::path& path, const Image& image);
 
