@@ -32,10 +32,20 @@
 //   msm_rectified_row_step(bounds, v, width)                 Δ(v) of §5.1.1
 //   msm_prefix_sum_weight(σt, Δ, j)                          w(j, v) of §5.1.1
 //   msm_prefix_sum_lookup_u(bounds, r, width)                where a view ray of reach r reads
+//   msm_rectified_view_lookup(frame, bounds, end_world, width)  a pixel's (u, v, depth) lookup
+// Resampling (§5.2), per rectified texel, from the scene's shadow map:
+//   msm_rectified_one_depth(bounds, r, depth_to_z, map_depth)           without filtering
+//   msm_rectified_two_depths(bounds, r, depth_to_z, map_moments)        filtered (Algorithm 2)
+//   msm_rectified_moments4 / msm_rectified_moments6 / msm_rectified_csm(two_depths[, terms])
+// then the storage transform of the technique (msm_theta4_star, msm_theta6_star, msm_csm_to_unorm
+// per texel; quantize.h, baselines.h), which commutes with the prefix sums (both are affine).
 #ifndef MSM_RECTIFICATION_H
 #define MSM_RECTIFICATION_H
+#include "msm/baselines.h"
+#include "msm/moments.h"
 #include "msm/scattering.h"
 #include "msm/shared.h"
+#include "msm/three_moments.h"
 
 MSM_BEGIN
 
@@ -251,6 +261,55 @@ MSM_FN float msm_prefix_sum_weight(float extinction, float delta, float j) {
 // so u = r / r_max − 0.5 / width (linear filtering interpolates between whole texels; rays
 // shorter than one texel read texel 0 with clamp-to-edge addressing).
 MSM_FN float msm_prefix_sum_lookup_u(RectifiedBounds b, float r, float width) { return r / b.r_max - 0.5f / width; }
+
+// The lookup of a pixel whose view ray ends at end_world: (u, v, depth) with u where the prefix
+// sums of a map `width` texels wide are read (msm_prefix_sum_lookup_u), v the row and depth the
+// ray's rectified depth in [0,1] (the receiver depth zf = msm_signed_depth(depth) for moments).
+MSM_FN vec3 msm_rectified_view_lookup(RectificationFrame f, RectifiedBounds b, vec3 end_world, float width) {
+  vec3 c = msm_rectified_coordinates(b, msm_to_rectification_space(f, end_world));
+  return vec3(c.x - 0.5f / width, c.y, c.z);
+}
+
+// ---- Resampling (§5.2) ----
+// The source shadow map is orthographic along the light: its depth d (in its own convention,
+// [0,1] or [-1,1]) lies at rectification z = depth_to_z.x * d + depth_to_z.y on the light ray
+// (depth_to_z.x > 0: depth grows along the light's travel). r is the texel's distance from the
+// camera's light ray (msm_rectified_r_phi(bounds, uv).x). Depths come back in rectified SIGNED
+// depth [-1, 1], clamped (occluders beyond the bounds land on its ends).
+MSM_FN float msm_rectified_signed_depth_of_map_depth(RectifiedBounds b, float r, vec2 depth_to_z, float map_depth) {
+  return msm_signed_depth(msm_rectified_depth_of_rz(b, r, depth_to_z.x * map_depth + depth_to_z.y));
+}
+
+// Without filtering: the map's depth at the texel, weight 1.
+MSM_FN TwoDepths msm_rectified_one_depth(RectifiedBounds b, float r, vec2 depth_to_z, float map_depth) {
+  float z = msm_rectified_signed_depth_of_map_depth(b, r, depth_to_z, map_depth);
+  return TwoDepths(vec2(z, z), vec2(1.0f, 0.0f));
+}
+
+// With filtering: a filtered sample of the map's four moments (canonical b1..b4, after the map's
+// inverse quantization transform, in the map's depth convention) turned into two depths by JCGT
+// Algorithm 2 (three_moments.h; a single depth for zero variance), each mapped to rectified depth.
+// The weights stay, and so does the order z.x <= z.y: along one light ray the rectified depth
+// grows monotonically with the map's depth (clamping may make both equal).
+MSM_FN TwoDepths msm_rectified_two_depths(RectifiedBounds b, float r, vec2 depth_to_z, vec4 map_moments) {
+  TwoDepths d = msm_two_depths_from_three_moments(vec3(map_moments[0], map_moments[1], map_moments[2]));
+  return TwoDepths(vec2(msm_rectified_signed_depth_of_map_depth(b, r, depth_to_z, d.z.x),
+                        msm_rectified_signed_depth_of_map_depth(b, r, depth_to_z, d.z.y)),
+                   d.w);
+}
+
+// The moments of w.x δ(z.x) + w.y δ(z.y): what a rectified texel stores before its transform.
+MSM_FN vec4 msm_rectified_moments4(TwoDepths d) { return d.w.x * msm_moments4(d.z.x) + d.w.y * msm_moments4(d.z.y); }
+MSM_FN Moments6 msm_rectified_moments6(TwoDepths d) {
+  return msm_moments6_scale_add(msm_moments6_scale_add(Moments6(vec3(0.0f), vec3(0.0f)), msm_moments6(d.z.x), d.w.x),
+                                msm_moments6(d.z.y), d.w.y);
+}
+// Klehm et al.'s convolution shadow map of the same distribution, on [0,1] depth (baselines.h).
+MSM_FN CsmMoments msm_rectified_csm(TwoDepths d, int terms) {
+  CsmMoments m = msm_csm_moments_scale_add(CsmMoments(mat4(0.0f), mat4(0.0f)),
+                                           msm_csm_moments(msm_unit_depth(d.z.x), terms), d.w.x);
+  return msm_csm_moments_scale_add(m, msm_csm_moments(msm_unit_depth(d.z.y), terms), d.w.y);
+}
 
 MSM_END
 
