@@ -54,6 +54,10 @@ const int MSM_TECH_MSSM4 = 23; // Θ4*, [-1,1], one table
 const int MSM_TECH_MSSM6 = 24; // Θ6*, [-1,1], two tables (Kneiphof §4.2), layout of MSM_TECH_MSM6_96
 const int MSM_TECH_VSSM = 25;  // (z, z²) of [0,1] depth, one table (naive variance soft shadows)
 const int MSM_TECH_PCSS = 26;  // percentage-closer soft shadows [Fernando 2005]: depth-based
+// Single scattering in the scene's medium (JCGT §5, scattering.h), composited over surfaces shaded
+// with PCF. Ray marching (ray_march.h): equidistant jittered samples of the hard depth map.
+const int MSM_TECH_SCATTER_MARCH32 = 27;
+const int MSM_TECH_SCATTER_MARCH128 = 28;
 
 // Soft shadows from summed-area tables instead of a filtered map.
 MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
@@ -69,9 +73,19 @@ struct MsmTexel {
   vec4 b;
 };
 
-// True for the techniques that read the depth map instead of filterable channels.
+// Single scattering techniques: a scattering pass after the shading (src/render).
+MSM_FN bool msm_technique_is_scattering(int t) {
+  return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128;
+}
+// Samples per view ray of the ray-marching techniques (0 for the others).
+MSM_FN int msm_technique_march_samples(int t) {
+  return t == MSM_TECH_SCATTER_MARCH32 ? 32 : (t == MSM_TECH_SCATTER_MARCH128 ? 128 : 0);
+}
+
+// True for the techniques that read the depth map instead of filterable channels (the ray-marching
+// ones shade their surfaces with PCF).
 MSM_FN bool msm_technique_is_depth_based(int t) {
-  return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS;
+  return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS || msm_technique_march_samples(t) > 0;
 }
 
 // The non-linear techniques store Φ of the filtered moments: they filter before storage (the

@@ -111,6 +111,7 @@ struct FrameResources {
   const vk::Sampler& point_sampler;
   const vk::Sampler& linear_sampler;
   glm::vec3 camera_position{0.0f};
+  ScatteringPush scattering{}; // the scattering pass's (scattering techniques)
 };
 
 // An allocated image and its views: the whole array (2D_ARRAY, every mip: for the shading), and per

@@ -15,6 +15,7 @@
 #include "msm/noise/blue_noise.h"
 #include "msm/render/frame.h"
 #include "msm/sat.h"
+#include "msm/shading.h"
 #include "msm/soft.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
@@ -111,6 +112,7 @@ struct Renderer::Impl {
   FrameConfig config;
   std::unique_ptr<FrameGraph> graph;
   std::vector<LightUniforms> light_data;
+  ScatteringPush scattering{}; // scattering techniques
   // Fitting a light's frustum visits every vertex: one fit per light direction, kept.
   std::vector<std::pair<glm::vec3, scene::LightFrame>> frames;
 
@@ -268,7 +270,7 @@ struct Renderer::Impl {
                                         int(c.formats()[size_t(i)]), technique.name));
     if (!graph || !(config == c)) {
       graph.reset();
-      graph = std::make_unique<FrameGraph>(ctx, recipe(c), std::vector<std::string>{}, frame_outputs(),
+      graph = std::make_unique<FrameGraph>(ctx, recipe(c), std::vector<std::string>{}, frame_outputs(c),
                                            PassResources{programs, sat_builder});
       config = c;
     }
@@ -281,13 +283,29 @@ struct Renderer::Impl {
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
     // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
+    scattering = scattering_push(s, technique);
     return technique;
+  }
+
+  // The scattering pass's parameters: the camera's rays and the scene's medium (none: the pass only
+  // tone maps).
+  ScatteringPush scattering_push(const RenderSettings& s, const Technique& technique) const {
+    ScatteringPush p{};
+    glm::dmat4 view_projection(scene.camera_view_projection(float(s.width) / float(s.height)));
+    p.inverse_view_projection = glm::mat4(glm::inverse(view_projection));
+    p.camera = glm::vec4(scene.camera.position, 0.0f);
+    if (scene.medium)
+      p.medium = glm::vec4(scene.medium->extinction, scene.medium->scattering_albedo, scene.medium->g, 1.0f);
+    p.march = glm::ivec4(msm_technique_march_samples(technique.id), 0, 0, 0);
+    for (int c = 0; c < 3; ++c) p.sky[c] = msm_aces_inverse(MSM_SKY_RADIANCE[c]) / s.exposure;
+    return p;
   }
 
   void record(VkCommandBuffer cmd, std::optional<std::string_view> stop_after = std::nullopt) {
     timer.reset(cmd);
     FrameResources resources{gpu,   uniforms,      lights,         light_data,
                              noise, point_sampler, linear_sampler, scene.camera.position};
+    resources.scattering = scattering;
     graph->record(cmd, timer, resources, config, stop_after);
   }
 
@@ -385,6 +403,15 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   std::span<float> c = r.color.pixels();
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
     for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
+
+  if (g.has_image(kScattering)) {
+    image::Image rgba =
+        to_float_image(vk::readback_image(m.ctx, g.image(kScattering).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL),
+                       VK_FORMAT_R32G32B32A32_SFLOAT, s.width, s.height);
+    r.scattering =
+        image::Image(s.width, s.height, {"scattering_r", "scattering_g", "scattering_b", "visible_fraction"});
+    std::copy(rgba.pixels().begin(), rgba.pixels().end(), r.scattering.pixels().begin());
+  }
 
   std::vector<std::byte> shadow =
       vk::readback_image(m.ctx, g.image(kShadowBuffer).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);

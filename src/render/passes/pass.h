@@ -151,6 +151,22 @@ class ShadingPass : public Pass {
   FrameConfig config_;
 };
 
+// Scattering techniques: camera_depth + surface_radiance + the first light's shadow map -> color
+// (sRGB) and scattering (in-scattered radiance, visible fraction): single scattering in the scene's
+// medium composited over the surfaces, tone mapped (a full-screen triangle, JCGT §5.5's deferred pass).
+class ScatteringPass : public Pass {
+ public:
+  explicit ScatteringPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "scattering"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
 // The images every shadow-map pass creates.
 ImageSpec moment_image_spec(const FrameConfig& config, int i);
 // Binds the scene's vertex and index buffers (every graphics pass draws the scene).
