@@ -14,6 +14,7 @@
 #include "msm/nonlinear.h"
 #include "msm/quantize.h"
 #include "msm/ray_march.h"
+#include "msm/rectification.h"
 #include "msm/roots.h"
 #include "msm/sat.h"
 #include "msm/scattering.h"

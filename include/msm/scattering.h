@@ -11,6 +11,11 @@
 // isotropic, 1/(4π).
 #ifndef MSM_SCATTERING_H
 #define MSM_SCATTERING_H
+#include "msm/baselines.h"
+#include "msm/bias.h"
+#include "msm/hamburger4.h"
+#include "msm/hamburger6.h"
+#include "msm/quantize.h"
 #include "msm/shared.h"
 
 MSM_BEGIN
@@ -45,10 +50,75 @@ MSM_FN float msm_transmittance_integral(float extinction, float a, float b) {
 // The radiance at the camera of a ray of length s ending on a surface of radiance L_s, given the
 // visible fraction of its in-scattering (1 everywhere lit, 0 everywhere shadowed):
 //   exp(−σt s) L_s + f E_l visible_fraction ∫₀ˢ exp(−σt t) dt.
-MSM_FN vec3 msm_scattered_radiance(vec3 surface_radiance, vec3 irradiance, float extinction, float phase_term,
-                                   float s, float visible_fraction) {
+MSM_FN vec3 msm_scattered_radiance(vec3 surface_radiance, vec3 irradiance, float extinction, float phase_term, float s,
+                                   float visible_fraction) {
   return exp(-extinction * s) * surface_radiance +
          (phase_term * visible_fraction * msm_transmittance_integral(extinction, 0.0f, s)) * irradiance;
+}
+
+// ---- Prefiltered single scattering (JCGT §5.3-5.4): the visible fraction of a view ray ----
+// Every function below turns one bilinear lookup in the prefix-summed rectified map
+// (rectification.h: msm_rectified_view_lookup) into the transmittance-weighted visible fraction
+// of the ray, for msm_scattered_radiance's visible_fraction. zf is the ray's rectified depth in
+// SIGNED [-1, 1] (msm_signed_depth of the lookup's depth) for moments, in [0,1] for CSM.
+//
+// β (§5.3.1) weighs the canonical atom at zf (weight w0) in the VISIBILITY: the paper's
+// v0 = β, v_l = 1 for atoms at or behind zf. So visibility = 1 − (lower + (1 − β) w0):
+// β = 0 is the sharp lower bound of the visibility (the upper bound of the shadow, i.e. scattering
+// underestimated), β = 1 the sharp upper bound (overestimated), β = ½ the worst-case optimum.
+const float MSM_SCATTERING_BETA_DEFAULT = 0.5f;
+
+// Adaptive overestimation (§5.3.1): β = (1 + ω_lᵀ ω_p) / 2, with ω_l towards the light and ω_p
+// from the scattering point towards the camera, i.e. −view_dir for view_dir from the camera
+// outwards. Looking into the light (view_dir = towards_light, the epipole, where leaking is
+// worst) gives β = 0; looking away from it (the anti-epipole, where no occluder can lie behind
+// the ray and underestimation would remove all scattering) gives β = 1.
+MSM_FN float msm_scattering_beta_adaptive(vec3 towards_light, vec3 view_dir) {
+  return msm_adaptive_overestimation_beta(towards_light, -view_dir);
+}
+
+// Four moments. stored: the prefix-summed texel as sampled; representation MSM_REP_SIGNED_THETA4
+// (Θ4* in 4 x 16-bit UNORM, 64 bits, α = 6e-5: the 64-bit Θ4*) or MSM_REP_SIGNED_FLOAT
+// (canonical moments in 4 x 32-bit float, α = 3e-7). Sharp lower and upper bounds of
+// Hamburger 4MSM (hamburger4.h), blended by β.
+MSM_FN float msm_scattering_visibility4(vec4 stored, int representation, float zf, float beta) {
+  vec4 b = representation == MSM_REP_SIGNED_THETA4 ? msm_theta4_star_inverse(stored) : stored;
+  b = msm_apply_bias(b, msm_moment_bias(representation));
+  vec2 bounds = msm_hamburger4_bounds(b, zf);
+  return 1.0f - msm_saturate(mix(bounds.x, bounds.y, 1.0f - beta));
+}
+
+// Six moments (§5.4): stored holds Θ6* moments (quantize.h) in the representation
+// MSM_REP6_UNORM10 (6 x 10 bits, α = 4e-3), MSM_REP6_UNORM16 (2 + 4 x 16 bits, α = 8e-5) or
+// MSM_REP6_FLOAT (6 x 32-bit float, α = 5e-6), biased towards the b* of §5.4.3 (config.h).
+// Blinn's cubic and the divided-difference weights of §5.4.2 are hamburger6.h's.
+MSM_FN float msm_scattering_visibility6(Moments6 stored, int representation, float zf, float beta) {
+  Moments6 b = msm_apply_bias6(msm_theta6_star_inverse(stored), msm_moment_bias6(representation));
+  return 1.0f - msm_hamburger6_blend(b, zf, 1.0f - beta);
+}
+
+// Klehm et al. 2014: a convolution shadow map of 32 coefficients (16 sin/cos terms) at 8 bits.
+// Its reconstruction has no bounds to blend; the scaled expansion of surface shadows (scale 2,
+// which biases towards a lower bound of the shadow, baselines.h) would remove the scattering of
+// every ray as long as the ray's own depth is reconstructed as half-shadowed, so scattering uses
+// scale 1 (the plain estimate, ½ at an occluder's depth: the analogue of β = ½) and the default
+// damping against ringing. Depth on [0,1].
+MSM_FN CsmParams msm_csm_scattering_params() {
+  return CsmParams(MSM_CSM_MAX_TERMS, MSM_CSM_DAMPING_DEFAULT, 1.0f, 0.0f);
+}
+// m: the prefix-summed texels decoded to [-1,1] (msm_csm_from_unorm per texel).
+MSM_FN float msm_scattering_visibility_csm(CsmMoments m, float zf, CsmParams p) {
+  return 1.0f - msm_csm_shadow(m, zf, p);
+}
+
+// ---- Ray marching (the baseline; Tóth and Umenhoffer 2009) ----
+// n equidistant segments of a ray of length s; sample i (0-based) at distance (i + jitter) s / n
+// with jitter in [0, 1) (the same for all samples of a pixel: blue noise per pixel), weighted by
+// the segment's transmittance integral. visible_fraction = Σ weight_i V_i / ∫_0^s exp(−σt t) dt,
+// exactly 1 when every sample is lit.
+MSM_FN float msm_ray_march_distance(float s, int n, int i, float jitter) { return (float(i) + jitter) * s / float(n); }
+MSM_FN float msm_ray_march_weight(float extinction, float s, int n, int i) {
+  return msm_transmittance_integral(extinction, float(i) * s / float(n), float(i + 1) * s / float(n));
 }
 
 MSM_END

@@ -172,4 +172,14 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 EffectResult effect_translucent(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 
+// scattering (effect_scattering.cpp): the transmittance-weighted visible fraction of the light
+// along camera + t dir, t in [0, s] (dir unit), with ctx.settings.samples shadow rays.
+struct ScatteringSample {
+  double visible = 1.0, std_error = 0.0;
+  int samples = 0;
+  std::uint64_t rays = 0;
+};
+ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Medium& medium, const glm::dvec3& camera,
+                                      const glm::dvec3& dir, double s, Rng& rng);
+
 } // namespace msm::reference::detail

@@ -16,6 +16,7 @@
 #include <tbb/task_arena.h>
 
 #include "internal.h"
+#include "msm/scattering.h"
 #include "msm/shading.h"
 #include "msm/util/limits.h"
 
@@ -29,6 +30,7 @@ std::string_view to_string(Effect effect) {
   case Effect::filtered: return "filtered";
   case Effect::soft: return "soft";
   case Effect::translucent: return "translucent";
+  case Effect::scattering: return "scattering";
   }
   return "?";
 }
@@ -39,7 +41,9 @@ std::optional<Effect> parse_effect(std::string_view name) {
   return std::nullopt;
 }
 
-bool is_monte_carlo(Effect effect) { return effect == Effect::filtered || effect == Effect::soft; }
+bool is_monte_carlo(Effect effect) {
+  return effect == Effect::filtered || effect == Effect::soft || effect == Effect::scattering;
+}
 
 std::string_view to_string(LightShape shape) { return shape == LightShape::disc ? "disc" : "rectangle"; }
 
@@ -87,8 +91,9 @@ void validate(const Settings& s) {
 }
 
 std::uint64_t estimated_bytes(const Settings& s, std::uint64_t triangles) {
-  const std::uint64_t per_pixel =
-      s.effect == Effect::translucent ? limits::kTracerBytesPerPixelTranslucent : limits::kTracerBytesPerPixel;
+  const std::uint64_t per_pixel = s.effect == Effect::translucent  ? limits::kTracerBytesPerPixelTranslucent
+                                  : s.effect == Effect::scattering ? limits::kTracerBytesPerPixelScattering
+                                                                   : limits::kTracerBytesPerPixel;
   return triangles * limits::kTracerBytesPerTriangle + std::uint64_t(s.width) * std::uint64_t(s.height) * per_pixel;
 }
 
@@ -111,6 +116,7 @@ EffectFunction effect_function(Effect effect) {
   case Effect::filtered: return effect_filtered;
   case Effect::soft: return effect_soft;
   case Effect::translucent: return effect_translucent;
+  case Effect::scattering: return effect_hard; // the surface's own shadow; the ray's is added apart
   }
   throw std::invalid_argument("unknown effect");
 }
@@ -139,6 +145,9 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const int W = settings.width, H = settings.height;
   const bool mc = is_monte_carlo(settings.effect);
 
+  const bool scattering = settings.effect == Effect::scattering;
+  if (scattering && !scene.medium)
+    throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
   const Tracer tracer(scene);
   result.build_seconds = seconds_since(start);
 
@@ -175,6 +184,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
   result.radiance = image::Image(W, H, 3);
   result.surface = image::Image(W, H, {"n_dot_l", "object"});
+  if (scattering) result.scattering = image::Image(W, H, {"R", "G", "B", "length"});
   for (std::size_t i = 0; i < result.surface.pixel_count(); ++i) result.surface.pixels()[2 * i + 1] = -1.0f;
   result.samples = mc ? settings.samples : 1;
 
@@ -185,6 +195,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     return glm::dvec3(q) / q.w;
   };
   const glm::dvec3 irradiance(scene.light().irradiance);
+  const glm::dvec3 camera(scene.camera.position);
 
   std::vector<double> row_sum(H, 0.0);
   std::vector<std::size_t> row_background(H, 0);
@@ -198,6 +209,30 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   float* rad = result.radiance.pixels().data();
   float* surf = result.surface.pixels().data();
   float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
+  // scattering: the visible fraction of the ray from the camera to `end` (std_error, samples into
+  // the visibility image), the in-scattered radiance, and the composite over surface_radiance.
+  const auto add_scattering = [&](int x, int y, const glm::dvec3& dir, const glm::dvec3& end,
+                                  const glm::vec3& surface_radiance, std::uint64_t& row_rays) {
+    const scene::Medium& m = *scene.medium;
+    const double s = glm::length(end - camera);
+    Rng rng = pixel_rng(settings.seed, x, y, Effect::scattering);
+    const ScatteringSample e = scattering_along_ray(ctx, m, camera, dir, s, rng);
+    row_rays += e.rays;
+    row_sum[y] += e.visible;
+    float* v = result.visibility.pixels().data() + (std::size_t(y) * W + x) * result.visibility.channels();
+    v[0] = float(e.visible);
+    v[2] = float(e.samples);
+    v[3] = float(e.std_error);
+    const float f =
+        msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, float(glm::dot(ctx.towards_light, dir)));
+    const glm::vec3 e_l(irradiance);
+    const glm::vec3 in = msm_scattered_radiance(glm::vec3(0.0f), e_l, m.extinction, f, float(s), float(e.visible));
+    const glm::vec3 all = msm_scattered_radiance(surface_radiance, e_l, m.extinction, f, float(s), float(e.visible));
+    float* q = result.scattering.pixels().data() + (std::size_t(y) * W + x) * 4;
+    q[0] = in.r, q[1] = in.g, q[2] = in.b, q[3] = float(s);
+    float* c = result.radiance.pixels().data() + (std::size_t(y) * W + x) * 3;
+    c[0] = all.r, c[1] = all.g, c[2] = all.b;
+  };
   const auto trace_start = std::chrono::steady_clock::now();
 
   tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& range) {
@@ -229,7 +264,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
           v[0] = 1.0f;
           v[1] = 1.0f;
           ++row_background[y];
-          continue; // radiance 0, sample_count and std_error 0
+          if (scattering) add_scattering(x, y, dir, far, glm::vec3(0.0f), row_rays);
+          continue; // radiance 0, sample_count and std_error 0 (scattering: the ray's)
         }
         Rng rng = pixel_rng(settings.seed, x, y, settings.effect);
         const EffectResult e = effect(ctx, hit, rng);
@@ -246,7 +282,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
           t[1] = rgb.g;
           t[2] = rgb.b;
         }
-        row_sum[y] += e.value;
+        if (!scattering) row_sum[y] += e.value;
         // Shading: interpolated normal turned towards the viewer; per channel where the
         // effect gives a visibility per channel (translucent).
         glm::dvec3 n = tracer.shading_normal(hit);
@@ -260,6 +296,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         c[0] = colour.r;
         c[1] = colour.g;
         c[2] = colour.b;
+        if (scattering) add_scattering(x, y, dir, hit.p, colour, row_rays);
       }
       rays += row_rays;
       const std::size_t done = ++rows_done;
@@ -279,7 +316,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     sum += row_sum[y];
     result.background_pixels += row_background[y];
   }
-  const std::size_t covered = std::size_t(W) * H - result.background_pixels;
+  const std::size_t covered = scattering ? std::size_t(W) * H : std::size_t(W) * H - result.background_pixels;
   result.mean_visibility = covered ? sum / double(covered) : 1.0;
   result.threads =
       unsigned(std::min<std::size_t>(tbb::this_task_arena::max_concurrency(),

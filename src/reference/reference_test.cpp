@@ -700,6 +700,160 @@ TEST(reference_translucent, ClosedMeshesAndOpaqueSurfaces) {
   EXPECT_EQ(channel(r.visibility, "visibility", 3, 3), 0.0f);
 }
 
+// ---- scattering -----------------------------------------------------------------------------------
+
+namespace {
+
+const char* kMediumJson =
+    R"("medium": {"extinction": 0.3, "scattering_albedo": 0.8, "phase": "henyey_greenstein", "g": 0.4}, )";
+
+// The phase term of the medium above, independently: ρ σt (1 − g²) / (4π (1 + g² − 2 g cos)^1.5).
+double phase_term(double cos_theta) {
+  const double g = 0.4;
+  return 0.8 * 0.3 * (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * cos_theta, 1.5));
+}
+
+// ∫ exp(−σ t) dt over [a, b] ∩ [0, s] (empty: 0).
+double exp_integral(double sigma, double a, double b, double s) {
+  a = std::max(a, 0.0), b = std::min(b, s);
+  return b > a ? (std::exp(-sigma * a) - std::exp(-sigma * b)) / sigma : 0.0;
+}
+
+// The interval of t where lo < o + t d < hi (one axis), intersected into [a, b].
+void clip_axis(double o, double d, double lo, double hi, double& a, double& b) {
+  if (d == 0.0) {
+    if (!(o > lo && o < hi)) a = 1.0, b = 0.0;
+    return;
+  }
+  double t0 = (lo - o) / d, t1 = (hi - o) / d;
+  if (t0 > t1) std::swap(t0, t1);
+  a = std::max(a, t0), b = std::min(b, t1);
+}
+
+} // namespace
+
+// No occluder above the ground, light straight up: every shadow ray escapes, the visible fraction
+// is exactly 1 and the in-scattered radiance the closed form f E (1 − exp(−σt s)) / σt, with s the
+// distance from the camera to the ground or, on background pixels, to the far plane. The radiance
+// adds the ground's attenuated by exp(−σt s).
+TEST(reference_scattering, ClearAirIsTheClosedForm) {
+  const CameraSpec camera{{0.5, 2.0, 4.0}, {-1.0, 1.0, -2.0}, {0.0, 1.0, 0.0}, 50.0, 0.05, 30.0};
+  const Scene scene = make_scene(camera, light_json({0, 1, 0}),
+                                 R"({"name": "ground", "primitive": {"type": "plane", "size": [20, 20]},
+                                     "material": {"albedo": [0.5, 0.5, 0.5]}})",
+                                 kMediumJson);
+  Settings s;
+  s.effect = Effect::scattering;
+  s.width = 64;
+  s.height = 48;
+  s.samples = 16;
+  const Result r = render(scene, s);
+  ASSERT_EQ(r.visibility.channel_names(),
+            (std::vector<std::string>{"visibility", "background", "sample_count", "std_error"}));
+  ASSERT_EQ(r.scattering.channel_names(), (std::vector<std::string>{"R", "G", "B", "length"}));
+  const glm::dvec3 forward = glm::normalize(camera.target - camera.position);
+  int ground = 0, sky = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const glm::dvec3 d = camera.ray(x, y, s.width, s.height);
+      const double tg = d.y < 0.0 ? -camera.position.y / d.y : -1.0;
+      const glm::dvec3 pg = camera.position + tg * d;
+      const bool hits = tg > 0.0 && std::abs(pg.x) < 10.0 && std::abs(pg.z) < 10.0;
+      if (tg > 0.0 && std::min(10.0 - std::abs(pg.x), 10.0 - std::abs(pg.z)) < 1e-3) continue; // the rim
+      // The far point comes from the float view-projection matrix (as the rasterizer's depth 1
+      // does): its distance is known to ~1e-4 relative; the ground hit is exact.
+      const double far_len = camera.far / glm::dot(d, forward);
+      ASSERT_NEAR(channel(r.scattering, "length", x, y), hits ? tg : far_len, (hits ? 1e-5 : 1e-3) * far_len);
+      const double len = hits ? tg : channel(r.scattering, "length", x, y);
+      const double in = phase_term(d.y) * 2.0 * -std::expm1(-0.3 * len) / 0.3;
+      ASSERT_EQ(channel(r.visibility, "visibility", x, y), 1.0f);
+      ASSERT_EQ(channel(r.visibility, "std_error", x, y), 0.0f);
+      ASSERT_EQ(channel(r.visibility, "sample_count", x, y), 16.0f);
+      ASSERT_NEAR(channel(r.scattering, "R", x, y), in, 2e-5 * in) << x << "," << y;
+      const double surface = hits ? 0.5 * 2.0 / kPi + 0.03 * 0.5 : 0.0; // lit ground, n = +Y
+      ASSERT_NEAR(r.radiance.at(x, y, 1), std::exp(-0.3 * len) * surface + in, 2e-5 * (surface + in));
+      (hits ? ground : sky)++;
+    }
+  EXPECT_GT(ground, 1000);
+  EXPECT_GT(sky, 300);
+  EXPECT_EQ(r.mean_visibility, 1.0);
+}
+
+// A half-plane occluder (y = 1 over -10 < x < 0, |z| < 10) above the ground, light straight up:
+// a point of a view ray is shadowed iff it lies in the slab below the occluder, so the shadowed
+// part of the ray is one interval [a, b] of t (the intersection of three axis ranges) and the
+// visible fraction is 1 − ∫_a^b e^{−σ t} / ∫_0^s e^{−σ t} in closed form. Stratified sampling in
+// proportion to the transmittance puts each of the interval's (at most two) ends in one stratum,
+// so the estimate is within 2 / N of it, for every pixel.
+TEST(reference_scattering, HalfPlaneShadowIsTheClosedForm) {
+  const double h = 1.0, sigma = 0.3;
+  const CameraSpec camera{{0.3, 0.6, 1.5}, {-0.6, 0.0, -0.5}};
+  const Scene scene = make_scene(camera, light_json({0, 1, 0}), ground_and_half_plane(h, true), kMediumJson);
+  Settings s;
+  s.effect = Effect::scattering;
+  s.width = 80;
+  s.height = 60;
+  s.samples = 64;
+  const Result r = render(scene, s);
+  const double inf = std::numeric_limits<double>::infinity();
+  double worst = 0.0, mean_error = 0.0, partial = 0;
+  int n = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const glm::dvec3 d = camera.ray(x, y, s.width, s.height);
+      const glm::dvec3 o = camera.position;
+      const double tg = d.y < 0.0 ? -o.y / d.y : inf, to = d.y > 0.0 ? (h - o.y) / d.y : inf;
+      const glm::dvec3 pg = o + (std::isfinite(tg) ? tg : 0.0) * d, po = o + (std::isfinite(to) ? to : 0.0) * d;
+      const double rim_g = std::min(10.0 - std::abs(pg.x), 10.0 - std::abs(pg.z));
+      const double rim_o = std::min({-po.x, 10.0 + po.x, 10.0 - std::abs(po.z)});
+      if ((std::isfinite(tg) && std::abs(rim_g) < 1e-3) || (std::isfinite(to) && std::abs(rim_o) < 1e-3)) continue;
+      const double len = channel(r.scattering, "length", x, y); // the geometry is checked by ClearAir
+      // Shadowed: −10 < x < 0, |z| < 10, y < h (and y > 0: the ray ends on the ground anyway).
+      double a = 0.0, b = inf;
+      clip_axis(o.x, d.x, -10.0, 0.0, a, b);
+      clip_axis(o.z, d.z, -10.0, 10.0, a, b);
+      clip_axis(o.y, d.y, -inf, h, a, b);
+      const double total = exp_integral(sigma, 0.0, len, len);
+      const double exact = 1.0 - (b > a ? exp_integral(sigma, a, b, len) : 0.0) / total;
+      const double got = channel(r.visibility, "visibility", x, y);
+      worst = std::max(worst, std::abs(got - exact));
+      mean_error += std::abs(got - exact);
+      if (exact > 0.05 && exact < 0.95) ++partial;
+      ++n;
+      ASSERT_LE(std::abs(got - exact), 2.0 / s.samples + 1e-6) << x << "," << y << " exact " << exact;
+      const double in = phase_term(d.y) * 2.0 * exact * total;
+      ASSERT_NEAR(channel(r.scattering, "G", x, y), in, 2.0 / s.samples * phase_term(d.y) * 2.0 * total + 1e-6);
+    }
+  std::printf("[scattering half-plane] %d pixels (%g partly shadowed): max |error| %.2e, mean %.2e (bound %.2e)\n", n,
+              partial, worst, mean_error / n, 2.0 / s.samples);
+  EXPECT_GT(partial, 500);
+}
+
+// Bad input: no medium; a camera inside a closed box (its inside faces are culled back faces:
+// the view rays go on, the points inside are shadowed): finite everywhere, and the in-scattering
+// of every ray is at most that of clear air.
+TEST(reference_scattering, NoMediumAndCameraInsideAnOccluder) {
+  const CameraSpec camera{{0.0, 1.0, 0.0}, {0.0, 0.0, -3.0}};
+  const std::string objects = ground_and_half_plane(2.0) + R"(, {"name": "box", "primitive": {"type": "box",
+      "size": [1, 1, 1]}, "transform": {"translate": [0, 1, 0]}})";
+  Settings s;
+  s.effect = Effect::scattering;
+  s.width = 24;
+  s.height = 16;
+  s.samples = 32;
+  expect_invalid([&] { render(make_scene(camera, light_json({0.2, 1, 0.1}), objects), s); }, "medium");
+  const Result r = render(make_scene(camera, light_json({0.2, 1, 0.1}), objects, kMediumJson), s);
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const float v = channel(r.visibility, "visibility", x, y);
+      ASSERT_TRUE(v >= 0.0f && v <= 1.0f) << x << "," << y;
+      for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(r.radiance.at(x, y, c)));
+      // The first 0.5 (at least) of every ray lies inside the box: shadowed.
+      const double len = channel(r.scattering, "length", x, y);
+      ASSERT_LE(v, 1.0 - (-std::expm1(-0.3 * 0.5)) / (-std::expm1(-0.3 * len)) + 2.0 / s.samples);
+    }
+}
+
 // ---- determinism ---------------------------------------------------------------------------------
 
 TEST(reference_determinism, SameSeedSameImageForAnyThreadCount) {

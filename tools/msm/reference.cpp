@@ -1,6 +1,7 @@
 // `msm reference`: ground truth of a scene's shadows by CPU ray tracing (msm::reference): writes
 // DIR/visibility.exr (the shadow buffer), DIR/radiance.exr, DIR/surface.exr (n_dot_l and object
-// index, masks for comparisons) and DIR/reference.json (settings, timings, sample count), all or
+// index, masks for comparisons), for --effect scattering DIR/scattering.exr (the in-scattered radiance
+// and the ray length), and DIR/reference.json (settings, timings, sample count), all or
 // none (msm::image::FileSet). Bad input is a UsageError (exit status 2); scene
 // errors (SceneError) name the file and the problem.
 #include <unistd.h>
@@ -83,10 +84,10 @@ void add_reference(CLI::App& app) {
   auto* cmd = app.add_subcommand("reference", "Ground-truth shadows of a scene by CPU ray tracing (Embree): "
                                               "visibility.exr, radiance.exr, reference.json");
   cmd->add_option("--scene", opt->scene, "Built-in scene name or scene file (default fence)");
-  cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent")->required();
+  cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent | scattering")->required();
   cmd->add_option("--width", opt->width, "Image width (default 640)");
   cmd->add_option("--height", opt->height, "Image height (default 360)");
-  cmd->add_option("--samples", opt->samples, "Samples per pixel of filtered and soft (default 256)");
+  cmd->add_option("--samples", opt->samples, "Samples per pixel of filtered, soft and scattering (default 256)");
   cmd->add_option("--seed", opt->seed, "Seed of the per-pixel generators (default 1)");
   cmd->add_option("--sampler", opt->sampler, "stratified (default) | independent");
   cmd->add_option("--shadow-size", opt->shadow_size, "filtered: shadow map size in texels (default 1024)");
@@ -109,7 +110,8 @@ void add_reference(CLI::App& app) {
     Settings settings;
     const auto effect = msm::reference::parse_effect(opt->effect);
     if (!effect)
-      throw UsageError(fmt::format("--effect {}: expected hard, filtered, soft or translucent", opt->effect));
+      throw UsageError(
+          fmt::format("--effect {}: expected hard, filtered, soft, translucent or scattering", opt->effect));
     settings.effect = *effect;
     const auto shape = msm::reference::parse_light_shape(opt->light_shape);
     if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
@@ -135,6 +137,10 @@ void add_reference(CLI::App& app) {
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
     const msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    if (settings.effect == msm::reference::Effect::scattering && !scene.medium)
+      throw UsageError(fmt::format("{}: --effect scattering needs a scene with a \"medium\" (extinction, "
+                                   "scattering_albedo, phase; scenes/README.md)",
+                                   scene.source.string()));
     if (settings.effect == msm::reference::Effect::filtered)
       if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
         fmt::print(stderr, "msm reference: {}\n", *w);
@@ -177,6 +183,10 @@ void add_reference(CLI::App& app) {
         files.add_exr(out / "visibility_rgb.exr", result.visibility_rgb);
       else
         files.remove(out / "visibility_rgb.exr");
+      if (!result.scattering.empty())
+        files.add_exr(out / "scattering.exr", result.scattering);
+      else
+        files.remove(out / "scattering.exr");
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
 
     nlohmann::ordered_json j;
@@ -202,6 +212,13 @@ void add_reference(CLI::App& app) {
     j["channels"] = {{"visibility", result.visibility.channel_names()},
                      {"radiance", result.radiance.channel_names()},
                      {"surface", result.surface.channel_names()}};
+    if (!result.scattering.empty()) {
+      j["files"]["scattering"] = "scattering.exr";
+      j["channels"]["scattering"] = result.scattering.channel_names();
+      j["medium"] = {{"extinction", scene.medium->extinction},
+                     {"scattering_albedo", scene.medium->scattering_albedo},
+                     {"g", scene.medium->g}};
+    }
     if (!result.visibility_rgb.empty()) {
       j["files"]["visibility_rgb"] = "visibility_rgb.exr";
       j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();

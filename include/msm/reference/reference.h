@@ -68,7 +68,24 @@
 //               the mean (T_r + T_g + T_b) / 3, exactly T_r when the channels agree. A closed mesh
 //               is crossed twice. At most max_crossings surfaces are counted.
 //
-// Samplers (filtered, soft): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
+//   scattering  Single scattering in the scene's homogeneous medium (scene.medium, required; JCGT
+//               2017 §5.1.1, msm/scattering.h) along the view ray of every pixel, background too:
+//               from the camera position c (not the near plane: scattering accumulates from the
+//               eye, as the paper has it) along the primary ray's unit direction d to the visible
+//               surface (s = |p - c|) or, where the ray hits nothing, to the far plane (s = |far
+//               point - c|, what a depth buffer cleared to 1 gives). The visible fraction
+//                 V = integral_0^s exp(-st t) V(c + t d) dt / integral_0^s exp(-st t) dt
+//               (V(q) = 1 if the ray q -> L reaches infinity, every surface blocking it) is
+//               estimated with `samples` shadow rays from t drawn in proportion to
+//               st exp(-st t) on [0, s] (inverse CDF; `stratified`: one per stratum of [0, 1)),
+//               whose plain mean estimates V; std_error as below. The radiance is
+//               msm_scattered_radiance: exp(-st s) L_s + f E V integral_0^s exp(-st t) dt, with
+//               f = msm_scattering_phase_term(st, albedo, g, dot(L, d)) and L_s the surface's
+//               radiance with its exact (hard) shadow, 0 on background. A camera inside an
+//               occluder: the points inside are shadowed (their shadow rays hit its inside), its
+//               back faces are looked through as above; nothing special, never NaN.
+//
+// Samplers (filtered, soft, scattering): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
 // for the first m^2 of the N samples per pixel and independent uniform points for the rest (so a
 // square N is fully stratified); the soft disc light maps the grid with Shirley and Chiu's
 // concentric map, the filter kernel with FilterKernel::sample per axis. `independent` uses N
@@ -87,7 +104,12 @@
 //   visibility_rgb  translucent only (empty for the other effects; an image holds at most 4
 //                channels, so not in `visibility`): "visibility_r", "visibility_g",
 //                "visibility_b" = T_r, T_g, T_b; 1 on background.
+//                scattering: "visibility" is the visible fraction V of the view ray (on background
+//                pixels too), with "sample_count" and "std_error".
+//   scattering   scattering only: "R", "G", "B" the in-scattered radiance f E V integral_0^s
+//                exp(-st t) dt alone, "length" the ray's length s.
 //   radiance     "R", "G", "B" (linear): msm/shading.h's radiance at the visible surface, 0 on background;
+//                scattering: that radiance attenuated plus the in-scattered (msm_scattered_radiance);
 //                for translucent with the visibility of each channel (T_r, T_g, T_b) in its
 //                channel. Result::mean_visibility averages "visibility".
 //   surface      "n_dot_l": the cosine of the radiance (msm/shading.h) (interpolated normal turned towards the viewer,
@@ -112,11 +134,12 @@
 
 namespace msm::reference {
 
-enum class Effect { hard, filtered, soft, translucent };
-inline constexpr std::array<Effect, 4> kEffects{Effect::hard, Effect::filtered, Effect::soft, Effect::translucent};
+enum class Effect { hard, filtered, soft, translucent, scattering };
+inline constexpr std::array<Effect, 5> kEffects{Effect::hard, Effect::filtered, Effect::soft, Effect::translucent,
+                                                Effect::scattering};
 std::string_view to_string(Effect effect);
 std::optional<Effect> parse_effect(std::string_view name);
-bool is_monte_carlo(Effect effect); // filtered, soft
+bool is_monte_carlo(Effect effect); // filtered, soft, scattering
 
 enum class LightShape { disc, rectangle };
 std::string_view to_string(LightShape shape);
@@ -150,7 +173,7 @@ struct Progress {
 struct Settings {
   Effect effect = Effect::hard;
   int width = 640, height = 360; // 1..kMaxSide
-  int samples = 256;             // per pixel (filtered, soft), 1..kMaxSamples
+  int samples = 256;             // per pixel (filtered, soft, scattering), 1..kMaxSamples
   std::uint64_t seed = 1;
   Sampler sampler = Sampler::stratified;
   // filtered: the renderer's shadow map and filter.
@@ -183,6 +206,7 @@ void check_limits(const Settings& settings, std::uint64_t triangles);
 struct Result {
   image::Image visibility;     // see above for the channels
   image::Image visibility_rgb; // translucent: T_r, T_g, T_b ("visibility_r/_g/_b"); else empty
+  image::Image scattering;     // scattering: R, G, B in-scattered radiance, length; else empty
   image::Image radiance;       // R, G, B
   image::Image surface;        // n_dot_l, object (see above)
   int samples = 1;             // per covered pixel (1 for hard and translucent)
@@ -191,11 +215,13 @@ struct Result {
   double render_seconds = 0.0;                                                  // tracing
   std::uint64_t rays = 0;                                                       // primary + shadow rays traced
   std::size_t background_pixels = 0;
-  double mean_visibility = 0.0; // over the covered (non-background) pixels; 1 if none
+  double mean_visibility = 0.0; // over the covered (non-background) pixels; 1 if none; scattering: the
+                                // mean visible fraction over every pixel
   unsigned threads = 0;         // TBB concurrency used
 };
 
-// Throws std::invalid_argument for bad settings or a scene with non-finite vertices, and
+// Throws std::invalid_argument for bad settings, a scene with non-finite vertices or, for
+// scattering, a scene without a medium, and
 // std::runtime_error when Embree fails.
 Result render(const scene::Scene& scene, const Settings& settings);
 

@@ -42,6 +42,8 @@ inline constexpr std::uint64_t kRendererBytesPerPixel = 96;
 // Measured: 28 B for hard at 4096² (the encoded files are compressed).
 inline constexpr std::uint64_t kTracerBytesPerPixel = 40;
 inline constexpr std::uint64_t kTracerBytesPerPixelTranslucent = 52;
+// scattering: visibility 4, radiance 3, surface 2, scattering 4 floats, and the encoder's copy of 4.
+inline constexpr std::uint64_t kTracerBytesPerPixelScattering = 68;
 // Shadow-map depth: 32-bit depth per MSAA sample.
 inline constexpr std::uint64_t kDepthBytesPerSample = 4;
 
