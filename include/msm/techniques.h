@@ -58,6 +58,9 @@ const int MSM_TECH_PCSS = 26;  // percentage-closer soft shadows [Fernando 2005]
 // with PCF. Ray marching (ray_march.h): equidistant jittered samples of the hard depth map.
 const int MSM_TECH_SCATTER_MARCH32 = 27;
 const int MSM_TECH_SCATTER_MARCH128 = 28;
+// Prefiltered single scattering (JCGT §5.1.1-5.3): the depth map resampled into the rectified map
+// (rectification.h), transmittance-weighted prefix sums along its rows, one lookup per pixel.
+const int MSM_TECH_SCATTER_MSM4_64 = 29; // four moments, Θ4* in 4 x UNORM16, adaptive β
 
 // Soft shadows from summed-area tables instead of a filtered map.
 MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
@@ -74,18 +77,19 @@ struct MsmTexel {
 };
 
 // Single scattering techniques: a scattering pass after the shading (src/render).
+MSM_FN bool msm_technique_is_prefiltered_scattering(int t) { return t == MSM_TECH_SCATTER_MSM4_64; }
 MSM_FN bool msm_technique_is_scattering(int t) {
-  return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128;
+  return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128 || msm_technique_is_prefiltered_scattering(t);
 }
 // Samples per view ray of the ray-marching techniques (0 for the others).
 MSM_FN int msm_technique_march_samples(int t) {
   return t == MSM_TECH_SCATTER_MARCH32 ? 32 : (t == MSM_TECH_SCATTER_MARCH128 ? 128 : 0);
 }
 
-// True for the techniques that read the depth map instead of filterable channels (the ray-marching
+// True for the techniques that read the depth map instead of filterable channels (the scattering
 // ones shade their surfaces with PCF).
 MSM_FN bool msm_technique_is_depth_based(int t) {
-  return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS || msm_technique_march_samples(t) > 0;
+  return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS || msm_technique_is_scattering(t);
 }
 
 // The non-linear techniques store Φ of the filtered moments: they filter before storage (the

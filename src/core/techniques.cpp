@@ -420,6 +420,19 @@ constexpr Technique kTechniques[] = {
      nullptr,
      nullptr,
      nullptr},
+    {"scatter-msm4-64",
+     "Prefiltered single scattering with four moments (JCGT §5.3): the depth map resampled without filtering into "
+     "the rectified map (§5.1.1), transmittance-weighted prefix sums along its rows stored as Θ4* in 4 x 16 bits, "
+     "one bilinear lookup per pixel, sharp bounds blended by the adaptive β of §5.3.1; surfaces shaded with PCF",
+     MSM_TECH_SCATTER_MSM4_64,
+     64,
+     4,
+     {TexelFormat::none, TexelFormat::none},
+     "",
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
 };
 
 // One short name per family, for its recommended storage: the JCGT 2017 64-bit MSM, the 2015

@@ -111,7 +111,8 @@ struct FrameResources {
   const vk::Sampler& point_sampler;
   const vk::Sampler& linear_sampler;
   glm::vec3 camera_position{0.0f};
-  ScatteringPush scattering{}; // the scattering pass's (scattering techniques)
+  ScatteringPush scattering{};               // the scattering pass's (scattering techniques)
+  const vk::Buffer* rectification = nullptr; // RectificationUniforms (render/rectification_uniforms.h)
 };
 
 // An allocated image and its views: the whole array (2D_ARRAY, every mip: for the shading), and per

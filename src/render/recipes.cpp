@@ -29,6 +29,10 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
     }
   }
   passes.push_back(std::make_unique<ShadingPass>(c));
+  if (msm_technique_is_prefiltered_scattering(id)) {
+    passes.push_back(std::make_unique<RectifyPass>(c));
+    passes.push_back(std::make_unique<PrefixSumPass>(c));
+  }
   if (msm_technique_is_scattering(id)) passes.push_back(std::make_unique<ScatteringPass>(c));
   return passes;
 }

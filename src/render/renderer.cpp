@@ -14,6 +14,7 @@
 #include "msm/gpu/sat_builder.h"
 #include "msm/noise/blue_noise.h"
 #include "msm/render/frame.h"
+#include "msm/render/rectification_uniforms.h"
 #include "msm/sat.h"
 #include "msm/shading.h"
 #include "msm/soft.h"
@@ -103,6 +104,7 @@ struct Renderer::Impl {
   scene::Scene scene;
   GpuScene gpu;
   vk::Buffer uniforms, lights;
+  vk::Buffer rectification; // RectificationUniforms (prefiltered scattering)
   vk::GpuTimer timer;
   vk::Image noise;
   vk::Sampler point_sampler, linear_sampler;
@@ -121,6 +123,8 @@ struct Renderer::Impl {
         uniforms(vk::create_buffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         lights(vk::create_buffer(c, sizeof(LightUniforms) * MSM_MAX_LIGHTS, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                  vk::Memory::host)),
+        rectification(
+            vk::create_buffer(c, sizeof(RectificationUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         timer(c, 32), noise(upload_blue_noise(c)), point_sampler(vk::create_sampler(c, VK_FILTER_NEAREST)),
         linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)), programs(c), sat_builder(c) {}
 
@@ -284,6 +288,10 @@ struct Renderer::Impl {
     // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
     scattering = scattering_push(s, technique);
+    if (msm_technique_is_prefiltered_scattering(technique.id)) {
+      RectificationUniforms r = rectification_uniforms(s, frame_lights.front());
+      std::memcpy(rectification.data(), &r, sizeof(r)); // NOLINT(bugprone-undefined-memory-manipulation)
+    }
     return technique;
   }
 
@@ -301,11 +309,30 @@ struct Renderer::Impl {
     return p;
   }
 
+  // The rectification of the first light for this camera (rectification.h, JCGT Appendix A): the
+  // bounds cover the pyramid from the camera to its far plane.
+  RectificationUniforms rectification_uniforms(const RenderSettings& s, const scene::DirectionalLight& light) {
+    glm::dmat4 inverse = glm::inverse(glm::dmat4(scene.camera_view_projection(float(s.width) / float(s.height))));
+    glm::mat4x3 corners;
+    const glm::dvec2 ndc[4] = {{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}}; // around the quad
+    for (int j = 0; j < 4; ++j) {
+      glm::dvec4 p = inverse * glm::dvec4(ndc[j], 1.0, 1.0);
+      corners[j] = glm::vec3(glm::dvec3(p) / p.w);
+    }
+    RectificationFrame f = msm_rectification_frame(scene.camera.position, light.towards_light);
+    RectifiedBounds b = msm_rectification_bounds(f, corners);
+    float extinction = scene.medium ? scene.medium->extinction : 0.0f;
+    return msm_rectification_uniforms(
+        f, b,
+        glm::vec4(float(s.shadow_size), float(s.shadow_size), float(light_frame(light).depth_extent), extinction));
+  }
+
   void record(VkCommandBuffer cmd, std::optional<std::string_view> stop_after = std::nullopt) {
     timer.reset(cmd);
     FrameResources resources{gpu,   uniforms,      lights,         light_data,
                              noise, point_sampler, linear_sampler, scene.camera.position};
     resources.scattering = scattering;
+    resources.rectification = &rectification;
     graph->record(cmd, timer, resources, config, stop_after);
   }
 

@@ -34,18 +34,18 @@ TEST(AcesInverse, RoundTrip) {
 constexpr int kWidth = 96, kHeight = 64;
 
 // A ground plane (8 x 8 at y = 0) under a light from `towards`, in a forward-scattering medium;
-// `post` adds a box above the ground whose shadow crosses the view.
-scene::Scene medium_scene(bool post, bool medium = true, glm::vec3 towards = {0.4f, 1.0f, -0.3f}) {
+// `wall` adds a wall above the ground whose shadow crosses the view.
+scene::Scene medium_scene(bool wall, bool medium = true, glm::vec3 towards = {0.4f, 1.0f, -0.3f}) {
   return scene::load_scene_json(
       fmt::format(R"({{ "msm_scene": 1, "name": "medium",
-        "camera": {{ "position": [0, 2.5, 6], "target": [0, 0, 0], "fov_y_deg": 50 }},
+        "camera": {{ "position": [0, 2.5, 6], "target": [0, 0, 0], "fov_y_deg": 50, "near": 0.1, "far": 20 }},
         "light": {{ "towards_light": [{}, {}, {}], "irradiance": [3, 2.5, 2] }},
         {} "objects": [ {{ "name": "ground", "primitive": {{ "type": "plane", "size": [8, 8] }} }} {} ] }})",
                   towards.x, towards.y, towards.z,
                   medium ? R"("medium": { "extinction": 0.2, "scattering_albedo": 0.8, "phase": "henyey_greenstein",
                                          "g": 0.4 },)"
                          : "",
-                  post ? R"(, { "name": "post", "primitive": { "type": "box", "size": [0.6, 3, 0.6] },
+                  wall ? R"(, { "name": "wall", "primitive": { "type": "box", "size": [3, 3, 0.6] },
                                "transform": { "translate": [0, 1.5, 0] } })"
                        : ""),
       ".", "medium");
@@ -114,8 +114,8 @@ TEST_F(ScatteringTest, UnshadowedMediumMatchesTheClosedForm) {
   }
 }
 
-// A post in the light shadows part of the medium: its shadow's rays lose in-scattering (visible
-// fraction well below 1 somewhere, never outside [0, 1] or NaN), and 32 and 128 samples estimate the
+// A wall in the light shadows part of the medium: its shadow's rays lose in-scattering (visible
+// fraction below 0.95 somewhere, never outside [0, 1] or NaN), and 32 and 128 samples estimate the
 // same integral (mean visible fraction within 0.01 of each other).
 TEST_F(ScatteringTest, AnOccluderShadowsTheMedium) {
   Renderer renderer(ctx(), medium_scene(true));
@@ -133,11 +133,46 @@ TEST_F(ScatteringTest, AnOccluderShadowsTheMedium) {
         lowest = std::min(lowest, v);
         mean[k] += v / (kWidth * kHeight);
       }
-    EXPECT_LT(lowest, 0.9f);
+    fmt::print("{}: lowest visible fraction {:.3f}\n", technique, lowest);
+    EXPECT_LT(lowest, 0.95f); // measured 0.896 (32 samples), 0.898 (128)
     ++k;
   }
   EXPECT_NEAR(mean[0], mean[1], 0.01);
   EXPECT_LT(mean[1], 0.999);
+}
+
+// Mean absolute difference of the visible fractions of two renders, and the largest.
+std::pair<double, double> visible_difference(const RenderResult& a, const RenderResult& b) {
+  double sum = 0.0, worst = 0.0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      double d = std::abs(double(a.scattering.at(x, y, 3)) - double(b.scattering.at(x, y, 3)));
+      sum += d;
+      worst = std::max(worst, d);
+    }
+  return {sum / (kWidth * kHeight), worst};
+}
+
+// Prefiltered scattering with four moments against ray marching with 128 samples (the better
+// estimate of the same integral): unshadowed, lit from above, and with the wall's shadow under a
+// tilted light. The camera's far plane is at 20 (the rectified map spans r up to the far plane: at
+// the default 1000 the 256 texels of a row would be 3.5 units wide, wider than the ground's detail).
+// Measured on lavapipe: unshadowed MAE 0.0137, max 0.034; with the wall MAE 0.022, max 0.093 (the
+// four-moment reconstruction of the rays through the shadow's edges; ray marching has its noise).
+TEST_F(ScatteringTest, PrefilteredFourMomentsAgreeWithRayMarching) {
+  for (bool wall : {false, true}) {
+    SCOPED_TRACE(wall ? "wall" : "unshadowed");
+    scene::Scene scene = wall ? medium_scene(true) : medium_scene(false, true, {0.0f, 1.0f, 0.0f});
+    Renderer renderer(ctx(), scene);
+    RenderResult march = renderer.render(settings("scatter-march-128"));
+    RenderResult prefiltered = renderer.render(settings("scatter-msm4-64"));
+    for (float v : prefiltered.scattering.pixels()) ASSERT_TRUE(std::isfinite(v));
+    auto [mae, worst] = visible_difference(prefiltered, march);
+    fmt::print("scatter-msm4-64 vs scatter-march-128 ({}): visible fraction MAE {:.4f}, max {:.4f}\n",
+               wall ? "wall" : "unshadowed", mae, worst);
+    EXPECT_LT(mae, wall ? 0.03 : 0.02);
+    EXPECT_LT(worst, wall ? 0.15 : 0.05);
+  }
 }
 
 // Without a medium the scattering pass only tone maps: the image is PCF's up to the 16-bit float

@@ -163,6 +163,37 @@ class ScatteringPass : public Pass {
   void execute(const PassContext& c) const override;
 
  private:
+  bool prefiltered() const;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
+// Prefiltered scattering (JCGT §5.1.1, §5.2): the first light's depth map resampled without filtering
+// into the rectified map (compute, rectify.glsl): moments of the rectified depth in float.
+class RectifyPass : public Pass {
+ public:
+  explicit RectifyPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "rectify"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
+// The rectified map -> transmittance-weighted prefix sums along its rows (JCGT Appendix C's 8 x 8
+// scheme, prefix_sums.comp), in the technique's storage format.
+class PrefixSumPass : public Pass {
+ public:
+  explicit PrefixSumPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "prefix_sums"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
   const vk::Program* program_ = nullptr;
   FrameConfig config_;
 };
