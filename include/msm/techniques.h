@@ -60,7 +60,10 @@ const int MSM_TECH_SCATTER_MARCH32 = 27;
 const int MSM_TECH_SCATTER_MARCH128 = 28;
 // Prefiltered single scattering (JCGT §5.1.1-5.3): the depth map resampled into the rectified map
 // (rectification.h), transmittance-weighted prefix sums along its rows, one lookup per pixel.
-const int MSM_TECH_SCATTER_MSM4_64 = 29; // four moments, Θ4* in 4 x UNORM16, adaptive β
+const int MSM_TECH_SCATTER_MSM4_64 = 29;  // four moments, Θ4* in 4 x UNORM16, adaptive β
+const int MSM_TECH_SCATTER_MSM6_64 = 30;  // six moments (§5.4), Θ6* in 6 x 10 bits (two RGB10A2)
+const int MSM_TECH_SCATTER_MSM6_96 = 31;  // Θ6* in 6 x 16 bits (RGBA16 + RG16)
+const int MSM_TECH_SCATTER_MSM6_192 = 32; // Θ6* in 6 x 32-bit float (RGBA32F + RG32F)
 
 // Soft shadows from summed-area tables instead of a filtered map.
 MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
@@ -77,7 +80,16 @@ struct MsmTexel {
 };
 
 // Single scattering techniques: a scattering pass after the shading (src/render).
-MSM_FN bool msm_technique_is_prefiltered_scattering(int t) { return t == MSM_TECH_SCATTER_MSM4_64; }
+MSM_FN bool msm_technique_is_prefiltered_scattering(int t) {
+  return t >= MSM_TECH_SCATTER_MSM4_64 && t <= MSM_TECH_SCATTER_MSM6_192;
+}
+// The six-moment storage (MSM_REP6_* of bias.h) of a prefiltered technique; -1 for four moments.
+MSM_FN int msm_technique_scatter_representation6(int t) {
+  return t == MSM_TECH_SCATTER_MSM6_64    ? MSM_REP6_UNORM10
+         : t == MSM_TECH_SCATTER_MSM6_96  ? MSM_REP6_UNORM16
+         : t == MSM_TECH_SCATTER_MSM6_192 ? MSM_REP6_FLOAT
+                                          : -1;
+}
 MSM_FN bool msm_technique_is_scattering(int t) {
   return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128 || msm_technique_is_prefiltered_scattering(t);
 }

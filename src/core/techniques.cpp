@@ -433,6 +433,45 @@ constexpr Technique kTechniques[] = {
      nullptr,
      nullptr,
      nullptr},
+    {"scatter-msm6-64",
+     "Prefiltered single scattering with six moments (JCGT §5.4): as scatter-msm4-64, Θ6* prefix sums in 6 x 10 bits "
+     "(two RGB10A2 images, alpha 4e-3), "
+     "Blinn's cubic and the divided-difference weights, adaptive β",
+     MSM_TECH_SCATTER_MSM6_64,
+     64,
+     6,
+     {TexelFormat::none, TexelFormat::none},
+     "",
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
+    {"scatter-msm6-96",
+     "Prefiltered single scattering with six moments (JCGT §5.4): as scatter-msm4-64, Θ6* prefix sums in 2 + 4 x 16 "
+     "bits (alpha 8e-5), "
+     "Blinn's cubic and the divided-difference weights, adaptive β",
+     MSM_TECH_SCATTER_MSM6_96,
+     96,
+     6,
+     {TexelFormat::none, TexelFormat::none},
+     "",
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
+    {"scatter-msm6-192",
+     "Prefiltered single scattering with six moments (JCGT §5.4): as scatter-msm4-64, Θ6* prefix sums in 6 x 32-bit "
+     "float (alpha 5e-6), "
+     "Blinn's cubic and the divided-difference weights, adaptive β",
+     MSM_TECH_SCATTER_MSM6_192,
+     192,
+     6,
+     {TexelFormat::none, TexelFormat::none},
+     "",
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
 };
 
 // One short name per family, for its recommended storage: the JCGT 2017 64-bit MSM, the 2015

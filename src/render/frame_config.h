@@ -46,6 +46,8 @@ inline constexpr const char* kScattering = "scattering";
 // Prefiltered scattering: the rectified map (float moments) and its prefix sums (storage format).
 inline constexpr const char* kRectified = "rectified";
 inline constexpr const char* kPrefixSums = "prefix_sums";
+inline constexpr const char* kRectified1 = "rectified1"; // six moments: the second image of each
+inline constexpr const char* kPrefixSums1 = "prefix_sums1";
 // Moment image i (0 or 1) of colour channel c (0 = the only one, or red; 1 green; 2 blue).
 std::string moment_image(int channel, int i);
 // Summed-area table of moment image i (soft shadows).

@@ -304,7 +304,8 @@ struct Renderer::Impl {
     p.camera = glm::vec4(scene.camera.position, 0.0f);
     if (scene.medium)
       p.medium = glm::vec4(scene.medium->extinction, scene.medium->scattering_albedo, scene.medium->g, 1.0f);
-    p.march = glm::ivec4(msm_technique_march_samples(technique.id), 0, 0, 0);
+    p.march = glm::ivec4(msm_technique_march_samples(technique.id), msm_technique_scatter_representation6(technique.id),
+                         0, 0);
     for (int c = 0; c < 3; ++c) p.sky[c] = msm_aces_inverse(MSM_SKY_RADIANCE[c]) / s.exposure;
     return p;
   }

@@ -78,7 +78,8 @@ struct ScatteringPush {
   vec4 camera;                  // xyz: camera position, w: unused
   vec4 medium;                  // x: extinction σt, y: scattering albedo ρ, z: HG g,
                                 // w: 1 with a medium, 0 without (the pass only tone maps)
-  ivec4 march;                  // x: ray-marching samples per pixel, yzw: unused
+  ivec4 march;                  // x: ray-marching samples per pixel, y: six-moment storage
+                                // (MSM_REP6_*, prefiltered), zw: unused
   vec4 sky;                     // rgb: the background's linear radiance (msm_aces_inverse of
                                 // MSM_SKY_RADIANCE over the exposure: shown as before), a: unused
 };

@@ -164,6 +164,7 @@ class ScatteringPass : public Pass {
 
  private:
   bool prefiltered() const;
+  bool six_moments() const;
   const vk::Program* program_ = nullptr;
   FrameConfig config_;
 };
@@ -197,6 +198,9 @@ class PrefixSumPass : public Pass {
   const vk::Program* program_ = nullptr;
   FrameConfig config_;
 };
+
+// Six-moment prefiltered scattering: two images per map (rectified, prefix sums).
+bool prefix_sums_have_two_images(const FrameConfig& config);
 
 // The images every shadow-map pass creates.
 ImageSpec moment_image_spec(const FrameConfig& config, int i);

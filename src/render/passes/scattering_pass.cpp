@@ -5,16 +5,18 @@
 namespace msm::render {
 
 bool ScatteringPass::prefiltered() const { return msm_technique_is_prefiltered_scattering(config_.technique->id); }
+bool ScatteringPass::six_moments() const { return msm_technique_scatter_representation6(config_.technique->id) >= 0; }
 
 void ScatteringPass::prepare(const PassResources& r) {
   vk::GraphicsDesc d{.name = std::string("scattering ") + std::string(config_.technique->name),
                      .vertex_shader = "fullscreen.vert",
-                     .fragment_shader = prefiltered()       ? "scatter_prefiltered.frag"
+                     .fragment_shader = six_moments()       ? "scatter_prefiltered6.frag"
+                                        : prefiltered()     ? "scatter_prefiltered.frag"
                                         : config_.msaa == 1 ? "scatter_march_1x.frag"
                                                             : "scatter_march.frag",
                      .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
                                   vk::Binding::sampled_image, vk::Binding::sampled_image, vk::Binding::storage_buffer,
-                                  vk::Binding::uniform_buffer},
+                                  vk::Binding::uniform_buffer, vk::Binding::sampled_image},
                      .push_constant_size = sizeof(ScatteringPush),
                      .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
                      .depth_write = false};
@@ -27,6 +29,7 @@ void ScatteringPass::reflect(PassBuilder& b) const {
   b.read(kSurfaceRadiance, use::sampled(fragment));
   // Ray marching reads the depth map, the prefiltered techniques their prefix sums.
   b.read(prefiltered() ? kPrefixSums : kShadowDepth, use::sampled(fragment));
+  if (six_moments()) b.read(kPrefixSums1, use::sampled(fragment));
   uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
   b.create(kColor, {.format = VK_FORMAT_R8G8B8A8_SRGB, .width = w, .height = h}, use::color_attachment());
   b.create(kScattering, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
@@ -46,7 +49,10 @@ void ScatteringPass::execute(const PassContext& c) const {
        prefiltered() ? vk::Descriptor(c.image(kPrefixSums).layer_views[0], read_only, c.frame.linear_sampler)
                      : vk::Descriptor(c.image(kShadowDepth).layer_views[0], read_only, point), // light 0
        vk::Descriptor(c.frame.blue_noise.view(), read_only, point), vk::Descriptor(c.frame.lights),
-       vk::Descriptor(*c.frame.rectification)},
+       vk::Descriptor(*c.frame.rectification),
+       // The second image of six moments (the others: any 2D image, unused).
+       vk::Descriptor(c.image(six_moments() ? kPrefixSums1 : kSurfaceRadiance).layer_views[0], read_only,
+                      c.frame.linear_sampler)},
       c.frame.scattering);
   vkCmdDraw(c.cmd, 3, 1, 0, 0);
   vkCmdEndRendering(c.cmd);

@@ -2,7 +2,8 @@
 // scattering (JCGT §5.1.1, §5.2; rectification.h): per rectified texel, the light ray at (r, φ) is
 // looked up in the light's depth map (without filtering: the nearest texel, sample 0), its depth
 // mapped to the rectified depth π − θ and turned into the technique's moments in its storage basis
-// (Θ4*), written as float for the prefix sums. A light ray outside the map, or over a texel without
+// (Θ4*; with MSM_SIX_MOMENTS Θ6* over two images: (odd, even.x) and (even.y, even.z)), written as
+// float for the prefix sums. A light ray outside the map, or over a texel without
 // a caster, gets the farthest rectified depth: nothing on it shadows any view ray.
 #include "msm/render/rectification_uniforms.h"
 #include "msm/quantize.h"
@@ -14,6 +15,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, binding = 1) uniform RectificationBlock { RectificationUniforms rect; };
 layout(binding = 4, rgba32f) uniform writeonly image2D rectified;
+#ifdef MSM_SIX_MOMENTS
+layout(binding = 5, rgba32f) uniform writeonly image2D rectified1;
+#endif
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
@@ -36,5 +40,11 @@ void main() {
     float depth = depth_sample(t, 0);
     if (depth < 1.0f) d = msm_rectified_one_depth(b, r, depth_to_z, depth);
   }
+#ifdef MSM_SIX_MOMENTS
+  Moments6 m = msm_theta6_star(msm_rectified_moments6(d));
+  imageStore(rectified, texel, vec4(m.odd, m.even.x));
+  imageStore(rectified1, texel, vec4(m.even.y, m.even.z, 0.0f, 0.0f));
+#else
   imageStore(rectified, texel, msm_theta4_star(msm_rectified_moments4(d)));
+#endif
 }

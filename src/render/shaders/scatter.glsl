@@ -6,16 +6,18 @@
 //    against the first light's hard depth map (sample 0 of each texel). Samples outside the map's
 //    x, y range count as lit (nothing there casts into the map); below its far plane they compare
 //    at depth 1.
-//  - prefiltered (MSM_SCATTER_PREFILTERED, JCGT §5.1.1, §5.3): one bilinear lookup in the
-//    prefix-summed rectified map (rectification.h), four moments with adaptive β.
+//  - prefiltered (MSM_SCATTER_PREFILTERED, JCGT §5.1.1, §5.3, §5.4): one bilinear lookup in the
+//    prefix-summed rectified map (rectification.h), four (or, MSM_SIX_MOMENTS, six) moments with
+//    adaptive β.
 #include "msm/ray_march.h"
 #include "msm/render/rectification_uniforms.h"
 #include "msm/shading.h"
 #define MSM_LIGHT_BINDING 5
 #include "frame.glsl"
 #ifdef MSM_SCATTER_PREFILTERED
-layout(binding = 3) uniform sampler2D prefix_sums; // Θ4*, 16-bit, bilinear
+layout(binding = 3) uniform sampler2D prefix_sums; // Θ4* (16-bit) or Θ6* image 0, bilinear
 layout(std140, binding = 6) uniform RectificationBlock { RectificationUniforms rect; };
+layout(binding = 7) uniform sampler2D prefix_sums1; // Θ6* image 1
 #else
 #define MSM_DEPTH_BINDING 3
 #include "depth_map.glsl"
@@ -61,9 +63,21 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
   RectificationFrame f = msm_rectification_frame_of(rect);
   RectifiedBounds b = msm_rectified_bounds_of(rect);
   vec3 lookup = msm_rectified_view_lookup(f, b, camera + s * direction, rect.map.x);
-  vec4 stored = textureLod(prefix_sums, vec2(lookup.x, lookup.y), 0.0f);
+  vec2 uv = vec2(lookup.x, lookup.y);
+  vec4 stored = textureLod(prefix_sums, uv, 0.0f);
   float beta = msm_scattering_beta_adaptive(lights[0].towards_light.xyz, direction);
-  return msm_scattering_visibility4(stored, MSM_REP_SIGNED_THETA4, msm_signed_depth(lookup.z), beta);
+  float zf = msm_signed_depth(lookup.z);
+#ifdef MSM_SIX_MOMENTS
+  // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
+  int representation = scatter.march.y;
+  vec4 stored1 = textureLod(prefix_sums1, uv, 0.0f);
+  Moments6 m = representation == MSM_REP6_UNORM10
+                   ? Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored1.x, stored1.y, stored1.z))
+                   : Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored.w, stored1.x, stored1.y));
+  return msm_scattering_visibility6(m, representation, zf, beta);
+#else
+  return msm_scattering_visibility4(stored, MSM_REP_SIGNED_THETA4, zf, beta);
+#endif
 }
 #endif
 
