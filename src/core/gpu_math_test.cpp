@@ -208,10 +208,6 @@ const Spec kSpecs[] = {
     {MSM_K_SOFT4, "soft4", Metric::abs, A3, Layout::none, 1e-3, 2e-4},
     {MSM_K_SOFT6, "soft6", Metric::abs, A3, Layout::none, 0.01, 2e-3},
     {MSM_K_RAISE_D2, "raise_d2", Metric::abs, A4, Layout::none, 1e-6, 5e-7},
-    // Prefiltered scattering's visible fraction: the bounds of hamburger4/6 blended by β, on stored
-    // texels of every representation; the bounds of the functions underneath.
-    {MSM_K_SCATTER_VISIBILITY4, "scatter_visibility4", Metric::abs, A1, Layout::none, 0.01, 2e-4},
-    {MSM_K_SCATTER_VISIBILITY6, "scatter_visibility6", Metric::abs, A1, Layout::none, 5e-3, 1e-3},
 };
 
 // The functions whose outputs are shadows, bounds or blocker depths: finite on every input,
@@ -220,7 +216,7 @@ bool finite_outputs(int id) {
   return id == MSM_K_HAMBURGER4_BOUNDS || id == MSM_K_HAUSDORFF4 || id == MSM_K_HAMBURGER6_BOUNDS ||
          id == MSM_K_HAMBURGER6_BLEND || id == MSM_K_BLOCKER4 || id == MSM_K_BLOCKER4_UPPER || id == MSM_K_BLOCKER6 ||
          id == MSM_K_BLOCKER6_UPPER || id == MSM_K_NL_SHADOW || id == MSM_K_TECHNIQUE_SHADOW4 || id == MSM_K_SOFT4 ||
-         id == MSM_K_SOFT6 || id == MSM_K_SCATTER_VISIBILITY4 || id == MSM_K_SCATTER_VISIBILITY6;
+         id == MSM_K_SOFT6;
 }
 
 const Spec& spec_of(int id) {
@@ -805,23 +801,6 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       x.a = g.moments4(t).b;
       x.b[0] = g.log_uniform(1e-8f, 1e-5f);
       break;
-    case MSM_K_SCATTER_VISIBILITY4: {
-      bool theta4 = g.chance(0.5);
-      x.a = theta4 ? msm_quantize_unorm16(msm_theta4_star(t.signed4())) : t.signed4();
-      x.b = vec4(g.receiver(float(t.surface), -1.0f, 1.0f), g.uni(0.0f, 1.0f), 0.0f, 0.0f);
-      x.u[0] = uint32_t(theta4 ? MSM_REP_SIGNED_THETA4 : MSM_REP_SIGNED_FLOAT);
-      break;
-    }
-    case MSM_K_SCATTER_VISIBILITY6: {
-      int rep = g.integer(MSM_REP6_UNORM10, MSM_REP6_FLOAT);
-      Moments6 q = msm_theta6_star(t.signed6());
-      if (rep == MSM_REP6_UNORM10) q = msm_quantize_unorm10(q);
-      if (rep == MSM_REP6_UNORM16) q = msm_quantize_unorm16(q);
-      x.a = vec4(q.odd, g.receiver(float(t.surface), -1.0f, 1.0f));
-      x.b = vec4(q.even, g.uni(0.0f, 1.0f));
-      x.u[0] = uint32_t(rep);
-      break;
-    }
     default: ADD_FAILURE() << "no inputs for function id " << id;
     }
     // Non-finite and huge inputs for the reconstructions: one moment or the receiver.
@@ -830,7 +809,7 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       if (k < 4)
         x.a[k] = g.special();
       else if (id == MSM_K_HAMBURGER6_BOUNDS || id == MSM_K_HAMBURGER6_BLEND || id == MSM_K_BLOCKER6 ||
-               id == MSM_K_BLOCKER6_UPPER || id == MSM_K_SOFT6 || id == MSM_K_SCATTER_VISIBILITY6)
+               id == MSM_K_BLOCKER6_UPPER || id == MSM_K_SOFT6)
         x.a[3] = g.special();
       else if (id != MSM_K_TECHNIQUE_SHADOW4)
         x.b[0] = g.special();
