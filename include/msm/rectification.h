@@ -18,7 +18,9 @@
 // The bounds cover the whole view frustum (the far plane's corners and the camera; the near plane
 // is ignored, since scattering accumulates from the camera on), with a guard band of 10% on θ
 // against leaking (§5.1.1), clamped to [0, π]. If the light's direction or its opposite lies in the
-// view (the epipole in view: looking into the light or away from it), φ spans the full circle.
+// view (the epipole in view: looking into the light or away from it), φ spans the full circle:
+// then rows 0 and height − 1 are neighbours, and the map is sampled with repeat addressing in v
+// (clamp-to-edge otherwise, and always in u).
 //
 // Functions (shared GLSL/C++, shared.h rules):
 //   msm_rectification_frame(camera, towards_light)           the frame (origin and axes)

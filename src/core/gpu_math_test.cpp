@@ -208,6 +208,11 @@ const Spec kSpecs[] = {
     {MSM_K_SOFT4, "soft4", Metric::abs, A3, Layout::none, 1e-3, 2e-4},
     {MSM_K_SOFT6, "soft6", Metric::abs, A3, Layout::none, 0.01, 2e-3},
     {MSM_K_RAISE_D2, "raise_d2", Metric::abs, A4, Layout::none, 1e-6, 5e-7},
+    // Prefiltered scattering: the bounds of hamburger4/6 blended by β after the inverse transform
+    // and the bias, so the tolerances of hamburger4_bounds and hamburger6_blend. Measured on
+    // lavapipe (emulated fma): four 6.1e-5 / 3.1e-5, six 4.9e-4 / 2.4e-4.
+    {MSM_K_SCATTERING4, "scattering_visibility4", Metric::abs, A1, Layout::none, 0.01, 2e-4},
+    {MSM_K_SCATTERING6, "scattering_visibility6", Metric::abs, A1, Layout::none, 5e-3, 1e-3},
 };
 
 // The functions whose outputs are shadows, bounds or blocker depths: finite on every input,
@@ -216,7 +221,7 @@ bool finite_outputs(int id) {
   return id == MSM_K_HAMBURGER4_BOUNDS || id == MSM_K_HAUSDORFF4 || id == MSM_K_HAMBURGER6_BOUNDS ||
          id == MSM_K_HAMBURGER6_BLEND || id == MSM_K_BLOCKER4 || id == MSM_K_BLOCKER4_UPPER || id == MSM_K_BLOCKER6 ||
          id == MSM_K_BLOCKER6_UPPER || id == MSM_K_NL_SHADOW || id == MSM_K_TECHNIQUE_SHADOW4 || id == MSM_K_SOFT4 ||
-         id == MSM_K_SOFT6;
+         id == MSM_K_SOFT6 || id == MSM_K_SCATTERING4 || id == MSM_K_SCATTERING6;
 }
 
 const Spec& spec_of(int id) {
@@ -797,6 +802,24 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       x.u[0] = uint32_t(g.integer(0, 1));
       break;
     }
+    case MSM_K_SCATTERING4: {
+      // A prefix-summed texel as the lookup sees it: 16-bit Θ4* or float moments.
+      const bool theta = g.chance(0.5);
+      x.a = theta ? msm_quantize_unorm16(msm_theta4_star(t.signed4())) : t.signed4();
+      x.b = vec4(g.receiver(float(t.surface), -1.0f, 1.0f), g.uni(0.0f, 1.0f), 0.0f, 0.0f);
+      x.u[0] = uint32_t(theta ? MSM_REP_SIGNED_THETA4 : MSM_REP_SIGNED_FLOAT);
+      break;
+    }
+    case MSM_K_SCATTERING6: {
+      const int rep = g.integer(MSM_REP6_UNORM10, MSM_REP6_FLOAT);
+      Moments6 q = msm_theta6_star(t.signed6());
+      if (rep == MSM_REP6_UNORM10) q = msm_quantize_unorm10(q);
+      if (rep == MSM_REP6_UNORM16) q = msm_quantize_unorm16(q);
+      x.a = vec4(q.odd, g.receiver(float(t.surface), -1.0f, 1.0f));
+      x.b = vec4(q.even, g.uni(0.0f, 1.0f));
+      x.u[0] = uint32_t(rep);
+      break;
+    }
     case MSM_K_RAISE_D2:
       x.a = g.moments4(t).b;
       x.b[0] = g.log_uniform(1e-8f, 1e-5f);
@@ -809,7 +832,7 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       if (k < 4)
         x.a[k] = g.special();
       else if (id == MSM_K_HAMBURGER6_BOUNDS || id == MSM_K_HAMBURGER6_BLEND || id == MSM_K_BLOCKER6 ||
-               id == MSM_K_BLOCKER6_UPPER || id == MSM_K_SOFT6)
+               id == MSM_K_BLOCKER6_UPPER || id == MSM_K_SOFT6 || id == MSM_K_SCATTERING6)
         x.a[3] = g.special();
       else if (id != MSM_K_TECHNIQUE_SHADOW4)
         x.b[0] = g.special();

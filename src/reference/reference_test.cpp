@@ -854,6 +854,52 @@ TEST(reference_scattering, NoMediumAndCameraInsideAnOccluder) {
     }
 }
 
+// The built-in scattering scenes (scenes/README.md) stress what their figures show: shafts (view
+// rays partly lit) in every one; the room mostly dark (shadowed air outside the window's shaft);
+// the tower's view ray into the light ends on the tower just below its parapet, so the rays around
+// it are dark while most of the image is lit.
+TEST(reference_scattering, BuiltinScenesHaveShafts) {
+  Settings s;
+  s.effect = Effect::scattering;
+  s.width = 64;
+  s.height = 36;
+  s.samples = 16;
+  for (const char* name : {"tower", "trees", "gate", "room"}) {
+    SCOPED_TRACE(name);
+    const Scene scene = msm::scene::builtin_scene(name);
+    const Result r = render(scene, s);
+    int partial = 0, dark = 0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        const float v = channel(r.visibility, "visibility", x, y);
+        partial += v > 0.02f && v < 0.98f;
+        dark += v <= 0.02f;
+      }
+    const int n = s.width * s.height;
+    std::printf("[scattering scenes] %-5s partly lit %.2f, dark %.2f, mean %.3f\n", name, double(partial) / n,
+                double(dark) / n, r.mean_visibility);
+    // Measured (64 x 36, 16 spp): partly lit tower 0.91, trees 0.56, gate 0.92, room 0.06 (the
+    // shaft); dark room 0.94.
+    EXPECT_GT(partial, n / 25);
+    if (std::string(name) == "room") EXPECT_GT(dark, n / 2);
+    if (std::string(name) == "tower") {
+      // Around the pixel through which the camera sees the light (a pixel here spans 1.4 degrees;
+      // the light lies 0.5 degrees below the parapet's top edge): a dark ray, while the image is
+      // mostly lit.
+      const glm::vec4 c = scene.camera_view_projection(float(s.width) / s.height) *
+                          glm::vec4(scene.camera.position + scene.light().towards_light, 1.0f);
+      const int px = int((c.x / c.w * 0.5f + 0.5f) * s.width), py = int((c.y / c.w * 0.5f + 0.5f) * s.height);
+      ASSERT_TRUE(px >= 1 && px < s.width - 1 && py >= 1 && py < s.height - 1);
+      float darkest = 1.0f;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          darkest = std::min(darkest, channel(r.visibility, "visibility", px + dx, py + dy));
+      EXPECT_LT(darkest, 0.1f);
+      EXPECT_GT(r.mean_visibility, 0.5);
+    }
+  }
+}
+
 // ---- determinism ---------------------------------------------------------------------------------
 
 TEST(reference_determinism, SameSeedSameImageForAnyThreadCount) {

@@ -76,7 +76,7 @@ void expect_json_error(const std::string& json, std::initializer_list<std::strin
 TEST(BuiltinScenes, NamesAndDefault) {
   const auto names = builtin_scene_names();
   EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke", "models", "pillar_wall",
-                                             "disc", "glass"}));
+                                             "disc", "glass", "tower", "trees", "gate", "room"}));
   EXPECT_EQ(default_scene_name(), "fence");
 }
 
@@ -229,6 +229,55 @@ TEST(BuiltinScenes, SoftShadowScenes) {
   EXPECT_EQ(occluder.primitive, "cylinder");
   EXPECT_LT(occluder.bounds.size().y, 2e-4f);
   EXPECT_NEAR(occluder.bounds.size().x, 0.5f, 1e-6f);
+}
+
+// The scenes of single scattering (JCGT 2017 §5.5) carry a medium, the others none; each has
+// the property its figure needs.
+TEST(BuiltinScenes, ScatteringScenes) {
+  const std::vector<std::string> scattering{"tower", "trees", "gate", "room"};
+  for (const std::string& name : builtin_scene_names()) {
+    const Scene s = builtin_scene(name);
+    const bool expected = std::find(scattering.begin(), scattering.end(), name) != scattering.end();
+    EXPECT_EQ(s.medium.has_value(), expected) << name;
+    if (s.medium) EXPECT_GT(s.medium->extinction, 0.0f) << name;
+  }
+  const auto in_view = [](const Scene& s, glm::vec3 direction) {
+    const glm::vec4 c = s.camera_view_projection(16.0f / 9.0f) * glm::vec4(s.camera.position + direction, 1.0f);
+    return c.w > 0.0f && std::abs(c.x) < c.w && std::abs(c.y) < c.w;
+  };
+  // tower (Fig. 14): the light is in the view (the epipole), hidden behind the parapet: the ray
+  // from the camera towards the light passes through the box around the merlons and pinnacles.
+  const Scene tower = builtin_scene("tower");
+  EXPECT_TRUE(in_view(tower, tower.light().towards_light));
+  Bounds top;
+  for (const Object& o : tower.objects)
+    if (o.name.rfind("merlon", 0) == 0 || o.name.rfind("pinnacle", 0) == 0) top.extend(o.bounds);
+  const glm::vec3 o = tower.camera.position, d = tower.light().towards_light;
+  float t0 = 0.0f, t1 = 1e9f;
+  for (int a = 0; a < 3; ++a) {
+    float ta = (top.min[a] - o[a]) / d[a], tb = (top.max[a] - o[a]) / d[a];
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+  EXPECT_LT(t0, t1) << "the view ray into the light misses the parapet";
+  // trees (Fig. 16): many leaf clusters.
+  int leaves = 0;
+  for (const Object& x : builtin_scene("trees").objects) leaves += x.name.rfind("leaves", 0) == 0;
+  EXPECT_GE(leaves, 60);
+  // gate (Fig. 17): thin bars between the camera and the light.
+  const Scene gate = builtin_scene("gate");
+  EXPECT_LT(gate.light().towards_light.z, 0.0f);
+  EXPECT_GT(gate.camera.position.z, object_named(gate, "grille").bounds.max.z);
+  // room (Figs. 15, 19): the camera inside, walls 4 cm thin.
+  const Scene room = builtin_scene("room");
+  Bounds inside;
+  for (const char* wall : {"wall_front", "wall_left", "wall_right", "wall_back_left", "wall_back_right"}) {
+    const glm::vec3 size = object_named(room, wall).bounds.size();
+    EXPECT_NEAR(std::min({size.x, size.y, size.z}), 0.04f, 1e-5f) << wall;
+    inside.extend(object_named(room, wall).bounds);
+  }
+  EXPECT_TRUE(glm::all(glm::greaterThan(room.camera.position, inside.min)) &&
+              glm::all(glm::lessThan(room.camera.position, inside.max)));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -386,7 +386,8 @@ Scene load_scene_json(std::string_view json_text, const std::filesystem::path& b
                       const std::string& source_name);
 
 // Built-in scenes (scenes/README.md): "fence" (the default), "railing", "stair", "column", "smoke",
-// "models", "pillar_wall", "disc".
+// "models", "pillar_wall", "disc", "glass"; with a medium (single scattering): "tower", "trees",
+// "gate", "room".
 std::vector<std::string> builtin_scene_names();
 std::string_view default_scene_name();                      // "fence"
 std::string_view builtin_scene_json(std::string_view name); // throws SceneError if unknown
