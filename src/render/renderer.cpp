@@ -108,6 +108,7 @@ struct Renderer::Impl {
   vk::GpuTimer timer;
   vk::Image noise;
   vk::Sampler point_sampler, linear_sampler;
+  vk::Sampler repeat_sampler; // prefiltered scattering's lookups (scatter.glsl clamps u itself)
   ProgramCache programs;
   gpu::SatBuilder sat_builder;
   std::unique_ptr<vk::Program> depth_copy;
@@ -126,7 +127,9 @@ struct Renderer::Impl {
         rectification(
             vk::create_buffer(c, sizeof(RectificationUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         timer(c, 32), noise(upload_blue_noise(c)), point_sampler(vk::create_sampler(c, VK_FILTER_NEAREST)),
-        linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)), programs(c), sat_builder(c) {}
+        linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)),
+        repeat_sampler(vk::create_sampler(c, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT)), programs(c),
+        sat_builder(c) {}
 
   static vk::Image upload_blue_noise(const vk::Context& ctx) {
     const msm::noise::BlueNoise& n = msm::noise::blue_noise();
@@ -334,6 +337,7 @@ struct Renderer::Impl {
                              noise, point_sampler, linear_sampler, scene.camera.position};
     resources.scattering = scattering;
     resources.rectification = &rectification;
+    resources.repeat_sampler = &repeat_sampler;
     graph->record(cmd, timer, resources, config, stop_after);
   }
 

@@ -46,13 +46,13 @@ void ScatteringPass::execute(const PassContext& c) const {
       c.cmd, *program_,
       {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, point),
        vk::Descriptor(c.image(kCameraDepth).layer_views[0], read_only, point),
-       prefiltered() ? vk::Descriptor(c.image(kPrefixSums).layer_views[0], read_only, c.frame.linear_sampler)
+       prefiltered() ? vk::Descriptor(c.image(kPrefixSums).layer_views[0], read_only, *c.frame.repeat_sampler)
                      : vk::Descriptor(c.image(kShadowDepth).layer_views[0], read_only, point), // light 0
        vk::Descriptor(c.frame.blue_noise.view(), read_only, point), vk::Descriptor(c.frame.lights),
        vk::Descriptor(*c.frame.rectification),
        // The second image of six moments (the others: any 2D image, unused).
        vk::Descriptor(c.image(six_moments() ? kPrefixSums1 : kSurfaceRadiance).layer_views[0], read_only,
-                      c.frame.linear_sampler)},
+                      *c.frame.repeat_sampler)},
       c.frame.scattering);
   vkCmdDraw(c.cmd, 3, 1, 0, 0);
   vkCmdEndRendering(c.cmd);

@@ -63,7 +63,12 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
   RectificationFrame f = msm_rectification_frame_of(rect);
   RectifiedBounds b = msm_rectified_bounds_of(rect);
   vec3 lookup = msm_rectified_view_lookup(f, b, camera + s * direction, rect.map.x);
-  vec2 uv = vec2(lookup.x, lookup.y);
+  // The sampler repeats: u and, unless φ spans the full circle (rows 0 and height − 1 neighbours,
+  // rectification.h), v are clamped to the texel centres at the edges here.
+  vec2 half_texel = 0.5f / vec2(rect.map.x, rect.map.y);
+  bool full_circle = b.phi_span >= MSM_TWO_PI;
+  vec2 uv = vec2(clamp(lookup.x, half_texel.x, 1.0f - half_texel.x),
+                 full_circle ? lookup.y : clamp(lookup.y, half_texel.y, 1.0f - half_texel.y));
   vec4 stored = textureLod(prefix_sums, uv, 0.0f);
   float beta = msm_scattering_beta_adaptive(lights[0].towards_light.xyz, direction);
   float zf = msm_signed_depth(lookup.z);
