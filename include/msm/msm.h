@@ -15,6 +15,7 @@
 #include "msm/moments.h"
 #include "msm/nonlinear.h"
 #include "msm/quantize.h"
+#include "msm/ray_march.h"
 #include "msm/rectification.h"
 #include "msm/roots.h"
 #include "msm/sat.h"

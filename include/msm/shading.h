@@ -38,6 +38,14 @@ MSM_FN vec3 msm_aces(vec3 x) {
   return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), vec3(0.0f), vec3(1.0f));
 }
 
+// The radiance x >= 0 that msm_aces maps to y in [0, 1) (the positive root of
+// (2.51 − 2.43 y) x² + (0.03 − 0.59 y) x − 0.14 y = 0): the background's radiance where a frame
+// composites over linear radiance (the scattering techniques) and must still show the sky as before.
+MSM_FN float msm_aces_inverse(float y) {
+  const float a = 2.51f - 2.43f * y, b = 0.03f - 0.59f * y, c = -0.14f * y;
+  return (-b + sqrt(max(b * b - 4.0f * a * c, 0.0f))) / (2.0f * a);
+}
+
 MSM_END
 
 #endif // MSM_SHADING_H

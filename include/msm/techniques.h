@@ -54,6 +54,16 @@ const int MSM_TECH_MSSM4 = 23; // Θ4*, [-1,1], one table
 const int MSM_TECH_MSSM6 = 24; // Θ6*, [-1,1], two tables (Kneiphof §4.2), layout of MSM_TECH_MSM6_96
 const int MSM_TECH_VSSM = 25;  // (z, z²) of [0,1] depth, one table (naive variance soft shadows)
 const int MSM_TECH_PCSS = 26;  // percentage-closer soft shadows [Fernando 2005]: depth-based
+// Single scattering in the scene's medium (JCGT §5, scattering.h), composited over surfaces shaded
+// with PCF. Ray marching (ray_march.h): equidistant jittered samples of the hard depth map.
+const int MSM_TECH_SCATTER_MARCH32 = 27;
+const int MSM_TECH_SCATTER_MARCH128 = 28;
+// Prefiltered single scattering (JCGT §5.1.1-5.3): the depth map resampled into the rectified map
+// (rectification.h), transmittance-weighted prefix sums along its rows, one lookup per pixel.
+const int MSM_TECH_SCATTER_MSM4_64 = 29;  // four moments, Θ4* in 4 x UNORM16, adaptive β
+const int MSM_TECH_SCATTER_MSM6_64 = 30;  // six moments (§5.4), Θ6* in 6 x 10 bits (two RGB10A2)
+const int MSM_TECH_SCATTER_MSM6_96 = 31;  // Θ6* in 6 x 16 bits (RGBA16 + RG16)
+const int MSM_TECH_SCATTER_MSM6_192 = 32; // Θ6* in 6 x 32-bit float (RGBA32F + RG32F)
 
 // Soft shadows from summed-area tables instead of a filtered map.
 MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
@@ -69,9 +79,29 @@ struct MsmTexel {
   vec4 b;
 };
 
-// True for the techniques that read the depth map instead of filterable channels.
+// Single scattering techniques: a scattering pass after the shading (src/render).
+MSM_FN bool msm_technique_is_prefiltered_scattering(int t) {
+  return t >= MSM_TECH_SCATTER_MSM4_64 && t <= MSM_TECH_SCATTER_MSM6_192;
+}
+// The six-moment storage (MSM_REP6_* of bias.h) of a prefiltered technique; -1 for four moments.
+MSM_FN int msm_technique_scatter_representation6(int t) {
+  return t == MSM_TECH_SCATTER_MSM6_64    ? MSM_REP6_UNORM10
+         : t == MSM_TECH_SCATTER_MSM6_96  ? MSM_REP6_UNORM16
+         : t == MSM_TECH_SCATTER_MSM6_192 ? MSM_REP6_FLOAT
+                                          : -1;
+}
+MSM_FN bool msm_technique_is_scattering(int t) {
+  return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128 || msm_technique_is_prefiltered_scattering(t);
+}
+// Samples per view ray of the ray-marching techniques (0 for the others).
+MSM_FN int msm_technique_march_samples(int t) {
+  return t == MSM_TECH_SCATTER_MARCH32 ? 32 : (t == MSM_TECH_SCATTER_MARCH128 ? 128 : 0);
+}
+
+// True for the techniques that read the depth map instead of filterable channels (the scattering
+// ones shade their surfaces with PCF).
 MSM_FN bool msm_technique_is_depth_based(int t) {
-  return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS;
+  return t == MSM_TECH_PLAIN || t == MSM_TECH_PCF || t == MSM_TECH_PCSS || msm_technique_is_scattering(t);
 }
 
 // The non-linear techniques store Φ of the filtered moments: they filter before storage (the

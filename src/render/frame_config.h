@@ -39,6 +39,15 @@ inline constexpr const char* kShadowDepth = "shadow_depth";
 inline constexpr const char* kColor = "color";
 inline constexpr const char* kShadowBuffer = "shadow_buffer";
 inline constexpr const char* kCameraDepth = "camera_depth";
+// Scattering techniques: the shading's linear radiance (RGBA16F, before exposure) and the
+// scattering pass's in-scattered radiance and visible fraction (RGBA32F, an output of the frame).
+inline constexpr const char* kSurfaceRadiance = "surface_radiance";
+inline constexpr const char* kScattering = "scattering";
+// Prefiltered scattering: the rectified map (float moments) and its prefix sums (storage format).
+inline constexpr const char* kRectified = "rectified";
+inline constexpr const char* kPrefixSums = "prefix_sums";
+inline constexpr const char* kRectified1 = "rectified1"; // six moments: the second image of each
+inline constexpr const char* kPrefixSums1 = "prefix_sums1";
 // Moment image i (0 or 1) of colour channel c (0 = the only one, or red; 1 green; 2 blue).
 std::string moment_image(int channel, int i);
 // Summed-area table of moment image i (soft shadows).

@@ -111,6 +111,9 @@ struct FrameResources {
   const vk::Sampler& point_sampler;
   const vk::Sampler& linear_sampler;
   glm::vec3 camera_position{0.0f};
+  ScatteringPush scattering{};                 // the scattering pass's (scattering techniques)
+  const vk::Buffer* rectification = nullptr;   // RectificationUniforms (render/rectification_uniforms.h)
+  const vk::Sampler* repeat_sampler = nullptr; // linear, repeat: the prefix sums (v wraps on the circle)
 };
 
 // An allocated image and its views: the whole array (2D_ARRAY, every mip: for the shading), and per

@@ -29,10 +29,20 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
     }
   }
   passes.push_back(std::make_unique<ShadingPass>(c));
+  if (msm_technique_is_prefiltered_scattering(id)) {
+    passes.push_back(std::make_unique<RectifyPass>(c));
+    passes.push_back(std::make_unique<PrefixSumPass>(c));
+  }
+  if (msm_technique_is_scattering(id)) passes.push_back(std::make_unique<ScatteringPass>(c));
   return passes;
 }
 
 std::vector<std::string> frame_outputs() { return {kColor, kShadowBuffer}; }
+
+std::vector<std::string> frame_outputs(const FrameConfig& c) {
+  if (msm_technique_is_scattering(c.technique->id)) return {kColor, kShadowBuffer, kScattering};
+  return frame_outputs();
+}
 
 std::vector<std::string> technique_passes(const Technique& technique, bool translucent, bool coloured) {
   RenderSettings defaults;
@@ -49,7 +59,7 @@ std::vector<std::string> technique_passes(const Technique& technique, bool trans
   c.coloured = c.translucent && coloured;
   std::vector<std::unique_ptr<Pass>> passes = recipe(c);
   std::vector<std::string> names;
-  for (size_t i : order_passes(passes, {}, frame_outputs())) names.emplace_back(passes[i]->name());
+  for (size_t i : order_passes(passes, {}, frame_outputs(c))) names.emplace_back(passes[i]->name());
   return names;
 }
 

@@ -15,6 +15,7 @@ namespace msm::render {
 std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& config);
 
 // The images the frame hands back (left ready for a transfer after the frame).
-std::vector<std::string> frame_outputs();
+std::vector<std::string> frame_outputs(const FrameConfig& config);
+std::vector<std::string> frame_outputs(); // of the shadow techniques
 
 } // namespace msm::render

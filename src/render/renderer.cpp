@@ -14,7 +14,9 @@
 #include "msm/gpu/sat_builder.h"
 #include "msm/noise/blue_noise.h"
 #include "msm/render/frame.h"
+#include "msm/render/rectification_uniforms.h"
 #include "msm/sat.h"
+#include "msm/shading.h"
 #include "msm/soft.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
@@ -102,15 +104,18 @@ struct Renderer::Impl {
   scene::Scene scene;
   GpuScene gpu;
   vk::Buffer uniforms, lights;
+  vk::Buffer rectification; // RectificationUniforms (prefiltered scattering)
   vk::GpuTimer timer;
   vk::Image noise;
   vk::Sampler point_sampler, linear_sampler;
+  vk::Sampler repeat_sampler; // prefiltered scattering's lookups (scatter.glsl clamps u itself)
   ProgramCache programs;
   gpu::SatBuilder sat_builder;
   std::unique_ptr<vk::Program> depth_copy;
   FrameConfig config;
   std::unique_ptr<FrameGraph> graph;
   std::vector<LightUniforms> light_data;
+  ScatteringPush scattering{}; // scattering techniques
   // Fitting a light's frustum visits every vertex: one fit per light direction, kept.
   std::vector<std::pair<glm::vec3, scene::LightFrame>> frames;
 
@@ -119,8 +124,12 @@ struct Renderer::Impl {
         uniforms(vk::create_buffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         lights(vk::create_buffer(c, sizeof(LightUniforms) * MSM_MAX_LIGHTS, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                  vk::Memory::host)),
+        rectification(
+            vk::create_buffer(c, sizeof(RectificationUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         timer(c, 32), noise(upload_blue_noise(c)), point_sampler(vk::create_sampler(c, VK_FILTER_NEAREST)),
-        linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)), programs(c), sat_builder(c) {}
+        linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)),
+        repeat_sampler(vk::create_sampler(c, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT)), programs(c),
+        sat_builder(c) {}
 
   static vk::Image upload_blue_noise(const vk::Context& ctx) {
     const msm::noise::BlueNoise& n = msm::noise::blue_noise();
@@ -270,7 +279,7 @@ struct Renderer::Impl {
                                         int(c.formats()[size_t(i)]), technique.name));
     if (!graph || !(config == c)) {
       graph.reset();
-      graph = std::make_unique<FrameGraph>(ctx, recipe(c), std::vector<std::string>{}, frame_outputs(),
+      graph = std::make_unique<FrameGraph>(ctx, recipe(c), std::vector<std::string>{}, frame_outputs(c),
                                            PassResources{programs, sat_builder});
       config = c;
     }
@@ -283,13 +292,54 @@ struct Renderer::Impl {
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
     // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
+    scattering = scattering_push(s, technique);
+    if (msm_technique_is_prefiltered_scattering(technique.id)) {
+      RectificationUniforms r = rectification_uniforms(s, frame_lights.front());
+      std::memcpy(rectification.data(), &r, sizeof(r)); // NOLINT(bugprone-undefined-memory-manipulation)
+    }
     return technique;
+  }
+
+  // The scattering pass's parameters: the camera's rays and the scene's medium (none: the pass only
+  // tone maps).
+  ScatteringPush scattering_push(const RenderSettings& s, const Technique& technique) const {
+    ScatteringPush p{};
+    glm::dmat4 view_projection(scene.camera_view_projection(float(s.width) / float(s.height)));
+    p.inverse_view_projection = glm::mat4(glm::inverse(view_projection));
+    p.camera = glm::vec4(scene.camera.position, 0.0f);
+    if (scene.medium)
+      p.medium = glm::vec4(scene.medium->extinction, scene.medium->scattering_albedo, scene.medium->g, 1.0f);
+    p.march = glm::ivec4(msm_technique_march_samples(technique.id), msm_technique_scatter_representation6(technique.id),
+                         0, 0);
+    for (int c = 0; c < 3; ++c) p.sky[c] = msm_aces_inverse(MSM_SKY_RADIANCE[c]) / s.exposure;
+    return p;
+  }
+
+  // The rectification of the first light for this camera (rectification.h, JCGT Appendix A): the
+  // bounds cover the pyramid from the camera to its far plane.
+  RectificationUniforms rectification_uniforms(const RenderSettings& s, const scene::DirectionalLight& light) {
+    glm::dmat4 inverse = glm::inverse(glm::dmat4(scene.camera_view_projection(float(s.width) / float(s.height))));
+    glm::mat4x3 corners;
+    const glm::dvec2 ndc[4] = {{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}}; // around the quad
+    for (int j = 0; j < 4; ++j) {
+      glm::dvec4 p = inverse * glm::dvec4(ndc[j], 1.0, 1.0);
+      corners[j] = glm::vec3(glm::dvec3(p) / p.w);
+    }
+    RectificationFrame f = msm_rectification_frame(scene.camera.position, light.towards_light);
+    RectifiedBounds b = msm_rectification_bounds(f, corners);
+    float extinction = scene.medium ? scene.medium->extinction : 0.0f;
+    return msm_rectification_uniforms(
+        f, b,
+        glm::vec4(float(s.shadow_size), float(s.shadow_size), float(light_frame(light).depth_extent), extinction));
   }
 
   void record(VkCommandBuffer cmd, std::optional<std::string_view> stop_after = std::nullopt) {
     timer.reset(cmd);
     FrameResources resources{gpu,   uniforms,      lights,         light_data,
                              noise, point_sampler, linear_sampler, scene.camera.position};
+    resources.scattering = scattering;
+    resources.rectification = &rectification;
+    resources.repeat_sampler = &repeat_sampler;
     graph->record(cmd, timer, resources, config, stop_after);
   }
 
@@ -387,6 +437,15 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   std::span<float> c = r.color.pixels();
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
     for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
+
+  if (g.has_image(kScattering)) {
+    image::Image rgba =
+        to_float_image(vk::readback_image(m.ctx, g.image(kScattering).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL),
+                       VK_FORMAT_R32G32B32A32_SFLOAT, s.width, s.height);
+    r.scattering =
+        image::Image(s.width, s.height, {"scattering_r", "scattering_g", "scattering_b", "visible_fraction"});
+    std::copy(rgba.pixels().begin(), rgba.pixels().end(), r.scattering.pixels().begin());
+  }
 
   std::vector<std::byte> shadow =
       vk::readback_image(m.ctx, g.image(kShadowBuffer).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);

@@ -6,6 +6,7 @@
 #include "msm/image/io.h"
 #include "msm/techniques.h"
 #include "msm/util/statistics.h"
+#include "msm/vk/vk.h"
 
 #include <fmt/core.h>
 
@@ -33,6 +34,41 @@ Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const s
     sums.push_back(sum);
   }
   return stats(sums);
+}
+
+// The device's copy bandwidth, the bound of the prefix sums (JCGT App. C): vkCmdCopyImage of an
+// RGBA32F image of size² texels (16 B read and 16 B written per texel), median over `runs`
+// submissions after one warm-up. Returns the copy's milliseconds.
+double copy_ms(const vk::Context& ctx, uint32_t size, int runs) {
+  const VkImageUsageFlags usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  vk::Image from = vk::create_image(
+      ctx, vk::ImageDesc{.width = size, .height = size, .format = VK_FORMAT_R32G32B32A32_SFLOAT, .usage = usage});
+  vk::Image to = vk::create_image(
+      ctx, vk::ImageDesc{.width = size, .height = size, .format = VK_FORMAT_R32G32B32A32_SFLOAT, .usage = usage});
+  // Written once from the host (an image never written may not be copied at full cost).
+  std::vector<float> zeros(size_t(size) * size * 4, 0.5f);
+  vk::upload_image(ctx, from, std::as_bytes(std::span(zeros)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+  vk::GpuTimer timer(ctx);
+  std::vector<double> times;
+  for (int r = 0; r <= runs; ++r) {
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+      for (const vk::Image* image : {&to})
+        vk::pipeline_barrier(cmd, vk::image_barrier(image->handle(), image->aspect(),
+                                                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                                    VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                                                    VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                    VK_IMAGE_LAYOUT_GENERAL));
+      timer.reset(cmd);
+      timer.begin(cmd, "copy");
+      VkImageCopy region{.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                         .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                         .extent = {size, size, 1}};
+      vkCmdCopyImage(cmd, from.handle(), VK_IMAGE_LAYOUT_GENERAL, to.handle(), VK_IMAGE_LAYOUT_GENERAL, 1, &region);
+      timer.end(cmd);
+    });
+    if (r > 0) times.push_back(timer.read().total("copy"));
+  }
+  return util::median(times);
 }
 
 std::pair<int, int> parse_resolution(const std::string& text) {
@@ -119,6 +155,8 @@ void add_bench(CLI::App& app) {
                               {"shading", nlohmann::json::object()},
                               {"shadow_map", nlohmann::json::object()},
                               {"passes", nlohmann::json::object()}};
+      const int id = render::find_rendered_technique(name).id;
+      const bool scatters = msm_technique_is_scattering(id), prefiltered = msm_technique_is_prefiltered_scattering(id);
       for (auto [w, h] : resolutions) {
         render::RenderSettings s = settings_for(opt->frame, name);
         s.width = w;
@@ -131,6 +169,13 @@ void add_bench(CLI::App& app) {
         per_unit[name]["shading " + key] = ns;
         entry["shading"][key] = {
             {"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_pixel", ns}};
+        if (scatters) { // the deferred pass alone (the prefiltered maps: per texel below)
+          Stats sc = pass_sum(frames, {"scattering"});
+          entry["scattering"][key] = {{"median_ms", sc.median},
+                                      {"p10_ms", sc.p10},
+                                      {"p90_ms", sc.p90},
+                                      {"ns_per_pixel", sc.median * 1e6 / (double(w) * h)}};
+        }
         if (key == fmt::format("{}x{}", resolutions[0].first, resolutions[0].second))
           for (const render::PassTime& p : frames[0]) {
             Stats ps = pass_sum(frames, {p.name});
@@ -143,7 +188,19 @@ void add_bench(CLI::App& app) {
         s.height = 180;
         s.shadow_size = size;
         progress(fmt::format("[{}/{}] {:<26} shadow map {}²", ++done, total, name, size));
-        Stats st = pass_sum(run(s), shadow_passes);
+        auto frames = run(s);
+        Stats st = pass_sum(frames, shadow_passes);
+        if (prefiltered) {
+          // The rectified map and its prefix sums per texel, the prefix sums against the copy bound:
+          // they read the float moments (16 B) and write the stored ones (8 B) per texel.
+          Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"});
+          double copy = copy_ms(*ctx, uint32_t(size), std::max(opt->frames, 3));
+          double bound = copy * 24.0 / 32.0;
+          entry["rectified"][std::to_string(size)] = {
+              {"rectify_ms", rect.median},     {"prefix_sums_ms", prefix.median},
+              {"copy_rgba32f_ms", copy},       {"bandwidth_gb_s", 32.0 * size * size / (copy * 1e6)},
+              {"prefix_sums_bound_ms", bound}, {"fraction_of_bound", bound / prefix.median}};
+        }
         std::string key = std::to_string(size);
         double ns = st.median * 1e6 / (double(size) * size);
         per_unit[name]["shadow " + key] = ns;
@@ -199,6 +256,52 @@ void add_bench(CLI::App& app) {
                               v["ratio_to_pcss"].get<double>());
         }
       md += "\n";
+    }
+    // Scattering: the deferred pass per pixel against ray marching in the same run, and the prefiltered
+    // maps per texel with the prefix sums against the copy bound.
+    bool any_scattering = false;
+    for (const nlohmann::json& entry : results) any_scattering = any_scattering || entry.contains("scattering");
+    if (any_scattering) {
+      md += "\nSingle scattering, the scattering pass alone: ms (ns per pixel; × scatter-march-128, × scatter-march-32 "
+            "where they ran)\n\n| technique |";
+      for (auto [w, h] : resolutions) md += fmt::format(" {}x{} |", w, h);
+      md += "\n|---|";
+      for (size_t i = 0; i < resolutions.size(); ++i) md += "---:|";
+      md += "\n";
+      auto pass_ns = [&](const std::string& technique, const std::string& key) {
+        for (const nlohmann::json& e : results)
+          if (e["technique"] == technique && e.contains("scattering"))
+            return e["scattering"][key]["ns_per_pixel"].get<double>();
+        return 0.0;
+      };
+      for (nlohmann::json& entry : results) {
+        if (!entry.contains("scattering")) continue;
+        md += fmt::format("| {} |", entry["technique"].get<std::string>());
+        for (auto [w, h] : resolutions) {
+          std::string key = fmt::format("{}x{}", w, h);
+          nlohmann::json& v = entry["scattering"][key];
+          double ns = v["ns_per_pixel"].get<double>();
+          md += fmt::format(" {:.3f} ({:.1f}", v["median_ms"].get<double>(), ns);
+          for (const char* march : {"scatter-march-128", "scatter-march-32"})
+            if (double m = pass_ns(march, key); m > 0.0) {
+              v[std::string("ratio_to_") + march] = ns / m;
+              md += fmt::format("; {:.3f}", ns / m);
+            }
+          md += ") |";
+        }
+        md += "\n";
+      }
+      for (const nlohmann::json& entry : results) {
+        if (!entry.contains("rectified")) continue;
+        md += fmt::format("\n{}: rectified map per size: rectify ms, prefix sums ms, bound ms (copy bandwidth), "
+                          "fraction of the bound:",
+                          entry["technique"].get<std::string>());
+        for (auto& [size, v] : entry["rectified"].items())
+          md += fmt::format(" {}²: {:.3f}, {:.3f}, {:.3f} ({:.1f} GB/s), {:.2f};", size, v["rectify_ms"].get<double>(),
+                            v["prefix_sums_ms"].get<double>(), v["prefix_sums_bound_ms"].get<double>(),
+                            v["bandwidth_gb_s"].get<double>(), v["fraction_of_bound"].get<double>());
+        md += "\n";
+      }
     }
     fmt::print("{}", md);
     nlohmann::json doc = {{"device", ctx->info().describe()},

@@ -95,10 +95,10 @@ void add_render(CLI::App& app) {
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
       write_render(opt->out, names[i], result, render_json(s, scene, *ctx, result));
       double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-      fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU {:8.0f} ms wall -> {}/{}.png{}\n", i + 1, names.size(),
+      fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU {:8.0f} ms wall -> {}/{}.png{}{}\n", i + 1, names.size(),
                  names[i], result.total_ms, wall_ms, opt->out, names[i],
-                 result.shadow_rgb.empty() ? ""
-                                           : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]));
+                 result.shadow_rgb.empty() ? "" : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]),
+                 result.scattering.empty() ? "" : fmt::format(", {}-scattering.exr", names[i]));
     }
   });
 }

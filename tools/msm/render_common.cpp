@@ -204,6 +204,10 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
       files.add_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
     else
       files.remove(dir / (stem + "-rgb.exr")); // no stale copy of an earlier coloured render
+    if (!result.scattering.empty())            // scattering techniques: in-scattered radiance, visible fraction
+      files.add_exr(dir / (stem + "-scattering.exr"), result.scattering);
+    else
+      files.remove(dir / (stem + "-scattering.exr"));
     std::string text = json.dump(2) + "\n";
     files.add(dir / (stem + ".json"), std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
     files.commit();

@@ -72,5 +72,18 @@ struct ImagePassPush {
   ivec4 size; // xy: image size in texels, z: pass-specific, w: unused
 };
 
+// The scattering pass (push constants): single scattering of the frame's first light in the
+// scene's medium, composited over the linear surface radiance (scattering.h).
+struct ScatteringPush {
+  mat4 inverse_view_projection; // camera clip space -> world (pixels' rays and far-plane ends)
+  vec4 camera;                  // xyz: camera position, w: unused
+  vec4 medium;                  // x: extinction σt, y: scattering albedo ρ, z: HG g,
+                                // w: 1 with a medium, 0 without (the pass only tone maps)
+  ivec4 march;                  // x: ray-marching samples per pixel, y: six-moment storage
+                                // (MSM_REP6_*, prefiltered), zw: unused
+  vec4 sky;                     // rgb: the background's linear radiance (msm_aces_inverse of
+                                // MSM_SKY_RADIANCE over the exposure: shown as before), a: unused
+};
+
 MSM_END
 #endif // MSM_RENDER_FRAME_H

@@ -165,6 +165,9 @@ struct RenderResult {
                                            // faces away from the light) and "background" (1 where no surface)
   image::Image shadow_rgb;                 // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
                                            // "visibility" is then their mean, as the ray tracer's); else empty
+  image::Image scattering;                 // scattering techniques: "scattering_r", "_g", "_b" (linear
+                                           // in-scattered radiance of the first light, before exposure) and
+                                           // "visible_fraction" (of the ray's in-scattering); else empty
   std::vector<PassTime> passes;            // in execution order; empty where the queue has no timestamps
   double total_ms = 0;                     // sum of the passes
   std::vector<LightPassTime> light_passes; // several lights: each light's share of the passes

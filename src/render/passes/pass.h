@@ -151,6 +151,57 @@ class ShadingPass : public Pass {
   FrameConfig config_;
 };
 
+// Scattering techniques: camera_depth + surface_radiance + the first light's shadow map -> color
+// (sRGB) and scattering (in-scattered radiance, visible fraction): single scattering in the scene's
+// medium composited over the surfaces, tone mapped (a full-screen triangle, JCGT §5.5's deferred pass).
+class ScatteringPass : public Pass {
+ public:
+  explicit ScatteringPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "scattering"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  bool prefiltered() const;
+  bool six_moments() const;
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
+// Prefiltered scattering (JCGT §5.1.1, §5.2): the first light's depth map resampled without filtering
+// into the rectified map (compute, rectify.glsl): moments of the rectified depth in float.
+class RectifyPass : public Pass {
+ public:
+  explicit RectifyPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "rectify"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
+// The rectified map -> transmittance-weighted prefix sums along its rows (JCGT Appendix C's 8 x 8
+// scheme, prefix_sums.comp), in the technique's storage format.
+class PrefixSumPass : public Pass {
+ public:
+  explicit PrefixSumPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "prefix_sums"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
+// Six-moment prefiltered scattering: two images per map (rectified, prefix sums).
+bool prefix_sums_have_two_images(const FrameConfig& config);
+
 // The images every shadow-map pass creates.
 ImageSpec moment_image_spec(const FrameConfig& config, int i);
 // Binds the scene's vertex and index buffers (every graphics pass draws the scene).

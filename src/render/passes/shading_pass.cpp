@@ -31,6 +31,11 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, bool translucent) {
       .depth_format = VK_FORMAT_D32_SFLOAT,
       .depth_write = !translucent,
       .constants = {{0, uint32_t(technique.id)}, {3, config.split_rg() ? 1u : 0u}, {4, config.lights == 1 ? 1u : 0u}}};
+  // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
+  if (msm_technique_is_scattering(technique.id)) {
+    d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;
+    d.constants.push_back({5, 1u});
+  }
   // Second moment image, blue noise, opacity texture, the green and blue channels' moment images
   // (coloured translucency), then the lights (binding 10); the same layout for every technique.
   for (int i = 0; i < 7; ++i) d.bindings.push_back(vk::Binding::sampled_image);
@@ -62,7 +67,11 @@ void ShadingPass::reflect(PassBuilder& b) const {
       for (int i = 0; i < config_.moment_images(); ++i) b.read(moment_image(channel, i), use::sampled(fragment));
   }
   uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
-  b.create(kColor, {.format = VK_FORMAT_R8G8B8A8_SRGB, .width = w, .height = h}, use::color_attachment());
+  if (msm_technique_is_scattering(id))
+    b.create(kSurfaceRadiance, {.format = VK_FORMAT_R16G16B16A16_SFLOAT, .width = w, .height = h},
+             use::color_attachment());
+  else
+    b.create(kColor, {.format = VK_FORMAT_R8G8B8A8_SRGB, .width = w, .height = h}, use::color_attachment());
   b.create(kShadowBuffer, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
   b.create(kCameraDepth, {.format = VK_FORMAT_D32_SFLOAT, .width = w, .height = h}, use::depth_attachment());
 }
@@ -72,12 +81,14 @@ void ShadingPass::execute(const PassContext& c) const {
   int id = config_.technique->id;
   bool depth_based = msm_technique_is_depth_based(id), soft = msm_technique_is_soft(id),
        nonlinear = msm_technique_is_nonlinear(id);
-  const GraphImage& color = c.image(kColor);
+  // Scattering techniques: the linear radiance (the sky's too), composited by the scattering pass.
+  bool scatters = msm_technique_is_scattering(id);
+  const GraphImage& color = c.image(scatters ? kSurfaceRadiance : kColor);
   const GraphImage& shadow_buffer = c.image(kShadowBuffer);
   VkExtent2D size{uint32_t(config_.width), uint32_t(config_.height)};
   // The background: visibility 1 (nothing to shadow), coverage 0. The sky colour is linear.
-  VkClearColorValue sky{{MSM_SKY_RADIANCE.r, MSM_SKY_RADIANCE.g, MSM_SKY_RADIANCE.b, 1.0f}},
-      lit{{1.0f, 1.0f, 1.0f, 0.0f}};
+  glm::vec3 sky_radiance = scatters ? glm::vec3(c.frame.scattering.sky) : MSM_SKY_RADIANCE; // shown the same
+  VkClearColorValue sky{{sky_radiance.r, sky_radiance.g, sky_radiance.b, 1.0f}}, lit{{1.0f, 1.0f, 1.0f, 0.0f}};
   vk::begin_rendering(c.cmd, size, {{color.layer_views[0], sky}, {shadow_buffer.layer_views[0], lit}},
                       vk::DepthAttachment{c.image(kCameraDepth).layer_views[0], 1.0f});
   vk::set_viewport_scissor(c.cmd, size);

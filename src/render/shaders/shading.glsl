@@ -13,6 +13,9 @@
 // with one light specialize it to the constant 0 (kOneLight): lavapipe fetches from a constant
 // layer several times faster than from a variable one.
 layout(constant_id = 4) const bool kOneLight = false;
+// Scattering techniques: the colour attachment takes linear radiance (before exposure and tone
+// mapping), which the scattering pass composites with the medium's in-scattering.
+layout(constant_id = 5) const bool kLinearRadiance = false;
 int current_layer = 0;
 #define shadow_layer (kOneLight ? 0 : current_layer)
 
@@ -24,7 +27,7 @@ layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec2 texcoord;
 
-layout(location = 0) out vec4 out_color;  // tone mapped; the attachment is sRGB
+layout(location = 0) out vec4 out_color;  // tone mapped; the attachment is sRGB (kLinearRadiance: linear)
 layout(location = 1) out vec4 out_shadow; // rgb: light visibility per colour channel, a: 1 (a surface)
 
 // Where a fragment looks up the shadow map: t in texel-centre coordinates (texel i covers
@@ -111,7 +114,7 @@ void main() {
   // Alpha: the surface's opacity (translucent objects blend over the opaque image).
   float opacity = object.albedo_opacity.a;
   if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
-  out_color = vec4(msm_aces(radiance * frame.shading.y), opacity);
+  out_color = kLinearRadiance ? vec4(radiance, opacity) : vec4(msm_aces(radiance * frame.shading.y), opacity);
   out_shadow = vec4(visibility, 1.0f);
   if (cut_out) discard;
 }

@@ -1,0 +1,36 @@
+// The rectification of prefiltered single scattering (rectification.h) as the renderer's passes
+// receive it: one uniform block per frame (vec4 members only, so that std140 and C++ agree), and
+// the functions that turn it back into the shared structs on both sides.
+#ifndef MSM_RENDER_RECTIFICATION_UNIFORMS_H
+#define MSM_RENDER_RECTIFICATION_UNIFORMS_H
+#include "msm/rectification.h"
+MSM_BEGIN
+
+struct RectificationUniforms {
+  vec4 origin, x_axis, y_axis, z_axis; // RectificationFrame (xyz)
+  vec4 bounds0;                        // r_max, phi_min, phi_span, theta_min
+  vec4 bounds1;                        // theta_max, view_theta_min, view_theta_max, unused
+  vec4 side0, side1, side2, side3;     // the frustum's side normals (xyz)
+  vec4 map;                            // x: width, y: height of the rectified map, z: the light
+                                       // frustum's depth extent (world units from depth 0 to 1),
+                                       // w: extinction σt (0 without a medium)
+};
+
+MSM_FN RectificationUniforms msm_rectification_uniforms(RectificationFrame f, RectifiedBounds b, vec4 map) {
+  return RectificationUniforms(vec4(f.origin, 0.0f), vec4(f.x_axis, 0.0f), vec4(f.y_axis, 0.0f), vec4(f.z_axis, 0.0f),
+                               vec4(b.r_max, b.phi_min, b.phi_span, b.theta_min),
+                               vec4(b.theta_max, b.view_theta_min, b.view_theta_max, 0.0f), vec4(b.side0, 0.0f),
+                               vec4(b.side1, 0.0f), vec4(b.side2, 0.0f), vec4(b.side3, 0.0f), map);
+}
+
+MSM_FN RectificationFrame msm_rectification_frame_of(RectificationUniforms u) {
+  return RectificationFrame(vec3(u.origin), vec3(u.x_axis), vec3(u.y_axis), vec3(u.z_axis));
+}
+
+MSM_FN RectifiedBounds msm_rectified_bounds_of(RectificationUniforms u) {
+  return RectifiedBounds(u.bounds0.x, u.bounds0.y, u.bounds0.z, u.bounds0.w, u.bounds1.x, vec3(u.side0), vec3(u.side1),
+                         vec3(u.side2), vec3(u.side3), u.bounds1.y, u.bounds1.z);
+}
+
+MSM_END
+#endif // MSM_RENDER_RECTIFICATION_UNIFORMS_H

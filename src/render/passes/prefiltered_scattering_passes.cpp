@@ -1,0 +1,89 @@
+#include "pass.h"
+
+#include "msm/techniques.h"
+
+namespace msm::render {
+namespace {
+constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+uint32_t size(const FrameConfig& c) { return uint32_t(c.shadow_size); } // the rectified map's side
+int representation6(const FrameConfig& c) { return msm_technique_scatter_representation6(c.technique->id); }
+
+// The prefix sums' storage formats (JCGT §5.3, §5.4.3): Θ4* in RGBA16; Θ6* in two RGB10A2 (odd,
+// even), RGBA16 + RG16 or RGBA32F + RG32F ((odd, even.x), (even.y, even.z)).
+std::array<VkFormat, 2> prefix_formats(const FrameConfig& c) {
+  switch (representation6(c)) {
+  case MSM_REP6_UNORM10: return {VK_FORMAT_A2B10G10R10_UNORM_PACK32, VK_FORMAT_A2B10G10R10_UNORM_PACK32};
+  case MSM_REP6_UNORM16: return {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM};
+  case MSM_REP6_FLOAT: return {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT};
+  default: return {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_UNDEFINED};
+  }
+}
+} // namespace
+
+bool prefix_sums_have_two_images(const FrameConfig& c) { return representation6(c) >= 0; }
+
+void RectifyPass::prepare(const PassResources& r) {
+  bool six = prefix_sums_have_two_images(config_);
+  std::string shader = std::string(six ? "rectify6" : "rectify") + (config_.msaa == 1 ? "_1x.comp" : ".comp");
+  std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::uniform_buffer,
+                                       vk::Binding::storage_buffer, vk::Binding::sampled_image,
+                                       vk::Binding::storage_image};
+  if (six) bindings.push_back(vk::Binding::storage_image);
+  program_ = &r.programs.compute(shader, bindings, 0);
+}
+
+void RectifyPass::reflect(PassBuilder& b) const {
+  b.read(kShadowDepth, use::sampled(kCompute));
+  ImageSpec spec{.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = size(config_), .height = size(config_)};
+  b.create(kRectified, spec, use::compute_general());
+  if (prefix_sums_have_two_images(config_)) b.create(kRectified1, spec, use::compute_general());
+}
+
+void RectifyPass::execute(const PassContext& c) const {
+  uint32_t groups = vk::group_count(size(config_), 8);
+  std::vector<vk::Descriptor> d = {
+      vk::Descriptor(c.frame.uniforms), vk::Descriptor(*c.frame.rectification), vk::Descriptor(c.frame.lights),
+      vk::Descriptor(c.image(kShadowDepth).layer_views[0], kReadOnly, c.frame.point_sampler), // the first light
+      vk::Descriptor(c.image(kRectified).layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
+  if (prefix_sums_have_two_images(config_))
+    d.emplace_back(c.image(kRectified1).layer_views[0], VK_IMAGE_LAYOUT_GENERAL);
+  vk::dispatch(c.cmd, *program_, groups, groups, 1, d);
+}
+
+void PrefixSumPass::prepare(const PassResources& r) {
+  int rep = representation6(config_);
+  std::string shader = rep == MSM_REP6_UNORM10   ? "prefix_sums6_10.comp"
+                       : rep == MSM_REP6_UNORM16 ? "prefix_sums6_16.comp"
+                       : rep == MSM_REP6_FLOAT   ? "prefix_sums6_32.comp"
+                                                 : "prefix_sums.comp";
+  std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image,
+                                       vk::Binding::storage_image};
+  if (rep >= 0) bindings.insert(bindings.end(), {vk::Binding::sampled_image, vk::Binding::storage_image});
+  program_ = &r.programs.compute(shader, bindings, 0);
+}
+
+void PrefixSumPass::reflect(PassBuilder& b) const {
+  std::array<VkFormat, 2> formats = prefix_formats(config_);
+  b.read(kRectified, use::sampled(kCompute));
+  b.create(kPrefixSums, {.format = formats[0], .width = size(config_), .height = size(config_)},
+           use::compute_general());
+  if (prefix_sums_have_two_images(config_)) {
+    b.read(kRectified1, use::sampled(kCompute));
+    b.create(kPrefixSums1, {.format = formats[1], .width = size(config_), .height = size(config_)},
+             use::compute_general());
+  }
+}
+
+void PrefixSumPass::execute(const PassContext& c) const {
+  std::vector<vk::Descriptor> d = {vk::Descriptor(*c.frame.rectification),
+                                   vk::Descriptor(c.image(kRectified).layer_views[0], kReadOnly, c.frame.point_sampler),
+                                   vk::Descriptor(c.image(kPrefixSums).layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
+  if (prefix_sums_have_two_images(config_)) {
+    d.emplace_back(c.image(kRectified1).layer_views[0], kReadOnly, c.frame.point_sampler);
+    d.emplace_back(c.image(kPrefixSums1).layer_views[0], VK_IMAGE_LAYOUT_GENERAL);
+  }
+  vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, 1, d);
+}
+
+} // namespace msm::render

@@ -1,0 +1,61 @@
+#include "pass.h"
+
+#include "msm/techniques.h"
+
+namespace msm::render {
+
+bool ScatteringPass::prefiltered() const { return msm_technique_is_prefiltered_scattering(config_.technique->id); }
+bool ScatteringPass::six_moments() const { return msm_technique_scatter_representation6(config_.technique->id) >= 0; }
+
+void ScatteringPass::prepare(const PassResources& r) {
+  vk::GraphicsDesc d{.name = std::string("scattering ") + std::string(config_.technique->name),
+                     .vertex_shader = "fullscreen.vert",
+                     .fragment_shader = six_moments()       ? "scatter_prefiltered6.frag"
+                                        : prefiltered()     ? "scatter_prefiltered.frag"
+                                        : config_.msaa == 1 ? "scatter_march_1x.frag"
+                                                            : "scatter_march.frag",
+                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
+                                  vk::Binding::sampled_image, vk::Binding::sampled_image, vk::Binding::storage_buffer,
+                                  vk::Binding::uniform_buffer, vk::Binding::sampled_image},
+                     .push_constant_size = sizeof(ScatteringPush),
+                     .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
+                     .depth_write = false};
+  program_ = &r.programs.graphics(d);
+}
+
+void ScatteringPass::reflect(PassBuilder& b) const {
+  const VkPipelineStageFlags2 fragment = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
+  b.read(kCameraDepth, use::sampled(fragment));
+  b.read(kSurfaceRadiance, use::sampled(fragment));
+  // Ray marching reads the depth map, the prefiltered techniques their prefix sums.
+  b.read(prefiltered() ? kPrefixSums : kShadowDepth, use::sampled(fragment));
+  if (six_moments()) b.read(kPrefixSums1, use::sampled(fragment));
+  uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
+  b.create(kColor, {.format = VK_FORMAT_R8G8B8A8_SRGB, .width = w, .height = h}, use::color_attachment());
+  b.create(kScattering, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
+}
+
+void ScatteringPass::execute(const PassContext& c) const {
+  VkExtent2D size{uint32_t(config_.width), uint32_t(config_.height)};
+  vk::begin_rendering(c.cmd, size, {{c.image(kColor).layer_views[0], {}}, {c.image(kScattering).layer_views[0], {}}});
+  vk::set_viewport_scissor(c.cmd, size);
+  vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
+  const VkImageLayout read_only = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+  VkSampler point = c.frame.point_sampler;
+  vk::bind_program(
+      c.cmd, *program_,
+      {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, point),
+       vk::Descriptor(c.image(kCameraDepth).layer_views[0], read_only, point),
+       prefiltered() ? vk::Descriptor(c.image(kPrefixSums).layer_views[0], read_only, *c.frame.repeat_sampler)
+                     : vk::Descriptor(c.image(kShadowDepth).layer_views[0], read_only, point), // light 0
+       vk::Descriptor(c.frame.blue_noise.view(), read_only, point), vk::Descriptor(c.frame.lights),
+       vk::Descriptor(*c.frame.rectification),
+       // The second image of six moments (the others: any 2D image, unused).
+       vk::Descriptor(c.image(six_moments() ? kPrefixSums1 : kSurfaceRadiance).layer_views[0], read_only,
+                      *c.frame.repeat_sampler)},
+      c.frame.scattering);
+  vkCmdDraw(c.cmd, 3, 1, 0, 0);
+  vkCmdEndRendering(c.cmd);
+}
+
+} // namespace msm::render

@@ -1,0 +1,7 @@
+// One triangle covering the viewport (vertices 0..2, no vertex input): deferred full-screen passes.
+#version 460
+
+void main() {
+  vec2 p = vec2(float((gl_VertexIndex << 1) & 2), float(gl_VertexIndex & 2));
+  gl_Position = vec4(p * 2.0f - 1.0f, 0.0f, 1.0f);
+}

@@ -1,0 +1,56 @@
+// Transmittance-weighted prefix sums along the rows of the rectified map (JCGT §5.1.1, the scheme of
+// Appendix C): groups of 8 x 8 threads, eight rows per group and eight threads per row; walking the
+// row in blocks of eight texels, every thread sums the whole row (eight times the reads, which the
+// texture cache absorbs) and writes the one normalized prefix sum of its column in the block, so
+// that the writes of a block are coalesced. Weights w(j, v) and Δ(v) are rectification.h's.
+// The including file defines the storage: MSM_PREFIX_FORMAT0 (and, with MSM_SIX_MOMENTS, the second
+// image's MSM_PREFIX_FORMAT1 and MSM_PREFIX_ODD_EVEN for two RGB10A2 images holding the odd and the
+// even moments; otherwise (odd, even.x) and (even.y, even.z) as in the rectified map).
+#include "msm/render/rectification_uniforms.h"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, binding = 0) uniform RectificationBlock { RectificationUniforms rect; };
+layout(binding = 1) uniform sampler2D rectified; // float moments, texelFetch only
+layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2D prefix_sums;
+#ifdef MSM_SIX_MOMENTS
+layout(binding = 3) uniform sampler2D rectified1;
+layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2D prefix_sums1;
+#endif
+
+void main() {
+  ivec2 size = ivec2(int(rect.map.x), int(rect.map.y));
+  int row = int(gl_WorkGroupID.x) * 8 + int(gl_LocalInvocationID.y);
+  int column = int(gl_LocalInvocationID.x);
+  if (row >= size.y) return;
+  RectifiedBounds b = msm_rectified_bounds_of(rect);
+  float delta = msm_rectified_row_step(b, (float(row) + 0.5f) / float(size.y), float(size.x));
+  float extinction = rect.map.w;
+  vec4 sum = vec4(0.0f), sum1 = vec4(0.0f);
+  float weight_sum = 0.0f;
+  for (int x0 = 0; x0 < size.x; x0 += 8) {
+    vec4 mine = vec4(0.0f), mine1 = vec4(0.0f);
+    for (int k = 0; k < 8 && x0 + k < size.x; ++k) {
+      float w = msm_prefix_sum_weight(extinction, delta, float(x0 + k));
+      sum += w * texelFetch(rectified, ivec2(x0 + k, row), 0);
+#ifdef MSM_SIX_MOMENTS
+      sum1 += w * texelFetch(rectified1, ivec2(x0 + k, row), 0);
+#endif
+      weight_sum += w;
+      if (k == column) {
+        mine = sum / weight_sum;
+        mine1 = sum1 / weight_sum;
+      }
+    }
+    if (x0 + column >= size.x) continue;
+    ivec2 texel = ivec2(x0 + column, row);
+#if defined(MSM_SIX_MOMENTS) && defined(MSM_PREFIX_ODD_EVEN)
+    imageStore(prefix_sums, texel, vec4(mine.x, mine.y, mine.z, 0.0f));
+    imageStore(prefix_sums1, texel, vec4(mine.w, mine1.x, mine1.y, 0.0f));
+#else
+    imageStore(prefix_sums, texel, mine);
+#ifdef MSM_SIX_MOMENTS
+    imageStore(prefix_sums1, texel, mine1);
+#endif
+#endif
+  }
+}

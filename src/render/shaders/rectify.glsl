@@ -1,0 +1,68 @@
+// Resampling of the first light's shadow map into the rectified map of prefiltered single
+// scattering (JCGT §5.1.1, §5.2; rectification.h): per rectified texel, the light ray at (r, φ) is
+// looked up in the light's depth map, without filtering (the nearest texel, sample 0), or, where
+// the technique's parameter x is 1, with filtering (§5.2): a bilinear sample of the map's four
+// moments (each texel the mean of its MSAA samples' moments: the resolved, unblurred moment map of
+// [0,1] depth) turned into two depths by JCGT Algorithm 2. Each depth is mapped to the rectified
+// depth π − θ and turned into the technique's moments in its storage basis
+// (Θ4*; with MSM_SIX_MOMENTS Θ6* over two images: (odd, even.x) and (even.y, even.z)), written as
+// float for the prefix sums. A light ray outside the map, or over a texel without
+// a caster, gets the farthest rectified depth: nothing on it shadows any view ray.
+#include "msm/render/rectification_uniforms.h"
+#include "msm/quantize.h"
+#define MSM_LIGHT_BINDING 2
+#include "frame.glsl"
+#define MSM_DEPTH_BINDING 3
+#include "depth_map.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std140, binding = 1) uniform RectificationBlock { RectificationUniforms rect; };
+layout(binding = 4, rgba32f) uniform writeonly image2D rectified;
+#ifdef MSM_SIX_MOMENTS
+layout(binding = 5, rgba32f) uniform writeonly image2D rectified1;
+#endif
+
+void main() {
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(int(rect.map.x), int(rect.map.y));
+  if (texel.x >= size.x || texel.y >= size.y) return;
+  RectificationFrame f = msm_rectification_frame_of(rect);
+  RectifiedBounds b = msm_rectified_bounds_of(rect);
+  vec2 uv = (vec2(texel) + 0.5f) / vec2(size);
+  vec3 p = msm_rectified_light_ray_point(f, b, uv);
+  float r = msm_rectified_r_phi(b, uv).x;
+  vec4 clip = lights[0].view_projection * vec4(p, 1.0f);
+  // The map's depth d lies at rectification z = extent (d − d(p)) on this light ray.
+  vec2 depth_to_z = vec2(rect.map.z, -clip.z * rect.map.z);
+  TwoDepths d = TwoDepths(vec2(1.0f), vec2(1.0f, 0.0f));
+  bool inside = all(greaterThanEqual(vec2(clip.x, clip.y), vec2(-1.0f))) &&
+                all(lessThanEqual(vec2(clip.x, clip.y), vec2(1.0f)));
+  if (inside) {
+    int map = int(frame.shadow_map.x);
+    ivec2 t = clamp(ivec2(floor((vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0), ivec2(map - 1));
+    if (frame.technique_params.x != 0.0f) {
+      vec2 p = (vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
+      ivec2 i0 = ivec2(floor(p));
+      vec2 f = p - vec2(i0);
+      int samples = frame.kernel.y;
+      vec4 moments = vec4(0.0f);
+      for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        float w = (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) / float(samples);
+        ivec2 c = clamp(i0 + o, ivec2(0), ivec2(map - 1));
+        for (int s = 0; s < samples; ++s) moments += w * msm_moments4(msm_saturate(depth_sample(c, s)));
+      }
+      d = msm_rectified_two_depths(b, r, depth_to_z, moments);
+    } else {
+      float depth = depth_sample(t, 0);
+      if (depth < 1.0f) d = msm_rectified_one_depth(b, r, depth_to_z, depth);
+    }
+  }
+#ifdef MSM_SIX_MOMENTS
+  Moments6 m = msm_theta6_star(msm_rectified_moments6(d));
+  imageStore(rectified, texel, vec4(m.odd, m.even.x));
+  imageStore(rectified1, texel, vec4(m.even.y, m.even.z, 0.0f, 0.0f));
+#else
+  imageStore(rectified, texel, msm_theta4_star(msm_rectified_moments4(d)));
+#endif
+}

@@ -1,0 +1,113 @@
+// The scattering pass (JCGT §5.5: a deferred pass after the shading): per pixel, the view ray from
+// the camera to the visible surface (to the far plane where there is none), the visible fraction
+// of its in-scattering, and the composite over the surface radiance (scattering.h), tone mapped.
+// The visible fraction:
+//  - ray marching (JCGT §5.5.1's baseline): equidistant jittered samples (scattering.h, ray_march.h)
+//    against the first light's hard depth map (sample 0 of each texel). Samples outside the map's
+//    x, y range count as lit (nothing there casts into the map); below its far plane they compare
+//    at depth 1.
+//  - prefiltered (MSM_SCATTER_PREFILTERED, JCGT §5.1.1, §5.3, §5.4): one bilinear lookup in the
+//    prefix-summed rectified map (rectification.h), four (or, MSM_SIX_MOMENTS, six) moments with
+//    adaptive β.
+#include "msm/ray_march.h"
+#include "msm/render/rectification_uniforms.h"
+#include "msm/shading.h"
+#define MSM_LIGHT_BINDING 5
+#include "frame.glsl"
+#ifdef MSM_SCATTER_PREFILTERED
+layout(binding = 3) uniform sampler2D prefix_sums; // Θ4* (16-bit) or Θ6* image 0, bilinear
+layout(std140, binding = 6) uniform RectificationBlock { RectificationUniforms rect; };
+layout(binding = 7) uniform sampler2D prefix_sums1; // Θ6* image 1
+#else
+#define MSM_DEPTH_BINDING 3
+#include "depth_map.glsl"
+#endif
+
+layout(binding = 1) uniform sampler2D surface_radiance; // linear, before exposure
+layout(binding = 2) uniform sampler2D camera_depth;
+layout(binding = 4) uniform sampler2DArray blue_noise;
+layout(push_constant) uniform Push { ScatteringPush scatter; };
+
+layout(location = 0) out vec4 out_color;      // tone mapped; the attachment is sRGB
+layout(location = 1) out vec4 out_scattering; // rgb: in-scattered radiance, a: visible fraction
+
+#ifndef MSM_SCATTER_PREFILTERED
+// 1 where the first light reaches p, 0 where its depth map has an occluder in front of p.
+float light_reaches(vec3 p) {
+  vec4 clip = lights[0].view_projection * vec4(p, 1.0f);
+  if (any(lessThan(vec2(clip.x, clip.y), vec2(-1.0f))) || any(greaterThan(vec2(clip.x, clip.y), vec2(1.0f))))
+    return 1.0f;
+  int size = int(frame.shadow_map.x);
+  ivec2 texel = clamp(ivec2(floor((vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0),
+                      ivec2(size - 1));
+  return depth_sample(texel, 0) < min(clip.z, 1.0f) - frame.shadow_map.w ? 0.0f : 1.0f;
+}
+
+float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  float extinction = scatter.medium.x;
+  int count = scatter.march.x;
+  // One blue-noise jitter per pixel (the frame's layer and offset), strictly below 1.
+  ivec2 n = (pixel + ivec2(frame.lookup.z, frame.lookup.w)) & 63;
+  float jitter = (texelFetch(blue_noise, ivec3(n, frame.lookup.y), 0).x * 255.0f + 0.5f) / 256.0f;
+  float weighted = 0.0f;
+  for (int i = 0; i < count; ++i) {
+    vec3 p = camera + msm_ray_march_distance(s, count, i, jitter) * direction;
+    weighted += msm_ray_march_weight(extinction, s, count, i) * light_reaches(p);
+  }
+  return msm_ray_march_visible_fraction(weighted, extinction, s);
+}
+#else
+// One lookup in the prefix sums at the ray's row and reach, reconstructed at the ray's rectified
+// depth with adaptive overestimation (§5.3.1).
+float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  RectificationFrame f = msm_rectification_frame_of(rect);
+  RectifiedBounds b = msm_rectified_bounds_of(rect);
+  vec3 lookup = msm_rectified_view_lookup(f, b, camera + s * direction, rect.map.x);
+  // The sampler repeats: u and, unless φ spans the full circle (rows 0 and height − 1 neighbours,
+  // rectification.h), v are clamped to the texel centres at the edges here.
+  vec2 half_texel = 0.5f / vec2(rect.map.x, rect.map.y);
+  bool full_circle = b.phi_span >= MSM_TWO_PI;
+  vec2 uv = vec2(clamp(lookup.x, half_texel.x, 1.0f - half_texel.x),
+                 full_circle ? lookup.y : clamp(lookup.y, half_texel.y, 1.0f - half_texel.y));
+  vec4 stored = textureLod(prefix_sums, uv, 0.0f);
+  float beta = msm_scattering_beta_adaptive(lights[0].towards_light.xyz, direction);
+  float zf = msm_signed_depth(lookup.z);
+#ifdef MSM_SIX_MOMENTS
+  // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
+  int representation = scatter.march.y;
+  vec4 stored1 = textureLod(prefix_sums1, uv, 0.0f);
+  Moments6 m = representation == MSM_REP6_UNORM10
+                   ? Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored1.x, stored1.y, stored1.z))
+                   : Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored.w, stored1.x, stored1.y));
+  return msm_scattering_visibility6(m, representation, zf, beta);
+#else
+  return msm_scattering_visibility4(stored, MSM_REP_SIGNED_THETA4, zf, beta);
+#endif
+}
+#endif
+
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  vec3 surface = texelFetch(surface_radiance, pixel, 0).rgb;
+  float depth = texelFetch(camera_depth, pixel, 0).x;
+  vec2 ndc = (vec2(pixel) + 0.5f) / vec2(textureSize(camera_depth, 0)) * 2.0f - 1.0f;
+  vec4 end = scatter.inverse_view_projection * vec4(ndc, depth, 1.0f);
+  vec3 camera = scatter.camera.xyz;
+  vec3 ray = end.xyz / end.w - camera;
+  float s = length(ray);
+  vec3 direction = s > 0.0f ? ray / s : vec3(0.0f, 0.0f, -1.0f);
+
+  vec3 radiance = surface, inscattered = vec3(0.0f);
+  float visible = 1.0f;
+  if (scatter.medium.w != 0.0f) {
+    float extinction = scatter.medium.x;
+    visible = visible_fraction(pixel, camera, direction, s);
+    float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
+                                            dot(lights[0].towards_light.xyz, direction));
+    vec3 irradiance = lights[0].irradiance.rgb;
+    radiance = msm_scattered_radiance(surface, irradiance, extinction, phase, s, visible);
+    inscattered = msm_scattered_radiance(vec3(0.0f), irradiance, extinction, phase, s, visible);
+  }
+  out_color = vec4(msm_aces(radiance * frame.shading.y), 1.0f);
+  out_scattering = vec4(inscattered, visible);
+}
