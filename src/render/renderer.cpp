@@ -418,6 +418,19 @@ std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s
   return out;
 }
 
+void Renderer::submit_frame_prefix(const RenderSettings& s, std::size_t passes) {
+  Impl& m = *impl_;
+  m.prepare(s);
+  std::vector<std::string_view> names = m.graph->pass_names();
+  if (passes > names.size()) throw RenderError(fmt::format("the frame has {} passes, not {}", names.size(), passes));
+  vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) {
+    if (passes == 0)
+      m.timer.reset(cmd);
+    else
+      m.record(cmd, names[passes - 1]);
+  });
+}
+
 std::vector<std::string> Renderer::frame_passes(const RenderSettings& s) {
   impl_->prepare(s);
   std::vector<std::string> out;
