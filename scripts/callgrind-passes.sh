@@ -58,5 +58,5 @@ done | sort -k1,1 -k2,2 -k3,3n -k4,4n | awk '
     split($2, wh, "x")
     d = $6 - prev; prev = $6
     unit = ($5 == "shading") ? wh[1] * wh[2] : $3 * $3
-    printf "%-26s %-10s %6d %-16s %14d %10.1f\n", $1, $2, $3, $5, d, d / unit
+    printf "%-26s %-10s %6d %-16s %14.0f %10.1f\n", $1, $2, $3, $5, d, d / unit
   }'

@@ -247,6 +247,7 @@ struct Renderer::Impl {
                   .shadow_size = s.shadow_size,
                   .msaa = s.msaa,
                   .taps = s.filter_size,
+                  .sigma = s.filter_sigma,
                   .lights = int(frame_lights.size()),
                   .one_pass = one_pass,
                   .translucent = translucent,
@@ -384,7 +385,7 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   r.color = image::Image(s.width, s.height, 3);
   std::span<float> c = r.color.pixels();
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
-    for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
+    for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb8_to_linear(uint8_t(color[4 * i + k]));
 
   std::vector<std::byte> shadow =
       vk::readback_image(m.ctx, g.image(kShadowBuffer).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);

@@ -2,23 +2,50 @@
 
 #include <fmt/format.h>
 
+#include <bit>
+
 namespace msm::render {
 
-void BlurPass::prepare(const PassResources& r) {
-  program_ = &r.programs.compute("blur.comp",
-                                 {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
-                                 sizeof(ImagePassPush));
+namespace {
+
+std::string temp_name(int channel, int i) { return fmt::format("blur_temp{}.{}", i, channel); }
+
+// Between the two directions, in float, read with bilinear fetches.
+constexpr VkFormat kTempFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+
+} // namespace
+
+std::vector<vk::SpecConstant> blur_constants(int taps, float sigma) {
+  static_assert(MSM_BLUR_MAX_PAIRS == (MSM_FILTER_MAX_TAPS / 2 + 1) / 2);
+  auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+  int pairs = msm_filter_pairs(taps);
+  std::vector<vk::SpecConstant> c = {{MSM_BLUR_SPEC_ID, uint32_t(pairs)},
+                                     {MSM_BLUR_SPEC_ID + 1, bits(msm_filter_weight_at(0, taps, sigma))}};
+  for (int j = 1; j <= pairs; ++j) {
+    c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 1 + j), bits(msm_filter_pair_offset(j, taps, sigma))});
+    c.push_back(
+        {uint32_t(MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + j), bits(msm_filter_pair_weight(j, taps, sigma))});
+  }
+  return c;
 }
 
-namespace {
-std::string temp_name(int channel, int i) { return fmt::format("blur_temp{}.{}", i, channel); }
-} // namespace
+void BlurPass::prepare(const PassResources& r) {
+  const vk::Context& ctx = r.programs.context();
+  VkFormatProperties props{};
+  vkGetPhysicalDeviceFormatProperties(ctx.physical_device(), kTempFormat, &props);
+  if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+    throw RenderError(fmt::format("the blur needs linear filtering of RGBA32F images; {} has none (use "
+                                  "--filter-mode one-pass or --filter 1)",
+                                  ctx.info().name));
+  program_ = &r.programs.compute("blur.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
+                                 sizeof(ImagePassPush), blur_constants(config_.taps, config_.sigma));
+}
 
 void BlurPass::reflect(PassBuilder& b) const {
   for (int i = 0; i < config_.moment_images(); ++i) {
     b.modify(moment_image(channel_, i), use::compute_general());
-    // Between the two directions, in float: one layer, reused light after light.
-    b.scratch(temp_name(channel_, i), {.format = VK_FORMAT_R32G32B32A32_SFLOAT,
+    // One layer, reused light after light.
+    b.scratch(temp_name(channel_, i), {.format = kTempFormat,
                                        .width = uint32_t(config_.shadow_size),
                                        .height = uint32_t(config_.shadow_size),
                                        .extra_usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
@@ -39,19 +66,18 @@ void BlurPass::execute(const PassContext& c) const {
       vk::pipeline_barrier(c.cmd, vk::image_barrier(temp.image.handle(), VK_IMAGE_ASPECT_COLOR_BIT, compute,
                                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                                                     compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
-      vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(c.frame.uniforms), vk::Descriptor(moments, general, c.frame.point_sampler),
-                    vk::Descriptor(temp.layer_views[0], general)},
-                   ImagePassPush{glm::ivec4(size, size, 0, 0)});
+      vk::dispatch(
+          c.cmd, *program_, groups, groups, 1,
+          {vk::Descriptor(moments, general, c.frame.linear_sampler), vk::Descriptor(temp.layer_views[0], general)},
+          ImagePassPush{glm::ivec4(size, size, 0, 0)});
       vk::pipeline_barrier(
           c.cmd,
           vk::memory_barrier(compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
                              compute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
-      vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(c.frame.uniforms),
-                    vk::Descriptor(temp.layer_views[0], general, c.frame.point_sampler),
-                    vk::Descriptor(moments, general)},
-                   ImagePassPush{glm::ivec4(size, size, 1, 0)});
+      vk::dispatch(
+          c.cmd, *program_, groups, groups, 1,
+          {vk::Descriptor(temp.layer_views[0], general, c.frame.linear_sampler), vk::Descriptor(moments, general)},
+          ImagePassPush{glm::ivec4(size, size, 1, 0)});
     }
     c.end_light();
   }
