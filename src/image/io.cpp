@@ -52,6 +52,12 @@ unsigned char* msm_zlib_compress(unsigned char* data, int length, int* out_lengt
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
+namespace {
+// stb tries all five PNG row filters on every row and keeps the best; Paeth alone compresses the
+// renders nearly as well at a fifth of the filtering work. Set once, before any thread writes.
+[[maybe_unused]] const bool kPaethOnly = (stbi_write_force_png_filter = 4, true);
+} // namespace
+
 namespace msm::image {
 
 namespace fs = std::filesystem;

@@ -292,48 +292,49 @@ TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
     return v[size_t((std::clamp(y, 0, n - 1) * n + std::clamp(x, 0, n - 1)) * 4 + c)];
   };
   for (auto [taps, sigma] : {std::pair{9, MSM_FILTER_DEFAULT_SIGMA}, std::pair{15, 1.5f}, std::pair{3, 0.8f},
-                             std::pair{MSM_FILTER_MAX_TAPS, 20.0f}}) {
-    SCOPED_TRACE(fmt::format("{} taps, sigma {}", taps, sigma));
-    const std::vector<vk::Binding> bindings = {vk::Binding::sampled_image, vk::Binding::storage_image};
-    vk::Program blur = vk::create_program(ctx(), vk::embedded_shader("blur.comp"), "blur.comp", bindings,
-                                          sizeof(ImagePassPush), blur_constants(taps, sigma));
-    vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
-      VkImageMemoryBarrier2 init[2];
-      int i = 0;
-      for (const vk::Image* image : {&temp, &output})
-        init[i++] = vk::image_barrier(image->handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_NONE, 0,
-                                      VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                      VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
-      vk::pipeline_barrier(cmd, {}, {}, init);
-      uint32_t groups = vk::group_count(n, 8);
-      vk::dispatch(cmd, blur, groups, groups, 1,
-                   {vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp)},
-                   ImagePassPush{glm::ivec4(n, n, 0, 0)});
-      vk::pipeline_barrier(
-          cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                  VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
-      vk::dispatch(cmd, blur, groups, groups, 1,
-                   {vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output)},
-                   ImagePassPush{glm::ivec4(n, n, 1, 0)});
-    });
-    std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
-    std::vector<float> out(texels.size());
-    std::memcpy(out.data(), bytes.data(), bytes.size());
-    const int radius = taps / 2;
-    double worst = 0;
-    for (int y = 0; y < n; ++y)
-      for (int x = 0; x < n; ++x)
-        for (int c = 0; c < 4; ++c) {
-          double expected = 0;
-          for (int j = 0; j < taps; ++j)
-            for (int i = 0; i < taps; ++i)
-              expected += double(msm_gaussian_weight(i, taps, sigma)) * msm_gaussian_weight(j, taps, sigma) *
-                          at(texels, x + i - radius, y + j - radius, c);
-          worst = std::max(worst, std::abs(double(at(out, x, y, c)) - expected));
-        }
-    // Float sums of 2 x 33 weighted fetches of values in [0, 1]: a few ulps of 1 each.
-    EXPECT_LE(worst, 2e-6);
-  }
+                             std::pair{MSM_FILTER_MAX_TAPS, 20.0f}})
+    for (bool bilinear : {true, false}) {
+      SCOPED_TRACE(fmt::format("{} taps, sigma {}, {}", taps, sigma, bilinear ? "bilinear" : "point pairs"));
+      const std::vector<vk::Binding> bindings = {vk::Binding::sampled_image, vk::Binding::storage_image};
+      vk::Program blur = vk::create_program(ctx(), vk::embedded_shader("blur.comp"), "blur.comp", bindings,
+                                            sizeof(ImagePassPush), blur_constants(taps, sigma, bilinear));
+      vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+        VkImageMemoryBarrier2 init[2];
+        int i = 0;
+        for (const vk::Image* image : {&temp, &output})
+          init[i++] = vk::image_barrier(image->handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_NONE, 0,
+                                        VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
+        vk::pipeline_barrier(cmd, {}, {}, init);
+        uint32_t groups = vk::group_count(n, 8);
+        vk::dispatch(cmd, blur, groups, groups, 1,
+                     {vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp)},
+                     ImagePassPush{glm::ivec4(n, n, 0, 0)});
+        vk::pipeline_barrier(
+            cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
+        vk::dispatch(cmd, blur, groups, groups, 1,
+                     {vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output)},
+                     ImagePassPush{glm::ivec4(n, n, 1, 0)});
+      });
+      std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
+      std::vector<float> out(texels.size());
+      std::memcpy(out.data(), bytes.data(), bytes.size());
+      const int radius = taps / 2;
+      double worst = 0;
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          for (int c = 0; c < 4; ++c) {
+            double expected = 0;
+            for (int j = 0; j < taps; ++j)
+              for (int i = 0; i < taps; ++i)
+                expected += double(msm_gaussian_weight(i, taps, sigma)) * msm_gaussian_weight(j, taps, sigma) *
+                            at(texels, x + i - radius, y + j - radius, c);
+            worst = std::max(worst, std::abs(double(at(out, x, y, c)) - expected));
+          }
+      // Float sums of 2 x 33 weighted fetches of values in [0, 1]: a few ulps of 1 each.
+      EXPECT_LE(worst, 2e-6);
+    }
 }
 
 // The blur takes every texel as finite (no test per tap), so the resolve must write finite moments:

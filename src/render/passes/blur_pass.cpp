@@ -15,7 +15,7 @@ constexpr VkFormat kTempFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 } // namespace
 
-std::vector<vk::SpecConstant> blur_constants(int taps, float sigma) {
+std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear) {
   static_assert(MSM_BLUR_MAX_PAIRS == (MSM_FILTER_MAX_TAPS / 2 + 1) / 2);
   auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
   int pairs = msm_filter_pairs(taps);
@@ -26,8 +26,19 @@ std::vector<vk::SpecConstant> blur_constants(int taps, float sigma) {
     c.push_back(
         {uint32_t(MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + j), bits(msm_filter_pair_weight(j, taps, sigma))});
   }
+  c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS), bilinear ? 1u : 0u});
   return c;
 }
+
+namespace {
+// The 32-bit float maps keep their precision (a bilinear fetch's fraction is as coarse as its
+// coordinate: RenderTest.OnePassFilterEqualsTheThreePassFilter); the others take half the fetches.
+bool bilinear_blur(const FrameConfig& config) {
+  for (VkFormat f : config.formats())
+    if (f == VK_FORMAT_R32_SFLOAT || f == VK_FORMAT_R32G32_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT) return false;
+  return true;
+}
+} // namespace
 
 void BlurPass::prepare(const PassResources& r) {
   const vk::Context& ctx = r.programs.context();
@@ -37,8 +48,9 @@ void BlurPass::prepare(const PassResources& r) {
     throw RenderError(fmt::format("the blur needs linear filtering of RGBA32F images; {} has none (use "
                                   "--filter-mode one-pass or --filter 1)",
                                   ctx.info().name));
-  program_ = &r.programs.compute("blur.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
-                                 sizeof(ImagePassPush), blur_constants(config_.taps, config_.sigma));
+  program_ =
+      &r.programs.compute("blur.comp", {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(ImagePassPush),
+                          blur_constants(config_.taps, config_.sigma, bilinear_blur(config_)));
 }
 
 void BlurPass::reflect(PassBuilder& b) const {
@@ -56,6 +68,7 @@ void BlurPass::execute(const PassContext& c) const {
   int size = config_.shadow_size;
   uint32_t groups = vk::group_count(uint32_t(size), 8);
   constexpr VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
+  VkSampler sampler = bilinear_blur(config_) ? c.frame.linear_sampler : c.frame.point_sampler;
   constexpr VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
@@ -66,18 +79,16 @@ void BlurPass::execute(const PassContext& c) const {
       vk::pipeline_barrier(c.cmd, vk::image_barrier(temp.image.handle(), VK_IMAGE_ASPECT_COLOR_BIT, compute,
                                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                                                     compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
-      vk::dispatch(
-          c.cmd, *program_, groups, groups, 1,
-          {vk::Descriptor(moments, general, c.frame.linear_sampler), vk::Descriptor(temp.layer_views[0], general)},
-          ImagePassPush{glm::ivec4(size, size, 0, 0)});
+      vk::dispatch(c.cmd, *program_, groups, groups, 1,
+                   {vk::Descriptor(moments, general, sampler), vk::Descriptor(temp.layer_views[0], general)},
+                   ImagePassPush{glm::ivec4(size, size, 0, 0)});
       vk::pipeline_barrier(
           c.cmd,
           vk::memory_barrier(compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
                              compute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
-      vk::dispatch(
-          c.cmd, *program_, groups, groups, 1,
-          {vk::Descriptor(temp.layer_views[0], general, c.frame.linear_sampler), vk::Descriptor(moments, general)},
-          ImagePassPush{glm::ivec4(size, size, 1, 0)});
+      vk::dispatch(c.cmd, *program_, groups, groups, 1,
+                   {vk::Descriptor(temp.layer_views[0], general, sampler), vk::Descriptor(moments, general)},
+                   ImagePassPush{glm::ivec4(size, size, 1, 0)});
     }
     c.end_light();
   }
