@@ -46,6 +46,32 @@ MSM_FN float msm_gaussian_variance(int taps, float sigma) {
   return variance;
 }
 
+// The same kernel in bilinear fetches (the blur): the centre tap alone, then on each side the
+// taps 2j - 1 and 2j (j = 1 .. msm_filter_pairs) as one linear fetch between the two texels,
+// with their summed weight at their weighted mean offset. A clamp-to-edge linear fetch returns
+// exactly what the two clamped point fetches, so weighted, add up to: ceil(r/2) fetches per side
+// instead of r, the same Gaussian. (The fraction is exact in float on lavapipe; GPUs that keep
+// 8 bits of it move a pair's split by up to 1/512.) Where r is odd the outermost pair has one tap.
+MSM_FN int msm_filter_pairs(int taps) { return (taps / 2 + 1) / 2; }
+
+// Normalized weight of the tap `offset` texels from the centre, 0 outside the kernel.
+MSM_FN float msm_filter_weight_at(int offset, int taps, float sigma) {
+  int r = taps / 2;
+  return abs(offset) <= r ? msm_gaussian_weight(offset + r, taps, sigma) : 0.0f;
+}
+
+// Summed weight of pair j in [1, msm_filter_pairs(taps)] (on one side).
+MSM_FN float msm_filter_pair_weight(int j, int taps, float sigma) {
+  return msm_filter_weight_at(2 * j - 1, taps, sigma) + msm_filter_weight_at(2 * j, taps, sigma);
+}
+
+// Offset in texels (> 0) of pair j's fetch; the other side's pair is at minus this. (A pair whose
+// weights underflow, for a tiny σ, sits on its inner texel.)
+MSM_FN float msm_filter_pair_offset(int j, int taps, float sigma) {
+  float w = msm_filter_pair_weight(j, taps, sigma);
+  return float(2 * j - 1) + (w > 0.0f ? msm_filter_weight_at(2 * j, taps, sigma) / w : 0.0f);
+}
+
 MSM_END
 
 #endif // MSM_FILTER_H

@@ -3,7 +3,10 @@
 #include "msm/shading.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include <fmt/core.h>
@@ -113,8 +116,56 @@ float srgb_to_linear(float e) {
   return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
 }
 
-std::uint8_t linear_to_srgb8(float x) {
+namespace {
+
+std::uint8_t linear_to_srgb8_formula(float x) {
   return static_cast<std::uint8_t>(std::lround(255.0 * double(linear_to_srgb(x))));
+}
+
+// steps[k]: the smallest float x with linear_to_srgb8_formula(x) >= k (k = 1 .. 255), found by
+// bisection over the ordered bit patterns of the floats in (0, 1]; steps[0] = -inf, steps[256] =
+// +inf. first[b]: the code of b / kBuckets. The steepest part of the curve (12.92 x, 3295 codes per
+// unit) stays below one step per bucket, so a value's code is first[b] or the next one.
+constexpr int kBuckets = 4096;
+struct Srgb8Steps {
+  std::array<float, 257> steps{};
+  std::array<std::uint8_t, kBuckets> first{};
+  Srgb8Steps() {
+    steps[0] = -std::numeric_limits<float>::infinity();
+    steps[256] = std::numeric_limits<float>::infinity();
+    for (int k = 1; k < 256; ++k) {
+      auto lo = std::bit_cast<std::uint32_t>(0.0f), hi = std::bit_cast<std::uint32_t>(1.0f); // code(lo) < k <= code(hi)
+      while (hi - lo > 1) {
+        std::uint32_t mid = lo + (hi - lo) / 2;
+        (linear_to_srgb8_formula(std::bit_cast<float>(mid)) >= k ? hi : lo) = mid;
+      }
+      steps[size_t(k)] = std::bit_cast<float>(hi);
+    }
+    for (int b = 0; b < kBuckets; ++b) first[size_t(b)] = linear_to_srgb8_formula(float(b) / float(kBuckets));
+  }
+};
+const Srgb8Steps& srgb8_steps() {
+  static const Srgb8Steps table;
+  return table;
+}
+
+} // namespace
+
+std::uint8_t linear_to_srgb8(float x) {
+  const Srgb8Steps& t = srgb8_steps();
+  if (!(x > 0.0f)) return 0; // also NaN
+  if (x >= 1.0f) return 255;
+  unsigned k = t.first[size_t(x * float(kBuckets))]; // x * 4096 is exact: the bucket of x
+  return static_cast<std::uint8_t>(k + (t.steps[k + 1] <= x ? 1 : 0));
+}
+
+float srgb8_to_linear(std::uint8_t code) {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[size_t(i)] = srgb_to_linear(float(i) / 255.0f);
+    return t;
+  }();
+  return table[code];
 }
 
 float luminance(float r, float g, float b) { return msm::msm_luminance(glm::vec3(r, g, b)); }

@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include <unistd.h>
 
@@ -99,6 +101,30 @@ TEST(Colour, ExactSrgbTransfer) {
   EXPECT_EQ(linear_to_srgb8(5.0f), 255);
   for (int i = 0; i <= 255; ++i) // decode then encode is the identity on 8-bit codes
     EXPECT_EQ(linear_to_srgb8(srgb_to_linear(float(i) / 255.0f)), i) << i;
+}
+
+// The table-driven paths give the formula's result: round(255 linear_to_srgb(x)) for floats on
+// both sides of every step (where an off-by-one would show) and spread over [0, 1], and the
+// formula's decode of every 8-bit code.
+TEST(Colour, TablesEqualTheFormula) {
+  auto formula = [](float x) { return int(std::lround(255.0 * double(linear_to_srgb(x)))); };
+  int checked = 0;
+  for (int code = 1; code <= 255; ++code) {
+    // The step between code - 1 and code, from the formula's inverse, then 200 floats either side.
+    float edge = srgb_to_linear((float(code) - 0.5f) / 255.0f);
+    float x = edge;
+    for (int i = 0; i < 200; ++i) x = std::nextafter(x, 0.0f);
+    for (int i = 0; i < 400; ++i, x = std::nextafter(x, 2.0f), ++checked)
+      ASSERT_EQ(int(linear_to_srgb8(x)), formula(x)) << x;
+  }
+  for (std::uint32_t bits = 0; bits <= std::bit_cast<std::uint32_t>(1.0f); bits += 997, ++checked) {
+    float x = std::bit_cast<float>(bits);
+    ASSERT_EQ(int(linear_to_srgb8(x)), formula(x)) << x;
+  }
+  EXPECT_GT(checked, 1000000);
+  EXPECT_EQ(linear_to_srgb8(std::numeric_limits<float>::infinity()), 255);
+  EXPECT_EQ(linear_to_srgb8(-std::numeric_limits<float>::infinity()), 0);
+  for (int i = 0; i <= 255; ++i) EXPECT_EQ(srgb8_to_linear(std::uint8_t(i)), srgb_to_linear(float(i) / 255.0f)) << i;
 }
 
 TEST(Colour, ToneMapping) {

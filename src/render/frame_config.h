@@ -14,9 +14,10 @@ namespace msm::render {
 struct FrameConfig {
   const Technique* technique = nullptr;
   int width = 0, height = 0, shadow_size = 0, msaa = 1, taps = 1;
-  int lights = 1;          // shadow-casting lights: layers of every shadow-map image
-  uint32_t mip_levels = 1; // of the filtered moment images (1: no mips)
-  bool one_pass = false;   // one_pass_filter instead of moment_resolve + blur
+  float sigma = MSM_FILTER_DEFAULT_SIGMA; // of the Gaussian: compiled into the blur
+  int lights = 1;                         // shadow-casting lights: layers of every shadow-map image
+  uint32_t mip_levels = 1;                // of the filtered moment images (1: no mips)
+  bool one_pass = false;                  // one_pass_filter instead of moment_resolve + blur
   // Translucent occluders are blended into the map (JCGT §3): a four-channel technique then
   // stores its moments as two RG images, because the blend factor is the fragment's alpha.
   bool translucent = false;

@@ -1,6 +1,6 @@
 // The renderer on the device (lavapipe in CI) with the validation layer on: every technique on
 // the built-in stress scenes against the PCF reference of the same kernel, the resolve against
-// the CPU single-source computation, the blur against NaN, and bad settings.
+// the CPU single-source computation, the blur against the CPU Gaussian, finite resolves, and bad settings.
 #include "msm/render/renderer.h"
 
 #include "msm/image/compare.h"
@@ -10,6 +10,8 @@
 #include "msm/techniques.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
+
+#include "passes/pass.h"
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -271,22 +273,12 @@ TEST_F(RenderTest, FlatReceiverFacingTheLightIsLit) {
   }
 }
 
-// A NaN texel (which the resolve never writes: it clamps depths) gets weight zero in the blur:
-// nothing non-finite comes out, and texels whose kernel misses it are blurred as usual.
-TEST_F(RenderTest, BlurNeverSpreadsNaN) {
-  const int n = 32, taps = 9, radius = 4;
-  vk::Program blur = vk::create_program(
-      ctx(), "blur.comp", {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
-      sizeof(ImagePassPush));
-  FrameUniforms u{};
-  u.kernel = glm::ivec4(taps, 1, radius, 0);
-  for (int k = 0; k < taps; ++k)
-    u.filter_weights[k / 4][k % 4] = msm_gaussian_weight(k, taps, MSM_FILTER_DEFAULT_SIGMA);
-  vk::Buffer uniforms = vk::create_buffer(ctx(), sizeof(u), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host);
-  std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation): renderer.cpp
+// The blur (bilinear pairs of taps, msm/filter.h, compiled in) is the separable Gaussian of the
+// clamped texels, for kernels with an even and an odd radius and one of a single pair.
+TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
+  const int n = 32;
   std::vector<float> texels(size_t(n * n * 4));
   for (size_t i = 0; i < texels.size(); ++i) texels[i] = float((i * 7919) % 1000) / 1000.0f;
-  for (int c = 0; c < 4; ++c) texels[size_t((10 * n + 10) * 4 + c)] = NAN;
   auto make = [&] {
     return vk::create_image(ctx(), {.width = n,
                                     .height = n,
@@ -296,47 +288,97 @@ TEST_F(RenderTest, BlurNeverSpreadsNaN) {
   };
   vk::Image input = make(), temp = make(), output = make();
   vk::upload_image(ctx(), input, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
-  vk::Sampler sampler = vk::create_sampler(ctx(), VK_FILTER_NEAREST);
-  vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
-    VkImageMemoryBarrier2 init[2];
-    int i = 0;
-    for (const vk::Image* image : {&temp, &output})
-      init[i++] = vk::image_barrier(image->handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_NONE, 0,
-                                    VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-                                    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
-    vk::pipeline_barrier(cmd, {}, {}, init);
-    uint32_t groups = vk::group_count(n, 8);
-    vk::dispatch(
-        cmd, blur, groups, groups, 1,
-        {vk::Descriptor(uniforms), vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp)},
-        ImagePassPush{glm::ivec4(n, n, 0, 0)});
-    vk::pipeline_barrier(
-        cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
-    vk::dispatch(
-        cmd, blur, groups, groups, 1,
-        {vk::Descriptor(uniforms), vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output)},
-        ImagePassPush{glm::ivec4(n, n, 1, 0)});
-  });
-  std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
-  std::vector<float> out(texels.size());
-  std::memcpy(out.data(), bytes.data(), bytes.size());
+  vk::Sampler sampler = vk::create_sampler(ctx(), VK_FILTER_LINEAR);
   auto at = [&](const std::vector<float>& v, int x, int y, int c) {
     return v[size_t((std::clamp(y, 0, n - 1) * n + std::clamp(x, 0, n - 1)) * 4 + c)];
   };
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      for (int c = 0; c < 4; ++c) {
-        float v = at(out, x, y, c);
-        ASSERT_TRUE(std::isfinite(v) && v >= 0.0f && v <= 1.0f) << x << "," << y << ": " << v;
-        if (std::abs(x - 10) <= radius || std::abs(y - 10) <= radius) continue;
-        double expected = 0;
-        for (int j = 0; j < taps; ++j)
-          for (int i = 0; i < taps; ++i)
-            expected += double(u.filter_weights[i / 4][i % 4]) * u.filter_weights[j / 4][j % 4] *
-                        at(texels, x + i - radius, y + j - radius, c);
-        EXPECT_NEAR(v, expected, 1e-5) << x << "," << y;
+  for (auto [taps, sigma] : {std::pair{9, MSM_FILTER_DEFAULT_SIGMA}, std::pair{15, 1.5f}, std::pair{3, 0.8f},
+                             std::pair{MSM_FILTER_MAX_TAPS, 20.0f}})
+    for (bool bilinear : {true, false}) {
+      SCOPED_TRACE(fmt::format("{} taps, sigma {}, {}", taps, sigma, bilinear ? "bilinear" : "point pairs"));
+      const std::vector<vk::Binding> bindings = {vk::Binding::sampled_image, vk::Binding::storage_image};
+      vk::Program blur = vk::create_program(ctx(), vk::embedded_shader("blur.comp"), "blur.comp", bindings,
+                                            sizeof(ImagePassPush), blur_constants(taps, sigma, bilinear));
+      vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+        VkImageMemoryBarrier2 init[2];
+        int i = 0;
+        for (const vk::Image* image : {&temp, &output})
+          init[i++] = vk::image_barrier(image->handle(), VK_IMAGE_ASPECT_COLOR_BIT, VK_PIPELINE_STAGE_2_NONE, 0,
+                                        VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                        VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
+        vk::pipeline_barrier(cmd, {}, {}, init);
+        uint32_t groups = vk::group_count(n, 8);
+        vk::dispatch(cmd, blur, groups, groups, 1,
+                     {vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp)},
+                     ImagePassPush{glm::ivec4(n, n, 0, 0)});
+        vk::pipeline_barrier(
+            cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                    VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
+        vk::dispatch(cmd, blur, groups, groups, 1,
+                     {vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output)},
+                     ImagePassPush{glm::ivec4(n, n, 1, 0)});
+      });
+      std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
+      std::vector<float> out(texels.size());
+      std::memcpy(out.data(), bytes.data(), bytes.size());
+      const int radius = taps / 2;
+      double worst = 0;
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          for (int c = 0; c < 4; ++c) {
+            double expected = 0;
+            for (int j = 0; j < taps; ++j)
+              for (int i = 0; i < taps; ++i)
+                expected += double(msm_gaussian_weight(i, taps, sigma)) * msm_gaussian_weight(j, taps, sigma) *
+                            at(texels, x + i - radius, y + j - radius, c);
+            worst = std::max(worst, std::abs(double(at(out, x, y, c)) - expected));
+          }
+      // Float sums of 2 x 33 weighted fetches of values in [0, 1]: a few ulps of 1 each.
+      EXPECT_LE(worst, 2e-6);
+    }
+}
+
+// The blur takes every texel as finite (no test per tap), so the resolve must write finite moments:
+// every 16-bit depth the rasterizer can produce generates moments that the storage format holds
+// (averages of these stay within their range), the device's resolve writes them, and parameters
+// that would overflow a format are refused before anything runs.
+TEST_F(RenderTest, ResolveWritesFiniteMoments) {
+  std::vector<std::string> floating;
+  for (const Technique* tp : rendered_techniques()) {
+    const Technique& t = *tp;
+    if (msm_technique_is_depth_based(t.id) || msm_technique_is_nonlinear(t.id) || msm_technique_is_soft(t.id)) continue;
+    for (int image = 0; image < 2; ++image) {
+      TexelFormat f = t.formats[size_t(image)];
+      bool half = f == TexelFormat::rg16_float || f == TexelFormat::rgba16_float;
+      if (image == 0 && f != TexelFormat::rg16_unorm && f != TexelFormat::rgba16_unorm) floating.emplace_back(t.name);
+      if (f == TexelFormat::none || f == TexelFormat::rg16_unorm || f == TexelFormat::rgba16_unorm) continue;
+      for (uint32_t d16 = 0; d16 <= 65535; ++d16) {
+        MsmTexel texel = msm_technique_generate(t.id, float(d16) / 65535.0f, t.default_params());
+        glm::vec4 v = image == 0 ? texel.a : texel.b;
+        for (int c = 0; c < 4; ++c) {
+          float stored = half ? glm::unpackHalf1x16(glm::packHalf1x16(v[c])) : v[c];
+          ASSERT_TRUE(std::isfinite(stored))
+              << t.name << " at depth " << d16 << "/65535, channel " << c << ": " << v[c];
+        }
       }
+    }
+  }
+  ASSERT_GE(floating.size(), 5u) << "the techniques with float storage";
+  Renderer renderer(ctx(), scene::builtin_scene("fence"));
+  for (const std::string& name : floating) {
+    RenderSettings s = small(name);
+    s.shadow_size = 128;
+    Intermediates in;
+    renderer.render(s, &in);
+    for (const image::Image* image : {&in.moments, &in.moments1})
+      for (float v : image->pixels()) ASSERT_TRUE(std::isfinite(v)) << name;
+  }
+  RenderSettings overflow = small("esm-32");
+  overflow.params = glm::vec4(0.0f, 100.0f, 0.0f, 0.0f); // exp(100) > the largest float
+  EXPECT_THROW(overflow.validate(), RenderError);
+  RenderSettings half = small("evsm2-32");
+  half.params = glm::vec4(0.0f, 5.6f, 5.54f, 1e-4f); // exp(2 x 5.6) > the largest half
+  EXPECT_THROW(half.validate(), RenderError);
 }
 
 // The parameters reach the shaders: over-darkening only darkens (it divides the shadow

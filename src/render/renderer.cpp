@@ -258,6 +258,7 @@ struct Renderer::Impl {
                   .shadow_size = s.shadow_size,
                   .msaa = s.msaa,
                   .taps = s.filter_size,
+                  .sigma = s.filter_sigma,
                   .lights = int(frame_lights.size()),
                   .one_pass = one_pass,
                   .translucent = translucent,
@@ -436,7 +437,7 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   r.color = image::Image(s.width, s.height, 3);
   std::span<float> c = r.color.pixels();
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
-    for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb_to_linear(float(uint8_t(color[4 * i + k])) / 255.0f);
+    for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb8_to_linear(uint8_t(color[4 * i + k]));
 
   if (g.has_image(kScattering)) {
     image::Image rgba =
@@ -502,6 +503,19 @@ std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s
     m.read_times(out.back(), nullptr);
   }
   return out;
+}
+
+void Renderer::submit_frame_prefix(const RenderSettings& s, std::size_t passes) {
+  Impl& m = *impl_;
+  m.prepare(s);
+  std::vector<std::string_view> names = m.graph->pass_names();
+  if (passes > names.size()) throw RenderError(fmt::format("the frame has {} passes, not {}", names.size(), passes));
+  vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) {
+    if (passes == 0)
+      m.timer.reset(cmd);
+    else
+      m.record(cmd, names[passes - 1]);
+  });
 }
 
 std::vector<std::string> Renderer::frame_passes(const RenderSettings& s) {

@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <fmt/format.h>
+
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -112,6 +114,28 @@ void RenderSettings::validate() const {
           fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
     if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
       throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
+  }
+  // The blur does not guard against non-finite texels: the resolve must not make any. The warps are
+  // monotone in depth, so the ends of the depth range bound every texel.
+  if (!msm_technique_is_depth_based(t.id) && !nonlinear) {
+    glm::vec4 p = params.value_or(t.default_params());
+    for (float depth : {0.0f, 1.0f}) {
+      MsmTexel texel = msm_technique_generate(t.id, depth, p);
+      for (int image = 0; image < 2; ++image) {
+        TexelFormat f = t.formats[size_t(image)];
+        float largest = f == TexelFormat::rg16_float || f == TexelFormat::rgba16_float ? 65504.0f
+                        : f == TexelFormat::r32_float || f == TexelFormat::rg32_float || f == TexelFormat::rgba32_float
+                            ? std::numeric_limits<float>::max()
+                            : 0.0f; // UNORM clamps, the rest has no image
+        for (int c = 0; c < 4 && largest > 0.0f; ++c) {
+          float v = (image == 0 ? texel.a : texel.b)[c];
+          if (!std::isfinite(v) || std::abs(v) > largest)
+            throw RenderError(fmt::format("{}: parameters {},{},{},{} make moments of {} at depth {}, beyond the "
+                                          "storage format's largest value {}",
+                                          technique, p.x, p.y, p.z, p.w, v, depth, largest));
+        }
+      }
+    }
   }
 }
 

@@ -15,6 +15,15 @@
 #include <map>
 #include <unistd.h>
 
+// Optional: without valgrind's header --callgrind says so (the client requests are inline asm, no-ops when
+// the process does not run under valgrind).
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#define MSM_HAS_CALLGRIND 1
+#else
+#define MSM_HAS_CALLGRIND 0
+#endif
+
 namespace msm::tool {
 namespace {
 
@@ -77,6 +86,54 @@ std::pair<int, int> parse_resolution(const std::string& text) {
   return {w, h};
 }
 
+// Instruction counts must not depend on when the machine is busy: every prefix of the frame (its
+// first k passes, k = 0 .. n) is submitted alone and waited for, and callgrind dumps what it
+// counted in between, labelled "msm-prefix <technique> <WxH> <shadow size> <k> <pass k or ->". Pass k
+// costs the difference of prefixes k and k - 1: both include the same submission, so it cancels.
+// Each prefix runs once uninstrumented first, so that the driver's lazy work (shader variants)
+// is not counted.
+void callgrind_prefixes(render::Renderer& renderer, const FrameOptions& frame, const std::vector<std::string>& names,
+                        std::pair<int, int> resolution, const std::vector<int>& shadow_sizes, int warmup) {
+#if MSM_HAS_CALLGRIND
+  for (const std::string& name : names)
+    for (int size : shadow_sizes) {
+      render::RenderSettings s = settings_for(frame, name);
+      s.width = resolution.first;
+      s.height = resolution.second;
+      s.shadow_size = size;
+      renderer.time_frames(s, std::max(warmup, 1));
+      std::vector<std::string> passes = renderer.frame_passes(s);
+      for (int instrumented = 0; instrumented < 2; ++instrumented) {
+        if (instrumented) CALLGRIND_START_INSTRUMENTATION;
+        for (size_t k = 0; k <= passes.size(); ++k) {
+          CALLGRIND_ZERO_STATS;
+          renderer.submit_frame_prefix(s, k);
+          if (instrumented) {
+            std::string label =
+                fmt::format("msm-prefix {} {}x{} {} {} {}", name, s.width, s.height, size, k, k ? passes[k - 1] : "-");
+            CALLGRIND_DUMP_STATS_AT(label.c_str());
+          }
+        }
+        if (instrumented) CALLGRIND_STOP_INSTRUMENTATION;
+      }
+      fmt::print("{} {}x{} {}: {} prefixes dumped\n", name, s.width, s.height, size, passes.size() + 1);
+    }
+#else
+  (void)renderer, (void)frame, (void)names, (void)resolution, (void)shadow_sizes, (void)warmup;
+#endif
+}
+
+// Before the device opens: --callgrind counts nothing outside callgrind.
+void check_callgrind() {
+#if MSM_HAS_CALLGRIND
+  if (!RUNNING_ON_VALGRIND)
+    throw UsageError("--callgrind: run under valgrind --tool=callgrind --instr-atstart=no "
+                     "(scripts/callgrind-passes.sh does)");
+#else
+  throw UsageError("--callgrind: this msm was built without valgrind/callgrind.h (apt-get install valgrind)");
+#endif
+}
+
 } // namespace
 
 void add_bench(CLI::App& app) {
@@ -87,6 +144,7 @@ void add_bench(CLI::App& app) {
     std::vector<int> shadow_sizes = {1024, 2048};
     int frames = 20, warmup = 2;
     std::string json, markdown;
+    bool callgrind = false;
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
@@ -102,15 +160,21 @@ void add_bench(CLI::App& app) {
   cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str();
   cmd->add_option("--json", opt->json, "Write the results as JSON here");
   cmd->add_option("--markdown", opt->markdown, "Write the results as a markdown table here");
+  cmd->add_flag("--callgrind", opt->callgrind,
+                "Under valgrind --tool=callgrind --instr-atstart=no: one callgrind dump per prefix of each frame "
+                "(first resolution, each shadow size) instead of times; scripts/callgrind-passes.sh turns them into "
+                "instructions per pass");
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
     if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
     if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
+    if (opt->callgrind) check_callgrind();
     std::vector<std::string> names = canonical_technique_names(opt->techniques);
     if (names.empty())
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
-    if (std::find(names.begin(), names.end(), "pcf") == names.end()) names.insert(names.begin(), "pcf");
+    if (!opt->callgrind && std::find(names.begin(), names.end(), "pcf") == names.end())
+      names.insert(names.begin(), "pcf");
     std::vector<std::pair<int, int>> resolutions;
     for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
     // Validate every configuration before the first frame.
@@ -132,6 +196,10 @@ void add_bench(CLI::App& app) {
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
     check_on_device(renderer, opt->frame, names); // before the first frame, not after some
+    if (opt->callgrind) {
+      callgrind_prefixes(renderer, opt->frame, names, resolutions[0], opt->shadow_sizes, opt->warmup);
+      return;
+    }
     const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve",  "translucent", "blur",
                                                     "mipmaps",      "one_pass_filter", "sat"};
 

@@ -84,8 +84,13 @@ class Image {
 // NaN gives 0.
 float linear_to_srgb(float linear);
 float srgb_to_linear(float encoded);
-// round(255 * linear_to_srgb(x)).
+// round(255 * linear_to_srgb(x)), without a pow per call: the smallest float of each of the 255
+// steps is found once (by bisection on linear_to_srgb itself, which is monotone); a value's code
+// is its bucket's first code or the next, one comparison with a step. Equal to the formula for
+// every float (Colour.TablesEqualTheFormula).
 std::uint8_t linear_to_srgb8(float linear);
+// srgb_to_linear(code / 255) from a table of the 256 values (the decode of 8-bit images).
+float srgb8_to_linear(std::uint8_t code);
 
 // Rec. 709 / sRGB relative luminance of linear RGB: 0.2126 R + 0.7152 G + 0.0722 B.
 float luminance(float r, float g, float b);

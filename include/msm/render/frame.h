@@ -67,6 +67,13 @@ struct ObjectPush {
   ivec4 light;         // x: the light (shadow-map layer) the shadow and translucent passes draw for
 };
 
+// The blur's specialization constants (blur.comp, passes/blur_pass.cpp): id MSM_BLUR_SPEC_ID holds
+// the fetches per side, + 1 the centre weight, + 2 + i the offset and + 2 + MSM_BLUR_MAX_PAIRS + i
+// the weight of fetch i + 1 (msm_filter_pairs of the largest kernel: 16); + 2 + 2 MSM_BLUR_MAX_PAIRS
+// is true for bilinear fetches, false for each pair's two texels (exact: the 32-bit float maps).
+#define MSM_BLUR_SPEC_ID 10
+#define MSM_BLUR_MAX_PAIRS 16
+
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {
   ivec4 size; // xy: image size in texels, z: pass-specific, w: unused

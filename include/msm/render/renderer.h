@@ -226,6 +226,13 @@ class Renderer {
   // The passes of the frame these settings make, in the order the frame graph runs them.
   std::vector<std::string> frame_passes(const RenderSettings& settings);
 
+  // One frame recorded up to and including its first `passes` passes (frame_passes order; 0:
+  // none, only the submission), submitted and waited for, nothing read back. A profiler counts
+  // each pass as the difference of two prefixes (msm bench --callgrind). Precondition: settings
+  // prepared by a frame with the same configuration first when the count must exclude pipeline
+  // creation.
+  void submit_frame_prefix(const RenderSettings& settings, std::size_t passes);
+
   const scene::Scene& scene() const noexcept;
 
  private:

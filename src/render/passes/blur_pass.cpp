@@ -2,23 +2,62 @@
 
 #include <fmt/format.h>
 
+#include <bit>
+
 namespace msm::render {
 
-void BlurPass::prepare(const PassResources& r) {
-  program_ = &r.programs.compute("blur.comp",
-                                 {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
-                                 sizeof(ImagePassPush));
+namespace {
+
+std::string temp_name(int channel, int i) { return fmt::format("blur_temp{}.{}", i, channel); }
+
+// Between the two directions, in float, read with bilinear fetches.
+constexpr VkFormat kTempFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+
+} // namespace
+
+std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear) {
+  static_assert(MSM_BLUR_MAX_PAIRS == (MSM_FILTER_MAX_TAPS / 2 + 1) / 2);
+  auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+  int pairs = msm_filter_pairs(taps);
+  std::vector<vk::SpecConstant> c = {{MSM_BLUR_SPEC_ID, uint32_t(pairs)},
+                                     {MSM_BLUR_SPEC_ID + 1, bits(msm_filter_weight_at(0, taps, sigma))}};
+  for (int j = 1; j <= pairs; ++j) {
+    c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 1 + j), bits(msm_filter_pair_offset(j, taps, sigma))});
+    c.push_back(
+        {uint32_t(MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + j), bits(msm_filter_pair_weight(j, taps, sigma))});
+  }
+  c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS), bilinear ? 1u : 0u});
+  return c;
 }
 
 namespace {
-std::string temp_name(int channel, int i) { return fmt::format("blur_temp{}.{}", i, channel); }
+// The 32-bit float maps keep their precision (a bilinear fetch's fraction is as coarse as its
+// coordinate: RenderTest.OnePassFilterEqualsTheThreePassFilter); the others take half the fetches.
+bool bilinear_blur(const FrameConfig& config) {
+  for (VkFormat f : config.formats())
+    if (f == VK_FORMAT_R32_SFLOAT || f == VK_FORMAT_R32G32_SFLOAT || f == VK_FORMAT_R32G32B32A32_SFLOAT) return false;
+  return true;
+}
 } // namespace
+
+void BlurPass::prepare(const PassResources& r) {
+  const vk::Context& ctx = r.programs.context();
+  VkFormatProperties props{};
+  vkGetPhysicalDeviceFormatProperties(ctx.physical_device(), kTempFormat, &props);
+  if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+    throw RenderError(fmt::format("the blur needs linear filtering of RGBA32F images; {} has none (use "
+                                  "--filter-mode one-pass or --filter 1)",
+                                  ctx.info().name));
+  program_ =
+      &r.programs.compute("blur.comp", {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(ImagePassPush),
+                          blur_constants(config_.taps, config_.sigma, bilinear_blur(config_)));
+}
 
 void BlurPass::reflect(PassBuilder& b) const {
   for (int i = 0; i < config_.moment_images(); ++i) {
     b.modify(moment_image(channel_, i), use::compute_general());
-    // Between the two directions, in float: one layer, reused light after light.
-    b.scratch(temp_name(channel_, i), {.format = VK_FORMAT_R32G32B32A32_SFLOAT,
+    // One layer, reused light after light.
+    b.scratch(temp_name(channel_, i), {.format = kTempFormat,
                                        .width = uint32_t(config_.shadow_size),
                                        .height = uint32_t(config_.shadow_size),
                                        .extra_usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT});
@@ -29,6 +68,7 @@ void BlurPass::execute(const PassContext& c) const {
   int size = config_.shadow_size;
   uint32_t groups = vk::group_count(uint32_t(size), 8);
   constexpr VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
+  VkSampler sampler = bilinear_blur(config_) ? c.frame.linear_sampler : c.frame.point_sampler;
   constexpr VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
@@ -40,17 +80,14 @@ void BlurPass::execute(const PassContext& c) const {
                                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                                                     compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
       vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(c.frame.uniforms), vk::Descriptor(moments, general, c.frame.point_sampler),
-                    vk::Descriptor(temp.layer_views[0], general)},
+                   {vk::Descriptor(moments, general, sampler), vk::Descriptor(temp.layer_views[0], general)},
                    ImagePassPush{glm::ivec4(size, size, 0, 0)});
       vk::pipeline_barrier(
           c.cmd,
           vk::memory_barrier(compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
                              compute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
       vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(c.frame.uniforms),
-                    vk::Descriptor(temp.layer_views[0], general, c.frame.point_sampler),
-                    vk::Descriptor(moments, general)},
+                   {vk::Descriptor(temp.layer_views[0], general, sampler), vk::Descriptor(moments, general)},
                    ImagePassPush{glm::ivec4(size, size, 1, 0)});
     }
     c.end_light();

@@ -91,6 +91,11 @@ class TranslucentPass : public Pass {
   int channel_;
 };
 
+// blur.comp's specialization constants for a kernel (msm/filter.h's pairs of taps), fetched
+// bilinearly or as point pairs; the shader's bindings are the source (sampled through a linear,
+// clamp-to-edge sampler when bilinear) and the target.
+std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear);
+
 // Moment images (mip 0) of one channel -> separable Gaussian (msm/filter.h) in place, through a
 // float scratch image.
 class BlurPass : public Pass {

@@ -1,35 +1,90 @@
-// One direction of the separable Gaussian blur of a moment image (frame.filter_weights, taps
-// frame.kernel.x): horizontal when pc.size.z == 0, vertical otherwise. Clamp-to-edge. A texel
-// that is not finite (it cannot come from the resolve, which clamps depths) gets weight zero and
-// the others are renormalized, so that one bad texel never spreads over the kernel.
+// One direction of the separable Gaussian blur of a moment image: horizontal when pc.size.z == 0,
+// vertical otherwise. The kernel is compiled in (specialization constants, MSM_BLUR_SPEC_ID in
+// msm/render/frame.h): the centre fetch, then kPairs fetches on each side at fixed offsets and
+// weights, unrolled. With a linear sampler each side fetch is one bilinear pair of taps
+// (msm_filter_pair_offset in msm/filter.h); with a point sampler the host passes the single taps
+// at integer offsets. Clamp-to-edge comes from the sampler. No test for non-finite texels: the
+// resolve writes finite moments only (RenderTest.ResolveWritesFiniteMoments).
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#include "frame.glsl"
+#include "msm/render/frame.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 1) uniform sampler2D source;
-layout(binding = 2) writeonly uniform image2D target;
+layout(binding = 0) uniform sampler2D source;
+layout(binding = 1) writeonly uniform image2D target;
 
 layout(push_constant) uniform Push { ImagePassPush pc; };
 
-bool finite4(vec4 v) { return !any(isnan(v)) && !any(isinf(v)); }
+layout(constant_id = MSM_BLUR_SPEC_ID) const int kPairs = 2;
+layout(constant_id = MSM_BLUR_SPEC_ID + 1) const float kCentre = 1.0f;
+#define MSM_BLUR_PAIR(I)                                                                                           \
+  layout(constant_id = MSM_BLUR_SPEC_ID + 1 + I) const float kOffset##I = 0.0f;                                   \
+  layout(constant_id = MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + I) const float kWeight##I = 0.0f;
+MSM_BLUR_PAIR(1)
+MSM_BLUR_PAIR(2)
+MSM_BLUR_PAIR(3)
+MSM_BLUR_PAIR(4)
+MSM_BLUR_PAIR(5)
+MSM_BLUR_PAIR(6)
+MSM_BLUR_PAIR(7)
+MSM_BLUR_PAIR(8)
+MSM_BLUR_PAIR(9)
+MSM_BLUR_PAIR(10)
+MSM_BLUR_PAIR(11)
+MSM_BLUR_PAIR(12)
+MSM_BLUR_PAIR(13)
+MSM_BLUR_PAIR(14)
+MSM_BLUR_PAIR(15)
+MSM_BLUR_PAIR(16)
+
+// false: each pair as its two texels, point fetches with the weights W (1 - f) and W f, f the
+// fraction of the pair's offset: exact, for the 32-bit float maps (a bilinear fetch's fraction is
+// only as precise as the coordinate, ~1e-5 of a texel at 200 texels, 2e-4 at 2048).
+layout(constant_id = MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS) const bool kBilinear = true;
+
+ivec2 g_p, g_step, g_last;
+vec4 point_pair(int inner, float offset, float weight) {
+  float f = offset - float(inner);
+  return weight * (1.0f - f) *
+             (texelFetch(source, clamp(g_p - inner * g_step, ivec2(0), g_last), 0) +
+              texelFetch(source, clamp(g_p + inner * g_step, ivec2(0), g_last), 0)) +
+         weight * f *
+             (texelFetch(source, clamp(g_p - (inner + 1) * g_step, ivec2(0), g_last), 0) +
+              texelFetch(source, clamp(g_p + (inner + 1) * g_step, ivec2(0), g_last), 0));
+}
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (p.x >= pc.size.x || p.y >= pc.size.y) return;
-  ivec2 step = pc.size.z == 0 ? ivec2(1, 0) : ivec2(0, 1);
-  int taps = frame.kernel.x, radius = frame.kernel.z;
-  ivec2 last = pc.size.xy - ivec2(1);
-  vec4 sum = vec4(0.0f);
-  float total = 0.0f;
-  for (int k = 0; k < taps; ++k) {
-    vec4 v = texelFetch(source, clamp(p + (k - radius) * step, ivec2(0), last), 0);
-    if (finite4(v)) {
-      float w = kernel_weight(k);
-      sum += w * v;
-      total += w;
-    }
-  }
-  imageStore(target, p, total > 0.0f ? sum / total : vec4(0.0f));
+  vec2 texel = 1.0f / vec2(pc.size.xy);
+  vec2 centre = (vec2(p) + 0.5f) * texel;
+  vec2 step = pc.size.z == 0 ? vec2(texel.x, 0.0f) : vec2(0.0f, texel.y);
+  g_p = p;
+  g_step = pc.size.z == 0 ? ivec2(1, 0) : ivec2(0, 1);
+  g_last = pc.size.xy - 1;
+  vec4 sum = kCentre * texelFetch(source, p, 0); // on the texel: no filtering to pay for
+  // Dead after specialization beyond kPairs: the driver keeps kPairs straight-line fetch pairs.
+#define MSM_BLUR_FETCH(I)                                                                                          \
+  if (kPairs >= I && kBilinear)                                                                                    \
+    sum += kWeight##I * (textureLod(source, centre - kOffset##I * step, 0.0f) +                                    \
+                         textureLod(source, centre + kOffset##I * step, 0.0f));                                    \
+  if (kPairs >= I && !kBilinear) sum += point_pair(2 * I - 1, kOffset##I, kWeight##I);
+  MSM_BLUR_FETCH(1)
+  MSM_BLUR_FETCH(2)
+  MSM_BLUR_FETCH(3)
+  MSM_BLUR_FETCH(4)
+  MSM_BLUR_FETCH(5)
+  MSM_BLUR_FETCH(6)
+  MSM_BLUR_FETCH(7)
+  MSM_BLUR_FETCH(8)
+  MSM_BLUR_FETCH(9)
+  MSM_BLUR_FETCH(10)
+  MSM_BLUR_FETCH(11)
+  MSM_BLUR_FETCH(12)
+  MSM_BLUR_FETCH(13)
+  MSM_BLUR_FETCH(14)
+  MSM_BLUR_FETCH(15)
+  MSM_BLUR_FETCH(16)
+  imageStore(target, p, sum);
 }
