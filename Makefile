@@ -49,7 +49,7 @@ sanitize-cpu: deps
 	@cd $(SANITIZE_CPU_DIR) && ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 \
 		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS) --timeout 1800 $(SANITIZE_CPU_CTEST_ARGS)
 
-# The libFuzzer targets (tests/fuzz; clang-14, ASan + UBSan, in build-fuzz), FUZZ_SECONDS each.
+# The libFuzzer targets (tests/fuzz; clang-16, ASan + UBSan, in build-fuzz), FUZZ_SECONDS each.
 FUZZ_SECONDS ?= 60
 fuzz: deps
 	@scripts/fuzz.sh $(FUZZ_SECONDS)

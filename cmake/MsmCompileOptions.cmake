@@ -18,7 +18,7 @@ if(MSM_SANITIZE)
 endif()
 if(MSM_BUILD_FUZZERS)
   if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
-    message(FATAL_ERROR "MSM_BUILD_FUZZERS needs clang (libFuzzer): CXX=clang++-14")
+    message(FATAL_ERROR "MSM_BUILD_FUZZERS needs clang (libFuzzer): CXX=clang++-16")
   endif()
   # Coverage feedback from all of msm's code; the fuzz targets link libFuzzer itself.
   target_compile_options(msm_compile_options INTERFACE -fsanitize=fuzzer-no-link)

@@ -12,7 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # MPI ranks of msm evaluate (Open MPI)
   clang-format clang-tidy  # .ci/check-format (clang-format 14) and .ci/tidy
-  clang-14 libfuzzer-14-dev  # the fuzz targets (make fuzz, tests/fuzz)
+  clang-16 libclang-rt-16-dev  # the fuzz targets (make fuzz, tests/fuzz; clang 16: C++20 aggregate init with parentheses)
   glmark2-data  # real meshes for the import tests (the bunny, 9 MB)
   blender-data  # CC0 equirectangular HDR light probes (studiolights/world) for the light-probe tests
   libglfw3-dev libimgui-dev xvfb xauth  # msm view (GLFW, Dear ImGui) and its tests in a virtual X server

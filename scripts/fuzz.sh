@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (tests/fuzz) with clang-14 under ASan + UBSan in build-fuzz and
+# Builds the libFuzzer targets (tests/fuzz) with clang-16 under ASan + UBSan in build-fuzz and
 # fuzzes each for SECONDS (default 60), one process each, from the committed seed corpus.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
 # New inputs go to build-fuzz/corpus/<target> (the committed corpus is only read); a crash stops
@@ -15,7 +15,7 @@ targets=("$@")
 build=${FUZZ_BUILD_DIR:-build-fuzz}
 launcher=()
 command -v ccache > /dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-16 \
   "${launcher[@]}" -DMSM_BUILD_FUZZERS=ON -DMSM_SANITIZE=address,undefined -DMSM_BUILD_TESTS=OFF \
   -DMSM_BUILD_VULKAN=OFF -DMSM_BUILD_TOOLS=OFF -DMSM_BUILD_BENCHMARKS=OFF \
   "-DCMAKE_CXX_FLAGS=-fno-sanitize-recover=all" > "$build.configure.log" 2>&1 || { cat "$build.configure.log"; exit 1; }
