@@ -14,7 +14,12 @@ targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(scene_json mesh_import image compare)
 build=${FUZZ_BUILD_DIR:-build-fuzz}
 launcher=()
-command -v ccache > /dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# ccache where present, its cache inside the build folder unless CCACHE_DIR says otherwise: nothing
+# is written under $HOME (a fresh clone's CI run checks that HOME stays empty).
+if command -v ccache > /dev/null; then
+  export CCACHE_DIR=${CCACHE_DIR:-$PWD/$build/ccache}
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+fi
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-16 \
   "${launcher[@]}" -DMSM_BUILD_FUZZERS=ON -DMSM_SANITIZE=address,undefined -DMSM_BUILD_TESTS=OFF \
   -DMSM_BUILD_VULKAN=OFF -DMSM_BUILD_TOOLS=OFF -DMSM_BUILD_BENCHMARKS=OFF \
