@@ -69,11 +69,11 @@ MSM_FN float msm_cube_face_coordinate(int i, float offset, float size) {
 
 // The panorama point (s, t) in [0, 1]² of a direction (precondition: d != 0): azimuth
 // φ = atan2(x, −z) about +Y (φ = 0 along −Z, increasing towards +X) at s = (φ + π) / 2π, polar
-// angle θ from +Y at t = θ / π.
+// angle θ from +Y at t = θ / π. θ = atan2(sqrt(x² + z²), y), not acos(y / |d|), which loses
+// half the digits near the poles (acos(1 − ε) ≈ sqrt(2ε)); neither needs d normalized.
 MSM_FN vec2 msm_equirect_of(vec3 d) {
-  vec3 n = normalize(d);
-  float phi = atan(n.x, -n.z);
-  float theta = acos(clamp(n.y, -1.0f, 1.0f));
+  float phi = atan(d.x, -d.z);
+  float theta = atan(length(vec2(d.x, d.z)), d.y);
   return vec2((phi + MSM_PI) / MSM_TWO_PI, theta / MSM_PI);
 }
 

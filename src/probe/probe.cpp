@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -93,7 +94,7 @@ CubeMap cube_from_equirect(int width, int height, const std::vector<glm::vec3>& 
   return cube;
 }
 
-CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float rotation_deg) {
+Panorama load_equirect(const std::filesystem::path& file) {
   image::Image picture;
   try {
     picture = image::read_exr(file);
@@ -123,7 +124,12 @@ CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float r
     // dark texels: no light is negative.
     rgb[k] = glm::max(value, glm::vec3(0.0f));
   }
-  return cube_from_equirect(picture.width(), picture.height(), rgb, size, rotation_deg);
+  return Panorama{picture.width(), picture.height(), std::move(rgb)};
+}
+
+CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float rotation_deg) {
+  const Panorama p = load_equirect(file);
+  return cube_from_equirect(p.width, p.height, p.rgb, size, rotation_deg);
 }
 
 CubeMap make_sky_sun_probe(int size, glm::vec3 sky, glm::vec3 sun, glm::vec3 towards_sun, float sun_radius_rad) {

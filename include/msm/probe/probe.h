@@ -50,6 +50,15 @@ glm::vec2 rotation_cos_sin(float rotation_deg);
 glm::vec3 direction_of_equirect(glm::vec2 st);
 glm::vec2 equirect_of(glm::vec3 direction);
 
+// An equirectangular panorama of linear RGB radiance, row 0 at the zenith.
+struct Panorama {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> rgb; // row-major
+};
+// An equirectangular EXR as it is (the checks and clamping of load_equirect_probe, no resampling):
+// what the device pipeline (DeviceProbe) resamples itself.
+Panorama load_equirect(const std::filesystem::path& file);
+
 // An equirectangular EXR (any compression OpenEXR reads: ZIP, PIZ, DWAB, ...) as a cube map;
 // throws ProbeError naming the file (missing, not an EXR, no R, G and B channels, a non-finite
 // radiance, not 2:1). Negative values (lossy DWA compression rings below zero) are clamped to 0.
