@@ -294,14 +294,16 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
   return lights;
 }
 
-CubeMap sky_probe(int size) {
+CubeMap sky_probe(int size, float rotation_deg) {
+  // Where cube_from_equirect shows the panorama's direction p: the direction that looks p up.
+  const glm::vec2 inverse = rotation_cos_sin(-rotation_deg);
   return make_sky_sun_probe(size, glm::vec3(0.15f, 0.22f, 0.4f), glm::vec3(40000.0f, 36000.0f, 30000.0f),
-                            glm::vec3(0.4f, 0.6f, -0.3f), glm::radians(0.27f));
+                            msm_probe_lookup_direction(glm::vec3(0.4f, 0.6f, -0.3f), inverse), glm::radians(0.27f));
 }
 
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
                                             float intensity) {
-  CubeMap cube = probe == "sky" ? sky_probe(size) : load_equirect_probe(probe, size, rotation_deg);
+  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_equirect_probe(probe, size, rotation_deg);
   for (auto& face : cube.faces)
     for (glm::vec3& t : face) t *= intensity;
   const ProbeTables tables(cube);

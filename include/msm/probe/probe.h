@@ -137,7 +137,8 @@ std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, 
 // The procedural sky of `msm probe sky` and of scenes with "file": "sky": a blue sky of radiance
 // (0.15, 0.22, 0.4) all around and a sun disc of radius 0.27° and radiance (40000, 36000, 30000)
 // towards (0.4, 0.6, −0.3): on a horizontal surface the sun brings about four times the sky's
-// luminance, as on a clear day.
-CubeMap sky_probe(int size);
+// luminance, as on a clear day. rotation_deg turns it about +Y as cube_from_equirect turns a
+// panorama (the sun's direction turns with it).
+CubeMap sky_probe(int size, float rotation_deg = 0.0f);
 
 } // namespace msm::probe
