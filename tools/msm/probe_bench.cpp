@@ -41,10 +41,11 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
   fmt::print(stderr, "msm bench: light probe {} on {}, {} frames after {} warm-up\n", o.probe, ctx->info().name, frames,
              warmup);
   vk::GpuTimer timer(*ctx);
-  nlohmann::json results = nlohmann::json::array();
-  std::string table = "| face | lights | cube ms | tables ms | cut ms | tables / 64² tables | face area ratio | cut / "
-                      "cut at first N | log2 N ratio |\n|---|---|---|---|---|---|---|---|---|\n";
-  std::map<int, double> tables_at_size;
+  struct Row {
+    int size, lights;
+    double cube, tables, cut;
+  };
+  std::vector<Row> rows;
   for (int size : o.sizes) {
     probe::DeviceProbe device(*ctx, size);
     // The sky is a cube map made on the host (no resampling pass); a panorama is resampled each run.
@@ -52,9 +53,7 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
       device.set_cube(probe::sky_probe(size));
     else
       device.set_panorama(panorama);
-    double first_cut = 0.0;
-    for (std::size_t i = 0; i < o.lights.size(); ++i) {
-      const int n = o.lights[i];
+    for (int n : o.lights) {
       std::map<std::string, std::vector<double>> ms;
       for (int f = 0; f < warmup + frames; ++f) {
         device.run(n, 10.0f * float(f), &timer); // a new rotation every run, as per frame
@@ -62,28 +61,52 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
         if (f < warmup) continue;
         for (const char* pass : {"probe_cube", "probe_tables", "probe_cut"}) ms[pass].push_back(t.total(pass));
       }
-      const double cube = sky ? 0.0 : util::median(ms["probe_cube"]), tables = util::median(ms["probe_tables"]),
-                   cut = util::median(ms["probe_cut"]);
-      if (i == 0) first_cut = cut;
-      if (!tables_at_size.count(size)) tables_at_size[size] = tables;
-      const int base = o.sizes.front();
-      const double tables_ratio = tables / tables_at_size[base];
-      const double area_ratio = double(size) * size / (double(base) * base);
-      const double cut_ratio = cut / first_cut, log_ratio = std::log2(double(n)) / std::log2(double(o.lights[0]));
-      table += fmt::format("| {}² | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:.2f} | {:.2f} |\n", size, n,
-                           cube, tables, cut, tables_ratio, area_ratio, cut_ratio, log_ratio);
-      results.push_back({{"size", size},
-                         {"lights", n},
-                         {"probe_cube_ms", cube},
-                         {"probe_tables_ms", tables},
-                         {"probe_cut_ms", cut},
-                         {"tables_ratio", tables_ratio},
-                         {"area_ratio", area_ratio},
-                         {"cut_ratio", cut_ratio},
-                         {"log2_ratio", log_ratio}});
-      fmt::print(stderr, "  {}² {:>3} lights: cube {:.2f} ms, tables {:.2f} ms, cut {:.2f} ms\n", size, n, cube, tables,
-                 cut);
+      rows.push_back(Row{size, n, sky ? 0.0 : util::median(ms["probe_cube"]), util::median(ms["probe_tables"]),
+                         util::median(ms["probe_cut"])});
+      const Row& r = rows.back();
+      fmt::print(stderr, "  {}² {:>3} lights: cube {:.2f} ms, tables {:.2f} ms, cut {:.2f} ms\n", size, n, r.cube,
+                 r.tables, r.cut);
     }
+  }
+  // Ratios against the first size and the first light count. The cube map and the tables do not
+  // depend on the light count: per size, their median over the light counts.
+  const auto per_size = [&](int size, double Row::*field) {
+    std::vector<double> v;
+    for (const Row& r : rows)
+      if (r.size == size) v.push_back(r.*field);
+    return util::median(v);
+  };
+  const auto cut_at = [&](int size, int n) {
+    for (const Row& r : rows)
+      if (r.size == size && r.lights == n) return r.cut;
+    return 0.0;
+  };
+  const int base_size = o.sizes.front(), base_n = o.lights.front();
+  std::string table = "| face | lights | cube ms | tables ms | cut ms | tables ratio | cube ratio | face area ratio | "
+                      "cut ratio | lights ratio | log2 N ratio |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+  nlohmann::json results = nlohmann::json::array();
+  for (const Row& r : rows) {
+    const double tables_ratio = per_size(r.size, &Row::tables) / per_size(base_size, &Row::tables);
+    const double base_cube = per_size(base_size, &Row::cube);
+    const double cube_ratio = base_cube > 0.0 ? per_size(r.size, &Row::cube) / base_cube : 0.0;
+    const double area_ratio = double(r.size) * r.size / (double(base_size) * base_size);
+    const double base_cut = cut_at(r.size, base_n);
+    const double cut_ratio = base_cut > 0.0 ? r.cut / base_cut : 0.0;
+    const double lights_ratio = double(r.lights) / base_n, log_ratio = std::log2(double(r.lights)) / std::log2(base_n);
+    table += fmt::format(
+        "| {}² | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:.2f} | {:.0f} | {:.2f} |\n", r.size,
+        r.lights, r.cube, r.tables, r.cut, tables_ratio, cube_ratio, area_ratio, cut_ratio, lights_ratio, log_ratio);
+    results.push_back({{"size", r.size},
+                       {"lights", r.lights},
+                       {"probe_cube_ms", r.cube},
+                       {"probe_tables_ms", r.tables},
+                       {"probe_cut_ms", r.cut},
+                       {"tables_ratio", tables_ratio},
+                       {"cube_ratio", cube_ratio},
+                       {"area_ratio", area_ratio},
+                       {"cut_ratio", cut_ratio},
+                       {"lights_ratio", lights_ratio},
+                       {"log2_ratio", log_ratio}});
   }
   fmt::print("{}", table);
   const nlohmann::json doc = {
