@@ -2,6 +2,7 @@
 #include "msm/probe/device_probe.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -48,9 +49,16 @@ const VkMemoryBarrier2 kComputeToCompute = vk::memory_barrier(
     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
     VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 
+// The largest component; ProbeError for a NaN, infinite or negative one (the fixed-point tables
+// and their scale need finite radiance >= 0; load_equirect clamps and checks files the same way).
 float largest_component(const std::vector<glm::vec3>& texels) {
   float m = 0.0f;
-  for (const glm::vec3& t : texels) m = std::max({m, t.x, t.y, t.z});
+  for (const glm::vec3& t : texels) {
+    if (!glm::all(glm::greaterThanEqual(t, glm::vec3(0.0f))) || !glm::all(glm::lessThan(t, glm::vec3(3e38f))))
+      throw ProbeError(
+          fmt::format("a light probe texel of ({}, {}, {}): radiance must be finite and >= 0", t.x, t.y, t.z));
+    m = std::max({m, t.x, t.y, t.z});
+  }
   return m;
 }
 
@@ -89,24 +97,25 @@ DeviceProbe::DeviceProbe(const vk::Context& ctx, int size) : ctx_(&ctx), size_(s
 void DeviceProbe::set_panorama(const Panorama& p) {
   if (p.width < 2 || p.height < 1 || p.rgb.size() != std::size_t(p.width) * std::size_t(p.height))
     throw ProbeError(fmt::format("equirectangular image of {}x{} with {} texels", p.width, p.height, p.rgb.size()));
+  const float largest = largest_component(p.rgb); // checks before anything changes
   const std::vector<glm::vec4> texels = padded(p.rgb);
   panorama_ = vk::create_buffer(*ctx_, texels.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   vk::upload_buffer(*ctx_, panorama_, std::as_bytes(std::span(texels)));
   panorama_width_ = p.width;
   panorama_height_ = p.height;
-  scale_ = table_scale(largest_component(p.rgb));
+  scale_ = table_scale(largest);
   has_probe_ = resample_ = true;
 }
 
 void DeviceProbe::set_cube(const CubeMap& cube) {
   if (cube.size != size_)
     throw ProbeError(fmt::format("a cube map of {}² faces for a device probe of {}²", cube.size, size_));
-  std::vector<glm::vec4> texels;
   float largest = 0.0f;
+  for (const auto& face : cube.faces) largest = std::max(largest, largest_component(face)); // checks first
+  std::vector<glm::vec4> texels;
   for (const auto& face : cube.faces) {
     const std::vector<glm::vec4> f = padded(face);
     texels.insert(texels.end(), f.begin(), f.end());
-    largest = std::max(largest, largest_component(face));
   }
   vk::upload_buffer(*ctx_, cube_buffer_, std::as_bytes(std::span(texels)));
   scale_ = table_scale(largest);

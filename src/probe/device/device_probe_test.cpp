@@ -6,7 +6,7 @@
 //  - the cut equals median_cut's region for region, for N in {6, 7, 16, 32, 64, 256}, on the
 //    procedural sky and on blender-data's studio.exr (rotated too), and the regions partition the cube;
 //  - the lights agree with area_lights' of the same regions;
-//  - bad input (N outside 6..256, sizes, no probe) is a ProbeError; a black probe gives no lights.
+//  - bad input (N outside 6..256, sizes, no probe, NaN/inf/negative texels) is a ProbeError; a black probe gives no lights.
 #include "msm/probe/device_probe.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
@@ -192,6 +192,15 @@ TEST_F(DeviceProbeTest, BadInputIsAProbeError) {
   EXPECT_THROW(probe.run(6), ProbeError); // no probe yet
   EXPECT_THROW(probe.set_cube(sky_probe(8)), ProbeError);
   EXPECT_THROW(probe.set_panorama(Panorama{4, 2, std::vector<glm::vec3>(7)}), ProbeError);
+  // Texels the tables cannot hold: NaN, infinite, negative.
+  for (const glm::vec3 bad : {glm::vec3(std::nanf(""), 0, 0), glm::vec3(0, INFINITY, 0), glm::vec3(0, 0, -1)}) {
+    Panorama p{4, 2, std::vector<glm::vec3>(8, glm::vec3(1.0f))};
+    p.rgb[5] = bad;
+    EXPECT_THROW(probe.set_panorama(p), ProbeError);
+    CubeMap c = sky_probe(4);
+    c.faces[3][7] = bad;
+    EXPECT_THROW(probe.set_cube(c), ProbeError);
+  }
   probe.set_cube(sky_probe(4));
   EXPECT_THROW(probe.run(5), ProbeError);
   EXPECT_THROW(probe.run(257), ProbeError);
