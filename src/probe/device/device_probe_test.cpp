@@ -4,7 +4,8 @@
 //    light_probe.h; the device's atan/acos/division may round differently: stated tolerance);
 //  - the fixed-point tables equal ProbeTables' bit for bit;
 //  - the cut equals median_cut's region for region, for N in {6, 7, 16, 32, 64, 256}, on the
-//    procedural sky and on blender-data's studio.exr (rotated too), and the regions partition the cube;
+//    procedural sky and on blender-data's studio.exr (rotated too; and 512² faces for N = 32, 256),
+//    and the regions partition the cube;
 //  - the lights agree with area_lights' of the same regions;
 //  - bad input (N outside 6..256, sizes, no probe, NaN/inf/negative texels) is a ProbeError; a black probe gives no lights.
 #include "msm/probe/device_probe.h"
@@ -17,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <span>
 
 namespace {
 
@@ -67,10 +69,11 @@ bool partitions(const std::vector<Region>& regions, int size) {
 
 // The device's cut of its own cube map against the CPU's cut of the same cube map with the same
 // scale, region for region, and their lights.
-void expect_cut_equals_cpu(const DeviceProbe& probe, const char* what, float rotation_deg) {
+void expect_cut_equals_cpu(const DeviceProbe& probe, const char* what, float rotation_deg,
+                           std::span<const int> counts = kCounts) {
   const CubeMap cube = probe.read_cube();
   const ProbeTables tables(cube, probe.scale());
-  for (int n : kCounts) {
+  for (int n : counts) {
     const DeviceCut device = probe.run(n, rotation_deg);
     const std::vector<Region> cpu = median_cut(tables, n);
     ASSERT_EQ(device.regions.size(), cpu.size()) << what << " N " << n;
@@ -150,6 +153,15 @@ TEST_F(DeviceProbeTest, CutOfStudioEqualsTheCpuCut) {
     probe.run(6, rotation); // the cube map that the cuts below start from
     expect_cut_equals_cpu(probe, rotation == 0.0f ? "studio.exr 64" : "studio.exr 64 rotated 100°", rotation);
   }
+}
+
+TEST_F(DeviceProbeTest, CutAtTheLargestBenchedFaceEqualsTheCpuCut) {
+  // 512² faces (msm bench's largest): the face sums come closest to the fixed point's 2^63.
+  DeviceProbe probe(ctx(), 512);
+  probe.set_panorama(load_equirect(kStudio));
+  probe.run(6, 45.0f);
+  const int counts[] = {32, 256};
+  expect_cut_equals_cpu(probe, "studio.exr 512 rotated 45°", 45.0f, counts);
 }
 
 TEST_F(DeviceProbeTest, DeviceLightsAgreeWithTheCpuPipeline) {
