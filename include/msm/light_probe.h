@@ -58,10 +58,64 @@ MSM_FN float msm_cube_texel_weight(float u, float v, float m) {
   return 4.0f / (m * m * r2 * sqrt(r2));
 }
 
+// The face coordinate (u or v) of the point at `offset` in [0, 1] across texel i of a face of
+// `size` texels (offset 0.5: the texel's centre).
+MSM_FN float msm_cube_face_coordinate(int i, float offset, float size) {
+  return (2.0f * (float(i) + offset)) / size - 1.0f;
+}
+
+// --- Equirectangular panorama -> cube map (msm::probe::cube_from_equirect and the device's
+// probe_cube.comp): each cube texel averages ss² bilinear point samples of the panorama. ---
+
+// The panorama point (s, t) in [0, 1]² of a direction (precondition: d != 0): azimuth
+// φ = atan2(x, −z) about +Y (φ = 0 along −Z, increasing towards +X) at s = (φ + π) / 2π, polar
+// angle θ from +Y at t = θ / π. θ = atan2(sqrt(x² + z²), y), not acos(y / |d|), which loses
+// half the digits near the poles (acos(1 − ε) ≈ sqrt(2ε)); neither needs d normalized.
+MSM_FN vec2 msm_equirect_of(vec3 d) {
+  float phi = atan(d.x, -d.z);
+  float theta = atan(length(vec2(d.x, d.z)), d.y);
+  return vec2((phi + MSM_PI) / MSM_TWO_PI, theta / MSM_PI);
+}
+
+// Where a world direction looks the probe up when the probe is turned by an angle whose cosine
+// and sine are cos_sin about +Y (counter-clockwise seen from above): the direction turned back.
+MSM_FN vec3 msm_probe_lookup_direction(vec3 d, vec2 cos_sin) {
+  return vec3(cos_sin.x * d.x - cos_sin.y * d.z, d.y, cos_sin.y * d.x + cos_sin.x * d.z);
+}
+
+// The bilinear footprint of panorama point st on a width x height panorama: texel p0 and its
+// neighbours p0 + (1, 0), (0, 1), (1, 1), weighted by the fractions f.
+struct MsmBilinearTap {
+  ivec2 p0;
+  vec2 f;
+};
+MSM_FN MsmBilinearTap msm_equirect_tap(vec2 st, ivec2 size) {
+  float x = st.x * float(size.x) - 0.5f, y = st.y * float(size.y) - 0.5f;
+  float fx = floor(x), fy = floor(y);
+  return MsmBilinearTap(ivec2(int(fx), int(fy)), vec2(x - fx, y - fy));
+}
+// A texel of a tap's footprint on the panorama: wrapping in longitude, clamped in latitude.
+// Precondition: −1 <= p.x <= width (what msm_equirect_tap gives for s in [0, 1]).
+MSM_FN ivec2 msm_equirect_texel(ivec2 p, ivec2 size) {
+  int x = p.x < 0 ? p.x + size.x : (p.x >= size.x ? p.x - size.x : p.x);
+  return ivec2(x, clamp(p.y, 0, size.y - 1));
+}
+MSM_FN vec3 msm_bilinear(vec3 a00, vec3 a10, vec3 a01, vec3 a11, vec2 f) {
+  return (1.0f - f.y) * ((1.0f - f.x) * a00 + f.x * a10) + f.y * ((1.0f - f.x) * a01 + f.x * a11);
+}
+
+// a.x b.x + a.y b.y + a.z b.z in this order, nothing fused: the same bits on every device.
+MSM_FN float msm_dot_in_order(vec3 a, vec3 b) {
+  MSM_PRECISE float r = a.x * b.x + a.y * b.y + a.z * b.z;
+  return r;
+}
+
 // CIE XYZ of linear Rec. 709 RGB (Y = msm_luminance): the median cut splits by luminance and its
-// tables keep X, Y, Z (Kneiphof §5: Y is the luminance, X and Z carry the colour back).
+// tables keep X, Y, Z (Kneiphof §5: Y is the luminance, X and Z carry the colour back). Every
+// component is summed in a fixed order (the fixed-point tables below need the same bits everywhere).
 MSM_FN vec3 msm_rgb_to_xyz(vec3 c) {
-  return vec3(dot(c, vec3(0.4124f, 0.3576f, 0.1805f)), msm_luminance(c), dot(c, vec3(0.0193f, 0.1192f, 0.9505f)));
+  return vec3(msm_dot_in_order(c, vec3(0.4124f, 0.3576f, 0.1805f)), msm_luminance(c),
+              msm_dot_in_order(c, vec3(0.0193f, 0.1192f, 0.9505f)));
 }
 MSM_FN vec3 msm_xyz_to_rgb(vec3 c) {
   return vec3(dot(c, vec3(3.2406f, -1.5372f, -0.4986f)), dot(c, vec3(-0.9689f, 1.8758f, 0.0415f)),
@@ -77,6 +131,43 @@ struct MsmRegionSums {
   vec2 first;
   vec2 second;
 };
+
+// --- Fixed-point probe tables (msm::probe::ProbeTables on the CPU, probe_table_rows.comp on the
+// device). The median cut must make the same regions on the device and the CPU, so its tables are
+// integers: every texel's seven values below are scaled by a power of two `scale` (chosen on the
+// host from the probe's largest component, msm::probe::table_scale, so that a face's sums fit in
+// 64 bits) and truncated to uint64; integer sums are exact in any order, so both tables are equal
+// bit for bit when the texel values are. They are: each product and sum rounds once in a fixed
+// order (MSM_PRECISE), and the weight w and the coordinates u, v come from the host
+// (msm_cube_texel_weight and msm_cube_face_coordinate evaluated there), as the device's division
+// and square root need not round correctly. ---
+
+// One texel's values times scale: a = (w X, w Y, w Z, w Y (1 + u)), b = (w Y (1 + v), w Y u²,
+// w Y v²). The first moments are kept shifted by the region's energy (w Y (1 + u) >= 0) so that
+// they are unsigned; msm_region_sums_from_fixed shifts them back.
+struct MsmProbeTexel {
+  vec4 a;
+  vec3 b;
+};
+MSM_FN MsmProbeTexel msm_probe_texel(vec3 rgb, float w, float u, float v, float scale) {
+  vec3 xyz = msm_rgb_to_xyz(rgb);
+  MSM_PRECISE float wx = (w * xyz.x) * scale;
+  MSM_PRECISE float wy = w * xyz.y;
+  MSM_PRECISE float wz = (w * xyz.z) * scale;
+  MSM_PRECISE float fu = (wy * (1.0f + u)) * scale;
+  MSM_PRECISE float fv = (wy * (1.0f + v)) * scale;
+  MSM_PRECISE float su = ((wy * u) * u) * scale;
+  MSM_PRECISE float sv = ((wy * v) * v) * scale;
+  MSM_PRECISE float sy = wy * scale;
+  return MsmProbeTexel(vec4(wx, sy, wz, fu), vec3(fv, su, sv));
+}
+
+// A region's MsmRegionSums from its fixed-point sums, converted to float after the integer
+// differences: xyz = (Σ w X, Σ w Y, Σ w Z), first = (Σ w Y (1 + u), Σ w Y (1 + v)) − Σ w Y, second
+// = (Σ w Y u², Σ w Y v²), all times scale; inv_scale = 1 / scale.
+MSM_FN MsmRegionSums msm_region_sums_from_fixed(vec3 xyz, vec2 first, vec2 second, float inv_scale) {
+  return MsmRegionSums(xyz * inv_scale, first * inv_scale, second * inv_scale);
+}
 
 // A circular area light made from a region (Kneiphof §4.1.2–4.1.3).
 struct MsmAreaLight {

@@ -26,7 +26,12 @@ MSM_FN vec3 msm_surface_radiance(vec3 albedo, vec3 direct, float ambient) { retu
 
 // Relative luminance (CIE Y) of linear Rec. 709 / sRGB: weights lights and colours wherever one
 // number has to stand for a colour (the shadow buffer of several lights, metrics, light probes).
-MSM_FN float msm_luminance(vec3 rgb) { return dot(rgb, vec3(0.2126f, 0.7152f, 0.0722f)); }
+// Products and sums in this order, none fused (precise; C++ builds with -ffp-contract=off): the
+// light probe's fixed-point tables (light_probe.h) need the same bits on every device and the CPU.
+MSM_FN float msm_luminance(vec3 rgb) {
+  MSM_PRECISE float y = rgb.x * 0.2126f + rgb.y * 0.7152f + rgb.z * 0.0722f;
+  return y;
+}
 
 // Narkowicz 2015 fit of the ACES filmic curve, x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14),
 // clamped to [0, 1]; applied after the exposure. Precondition: x >= 0 and finite (callers map NaN,

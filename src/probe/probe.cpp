@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -14,9 +15,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-float face_coordinate(int i, int size, float offset = 0.5f) {
-  return (2.0f * (float(i) + offset)) / float(size) - 1.0f;
-}
+float face_coordinate(int i, int size, float offset = 0.5f) { return msm_cube_face_coordinate(i, offset, float(size)); }
 
 void check_size(int size) {
   if (size < 1 || size > kMaxCubeSize)
@@ -25,30 +24,54 @@ void check_size(int size) {
 
 } // namespace
 
+glm::vec2 rotation_cos_sin(float rotation_deg) {
+  const double rotation = glm::radians(double(rotation_deg));
+  return glm::vec2(float(std::cos(rotation)), float(std::sin(rotation)));
+}
+
+std::vector<float> texel_weights(int size) {
+  check_size(size);
+  std::vector<float> w(std::size_t(size) * size);
+  for (int j = 0; j < size; ++j)
+    for (int i = 0; i < size; ++i)
+      w[std::size_t(j) * size + i] =
+          msm_cube_texel_weight(face_coordinate(i, size), face_coordinate(j, size), float(size));
+  return w;
+}
+
+std::vector<float> face_coordinates(int size) {
+  check_size(size);
+  std::vector<float> c(static_cast<std::size_t>(size));
+  for (int i = 0; i < size; ++i) c[i] = face_coordinate(i, size);
+  return c;
+}
+
+float table_scale(float max_component) {
+  if (!(max_component > 0.0f)) return 1.0f;
+  int e = 0;
+  std::frexp(max_component, &e); // max_component < 2^e
+  return std::ldexp(1.0f, std::clamp(60 - e, -100, 100));
+}
+
 glm::vec3 direction_of_equirect(glm::vec2 st) {
   const double phi = 2.0 * kPi * st.x - kPi, theta = kPi * st.y;
   return glm::vec3(float(std::sin(theta) * std::sin(phi)), float(std::cos(theta)),
                    float(-std::sin(theta) * std::cos(phi)));
 }
 
-glm::vec2 equirect_of(glm::vec3 d) {
-  const glm::dvec3 n = glm::normalize(glm::dvec3(d));
-  const double phi = std::atan2(n.x, -n.z), theta = std::acos(std::clamp(n.y, -1.0, 1.0));
-  return glm::vec2(float((phi + kPi) / (2.0 * kPi)), float(theta / kPi));
-}
+glm::vec2 equirect_of(glm::vec3 d) { return msm_equirect_of(d); }
 
 CubeMap cube_from_equirect(int width, int height, const std::vector<glm::vec3>& rgb, int size, float rotation_deg,
                            int supersampling) {
   check_size(size);
   if (width < 2 || height < 1 || rgb.size() != std::size_t(width) * std::size_t(height))
     throw ProbeError(fmt::format("equirectangular image of {}x{} with {} texels", width, height, rgb.size()));
-  const auto fetch = [&](int x, int y) {
-    x = ((x % width) + width) % width;
-    y = std::clamp(y, 0, height - 1);
-    return rgb[std::size_t(y) * width + x];
+  const glm::ivec2 extent(width, height);
+  const auto fetch = [&](glm::ivec2 p) {
+    const glm::ivec2 q = msm_equirect_texel(p, extent);
+    return rgb[std::size_t(q.y) * width + q.x];
   };
-  const double rotation = glm::radians(double(rotation_deg));
-  const float c = float(std::cos(rotation)), s = float(std::sin(rotation));
+  const glm::vec2 cos_sin = rotation_cos_sin(rotation_deg);
   CubeMap cube;
   cube.size = size;
   const int ss = std::max(supersampling, 1);
@@ -60,15 +83,10 @@ CubeMap cube_from_equirect(int width, int height, const std::vector<glm::vec3>& 
         for (int b = 0; b < ss; ++b)
           for (int a = 0; a < ss; ++a) {
             const float u = face_coordinate(i, size, (a + 0.5f) / ss), v = face_coordinate(j, size, (b + 0.5f) / ss);
-            const glm::vec3 d = msm_cube_direction(face, u, v);
-            // The probe turned by +rotation about +Y: look the direction up turned by −rotation.
-            const glm::vec3 local(c * d.x - s * d.z, d.y, s * d.x + c * d.z);
-            const glm::vec2 st = equirect_of(local);
-            const float x = st.x * float(width) - 0.5f, y = st.y * float(height) - 0.5f;
-            const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
-            const float fx = x - float(x0), fy = y - float(y0);
-            sum += (1 - fy) * ((1 - fx) * fetch(x0, y0) + fx * fetch(x0 + 1, y0)) +
-                   fy * ((1 - fx) * fetch(x0, y0 + 1) + fx * fetch(x0 + 1, y0 + 1));
+            const glm::vec3 d = msm_probe_lookup_direction(msm_cube_direction(face, u, v), cos_sin);
+            const MsmBilinearTap tap = msm_equirect_tap(msm_equirect_of(d), extent);
+            sum += msm_bilinear(fetch(tap.p0), fetch(tap.p0 + glm::ivec2(1, 0)), fetch(tap.p0 + glm::ivec2(0, 1)),
+                                fetch(tap.p0 + glm::ivec2(1, 1)), tap.f);
           }
         cube.at(face, i, j) = sum / float(ss * ss);
       }
@@ -76,7 +94,7 @@ CubeMap cube_from_equirect(int width, int height, const std::vector<glm::vec3>& 
   return cube;
 }
 
-CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float rotation_deg) {
+Panorama load_equirect(const std::filesystem::path& file) {
   image::Image picture;
   try {
     picture = image::read_exr(file);
@@ -106,7 +124,12 @@ CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float r
     // dark texels: no light is negative.
     rgb[k] = glm::max(value, glm::vec3(0.0f));
   }
-  return cube_from_equirect(picture.width(), picture.height(), rgb, size, rotation_deg);
+  return Panorama{picture.width(), picture.height(), std::move(rgb)};
+}
+
+CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float rotation_deg) {
+  const Panorama p = load_equirect(file);
+  return cube_from_equirect(p.width, p.height, p.rgb, size, rotation_deg);
 }
 
 CubeMap make_sky_sun_probe(int size, glm::vec3 sky, glm::vec3 sun, glm::vec3 towards_sun, float sun_radius_rad) {
@@ -156,37 +179,51 @@ glm::dvec3 integrate(const CubeMap& cube) {
   return sum;
 }
 
-ProbeTables::ProbeTables(const CubeMap& cube) : size_(cube.size) {
+ProbeTables::ProbeTables(const CubeMap& cube, float scale) : size_(cube.size) {
   check_size(size_);
+  if (scale <= 0.0f) {
+    float largest = 0.0f;
+    for (const auto& face : cube.faces)
+      for (const glm::vec3& t : face) largest = std::max({largest, t.x, t.y, t.z});
+    scale = table_scale(largest);
+  }
+  scale_ = scale;
+  const std::vector<float> weights = texel_weights(size_), coordinates = face_coordinates(size_);
   const std::size_t stride = std::size_t(size_) + 1;
   for (int face = 0; face < 6; ++face) {
-    for (auto& table : tables_[face]) table.assign(stride * stride, 0.0);
+    for (auto& table : tables_[face]) table.assign(stride * stride, 0);
     for (int j = 0; j < size_; ++j)
       for (int i = 0; i < size_; ++i) {
-        const float u = face_coordinate(i, size_), v = face_coordinate(j, size_);
-        const double w = msm_cube_texel_weight(u, v, float(size_));
-        const glm::dvec3 xyz = w * glm::dvec3(msm_rgb_to_xyz(cube.at(face, i, j)));
-        const double values[7] = {xyz.x, xyz.y, xyz.z, xyz.y * u, xyz.y * v, xyz.y * u * u, xyz.y * v * v};
+        const MsmProbeTexel t = msm_probe_texel(cube.at(face, i, j), weights[std::size_t(j) * size_ + i],
+                                                coordinates[i], coordinates[j], scale_);
+        const float values[7] = {t.a.x, t.a.y, t.a.z, t.a.w, t.b.x, t.b.y, t.b.z};
         for (int k = 0; k < 7; ++k) {
-          auto& t = tables_[face][k];
-          t[(j + 1) * stride + i + 1] = values[k] + t[j * stride + i + 1] + t[(j + 1) * stride + i] - t[j * stride + i];
+          auto& s = tables_[face][k];
+          // Wrapping arithmetic as on the device; the scale keeps true sums below 2^63.
+          s[(j + 1) * stride + i + 1] =
+              std::uint64_t(values[k]) + s[j * stride + i + 1] + s[(j + 1) * stride + i] - s[j * stride + i];
         }
       }
   }
 }
 
-double ProbeTables::rect(int face, int k, const Region& r) const {
+std::uint64_t ProbeTables::rect(int face, int k, const Region& r) const {
   const auto& t = tables_[face][k];
   const std::size_t stride = std::size_t(size_) + 1;
   return t[r.y1 * stride + r.x1] - t[r.y0 * stride + r.x1] - t[r.y1 * stride + r.x0] + t[r.y0 * stride + r.x0];
 }
 
-double ProbeTables::energy(const Region& r) const { return rect(r.face, 1, r); }
+std::uint64_t ProbeTables::fixed_energy(const Region& r) const { return rect(r.face, 1, r); }
+
+double ProbeTables::energy(const Region& r) const { return double(rect(r.face, 1, r)) / double(scale_); }
 
 MsmRegionSums ProbeTables::sums(const Region& r) const {
-  return MsmRegionSums(glm::vec3(float(rect(r.face, 0, r)), float(rect(r.face, 1, r)), float(rect(r.face, 2, r))),
-                       glm::vec2(float(rect(r.face, 3, r)), float(rect(r.face, 4, r))),
-                       glm::vec2(float(rect(r.face, 5, r)), float(rect(r.face, 6, r))));
+  const auto rect_float = [&](int k) { return float(rect(r.face, k, r)); };
+  // The first moments come shifted by Σ w Y: the difference is taken in integers, then rounded.
+  const std::int64_t y = std::int64_t(rect(r.face, 1, r));
+  const glm::vec2 first(float(std::int64_t(rect(r.face, 3, r)) - y), float(std::int64_t(rect(r.face, 4, r)) - y));
+  return msm_region_sums_from_fixed(glm::vec3(rect_float(0), rect_float(1), rect_float(2)), first,
+                                    glm::vec2(rect_float(5), rect_float(6)), 1.0f / scale_);
 }
 
 std::vector<Region> median_cut(const ProbeTables& tables, int count) {
@@ -197,6 +234,7 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count) {
   std::vector<Region> regions;
   for (int face = 0; face < 6; ++face) {
     Region r{face, 0, 0, tables.size(), tables.size()};
+    r.fixed_energy = tables.fixed_energy(r);
     r.energy = tables.energy(r);
     regions.push_back(r);
   }
@@ -206,7 +244,7 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count) {
     for (int k = 0; k < int(regions.size()); ++k) {
       const Region& r = regions[k];
       if (r.x1 - r.x0 < 2 && r.y1 - r.y0 < 2) continue;
-      if (best < 0 || r.energy > regions[best].energy) best = k;
+      if (best < 0 || r.fixed_energy > regions[best].fixed_energy) best = k;
     }
     if (best < 0) break; // every region is one texel
     const Region r = regions[best];
@@ -217,23 +255,27 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count) {
       (along_x ? a.x1 : a.y1) = cut;
       return a;
     };
-    // The cut in (lo, hi) where the first part's energy is closest to half: the energy grows with
-    // the cut, so a binary search finds the first cut reaching half, then its neighbour is compared.
-    const double half = 0.5 * r.energy;
+    // The cut in (lo, hi) where the first part's energy is closest to half (in integers: twice the
+    // part against the whole, which stays below 2^63): the energy grows with the cut, so a binary
+    // search finds the first cut reaching half, then its neighbour is compared (a tie: the lower
+    // cut). probe_cut.comp does the same.
+    const auto twice_minus_whole = [&](int cut) {
+      return 2 * std::int64_t(tables.fixed_energy(first_part(cut))) - std::int64_t(r.fixed_energy);
+    };
     int a = lo + 1, b = hi - 1;
     while (a < b) {
       const int mid = (a + b) / 2;
-      if (tables.energy(first_part(mid)) < half)
+      if (twice_minus_whole(mid) < 0)
         a = mid + 1;
       else
         b = mid;
     }
     int cut = a;
-    if (cut - 1 > lo &&
-        std::abs(tables.energy(first_part(cut - 1)) - half) <= std::abs(tables.energy(first_part(cut)) - half))
-      cut -= 1;
+    if (cut - 1 > lo && std::abs(twice_minus_whole(cut - 1)) <= std::abs(twice_minus_whole(cut))) cut -= 1;
     Region first = first_part(cut), second = r;
     (along_x ? second.x0 : second.y0) = cut;
+    first.fixed_energy = tables.fixed_energy(first);
+    second.fixed_energy = tables.fixed_energy(second);
     first.energy = tables.energy(first);
     second.energy = tables.energy(second);
     regions[best] = first;
@@ -252,14 +294,16 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
   return lights;
 }
 
-CubeMap sky_probe(int size) {
+CubeMap sky_probe(int size, float rotation_deg) {
+  // Where cube_from_equirect shows the panorama's direction p: the direction that looks p up.
+  const glm::vec2 inverse = rotation_cos_sin(-rotation_deg);
   return make_sky_sun_probe(size, glm::vec3(0.15f, 0.22f, 0.4f), glm::vec3(40000.0f, 36000.0f, 30000.0f),
-                            glm::vec3(0.4f, 0.6f, -0.3f), glm::radians(0.27f));
+                            msm_probe_lookup_direction(glm::vec3(0.4f, 0.6f, -0.3f), inverse), glm::radians(0.27f));
 }
 
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
                                             float intensity) {
-  CubeMap cube = probe == "sky" ? sky_probe(size) : load_equirect_probe(probe, size, rotation_deg);
+  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_equirect_probe(probe, size, rotation_deg);
   for (auto& face : cube.faces)
     for (glm::vec3& t : face) t *= intensity;
   const ProbeTables tables(cube);

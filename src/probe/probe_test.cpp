@@ -103,6 +103,9 @@ TEST(CubeMap, EquirectangularMappingAndRotation) {
   };
   EXPECT_GT(glm::dot(brightest(turned), glm::vec3(-1, 0, 0)), 0.99f);
   EXPECT_GT(glm::dot(brightest(cube_from_equirect(w, h, spot, 16)), glm::vec3(0, 0, -1)), 0.99f);
+  // The procedural sky turns the same way: its sun (0.4, 0.6, −0.3) turned by 90° is at (−0.3, 0.6, −0.4).
+  EXPECT_GT(glm::dot(brightest(sky_probe(64, 90.0f)), glm::normalize(glm::vec3(-0.3f, 0.6f, -0.4f))), 0.999f);
+  EXPECT_GT(glm::dot(brightest(sky_probe(64)), glm::normalize(glm::vec3(0.4f, 0.6f, -0.3f))), 0.999f);
 }
 
 TEST(CubeMap, SkySunProbeIntegratesToItsClosedForm) {

@@ -237,14 +237,7 @@ class Parser {
                                              p.rotation_deg, p.intensity);
     } catch (const msm::probe::ProbeError& e) { fail(ptr + "/file", e.what()); }
     p.first_light = s.lights.size();
-    for (const msm::MsmAreaLight& a : lights) {
-      DirectionalLight l;
-      l.towards_light = a.direction;
-      l.irradiance = msm::msm_area_light_facing_irradiance(a);
-      // Discs below 90° across (the renderer's and the ray tracer's limit on angular_extent_deg).
-      l.angular_extent_deg = std::min(2.0f * glm::degrees(a.cone_half_angle), 89.0f);
-      s.lights.push_back(l);
-    }
+    for (const msm::MsmAreaLight& a : lights) s.lights.push_back(light_of_area_light(a));
     if (s.lights.empty()) fail(ptr + "/file", "the probe has no light (every texel is black)");
     s.probe = p;
   }
@@ -533,6 +526,14 @@ class Parser {
 };
 
 } // namespace
+
+DirectionalLight light_of_area_light(const msm::MsmAreaLight& area) {
+  DirectionalLight l;
+  l.towards_light = area.direction;
+  l.irradiance = msm::msm_area_light_facing_irradiance(area);
+  l.angular_extent_deg = std::min(2.0f * glm::degrees(area.cone_half_angle), 89.0f);
+  return l;
+}
 
 SceneError::SceneError(std::string file, std::string where, std::string problem)
     : std::runtime_error(compose(file, where, problem)), file_(std::move(file)), where_(std::move(where)),

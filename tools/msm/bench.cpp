@@ -1,6 +1,7 @@
 // `msm bench`: GPU time per pass over repeated frames (median and spread), and per technique the
 // cost relative to PCF with the same kernel: shading per pixel at the given resolutions, shadow
 // map (depth, resolve, blur, mips) per texel at the given sizes. JSON and a markdown table.
+#include "probe_bench.h"
 #include "render_common.h"
 
 #include "msm/image/io.h"
@@ -145,6 +146,7 @@ void add_bench(CLI::App& app) {
     int frames = 20, warmup = 2;
     std::string json, markdown;
     bool callgrind = false;
+    ProbeBench probe;
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
@@ -164,11 +166,22 @@ void add_bench(CLI::App& app) {
                 "Under valgrind --tool=callgrind --instr-atstart=no: one callgrind dump per prefix of each frame "
                 "(first resolution, each shadow size) instead of times; scripts/callgrind-passes.sh turns them into "
                 "instructions per pass");
+  cmd->add_option("--probe", opt->probe.probe,
+                  "Time the light-probe pipeline instead (an equirectangular EXR, or 'sky'): cube map, tables and "
+                  "median cut on the device against face size and light count");
+  cmd->add_option("--probe-sizes", opt->probe.sizes, "Face sizes for --probe")->delimiter(',')->capture_default_str();
+  cmd->add_option("--probe-lights", opt->probe.lights, "Light counts for --probe")
+      ->delimiter(',')
+      ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
     if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
     if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
+    if (!opt->probe.probe.empty()) {
+      bench_probe(opt->probe, opt->frame.device, opt->frames, opt->warmup, opt->json, opt->markdown);
+      return;
+    }
     if (opt->callgrind) check_callgrind();
     std::vector<std::string> names = canonical_technique_names(opt->techniques);
     if (names.empty())

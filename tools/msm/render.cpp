@@ -1,4 +1,5 @@
 // `msm render`: one or more techniques on one scene; `msm scenes`: the built-in scenes.
+#include "probe_frames.h"
 #include "render_common.h"
 
 #include "msm/viewer/view_file.h"
@@ -32,6 +33,7 @@ void add_render(CLI::App& app) {
     std::string techniques = "msm-hamburger-64";
     std::string out = "msm-render";
     std::string view; // a view file (msm view)
+    ProbeFrames probe_frames;
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
@@ -44,7 +46,14 @@ void add_render(CLI::App& app) {
                   "A view file of msm view (scene, camera, lights, every setting): renders exactly that view; only "
                   "-t, -o and --device go with it");
   add_frame_options(cmd, opt->frame);
+  cmd->add_option("--frames", opt->probe_frames.frames,
+                  "Frames to render of a scene with a light probe: each frame splits the (turned) probe into its "
+                  "area lights again on the device and reports the timings (probe_frames.h)")
+      ->check(CLI::Range(1, 10000));
+  cmd->add_option("--probe-rotation-speed", opt->probe_frames.rotation_speed_deg,
+                  "Degrees the scene's light probe turns about +Y per frame (with --frames)");
   cmd->callback([opt, cmd] {
+    const bool probe_frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
     std::optional<scene::Camera> view_camera;
     if (!opt->view.empty()) {
       for (const CLI::Option* o : cmd->get_options()) {
@@ -76,6 +85,7 @@ void add_render(CLI::App& app) {
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);
     check_limits(opt->frame, scene, names);
+    if (probe_frames) check_probe_frames(scene, opt->probe_frames);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     fmt::print(stderr, "msm render: scene '{}', {} triangles, {}x{}, shadow map {}², on {}\n", scene.name,
                scene.triangle_count(), f.width, f.height, f.shadow_size, ctx->info().name);
@@ -83,6 +93,10 @@ void add_render(CLI::App& app) {
     // What the device cannot do is refused before the output directory exists.
     check_on_device(renderer, opt->frame, names);
     ensure_output_dir(opt->out);
+    if (probe_frames) {
+      render_probe_frames(*ctx, renderer, scene, opt->frame, names, opt->out, opt->probe_frames);
+      return;
+    }
     for (size_t i = 0; i < names.size(); ++i) {
       render::RenderSettings s = settings_for(opt->frame, names[i]);
       render::RenderResult result;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -39,10 +40,24 @@ inline constexpr int kMaxCubeSize = 4096;
 CubeMap cube_from_equirect(int width, int height, const std::vector<glm::vec3>& rgb, int size,
                            float rotation_deg = 0.0f, int supersampling = 4);
 
+// (cos, sin) of a probe rotation about +Y in degrees (computed in double), as
+// msm_probe_lookup_direction takes it.
+glm::vec2 rotation_cos_sin(float rotation_deg);
+
 // Unit direction of the panorama point (s, t) in [0,1]²: azimuth φ = 2π s − π about +Y (φ = 0
-// along −Z, increasing towards +X), polar angle θ = π t from +Y. Its inverse is equirect_of.
+// along −Z, increasing towards +X), polar angle θ = π t from +Y. Its inverse is equirect_of
+// (msm_equirect_of, in float as cube_from_equirect and the device use it).
 glm::vec3 direction_of_equirect(glm::vec2 st);
 glm::vec2 equirect_of(glm::vec3 direction);
+
+// An equirectangular panorama of linear RGB radiance, row 0 at the zenith.
+struct Panorama {
+  int width = 0, height = 0;
+  std::vector<glm::vec3> rgb; // row-major
+};
+// An equirectangular EXR as it is (the checks and clamping of load_equirect_probe, no resampling):
+// what the device pipeline (DeviceProbe) resamples itself.
+Panorama load_equirect(const std::filesystem::path& file);
 
 // An equirectangular EXR (any compression OpenEXR reads: ZIP, PIZ, DWAB, ...) as a cube map;
 // throws ProbeError naming the file (missing, not an EXR, no R, G and B channels, a non-finite
@@ -61,26 +76,51 @@ glm::dvec3 integrate(const CubeMap& cube);
 struct Region {
   int face = 0;
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  double energy = 0.0; // Σ w Y over its texels (illuminance from luminance)
+  double energy = 0.0;            // Σ w Y over its texels (illuminance from luminance)
+  std::uint64_t fixed_energy = 0; // the same in the tables' fixed point (ProbeTables::scale), what the cut compares
+  bool operator==(const Region&) const = default;
 };
 
-// Per-face summed-area tables of w X, w Y, w Z, w Y u, w Y v, w Y u², w Y v² (double), so that
-// any region's MsmRegionSums cost O(1).
+// The solid-angle weights msm_cube_texel_weight of one face's texels (row-major, the same on every
+// face) and the coordinates of the texel centres msm_cube_face_coordinate (u of column i = v of row
+// i): computed on the host for the CPU tables and uploaded for the device's.
+std::vector<float> texel_weights(int size);
+std::vector<float> face_coordinates(int size);
+
+// The power of two by which the fixed-point tables scale every texel value (light_probe.h,
+// msm_probe_texel) for a probe whose largest RGB component is max_component: 2^(60 − e) where
+// max_component < 2^e, so that a face's sums (at most 2 · 2π/3 · max_component · scale) stay below
+// 2^63; 1 for a black probe. Exponents are kept in [−100, 100] (float range, no denormals).
+float table_scale(float max_component);
+
+// Per-face summed-area tables of w X, w Y, w Z, w Y (1 + u), w Y (1 + v), w Y u², w Y v² in
+// fixed point (uint64, see msm_probe_texel), so that any region's MsmRegionSums cost O(1) and the
+// median cut compares exact integers: the device builds the same tables bit for bit
+// (msm::probe::DeviceProbe), so both cut the same regions.
 class ProbeTables {
  public:
-  explicit ProbeTables(const CubeMap& cube);
+  // scale 0: table_scale of the cube's largest component.
+  explicit ProbeTables(const CubeMap& cube, float scale = 0.0f);
   int size() const { return size_; }
+  float scale() const { return scale_; }
   MsmRegionSums sums(const Region& r) const;
-  double energy(const Region& r) const; // Σ w Y
+  double energy(const Region& r) const;              // Σ w Y
+  std::uint64_t fixed_energy(const Region& r) const; // Σ w Y times scale, as the tables hold it
+  // Entry (x, y) of table k (0..6, the order above) of a face: the sum over texels [0, x) x [0, y).
+  std::uint64_t at(int face, int k, int x, int y) const {
+    return tables_[face][k][std::size_t(y) * (std::size_t(size_) + 1) + std::size_t(x)];
+  }
+
  private:
   int size_ = 0;
+  float scale_ = 1.0f;
   // tables_[face][k] is (size + 1)² entries, entry (x, y) = sum over texels [0, x) x [0, y).
-  std::array<std::array<std::vector<double>, 7>, 6> tables_;
-  double rect(int face, int k, const Region& r) const;
+  std::array<std::array<std::vector<std::uint64_t>, 7>, 6> tables_;
+  std::uint64_t rect(int face, int k, const Region& r) const;
 };
 
 // The median cut (Kneiphof §3.1 after Debevec's): one region per face, then the region with the
-// largest energy is split across its longer side (the other side where the longer is one texel)
+// largest energy (fixed_energy; ties: the earliest in the list) is split across its longer side (the other side where the longer is one texel)
 // where the energy of the two parts is closest to equal, until there are `count` regions; regions
 // of one texel are not split. Regions never straddle faces, so count must be in [6, 256]
 // (ProbeError otherwise); a probe with fewer splittable texels than needed returns fewer regions.
@@ -97,7 +137,8 @@ std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, 
 // The procedural sky of `msm probe sky` and of scenes with "file": "sky": a blue sky of radiance
 // (0.15, 0.22, 0.4) all around and a sun disc of radius 0.27° and radiance (40000, 36000, 30000)
 // towards (0.4, 0.6, −0.3): on a horizontal surface the sun brings about four times the sky's
-// luminance, as on a clear day.
-CubeMap sky_probe(int size);
+// luminance, as on a clear day. rotation_deg turns it about +Y as cube_from_equirect turns a
+// panorama (the sun's direction turns with it).
+CubeMap sky_probe(int size, float rotation_deg = 0.0f);
 
 } // namespace msm::probe

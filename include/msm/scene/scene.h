@@ -138,6 +138,10 @@
 
 #include <glm/glm.hpp>
 
+namespace msm {
+struct MsmAreaLight; // msm/light_probe.h
+} // namespace msm
+
 namespace msm::scene {
 
 // Caps against absurd input (checked before anything is allocated).
@@ -290,6 +294,11 @@ struct Medium {
   float scattering_albedo = 1.0f; // ρ in [0, 1]
   float g = 0.0f;                 // in (-1, 1)
 };
+
+// The disc light that the renderer and the ray tracer draw for an area light of a probe: its
+// direction, the irradiance a facing surface receives (Eq. 18), and its cone's angular diameter
+// kept below 90° (their limit on angular_extent_deg).
+DirectionalLight light_of_area_light(const msm::MsmAreaLight& area);
 
 // Image-based lighting: the probe the scene's area lights were made from (Scene::lights holds them).
 struct ProbeLighting {

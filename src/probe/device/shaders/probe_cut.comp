@@ -1,0 +1,144 @@
+#version 460
+// The median cut in one workgroup (Kneiphof §5), region for region the CPU's msm::probe::median_cut
+// on the same fixed-point tables, then the area light of every region (msm_area_light_from_region).
+// Invocation t holds region t. Each step: a tree reduction finds the splittable region of the
+// largest energy (ties: the lowest index, the CPU's "first"), then invocation 0 splits it at the
+// energy median by a binary search through the tables; the first part replaces it, the second
+// part is appended — the CPU's order.
+#extension GL_GOOGLE_include_directive : require
+#include "probe_common.glsl"
+
+const int MAX_REGIONS = 256; // msm::probe::kMaxDeviceLights
+layout(local_size_x = 256) in;
+layout(binding = 0, std430) readonly buffer Tables { uint64_t tables[]; };
+
+struct RegionOut {
+  ivec4 rect; // x0, y0, x1, y1: texels [x0, x1) x [y0, y1)
+  int face;
+  uint lit;   // 1: the region has energy and lights[t] is its light
+  uint64_t fixed_energy;
+};
+struct LightOut {
+  vec4 direction_cone; // direction, cone_half_angle
+  vec4 x_axis_half_x;
+  vec4 y_axis_half_y;
+  vec4 irradiance;
+};
+layout(binding = 1, std430) writeonly buffer Result {
+  uint region_count;
+  uint pad0, pad1, pad2;
+  RegionOut regions[MAX_REGIONS];
+  LightOut lights[MAX_REGIONS];
+} result;
+
+shared ivec4 s_rect[MAX_REGIONS];
+shared int s_face[MAX_REGIONS];
+shared uint64_t s_energy[MAX_REGIONS];
+shared uint64_t s_key[MAX_REGIONS];
+shared uint s_index[MAX_REGIONS];
+
+// The sum over texels [0, x) x [0, y) of table k (the tables are inclusive).
+uint64_t corner(int face, int k, int x, int y) {
+  if (x == 0 || y == 0) return 0ul;
+  return tables[probe_table_index(face, k, x - 1, y - 1)];
+}
+uint64_t rect_sum(int face, int k, ivec4 r) {
+  return corner(face, k, r.z, r.w) - corner(face, k, r.x, r.w) - corner(face, k, r.z, r.y) + corner(face, k, r.x, r.y);
+}
+
+// The first part of r cut at `cut` along x or y.
+ivec4 first_part(ivec4 r, bool along_x, int cut) {
+  return along_x ? ivec4(r.x, r.y, cut, r.w) : ivec4(r.x, r.y, r.z, cut);
+}
+// 2 E(first part) − E(r): E < 2^62, so it fits in int64.
+int64_t twice_minus_whole(int face, ivec4 r, uint64_t energy, bool along_x, int cut) {
+  return int64_t(2ul * rect_sum(face, 1, first_part(r, along_x, cut))) - int64_t(energy);
+}
+int64_t abs64(int64_t a) { return a < 0l ? -a : a; }
+
+void split(uint best, int n) {
+  ivec4 r = s_rect[best];
+  int face = s_face[best];
+  uint64_t energy = s_energy[best];
+  bool along_x = (r.z - r.x) >= (r.w - r.y);
+  int lo = along_x ? r.x : r.y, hi = along_x ? r.z : r.w;
+  int a = lo + 1, b = hi - 1;
+  while (a < b) {
+    int mid = (a + b) / 2;
+    if (twice_minus_whole(face, r, energy, along_x, mid) < 0l)
+      a = mid + 1;
+    else
+      b = mid;
+  }
+  int cut = a;
+  if (cut - 1 > lo && abs64(twice_minus_whole(face, r, energy, along_x, cut - 1)) <=
+                          abs64(twice_minus_whole(face, r, energy, along_x, cut)))
+    cut -= 1;
+  ivec4 first = first_part(r, along_x, cut);
+  ivec4 second = along_x ? ivec4(cut, r.y, r.z, r.w) : ivec4(r.x, cut, r.z, r.w);
+  s_rect[best] = first;
+  s_energy[best] = rect_sum(face, 1, first);
+  s_rect[n] = second;
+  s_face[n] = face;
+  s_energy[n] = rect_sum(face, 1, second);
+}
+
+void main() {
+  uint t = gl_LocalInvocationID.x;
+  int m = pc.size;
+  if (t < 6u) {
+    s_rect[t] = ivec4(0, 0, m, m);
+    s_face[t] = int(t);
+    s_energy[t] = rect_sum(int(t), 1, ivec4(0, 0, m, m));
+  }
+  barrier();
+  int n = 6;
+  int count = min(pc.count, MAX_REGIONS);
+  while (n < count) {
+    // Splittable regions (more than one texel) have key energy + 1, the others 0.
+    uint64_t key = 0ul;
+    if (t < uint(n)) {
+      ivec4 r = s_rect[t];
+      if (r.z - r.x >= 2 || r.w - r.y >= 2) key = s_energy[t] + 1ul;
+    }
+    s_key[t] = key;
+    s_index[t] = t;
+    barrier();
+    for (uint stride = uint(MAX_REGIONS) / 2u; stride > 0u; stride >>= 1u) {
+      if (t < stride) {
+        uint64_t ka = s_key[t], kb = s_key[t + stride];
+        uint ia = s_index[t], ib = s_index[t + stride];
+        if (kb > ka || (kb == ka && ib < ia)) {
+          s_key[t] = kb;
+          s_index[t] = ib;
+        }
+      }
+      barrier();
+    }
+    uint64_t best_key = s_key[0];
+    uint best = s_index[0];
+    if (best_key == 0ul) break; // every region is one texel (the same in every invocation)
+    if (t == 0u) split(best, n);
+    barrier();
+    ++n;
+  }
+
+  if (t < uint(n)) {
+    ivec4 r = s_rect[t];
+    int face = s_face[t];
+    uint64_t y = s_energy[t];
+    vec3 xyz = vec3(float(rect_sum(face, 0, r)), float(y), float(rect_sum(face, 2, r)));
+    // The first moments are stored shifted by the energy: the difference in integers first.
+    vec2 first = vec2(float(int64_t(rect_sum(face, 3, r)) - int64_t(y)), float(int64_t(rect_sum(face, 4, r)) - int64_t(y)));
+    vec2 second = vec2(float(rect_sum(face, 5, r)), float(rect_sum(face, 6, r)));
+    MsmRegionSums sums = msm_region_sums_from_fixed(xyz, first, second, pc.inv_scale);
+    bool lit = sums.xyz.y > 0.0f;
+    result.regions[t] = RegionOut(r, face, lit ? 1u : 0u, y);
+    if (lit) {
+      MsmAreaLight l = msm_area_light_from_region(face, sums);
+      result.lights[t] = LightOut(vec4(l.direction, l.cone_half_angle), vec4(l.x_axis, l.half_extent.x),
+                                  vec4(l.y_axis, l.half_extent.y), vec4(l.irradiance, 0.0f));
+    }
+  }
+  if (t == 0u) result.region_count = uint(n);
+}

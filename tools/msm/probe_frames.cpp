@@ -1,0 +1,95 @@
+// Per-frame image-based lighting on the device (probe_frames.h).
+#include "probe_frames.h"
+
+#include "msm/image/io.h"
+#include "msm/probe/device_probe.h"
+#include "msm/vk/commands.h"
+#include "msm/vk/timer.h"
+
+#include <fmt/core.h>
+
+#include <chrono>
+#include <span>
+
+namespace msm::tool {
+
+void check_probe_frames(const scene::Scene& scene, const ProbeFrames& o) {
+  if (!scene.probe)
+    throw UsageError(
+        fmt::format("--probe-rotation-speed/--frames: scene '{}' has no light probe (its \"probe\" key)", scene.name));
+  if (o.frames < 1) throw UsageError("--frames must be at least 1");
+  if (scene.probe->size > probe::kMaxDeviceCubeSize)
+    throw UsageError(fmt::format("the probe's size {} exceeds the device pipeline's {}", scene.probe->size,
+                                 probe::kMaxDeviceCubeSize));
+}
+
+void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, const scene::Scene& scene,
+                         const FrameOptions& frame, const std::vector<std::string>& techniques, const std::string& out,
+                         const ProbeFrames& o) {
+  const scene::ProbeLighting& p = *scene.probe;
+  const bool sky = p.file == "sky";
+  probe::DeviceProbe device(ctx, p.size);
+  probe::Panorama panorama;
+  if (!sky) {
+    try {
+      panorama = probe::load_equirect(p.file);
+    } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+    for (glm::vec3& t : panorama.rgb) t *= p.intensity;
+    device.set_panorama(panorama);
+  }
+  // The directional lights that the scene has beside its probe come first and stay.
+  const std::vector<scene::DirectionalLight> fixed(scene.lights.begin(),
+                                                   scene.lights.begin() + std::ptrdiff_t(p.first_light));
+  vk::GpuTimer timer(ctx);
+  nlohmann::json list = nlohmann::json::array();
+  for (int k = 0; k < o.frames; ++k) {
+    const float rotation = p.rotation_deg + float(k) * o.rotation_speed_deg;
+    const auto start = std::chrono::steady_clock::now();
+    if (sky) {
+      // The procedural sky is made as a cube map on the host (no panorama to resample): it is
+      // uploaded each frame and the device's pipeline starts at the tables.
+      probe::CubeMap cube = probe::sky_probe(p.size, rotation);
+      for (auto& f : cube.faces)
+        for (glm::vec3& t : f) t *= p.intensity;
+      device.set_cube(cube);
+    }
+    const probe::DeviceCut cut = device.run(p.lights, rotation, &timer);
+    const double probe_wall_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const vk::TimerResults times = timer.read();
+    std::vector<scene::DirectionalLight> lights = fixed;
+    for (const MsmAreaLight& a : cut.lights) lights.push_back(scene::light_of_area_light(a));
+    const double cube_ms = times.total("probe_cube"), tables_ms = times.total("probe_tables"),
+                 cut_ms = times.total("probe_cut");
+    nlohmann::json entry = {{"frame", k},
+                            {"rotation_deg", rotation},
+                            {"lights", cut.lights.size()},
+                            {"probe_ms", {{"probe_cube", cube_ms}, {"probe_tables", tables_ms}, {"probe_cut", cut_ms}}},
+                            {"probe_wall_ms", probe_wall_ms},
+                            {"render_ms", nlohmann::json::object()}};
+    std::string line;
+    for (const std::string& name : techniques) {
+      render::RenderSettings s = settings_for(frame, name);
+      s.lights = lights;
+      render::RenderResult result;
+      try {
+        result = renderer.render(s);
+      } catch (const render::RenderError& e) { throw UsageError(e.what()); }
+      write_render(out, fmt::format("{}-frame{:03}", name, k), result, render_json(s, scene, ctx, result));
+      entry["render_ms"][name] = result.total_ms;
+      line += fmt::format("  {} {:.2f} ms", name, result.total_ms);
+    }
+    fmt::print(stderr,
+               "frame {:>3}/{}  rotation {:7.2f}°  {:>3} lights  probe GPU: cube {:.2f} ms, tables {:.2f} ms, cut "
+               "{:.2f} ms ({:.1f} ms wall with upload and read-back) |{}\n",
+               k + 1, o.frames, rotation, cut.lights.size(), cube_ms, tables_ms, cut_ms, probe_wall_ms, line);
+    list.push_back(entry);
+  }
+  const std::string text =
+      nlohmann::json{{"scene", scene.name}, {"probe_size", p.size}, {"frames", list}}.dump(2) + "\n";
+  image::write_file_atomic(std::filesystem::path(out) / "probe-frames.json",
+                           std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+  fmt::print(stderr, "wrote {}/probe-frames.json\n", out);
+}
+
+} // namespace msm::tool
