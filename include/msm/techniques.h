@@ -93,6 +93,17 @@ MSM_FN int msm_technique_scatter_representation6(int t) {
          : t == MSM_TECH_SCATTER_MSM6_192 ? MSM_REP6_FLOAT
                                           : -1;
 }
+// Bytes per rectified texel of a prefiltered technique's two maps (src/render/passes/
+// prefiltered_scattering_passes.cpp): x the float rectified map (RGBA32F; six moments two; CSM
+// eight RGBA16F layers), y the stored prefix sums (Θ4* RGBA16; Θ6* 2 x RGB10A2, RGBA16 + RG16,
+// RGBA32F + RG32F; CSM eight RGBA8). The prefix sums read x and write y per texel.
+MSM_FN ivec2 msm_technique_scatter_map_bytes(int t) {
+  return t == MSM_TECH_SCATTER_MSM6_64    ? ivec2(32, 8)
+         : t == MSM_TECH_SCATTER_MSM6_96  ? ivec2(32, 12)
+         : t == MSM_TECH_SCATTER_MSM6_192 ? ivec2(32, 24)
+         : t == MSM_TECH_SCATTER_CSM32    ? ivec2(64, 32)
+                                          : ivec2(16, 8);
+}
 MSM_FN bool msm_technique_is_scattering(int t) {
   return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128 || msm_technique_is_prefiltered_scattering(t);
 }

@@ -45,19 +45,6 @@ Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const s
   return stats(sums);
 }
 
-// Bytes the prefix sums read and write per rectified texel (prefiltered_scattering_passes.cpp's
-// formats): the float rectified map (RGBA32F; six moments two of them; CSM eight RGBA16F layers)
-// and the stored sums (Θ4* RGBA16; Θ6* 2 x RGB10A2, RGBA16 + RG16, RGBA32F + RG32F; CSM eight RGBA8).
-double prefix_sum_bytes(int id) {
-  switch (id) {
-  case MSM_TECH_SCATTER_MSM6_64: return 32.0 + 8.0;
-  case MSM_TECH_SCATTER_MSM6_96: return 32.0 + 12.0;
-  case MSM_TECH_SCATTER_MSM6_192: return 32.0 + 24.0;
-  case MSM_TECH_SCATTER_CSM32: return 64.0 + 32.0;
-  default: return 16.0 + 8.0; // four moments
-  }
-}
-
 // The device's copy bandwidth, the bound of the prefix sums (JCGT App. C): vkCmdCopyImage of an
 // RGBA32F image of size² texels (16 B read and 16 B written per texel), median over `runs`
 // submissions after one warm-up. Returns the copy's milliseconds.
@@ -276,7 +263,8 @@ void add_bench(CLI::App& app) {
           // the bytes they read and write per texel over the copy's 32.
           Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"});
           double copy = copy_ms(*ctx, uint32_t(size), std::max(opt->frames, 3));
-          double bound = copy * prefix_sum_bytes(id) / 32.0;
+          const glm::ivec2 bytes = msm_technique_scatter_map_bytes(id);
+          double bound = copy * double(bytes.x + bytes.y) / 32.0;
           entry["rectified"][std::to_string(size)] = {
               {"rectify_ms", rect.median},     {"prefix_sums_ms", prefix.median},
               {"copy_rgba32f_ms", copy},       {"bandwidth_gb_s", 32.0 * size * size / (copy * 1e6)},
