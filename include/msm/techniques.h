@@ -64,6 +64,9 @@ const int MSM_TECH_SCATTER_MSM4_64 = 29;  // four moments, Θ4* in 4 x UNORM16, 
 const int MSM_TECH_SCATTER_MSM6_64 = 30;  // six moments (§5.4), Θ6* in 6 x 10 bits (two RGB10A2)
 const int MSM_TECH_SCATTER_MSM6_96 = 31;  // Θ6* in 6 x 16 bits (RGBA16 + RG16)
 const int MSM_TECH_SCATTER_MSM6_192 = 32; // Θ6* in 6 x 32-bit float (RGBA32F + RG32F)
+// Klehm et al. 2014: the same passes with a convolution shadow map of 16 sin/cos terms (32
+// coefficients) in 8 bits each (eight RGBA8 layers), [0,1] rectified depth, no β (scattering.h).
+const int MSM_TECH_SCATTER_CSM32 = 33;
 
 // Soft shadows from summed-area tables instead of a filtered map.
 MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
@@ -81,7 +84,7 @@ struct MsmTexel {
 
 // Single scattering techniques: a scattering pass after the shading (src/render).
 MSM_FN bool msm_technique_is_prefiltered_scattering(int t) {
-  return t >= MSM_TECH_SCATTER_MSM4_64 && t <= MSM_TECH_SCATTER_MSM6_192;
+  return (t >= MSM_TECH_SCATTER_MSM4_64 && t <= MSM_TECH_SCATTER_MSM6_192) || t == MSM_TECH_SCATTER_CSM32;
 }
 // The six-moment storage (MSM_REP6_* of bias.h) of a prefiltered technique; -1 for four moments.
 MSM_FN int msm_technique_scatter_representation6(int t) {
@@ -89,6 +92,17 @@ MSM_FN int msm_technique_scatter_representation6(int t) {
          : t == MSM_TECH_SCATTER_MSM6_96  ? MSM_REP6_UNORM16
          : t == MSM_TECH_SCATTER_MSM6_192 ? MSM_REP6_FLOAT
                                           : -1;
+}
+// Bytes per rectified texel of a prefiltered technique's two maps (src/render/passes/
+// prefiltered_scattering_passes.cpp): x the float rectified map (RGBA32F; six moments two; CSM
+// eight RGBA16F layers), y the stored prefix sums (Θ4* RGBA16; Θ6* 2 x RGB10A2, RGBA16 + RG16,
+// RGBA32F + RG32F; CSM eight RGBA8). The prefix sums read x and write y per texel.
+MSM_FN ivec2 msm_technique_scatter_map_bytes(int t) {
+  return t == MSM_TECH_SCATTER_MSM6_64    ? ivec2(32, 8)
+         : t == MSM_TECH_SCATTER_MSM6_96  ? ivec2(32, 12)
+         : t == MSM_TECH_SCATTER_MSM6_192 ? ivec2(32, 24)
+         : t == MSM_TECH_SCATTER_CSM32    ? ivec2(64, 32)
+                                          : ivec2(16, 8);
 }
 MSM_FN bool msm_technique_is_scattering(int t) {
   return t == MSM_TECH_SCATTER_MARCH32 || t == MSM_TECH_SCATTER_MARCH128 || msm_technique_is_prefiltered_scattering(t);

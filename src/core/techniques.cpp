@@ -428,7 +428,8 @@ constexpr Technique kTechniques[] = {
      64,
      4,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default)",
+     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
      nullptr,
@@ -441,7 +442,8 @@ constexpr Technique kTechniques[] = {
      64,
      6,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default)",
+     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
      nullptr,
@@ -454,7 +456,8 @@ constexpr Technique kTechniques[] = {
      96,
      6,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default)",
+     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
      nullptr,
@@ -466,6 +469,21 @@ constexpr Technique kTechniques[] = {
      MSM_TECH_SCATTER_MSM6_192,
      192,
      6,
+     {TexelFormat::none, TexelFormat::none},
+     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
+    {"scatter-csm-32",
+     "Prefiltered single scattering with a convolution shadow map (Klehm et al. 2014): the passes of "
+     "scatter-msm4-64, 16 sin/cos terms of the rectified depth (32 coefficients) whose prefix sums are stored in 8 "
+     "bits each (eight RGBA8 layers), the plain Fourier reconstruction with damping (no bounds, no β); surfaces "
+     "shaded with PCF",
+     MSM_TECH_SCATTER_CSM32,
+     256,
+     32,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default)",
      true,

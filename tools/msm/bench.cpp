@@ -273,10 +273,11 @@ void add_bench(CLI::App& app) {
         Stats st = pass_sum(frames, shadow_passes);
         if (prefiltered) {
           // The rectified map and its prefix sums per texel, the prefix sums against the copy bound:
-          // they read the float moments (16 B) and write the stored ones (8 B) per texel.
+          // the bytes they read and write per texel over the copy's 32.
           Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"});
           double copy = copy_ms(*ctx, uint32_t(size), std::max(opt->frames, 3));
-          double bound = copy * 24.0 / 32.0;
+          const glm::ivec2 bytes = msm_technique_scatter_map_bytes(id);
+          double bound = copy * double(bytes.x + bytes.y) / 32.0;
           entry["rectified"][std::to_string(size)] = {
               {"rectify_ms", rect.median},     {"prefix_sums_ms", prefix.median},
               {"copy_rgba32f_ms", copy},       {"bandwidth_gb_s", 32.0 * size * size / (copy * 1e6)},

@@ -15,7 +15,7 @@ namespace msm::tool {
 
 void add_compare(CLI::App& app) {
   struct Options {
-    std::string reference, test, error_image, mask, mask_channel, channel;
+    std::string reference, test, error_image, mask, mask_channel, channel, test_channel;
     std::string signal = "visibility";
     double range = 0.1;
     std::optional<double> mask_above, mask_below;
@@ -40,6 +40,10 @@ void add_compare(CLI::App& app) {
                   "background)");
   cmd->add_option("--channel", opt->channel,
                   "Channel to compare (default: the only one, Y of Y+A, else the luminance of R,G,B)");
+  cmd->add_option("--test-channel", opt->test_channel,
+                  "Channel of the test image where its name differs from the reference's (default: --channel), "
+                  "e.g. visible_fraction of `msm render`'s <technique>-scattering.exr against visibility of `msm "
+                  "reference --effect scattering`'s visibility.exr");
   cmd->add_option("--signal", opt->signal,
                   "visibility (larger = brighter) or shadow (shadow intensity, larger = darker): "
                   "sets which sign is light leaking");
@@ -56,8 +60,13 @@ void add_compare(CLI::App& app) {
     options.channel = opt->channel;
     Metrics metrics;
     try {
-      const Image reference = read_image(opt->reference);
-      const Image test = read_image(opt->test);
+      Image reference = read_image(opt->reference);
+      Image test = read_image(opt->test);
+      if (!opt->test_channel.empty()) { // each image's own channel, then the one signal of both
+        reference = select_signal(reference, opt->channel);
+        test = select_signal(test, opt->test_channel);
+        options.channel.clear();
+      }
       std::optional<Image> mask;
       if (!opt->mask.empty()) {
         const Image source = read_image(opt->mask);

@@ -1,7 +1,10 @@
-// `msm demo` (what `make demo` runs), in two parts:
+// `msm demo` (what `make demo` runs), in three parts:
 //  1. filtered hard shadows: the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the
 //     non-linearly quantized MSM at 64 and 32 bits side by side, errors against PCF (same kernel);
-//  2. soft shadows: the `models` scene (JCGT Fig. 8) with moment soft shadows (four and six
+//  2. single scattering: the `trees` scene (JCGT Fig. 16) at a third of the width and height with ray
+//     marching (32, 128 samples), CSM-32 and four and six moments, errors in the visible fraction
+//     of each view ray against the ray-traced scattering;
+//  3. soft shadows: the `models` scene (JCGT Fig. 8) with moment soft shadows (four and six
 //     moments) and their baselines VSSM and PCSS, errors against the ray-traced area light.
 // Each part writes one labelled image with magnified insets where the techniques differ, and
 // prints a table of the errors and the GPU time per pass.
@@ -12,6 +15,7 @@
 #include "msm/image/metrics.h"
 #include "msm/reference/reference.h"
 #include "msm/shading.h"
+#include "msm/techniques.h"
 #include "msm/util/progress.h"
 #include "msm/util/statistics.h"
 
@@ -31,10 +35,12 @@ namespace {
 // One comparison: every technique rendered (per technique PNG, EXR, JSON in `out`), a table of
 // the errors against `truth` (the ray-traced visibility and its background) or, without it,
 // against the first technique, and the GPU time per pass (median of 5 frames); the figure in
-// out/figure_name. `truth_rgb` is the first panel where given.
+// out/figure_name. `truth_rgb` is the first panel where given. `scattering`: the signal is the
+// visible fraction of the view rays (background included) against the truth's "visibility".
 void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, const FrameOptions& frame,
                         const std::vector<std::string>& techniques, const image::Image* truth,
-                        const image::Image* truth_rgb, const std::string& out, const std::string& figure_name) {
+                        const image::Image* truth_rgb, const std::string& out, const std::string& figure_name,
+                        bool scattering = false) {
   const scene::Scene& scene = renderer.scene();
   bool tty = isatty(fileno(stderr));
   std::vector<render::RenderResult> results;
@@ -55,11 +61,13 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
     results.back().total_ms = 0;
     for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
     write_render(out, s.technique, results.back(), render_json(s, scene, ctx, results.back()));
-    signals.push_back(results.back().shadow.channel("visibility"));
+    signals.push_back(scattering ? results.back().scattering.channel("visible_fraction")
+                                 : results.back().shadow.channel("visibility"));
   }
   if (tty) fmt::print(stderr, "\r{:<40}\r", "");
 
   image::Image mask = truth ? truth->channel("background") : results[0].shadow.channel("background");
+  if (scattering) mask = image::Image(mask.width(), mask.height(), 1); // every ray counts
   image::Image reference = truth ? truth->channel("visibility") : signals[0];
   int side = std::max(16, frame.settings.width / 8);
   std::vector<image::Image> candidates = signals;
@@ -69,8 +77,8 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   if (truth_rgb) panels.push_back({"ray traced", *truth_rgb, "reference"});
   std::vector<std::string> pass_names;
   // Every pass any technique ran, in the order of a frame.
-  for (const char* name :
-       {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps", "shading"})
+  for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps",
+                           "shading", "rectify", "prefix_sums", "scattering"})
     for (const render::RenderResult& r : results)
       if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
         pass_names.push_back(name);
@@ -103,10 +111,33 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   try {
     image::write_png(file, figure);
   } catch (const image::ImageError& e) { throw UsageError(e.what()); }
-  fmt::print("\nErrors are in visibility against {}, background excluded; times are GPU timestamps, median of 5 "
+  fmt::print("\nErrors are in {}; times are GPU timestamps, median of 5 "
              "frames.\nWrote {} ({}x{}) and per technique PNG, shadow-buffer EXR and JSON in {}/\n",
-             truth ? "the ray-traced area light" : techniques[0] + " (same kernel)", file.string(), figure.width(),
-             figure.height(), out);
+             scattering ? "the visible fraction of each view ray against the ray-traced scattering, every pixel"
+             : truth    ? "visibility against the ray-traced area light, background excluded"
+                        : "visibility against " + techniques[0] + " (same kernel), background excluded",
+             file.string(), figure.width(), figure.height(), out);
+}
+
+// Part 3: single scattering against the ray-traced ground truth (stratified, `samples` per pixel),
+// the reference's composite of surface and in-scattered radiance as the first panel (tone mapped
+// like the renderer; its background has no sky behind the haze, which the medium hides anyway).
+void scatter_part(render::Renderer& renderer, const vk::Context& ctx, const FrameOptions& frame,
+                  const scene::Scene& scene, const std::vector<std::string>& techniques, int samples,
+                  const std::string& out) {
+  const render::RenderSettings& fs = frame.settings;
+  fmt::print("\nmsm demo: single scattering, scene '{}' at {}x{}, medium σt {}, shadow map {}², ray traced with {} "
+             "samples per pixel\n",
+             scene.name, fs.width, fs.height, scene.medium->extinction, fs.shadow_size, samples);
+  reference::Settings rs;
+  rs.effect = reference::Effect::scattering;
+  rs.width = fs.width;
+  rs.height = fs.height;
+  rs.samples = samples;
+  reference::Result truth = reference::render(scene, rs);
+  image::Image truth_rgb = image::tone_map(truth.radiance, {std::log2(fs.exposure), image::ToneCurve::aces});
+  compare_techniques(renderer, ctx, frame, techniques, &truth.visibility, &truth_rgb, out, "scatter-comparison.png",
+                     true);
 }
 
 } // namespace
@@ -120,15 +151,21 @@ void add_demo(CLI::App& app) {
     std::string soft_scene = "models";
     std::vector<std::string> soft_techniques = {"mssm4", "mssm6", "vssm", "pcss"};
     int soft_samples = 64;
+    std::string scatter_scene = "trees";
+    std::vector<std::string> scatter_techniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
+                                                   "scatter-msm4-64", "scatter-msm6-96"};
+    int scatter_samples = 32;
   };
   auto opt = std::make_shared<Options>();
   opt->frame.settings.width = 960;
   opt->frame.settings.height = 540;
   opt->frame.scene = std::string(scene::default_scene_name());
-  auto* cmd = app.add_subcommand("demo", "Render the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the "
-                                         "non-linear MSM 64/32 into one comparison image, then soft shadows (mssm4, "
-                                         "mssm6, vssm, pcss) against the ray-traced area light; print the errors and "
-                                         "the time per pass");
+  auto* cmd = app.add_subcommand(
+      "demo", "Render the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the "
+              "non-linear MSM 64/32 into one comparison image, then soft shadows (mssm4, "
+              "mssm6, vssm, pcss) against the ray-traced area light; print the errors and "
+              "the time per pass; single scattering (ray marching, CSM, four and six moments) against the ray-traced "
+              "scattering in between");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
       ->delimiter(',');
@@ -137,32 +174,65 @@ void add_demo(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--soft-samples", opt->soft_samples, "Ray-traced samples per pixel of the area-light reference")
       ->capture_default_str();
+  cmd->add_option("--scatter-scene", opt->scatter_scene,
+                  "Scene of the single-scattering part (rendered at a third of the width and height; needs a medium)")
+      ->capture_default_str();
+  cmd->add_option("--scatter-techniques", opt->scatter_techniques,
+                  "Scattering techniques (\"\": skip the scattering part)")
+      ->delimiter(',');
+  cmd->add_option("--scatter-samples", opt->scatter_samples, "Ray-traced samples per pixel of the scattering reference")
+      ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
     // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
-    for (auto* list : {&opt->techniques, &opt->soft_techniques}) {
+    for (auto* list : {&opt->techniques, &opt->soft_techniques, &opt->scatter_techniques}) {
       std::erase(*list, std::string());
       *list = canonical_technique_names(*list);
     }
     if (opt->techniques.empty()) throw UsageError("--techniques: none given");
     if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
+    if (opt->scatter_samples < 1 || opt->scatter_samples > 4096)
+      throw UsageError("--scatter-samples must be in [1, 4096]");
     validate_techniques(opt->frame, opt->techniques);
     FrameOptions soft = opt->frame;
     soft.scene = opt->soft_scene;
     if (!opt->soft_techniques.empty()) validate_techniques(soft, opt->soft_techniques);
+    FrameOptions scatter = opt->frame;
+    scatter.scene = opt->scatter_scene;
+    scatter.settings.width = std::max(16, opt->frame.settings.width / 3);
+    scatter.settings.height = std::max(16, opt->frame.settings.height / 3);
+    if (!opt->scatter_techniques.empty()) {
+      validate_techniques(scatter, opt->scatter_techniques);
+      for (const std::string& t : opt->scatter_techniques)
+        if (!msm_technique_is_scattering(render::find_rendered_technique(t).id))
+          throw UsageError(fmt::format("--scatter-techniques: {} is not a scattering technique (msm techniques: "
+                                       "scatter-*)",
+                                       t));
+    }
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     std::optional<scene::Scene> soft_scene;
     if (!opt->soft_techniques.empty()) soft_scene = load_scene_or_fail(soft.scene);
+    std::optional<scene::Scene> scatter_scene;
+    if (!opt->scatter_techniques.empty()) {
+      scatter_scene = load_scene_or_fail(scatter.scene);
+      if (!scatter_scene->medium)
+        throw UsageError(
+            fmt::format("--scatter-scene {}: the scene has no \"medium\" (scenes/README.md)", scatter.scene));
+    }
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     // Both parts' renderers first: what the device cannot do is refused before the output
     // directory exists (the first renderer is released before the soft part).
-    std::optional<render::Renderer> hard, soft_renderer;
+    std::optional<render::Renderer> hard, soft_renderer, scatter_renderer;
     hard.emplace(*ctx, scene);
     check_on_device(*hard, opt->frame, opt->techniques);
     if (soft_scene) {
       soft_renderer.emplace(*ctx, *soft_scene);
       check_on_device(*soft_renderer, soft, opt->soft_techniques);
+    }
+    if (scatter_scene) {
+      scatter_renderer.emplace(*ctx, *scatter_scene);
+      check_on_device(*scatter_renderer, scatter, opt->scatter_techniques);
     }
     ensure_output_dir(opt->out);
     const render::RenderSettings& fs = opt->frame.settings;
@@ -171,6 +241,12 @@ void add_demo(CLI::App& app) {
                ctx->info().name);
     compare_techniques(*hard, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
     hard.reset();
+    if (scatter_scene)
+      scatter_part(*scatter_renderer, *ctx, scatter, *scatter_scene, opt->scatter_techniques, opt->scatter_samples,
+                   opt->out);
+    else
+      fmt::print("\nmsm demo: scattering part skipped (no --scatter-techniques)\n");
+    scatter_renderer.reset();
     if (!soft_scene) {
       fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
       return;

@@ -8,6 +8,9 @@ constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BI
 constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 uint32_t size(const FrameConfig& c) { return uint32_t(c.shadow_size); } // the rectified map's side
 int representation6(const FrameConfig& c) { return msm_technique_scatter_representation6(c.technique->id); }
+// Klehm et al.'s convolution shadow map: 32 coefficients in the layers of one array image.
+bool csm(const FrameConfig& c) { return c.technique->id == MSM_TECH_SCATTER_CSM32; }
+constexpr uint32_t kCsmLayers = MSM_CSM_MAX_TEXELS;
 
 // The prefix sums' storage formats (JCGT §5.3, §5.4.3): Θ4* in RGBA16; Θ6* in two RGB10A2 (odd,
 // even), RGBA16 + RG16 or RGBA32F + RG32F ((odd, even.x), (even.y, even.z)).
@@ -16,7 +19,7 @@ std::array<VkFormat, 2> prefix_formats(const FrameConfig& c) {
   case MSM_REP6_UNORM10: return {VK_FORMAT_A2B10G10R10_UNORM_PACK32, VK_FORMAT_A2B10G10R10_UNORM_PACK32};
   case MSM_REP6_UNORM16: return {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM};
   case MSM_REP6_FLOAT: return {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT};
-  default: return {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_UNDEFINED};
+  default: return {csm(c) ? VK_FORMAT_R8G8B8A8_UNORM : VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_UNDEFINED};
   }
 }
 } // namespace
@@ -25,7 +28,10 @@ bool prefix_sums_have_two_images(const FrameConfig& c) { return representation6(
 
 void RectifyPass::prepare(const PassResources& r) {
   bool six = prefix_sums_have_two_images(config_);
-  std::string shader = std::string(six ? "rectify6" : "rectify") + (config_.msaa == 1 ? "_1x.comp" : ".comp");
+  std::string shader = std::string(csm(config_) ? "rectify_csm"
+                                   : six        ? "rectify6"
+                                                : "rectify") +
+                       (config_.msaa == 1 ? "_1x.comp" : ".comp");
   std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::uniform_buffer,
                                        vk::Binding::storage_buffer, vk::Binding::sampled_image,
                                        vk::Binding::storage_image};
@@ -36,7 +42,16 @@ void RectifyPass::prepare(const PassResources& r) {
 void RectifyPass::reflect(PassBuilder& b) const {
   b.read(kShadowDepth, use::sampled(kCompute));
   ImageSpec spec{.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = size(config_), .height = size(config_)};
-  b.create(kRectified, spec, use::compute_general());
+  // CSM: eight layers of coefficients in [0,1] for 8-bit storage; half floats lose nothing of that.
+  if (csm(config_))
+    b.create(kRectified,
+             {.format = VK_FORMAT_R16G16B16A16_SFLOAT,
+              .width = size(config_),
+              .height = size(config_),
+              .layers = kCsmLayers},
+             use::compute_general());
+  else
+    b.create(kRectified, spec, use::compute_general());
   if (prefix_sums_have_two_images(config_)) b.create(kRectified1, spec, use::compute_general());
 }
 
@@ -45,7 +60,8 @@ void RectifyPass::execute(const PassContext& c) const {
   std::vector<vk::Descriptor> d = {
       vk::Descriptor(c.frame.uniforms), vk::Descriptor(*c.frame.rectification), vk::Descriptor(c.frame.lights),
       vk::Descriptor(c.image(kShadowDepth).layer_views[0], kReadOnly, c.frame.point_sampler), // the first light
-      vk::Descriptor(c.image(kRectified).layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
+      csm(config_) ? vk::Descriptor(c.image(kRectified).array_view, VK_IMAGE_LAYOUT_GENERAL)
+                   : vk::Descriptor(c.image(kRectified).layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
   if (prefix_sums_have_two_images(config_))
     d.emplace_back(c.image(kRectified1).layer_views[0], VK_IMAGE_LAYOUT_GENERAL);
   vk::dispatch(c.cmd, *program_, groups, groups, 1, d);
@@ -56,6 +72,7 @@ void PrefixSumPass::prepare(const PassResources& r) {
   std::string shader = rep == MSM_REP6_UNORM10   ? "prefix_sums6_10.comp"
                        : rep == MSM_REP6_UNORM16 ? "prefix_sums6_16.comp"
                        : rep == MSM_REP6_FLOAT   ? "prefix_sums6_32.comp"
+                       : csm(config_)            ? "prefix_sums_csm.comp"
                                                  : "prefix_sums.comp";
   std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image,
                                        vk::Binding::storage_image};
@@ -66,8 +83,10 @@ void PrefixSumPass::prepare(const PassResources& r) {
 void PrefixSumPass::reflect(PassBuilder& b) const {
   std::array<VkFormat, 2> formats = prefix_formats(config_);
   b.read(kRectified, use::sampled(kCompute));
-  b.create(kPrefixSums, {.format = formats[0], .width = size(config_), .height = size(config_)},
-           use::compute_general());
+  b.create(
+      kPrefixSums,
+      {.format = formats[0], .width = size(config_), .height = size(config_), .layers = csm(config_) ? kCsmLayers : 1},
+      use::compute_general());
   if (prefix_sums_have_two_images(config_)) {
     b.read(kRectified1, use::sampled(kCompute));
     b.create(kPrefixSums1, {.format = formats[1], .width = size(config_), .height = size(config_)},
@@ -76,14 +95,18 @@ void PrefixSumPass::reflect(PassBuilder& b) const {
 }
 
 void PrefixSumPass::execute(const PassContext& c) const {
-  std::vector<vk::Descriptor> d = {vk::Descriptor(*c.frame.rectification),
-                                   vk::Descriptor(c.image(kRectified).layer_views[0], kReadOnly, c.frame.point_sampler),
-                                   vk::Descriptor(c.image(kPrefixSums).layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
+  // CSM: the whole arrays, one layer per dispatch z.
+  const bool array = csm(config_);
+  const GraphImage &rectified = c.image(kRectified), &prefix_sums = c.image(kPrefixSums);
+  std::vector<vk::Descriptor> d = {
+      vk::Descriptor(*c.frame.rectification),
+      vk::Descriptor(array ? rectified.array_view : rectified.layer_views[0], kReadOnly, c.frame.point_sampler),
+      vk::Descriptor(array ? prefix_sums.array_view : prefix_sums.layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
   if (prefix_sums_have_two_images(config_)) {
     d.emplace_back(c.image(kRectified1).layer_views[0], kReadOnly, c.frame.point_sampler);
     d.emplace_back(c.image(kPrefixSums1).layer_views[0], VK_IMAGE_LAYOUT_GENERAL);
   }
-  vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, 1, d);
+  vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, array ? kCsmLayers : 1, d);
 }
 
 } // namespace msm::render

@@ -10,7 +10,9 @@ bool ScatteringPass::six_moments() const { return msm_technique_scatter_represen
 void ScatteringPass::prepare(const PassResources& r) {
   vk::GraphicsDesc d{.name = std::string("scattering ") + std::string(config_.technique->name),
                      .vertex_shader = "fullscreen.vert",
-                     .fragment_shader = six_moments()       ? "scatter_prefiltered6.frag"
+                     .fragment_shader = six_moments() ? "scatter_prefiltered6.frag"
+                                        : config_.technique->id == MSM_TECH_SCATTER_CSM32
+                                            ? "scatter_prefiltered_csm.frag"
                                         : prefiltered()     ? "scatter_prefiltered.frag"
                                         : config_.msaa == 1 ? "scatter_march_1x.frag"
                                                             : "scatter_march.frag",
@@ -46,8 +48,12 @@ void ScatteringPass::execute(const PassContext& c) const {
       c.cmd, *program_,
       {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, point),
        vk::Descriptor(c.image(kCameraDepth).layer_views[0], read_only, point),
-       prefiltered() ? vk::Descriptor(c.image(kPrefixSums).layer_views[0], read_only, *c.frame.repeat_sampler)
-                     : vk::Descriptor(c.image(kShadowDepth).layer_views[0], read_only, point), // light 0
+       // CSM: the eight layers as one array.
+       prefiltered()
+           ? vk::Descriptor(config_.technique->id == MSM_TECH_SCATTER_CSM32 ? c.image(kPrefixSums).array_view
+                                                                            : c.image(kPrefixSums).layer_views[0],
+                            read_only, *c.frame.repeat_sampler)
+           : vk::Descriptor(c.image(kShadowDepth).layer_views[0], read_only, point), // light 0
        vk::Descriptor(c.frame.blue_noise.view(), read_only, point), vk::Descriptor(c.frame.lights),
        vk::Descriptor(*c.frame.rectification),
        // The second image of six moments (the others: any 2D image, unused).

@@ -5,13 +5,22 @@
 // that the writes of a block are coalesced. Weights w(j, v) and Δ(v) are rectification.h's.
 // The including file defines the storage: MSM_PREFIX_FORMAT0 (and, with MSM_SIX_MOMENTS, the second
 // image's MSM_PREFIX_FORMAT1 and MSM_PREFIX_ODD_EVEN for two RGB10A2 images holding the odd and the
-// even moments; otherwise (odd, even.x) and (even.y, even.z) as in the rectified map).
+// even moments; otherwise (odd, even.x) and (even.y, even.z) as in the rectified map). With MSM_CSM
+// both are eight-layer arrays (the convolution shadow map's 32 coefficients), one layer per
+// dispatch z.
 #include "msm/render/rectification_uniforms.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, binding = 0) uniform RectificationBlock { RectificationUniforms rect; };
+#ifdef MSM_CSM
+layout(binding = 1) uniform sampler2DArray rectified; // float coefficients, texelFetch only
+layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2DArray prefix_sums;
+#define MSM_TEXEL(x, y) ivec3(x, y, int(gl_WorkGroupID.z))
+#else
 layout(binding = 1) uniform sampler2D rectified; // float moments, texelFetch only
 layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2D prefix_sums;
+#define MSM_TEXEL(x, y) ivec2(x, y)
+#endif
 #ifdef MSM_SIX_MOMENTS
 layout(binding = 3) uniform sampler2D rectified1;
 layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2D prefix_sums1;
@@ -31,7 +40,7 @@ void main() {
     vec4 mine = vec4(0.0f), mine1 = vec4(0.0f);
     for (int k = 0; k < 8 && x0 + k < size.x; ++k) {
       float w = msm_prefix_sum_weight(extinction, delta, float(x0 + k));
-      sum += w * texelFetch(rectified, ivec2(x0 + k, row), 0);
+      sum += w * texelFetch(rectified, MSM_TEXEL(x0 + k, row), 0);
 #ifdef MSM_SIX_MOMENTS
       sum1 += w * texelFetch(rectified1, ivec2(x0 + k, row), 0);
 #endif
@@ -43,7 +52,9 @@ void main() {
     }
     if (x0 + column >= size.x) continue;
     ivec2 texel = ivec2(x0 + column, row);
-#if defined(MSM_SIX_MOMENTS) && defined(MSM_PREFIX_ODD_EVEN)
+#if defined(MSM_CSM)
+    imageStore(prefix_sums, MSM_TEXEL(texel.x, texel.y), mine);
+#elif defined(MSM_SIX_MOMENTS) && defined(MSM_PREFIX_ODD_EVEN)
     imageStore(prefix_sums, texel, vec4(mine.x, mine.y, mine.z, 0.0f));
     imageStore(prefix_sums1, texel, vec4(mine.w, mine1.x, mine1.y, 0.0f));
 #else

@@ -5,7 +5,9 @@
 // moments (each texel the mean of its MSAA samples' moments: the resolved, unblurred moment map of
 // [0,1] depth) turned into two depths by JCGT Algorithm 2. Each depth is mapped to the rectified
 // depth π − θ and turned into the technique's moments in its storage basis
-// (Θ4*; with MSM_SIX_MOMENTS Θ6* over two images: (odd, even.x) and (even.y, even.z)), written as
+// (Θ4*; with MSM_SIX_MOMENTS Θ6* over two images: (odd, even.x) and (even.y, even.z); with MSM_CSM
+// Klehm et al.'s 16 sin/cos terms of [0,1] depth mapped to [0,1] (msm_csm_to_unorm), four per layer
+// of an eight-layer RGBA16F array: the 8-bit storage comes after the prefix sums), written as
 // float for the prefix sums. A light ray outside the map, or over a texel without
 // a caster, gets the farthest rectified depth: nothing on it shadows any view ray.
 #include "msm/render/rectification_uniforms.h"
@@ -17,7 +19,11 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std140, binding = 1) uniform RectificationBlock { RectificationUniforms rect; };
+#ifdef MSM_CSM
+layout(binding = 4, rgba16f) uniform writeonly image2DArray rectified;
+#else
 layout(binding = 4, rgba32f) uniform writeonly image2D rectified;
+#endif
 #ifdef MSM_SIX_MOMENTS
 layout(binding = 5, rgba32f) uniform writeonly image2D rectified1;
 #endif
@@ -58,7 +64,10 @@ void main() {
       if (depth < 1.0f) d = msm_rectified_one_depth(b, r, depth_to_z, depth);
     }
   }
-#ifdef MSM_SIX_MOMENTS
+#if defined(MSM_CSM)
+  CsmMoments m = msm_rectified_csm(d, MSM_CSM_MAX_TERMS);
+  for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) imageStore(rectified, ivec3(texel, t), msm_csm_to_unorm(msm_csm_texel(m, t)));
+#elif defined(MSM_SIX_MOMENTS)
   Moments6 m = msm_theta6_star(msm_rectified_moments6(d));
   imageStore(rectified, texel, vec4(m.odd, m.even.x));
   imageStore(rectified1, texel, vec4(m.even.y, m.even.z, 0.0f, 0.0f));

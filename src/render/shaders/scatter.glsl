@@ -8,14 +8,19 @@
 //    at depth 1.
 //  - prefiltered (MSM_SCATTER_PREFILTERED, JCGT §5.1.1, §5.3, §5.4): one bilinear lookup in the
 //    prefix-summed rectified map (rectification.h), four (or, MSM_SIX_MOMENTS, six) moments with
-//    adaptive β.
+//    adaptive β (or a fixed one: parameters y, z); with MSM_CSM (Klehm et al. 2014) the eight layers of a convolution shadow map
+//    with 32 coefficients at 8 bits, reconstructed at the ray's [0,1] rectified depth.
 #include "msm/ray_march.h"
 #include "msm/render/rectification_uniforms.h"
 #include "msm/shading.h"
 #define MSM_LIGHT_BINDING 5
 #include "frame.glsl"
 #ifdef MSM_SCATTER_PREFILTERED
+#ifdef MSM_CSM
+layout(binding = 3) uniform sampler2DArray prefix_sums; // 8 layers of RGBA8: msm_csm_to_unorm
+#else
 layout(binding = 3) uniform sampler2D prefix_sums; // Θ4* (16-bit) or Θ6* image 0, bilinear
+#endif
 layout(std140, binding = 6) uniform RectificationBlock { RectificationUniforms rect; };
 layout(binding = 7) uniform sampler2D prefix_sums1; // Θ6* image 1
 #else
@@ -69,8 +74,21 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
   bool full_circle = b.phi_span >= MSM_TWO_PI;
   vec2 uv = vec2(clamp(lookup.x, half_texel.x, 1.0f - half_texel.x),
                  full_circle ? lookup.y : clamp(lookup.y, half_texel.y, 1.0f - half_texel.y));
+#ifdef MSM_CSM
+  CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
+  for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
+    vec4 texel = msm_csm_from_unorm(textureLod(prefix_sums, vec3(uv, float(t)), 0.0f));
+    if (t < 4)
+      m.lo[t] = texel;
+    else
+      m.hi[t - 4] = texel;
+  }
+  return msm_scattering_visibility_csm(m, msm_saturate(lookup.z), msm_csm_scattering_params());
+#else
   vec4 stored = textureLod(prefix_sums, uv, 0.0f);
-  float beta = msm_scattering_beta_adaptive(lights[0].towards_light.xyz, direction);
+  // The technique's parameter z = 1 fixes β to its y (§5.3.1's constant overestimation), else adaptive.
+  float beta = frame.technique_params.z == 1.0f ? msm_saturate(frame.technique_params.y)
+                                                : msm_scattering_beta_adaptive(lights[0].towards_light.xyz, direction);
   float zf = msm_signed_depth(lookup.z);
 #ifdef MSM_SIX_MOMENTS
   // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
@@ -83,6 +101,7 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
 #else
   return msm_scattering_visibility4(stored, MSM_REP_SIGNED_THETA4, zf, beta);
 #endif
+#endif // MSM_CSM
 }
 #endif
 

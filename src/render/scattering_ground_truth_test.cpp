@@ -1,0 +1,257 @@
+// Every scattering technique against the ray-traced ground truth (msm::reference, --effect
+// scattering) on the four scattering scenes, and the orderings JCGT 2017 §5 reports, each with
+// the margin measured on lavapipe. The signal is the visible fraction of each view ray (the
+// renderer's `visible_fraction`, the reference's `visibility`): the in-scattered radiance over the
+// ray's maximal scattering f E ∫₀ˢ exp(−σt t) dt, so that "off by > 3% of the maximal scattering"
+// is a difference above 0.03. Prints the table of docs/results.md, "Single scattering against the
+// ground truth".
+#include "msm/reference/reference.h"
+#include "msm/render/renderer.h"
+
+#include "msm/image/metrics.h"
+#include "msm/test/vulkan_test.h"
+
+#include <fmt/format.h>
+#include <glm/glm.hpp>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace msm::render {
+namespace {
+
+class ScatteringGroundTruthTest : public vk::test::VulkanTest {};
+
+constexpr int kWidth = 160, kHeight = 90, kShadowSize = 512, kReferenceSamples = 256;
+
+const std::vector<std::string> kTechniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
+                                              "scatter-msm4-64",  "scatter-msm6-64",   "scatter-msm6-96",
+                                              "scatter-msm6-192"};
+
+struct Measured {
+  double mae, share3; // MAE of the visible fraction, share of pixels off by > 0.03
+};
+// Measured on lavapipe at 160 x 90, 512² maps, 256 reference samples per pixel (seed 1).
+const std::map<std::string, std::map<std::string, Measured>> kMeasured = {
+    {"tower",
+     {{"scatter-march-32", {0.0762, 0.806}},
+      {"scatter-march-128", {0.0199, 0.232}},
+      {"scatter-csm-32", {0.0561, 0.710}},
+      {"scatter-msm4-64", {0.0625, 0.707}},
+      {"scatter-msm6-64", {0.0602, 0.707}},
+      {"scatter-msm6-96", {0.0587, 0.692}},
+      {"scatter-msm6-192", {0.0587, 0.692}}}},
+    {"trees",
+     {{"scatter-march-32", {0.0206, 0.199}},
+      {"scatter-march-128", {0.0061, 0.040}},
+      {"scatter-csm-32", {0.0168, 0.194}},
+      {"scatter-msm4-64", {0.0629, 0.424}},
+      {"scatter-msm6-64", {0.0398, 0.368}},
+      {"scatter-msm6-96", {0.0370, 0.357}},
+      {"scatter-msm6-192", {0.0370, 0.356}}}},
+    {"gate",
+     {{"scatter-march-32", {0.0527, 0.504}},
+      {"scatter-march-128", {0.0149, 0.137}},
+      {"scatter-csm-32", {0.0715, 0.703}},
+      {"scatter-msm4-64", {0.0998, 0.748}},
+      {"scatter-msm6-64", {0.0791, 0.733}},
+      {"scatter-msm6-96", {0.0784, 0.732}},
+      {"scatter-msm6-192", {0.0784, 0.732}}}},
+    {"room",
+     {{"scatter-march-32", {0.0008, 0.006}},
+      {"scatter-march-128", {0.0003, 0.000}},
+      {"scatter-csm-32", {0.0178, 0.151}},
+      {"scatter-msm4-64", {0.0120, 0.129}},
+      {"scatter-msm6-64", {0.0134, 0.149}},
+      {"scatter-msm6-96", {0.0082, 0.038}},
+      {"scatter-msm6-192", {0.0072, 0.037}}}},
+};
+
+// Bounds: 1.5x the measured MAE, at least the measured MAE + 0.004 (the reference's Monte Carlo
+// noise at 256 stratified samples and float rounding across drivers); the share above 3% within
+// 0.05 of the measured one.
+double mae_bound(double measured) { return std::max(1.5 * measured, measured + 0.004); }
+double share_bound(double measured) { return measured + 0.05; }
+
+RenderSettings settings(std::string technique, glm::vec4 params = glm::vec4(0.0f)) {
+  RenderSettings s;
+  s.technique = std::move(technique);
+  s.width = kWidth;
+  s.height = kHeight;
+  s.shadow_size = kShadowSize;
+  s.params = params;
+  return s;
+}
+
+image::Image visible_fraction(const RenderResult& r) { return r.scattering.channel("visible_fraction"); }
+
+reference::Result ground_truth(const scene::Scene& scene) {
+  reference::Settings r;
+  r.effect = reference::Effect::scattering;
+  r.width = kWidth;
+  r.height = kHeight;
+  r.samples = kReferenceSamples;
+  return reference::render(scene, r);
+}
+
+// 1 (ignored) for pixels whose view direction is more than max_deg away from the light's
+// direction (towards the light): the neighbourhood of the epipole.
+image::Image outside_of_the_epipole(const scene::Scene& scene, double max_deg) {
+  glm::dmat4 inverse = glm::inverse(glm::dmat4(scene.camera_view_projection(float(kWidth) / float(kHeight))));
+  glm::dvec3 origin(scene.camera.position), light = glm::normalize(glm::dvec3(scene.light().towards_light));
+  image::Image mask(kWidth, kHeight, 1);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      glm::dvec4 far = inverse * glm::dvec4((x + 0.5) / kWidth * 2.0 - 1.0, (y + 0.5) / kHeight * 2.0 - 1.0, 1.0, 1.0);
+      glm::dvec3 direction = glm::normalize(glm::dvec3(far) / far.w - origin);
+      double degrees = glm::degrees(std::acos(std::clamp(glm::dot(direction, light), -1.0, 1.0)));
+      mask.at(x, y, 0) = degrees > max_deg ? 1.0f : 0.0f;
+    }
+  return mask;
+}
+
+// Renders every technique on one scene, checks each against its measured errors, returns the
+// metrics by technique.
+std::map<std::string, image::Metrics> check_scene(Renderer& renderer, const std::string& name,
+                                                  const image::Image& truth) {
+  std::map<std::string, image::Metrics> metrics;
+  auto scene_measured = kMeasured.find(name);
+  for (const std::string& technique : kTechniques) {
+    SCOPED_TRACE(technique);
+    RenderResult r = renderer.render(settings(technique));
+    image::Metrics m = image::compute_metrics(visible_fraction(r), truth);
+    fmt::print("[scattering truth] {:<6} {:<18} MAE {:.4f}  > 3% {:5.1f}%  leaking {:.4f}  non-finite {}\n", name,
+               technique, m.mae, 100 * m.share_above_3pct, m.light_leaking, m.non_finite);
+    EXPECT_EQ(m.non_finite, 0u);
+    metrics[technique] = m;
+    if (scene_measured == kMeasured.end() || !scene_measured->second.contains(technique)) {
+      ADD_FAILURE() << "no measured value for " << technique << " on " << name;
+      continue;
+    }
+    const Measured& expected = scene_measured->second.at(technique);
+    EXPECT_LT(m.mae, mae_bound(expected.mae));
+    EXPECT_LT(m.share_above_3pct, share_bound(expected.share3));
+  }
+  return metrics;
+}
+
+struct SceneRun {
+  scene::Scene scene;
+  reference::Result truth;
+  image::Image truth_visibility;
+};
+
+SceneRun prepare(const std::string& name) {
+  SceneRun run{scene::builtin_scene(name), {}, {}};
+  run.truth = ground_truth(run.scene);
+  run.truth_visibility = run.truth.visibility.channel("visibility");
+  return run;
+}
+
+// Fig. 14: the tower hides the light, the epipole is in view. Moments ring less than the
+// convolution shadow map; adaptive β leaks less near the epipole than β = ½ and β = 1.
+TEST_F(ScatteringGroundTruthTest, Tower) {
+  SceneRun run = prepare("tower");
+  Renderer renderer(ctx(), run.scene);
+  std::map<std::string, image::Metrics> m = check_scene(renderer, "tower", run.truth_visibility);
+  fmt::print("[ordering] tower MAE: csm-32 {:.4f}, msm4-64 {:.4f}, msm6-96 {:.4f}\n", m["scatter-csm-32"].mae,
+             m["scatter-msm4-64"].mae, m["scatter-msm6-96"].mae);
+  // Not asserted: on this tower at this size the convolution shadow map has the LOWER error
+  // (measured MAE 0.0561 against 0.0625 for four and 0.0587 for six moments; docs/results.md).
+  struct Variant {
+    const char* technique;
+    const char* beta;
+    glm::vec4 params;
+  };
+  const Variant variants[] = {
+      {"scatter-msm4-64", "adaptive", glm::vec4(0.0f)},      {"scatter-msm4-64", "half", glm::vec4(0, 0.5f, 1, 0)},
+      {"scatter-msm4-64", "one", glm::vec4(0, 1.0f, 1, 0)},  {"scatter-msm6-96", "adaptive", glm::vec4(0.0f)},
+      {"scatter-msm6-96", "half", glm::vec4(0, 0.5f, 1, 0)}, {"scatter-msm6-96", "one", glm::vec4(0, 1.0f, 1, 0)}};
+  std::vector<image::Image> images;
+  for (const Variant& v : variants)
+    images.push_back(visible_fraction(renderer.render(settings(v.technique, v.params))));
+  for (double radius : {5.0, 10.0, 20.0}) {
+    image::Image mask = outside_of_the_epipole(run.scene, radius);
+    std::vector<double> leaking;
+    for (size_t i = 0; i < images.size(); ++i) {
+      image::Metrics e = image::compute_metrics(images[i], run.truth_visibility, {.mask = &mask});
+      leaking.push_back(e.light_leaking);
+      fmt::print("[ordering] tower within {:>2}° of the epipole ({} px): {} β {} leaking {:.4f}, MAE {:.4f}\n", radius,
+                 e.pixels, variants[i].technique, variants[i].beta, e.light_leaking, e.mae);
+    }
+    // Within 10°: adaptive β leaks less than β = ½, which leaks less than β = 1, for four and six
+    // moments (measured leaking 0.0870 < 0.1212 < 0.1572 and 0.0893 < 0.1066 < 0.1245: ratios 0.72-0.86;
+    // the same order at 5° and 20°).
+    if (radius != 10.0) continue;
+    for (size_t t : {0u, 3u}) {
+      EXPECT_LT(leaking[t], 0.9 * leaking[t + 1]) << variants[t].technique << ": adaptive vs ½";
+      EXPECT_LT(leaking[t + 1], 0.9 * leaking[t + 2]) << variants[t].technique << ": ½ vs 1";
+    }
+  }
+}
+
+// Fig. 16: complex shadows of many leaves: six moments have less error than four.
+TEST_F(ScatteringGroundTruthTest, Trees) {
+  SceneRun run = prepare("trees");
+  Renderer renderer(ctx(), run.scene);
+  std::map<std::string, image::Metrics> m = check_scene(renderer, "trees", run.truth_visibility);
+  fmt::print("[ordering] trees MAE: msm4-64 {:.4f}, msm6-64 {:.4f}, msm6-96 {:.4f}, msm6-192 {:.4f}\n",
+             m["scatter-msm4-64"].mae, m["scatter-msm6-64"].mae, m["scatter-msm6-96"].mae, m["scatter-msm6-192"].mae);
+  // Measured 0.0370 against 0.0629 (ratio 0.59); 60 bits 0.0398 (0.63).
+  EXPECT_LT(m["scatter-msm6-96"].mae, 0.75 * m["scatter-msm4-64"].mae);
+  EXPECT_LT(m["scatter-msm6-64"].mae, 0.75 * m["scatter-msm4-64"].mae);
+}
+
+// Fig. 17: the gate's fine shafts. Filtered resampling flickers less than unfiltered under a small
+// camera motion: the mean absolute change of the visible fraction between consecutive frames.
+TEST_F(ScatteringGroundTruthTest, Gate) {
+  SceneRun run = prepare("gate");
+  Renderer renderer(ctx(), run.scene);
+  check_scene(renderer, "gate", run.truth_visibility);
+  const scene::Camera start = run.scene.camera;
+  for (const char* technique : {"scatter-msm4-64", "scatter-msm6-96"}) {
+    double change[2] = {0.0, 0.0};
+    for (int filtered : {0, 1}) {
+      image::Image previous;
+      for (int frame = 0; frame < 8; ++frame) {
+        scene::Camera c = start;
+        const glm::vec3 step(0.004f * float(frame), 0.002f * float(frame), 0.0f); // a slow sideways drift
+        c.position += step;
+        c.target += step;
+        renderer.set_camera(c);
+        image::Image v = visible_fraction(renderer.render(settings(technique, glm::vec4(float(filtered), 0, 0, 0))));
+        if (frame > 0) change[filtered] += image::compute_metrics(v, previous).mae / 7.0;
+        previous = v;
+      }
+    }
+    renderer.set_camera(start);
+    fmt::print("[ordering] gate {} mean frame-to-frame change: unfiltered {:.5f}, filtered {:.5f}\n", technique,
+               change[0], change[1]);
+    // Measured 0.00303 vs 0.00634 (four moments) and 0.00325 vs 0.00670 (six): ratio 0.48-0.49.
+    EXPECT_LT(change[1], 0.6 * change[0]) << technique;
+  }
+}
+
+// Figs. 15, 19: the room's thin walls. 96 bits leak less than 60 (6 x 10 bits); moments ring less
+// than the convolution shadow map.
+TEST_F(ScatteringGroundTruthTest, Room) {
+  SceneRun run = prepare("room");
+  Renderer renderer(ctx(), run.scene);
+  std::map<std::string, image::Metrics> m = check_scene(renderer, "room", run.truth_visibility);
+  fmt::print("[ordering] room leaking: msm6-64 {:.4f}, msm6-96 {:.4f}; MAE csm-32 {:.4f}, msm4-64 {:.4f}, msm6-96 "
+             "{:.4f}\n",
+             m["scatter-msm6-64"].light_leaking, m["scatter-msm6-96"].light_leaking, m["scatter-csm-32"].mae,
+             m["scatter-msm4-64"].mae, m["scatter-msm6-96"].mae);
+  // Measured leaking 0.0056 vs 0.0106 (ratio 0.53); MAE 0.0082 (six, 96 bits) and 0.0120 (four)
+  // against 0.0178 (CSM): ratios 0.46, 0.67.
+  EXPECT_LT(m["scatter-msm6-96"].light_leaking, 0.7 * m["scatter-msm6-64"].light_leaking);
+  EXPECT_LT(m["scatter-msm6-96"].mae, 0.6 * m["scatter-csm-32"].mae);
+  EXPECT_LT(m["scatter-msm4-64"].mae, 0.8 * m["scatter-csm-32"].mae);
+}
+
+} // namespace
+} // namespace msm::render
