@@ -219,7 +219,9 @@ struct Renderer::Impl {
       float tan_half = std::tan(glm::radians(extent) * 0.5f);
       // soft.h: texels of reach per unit of [-1,1] depth.
       vec2 spread = msm_soft_spread(vec2(tan_half), float(0.5 * f.depth_extent), vec2(texel));
-      u.soft = glm::vec4(spread, 0.0f, 0.0f);
+      // The shading integrates the cosine over the disc (msm_cone_cosine); the other techniques
+      // shade their lights as points (soft.z = 0: max(n·l, 0)), as their shadows are hard.
+      u.soft = glm::vec4(spread, glm::radians(extent) * 0.5f, 0.0f);
     }
     return u;
   }
