@@ -690,6 +690,14 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
   rejects(
       [&] {
         auto q = s;
+        q.technique = "cssm8";
+        q.params = glm::vec4(2.0f, 0.5f, 0.0f, 0.01f);
+        return q;
+      }(),
+      "scale y >= 1");
+  rejects(
+      [&] {
+        auto q = s;
         q.technique = "pcss";
         q.soft_kernel = 64;
         return q;
