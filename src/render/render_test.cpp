@@ -695,6 +695,15 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
         return q;
       }(),
       "scale y >= 1");
+  if (9u * 2048u > ctx().properties().limits.maxImageDimension2D)
+    rejects(
+        [&] {
+          auto q = s;
+          q.technique = "cssm16";
+          q.shadow_size = 2048;
+          return q;
+        }(),
+        "stacks 9 shadow maps");
   rejects(
       [&] {
         auto q = s;

@@ -239,6 +239,14 @@ struct Renderer::Impl {
         uint32_t(s.shadow_size) > ctx.properties().limits.maxImageDimension2D)
       throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
                                     ctx.properties().limits.maxImageDimension2D));
+    // CSSM stacks its tiles along y in one image (cssm.h).
+    const int tiles = msm_technique_tiles(find_rendered_technique(s.technique).id);
+    if (std::uint64_t(s.shadow_size) * std::uint64_t(tiles) > ctx.properties().limits.maxImageDimension2D)
+      throw RenderError(fmt::format("{} stacks {} shadow maps of {}² in one image: {} supports {} texels per side; use "
+                                    "--shadow-size {} or less",
+                                    s.technique, tiles, s.shadow_size, ctx.info().name,
+                                    ctx.properties().limits.maxImageDimension2D,
+                                    ctx.properties().limits.maxImageDimension2D / uint32_t(tiles)));
     const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
     if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
       throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
