@@ -5,6 +5,7 @@
 #include "msm/bias.h"
 #include "msm/blocker.h"
 #include "msm/config.h"
+#include "msm/cssm.h"
 #include "msm/eft.h"
 #include "msm/filter.h"
 #include "msm/footprint.h"

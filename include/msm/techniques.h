@@ -67,9 +67,25 @@ const int MSM_TECH_SCATTER_MSM6_192 = 32; // Θ6* in 6 x 32-bit float (RGBA32F +
 // Klehm et al. 2014: the same passes with a convolution shadow map of 16 sin/cos terms (32
 // coefficients) in 8 bits each (eight RGBA8 layers), [0,1] rectified depth, no β (scattering.h).
 const int MSM_TECH_SCATTER_CSM32 = 33;
+// Convolution soft shadow maps (Annen et al. 2008; cssm.h), the baseline of Kneiphof's comparison:
+// CSM's Fourier basis, the basis times depth and the depth in one integer summed-area table of
+// stacked tiles.
+const int MSM_TECH_CSSM8 = 35;  // 4 frequencies: 17 values in 5 RGBA tiles
+const int MSM_TECH_CSSM16 = 36; // 8 frequencies: 33 values in 9 RGBA tiles
 
 // Soft shadows from summed-area tables instead of a filtered map.
-MSM_FN bool msm_technique_is_soft(int t) { return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM; }
+MSM_FN bool msm_technique_is_cssm(int t) { return t == MSM_TECH_CSSM8 || t == MSM_TECH_CSSM16; }
+MSM_FN bool msm_technique_is_soft(int t) {
+  return t == MSM_TECH_MSSM4 || t == MSM_TECH_MSSM6 || t == MSM_TECH_VSSM || msm_technique_is_cssm(t);
+}
+// CSM frequencies of the CSSM techniques (0 for the others); their moment image holds
+// msm_technique_tiles tiles of the shadow map's size stacked along y (1 for every other).
+MSM_FN int msm_technique_cssm_frequencies(int t) {
+  return t == MSM_TECH_CSSM8 ? msm_cssm_frequencies(8) : (t == MSM_TECH_CSSM16 ? msm_cssm_frequencies(16) : 0);
+}
+MSM_FN int msm_technique_tiles(int t) {
+  return msm_technique_is_cssm(t) ? msm_cssm_tiles(msm_technique_cssm_frequencies(t)) : 1;
+}
 // Six moments: the texel's b half (techniques.h layout) goes to a second image.
 MSM_FN bool msm_technique_is_six_moments(int t) {
   return t == MSM_TECH_MSM6_192 || t == MSM_TECH_MSM6_96 || t == MSM_TECH_MSSM6;
@@ -152,6 +168,9 @@ MSM_FN vec4 msm_technique_default_params(int t) {
   if (t == MSM_TECH_MSSM4) return vec4(MSM_BLOCKER_EPSILON, MSM_BLOCKER_EPSILON, 0.0f, 0.0f);
   if (t == MSM_TECH_MSSM6) return vec4(MSM_BLOCKER_EPSILON, MSM_SOFT6_DELTA2, 1.0f, 0.0f);
   if (t == MSM_TECH_VSSM) return vec4(0.0f, 0.0f, 0.0f, MSM_VSSM_MIN_VARIANCE);
+  // CSSM: x damping, y scale, z offset of CSM (baselines.h), w the blockers' least share (cssm.h).
+  if (msm_technique_is_cssm(t))
+    return vec4(MSM_CSM_DAMPING_DEFAULT, MSM_CSM_SCALE_DEFAULT, MSM_CSM_OFFSET_DEFAULT, 0.01f);
   return vec4(0.0f);
 }
 

@@ -20,6 +20,7 @@ constexpr std::string_view kEvsm = "y: c+, z: c- (EVSM4), w: minimum variance in
 constexpr std::string_view kSoftMoments =
     "x: δ1 (ε of JCGT Eq. 4), y: δ2, z: 1 = Kneiphof's upper-bound blocker depth (Eq. 19) with the mass at zf "
     "clamped to [δ1, δ2], 0 = JCGT Eq. 4";
+constexpr std::string_view kCssmParams = "x: CSM damping, y: CSM scale, z: CSM offset, w: least blocker share";
 
 Texel from(vec4 v) { return {v.x, v.y, v.z, v.w, 0, 0, 0, 0}; }
 vec4 to_vec4(const Texel& t) { return vec4(t[0], t[1], t[2], t[3]); }
@@ -486,6 +487,31 @@ constexpr Technique kTechniques[] = {
      32,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default)",
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
+    {"cssm8",
+     "Convolution soft shadow maps (Annen et al. 2008), Kneiphof's CSSM8: CSM of 4 frequencies, the basis times "
+     "depth and the depth (17 values) in a 32-bit integer summed-area table of stacked tiles; blocker depth "
+     "E[z f] / E[f], nine-region filter",
+     MSM_TECH_CSSM8,
+     640,
+     17,
+     {TexelFormat::rgba32_float, TexelFormat::none},
+     kCssmParams,
+     true,
+     nullptr,
+     nullptr,
+     nullptr},
+    {"cssm16",
+     "Convolution soft shadow maps (Annen et al. 2008), Kneiphof's CSSM16: CSM of 8 frequencies (33 values in "
+     "9 tiles of one summed-area table)",
+     MSM_TECH_CSSM16,
+     1152,
+     33,
+     {TexelFormat::rgba32_float, TexelFormat::none},
+     kCssmParams,
      true,
      nullptr,
      nullptr,

@@ -109,9 +109,6 @@ Panorama load_equirect(const std::filesystem::path& file) {
       if (names[c] == std::string(1, "RGB"[k])) index[k] = c;
   if (index[0] < 0 || index[1] < 0 || index[2] < 0)
     throw ProbeError(fmt::format("{}: a light probe needs channels R, G and B", file.string()));
-  if (picture.width() != 2 * picture.height())
-    throw ProbeError(fmt::format("{}: {}x{} is not an equirectangular panorama (width = 2 height)", file.string(),
-                                 picture.width(), picture.height()));
   std::vector<glm::vec3> rgb(picture.pixel_count());
   const int n = picture.channels();
   const float* p = picture.pixels().data();
@@ -130,6 +127,113 @@ Panorama load_equirect(const std::filesystem::path& file) {
 CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float rotation_deg) {
   const Panorama p = load_equirect(file);
   return cube_from_equirect(p.width, p.height, p.rgb, size, rotation_deg);
+}
+
+namespace {
+
+// (column, row) of each face's cell in the horizontal and the vertical cross.
+constexpr int kHorizontalCells[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 1}, {3, 1}};
+constexpr int kVerticalCells[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 1}, {1, 3}};
+
+// Picture texel of face texel (i, j) in a cross of faces of side m.
+std::size_t cross_index(int face, int i, int j, int m, bool vertical) {
+  const int(*cells)[2] = vertical ? kVerticalCells : kHorizontalCells;
+  if (vertical && face == 5) i = m - 1 - i, j = m - 1 - j; // −Z turned by 180°
+  const int width = (vertical ? 3 : 4) * m;
+  return std::size_t(cells[face][1] * m + j) * std::size_t(width) + std::size_t(cells[face][0] * m + i);
+}
+
+} // namespace
+
+CubeMap cube_from_cross(int width, int height, const std::vector<glm::vec3>& rgb) {
+  if (rgb.size() != std::size_t(width) * std::size_t(height))
+    throw ProbeError(fmt::format("cross image of {}x{} with {} texels", width, height, rgb.size()));
+  const bool horizontal = width > 0 && width % 4 == 0 && 3 * (width / 4) == height;
+  const bool vertical = height > 0 && height % 4 == 0 && 3 * (height / 4) == width;
+  if (!horizontal && !vertical)
+    throw ProbeError(
+        fmt::format("{}x{} is not a cube-map cross (4s x 3s horizontal or 3s x 4s vertical)", width, height));
+  CubeMap cube;
+  cube.size = horizontal ? width / 4 : height / 4;
+  check_size(cube.size);
+  for (int face = 0; face < 6; ++face) {
+    cube.faces[face].resize(std::size_t(cube.size) * cube.size);
+    for (int j = 0; j < cube.size; ++j)
+      for (int i = 0; i < cube.size; ++i) cube.at(face, i, j) = rgb[cross_index(face, i, j, cube.size, vertical)];
+  }
+  return cube;
+}
+
+std::vector<glm::vec3> cross_of_cube(const CubeMap& cube, bool vertical) {
+  const int m = cube.size;
+  std::vector<glm::vec3> rgb(std::size_t(12) * std::size_t(m) * std::size_t(m), glm::vec3(0.0f));
+  for (int face = 0; face < 6; ++face)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) rgb[cross_index(face, i, j, m, vertical)] = cube.at(face, i, j);
+  return rgb;
+}
+
+CubeMap cube_from_faces(const std::array<int, 6>& sizes, const std::array<std::vector<glm::vec3>, 6>& faces) {
+  CubeMap cube;
+  cube.size = sizes[0];
+  check_size(cube.size);
+  for (int face = 0; face < 6; ++face) {
+    if (sizes[face] != cube.size || faces[face].size() != std::size_t(cube.size) * std::size_t(cube.size))
+      throw ProbeError(
+          fmt::format("cube face {} is not {}² like face 0 ({} texels)", face, cube.size, faces[face].size()));
+    cube.faces[face] = faces[face];
+  }
+  return cube;
+}
+
+CubeMap downsample_cube(const CubeMap& cube, int size) {
+  check_size(size);
+  if (cube.size % size != 0)
+    throw ProbeError(fmt::format("cube faces of {}² cannot be box-filtered to {}² (not a divisor)", cube.size, size));
+  const int k = cube.size / size;
+  CubeMap out;
+  out.size = size;
+  for (int face = 0; face < 6; ++face) {
+    out.faces[face].resize(std::size_t(size) * size);
+    for (int j = 0; j < size; ++j)
+      for (int i = 0; i < size; ++i) {
+        glm::dvec3 sum(0.0);
+        for (int b = 0; b < k; ++b)
+          for (int a = 0; a < k; ++a) sum += glm::dvec3(cube.at(face, i * k + a, j * k + b));
+        out.at(face, i, j) = glm::vec3(sum / double(k * k));
+      }
+  }
+  return out;
+}
+
+CubeMap load_probe(const std::filesystem::path& file, int size, float rotation_deg) {
+  check_size(size);
+  Panorama picture = load_equirect(file);
+  if (picture.width == 2 * picture.height)
+    return cube_from_equirect(picture.width, picture.height, picture.rgb, size, rotation_deg);
+  if (4 * picture.height != 3 * picture.width && 4 * picture.width != 3 * picture.height)
+    throw ProbeError(fmt::format("{}: {}x{} is neither an equirectangular panorama (width = 2 height) nor a cube-map "
+                                 "cross (4:3 or 3:4)",
+                                 file.string(), picture.width, picture.height));
+  if (rotation_deg != 0.0f)
+    throw ProbeError(fmt::format("{}: a cube-map cross cannot be rotated (rotation {}°)", file.string(), rotation_deg));
+  try {
+    return downsample_cube(cube_from_cross(picture.width, picture.height, picture.rgb), size);
+  } catch (const ProbeError& e) { throw ProbeError(fmt::format("{}: {}", file.string(), e.what())); }
+}
+
+CubeMap load_cube_faces(const std::array<std::filesystem::path, 6>& files, int size) {
+  std::array<int, 6> sizes{};
+  std::array<std::vector<glm::vec3>, 6> faces;
+  for (int face = 0; face < 6; ++face) {
+    Panorama picture = load_equirect(files[face]);
+    if (picture.width != picture.height)
+      throw ProbeError(fmt::format("{}: a cube face must be square, not {}x{}", files[face].string(), picture.width,
+                                   picture.height));
+    sizes[face] = picture.width;
+    faces[face] = std::move(picture.rgb);
+  }
+  return downsample_cube(cube_from_faces(sizes, faces), size);
 }
 
 CubeMap make_sky_sun_probe(int size, glm::vec3 sky, glm::vec3 sun, glm::vec3 towards_sun, float sun_radius_rad) {
@@ -303,7 +407,7 @@ CubeMap sky_probe(int size, float rotation_deg) {
 
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
                                             float intensity) {
-  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_equirect_probe(probe, size, rotation_deg);
+  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_probe(probe, size, rotation_deg);
   for (auto& face : cube.faces)
     for (glm::vec3& t : face) t *= intensity;
   const ProbeTables tables(cube);

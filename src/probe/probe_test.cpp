@@ -1,12 +1,17 @@
 // Light probes: the cube-map conventions against hand-computed directions, the solid-angle weights
 // (4π), resampling, the procedural probe against its closed form, the median cut's invariants,
 // the area lights of known regions, the cone's cosine integral against quadrature, and a real
-// probe of blender-data.
+// probe of blender-data; cube-map crosses and faces.
 #include <cmath>
+#include <filesystem>
+#include <functional>
 #include <numeric>
+#include <string>
 
 #include <gtest/gtest.h>
 
+#include "msm/image/image.h"
+#include "msm/image/io.h"
 #include "msm/probe/probe.h"
 #include "msm/util/random.h"
 
@@ -261,4 +266,110 @@ TEST(Probes, BadInputIsAnError) {
   // A 1² cube map cannot be split past its six texels: six regions.
   const ProbeTables tiny(make_sky_sun_probe(1, glm::vec3(1), glm::vec3(2), glm::vec3(0, 1, 0), 0.1f));
   EXPECT_EQ(median_cut(tiny, 20).size(), 6u);
+}
+
+// ---- Cube-map inputs: crosses and six faces ----
+
+namespace {
+
+// A cube whose texels are their own unit directions (as colours) plus a texel-unique offset, so
+// that a misplaced or mirrored texel cannot go unnoticed.
+CubeMap direction_cube(int m) {
+  CubeMap cube;
+  cube.size = m;
+  for (int face = 0; face < 6; ++face) {
+    cube.faces[face].resize(std::size_t(m) * m);
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        const float u = (2.0f * float(i) + 1.0f) / float(m) - 1.0f, v = (2.0f * float(j) + 1.0f) / float(m) - 1.0f;
+        cube.at(face, i, j) = glm::normalize(msm::msm_cube_direction(face, u, v)) + glm::vec3(2.0f);
+      }
+  }
+  return cube;
+}
+
+bool same_cube(const CubeMap& a, const CubeMap& b) { return a.size == b.size && a.faces == b.faces; }
+
+std::string message_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const ProbeError& e) { return e.what(); }
+  return "(no error)";
+}
+
+} // namespace
+
+// A cross made from a known cube gives it back texel for texel (in memory and through an EXR
+// file), and the layout is continuous: across every border between two face cells of the picture,
+// neighbouring texels are neighbouring directions (at most 2.2 texel spacings apart, as inside a
+// face), which checks each face's cell and orientation against the cube-map conventions.
+TEST(CubeInputs, CrossRoundTripsAndIsContinuous) {
+  const int m = 8;
+  const CubeMap cube = direction_cube(m);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "msm_probe_cross_test";
+  std::filesystem::create_directories(dir);
+  for (bool vertical : {false, true}) {
+    const int width = (vertical ? 3 : 4) * m, height = (vertical ? 4 : 3) * m;
+    const std::vector<glm::vec3> rgb = cross_of_cube(cube, vertical);
+    EXPECT_TRUE(same_cube(cube_from_cross(width, height, rgb), cube)) << vertical;
+    const CubeMap tagged = [&] {
+      CubeMap t = cube;
+      for (int face = 0; face < 6; ++face)
+        for (glm::vec3& c : t.faces[face]) c = glm::vec3(float(face));
+      return t;
+    }();
+    const std::vector<glm::vec3> tags = cross_of_cube(tagged, vertical);
+    const std::vector<glm::vec3> filled = cross_of_cube(direction_cube(m), vertical);
+    int borders = 0;
+    double worst = 0.0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x)
+        for (auto [dx, dy] : {std::pair(1, 0), std::pair(0, 1)}) {
+          const int x2 = x + dx, y2 = y + dy;
+          if (x2 >= width || y2 >= height) continue;
+          const std::size_t a = std::size_t(y) * width + x, b = std::size_t(y2) * width + x2;
+          if (filled[a] == glm::vec3(0.0f) || filled[b] == glm::vec3(0.0f)) continue; // an empty cell
+          const double d = glm::length(glm::dvec3(filled[a] - filled[b]));
+          worst = std::max(worst, d);
+          borders += tags[a] != tags[b];
+        }
+    // Texel spacing on a face is at most 2/m radians (at its centre).
+    EXPECT_LT(worst, 2.2 * 2.0 / m) << (vertical ? "vertical" : "horizontal");
+    EXPECT_EQ(borders, 5 * m) << "face borders crossed"; // five borders between cells of either cross
+    msm::image::Image picture(width, height, std::vector<std::string>{"R", "G", "B"});
+    for (std::size_t k = 0; k < rgb.size(); ++k)
+      for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = rgb[k][c];
+    const std::filesystem::path file = dir / (vertical ? "vertical.exr" : "horizontal.exr");
+    msm::image::write_exr(file, picture);
+    EXPECT_TRUE(same_cube(load_probe(file, m), cube)) << file;
+    EXPECT_TRUE(same_cube(load_probe(file, m / 2), downsample_cube(cube, m / 2))) << file;
+    // Box filtering keeps the probe's integral to the midpoint rule's accuracy.
+    const glm::dvec3 full = integrate(cube), half = integrate(load_probe(file, m / 2));
+    EXPECT_NEAR(half.x, full.x, 0.02 * full.x);
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// Six faces of one size make the cube; anything else is refused with a message naming the problem.
+TEST(CubeInputs, BadLayoutsAreRefusedClearly) {
+  const CubeMap cube = direction_cube(4);
+  std::array<int, 6> sizes{4, 4, 4, 4, 4, 4};
+  EXPECT_TRUE(same_cube(cube_from_faces(sizes, cube.faces), cube));
+  sizes[3] = 2;
+  EXPECT_NE(message_of([&] { cube_from_faces(sizes, cube.faces); }).find("cube face 3"), std::string::npos);
+  EXPECT_NE(message_of([&] { cube_from_cross(5, 3, std::vector<glm::vec3>(15)); }).find("not a cube-map cross"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] { cube_from_cross(16, 12, std::vector<glm::vec3>(10)); }).find("with 10 texels"),
+            std::string::npos);
+  EXPECT_NE(message_of([&] { downsample_cube(cube, 3); }).find("not a divisor"), std::string::npos);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "msm_probe_bad_cross_test";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path odd = dir / "odd.exr", cross = dir / "cross.exr";
+  msm::image::write_exr(odd, msm::image::Image(30, 20, std::vector<std::string>{"R", "G", "B"}, 1.0f));
+  EXPECT_NE(message_of([&] { load_probe(odd, 4); }).find("is neither an equirectangular panorama"), std::string::npos);
+  msm::image::write_exr(cross, msm::image::Image(16, 12, std::vector<std::string>{"R", "G", "B"}, 1.0f));
+  EXPECT_NE(message_of([&] { load_probe(cross, 4, 30.0f); }).find("cannot be rotated"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_probe(cross, 3); }).find("not a divisor"), std::string::npos);
+  EXPECT_THROW(load_cube_faces({odd, odd, odd, odd, odd, odd}, 4), ProbeError); // not square
+  std::filesystem::remove_all(dir);
 }

@@ -1,10 +1,28 @@
 // soft: the fraction of a directional area light (a disc or a rectangle in the plane at unit
-// distance along towards_light) that the visible point sees.
+// distance along towards_light) that the visible point sees, and the light's cosine-weighted
+// visibility for the radiance (reference.h).
 #include <cmath>
+#include <numbers>
 
 #include "internal.h"
 
 namespace msm::reference::detail {
+
+namespace {
+
+// ∫ (d·L) dω over the light, the irradiance of radiance 1 on a surface facing it: π sin² α for the
+// disc of radius tan α, and for the rectangle [−X, X] x [−Y, Y] at unit distance the integral of
+// (1 + a² + b²)^−2 da db in closed form (checked against a midpoint rule to 1e-7).
+double facing_integral(bool disc, double half_x, double half_y) {
+  if (disc) {
+    const double s = std::sin(std::atan(half_x));
+    return std::numbers::pi * s * s;
+  }
+  const double rx = std::sqrt(1.0 + half_x * half_x), ry = std::sqrt(1.0 + half_y * half_y);
+  return 2.0 * (half_x / rx * std::atan(half_y / rx) + half_y / ry * std::atan(half_x / ry));
+}
+
+} // namespace
 
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng) {
   const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
@@ -12,15 +30,45 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
   // The origin is on the side of the surface facing the light's centre (as in `hard`); sampled
   // directions below that side's horizon cross the surface itself and are blocked.
   const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
+  // The radiance's normal: the interpolated one turned towards the viewer (reference.cpp).
+  glm::dvec3 n = ctx.tracer.shading_normal(hit);
+  if (glm::dot(hit.normal, hit.incoming) > 0.0) n = -n;
+  const double n_dot_l = glm::dot(n, ctx.towards_light);
+  // The light reaches the viewer's side of the surface: where the light's centre is below that
+  // side's horizon, `lit` traces its own rays from there.
+  const glm::dvec3 viewer_side = offset_origin(hit.p, hit.normal, hit.scale, -hit.incoming);
+  const bool same_side = viewer_side == origin;
+  std::uint64_t extra_rays = 0;
+  // Directions are uniform over the light's area in the plane at unit distance: one of them stands
+  // for area / cos³ θ of solid angle (θ its angle off L).
+  const double area = disc ? std::numbers::pi * ctx.half_x * ctx.half_x : 4.0 * ctx.half_x * ctx.half_y;
+  const double facing = facing_integral(disc, ctx.half_x, ctx.half_y);
   RunningStats stats;
+  double deviation = 0.0;
   for (int i = 0; i < set.count(); ++i) {
     const glm::dvec2 u = set.point(i, rng);
     const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
                                : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
     const glm::dvec3 dir = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
-    stats.add(ctx.tracer.occluded(origin, dir) ? 0.0 : 1.0);
+    const bool visible = !ctx.tracer.occluded(origin, dir);
+    stats.add(visible ? 1.0 : 0.0);
+    bool lit_visible = visible;
+    if (!same_side) {
+      lit_visible = !ctx.tracer.occluded(viewer_side, dir);
+      ++extra_rays;
+    }
+    // ∫ max(n·d, 0) V dω = (n·L) ∫ (d·L) dω + ∫ (max(n·d, 0) V − n·d) dω (the light is symmetric
+    // about L, so ∫ d dω is along L): only the second integral is sampled, and it is exactly 0
+    // where the whole light is visible and above the horizon.
+    const double cos_n = glm::dot(n, dir), cos_l = glm::dot(ctx.towards_light, dir);
+    deviation += ((lit_visible ? std::max(cos_n, 0.0) : 0.0) - cos_n) * cos_l * cos_l * cos_l;
   }
-  return monte_carlo_result(stats);
+  EffectResult r = monte_carlo_result(stats);
+  r.rays += extra_rays;
+  // A light of no area is the point light of `hard`.
+  r.lit = facing > 0.0 ? std::max(n_dot_l + area * deviation / (set.count() * facing), 0.0)
+                       : std::max(n_dot_l, 0.0) * r.value;
+  return r;
 }
 
 } // namespace msm::reference::detail

@@ -150,6 +150,9 @@ struct EffectContext {
 struct EffectResult {
   double value = 1.0;            // visibility or transmittance (translucent: the mean of rgb)
   std::optional<glm::dvec3> rgb; // translucent only: transmittance per RGB channel
+  // soft only: the light's cosine-weighted visibility that replaces max(n·L, 0) V in the radiance
+  // (reference.h, effect soft)
+  std::optional<double> lit;
   double std_error = 0.0;
   int samples = 1;
   std::uint64_t rays = 0; // shadow rays traced

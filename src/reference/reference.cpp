@@ -288,7 +288,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         glm::dvec3 n = tracer.shading_normal(hit);
         if (glm::dot(hit.normal, dir) > 0.0) n = -n;
         const float n_dot_l = float(glm::dot(n, ctx.towards_light));
-        const glm::vec3 direct = msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);
+        const glm::vec3 direct = e.lit ? msm_direct_light(glm::vec3(irradiance), float(*e.lit), glm::vec3(1.0f))
+                                       : msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);
         const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), direct, MSM_AMBIENT);
         float* q = surf + (std::size_t(y) * W + x) * 2;
         q[0] = n_dot_l;

@@ -690,6 +690,23 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
   rejects(
       [&] {
         auto q = s;
+        q.technique = "cssm8";
+        q.params = glm::vec4(2.0f, 0.5f, 0.0f, 0.01f);
+        return q;
+      }(),
+      "scale y >= 1");
+  if (9u * 2048u > ctx().properties().limits.maxImageDimension2D)
+    rejects(
+        [&] {
+          auto q = s;
+          q.technique = "cssm16";
+          q.shadow_size = 2048;
+          return q;
+        }(),
+        "stacks 9 shadow maps");
+  rejects(
+      [&] {
+        auto q = s;
         q.technique = "pcss";
         q.soft_kernel = 64;
         return q;

@@ -219,7 +219,9 @@ struct Renderer::Impl {
       float tan_half = std::tan(glm::radians(extent) * 0.5f);
       // soft.h: texels of reach per unit of [-1,1] depth.
       vec2 spread = msm_soft_spread(vec2(tan_half), float(0.5 * f.depth_extent), vec2(texel));
-      u.soft = glm::vec4(spread, 0.0f, 0.0f);
+      // The shading integrates the cosine over the disc (msm_cone_cosine); the other techniques
+      // shade their lights as points (soft.z = 0: max(n·l, 0)), as their shadows are hard.
+      u.soft = glm::vec4(spread, glm::radians(extent) * 0.5f, 0.0f);
     }
     return u;
   }
@@ -237,6 +239,14 @@ struct Renderer::Impl {
         uint32_t(s.shadow_size) > ctx.properties().limits.maxImageDimension2D)
       throw RenderError(fmt::format("{} supports images up to {} texels per side", ctx.info().name,
                                     ctx.properties().limits.maxImageDimension2D));
+    // CSSM stacks its tiles along y in one image (cssm.h).
+    const int tiles = msm_technique_tiles(find_rendered_technique(s.technique).id);
+    if (std::uint64_t(s.shadow_size) * std::uint64_t(tiles) > ctx.properties().limits.maxImageDimension2D)
+      throw RenderError(fmt::format("{} stacks {} shadow maps of {}² in one image: {} supports {} texels per side; use "
+                                    "--shadow-size {} or less",
+                                    s.technique, tiles, s.shadow_size, ctx.info().name,
+                                    ctx.properties().limits.maxImageDimension2D,
+                                    ctx.properties().limits.maxImageDimension2D / uint32_t(tiles)));
     const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
     if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
       throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,

@@ -112,6 +112,11 @@ void RenderSettings::validate() const {
     if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
       throw RenderError(
           fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
+    if (msm_technique_is_cssm(t.id) &&
+        !(p.x >= 0.0f && p.y >= 1.0f && p.z >= 0.0f && p.z < 1.0f && p.w >= 0.0f && p.w < 1.0f))
+      throw RenderError(fmt::format("{}: parameters need damping x >= 0, scale y >= 1, offset z in [0, 1) and least "
+                                    "blocker share w in [0, 1) (got {}, {}, {}, {})",
+                                    technique, p.x, p.y, p.z, p.w));
     if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
       throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
   }
@@ -160,7 +165,8 @@ std::uint64_t texel_bytes(TexelFormat f) {
 
 std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights) {
   const Technique& t = find_rendered_technique(s.technique);
-  const std::uint64_t moment_bytes = texel_bytes(t.formats[0]) + texel_bytes(t.formats[1]);
+  const std::uint64_t moment_bytes =
+      (texel_bytes(t.formats[0]) + texel_bytes(t.formats[1])) * std::uint64_t(msm_technique_tiles(t.id));
   const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
   // Prefiltered scattering: the rectified map and its prefix sums, shadow size² each.
   const glm::ivec2 scatter =

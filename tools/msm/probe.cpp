@@ -1,4 +1,4 @@
-// `msm probe`: a light probe (an equirectangular EXR, or the procedural sky) split by the median cut
+// `msm probe`: a light probe (an equirectangular or cross EXR, or the procedural sky) split by the median cut
 // into area lights (Kneiphof 2017): the table of lights, a scene "lights" list to render them with,
 // and a picture of the cube map with the regions outlined.
 #include <algorithm>
@@ -61,7 +61,7 @@ void make_parent(const std::string& path) {
 void run(const ProbeOptions& o) {
   probe::CubeMap cube;
   try {
-    cube = o.probe == "sky" ? probe::sky_probe(o.size) : probe::load_equirect_probe(o.probe, o.size, o.rotation_deg);
+    cube = o.probe == "sky" ? probe::sky_probe(o.size) : probe::load_probe(o.probe, o.size, o.rotation_deg);
   } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
   for (auto& face : cube.faces)
     for (glm::vec3& t : face) t *= o.intensity;
@@ -108,7 +108,8 @@ void add_probe(CLI::App& app) {
   auto options = std::make_shared<ProbeOptions>();
   auto* cmd = app.add_subcommand("probe", "Split a light probe into area lights by the median cut (Kneiphof 2017)");
   cmd->add_option("probe", options->probe,
-                  "An equirectangular EXR (e.g. /usr/share/blender/datafiles/studiolights/world/studio.exr), or "
+                  "An equirectangular or cube-map cross (4:3, 3:4) EXR (e.g. "
+                  "/usr/share/blender/datafiles/studiolights/world/studio.exr), or "
                   "'sky' for the procedural sky with a sun")
       ->required();
   cmd->add_option("--size", options->size, "Cube-map face size in texels")->check(CLI::Range(1, probe::kMaxCubeSize));

@@ -64,6 +64,28 @@ Panorama load_equirect(const std::filesystem::path& file);
 // radiance, not 2:1). Negative values (lossy DWA compression rings below zero) are clamped to 0.
 CubeMap load_equirect_probe(const std::filesystem::path& file, int size, float rotation_deg = 0.0f);
 
+// Cube-map probes. A cross is one image of six square faces of side s, each in its texel
+// orientation (light_probe.h: texel (i, j) at column i, row j of its cell, row 0 the top), so that
+// neighbouring faces continue each other across the cell borders:
+//   horizontal, 4s x 3s (the layout `msm probe --cross` writes):   vertical, 3s x 4s:
+//        .  +Y  .   .                                                .  +Y  .
+//       −X  +Z  +X  −Z                                              −X  +Z  +X
+//        .  −Y  .   .                                                .  −Y  .
+//                                                                    .  −Z  .   (−Z turned by 180°)
+// The cells outside the faces are ignored. Throws ProbeError for any other shape.
+CubeMap cube_from_cross(int width, int height, const std::vector<glm::vec3>& rgb);
+// The cross of a cube map (the inverse of cube_from_cross; horizontal or vertical), RGB texels.
+std::vector<glm::vec3> cross_of_cube(const CubeMap& cube, bool vertical);
+// Six face images, one per layer (+X, −X, +Y, −Y, +Z, −Z), square and of one size.
+CubeMap cube_from_faces(const std::array<int, 6>& sizes, const std::array<std::vector<glm::vec3>, 6>& faces);
+// A cube map box-filtered down to size² faces; size must divide cube.size (ProbeError otherwise).
+CubeMap downsample_cube(const CubeMap& cube, int size);
+// A probe file as a cube map of size² faces: an equirectangular panorama (2:1, as
+// load_equirect_probe) or a cross EXR (4:3 or 3:4; the faces box-filtered to `size`, which must
+// divide their side; rotation_deg must be 0 for a cross). Six separate face files: load_cube_faces.
+CubeMap load_probe(const std::filesystem::path& file, int size, float rotation_deg = 0.0f);
+CubeMap load_cube_faces(const std::array<std::filesystem::path, 6>& files, int size);
+
 // A probe with an exact answer: a sky of constant radiance `sky` with a sun disc of radiance
 // `sun` and angular radius `sun_radius_rad` around `towards_sun`; texels the disc's edge crosses
 // average 16² point samples.
@@ -129,7 +151,7 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count);
 // The area lights of the regions (msm_area_light_from_region), regions without energy skipped.
 std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vector<Region>& regions);
 
-// The whole CPU pipeline: the probe (an equirectangular EXR, or "sky" for make_sky_sun_probe's
+// The whole CPU pipeline: the probe (an equirectangular or cross EXR, load_probe, or "sky" for make_sky_sun_probe's
 // default sky: see sky_probe) as a cube map of size², scaled by intensity, cut into `count`
 // regions, and their area lights.
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg = 0.0f,

@@ -57,6 +57,14 @@
 //               1.5 tan^2(extent/2): 1.1e-4 at 1 degree, 1.1e-2 at 10 degrees). Light arriving
 //               from below the local horizon is blocked by the surface itself. Not weighted by the
 //               cosine: visibility, not irradiance. Extent 0 gives the hard shadow.
+//               The radiance replaces max(n·L, 0) V by the light's cosine-weighted visibility
+//                 lit = ∫ max(n·d, 0) V(d) dω / ∫ (d·L) dω
+//               over the light's directions, its radiance uniform in solid angle (the model of
+//               msm_cone_cosine in msm/light_probe.h, which gives lit for V = 1 and the disc),
+//               estimated as n·L + ∫ (max(n·d, 0) V − n·d) dω / ∫ (d·L) dω with the same samples,
+//               each weighted by its solid angle (area / cos³ θ): exact where the whole light is
+//               visible and above the horizon, sampled where it is not (light below the horizon
+//               included: the test of the renderer's horizon-aware shading). Extent 0: max(n·L, 0) V.
 //
 //   translucent Coloured transmittance (JCGT 2017, Sec. 3), per RGB channel c:
 //               T_c(p) = product over every surface i crossed by the ray p -> L of

@@ -47,7 +47,8 @@ struct LightUniforms {
                         // w: normal offset in world units (RenderSettings::normal_offset texels)
   vec4 irradiance;      // rgb: irradiance on a surface facing the light, a: unused
   vec4 soft;            // soft shadows: xy: texels of reach per unit of [-1,1] depth
-                        // (msm_soft_spread), zw: unused
+                        // (msm_soft_spread), z: the light's cone half-angle in radians for the
+                        // shading's msm_cone_cosine (0: a point light, max(n·l, 0)), w: unused
 };
 
 // How the shading reads a filtered shadow map.

@@ -1,11 +1,14 @@
 #include "pass.h"
 
+#include "msm/techniques.h"
+
 namespace msm::render {
 
 ImageSpec moment_image_spec(const FrameConfig& config, int i) {
   return {.format = config.formats()[size_t(i)],
           .width = uint32_t(config.shadow_size),
-          .height = uint32_t(config.shadow_size),
+          // CSSM: its tiles stacked along y (cssm.h).
+          .height = uint32_t(config.shadow_size * msm_technique_tiles(config.technique->id)),
           .mips = config.mip_levels,
           .layers = uint32_t(config.lights),
           // Renderer::Intermediates reads the resolved and the filtered moments back.

@@ -14,7 +14,7 @@ void SatPass::reflect(PassBuilder& b) const {
     b.create(sat_table(i),
              {.format = two ? VK_FORMAT_R32G32_UINT : VK_FORMAT_R32G32B32A32_UINT,
               .width = uint32_t(config_.shadow_size),
-              .height = uint32_t(config_.shadow_size),
+              .height = uint32_t(config_.shadow_size * msm_technique_tiles(config_.technique->id)),
               .layers = uint32_t(config_.lights)},
              use::compute_general());
   }

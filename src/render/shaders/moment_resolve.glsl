@@ -17,6 +17,15 @@ layout(push_constant) uniform Push { ImagePassPush pc; };
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (p.x >= pc.size.x || p.y >= pc.size.y) return;
+  if (msm_technique_is_cssm(kTechnique)) { // every tile of the texel's samples, averaged (cssm.h)
+    int frequencies = msm_technique_cssm_frequencies(kTechnique), samples = frame.kernel.y;
+    for (int tile = 0; tile < msm_cssm_tiles(frequencies); ++tile) {
+      vec4 sum = vec4(0.0f);
+      for (int s = 0; s < samples; ++s) sum += msm_cssm_generate(msm_saturate(depth_sample(p, s)), tile, frequencies);
+      imageStore(moments0, p + ivec2(0, tile * pc.size.y), sum / float(samples));
+    }
+    return;
+  }
   MsmTexel t = resolved_texel(p);
   vec4 a = t.a, b = t.b;
   if (kSplitRG) {

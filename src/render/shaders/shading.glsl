@@ -50,9 +50,9 @@ vec3 shadow_intensity_rgb(ShadowLookup s);
 #endif
 
 
-// Visibility of light l at the surface (0 where the surface faces away from it: its own shadow),
-// per colour channel.
-vec3 light_visibility(int l, vec3 n, float n_dot_l, MsmFootprint pixel) {
+// Visibility of light l at the surface (0 where no part of the light is above the surface's
+// horizon, lit <= 0: its own shadow), per colour channel.
+vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixel) {
   current_layer = l;
   // Normal offset: more at grazing light, where depth varies fastest across a texel.
   vec3 p = world_position + n * (lights[l].towards_light.w * (1.0f - n_dot_l));
@@ -62,7 +62,7 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, MsmFootprint pixel) {
   float texels_per_clip_unit = 0.5f * frame.shadow_map.x;
   s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
   s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
-  if (n_dot_l <= 0.0f) return vec3(0.0f);
+  if (lit <= 0.0f) return vec3(0.0f);
   vec3 nc = mat3(lights[l].normal_matrix) * n;
   s.z = clip.z - frame.shadow_map.w;
   // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
@@ -92,16 +92,20 @@ void main() {
   if (!gl_FrontFacing) n = -n; // only double-sided materials show back faces (culling)
 
   // The shadow buffer holds the visibility of the direct light: with one light its visibility,
-  // with several the mean weighted by the irradiance each one brings (luminance of E max(n·l, 0)).
+  // with several the mean weighted by the irradiance each one brings (luminance of E max(n·l, 0),
+  // the cone's integral for area lights).
   vec3 direct = vec3(0.0f), weighted = vec3(0.0f), first = vec3(0.0f);
   float weight_sum = 0.0f;
   int light_count = kOneLight ? 1 : frame.lights.x;
   MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
   for (int l = 0; l < light_count; ++l) {
     float n_dot_l = dot(n, lights[l].towards_light.xyz);
-    vec3 visibility = light_visibility(l, n, n_dot_l, pixel);
-    direct += msm_direct_light(lights[l].irradiance.rgb, n_dot_l, visibility);
-    float w = msm_luminance(lights[l].irradiance.rgb) * max(n_dot_l, 0.0f);
+    // Area lights: the cone's cosine integral with the horizon (msm/light_probe.h), which is
+    // max(n·l, 0) for point lights (soft.z = 0) and where the whole cone is above the horizon.
+    float lit = msm_cone_cosine(n_dot_l, lights[l].soft.z);
+    vec3 visibility = light_visibility(l, n, n_dot_l, lit, pixel);
+    direct += msm_direct_light(lights[l].irradiance.rgb, lit, visibility);
+    float w = msm_luminance(lights[l].irradiance.rgb) * lit;
     weighted += w * visibility;
     weight_sum += w;
     if (l == 0) first = visibility;
