@@ -252,17 +252,25 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
   return lights;
 }
 
-CubeMap sky_probe(int size) {
+CubeMap sky_probe(int size, float rotation_deg) {
+  // The sun turned by +rotation about +Y (cube_from_equirect looks directions up turned by −rotation).
+  const double r = glm::radians(double(rotation_deg));
+  const float c = float(std::cos(r)), s = float(std::sin(r));
+  const glm::vec3 sun(0.4f, 0.6f, -0.3f);
   return make_sky_sun_probe(size, glm::vec3(0.15f, 0.22f, 0.4f), glm::vec3(40000.0f, 36000.0f, 30000.0f),
-                            glm::vec3(0.4f, 0.6f, -0.3f), glm::radians(0.27f));
+                            glm::vec3(c * sun.x + s * sun.z, sun.y, -s * sun.x + c * sun.z), glm::radians(0.27f));
+}
+
+CubeMap load_probe(const std::string& probe, int size, float rotation_deg, float intensity) {
+  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_equirect_probe(probe, size, rotation_deg);
+  for (auto& face : cube.faces)
+    for (glm::vec3& t : face) t *= intensity;
+  return cube;
 }
 
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
                                             float intensity) {
-  CubeMap cube = probe == "sky" ? sky_probe(size) : load_equirect_probe(probe, size, rotation_deg);
-  for (auto& face : cube.faces)
-    for (glm::vec3& t : face) t *= intensity;
-  const ProbeTables tables(cube);
+  const ProbeTables tables(load_probe(probe, size, rotation_deg, intensity));
   return area_lights(tables, median_cut(tables, count));
 }
 

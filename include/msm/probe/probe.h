@@ -94,10 +94,14 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
 // regions, and their area lights.
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg = 0.0f,
                                             float intensity = 1.0f);
+// The cube map probe_area_lights cuts: the probe ("sky" or an equirectangular EXR) at size²,
+// turned by rotation_deg about +Y and scaled by intensity. The ray tracer's environment ground
+// truth lights the scene with exactly this (msm::reference, effect environment).
+CubeMap load_probe(const std::string& probe, int size, float rotation_deg = 0.0f, float intensity = 1.0f);
 // The procedural sky of `msm probe sky` and of scenes with "file": "sky": a blue sky of radiance
 // (0.15, 0.22, 0.4) all around and a sun disc of radius 0.27° and radiance (40000, 36000, 30000)
 // towards (0.4, 0.6, −0.3): on a horizontal surface the sun brings about four times the sky's
-// luminance, as on a clear day.
-CubeMap sky_probe(int size);
+// luminance, as on a clear day. rotation_deg turns it about +Y as cube_from_equirect does.
+CubeMap sky_probe(int size, float rotation_deg = 0.0f);
 
 } // namespace msm::probe
