@@ -162,3 +162,29 @@ TEST(Environment, SceneWithoutProbeIsRefused) {
 }
 
 } // namespace
+
+namespace {
+
+// msm render / reference --lights: re-cutting the probe gives what the scene file's count gives.
+TEST(Environment, ProbeLightCountMatchesTheSceneFilesCount) {
+  const std::string sky =
+      R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "probe": {"file": "sky", "size": 16, "lights": )";
+  const std::string rest = R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
+  const auto load = [&](int n) {
+    return msm::scene::load_scene_json(sky + std::to_string(n) + rest, std::filesystem::current_path(), "t.json");
+  };
+  Scene scene = load(32);
+  msm::scene::set_probe_light_count(scene, 16);
+  const Scene expected = load(16);
+  ASSERT_EQ(scene.lights.size(), expected.lights.size());
+  EXPECT_EQ(scene.probe->lights, 16);
+  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+    EXPECT_EQ(scene.lights[k].towards_light, expected.lights[k].towards_light) << k;
+    EXPECT_EQ(scene.lights[k].irradiance, expected.lights[k].irradiance) << k;
+    EXPECT_EQ(scene.lights[k].angular_extent_deg, expected.lights[k].angular_extent_deg) << k;
+  }
+  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 5), msm::scene::SceneError);
+  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 256), msm::scene::SceneError); // + the directional light
+}
+
+} // namespace

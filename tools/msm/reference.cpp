@@ -24,6 +24,7 @@
 #include "msm/image/io.h"
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
+#include "msm/shading.h"
 #include "msm/util/limits.h"
 #include "msm/util/progress.h"
 
@@ -79,6 +80,7 @@ void add_reference(CLI::App& app) {
     std::uint64_t seed = 1;
     double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
     std::optional<double> light_extent, light_width, light_height;
+    std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
     bool json = false, progress = false, probe_lights = false;
   };
   auto opt = std::make_shared<Options>();
@@ -101,6 +103,9 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--light-width", opt->light_width, "soft, rectangle: angular width in degrees (default: extent)");
   cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
   cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
+  cmd->add_option("--lights", opt->lights,
+                  "Image-based lighting: the number of area lights the scene's probe is cut into, 6 to 256 (default: "
+                  "the scene's)");
   cmd->add_flag("--probe-lights", opt->probe_lights,
                 "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
@@ -143,7 +148,10 @@ void add_reference(CLI::App& app) {
     } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
-    const msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    if (opt->lights) try {
+        msm::scene::set_probe_light_count(scene, *opt->lights);
+      } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
     if (settings.effect == msm::reference::Effect::scattering && !scene.medium)
       throw UsageError(fmt::format("{}: --effect scattering needs a scene with a \"medium\" (extinction, "
                                    "scattering_albedo, phase; scenes/README.md)",
@@ -198,10 +206,20 @@ void add_reference(CLI::App& app) {
         files.add_exr(out / "scattering.exr", result.scattering);
       else
         files.remove(out / "scattering.exr");
-      if (!result.irradiance.empty())
+      if (!result.irradiance.empty()) {
         files.add_exr(out / "irradiance.exr", result.irradiance);
-      else
+        // environment: the renderer's look (ACES at exposure 1, its sky where no surface is), to
+        // compare with msm render's PNG (msm compare radiance.png TECHNIQUE.png).
+        msm::image::Image look = msm::image::tone_map(result.radiance, {0.0, msm::image::ToneCurve::aces});
+        for (int y = 0; y < look.height(); ++y)
+          for (int x = 0; x < look.width(); ++x)
+            if (result.visibility.at(x, y, 1) > 0.5f)
+              for (int c = 0; c < 3; ++c) look.at(x, y, c) = msm::MSM_SKY_RADIANCE[c];
+        files.add_png(out / "radiance.png", look);
+      } else {
         files.remove(out / "irradiance.exr");
+        files.remove(out / "radiance.png");
+      }
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
 
     nlohmann::ordered_json j;
@@ -236,6 +254,7 @@ void add_reference(CLI::App& app) {
     }
     if (!result.irradiance.empty()) {
       j["files"]["irradiance"] = "irradiance.exr";
+      j["files"]["radiance_png"] = "radiance.png";
       j["channels"]["irradiance"] = result.irradiance.channel_names();
       const msm::scene::ProbeLighting& p = *scene.probe;
       j["probe"] = {{"file", p.file.string()},        {"lights", p.lights}, {"intensity", p.intensity},

@@ -31,7 +31,8 @@ void add_render(CLI::App& app) {
     FrameOptions frame;
     std::string techniques = "msm-hamburger-64";
     std::string out = "msm-render";
-    std::string view; // a view file (msm view)
+    std::string view;          // a view file (msm view)
+    std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
@@ -44,6 +45,9 @@ void add_render(CLI::App& app) {
                   "A view file of msm view (scene, camera, lights, every setting): renders exactly that view; only "
                   "-t, -o and --device go with it");
   add_frame_options(cmd, opt->frame);
+  cmd->add_option("--lights", opt->lights,
+                  "Image-based lighting: the number of area lights the scene's probe is cut into, 6 to 256 (default: "
+                  "the scene's)");
   cmd->callback([opt, cmd] {
     std::optional<scene::Camera> view_camera;
     if (!opt->view.empty()) {
@@ -72,6 +76,9 @@ void add_render(CLI::App& app) {
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;
+    if (opt->lights) try {
+        scene::set_probe_light_count(scene, *opt->lights);
+      } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);
