@@ -2,9 +2,10 @@
 // 2017 §6): the full probe (msm::reference, effect environment) and its extracted area lights
 // (--probe-lights). The orderings of the paper that hold on the built-in probe scenes, asserted
 // with margins from the measurements of docs/results.md ("Image-based lighting against the ground
-// truth", scripts/ibl-compare.sh): 32 soft-shadowed area lights are closer to the full probe than
-// 256 point lights with hard shadows; MSSM6 is closer to the area lights than MSSM4 under large
-// lights (16 lights, cones of tens of degrees). Tone-mapped images (the renderer's look), MAE of the
+// truth", scripts/ibl-compare.sh): on sky_probe, 32 soft-shadowed area lights are closer to the
+// full probe than 256 point lights with hard shadows (on city_probe they are not: not asserted
+// there); on both, MSSM6 is closer to the area lights than MSSM4 under large lights (16 lights,
+// cones of tens of degrees). Tone-mapped images (the renderer's look), MAE of the
 // luminance, background masked.
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
@@ -62,17 +63,21 @@ scene::Scene with_lights(const std::string& name, int count) {
 }
 
 // Measured margins (docs/results.md): MAE(256 hard point lights) − MAE(32 lights, mssm6) and
-// MAE(mssm4) − MAE(mssm6) at 16 lights; asserted at half their measured size, above the noise of
-// the truth at these sample counts (two seeds differ by less than a tenth of the margins).
+// MAE(mssm4) − MAE(mssm6) at 16 lights; asserted at half their measured size. The truth's noise at
+// these sample counts moves them far less: over seeds 1-3 the first spread by 6e-5, the second by
+// 1e-6 (msm reference and msm compare, 160x90).
+// area_over_points 0: not asserted (on city_probe the 256 point lights are closer, docs/results.md).
 struct Expected {
   double area_over_points, six_over_four;
 };
 
 void check_orderings(const vk::Context& ctx, const std::string& name, const Expected& e) {
-  const Truth probe = truth(scene::builtin_scene(name), false, 256);
-  const double area = mae(ctx, with_lights(name, 32), "mssm6", probe);
-  const double points = mae(ctx, with_lights(name, 256), "msm-hamburger-64", probe);
-  EXPECT_GT(points - area, 0.5 * e.area_over_points) << name << ": 32 area lights against 256 point lights";
+  if (e.area_over_points > 0.0) {
+    const Truth probe = truth(scene::builtin_scene(name), false, 256);
+    const double area = mae(ctx, with_lights(name, 32), "mssm6", probe);
+    const double points = mae(ctx, with_lights(name, 256), "msm-hamburger-64", probe);
+    EXPECT_GT(points - area, 0.5 * e.area_over_points) << name << ": 32 area lights against 256 point lights";
+  }
   const scene::Scene sixteen = with_lights(name, 16);
   const Truth lights = truth(sixteen, true, 64);
   const double six = mae(ctx, sixteen, "mssm6", lights), four = mae(ctx, sixteen, "mssm4", lights);
@@ -80,6 +85,7 @@ void check_orderings(const vk::Context& ctx, const std::string& name, const Expe
 }
 
 TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0046, 0.0006}); }
+TEST_F(IblTest, CityProbeOrderings) { check_orderings(ctx(), "city_probe", {0.0, 0.0014}); }
 
 } // namespace
 } // namespace msm::render
