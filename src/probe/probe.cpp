@@ -206,7 +206,7 @@ CubeMap downsample_cube(const CubeMap& cube, int size) {
   return out;
 }
 
-CubeMap load_probe(const std::filesystem::path& file, int size, float rotation_deg) {
+CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg) {
   check_size(size);
   Panorama picture = load_equirect(file);
   if (picture.width == 2 * picture.height)
@@ -405,12 +405,16 @@ CubeMap sky_probe(int size, float rotation_deg) {
                             msm_probe_lookup_direction(glm::vec3(0.4f, 0.6f, -0.3f), inverse), glm::radians(0.27f));
 }
 
-std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
-                                            float intensity) {
-  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_probe(probe, size, rotation_deg);
+CubeMap load_probe(const std::string& probe, int size, float rotation_deg, float intensity) {
+  CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_probe_file(probe, size, rotation_deg);
   for (auto& face : cube.faces)
     for (glm::vec3& t : face) t *= intensity;
-  const ProbeTables tables(cube);
+  return cube;
+}
+
+std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
+                                            float intensity) {
+  const ProbeTables tables(load_probe(probe, size, rotation_deg, intensity));
   return area_lights(tables, median_cut(tables, count));
 }
 

@@ -341,10 +341,10 @@ TEST(CubeInputs, CrossRoundTripsAndIsContinuous) {
       for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = rgb[k][c];
     const std::filesystem::path file = dir / (vertical ? "vertical.exr" : "horizontal.exr");
     msm::image::write_exr(file, picture);
-    EXPECT_TRUE(same_cube(load_probe(file, m), cube)) << file;
-    EXPECT_TRUE(same_cube(load_probe(file, m / 2), downsample_cube(cube, m / 2))) << file;
+    EXPECT_TRUE(same_cube(load_probe_file(file, m), cube)) << file;
+    EXPECT_TRUE(same_cube(load_probe_file(file, m / 2), downsample_cube(cube, m / 2))) << file;
     // Box filtering keeps the probe's integral to the midpoint rule's accuracy.
-    const glm::dvec3 full = integrate(cube), half = integrate(load_probe(file, m / 2));
+    const glm::dvec3 full = integrate(cube), half = integrate(load_probe_file(file, m / 2));
     EXPECT_NEAR(half.x, full.x, 0.02 * full.x);
   }
   std::filesystem::remove_all(dir);
@@ -366,10 +366,10 @@ TEST(CubeInputs, BadLayoutsAreRefusedClearly) {
   std::filesystem::create_directories(dir);
   const std::filesystem::path odd = dir / "odd.exr", cross = dir / "cross.exr";
   msm::image::write_exr(odd, msm::image::Image(30, 20, std::vector<std::string>{"R", "G", "B"}, 1.0f));
-  EXPECT_NE(message_of([&] { load_probe(odd, 4); }).find("is neither an equirectangular panorama"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_probe_file(odd, 4); }).find("is neither an equirectangular panorama"), std::string::npos);
   msm::image::write_exr(cross, msm::image::Image(16, 12, std::vector<std::string>{"R", "G", "B"}, 1.0f));
-  EXPECT_NE(message_of([&] { load_probe(cross, 4, 30.0f); }).find("cannot be rotated"), std::string::npos);
-  EXPECT_NE(message_of([&] { load_probe(cross, 3); }).find("not a divisor"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_probe_file(cross, 4, 30.0f); }).find("cannot be rotated"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_probe_file(cross, 3); }).find("not a divisor"), std::string::npos);
   EXPECT_THROW(load_cube_faces({odd, odd, odd, odd, odd, odd}, 4), ProbeError); // not square
   std::filesystem::remove_all(dir);
 }

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -184,5 +185,29 @@ struct ScatteringSample {
 };
 ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Medium& medium, const glm::dvec3& camera,
                                       const glm::dvec3& dir, double s, Rng& rng);
+
+// environment (effect_environment.cpp): the lights of a scene's image-based lighting, built once
+// per render. Throws std::invalid_argument for a scene without a "probe".
+struct ConeLight {
+  glm::dvec3 axis{0.0, 1.0, 0.0}, x{1.0, 0.0, 0.0}, y{0.0, 0.0, 1.0}; // orthonormal, axis towards the light
+  double cos_alpha = 1.0;                                             // of the half-angle
+  glm::dvec3 estimate{0.0}; // irradiance on a facing surface x 2 / (1 + cos α): f / pdf of a uniform cone sample
+};
+struct EnvironmentLighting {
+  EnvironmentLighting(const scene::Scene& scene, bool probe_lights);
+  int size = 0;                    // of the probe's faces; 0 with probe_lights (no probe sampled)
+  std::vector<glm::vec3> radiance; // 6 size² texels, face-major, rows along +v
+  std::vector<double> cdf;         // of luminance x texel weight, normalized, cdf.back() = 1
+  std::vector<ConeLight> cones;    // lights sampled as uniform cones
+};
+struct EnvironmentSample {
+  glm::dvec3 irradiance{0.0}, unoccluded{0.0};
+  double std_error = 0.0; // of the irradiance's luminance
+  int samples = 0;
+  std::uint64_t rays = 0;
+};
+// n: the shading normal turned towards the viewer; view: the primary ray's direction.
+EnvironmentSample environment_irradiance(const EffectContext& ctx, const EnvironmentLighting& lighting,
+                                         const SurfaceHit& hit, const glm::dvec3& n, const glm::dvec3& view, Rng& rng);
 
 } // namespace msm::reference::detail

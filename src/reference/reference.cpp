@@ -31,6 +31,7 @@ std::string_view to_string(Effect effect) {
   case Effect::soft: return "soft";
   case Effect::translucent: return "translucent";
   case Effect::scattering: return "scattering";
+  case Effect::environment: return "environment";
   }
   return "?";
 }
@@ -42,7 +43,8 @@ std::optional<Effect> parse_effect(std::string_view name) {
 }
 
 bool is_monte_carlo(Effect effect) {
-  return effect == Effect::filtered || effect == Effect::soft || effect == Effect::scattering;
+  return effect == Effect::filtered || effect == Effect::soft || effect == Effect::scattering ||
+         effect == Effect::environment;
 }
 
 std::string_view to_string(LightShape shape) { return shape == LightShape::disc ? "disc" : "rectangle"; }
@@ -91,9 +93,11 @@ void validate(const Settings& s) {
 }
 
 std::uint64_t estimated_bytes(const Settings& s, std::uint64_t triangles) {
-  const std::uint64_t per_pixel = s.effect == Effect::translucent  ? limits::kTracerBytesPerPixelTranslucent
-                                  : s.effect == Effect::scattering ? limits::kTracerBytesPerPixelScattering
-                                                                   : limits::kTracerBytesPerPixel;
+  // environment keeps a 4-channel irradiance image, as scattering keeps its scattering image.
+  const std::uint64_t per_pixel = s.effect == Effect::translucent ? limits::kTracerBytesPerPixelTranslucent
+                                  : s.effect == Effect::scattering || s.effect == Effect::environment
+                                      ? limits::kTracerBytesPerPixelScattering
+                                      : limits::kTracerBytesPerPixel;
   return triangles * limits::kTracerBytesPerTriangle + std::uint64_t(s.width) * std::uint64_t(s.height) * per_pixel;
 }
 
@@ -116,7 +120,8 @@ EffectFunction effect_function(Effect effect) {
   case Effect::filtered: return effect_filtered;
   case Effect::soft: return effect_soft;
   case Effect::translucent: return effect_translucent;
-  case Effect::scattering: return effect_hard; // the surface's own shadow; the ray's is added apart
+  case Effect::scattering: return effect_hard;  // the surface's own shadow; the ray's is added apart
+  case Effect::environment: return effect_hard; // unused: environment_irradiance() shades apart
   }
   throw std::invalid_argument("unknown effect");
 }
@@ -148,6 +153,9 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const bool scattering = settings.effect == Effect::scattering;
   if (scattering && !scene.medium)
     throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
+  const bool environment = settings.effect == Effect::environment;
+  std::optional<EnvironmentLighting> lighting;
+  if (environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
   const Tracer tracer(scene);
   result.build_seconds = seconds_since(start);
 
@@ -185,6 +193,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   result.radiance = image::Image(W, H, 3);
   result.surface = image::Image(W, H, {"n_dot_l", "object"});
   if (scattering) result.scattering = image::Image(W, H, {"R", "G", "B", "length"});
+  if (environment) result.irradiance = image::Image(W, H, {"R", "G", "B", "std_error"});
   for (std::size_t i = 0; i < result.surface.pixel_count(); ++i) result.surface.pixels()[2 * i + 1] = -1.0f;
   result.samples = mc ? settings.samples : 1;
 
@@ -268,6 +277,29 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
           continue; // radiance 0, sample_count and std_error 0 (scattering: the ray's)
         }
         Rng rng = pixel_rng(settings.seed, x, y, settings.effect);
+        // Shading: interpolated normal turned towards the viewer.
+        glm::dvec3 n = tracer.shading_normal(hit);
+        if (glm::dot(hit.normal, dir) > 0.0) n = -n;
+        if (environment) {
+          const EnvironmentSample e = environment_irradiance(ctx, *lighting, hit, n, dir, rng);
+          row_rays += e.rays;
+          const double lum0 = msm_luminance(glm::vec3(e.unoccluded));
+          const double visible = lum0 > 0.0 ? msm_luminance(glm::vec3(e.irradiance)) / lum0 : 0.0;
+          v[0] = float(visible);
+          v[2] = float(e.samples);
+          v[3] = float(lum0 > 0.0 ? e.std_error / lum0 : 0.0);
+          row_sum[y] += visible;
+          const glm::vec3 direct = msm_direct_light(glm::vec3(e.irradiance), 1.0f, glm::vec3(1.0f));
+          const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), direct, MSM_AMBIENT);
+          float* q = surf + (std::size_t(y) * W + x) * 2;
+          q[0] = float(glm::dot(n, ctx.towards_light));
+          q[1] = float(hit.object);
+          c[0] = colour.r, c[1] = colour.g, c[2] = colour.b;
+          float* ir = result.irradiance.pixels().data() + (std::size_t(y) * W + x) * 4;
+          ir[0] = float(e.irradiance.r), ir[1] = float(e.irradiance.g), ir[2] = float(e.irradiance.b);
+          ir[3] = float(e.std_error);
+          continue;
+        }
         const EffectResult e = effect(ctx, hit, rng);
         row_rays += e.rays;
         v[0] = float(e.value);
@@ -283,10 +315,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
           t[2] = rgb.b;
         }
         if (!scattering) row_sum[y] += e.value;
-        // Shading: interpolated normal turned towards the viewer; per channel where the
-        // effect gives a visibility per channel (translucent).
-        glm::dvec3 n = tracer.shading_normal(hit);
-        if (glm::dot(hit.normal, dir) > 0.0) n = -n;
+        // Per channel where the effect gives a visibility per channel (translucent).
         const float n_dot_l = float(glm::dot(n, ctx.towards_light));
         const glm::vec3 direct = e.lit ? msm_direct_light(glm::vec3(irradiance), float(*e.lit), glm::vec3(1.0f))
                                        : msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);

@@ -35,6 +35,16 @@ std::string compose(const std::string& file, const std::string& where, const std
   return s + problem;
 }
 
+// The probe's area lights (msm::probe: cube map, median cut, Kneiphof §4.1) as discs of the light's
+// cone with the irradiance a facing surface receives (Eq. 18). Throws msm::probe::ProbeError.
+std::vector<DirectionalLight> probe_directional_lights(const ProbeLighting& p) {
+  std::vector<DirectionalLight> out;
+  for (const msm::MsmAreaLight& a : msm::probe::probe_area_lights(p.file == "sky" ? "sky" : p.file.string(), p.size,
+                                                                  p.lights, p.rotation_deg, p.intensity))
+    out.push_back(light_of_area_light(a));
+  return out;
+}
+
 // Vulkan clip space: y down in NDC.
 glm::mat4 flip_y(const glm::mat4& p) {
   glm::mat4 f(1.0f);
@@ -211,8 +221,7 @@ class Parser {
     return l;
   }
 
-  // The probe's area lights (msm::probe: cube map, median cut, Kneiphof §4.1), appended to s.lights
-  // as discs of the light's cone with the irradiance a facing surface receives (Eq. 18).
+  // The probe's area lights (probe_directional_lights), appended to s.lights.
   void probe_lighting(const json& j, const std::string& ptr, Scene& s) const {
     keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size"});
     ProbeLighting p;
@@ -231,13 +240,10 @@ class Parser {
       p.rotation_deg = number_in(*v, ptr + "/rotation_deg", -360.0f, 360.0f, false, false);
     if (const json* v = find(j, "size")) p.size = integer(*v, ptr + "/size");
     if (p.size < 1 || p.size > 1024) fail(ptr + "/size", "must be in [1, 1024]");
-    std::vector<msm::MsmAreaLight> lights;
-    try {
-      lights = msm::probe::probe_area_lights(p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights,
-                                             p.rotation_deg, p.intensity);
-    } catch (const msm::probe::ProbeError& e) { fail(ptr + "/file", e.what()); }
     p.first_light = s.lights.size();
-    for (const msm::MsmAreaLight& a : lights) s.lights.push_back(light_of_area_light(a));
+    try {
+      for (const DirectionalLight& l : probe_directional_lights(p)) s.lights.push_back(l);
+    } catch (const msm::probe::ProbeError& e) { fail(ptr + "/file", e.what()); }
     if (s.lights.empty()) fail(ptr + "/file", "the probe has no light (every texel is black)");
     s.probe = p;
   }
@@ -640,6 +646,32 @@ std::string_view builtin_scene_json(std::string_view name) {
 Scene builtin_scene(std::string_view name) {
   const std::string source = fmt::format("builtin:{}", name);
   return load_scene_json(builtin_scene_json(name), std::filesystem::path("."), source);
+}
+
+void set_probe_light_count(Scene& scene, int count) {
+  const std::string file = scene.source.string();
+  if (!scene.probe) throw SceneError(file, "/probe", "the scene has no probe, so no probe lights to count");
+  ProbeLighting p = *scene.probe;
+  if (count < 6 || count > 256)
+    throw SceneError(file, "/probe/lights",
+                     fmt::format("{} lights: must be in [6, 256] (one region per cube face at least)", count));
+  const std::size_t old_end = std::min(scene.lights.size(), p.first_light + std::size_t(p.lights));
+  const std::size_t others = scene.lights.size() - (old_end - p.first_light);
+  if (others + std::size_t(count) > std::size_t(kMaxLights))
+    throw SceneError(
+        file, "/probe/lights",
+        fmt::format("{} directional lights and {} of the probe exceed {} lights", others, count, kMaxLights));
+  p.lights = count;
+  std::vector<DirectionalLight> lights;
+  try {
+    lights = probe_directional_lights(p);
+  } catch (const msm::probe::ProbeError& e) { throw SceneError(file, "/probe/file", e.what()); }
+  if (lights.empty() && others == 0)
+    throw SceneError(file, "/probe/file", "the probe has no light (every texel is black)");
+  scene.lights.erase(scene.lights.begin() + std::ptrdiff_t(p.first_light),
+                     scene.lights.begin() + std::ptrdiff_t(old_end));
+  scene.lights.insert(scene.lights.begin() + std::ptrdiff_t(p.first_light), lights.begin(), lights.end());
+  scene.probe = p;
 }
 
 Scene load_scene(std::string_view name_or_path) {

@@ -77,8 +77,9 @@ void expect_json_error(const std::string& json, std::initializer_list<std::strin
 
 TEST(BuiltinScenes, NamesAndDefault) {
   const auto names = builtin_scene_names();
-  EXPECT_EQ(names, (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke", "models", "pillar_wall",
-                                             "disc", "glass", "sky_probe", "tower", "trees", "gate", "room"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"fence", "railing", "stair", "column", "smoke", "models", "pillar_wall", "disc",
+                                      "glass", "sky_probe", "tower", "trees", "gate", "room", "city_probe"}));
   EXPECT_EQ(default_scene_name(), "fence");
 }
 

@@ -11,7 +11,7 @@ void add_bench(CLI::App& app);
 void add_techniques(CLI::App& app);
 void add_reconstruct(CLI::App& app);
 void add_compare(CLI::App& app);
-void add_probe(CLI::App& app);
+void add_lights(CLI::App& app); // msm lights, and msm probe: its alias of the first release
 void add_reference(CLI::App& app);
 void add_render(CLI::App& app);
 void add_scenes(CLI::App& app);

@@ -27,7 +27,7 @@ int main(int argc, char** argv) {
   msm::tool::add_scenes(app);
   msm::tool::add_view(app);
 #endif
-  msm::tool::add_probe(app);
+  msm::tool::add_lights(app);
   msm::tool::add_reference(app);
   msm::tool::add_evaluate(app);
   msm::tool::add_help(app);

@@ -1,7 +1,8 @@
 // `msm reference`: ground truth of a scene's shadows by CPU ray tracing (msm::reference): writes
 // DIR/visibility.exr (the shadow buffer), DIR/radiance.exr, DIR/surface.exr (n_dot_l and object
 // index, masks for comparisons), for --effect scattering DIR/scattering.exr (the in-scattered radiance
-// and the ray length), and DIR/reference.json (settings, timings, sample count), all or
+// and the ray length), for --effect environment DIR/irradiance.exr (E and its standard error),
+// and DIR/reference.json (settings, timings, sample count), all or
 // none (msm::image::FileSet). Bad input is a UsageError (exit status 2); scene
 // errors (SceneError) name the file and the problem.
 #include <unistd.h>
@@ -23,6 +24,7 @@
 #include "msm/image/io.h"
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
+#include "msm/shading.h"
 #include "msm/util/limits.h"
 #include "msm/util/progress.h"
 
@@ -78,13 +80,15 @@ void add_reference(CLI::App& app) {
     std::uint64_t seed = 1;
     double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
     std::optional<double> light_extent, light_width, light_height;
-    bool json = false, progress = false;
+    std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
+    bool json = false, progress = false, probe_lights = false;
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("reference", "Ground-truth shadows of a scene by CPU ray tracing (Embree): "
                                               "visibility.exr, radiance.exr, reference.json");
   cmd->add_option("--scene", opt->scene, "Built-in scene name or scene file (default fence)");
-  cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent | scattering")->required();
+  cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent | scattering | environment")
+      ->required();
   cmd->add_option("--width", opt->width, "Image width (default 640)");
   cmd->add_option("--height", opt->height, "Image height (default 360)");
   cmd->add_option("--samples", opt->samples, "Samples per pixel of filtered, soft and scattering (default 256)");
@@ -99,6 +103,11 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--light-width", opt->light_width, "soft, rectangle: angular width in degrees (default: extent)");
   cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
   cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
+  cmd->add_option("--lights", opt->lights,
+                  "Image-based lighting: the number of area lights the scene's probe is cut into, 6 to 256 (default: "
+                  "the scene's)");
+  cmd->add_flag("--probe-lights", opt->probe_lights,
+                "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
   cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
@@ -110,8 +119,11 @@ void add_reference(CLI::App& app) {
     Settings settings;
     const auto effect = msm::reference::parse_effect(opt->effect);
     if (!effect)
-      throw UsageError(
-          fmt::format("--effect {}: expected hard, filtered, soft, translucent or scattering", opt->effect));
+      throw UsageError(fmt::format("--effect {}: expected hard, filtered, soft, translucent, scattering or environment",
+                                   opt->effect));
+    if (opt->probe_lights && *effect != msm::reference::Effect::environment)
+      throw UsageError("--probe-lights applies to --effect environment only");
+    settings.probe_lights = opt->probe_lights;
     settings.effect = *effect;
     const auto shape = msm::reference::parse_light_shape(opt->light_shape);
     if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
@@ -136,10 +148,17 @@ void add_reference(CLI::App& app) {
     } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
-    const msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    if (opt->lights) try {
+        msm::scene::set_probe_light_count(scene, *opt->lights);
+      } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
     if (settings.effect == msm::reference::Effect::scattering && !scene.medium)
       throw UsageError(fmt::format("{}: --effect scattering needs a scene with a \"medium\" (extinction, "
                                    "scattering_albedo, phase; scenes/README.md)",
+                                   scene.source.string()));
+    if (settings.effect == msm::reference::Effect::environment && !scene.probe)
+      throw UsageError(fmt::format("{}: --effect environment needs a scene with a \"probe\" (file, lights, intensity, "
+                                   "rotation_deg, size; scenes/README.md)",
                                    scene.source.string()));
     if (settings.effect == msm::reference::Effect::filtered)
       if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
@@ -187,6 +206,20 @@ void add_reference(CLI::App& app) {
         files.add_exr(out / "scattering.exr", result.scattering);
       else
         files.remove(out / "scattering.exr");
+      if (!result.irradiance.empty()) {
+        files.add_exr(out / "irradiance.exr", result.irradiance);
+        // environment: the renderer's look (ACES at exposure 1, its sky where no surface is), to
+        // compare with msm render's PNG (msm compare radiance.png TECHNIQUE.png).
+        msm::image::Image look = msm::image::tone_map(result.radiance, {0.0, msm::image::ToneCurve::aces});
+        for (int y = 0; y < look.height(); ++y)
+          for (int x = 0; x < look.width(); ++x)
+            if (result.visibility.at(x, y, 1) > 0.5f)
+              for (int c = 0; c < 3; ++c) look.at(x, y, c) = msm::MSM_SKY_RADIANCE[c];
+        files.add_png(out / "radiance.png", look);
+      } else {
+        files.remove(out / "irradiance.exr");
+        files.remove(out / "radiance.png");
+      }
     } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
 
     nlohmann::ordered_json j;
@@ -218,6 +251,14 @@ void add_reference(CLI::App& app) {
       j["medium"] = {{"extinction", scene.medium->extinction},
                      {"scattering_albedo", scene.medium->scattering_albedo},
                      {"g", scene.medium->g}};
+    }
+    if (!result.irradiance.empty()) {
+      j["files"]["irradiance"] = "irradiance.exr";
+      j["files"]["radiance_png"] = "radiance.png";
+      j["channels"]["irradiance"] = result.irradiance.channel_names();
+      const msm::scene::ProbeLighting& p = *scene.probe;
+      j["probe"] = {{"file", p.file.string()},        {"lights", p.lights}, {"intensity", p.intensity},
+                    {"rotation_deg", p.rotation_deg}, {"size", p.size},     {"probe_lights", settings.probe_lights}};
     }
     if (!result.visibility_rgb.empty()) {
       j["files"]["visibility_rgb"] = "visibility_rgb.exr";

@@ -32,8 +32,9 @@ void add_render(CLI::App& app) {
     FrameOptions frame;
     std::string techniques = "msm-hamburger-64";
     std::string out = "msm-render";
-    std::string view; // a view file (msm view)
+    std::string view;          // a view file (msm view)
     ProbeFrames probe_frames;
+    std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
@@ -52,6 +53,9 @@ void add_render(CLI::App& app) {
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--probe-rotation-speed", opt->probe_frames.rotation_speed_deg,
                   "Degrees the scene's light probe turns about +Y per frame (with --frames)");
+  cmd->add_option("--lights", opt->lights,
+                  "Image-based lighting: the number of area lights the scene's probe is cut into, 6 to 256 (default: "
+                  "the scene's)");
   cmd->callback([opt, cmd] {
     const bool probe_frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
     std::optional<scene::Camera> view_camera;
@@ -81,6 +85,9 @@ void add_render(CLI::App& app) {
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;
+    if (opt->lights) try {
+        scene::set_probe_light_count(scene, *opt->lights);
+      } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);

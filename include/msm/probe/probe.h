@@ -83,7 +83,7 @@ CubeMap downsample_cube(const CubeMap& cube, int size);
 // A probe file as a cube map of size² faces: an equirectangular panorama (2:1, as
 // load_equirect_probe) or a cross EXR (4:3 or 3:4; the faces box-filtered to `size`, which must
 // divide their side; rotation_deg must be 0 for a cross). Six separate face files: load_cube_faces.
-CubeMap load_probe(const std::filesystem::path& file, int size, float rotation_deg = 0.0f);
+CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg = 0.0f);
 CubeMap load_cube_faces(const std::array<std::filesystem::path, 6>& files, int size);
 
 // A probe with an exact answer: a sky of constant radiance `sky` with a sun disc of radiance
@@ -151,11 +151,15 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count);
 // The area lights of the regions (msm_area_light_from_region), regions without energy skipped.
 std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vector<Region>& regions);
 
-// The whole CPU pipeline: the probe (an equirectangular or cross EXR, load_probe, or "sky" for make_sky_sun_probe's
-// default sky: see sky_probe) as a cube map of size², scaled by intensity, cut into `count`
+// The whole CPU pipeline: the probe (an equirectangular or cross EXR, load_probe_file, or "sky" for
+// make_sky_sun_probe's default sky: see sky_probe) as a cube map of size², scaled by intensity, cut into `count`
 // regions, and their area lights.
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg = 0.0f,
                                             float intensity = 1.0f);
+// The cube map probe_area_lights cuts: the probe ("sky" or an EXR, load_probe_file) at size²,
+// turned by rotation_deg about +Y and scaled by intensity. The ray tracer's environment ground
+// truth lights the scene with exactly this (msm::reference, effect environment).
+CubeMap load_probe(const std::string& probe, int size, float rotation_deg = 0.0f, float intensity = 1.0f);
 // The procedural sky of `msm probe sky` and of scenes with "file": "sky": a blue sky of radiance
 // (0.15, 0.22, 0.4) all around and a sun disc of radius 0.27° and radiance (40000, 36000, 30000)
 // towards (0.4, 0.6, −0.3): on a horizontal surface the sun brings about four times the sky's

@@ -93,7 +93,31 @@
 //               occluder: the points inside are shadowed (their shadow rays hit its inside), its
 //               back faces are looked through as above; nothing special, never NaN.
 //
-// Samplers (filtered, soft, scattering): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
+//   environment Image-based lighting (Kneiphof 2017) with exact visibility: the irradiance
+//                 E(p) = ∫ L(ω) V(ω) max(n_s·ω, 0) dω
+//               (n_s the interpolated normal turned towards the viewer; directions below the
+//               horizon of the geometric normal turned towards the viewer are blocked, V = 0),
+//               L the scene's probe exactly as its median cut saw it (msm::probe::load_probe: the
+//               same file, size, rotation and intensity; piecewise constant over the texels of the
+//               cube's faces) plus the scene's directional lights that are not the probe's, as
+//               uniform cones (below). Each of the `samples` samples draws one direction from the
+//               probe (a texel chosen in proportion to luminance x solid angle, msm_cube_texel_weight,
+//               then a uniform point of it on the face plane: density p_texel / msm_cube_texel_weight
+//               at that point) and one from the cosine-weighted hemisphere around n_s (Shirley-Chiu
+//               disc), combined by the balance heuristic: each adds f / (p_probe + p_cosine).
+//               --probe-lights (Settings::probe_lights): every light of the scene, the probe's
+//               extracted area lights included, is a cone of uniform radiance of half-angle
+//               alpha = angular_extent_deg / 2 whose irradiance on a facing surface is the light's
+//               `irradiance` (scene.cpp: msm_area_light_facing_irradiance), sampled uniformly in the
+//               cone (one direction per light per sample): the ground truth of the area lights,
+//               whose difference from the probe's is the error of the light extraction.
+//               The radiance is msm/shading.h's with this E: msm_surface_radiance(albedo,
+//               msm_direct_light(E, 1, 1), MSM_AMBIENT). "visibility" = E_Y / E0_Y, the luminance of
+//               E over that of the unoccluded E0 from the same samples (0 where E0_Y = 0);
+//               std_error = that of E_Y (the sample values' luminance) over E0_Y. The irradiance
+//               image holds E (R, G, B) and the standard error of its luminance.
+//
+// Samplers (filtered, soft, scattering, environment): `stratified` (default) uses a jittered m x m grid, m = floor(sqrt(N)),
 // for the first m^2 of the N samples per pixel and independent uniform points for the rest (so a
 // square N is fully stratified); the soft disc light maps the grid with Shirley and Chiu's
 // concentric map, the filter kernel with FilterKernel::sample per axis. `independent` uses N
@@ -142,12 +166,12 @@
 
 namespace msm::reference {
 
-enum class Effect { hard, filtered, soft, translucent, scattering };
-inline constexpr std::array<Effect, 5> kEffects{Effect::hard, Effect::filtered, Effect::soft, Effect::translucent,
-                                                Effect::scattering};
+enum class Effect { hard, filtered, soft, translucent, scattering, environment };
+inline constexpr std::array<Effect, 6> kEffects{Effect::hard,        Effect::filtered,   Effect::soft,
+                                                Effect::translucent, Effect::scattering, Effect::environment};
 std::string_view to_string(Effect effect);
 std::optional<Effect> parse_effect(std::string_view name);
-bool is_monte_carlo(Effect effect); // filtered, soft, scattering
+bool is_monte_carlo(Effect effect); // filtered, soft, scattering, environment
 
 enum class LightShape { disc, rectangle };
 std::string_view to_string(LightShape shape);
@@ -195,6 +219,9 @@ struct Settings {
   std::optional<double> light_width_deg, light_height_deg; // rectangle only
   // translucent
   int max_crossings = 64; // 1..kMaxCrossings
+  // environment: lit by the scene's extracted area lights (every light a uniform cone) instead of
+  // the full probe: the "lights" half of the error split.
+  bool probe_lights = false;
   // Worker threads: 0 = TBB's default (all cores, or a tbb::global_control limit), else a
   // task arena of that many (1..kMaxThreads). The image does not depend on it.
   int threads = 0;
@@ -216,6 +243,7 @@ struct Result {
   image::Image visibility_rgb; // translucent: T_r, T_g, T_b ("visibility_r/_g/_b"); else empty
   image::Image scattering;     // scattering: R, G, B in-scattered radiance, length; else empty
   image::Image radiance;       // R, G, B
+  image::Image irradiance;     // environment: R, G, B irradiance E, "std_error" of its luminance; else empty
   image::Image surface;        // n_dot_l, object (see above)
   int samples = 1;             // per covered pixel (1 for hard and translucent)
   double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0; // as used (soft)
@@ -229,7 +257,7 @@ struct Result {
 };
 
 // Throws std::invalid_argument for bad settings, a scene with non-finite vertices or, for
-// scattering, a scene without a medium, and
+// scattering, a scene without a medium, for environment, a scene without a probe, and
 // std::runtime_error when Embree fails.
 Result render(const scene::Scene& scene, const Settings& settings);
 

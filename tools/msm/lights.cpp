@@ -1,0 +1,215 @@
+// `msm lights` (and `msm probe`, its name in the first release, with the old options): a light
+// probe (an equirectangular or cube-map cross EXR, or the procedural sky) split by the median cut into area lights
+// (Kneiphof 2017): the table of lights (or JSON), a scene "lights" list to render them with, and a
+// picture of the cube map with the regions outlined. A black probe gives no lights (and a black
+// picture), exit status 0; a bad probe or count is a UsageError (exit status 2).
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "msm/image/io.h"
+#include "msm/probe/probe.h"
+
+namespace msm::tool {
+namespace {
+
+struct LightsOptions {
+  std::string probe;
+  int size = 128;
+  int count = 32;
+  float rotation_deg = 0.0f;
+  float intensity = 1.0f;
+  bool json = false;
+  std::string scene_lights, picture;
+};
+
+// The horizontal cross (−X faces... laid out as  . +Y . . / −X +Z +X −Z / . −Y . .), tone mapped,
+// with each region's border drawn in red.
+image::Image cross_picture(const probe::CubeMap& cube, const std::vector<probe::Region>& regions) {
+  const int m = cube.size;
+  image::Image out(4 * m, 3 * m, 3);
+  // (column, row) of each face in the cross; faces keep their texel orientation (row 0 at v = −1).
+  const int cells[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 1}, {3, 1}};
+  for (int f = 0; f < 6; ++f)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        const glm::vec3 c = cube.at(f, i, j);
+        for (int k = 0; k < 3; ++k) out.at(cells[f][0] * m + i, cells[f][1] * m + j, k) = msm::msm_aces(c[k]);
+      }
+  for (const probe::Region& r : regions)
+    for (int j = r.y0; j < r.y1; ++j)
+      for (int i = r.x0; i < r.x1; ++i)
+        if (i == r.x0 || j == r.y0 || i == r.x1 - 1 || j == r.y1 - 1) {
+          const int x = cells[r.face][0] * m + i, y = cells[r.face][1] * m + j;
+          out.at(x, y, 0) = 1.0f;
+          out.at(x, y, 1) = out.at(x, y, 2) = 0.0f;
+        }
+  return out;
+}
+
+// Σ of the texels' solid angles (msm_cube_texel_weight) over a region.
+double solid_angle(const probe::Region& r, int size) {
+  double sum = 0.0;
+  for (int j = r.y0; j < r.y1; ++j)
+    for (int i = r.x0; i < r.x1; ++i)
+      sum += msm_cube_texel_weight((2.0f * i + 1.0f) / size - 1.0f, (2.0f * j + 1.0f) / size - 1.0f, float(size));
+  return sum;
+}
+
+// Output files go where they are asked for, folders made as needed.
+void make_parent(const std::string& path) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code error;
+  if (!parent.empty()) std::filesystem::create_directories(parent, error);
+  if (error) throw UsageError(fmt::format("{}: cannot create the folder: {}", parent.string(), error.message()));
+}
+
+nlohmann::json vec(glm::vec3 v) { return {v.x, v.y, v.z}; }
+
+void run(const LightsOptions& o) {
+  // Checked here, not by CLI11, so that a bad value is a failed command (exit 2) naming the range.
+  if (o.count < 1 || o.count > 256)
+    throw UsageError(fmt::format("--count {}: the median cut makes 6 to 256 lights", o.count));
+  if (o.count < 6)
+    throw UsageError(fmt::format("--count {}: the median cut makes at least 6 lights (one region per cube face: "
+                                 "regions never straddle faces)",
+                                 o.count));
+  if (o.size < 1 || o.size > probe::kMaxCubeSize)
+    throw UsageError(
+        fmt::format("--size {}: the cube map's faces are 1 to {} texels wide", o.size, probe::kMaxCubeSize));
+  if (!(std::isfinite(o.intensity) && o.intensity >= 0.0f && o.intensity <= 1e6f))
+    throw UsageError(fmt::format("--intensity {}: expected 0 to 1e6", o.intensity));
+  if (!(std::isfinite(o.rotation_deg) && std::abs(o.rotation_deg) <= 360.0f))
+    throw UsageError(fmt::format("--rotation {}: expected -360 to 360 degrees", o.rotation_deg));
+  if (!o.picture.empty()) { // before anything is written: no list without its picture
+    std::string ext = std::filesystem::path(o.picture).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext != ".png" && ext != ".exr")
+      throw UsageError(fmt::format("--picture {}: expected a .png or .exr", o.picture));
+  }
+  probe::CubeMap cube;
+  try {
+    cube = probe::load_probe(o.probe, o.size, o.rotation_deg, o.intensity);
+  } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+  const probe::ProbeTables tables(cube);
+  std::vector<probe::Region> regions;
+  try {
+    regions = probe::median_cut(tables, o.count);
+  } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+  // The lights with their regions (area_lights skips regions without energy: a black probe has none).
+  std::vector<probe::Region> lit;
+  for (const probe::Region& r : regions)
+    if (tables.sums(r).xyz.y > 0.0f) lit.push_back(r);
+  const std::vector<MsmAreaLight> lights = probe::area_lights(tables, lit);
+  const glm::dvec3 total = probe::integrate(cube);
+  nlohmann::ordered_json doc;
+  doc["probe"] = o.probe;
+  doc["size"] = cube.size;
+  doc["rotation_deg"] = o.rotation_deg;
+  doc["intensity"] = o.intensity;
+  doc["regions"] = regions.size();
+  doc["integral"] = {total.x, total.y, total.z};
+  if (!o.json)
+    fmt::print("probe {}: {}² texels per face, {} regions, {} lights{}; ∫L dω = ({:.4g}, {:.4g}, {:.4g})\n", o.probe,
+               cube.size, regions.size(), lights.size(), lights.empty() ? " (the probe is black)" : "", total.x,
+               total.y, total.z);
+  if (!o.json && !lights.empty())
+    fmt::print("{:>3}  {:>24}  {:>15}  {:>7}  {:>8}  {:>30}\n", "#", "towards light", "half-extents °", "Ω sr",
+               "cone °", "irradiance M_e (RGB)");
+  nlohmann::json list = nlohmann::json::array(), table = nlohmann::json::array();
+  for (std::size_t k = 0; k < lights.size(); ++k) {
+    const MsmAreaLight& l = lights[k];
+    const glm::vec2 half_deg(glm::degrees(std::atan(l.half_extent.x)), glm::degrees(std::atan(l.half_extent.y)));
+    const double omega = solid_angle(lit[k], cube.size);
+    if (!o.json)
+      fmt::print("{:>3}  ({:>6.3f}, {:>6.3f}, {:>6.3f})  {:>6.2f} x {:>6.2f}  {:>7.4f}  {:>8.3f}  ({:>8.4g}, {:>8.4g}, "
+                 "{:>8.4g})\n",
+                 k, l.direction.x, l.direction.y, l.direction.z, half_deg.x, half_deg.y, omega,
+                 glm::degrees(l.cone_half_angle), l.irradiance.x, l.irradiance.y, l.irradiance.z);
+    const glm::vec3 facing = msm_area_light_facing_irradiance(l);
+    // The scene's lights are discs of an angular diameter below 90°.
+    const float diameter = std::min(2.0f * glm::degrees(l.cone_half_angle), 89.0f);
+    list.push_back(
+        {{"towards_light", vec(l.direction)}, {"irradiance", vec(facing)}, {"angular_extent_deg", diameter}});
+    const probe::Region& r = lit[k];
+    table.push_back({{"direction", vec(l.direction)},
+                     {"x_axis", vec(l.x_axis)},
+                     {"y_axis", vec(l.y_axis)},
+                     {"half_extent_deg", {half_deg.x, half_deg.y}},
+                     {"cone_half_angle_deg", glm::degrees(l.cone_half_angle)},
+                     {"solid_angle_sr", omega},
+                     {"irradiance", vec(l.irradiance)},
+                     {"facing_irradiance", vec(facing)},
+                     {"region", {{"face", r.face}, {"x", {r.x0, r.x1}}, {"y", {r.y0, r.y1}}}}});
+  }
+  doc["lights"] = table;
+  // Files first (each written whole under a temporary name, then renamed), then the JSON.
+  const auto wrote = [&](const std::string& path) {
+    if (o.json)
+      fmt::print(stderr, "wrote {}\n", path);
+    else
+      fmt::print("wrote {}\n", path);
+  };
+  if (!o.scene_lights.empty()) {
+    make_parent(o.scene_lights);
+    const std::string text = nlohmann::json{{"lights", list}}.dump(2) + "\n";
+    image::write_file_atomic(o.scene_lights,
+                             std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    wrote(o.scene_lights);
+  }
+  if (!o.picture.empty()) {
+    make_parent(o.picture);
+    try {
+      image::write_image(o.picture, cross_picture(cube, regions));
+    } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+    wrote(o.picture);
+  }
+  if (o.json) fmt::print("{}\n", doc.dump(2));
+}
+
+} // namespace
+
+void add_lights(CLI::App& app) {
+  const std::string probe_help = "An equirectangular or cube-map cross (4:3, 3:4) EXR (e.g. /usr/share/blender/datafiles/studiolights/world/"
+                                 "studio.exr), or 'sky' for the procedural sky with a sun";
+  const std::string scene_lights_help = "Write the lights as a scene's \"lights\" list (JSON: direction, irradiance "
+                                        "on a facing surface, angular diameter)";
+  const std::string picture_help = "Write the cube map as a cross with the regions outlined (.png or .exr)";
+  {
+    auto o = std::make_shared<LightsOptions>();
+    auto* cmd = app.add_subcommand(
+        "lights", "A light probe's area lights by the median cut (Kneiphof 2017): direction, extents, solid angle, "
+                  "irradiance; a picture of the regions");
+    cmd->add_option("--probe", o->probe, probe_help)->required();
+    cmd->add_option("--count", o->count, "Number of area lights (median-cut regions), 6 to 256 (default 32)");
+    cmd->add_flag("--json", o->json, "Print the lights as JSON");
+    cmd->add_option("--size", o->size, "Cube-map face size in texels (default 128)");
+    cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
+    cmd->add_option("--intensity", o->intensity, "Radiance scale (default 1)");
+    cmd->add_option("--picture", o->picture, picture_help);
+    cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
+    cmd->callback([o] { run(*o); });
+  }
+  {
+    auto o = std::make_shared<LightsOptions>();
+    auto* cmd = app.add_subcommand("probe", "The first name of msm lights: msm probe PROBE --lights N [--cross F]");
+    cmd->add_option("probe", o->probe, probe_help)->required();
+    cmd->add_option("--size", o->size, "Cube-map face size in texels");
+    cmd->add_option("--lights", o->count, "Number of area lights (median-cut regions), 6 to 256");
+    cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
+    cmd->add_option("--intensity", o->intensity, "Radiance scale");
+    cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
+    cmd->add_option("--cross", o->picture, picture_help);
+    cmd->add_flag("--json", o->json, "Print the lights as JSON");
+    cmd->callback([o] { run(*o); });
+  }
+}
+
+} // namespace msm::tool
