@@ -13,12 +13,17 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
   // directions below that side's horizon cross the surface itself and are blocked.
   const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);
   RunningStats stats;
-  for (int i = 0; i < set.count(); ++i) {
-    const glm::dvec2 u = set.point(i, rng);
-    const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
-                               : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
-    const glm::dvec3 dir = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
-    stats.add(ctx.tracer.occluded(origin, dir) ? 0.0 : 1.0);
+  // Directions of a batch first, then the rays (as effect_filtered, and why: kSampleBatch).
+  glm::dvec3 dirs[kSampleBatch];
+  for (int first = 0; first < set.count(); first += kSampleBatch) {
+    const int n = std::min(kSampleBatch, set.count() - first);
+    for (int k = 0; k < n; ++k) {
+      const glm::dvec2 u = set.point(first + k, rng);
+      const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
+                                 : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
+      dirs[k] = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
+    }
+    for (int k = 0; k < n; ++k) stats.add(ctx.tracer.occluded(origin, dirs[k]) ? 0.0 : 1.0);
   }
   return monte_carlo_result(stats);
 }

@@ -35,7 +35,13 @@ class SampleSet {
  private:
   Sampler sampler_;
   int count_, grid_;
+  double inverse_grid_ = 0.0; // 1 / grid_
 };
+
+// Samples whose rays an effect generates before it traces them (on the stack): the arithmetic of
+// one sample is a chain of dependent steps, which the processor overlaps across a batch, but not
+// across the tracer's calls.
+inline constexpr int kSampleBatch = 32;
 
 // Shirley-Chiu concentric map of [0,1)^2 onto the unit disc (area-preserving, keeps strata).
 glm::dvec2 concentric_disc(glm::dvec2 u);
