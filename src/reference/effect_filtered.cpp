@@ -49,7 +49,11 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
           kOffsetScale * std::max(hit.scale, point_scale(q)) + kReceiverPlaneTolerance * glm::length(o_world);
       origins[k] = q + tolerance * ctx.towards_light;
     }
-    for (int k = 0; k < n; ++k) stats.add(ctx.tracer.occluded(origins[k], ctx.towards_light) ? 0.0 : 1.0);
+    bool blocked[kSampleBatch];
+    glm::dvec3 dirs[kSampleBatch];
+    for (int k = 0; k < n; ++k) dirs[k] = ctx.towards_light;
+    ctx.tracer.occluded(origins, dirs, n, blocked);
+    for (int k = 0; k < n; ++k) stats.add(blocked[k] ? 0.0 : 1.0);
   }
   return monte_carlo_result(stats);
 }

@@ -23,7 +23,11 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
                                  : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
       dirs[k] = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
     }
-    for (int k = 0; k < n; ++k) stats.add(ctx.tracer.occluded(origin, dirs[k]) ? 0.0 : 1.0);
+    glm::dvec3 origins[kSampleBatch];
+    bool blocked[kSampleBatch];
+    for (int k = 0; k < n; ++k) origins[k] = origin;
+    ctx.tracer.occluded(origins, dirs, n, blocked);
+    for (int k = 0; k < n; ++k) stats.add(blocked[k] ? 0.0 : 1.0);
   }
   return monte_carlo_result(stats);
 }

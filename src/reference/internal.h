@@ -92,6 +92,8 @@ class Tracer {
   bool closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const;
   // True if anything lies on origin + t dir, t in [0, inf).
   bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
+  // occluded() of n rays, as packets of 8 (a pixel's sample rays are nearly coherent).
+  void occluded(const glm::dvec3* origins, const glm::dvec3* dirs, int n, bool* blocked) const;
 
   struct Transmission {
     glm::dvec3 channels{1.0};   // per RGB channel
