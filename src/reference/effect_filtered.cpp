@@ -31,16 +31,29 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
   const glm::dvec3 travel = -ctx.towards_light;
   const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
   RunningStats stats;
-  for (int i = 0; i < set.count(); ++i) {
-    const glm::dvec2 u = set.point(i, rng);
-    const glm::dvec2 o(ctx.kernel.sample(u.x), ctx.kernel.sample(u.y));
-    const glm::dvec3 o_world = o.x * ctx.texel_x + o.y * ctx.texel_y;
-    // The light ray through (x, y) + o at the plane's depth there; surfaces within the plane's
-    // tolerance of that point are the receiver itself, so the ray starts beyond them.
-    const glm::dvec3 q = hit.p + o_world + (glm::dot(slope, o) * ctx.frame.depth_extent) * travel;
-    const double tolerance =
-        kOffsetScale * std::max(hit.scale, point_scale(q)) + kReceiverPlaneTolerance * glm::length(o_world);
-    stats.add(ctx.tracer.occluded(q + tolerance * ctx.towards_light, ctx.towards_light) ? 0.0 : 1.0);
+  // The ray origins of a batch of samples first, then their rays: each sample's arithmetic is a
+  // chain of dependent steps (two square roots), which the processor overlaps across the samples
+  // of a batch but not across a call into Embree (issue 18). The same random numbers in the same
+  // order: the same rays as one sample at a time.
+  glm::dvec3 origins[kSampleBatch];
+  for (int first = 0; first < set.count(); first += kSampleBatch) {
+    const int n = std::min(kSampleBatch, set.count() - first);
+    for (int k = 0; k < n; ++k) {
+      const glm::dvec2 u = set.point(first + k, rng);
+      const glm::dvec2 o(ctx.kernel.sample(u.x), ctx.kernel.sample(u.y));
+      const glm::dvec3 o_world = o.x * ctx.texel_x + o.y * ctx.texel_y;
+      // The light ray through (x, y) + o at the plane's depth there; surfaces within the plane's
+      // tolerance of that point are the receiver itself, so the ray starts beyond them.
+      const glm::dvec3 q = hit.p + o_world + (glm::dot(slope, o) * ctx.frame.depth_extent) * travel;
+      const double tolerance =
+          kOffsetScale * std::max(hit.scale, point_scale(q)) + kReceiverPlaneTolerance * glm::length(o_world);
+      origins[k] = q + tolerance * ctx.towards_light;
+    }
+    bool blocked[kSampleBatch];
+    glm::dvec3 dirs[kSampleBatch];
+    for (int k = 0; k < n; ++k) dirs[k] = ctx.towards_light;
+    ctx.tracer.occluded(origins, dirs, n, blocked);
+    for (int k = 0; k < n; ++k) stats.add(blocked[k] ? 0.0 : 1.0);
   }
   return monte_carlo_result(stats);
 }

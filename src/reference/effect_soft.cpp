@@ -1,6 +1,7 @@
 // soft: the fraction of a directional area light (a disc or a rectangle in the plane at unit
 // distance along towards_light) that the visible point sees, and the light's cosine-weighted
 // visibility for the radiance (reference.h).
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -45,23 +46,34 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
   const double facing = facing_integral(disc, ctx.half_x, ctx.half_y);
   RunningStats stats;
   double deviation = 0.0;
-  for (int i = 0; i < set.count(); ++i) {
-    const glm::dvec2 u = set.point(i, rng);
-    const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
-                               : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
-    const glm::dvec3 dir = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
-    const bool visible = !ctx.tracer.occluded(origin, dir);
-    stats.add(visible ? 1.0 : 0.0);
-    bool lit_visible = visible;
-    if (!same_side) {
-      lit_visible = !ctx.tracer.occluded(viewer_side, dir);
-      ++extra_rays;
+  // Directions of a batch first, then the rays (as effect_filtered, and why: kSampleBatch).
+  glm::dvec3 dirs[kSampleBatch], origins[kSampleBatch];
+  bool blocked[kSampleBatch], lit_blocked[kSampleBatch];
+  for (int first = 0; first < set.count(); first += kSampleBatch) {
+    const int count = std::min(kSampleBatch, set.count() - first);
+    for (int k = 0; k < count; ++k) {
+      const glm::dvec2 u = set.point(first + k, rng);
+      const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
+                                 : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
+      dirs[k] = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
+      origins[k] = origin;
     }
-    // ∫ max(n·d, 0) V dω = (n·L) ∫ (d·L) dω + ∫ (max(n·d, 0) V − n·d) dω (the light is symmetric
-    // about L, so ∫ d dω is along L): only the second integral is sampled, and it is exactly 0
-    // where the whole light is visible and above the horizon.
-    const double cos_n = glm::dot(n, dir), cos_l = glm::dot(ctx.towards_light, dir);
-    deviation += ((lit_visible ? std::max(cos_n, 0.0) : 0.0) - cos_n) * cos_l * cos_l * cos_l;
+    ctx.tracer.occluded(origins, dirs, count, blocked);
+    if (same_side) {
+      std::copy(blocked, blocked + count, lit_blocked);
+    } else {
+      for (int k = 0; k < count; ++k) origins[k] = viewer_side;
+      ctx.tracer.occluded(origins, dirs, count, lit_blocked);
+      extra_rays += std::uint64_t(count);
+    }
+    for (int k = 0; k < count; ++k) {
+      stats.add(blocked[k] ? 0.0 : 1.0);
+      // ∫ max(n·d, 0) V dω = (n·L) ∫ (d·L) dω + ∫ (max(n·d, 0) V − n·d) dω (the light is symmetric
+      // about L, so ∫ d dω is along L): only the second integral is sampled, and it is exactly 0
+      // where the whole light is visible and above the horizon.
+      const double cos_n = glm::dot(n, dirs[k]), cos_l = glm::dot(ctx.towards_light, dirs[k]);
+      deviation += ((lit_blocked[k] ? 0.0 : std::max(cos_n, 0.0)) - cos_n) * cos_l * cos_l * cos_l;
+    }
   }
   EffectResult r = monte_carlo_result(stats);
   r.rays += extra_rays;

@@ -36,7 +36,13 @@ class SampleSet {
  private:
   Sampler sampler_;
   int count_, grid_;
+  double inverse_grid_ = 0.0; // 1 / grid_
 };
+
+// Samples whose rays an effect generates before it traces them (on the stack): the arithmetic of
+// one sample is a chain of dependent steps, which the processor overlaps across a batch, but not
+// across the tracer's calls.
+inline constexpr int kSampleBatch = 32;
 
 // Shirley-Chiu concentric map of [0,1)^2 onto the unit disc (area-preserving, keeps strata).
 glm::dvec2 concentric_disc(glm::dvec2 u);
@@ -87,6 +93,8 @@ class Tracer {
   bool closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const;
   // True if anything lies on origin + t dir, t in [0, inf).
   bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
+  // occluded() of n rays, as packets of 8 (a pixel's sample rays are nearly coherent).
+  void occluded(const glm::dvec3* origins, const glm::dvec3* dirs, int n, bool* blocked) const;
 
   struct Transmission {
     glm::dvec3 channels{1.0};   // per RGB channel

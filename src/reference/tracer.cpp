@@ -195,6 +195,36 @@ bool Tracer::occluded(const glm::dvec3& origin, const glm::dvec3& dir) const {
   return ray.tfar < 0.0f; // set to -inf on a hit
 }
 
+void Tracer::occluded(const glm::dvec3* origins, const glm::dvec3* dirs, int n, bool* blocked) const {
+  for (int first = 0; first < n; first += 8) {
+    const int m = std::min(8, n - first);
+    alignas(32) int valid[8];
+    alignas(32) RTCRay8 rays{};
+    for (int j = 0; j < 8; ++j) {
+      valid[j] = j < m ? -1 : 0;
+      const RTCRay r = make_ray(origins[first + std::min(j, m - 1)], dirs[first + std::min(j, m - 1)],
+                                std::numeric_limits<double>::infinity());
+      rays.org_x[j] = r.org_x;
+      rays.org_y[j] = r.org_y;
+      rays.org_z[j] = r.org_z;
+      rays.tnear[j] = r.tnear;
+      rays.dir_x[j] = r.dir_x;
+      rays.dir_y[j] = r.dir_y;
+      rays.dir_z[j] = r.dir_z;
+      rays.time[j] = r.time;
+      rays.tfar[j] = r.tfar;
+      rays.mask[j] = r.mask;
+      rays.id[j] = r.id;
+      rays.flags[j] = r.flags;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded8(valid, impl_->scene, &context, &rays);
+    for (int j = 0; j < m; ++j) blocked[first + j] = rays.tfar[j] < 0.0f; // -inf on a hit
+  }
+}
+
 Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const {
   Transmission result;
   glm::dvec3 o = origin;

@@ -25,6 +25,9 @@ struct FrameConfig {
   // blended with the channel's opacity α (1 − transmission colour); only with translucent.
   bool coloured = false;
   int soft_kernel = 0; // soft techniques: the tables' largest kernel width W (n_t = W²)
+  // Non-linear maps read with MSM_LOOKUP_BILINEAR (four decodes and Φ): a specialization constant of
+  // their shading, because lavapipe runs both sides of a branch on a uniform (issue 18).
+  bool nonlinear_bilinear = false;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                            // translucent and four channels in one image

@@ -273,7 +273,8 @@ struct Renderer::Impl {
                   .one_pass = one_pass,
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
-                  .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0};
+                  .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0,
+                  .nonlinear_bilinear = msm_technique_is_nonlinear(id) && s.lookup == RenderSettings::Lookup::bilinear};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     bool can_mip =

@@ -6,8 +6,12 @@
 
 #include <fmt/format.h>
 
+#include <array>
+#include <cstdint>
 #include <fstream>
+#include <future>
 #include <unistd.h>
+#include <vector>
 
 namespace msm::tool {
 
@@ -197,17 +201,31 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json) {
   try {
+    // The EXRs (zlib: most of the output's work) are encoded on a second thread while this one
+    // encodes the PNG (issue 18: image output was 16% of a one-shot 1080p render). The files are
+    // added in the same order as before.
+    const std::filesystem::path exr = dir / (stem + ".exr"), rgb = dir / (stem + "-rgb.exr"),
+                                scattering = dir / (stem + "-scattering.exr");
+    auto exrs = std::async(std::launch::async, [&] {
+      std::array<std::vector<std::uint8_t>, 3> bytes;
+      bytes[0] = image::encode_exr(exr, result.shadow);
+      if (!result.shadow_rgb.empty()) bytes[1] = image::encode_exr(rgb, result.shadow_rgb);
+      if (!result.scattering.empty()) bytes[2] = image::encode_exr(scattering, result.scattering);
+      return bytes;
+    });
+    std::vector<std::uint8_t> png = image::encode_png(dir / (stem + ".png"), result.color);
+    const std::array<std::vector<std::uint8_t>, 3> exr_bytes = exrs.get(); // rethrows its ImageError
     image::FileSet files;
-    files.add_png(dir / (stem + ".png"), result.color);
-    files.add_exr(dir / (stem + ".exr"), result.shadow);
+    files.add(dir / (stem + ".png"), png);
+    files.add(exr, exr_bytes[0]);
     if (!result.shadow_rgb.empty())
-      files.add_exr(dir / (stem + "-rgb.exr"), result.shadow_rgb);
+      files.add(rgb, exr_bytes[1]);
     else
-      files.remove(dir / (stem + "-rgb.exr")); // no stale copy of an earlier coloured render
-    if (!result.scattering.empty())            // scattering techniques: in-scattered radiance, visible fraction
-      files.add_exr(dir / (stem + "-scattering.exr"), result.scattering);
+      files.remove(rgb);            // no stale copy of an earlier coloured render
+    if (!result.scattering.empty()) // scattering techniques: in-scattered radiance, visible fraction
+      files.add(scattering, exr_bytes[2]);
     else
-      files.remove(dir / (stem + "-scattering.exr"));
+      files.remove(scattering);
     std::string text = json.dump(2) + "\n";
     files.add(dir / (stem + ".json"), std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
     files.commit();

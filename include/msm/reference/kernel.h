@@ -41,6 +41,8 @@ class FilterKernel {
   // Inverse-transform-like map of u in [0, 1) to a 1D offset distributed with density k:
   // the tap whose cumulative weight interval holds u, then the tent's inverse CDF of u rescaled
   // within that interval. Measure-preserving, so stratified u give stratified offsets per tap.
+  // The ray tracer calls it twice per filtered sample: the tap is found through a table of
+  // buckets of u (not a search from tap 0), and the rest has no branch on u (issue 18).
   double sample(double u) const;
 
  private:
@@ -48,6 +50,9 @@ class FilterKernel {
   double sigma_;
   double total_ = 0.0;                       // sum of weights_
   std::vector<double> weights_, cumulative_; // cumulative_[i] = sum of weights_[0..i) / total_
+  std::vector<double> inverse_share_;        // total_ / weights_[i]: u's scale within tap i
+  std::vector<double> upper_;                // cumulative_[i + 1], 2 for the last tap (beyond any u)
+  std::vector<int> first_tap_;               // per bucket [j, j + 1) / buckets of u: the tap at its start
 };
 
 } // namespace msm::reference

@@ -31,6 +31,7 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, bool translucent) {
       .depth_format = VK_FORMAT_D32_SFLOAT,
       .depth_write = !translucent,
       .constants = {{0, uint32_t(technique.id)}, {3, config.split_rg() ? 1u : 0u}, {4, config.lights == 1 ? 1u : 0u}}};
+  if (msm_technique_is_nonlinear(technique.id)) d.constants.push_back({9, config.nonlinear_bilinear ? 1u : 0u});
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
   if (msm_technique_is_scattering(technique.id)) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;

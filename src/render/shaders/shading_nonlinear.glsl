@@ -11,6 +11,12 @@ layout(binding = 3) uniform sampler2DArray unused_second_image; // the shading l
 #include "shading.glsl"
 #include "lookup.glsl"
 
+// frame.lookup.x == MSM_LOOKUP_BILINEAR, compiled in (FrameConfig::nonlinear_bilinear): llvmpipe
+// executes both sides of a branch on a uniform under a mask, so with the branch the nearest and
+// dithered lookups paid for the four decodes and Φ of the bilinear one (1416 instructions per
+// pixel of NL64 shading instead of 645, docs/results.md).
+layout(constant_id = 9) const bool kBilinearLookup = false;
+
 NonLinearMoments decode(ivec2 i) {
 #ifdef MSM_NL32
   return msm_nl_unpack32(texelFetch(moments0, ivec3(i, shadow_layer), 0).x);
@@ -22,7 +28,7 @@ NonLinearMoments decode(ivec2 i) {
 float shadow_intensity(ShadowLookup s) {
   s.z -= receiver_plane_bias(s, 0.0f); // the maps have no mips
   float zf = msm_signed_depth(s.z);
-  if (frame.lookup.x != MSM_LOOKUP_BILINEAR) {
+  if (!kBilinearLookup) {
     ivec2 i = lookup_texel(s.t);
     return msm_nl_shadow(decode(i), msm_signed_depth(receiver_depth_at(s, i)));
   }
