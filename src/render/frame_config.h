@@ -25,6 +25,9 @@ struct FrameConfig {
   // blended with the channel's opacity α (1 − transmission colour); only with translucent.
   bool coloured = false;
   int soft_kernel = 0; // soft techniques: the tables' largest kernel width W (n_t = W²)
+  // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
+  // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).
+  bool deferred = false;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                            // translucent and four channels in one image
@@ -40,6 +43,10 @@ inline constexpr const char* kShadowDepth = "shadow_depth";
 inline constexpr const char* kColor = "color";
 inline constexpr const char* kShadowBuffer = "shadow_buffer";
 inline constexpr const char* kCameraDepth = "camera_depth";
+// Deferred shading: the surfaces pass's visible surface per pixel (RGBA32F each).
+inline constexpr const char* kSurfacePosition = "surface_position";
+inline constexpr const char* kSurfaceNormal = "surface_normal";
+inline constexpr const char* kSurfaceAlbedo = "surface_albedo";
 // Scattering techniques: the shading's linear radiance (RGBA16F, before exposure) and the
 // scattering pass's in-scattered radiance and visible fraction (RGBA32F, an output of the frame).
 inline constexpr const char* kSurfaceRadiance = "surface_radiance";

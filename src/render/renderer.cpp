@@ -263,7 +263,9 @@ struct Renderer::Impl {
                   .one_pass = one_pass,
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
-                  .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0};
+                  .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0,
+                  .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
+                              supports_deferred_shading(technique)};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     bool can_mip =

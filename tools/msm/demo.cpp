@@ -69,8 +69,8 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   if (truth_rgb) panels.push_back({"ray traced", *truth_rgb, "reference"});
   std::vector<std::string> pass_names;
   // Every pass any technique ran, in the order of a frame.
-  for (const char* name :
-       {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps", "shading"})
+  for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps",
+                           "surfaces", "shading"})
     for (const render::RenderResult& r : results)
       if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
         pass_names.push_back(name);

@@ -141,8 +141,24 @@ class SatPass : public Pass {
   FrameConfig config_;
 };
 
+// Deferred shading (FrameConfig::deferred): the opaque scene -> camera_depth and the visible
+// surface of each pixel (surface_position, surface_normal, surface_albedo), cut-outs discarded.
+class SurfacesPass : public Pass {
+ public:
+  explicit SurfacesPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "surfaces"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
 // Scene + shadow_depth, moment images or tables -> color (sRGB) and shadow_buffer: Lambert + ambient
 // with every light's shadow (msm/shading.h), over-darkening, ACES; translucent surfaces blended over.
+// Deferred: the opaque surfaces come from the surfaces pass, shaded by one full-screen triangle.
 class ShadingPass : public Pass {
  public:
   explicit ShadingPass(const FrameConfig& config) : config_(config) {}
@@ -152,7 +168,8 @@ class ShadingPass : public Pass {
   void execute(const PassContext& c) const override;
 
  private:
-  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr; // opaque; translucent over it
+  // opaque (forward, or the full-screen deferred one); translucent over it (forward)
+  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr;
   FrameConfig config_;
 };
 
