@@ -34,6 +34,9 @@ struct FrameConfig {
   std::array<VkFormat, 2> formats() const;          // of the moment images as allocated
   int moment_images() const;                        // 0 (depth-based), 1 or 2 (6MSM, split_rg)
   int channels() const { return coloured ? 3 : 1; } // sets of moment images
+  // The vertical blur writes mip 1 too (three-pass filter with mips and an even size): one pass
+  // fewer reads mip 0; the mipmap pass starts at mip 2.
+  bool blur_writes_mip1() const { return !one_pass && taps > 1 && mip_levels > 1 && shadow_size % 2 == 0; }
 };
 
 VkFormat vk_format(TexelFormat format);
