@@ -11,7 +11,7 @@
 # in the counts) and VK_ICD_FILENAMES on lavapipe. msm submits every prefix of each frame alone
 # (the first k passes, k = 0 .. n), callgrind dumps the instructions of each submission, and this
 # script prints pass k as the difference of prefixes k and k - 1, in total and per unit: per
-# pixel for `shading`, per shadow-map texel (and light) for every other pass.
+# pixel for `shading` and `surfaces`, per shadow-map texel (and light) for every other pass.
 # Defaults: MSM = build/tools/msm/msm, DIR = a temporary directory (kept with -o). Needs valgrind
 # (scripts/bootstrap.sh installs it). A 1024² MSM-64 frame takes about a minute on this machine.
 set -euo pipefail
@@ -57,6 +57,6 @@ done | sort -k1,1 -k2,2 -k3,3n -k4,4n | awk '
     if (key != last_key) last_key = key
     split($2, wh, "x")
     d = $6 - prev; prev = $6
-    unit = ($5 == "shading") ? wh[1] * wh[2] : $3 * $3
+    unit = ($5 == "shading" || $5 == "surfaces") ? wh[1] * wh[2] : $3 * $3
     printf "%-26s %-10s %6d %-16s %14.0f %10.1f\n", $1, $2, $3, $5, d, d / unit
   }'

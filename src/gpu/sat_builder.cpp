@@ -72,6 +72,10 @@ SatBuilder::SatBuilder(const vk::Context& ctx)
                                         {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
       block_columns_rg_(
           vk::create_program(ctx, "sat_block_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
+      scan_rows_(vk::create_program(ctx, "sat_scan_rows.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
+                                    sizeof(SatPush))),
+      scan_rows_rg_(vk::create_program(ctx, "sat_scan_rows_rg.comp",
+                                       {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
       sampler_(vk::create_sampler(ctx, VK_FILTER_NEAREST)) {}
 
 void SatBuilder::record(VkCommandBuffer cmd, const SatImage& moments, const SatImage& table, int max_kernel_texels,
@@ -110,10 +114,12 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, 
                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                          VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 
-  if (scheme == Scheme::rows_then_columns) {
+  if (scheme == Scheme::rows_then_columns || scheme == Scheme::scan_rows_then_columns) {
+    bool scan = scheme == Scheme::scan_rows_then_columns;
     if (timer) timer->begin(cmd, "sat_rows");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, program(i, rows_, rows_rg_), vk::group_count(moments[i].height, 64), 1, 1,
+      vk::dispatch(cmd, scan ? program(i, scan_rows_, scan_rows_rg_) : program(i, rows_, rows_rg_),
+                   scan ? moments[i].height : vk::group_count(moments[i].height, 64), 1, 1,
                    {vk::Descriptor(moments[i].view, moments_layout, sampler_), vk::Descriptor(tables[i].view, general)},
                    push(i));
     if (timer) timer->end(cmd);

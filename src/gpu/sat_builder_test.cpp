@@ -150,8 +150,8 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
     std::vector<vec4> seen = upload(ctx(), moments, m);
     std::vector<uvec4> cpu = gpu::build_sat_cpu(seen, c.width, c.height, c.nt);
     ASSERT_EQ(cpu, reference_table(seen, c.width, c.height, c.nt)) << c.width << "x" << c.height;
-    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
-      if (scheme == Scheme::rows_then_columns && !c.rows_then_columns) continue;
+    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks}) {
+      if (scheme != Scheme::blocks && !c.rows_then_columns) continue;
       vk::Image table = table_image(ctx(), c.width, c.height);
       vk::GpuTimer timer(ctx());
       vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
@@ -171,7 +171,11 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
       EXPECT_EQ(times.count(blocks ? "sat_blocks" : "sat_rows"), 1u);
       EXPECT_EQ(times.count("sat_columns"), blocks ? 0u : 1u);
       std::printf("[sat-builder] %dx%d n_t %d format %d %s: %zu of %zu texels differ\n", c.width, c.height, c.nt,
-                  int(c.format), blocks ? "blocks" : "rows+columns", mismatches, gpu.size());
+                  int(c.format),
+                  blocks                                     ? "blocks"
+                  : scheme == Scheme::scan_rows_then_columns ? "scan rows+columns"
+                                                             : "rows+columns",
+                  mismatches, gpu.size());
       EXPECT_EQ(mismatches, 0u) << "first at texel " << first % size_t(c.width) << "," << first / size_t(c.width);
     }
   }
@@ -192,7 +196,7 @@ TEST_F(SatBuilderTest, SixMomentTablesInOneCall) {
   vk::Image ma = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
   vk::Image mb = moment_image(ctx(), VK_FORMAT_R32G32_SFLOAT, w, h);
   std::vector<vec4> sa = upload(ctx(), ma, a), sb = upload(ctx(), mb, b);
-  for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
+  for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks}) {
     vk::Image ta = table_image(ctx(), w, h), tb = table_image(ctx(), w, h);
     const gpu::SatImage moments[] = {ma, mb};
     const gpu::SatImage tables[] = {ta, tb};
@@ -214,7 +218,7 @@ TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
     std::vector<vec4> m = random_moments(rng, c.width, c.height);
     vk::Image moments = moment_image(ctx(), c.format, c.width, c.height);
     std::vector<uvec4> cpu = gpu::build_sat_cpu(upload(ctx(), moments, m), c.width, c.height, c.nt);
-    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::blocks}) {
+    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks}) {
       vk::Image table = table_image(ctx(), c.width, c.height, VK_FORMAT_R32G32_UINT);
       vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, table, c.nt, scheme); });
       std::vector<std::byte> bytes = vk::readback_image(ctx(), table, VK_IMAGE_LAYOUT_GENERAL);

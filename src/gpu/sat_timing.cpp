@@ -97,7 +97,8 @@ int main(int argc, char** argv) {
     const double texels = double(size) * size;
     const double copy_ms = median(copies);
     const double bandwidth = 32.0 * texels / (copy_ms * 1e-3); // bytes per second
-    for (auto scheme : {gpu::SatBuilder::Scheme::rows_then_columns, gpu::SatBuilder::Scheme::blocks}) {
+    for (auto scheme : {gpu::SatBuilder::Scheme::rows_then_columns, gpu::SatBuilder::Scheme::scan_rows_then_columns,
+                        gpu::SatBuilder::Scheme::blocks}) {
       const bool blocks = scheme == gpu::SatBuilder::Scheme::blocks;
       std::vector<double> times, rows, columns;
       for (int r = 0; r <= repeat; ++r) {
@@ -114,8 +115,10 @@ int main(int argc, char** argv) {
         columns.push_back(t.total("sat_columns"));
       }
       const double ms = median(times);
-      std::string name =
-          blocks ? "blocks (App. C)" : fmt::format("rows + columns ({:.2f} + {:.2f})", median(rows), median(columns));
+      bool scan = scheme == gpu::SatBuilder::Scheme::scan_rows_then_columns;
+      std::string name = blocks ? "blocks (App. C)"
+                                : fmt::format("{}rows + columns ({:.2f} + {:.2f})", scan ? "scan " : "", median(rows),
+                                              median(columns));
       const double bound64 = 64.0 * texels / bandwidth * 1e3, bound32 = 32.0 * texels / bandwidth * 1e3;
       fmt::print("| {}² | {:.2f} | {:.2f} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", n, copy_ms,
                  bandwidth * 1e-9, name, ms, bound64, bound64 / ms, bound32, bound32 / ms);

@@ -28,12 +28,18 @@ struct FrameConfig {
   // Non-linear maps read with MSM_LOOKUP_BILINEAR (four decodes and Φ): a specialization constant of
   // their shading, because lavapipe runs both sides of a branch on a uniform (issue 18).
   bool nonlinear_bilinear = false;
+  // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
+  // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).
+  bool deferred = false;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                            // translucent and four channels in one image
   std::array<VkFormat, 2> formats() const;          // of the moment images as allocated
   int moment_images() const;                        // 0 (depth-based), 1 or 2 (6MSM, split_rg)
   int channels() const { return coloured ? 3 : 1; } // sets of moment images
+  // The vertical blur writes mip 1 too (three-pass filter with mips and an even size): one pass
+  // fewer reads mip 0; the mipmap pass starts at mip 2.
+  bool blur_writes_mip1() const { return !one_pass && taps > 1 && mip_levels > 1 && shadow_size % 2 == 0; }
 };
 
 VkFormat vk_format(TexelFormat format);
@@ -43,6 +49,10 @@ inline constexpr const char* kShadowDepth = "shadow_depth";
 inline constexpr const char* kColor = "color";
 inline constexpr const char* kShadowBuffer = "shadow_buffer";
 inline constexpr const char* kCameraDepth = "camera_depth";
+// Deferred shading: the surfaces pass's visible surface per pixel (RGBA32F each).
+inline constexpr const char* kSurfacePosition = "surface_position";
+inline constexpr const char* kSurfaceNormal = "surface_normal";
+inline constexpr const char* kSurfaceAlbedo = "surface_albedo";
 // Scattering techniques: the shading's linear radiance (RGBA16F, before exposure) and the
 // scattering pass's in-scattered radiance and visible fraction (RGBA32F, an output of the frame).
 inline constexpr const char* kSurfaceRadiance = "surface_radiance";

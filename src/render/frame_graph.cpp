@@ -266,6 +266,9 @@ FrameGraph::FrameGraph(const vk::Context& ctx, std::vector<std::unique_ptr<Pass>
               vk::create_image_view(ctx, g.image.handle(), s.format, aspect, VK_IMAGE_VIEW_TYPE_2D, 0, s.mips, l, 1));
           g.layer_mip0_views.push_back(
               vk::create_image_view(ctx, g.image.handle(), s.format, aspect, VK_IMAGE_VIEW_TYPE_2D, 0, 1, l, 1));
+          if (s.mips > 1)
+            g.layer_mip1_views.push_back(
+                vk::create_image_view(ctx, g.image.handle(), s.format, aspect, VK_IMAGE_VIEW_TYPE_2D, 1, 1, l, 1));
         }
       }
       images_.emplace(u.name, std::move(g));

@@ -122,6 +122,7 @@ struct GraphImage {
   vk::Image image;
   vk::ImageView array_view;
   std::vector<vk::ImageView> layer_views, layer_mip0_views;
+  std::vector<vk::ImageView> layer_mip1_views; // images with mips: mip 1 alone (a storage target)
   ImageSpec spec;
 };
 

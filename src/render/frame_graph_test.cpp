@@ -39,7 +39,9 @@ std::vector<std::string> names_in_order(const std::vector<std::unique_ptr<Pass>>
 
 TEST(FrameGraph, RecipesListTheirPassesInOrder) {
   using V = std::vector<std::string>;
-  EXPECT_EQ(technique_passes(find_rendered_technique("pcf")), (V{"shadow_depth", "shading"}));
+  // pcf, pcss and the soft techniques are shaded deferred (a surfaces pass first).
+  EXPECT_EQ(technique_passes(find_rendered_technique("pcf")), (V{"shadow_depth", "surfaces", "shading"}));
+  EXPECT_EQ(technique_passes(find_rendered_technique("plain")), (V{"shadow_depth", "shading"}));
   EXPECT_EQ(technique_passes(find_rendered_technique("msm-hamburger-64")),
             (V{"shadow_depth", "moment_resolve", "blur", "mipmaps", "shading"}));
   EXPECT_EQ(technique_passes(find_rendered_technique("msm-hamburger-64"), true),
@@ -49,7 +51,7 @@ TEST(FrameGraph, RecipesListTheirPassesInOrder) {
                "blur", "mipmaps", "translucent", "blur", "mipmaps", "shading"}));
   EXPECT_EQ(technique_passes(find_rendered_technique("msm-nl64")), (V{"shadow_depth", "one_pass_filter", "shading"}));
   EXPECT_EQ(technique_passes(find_rendered_technique("mssm6")),
-            (V{"shadow_depth", "moment_resolve", "sat", "shading"}));
+            (V{"shadow_depth", "moment_resolve", "sat", "surfaces", "shading"}));
 }
 
 // The order comes from the declarations, not from the list: a shuffled recipe runs in the same

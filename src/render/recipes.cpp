@@ -28,6 +28,7 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
       if (c.mip_levels > 1) passes.push_back(std::make_unique<MipmapPass>(c, channel));
     }
   }
+  if (c.deferred) passes.push_back(std::make_unique<SurfacesPass>(c));
   passes.push_back(std::make_unique<ShadingPass>(c));
   if (msm_technique_is_prefiltered_scattering(id)) {
     passes.push_back(std::make_unique<RectifyPass>(c));
@@ -44,6 +45,16 @@ std::vector<std::string> frame_outputs(const FrameConfig& c) {
   return frame_outputs();
 }
 
+bool supports_deferred_shading(const Technique& technique) {
+  int id = technique.id;
+  return msm_technique_is_depth_based(id) || msm_technique_is_soft(id);
+}
+
+bool default_deferred_shading(const Technique& technique) {
+  int id = technique.id;
+  return id == MSM_TECH_PCF || id == MSM_TECH_PCSS || msm_technique_is_soft(id);
+}
+
 std::vector<std::string> technique_passes(const Technique& technique, bool translucent, bool coloured) {
   RenderSettings defaults;
   FrameConfig c;
@@ -57,6 +68,7 @@ std::vector<std::string> technique_passes(const Technique& technique, bool trans
   c.mip_levels = defaults.mipmaps && !c.one_pass && !msm_technique_is_soft(technique.id) ? 11 : 1;
   c.translucent = translucent && supports_translucency(technique);
   c.coloured = c.translucent && coloured;
+  c.deferred = default_deferred_shading(technique);
   std::vector<std::unique_ptr<Pass>> passes = recipe(c);
   std::vector<std::string> names;
   for (size_t i : order_passes(passes, {}, frame_outputs(c))) names.emplace_back(passes[i]->name());

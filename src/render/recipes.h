@@ -18,4 +18,11 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& config);
 std::vector<std::string> frame_outputs(const FrameConfig& config);
 std::vector<std::string> frame_outputs(); // of the shadow techniques
 
+// Whether a technique is shaded deferred unless the settings say otherwise
+// (RenderSettings::deferred_shading): the per-pixel filters, whose cost then follows visible pixels.
+bool default_deferred_shading(const Technique& technique);
+// Whether it can be: the depth-based and soft techniques (the others' lookups are one filtered fetch,
+// and the scattering pass composites the forward radiance).
+bool supports_deferred_shading(const Technique& technique);
+
 } // namespace msm::render

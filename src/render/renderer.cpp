@@ -274,7 +274,10 @@ struct Renderer::Impl {
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
                   .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0,
-                  .nonlinear_bilinear = msm_technique_is_nonlinear(id) && s.lookup == RenderSettings::Lookup::bilinear};
+                  .nonlinear_bilinear = msm_technique_is_nonlinear(id) && s.lookup == RenderSettings::Lookup::bilinear,
+
+                  .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
+                              supports_deferred_shading(technique)};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     bool can_mip =

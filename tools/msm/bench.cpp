@@ -244,7 +244,7 @@ void add_bench(CLI::App& app) {
         s.height = h;
         progress(fmt::format("[{}/{}] {:<26} shading {}x{}", ++done, total, name, w, h));
         auto frames = run(s);
-        Stats st = pass_sum(frames, {"shading"});
+        Stats st = pass_sum(frames, {"surfaces", "shading"}); // deferred shading: both per pixel
         std::string key = fmt::format("{}x{}", w, h);
         double ns = st.median * 1e6 / (double(w) * h);
         per_unit[name]["shading " + key] = ns;

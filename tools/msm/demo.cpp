@@ -78,7 +78,7 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   std::vector<std::string> pass_names;
   // Every pass any technique ran, in the order of a frame.
   for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps",
-                           "shading", "rectify", "prefix_sums", "scattering"})
+                           "surfaces", "shading", "rectify", "prefix_sums", "scattering"})
     for (const render::RenderResult& r : results)
       if (std::any_of(r.passes.begin(), r.passes.end(), [&](const render::PassTime& p) { return p.name == name; })) {
         pass_names.push_back(name);

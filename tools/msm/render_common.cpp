@@ -53,6 +53,11 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
                   "auto (one-pass for msm-nl*), one-pass (resolve + blur in shared "
                   "memory), three-pass (resolve, blur H, blur V)")
       ->capture_default_str();
+  cmd->add_option(
+         "--shading", o.shading,
+         "auto (deferred for pcf, pcss and the soft techniques), forward (shadows per shaded fragment), "
+         "deferred (a surfaces pass, then shadows once per visible pixel; depth-based and soft techniques only)")
+      ->capture_default_str();
   cmd->add_option("--light-extent", s.light_extent_deg,
                   "Angular diameter of the light in degrees, for soft "
                   "shadows (default: the scene's)");
@@ -86,6 +91,12 @@ void finish_frame_options(FrameOptions& o) {
     o.settings.one_pass = false;
   else if (o.filter_mode != "auto")
     throw UsageError(fmt::format("--filter-mode {}: use auto, one-pass or three-pass", o.filter_mode));
+  if (o.shading == "forward")
+    o.settings.deferred_shading = false;
+  else if (o.shading == "deferred")
+    o.settings.deferred_shading = true;
+  else if (o.shading != "auto")
+    throw UsageError(fmt::format("--shading {}: use auto, forward or deferred", o.shading));
 }
 
 render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique) {

@@ -23,6 +23,7 @@ struct FrameOptions {
   bool no_mipmaps = false;
   std::string lookup = "auto";      // auto, bilinear, nearest, dither
   std::string filter_mode = "auto"; // auto, one-pass, three-pass
+  std::string shading = "auto";     // auto, forward, deferred
 };
 
 // --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --param,

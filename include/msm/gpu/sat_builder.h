@@ -46,9 +46,13 @@ class SatBuilder {
     // JCGT Appendix C: 8 × 8 workgroups walking 8 × 8 blocks, eight threads per row (then per
     // column), each writing one prefix sum per block. Timer scope "sat_blocks" (both passes).
     blocks,
+    // rows_then_columns with coalesced rows: a workgroup of 64 threads per row scans it in chunks
+    // of 64 neighbouring texels (shared memory), then the column pass. Every texel read and
+    // written once per pass. Timer scopes "sat_rows" and "sat_columns".
+    scan_rows_then_columns,
   };
 
-  // Creates the four compute pipelines and a nearest sampler.
+  // Creates the compute pipelines and a nearest sampler.
   explicit SatBuilder(const vk::Context& ctx);
 
   // Records the passes that fill `table` with the summed-area table of `moments` for kernels of
@@ -77,6 +81,7 @@ class SatBuilder {
  private:
   vk::Program rows_, columns_, block_rows_, block_columns_;
   vk::Program rows_rg_, columns_rg_, block_rows_rg_, block_columns_rg_; // RG32_UINT tables
+  vk::Program scan_rows_, scan_rows_rg_;
   vk::Sampler sampler_;
 };
 

@@ -105,6 +105,12 @@ struct RenderSettings {
   // H, blur V through device memory. Default: on for the non-linear techniques (they need it),
   // off for the others; not for 6MSM; at most 17 taps.
   std::optional<bool> one_pass;
+  // Deferred shading: a surfaces pass writes the visible surface of each pixel, then the shadows
+  // are evaluated once per pixel in a full-screen pass, so their cost follows visible pixels, not
+  // shaded quads and overdraw (the same image: the surface is stored bit for bit). Default: on for
+  // the per-pixel filters (pcf, pcss and the soft techniques), off for the others; only the
+  // depth-based and soft techniques have it (the others' lookup is one filtered fetch).
+  std::optional<bool> deferred_shading;
   int frame = 0; // frame number: picks the blue-noise layer and offset
   // Translucent occluders (materials with opacity < 1 or an opacity texture): blended into the
   // moment map back to front after the opaque resolve (JCGT §3), by the linear techniques with

@@ -15,7 +15,7 @@ constexpr VkFormat kTempFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 } // namespace
 
-std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear) {
+std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear, bool mip1) {
   static_assert(MSM_BLUR_MAX_PAIRS == (MSM_FILTER_MAX_TAPS / 2 + 1) / 2);
   auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
   int pairs = msm_filter_pairs(taps);
@@ -27,6 +27,7 @@ std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinea
         {uint32_t(MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + j), bits(msm_filter_pair_weight(j, taps, sigma))});
   }
   c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS), bilinear ? 1u : 0u});
+  c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 3 + 2 * MSM_BLUR_MAX_PAIRS), mip1 ? 1u : 0u});
   return c;
 }
 
@@ -48,9 +49,15 @@ void BlurPass::prepare(const PassResources& r) {
     throw RenderError(fmt::format("the blur needs linear filtering of RGBA32F images; {} has none (use "
                                   "--filter-mode one-pass or --filter 1)",
                                   ctx.info().name));
-  program_ =
-      &r.programs.compute("blur.comp", {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(ImagePassPush),
-                          blur_constants(config_.taps, config_.sigma, bilinear_blur(config_)));
+  const std::vector<vk::Binding> bindings = {vk::Binding::sampled_image, vk::Binding::storage_image,
+                                             vk::Binding::storage_image};
+  bool bilinear = bilinear_blur(config_);
+  program_ = &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush),
+                                 blur_constants(config_.taps, config_.sigma, bilinear, false));
+  vertical_program_ = config_.blur_writes_mip1()
+                          ? &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush),
+                                                blur_constants(config_.taps, config_.sigma, bilinear, true))
+                          : program_;
 }
 
 void BlurPass::reflect(PassBuilder& b) const {
@@ -79,15 +86,21 @@ void BlurPass::execute(const PassContext& c) const {
       vk::pipeline_barrier(c.cmd, vk::image_barrier(temp.image.handle(), VK_IMAGE_ASPECT_COLOR_BIT, compute,
                                                     VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
                                                     compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
+      vk::Descriptor temp_storage(temp.layer_views[0], general);
       vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(moments, general, sampler), vk::Descriptor(temp.layer_views[0], general)},
+                   {vk::Descriptor(moments, general, sampler), temp_storage, temp_storage},
                    ImagePassPush{glm::ivec4(size, size, 0, 0)});
       vk::pipeline_barrier(
           c.cmd,
           vk::memory_barrier(compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
                              compute, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
-      vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(temp.layer_views[0], general, sampler), vk::Descriptor(moments, general)},
+      // With mips: mip 1 too, each invocation a 2 x 2 block (the mipmap pass starts at mip 2).
+      bool mip1 = config_.blur_writes_mip1();
+      const GraphImage& target = c.image(moment_image(channel_, i));
+      uint32_t vertical_groups = mip1 ? vk::group_count(uint32_t(size / 2), 8) : groups;
+      vk::dispatch(c.cmd, *vertical_program_, vertical_groups, vertical_groups, 1,
+                   {vk::Descriptor(temp.layer_views[0], general, sampler), vk::Descriptor(moments, general),
+                    vk::Descriptor(mip1 ? target.layer_mip1_views[size_t(l)] : moments, general)},
                    ImagePassPush{glm::ivec4(size, size, 1, 0)});
     }
     c.end_light();

@@ -21,7 +21,7 @@ void MipmapPass::execute(const PassContext& c) const {
   for (int i = 0; i < config_.moment_images(); ++i) {
     VkImage image = c.image(moment_image(channel_, i)).image.handle();
     int32_t size = config_.shadow_size;
-    for (uint32_t mip = 1; mip < config_.mip_levels; ++mip) {
+    for (uint32_t mip = config_.blur_writes_mip1() ? 2 : 1; mip < config_.mip_levels; ++mip) {
       vk::pipeline_barrier(c.cmd, vk::image_barrier(image, color, transfer, VK_ACCESS_2_TRANSFER_READ_BIT,
                                                     VK_IMAGE_LAYOUT_UNDEFINED, transfer, VK_ACCESS_2_TRANSFER_WRITE_BIT,
                                                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, mip, 1));

@@ -10,8 +10,9 @@ namespace {
 const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& config) {
   const vk::Context& ctx = programs.context();
   int radius = config.taps / 2;
-  // The tile of resolved moments: (32 + 2R) x (16 + 2R) texels of four floats (one_pass_filter.glsl).
-  uint32_t shared = uint32_t((32 + 2 * radius) * (16 + 2 * radius) * 16);
+  // Four resolved rows of 32 + 2R texels and a ring of 4 (1 + ceil(2R / 4)) horizontal rows of 32,
+  // four floats each (one_pass_filter.glsl).
+  uint32_t shared = uint32_t((4 * (32 + 2 * radius) + 4 * (1 + (2 * radius + 3) / 4) * 32) * 16);
   if (shared > ctx.properties().limits.maxComputeSharedMemorySize)
     throw RenderError(fmt::format("the one-pass filter with {} taps needs {} bytes of shared memory; {} has {}",
                                   config.taps, shared, ctx.info().name,
@@ -39,7 +40,7 @@ void OnePassFilterPass::execute(const PassContext& c) const {
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     vk::dispatch(
-        c.cmd, *program_, vk::group_count(size, 32), vk::group_count(size, 16), 1,
+        c.cmd, *program_, vk::group_count(size, 32), vk::group_count(size, 128), 1,
         {vk::Descriptor(c.frame.uniforms),
          vk::Descriptor(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler),
          vk::Descriptor(moments.layer_mip0_views[size_t(l)], VK_IMAGE_LAYOUT_GENERAL)},

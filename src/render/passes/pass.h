@@ -94,10 +94,12 @@ class TranslucentPass : public Pass {
 // blur.comp's specialization constants for a kernel (msm/filter.h's pairs of taps), fetched
 // bilinearly or as point pairs; the shader's bindings are the source (sampled through a linear,
 // clamp-to-edge sampler when bilinear) and the target.
-std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear);
+// With mip1 the shader blurs 2 x 2 texels per invocation and writes their average to binding 2
+// (dispatch over half the size in each direction; the size even).
+std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear, bool mip1);
 
 // Moment images (mip 0) of one channel -> separable Gaussian (msm/filter.h) in place, through a
-// float scratch image.
+// float scratch image; the vertical direction also writes mip 1 where FrameConfig::blur_writes_mip1().
 class BlurPass : public Pass {
  public:
   BlurPass(const FrameConfig& config, int channel) : config_(config), channel_(channel) {}
@@ -107,13 +109,13 @@ class BlurPass : public Pass {
   void execute(const PassContext& c) const override;
 
  private:
-  const vk::Program* program_ = nullptr;
+  const vk::Program *program_ = nullptr, *vertical_program_ = nullptr;
   FrameConfig config_;
   int channel_;
 };
 
-// Moment images of one channel: mips 1.. by linear blits of the previous mip (averages of moments
-// are moments).
+// Moment images of one channel: mips 1.. (2.. where the blur wrote mip 1) by linear blits of the
+// previous mip (averages of moments are moments).
 class MipmapPass : public Pass {
  public:
   MipmapPass(const FrameConfig& config, int channel) : config_(config), channel_(channel) {}
@@ -141,8 +143,24 @@ class SatPass : public Pass {
   FrameConfig config_;
 };
 
+// Deferred shading (FrameConfig::deferred): the opaque scene -> camera_depth and the visible
+// surface of each pixel (surface_position, surface_normal, surface_albedo), cut-outs discarded.
+class SurfacesPass : public Pass {
+ public:
+  explicit SurfacesPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "surfaces"; }
+  void prepare(const PassResources& r) override;
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  const vk::Program* program_ = nullptr;
+  FrameConfig config_;
+};
+
 // Scene + shadow_depth, moment images or tables -> color (sRGB) and shadow_buffer: Lambert + ambient
 // with every light's shadow (msm/shading.h), over-darkening, ACES; translucent surfaces blended over.
+// Deferred: the opaque surfaces come from the surfaces pass, shaded by one full-screen triangle.
 class ShadingPass : public Pass {
  public:
   explicit ShadingPass(const FrameConfig& config) : config_(config) {}
@@ -152,7 +170,8 @@ class ShadingPass : public Pass {
   void execute(const PassContext& c) const override;
 
  private:
-  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr; // opaque; translucent over it
+  // opaque (forward, or the full-screen deferred one); translucent over it (forward)
+  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr;
   FrameConfig config_;
 };
 

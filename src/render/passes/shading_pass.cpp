@@ -3,24 +3,40 @@
 #include "msm/shading.h"
 #include "msm/techniques.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <span>
 
 namespace msm::render {
 namespace {
 
-vk::GraphicsDesc shading_desc(const FrameConfig& config, bool translucent) {
+// The pipelines of the shading: forward (opaque, or translucent blended over), and deferred shading's
+// surfaces pass and full-screen pass.
+enum class Stage { opaque, translucent, surfaces, deferred };
+
+std::string fragment_shader(const FrameConfig& config, Stage stage) {
+  int id = config.technique->id;
+  if (stage == Stage::surfaces) return "surfaces.frag";
+  bool deferred = stage == Stage::deferred;
+  if (msm_technique_is_depth_based(id)) {
+    std::string family = deferred ? "shading_depth_deferred" : "shading_depth";
+    return family + (config.msaa == 1 ? "_1x.frag" : ".frag");
+  }
+  if (msm_technique_is_soft(id)) return deferred ? "shading_soft_deferred.frag" : "shading_soft.frag";
+  if (deferred) throw RenderError(fmt::format("{}: no deferred shading", config.technique->name));
+  return id == MSM_TECH_NL64   ? "shading_nl64.frag"
+         : id == MSM_TECH_NL32 ? "shading_nl32.frag"
+         : config.coloured     ? "shading_moments_rgb.frag"
+                               : "shading_moments.frag";
+}
+
+vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
   const Technique& technique = *config.technique;
-  std::string fragment = msm_technique_is_depth_based(technique.id)
-                             ? (config.msaa == 1 ? "shading_depth_1x.frag" : "shading_depth.frag")
-                         : technique.id == MSM_TECH_NL64       ? "shading_nl64.frag"
-                         : technique.id == MSM_TECH_NL32       ? "shading_nl32.frag"
-                         : msm_technique_is_soft(technique.id) ? "shading_soft.frag"
-                         : config.coloured                     ? "shading_moments_rgb.frag"
-                                                               : "shading_moments.frag";
   vk::GraphicsDesc d{
-      .name = std::string("shading ") + std::string(technique.name),
+      .name = std::string(stage == Stage::surfaces ? "surfaces " : "shading ") + std::string(technique.name),
       .vertex_shader = "shading.vert",
-      .fragment_shader = fragment,
+      .fragment_shader = fragment_shader(config, stage),
       .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image},
       .push_constant_size = sizeof(ObjectPush),
       .vertex_stride = sizeof(Vertex),
@@ -29,7 +45,7 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, bool translucent) {
                      {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
       .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
       .depth_format = VK_FORMAT_D32_SFLOAT,
-      .depth_write = !translucent,
+      .depth_write = stage == Stage::opaque || stage == Stage::surfaces,
       .constants = {{0, uint32_t(technique.id)}, {3, config.split_rg() ? 1u : 0u}, {4, config.lights == 1 ? 1u : 0u}}};
   if (msm_technique_is_nonlinear(technique.id)) d.constants.push_back({9, config.nonlinear_bilinear ? 1u : 0u});
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
@@ -41,19 +57,114 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, bool translucent) {
   // (coloured translucency), then the lights (binding 10); the same layout for every technique.
   for (int i = 0; i < 7; ++i) d.bindings.push_back(vk::Binding::sampled_image);
   d.bindings.push_back(vk::Binding::storage_buffer);
-  if (translucent) { // over the opaque image; the shadow buffer keeps the opaque surface's
+  if (stage == Stage::translucent) { // over the opaque image; the shadow buffer keeps the opaque surface's
     d.name += " (translucent)";
     d.alpha_blend = true;
     d.color_write_masks = {VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT, 0};
+  } else if (stage == Stage::surfaces) { // position, normal, albedo: exact, as the forward pass has them
+    d.color_formats.assign(3, VK_FORMAT_R32G32B32A32_SFLOAT);
+  } else if (stage == Stage::deferred) { // the surfaces (bindings 11-13), a full-screen triangle
+    d.name += " (deferred)";
+    d.vertex_shader = "fullscreen.vert";
+    d.vertex_stride = 0;
+    d.attributes.clear();
+    d.depth_compare = VK_COMPARE_OP_ALWAYS; // the translucent draws after it test against the surfaces
+    for (int i = 0; i < 3; ++i) d.bindings.push_back(vk::Binding::sampled_image);
   }
   return d;
 }
 
+const VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+
+// The shading's bindings 0-10 but the per-draw textures (1 and 5): the uniforms, the shadow maps of
+// the technique (placeholders of the declared kind where unused), the blue noise and the lights.
+std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameConfig& config, bool shadow_maps) {
+  const GpuScene& scene = c.frame.scene;
+  int id = config.technique->id;
+  bool depth_based = msm_technique_is_depth_based(id), soft = msm_technique_is_soft(id),
+       nonlinear = msm_technique_is_nonlinear(id);
+  auto array_of = [&](const std::string& name, VkSampler sampler) {
+    return vk::Descriptor(c.image(name).array_view, kReadOnly, sampler);
+  };
+  VkSampler moment_sampler = nonlinear ? c.frame.point_sampler : c.frame.linear_sampler;
+  vk::Descriptor white(scene.white.view(), kReadOnly, c.frame.point_sampler);
+  vk::Descriptor white_array(scene.white_array, kReadOnly, c.frame.point_sampler);
+  // Every shadow-map binding is an array (one layer per light); the unused ones get an image of the
+  // declared kind. The surfaces pass reads none.
+  vk::Descriptor first = !shadow_maps  ? white_array
+                         : depth_based ? array_of(kShadowDepth, c.frame.point_sampler)
+                         : soft        ? array_of(sat_table(0), c.frame.point_sampler)
+                                       : array_of(moment_image(0, 0), moment_sampler);
+  bool two = config.moment_images() > 1;
+  vk::Descriptor second = depth_based || !shadow_maps ? white
+                          : nonlinear                 ? white_array
+                          : !two                      ? first
+                          : soft                      ? array_of(sat_table(1), c.frame.point_sampler)
+                                                      : array_of(moment_image(0, 1), moment_sampler);
+  vk::Descriptor noise(c.frame.blue_noise.view(), kReadOnly, c.frame.point_sampler);
+  std::array<vk::Descriptor, 4> colour{first, second, first, second};
+  if (config.coloured && shadow_maps)
+    for (int channel = 1; channel < 3; ++channel)
+      for (int i = 0; i < 2; ++i)
+        colour[size_t(2 * (channel - 1) + i)] =
+            array_of(moment_image(channel, std::min(i, config.moment_images() - 1)), moment_sampler);
+  return {
+      vk::Descriptor(c.frame.uniforms), white, first, second, noise, white, colour[0], colour[1], colour[2], colour[3],
+      vk::Descriptor(c.frame.lights)};
+}
+
+// Draws the scene's `draws` (in that order) with `program`, each with its textures (bindings 1, 5).
+void draw_scene(const PassContext& c, const vk::Program& program, std::vector<vk::Descriptor> descriptors,
+                std::span<const Draw* const> draws) {
+  const GpuScene& scene = c.frame.scene;
+  for (const Draw* d : draws) {
+    const vk::Image& texture = d->texture >= 0 ? scene.textures[size_t(d->texture)] : scene.white;
+    const vk::Image& opacity =
+        d->opacity_texture >= 0 ? scene.opacity_textures[size_t(d->opacity_texture)] : scene.white;
+    descriptors[1] = vk::Descriptor(texture.view(), kReadOnly, scene.texture_sampler);
+    descriptors[5] = vk::Descriptor(opacity.view(), kReadOnly, scene.texture_sampler);
+    vkCmdSetCullMode(c.cmd, d->double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
+    vk::bind_program(c.cmd, program, descriptors, std::as_bytes(std::span(&d->push, 1)));
+    vkCmdDrawIndexed(c.cmd, d->index_count, 1, d->first_index, 0, 0);
+  }
+}
+
+std::vector<const Draw*> opaque_draws(const GpuScene& scene) {
+  std::vector<const Draw*> draws;
+  for (const Draw& d : scene.draws) draws.push_back(&d);
+  return draws;
+}
+
 } // namespace
 
+void SurfacesPass::prepare(const PassResources& r) {
+  program_ = &r.programs.graphics(shading_desc(config_, Stage::surfaces));
+}
+
+void SurfacesPass::reflect(PassBuilder& b) const {
+  uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
+  for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo})
+    b.create(name, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
+  b.create(kCameraDepth, {.format = VK_FORMAT_D32_SFLOAT, .width = w, .height = h}, use::depth_attachment());
+}
+
+void SurfacesPass::execute(const PassContext& c) const {
+  VkExtent2D size{uint32_t(config_.width), uint32_t(config_.height)};
+  VkClearColorValue none{{0.0f, 0.0f, 0.0f, 0.0f}}; // w = 0: no surface
+  vk::begin_rendering(c.cmd, size,
+                      {{c.image(kSurfacePosition).layer_views[0], none},
+                       {c.image(kSurfaceNormal).layer_views[0], none},
+                       {c.image(kSurfaceAlbedo).layer_views[0], none}},
+                      vk::DepthAttachment{c.image(kCameraDepth).layer_views[0], 1.0f});
+  vk::set_viewport_scissor(c.cmd, size);
+  bind_scene(c.cmd, c.frame.scene);
+  draw_scene(c, *program_, frame_descriptors(c, config_, false), opaque_draws(c.frame.scene));
+  vkCmdEndRendering(c.cmd);
+}
+
 void ShadingPass::prepare(const PassResources& r) {
-  program_ = &r.programs.graphics(shading_desc(config_, false));
-  translucent_program_ = &r.programs.graphics(shading_desc(config_, true));
+  program_ = &r.programs.graphics(shading_desc(config_, config_.deferred ? Stage::deferred : Stage::opaque));
+  translucent_program_ = &r.programs.graphics(shading_desc(config_, Stage::translucent));
 }
 
 void ShadingPass::reflect(PassBuilder& b) const {
@@ -74,16 +185,18 @@ void ShadingPass::reflect(PassBuilder& b) const {
   else
     b.create(kColor, {.format = VK_FORMAT_R8G8B8A8_SRGB, .width = w, .height = h}, use::color_attachment());
   b.create(kShadowBuffer, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
-  b.create(kCameraDepth, {.format = VK_FORMAT_D32_SFLOAT, .width = w, .height = h}, use::depth_attachment());
+  if (config_.deferred) {
+    for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo}) b.read(name, use::sampled(fragment));
+    b.modify(kCameraDepth, use::depth_attachment()); // the translucent draws test against it
+  } else {
+    b.create(kCameraDepth, {.format = VK_FORMAT_D32_SFLOAT, .width = w, .height = h}, use::depth_attachment());
+  }
 }
 
 void ShadingPass::execute(const PassContext& c) const {
   const GpuScene& scene = c.frame.scene;
-  int id = config_.technique->id;
-  bool depth_based = msm_technique_is_depth_based(id), soft = msm_technique_is_soft(id),
-       nonlinear = msm_technique_is_nonlinear(id);
   // Scattering techniques: the linear radiance (the sky's too), composited by the scattering pass.
-  bool scatters = msm_technique_is_scattering(id);
+  bool scatters = msm_technique_is_scattering(config_.technique->id);
   const GraphImage& color = c.image(scatters ? kSurfaceRadiance : kColor);
   const GraphImage& shadow_buffer = c.image(kShadowBuffer);
   VkExtent2D size{uint32_t(config_.width), uint32_t(config_.height)};
@@ -91,54 +204,28 @@ void ShadingPass::execute(const PassContext& c) const {
   glm::vec3 sky_radiance = scatters ? glm::vec3(c.frame.scattering.sky) : MSM_SKY_RADIANCE; // shown the same
   VkClearColorValue sky{{sky_radiance.r, sky_radiance.g, sky_radiance.b, 1.0f}}, lit{{1.0f, 1.0f, 1.0f, 0.0f}};
   vk::begin_rendering(c.cmd, size, {{color.layer_views[0], sky}, {shadow_buffer.layer_views[0], lit}},
-                      vk::DepthAttachment{c.image(kCameraDepth).layer_views[0], 1.0f});
+                      vk::DepthAttachment{c.image(kCameraDepth).layer_views[0], 1.0f, config_.deferred});
   vk::set_viewport_scissor(c.cmd, size);
   bind_scene(c.cmd, scene);
-
-  const VkImageLayout read_only = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  auto array_of = [&](const std::string& name, VkSampler sampler) {
-    return vk::Descriptor(c.image(name).array_view, read_only, sampler);
-  };
-  VkSampler moment_sampler = nonlinear ? c.frame.point_sampler : c.frame.linear_sampler;
-  vk::Descriptor white(scene.white.view(), read_only, c.frame.point_sampler);
-  // Every shadow-map binding is an array (one layer per light); the unused ones get an image of the
-  // declared kind.
-  vk::Descriptor first = depth_based ? array_of(kShadowDepth, c.frame.point_sampler)
-                         : soft      ? array_of(sat_table(0), c.frame.point_sampler)
-                                     : array_of(moment_image(0, 0), moment_sampler);
-  bool two = config_.moment_images() > 1;
-  vk::Descriptor second = depth_based ? white
-                          : nonlinear ? vk::Descriptor(scene.white_array, read_only, c.frame.point_sampler)
-                          : !two      ? first
-                          : soft      ? array_of(sat_table(1), c.frame.point_sampler)
-                                      : array_of(moment_image(0, 1), moment_sampler);
-  vk::Descriptor noise(c.frame.blue_noise.view(), read_only, c.frame.point_sampler);
-  std::array<vk::Descriptor, 4> colour{first, second, first, second};
-  if (config_.coloured)
-    for (int channel = 1; channel < 3; ++channel)
-      for (int i = 0; i < 2; ++i)
-        colour[size_t(2 * (channel - 1) + i)] =
-            array_of(moment_image(channel, std::min(i, config_.moment_images() - 1)), moment_sampler);
-  auto draw = [&](const vk::Program& program, const Draw& d) {
-    const vk::Image& texture = d.texture >= 0 ? scene.textures[size_t(d.texture)] : scene.white;
-    const vk::Image& opacity = d.opacity_texture >= 0 ? scene.opacity_textures[size_t(d.opacity_texture)] : scene.white;
-    vk::Descriptor albedo(texture.view(), read_only, scene.texture_sampler);
-    vk::Descriptor alpha(opacity.view(), read_only, scene.texture_sampler);
-    vkCmdSetCullMode(c.cmd, d.double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
-    vk::bind_program(c.cmd, program,
-                     {vk::Descriptor(c.frame.uniforms), albedo, first, second, noise, alpha, colour[0], colour[1],
-                      colour[2], colour[3], vk::Descriptor(c.frame.lights)},
-                     d.push);
-    vkCmdDrawIndexed(c.cmd, d.index_count, 1, d.first_index, 0, 0);
-  };
-  for (const Draw& d : scene.draws) draw(*program_, d);
+  std::vector<vk::Descriptor> descriptors = frame_descriptors(c, config_, true);
+  if (config_.deferred) { // one full-screen triangle over the surfaces
+    std::vector<vk::Descriptor> deferred = descriptors;
+    for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo})
+      deferred.emplace_back(c.image(name).layer_views[0], kReadOnly, c.frame.point_sampler);
+    vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
+    ObjectPush none{};
+    vk::bind_program(c.cmd, *program_, deferred, std::as_bytes(std::span(&none, 1)));
+    vkCmdDraw(c.cmd, 3, 1, 0, 0);
+  } else {
+    draw_scene(c, *program_, descriptors, opaque_draws(scene));
+  }
   // Translucent surfaces over the opaque image, far to near from the camera (per object).
   std::vector<const Draw*> order;
   for (const Draw& d : scene.translucent) order.push_back(&d);
   std::stable_sort(order.begin(), order.end(), [&](const Draw* a, const Draw* b) {
     return glm::distance(a->center, c.frame.camera_position) > glm::distance(b->center, c.frame.camera_position);
   });
-  for (const Draw* d : order) draw(*translucent_program_, *d);
+  draw_scene(c, *translucent_program_, descriptors, order);
   vkCmdEndRendering(c.cmd);
 }
 

@@ -5,6 +5,9 @@
 // (msm_filter_pair_offset in msm/filter.h); with a point sampler the host passes the single taps
 // at integer offsets. Clamp-to-edge comes from the sampler. No test for non-finite texels: the
 // resolve writes finite moments only (RenderTest.ResolveWritesFiniteMoments).
+// With kMip1 (the vertical direction where the map has mips) each invocation blurs a 2 x 2 block of
+// texels and also writes their average to `target_mip1`, the next mip: the mipmap pass then starts
+// at mip 2 and no pass reads mip 0 again for it.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "msm/render/frame.h"
@@ -13,6 +16,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(binding = 0) uniform sampler2D source;
 layout(binding = 1) writeonly uniform image2D target;
+layout(binding = 2) writeonly uniform image2D target_mip1; // kMip1
 
 layout(push_constant) uniform Push { ImagePassPush pc; };
 
@@ -42,6 +46,7 @@ MSM_BLUR_PAIR(16)
 // fraction of the pair's offset: exact, for the 32-bit float maps (a bilinear fetch's fraction is
 // only as precise as the coordinate, ~1e-5 of a texel at 200 texels, 2e-4 at 2048).
 layout(constant_id = MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS) const bool kBilinear = true;
+layout(constant_id = MSM_BLUR_SPEC_ID + 3 + 2 * MSM_BLUR_MAX_PAIRS) const bool kMip1 = false;
 
 ivec2 g_p, g_step, g_last;
 vec4 point_pair(int inner, float offset, float weight) {
@@ -54,9 +59,7 @@ vec4 point_pair(int inner, float offset, float weight) {
               texelFetch(source, clamp(g_p + (inner + 1) * g_step, ivec2(0), g_last), 0));
 }
 
-void main() {
-  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-  if (p.x >= pc.size.x || p.y >= pc.size.y) return;
+vec4 blur_at(ivec2 p) {
   vec2 texel = 1.0f / vec2(pc.size.xy);
   vec2 centre = (vec2(p) + 0.5f) * texel;
   vec2 step = pc.size.z == 0 ? vec2(texel.x, 0.0f) : vec2(0.0f, texel.y);
@@ -86,5 +89,25 @@ void main() {
   MSM_BLUR_FETCH(14)
   MSM_BLUR_FETCH(15)
   MSM_BLUR_FETCH(16)
-  imageStore(target, p, sum);
+  return sum;
+}
+
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  if (!kMip1) {
+    if (p.x >= pc.size.x || p.y >= pc.size.y) return;
+    imageStore(target, p, blur_at(p));
+    return;
+  }
+  // p: a texel of mip 1 (the host makes sure the size is even).
+  if (2 * p.x >= pc.size.x || 2 * p.y >= pc.size.y) return;
+  vec4 sum = vec4(0.0f);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) {
+      ivec2 q = 2 * p + ivec2(x, y);
+      vec4 v = blur_at(q);
+      imageStore(target, q, v);
+      sum += v;
+    }
+  imageStore(target_mip1, p, 0.25f * sum);
 }

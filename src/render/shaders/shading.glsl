@@ -23,12 +23,30 @@ layout(binding = 1) uniform sampler2D albedo_texture;
 layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
 layout(push_constant) uniform Push { ObjectPush object; };
 
+#ifdef MSM_DEFERRED_SHADOWS
+// Deferred shading (a full-screen pass): the visible surface of each pixel from the surfaces pass
+// (MSM_SURFACES below), bit for bit what the forward pass interpolates, so one shadow evaluation per
+// pixel gives the forward pass's result.
+layout(binding = 11) uniform sampler2D surface_position; // xyz; w: 1 where a surface, 0 background
+layout(binding = 12) uniform sampler2D surface_normal;   // xyz: towards the viewer
+layout(binding = 13) uniform sampler2D surface_albedo;   // rgb, a: opacity
+vec3 world_position;
+#else
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec2 texcoord;
+#endif
 
+#ifdef MSM_SURFACES
+layout(location = 0) out vec4 out_position;
+layout(location = 1) out vec4 out_normal;
+layout(location = 2) out vec4 out_albedo;
+#else
 layout(location = 0) out vec4 out_color;  // tone mapped; the attachment is sRGB (kLinearRadiance: linear)
 layout(location = 1) out vec4 out_shadow; // rgb: light visibility per colour channel, a: 1 (a surface)
+#endif
+
+#ifndef MSM_SURFACES
 
 // Where a fragment looks up the shadow map: t in texel-centre coordinates (texel i covers
 // [i - 0.5, i + 0.5)), z its depth in [0,1], and the receiver plane's depth per texel along x and
@@ -83,18 +101,13 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
   return 1.0f - shadow;
 }
 
-#include "alpha_test.glsl"
-
-void main() {
-  // Cut-outs (alpha mask) are discarded at the end: the lookups' derivatives need the whole quad.
-  bool cut_out = !alpha_test_passes(object, opacity_texture, texcoord);
-  vec3 n = normalize(world_normal);
-  if (!gl_FrontFacing) n = -n; // only double-sided materials show back faces (culling)
-
-  // The shadow buffer holds the visibility of the direct light: with one light its visibility,
-  // with several the mean weighted by the irradiance each one brings (luminance of E max(n·l, 0),
-  // the cone's integral for area lights).
-  vec3 direct = vec3(0.0f), weighted = vec3(0.0f), first = vec3(0.0f);
+// Direct light of every light at world_position with normal n (towards the viewer), and the
+// shadow buffer's visibility of the direct light: with one light its visibility, with several the
+// mean weighted by the irradiance each one brings (luminance of E max(n·l, 0), the cone's integral
+// for area lights).
+void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
+  vec3 weighted = vec3(0.0f), first = vec3(0.0f);
+  direct = vec3(0.0f);
   float weight_sum = 0.0f;
   int light_count = kOneLight ? 1 : frame.lights.x;
   MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
@@ -103,22 +116,65 @@ void main() {
     // Area lights: the cone's cosine integral with the horizon (msm/light_probe.h), which is
     // max(n·l, 0) for point lights (soft.z = 0) and where the whole cone is above the horizon.
     float lit = msm_cone_cosine(n_dot_l, lights[l].soft.z);
-    vec3 visibility = light_visibility(l, n, n_dot_l, lit, pixel);
-    direct += msm_direct_light(lights[l].irradiance.rgb, lit, visibility);
+    vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
+    direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
     float w = msm_luminance(lights[l].irradiance.rgb) * lit;
-    weighted += w * visibility;
+    weighted += w * v;
     weight_sum += w;
-    if (l == 0) first = visibility;
+    if (l == 0) first = v;
   }
-  vec3 visibility = light_count == 1 ? first : (weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f));
+  visibility = light_count == 1 ? first : (weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f));
+}
 
-  vec3 albedo = object.albedo_opacity.rgb;
-  if (object.flags.x != 0) albedo *= texture(albedo_texture, texcoord).rgb;
-  vec3 radiance = msm_surface_radiance(albedo, direct, MSM_AMBIENT);
+void write_shaded(vec4 albedo_opacity, vec3 direct, vec3 visibility) {
+  vec3 radiance = msm_surface_radiance(albedo_opacity.rgb, direct, MSM_AMBIENT);
   // Alpha: the surface's opacity (translucent objects blend over the opaque image).
-  float opacity = object.albedo_opacity.a;
-  if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
+  float opacity = albedo_opacity.a;
   out_color = kLinearRadiance ? vec4(radiance, opacity) : vec4(msm_aces(radiance * frame.shading.y), opacity);
   out_shadow = vec4(visibility, 1.0f);
+}
+#endif // !MSM_SURFACES
+
+#include "alpha_test.glsl"
+
+#ifndef MSM_DEFERRED_SHADOWS
+// The surface's albedo (rgb) and opacity (a).
+vec4 surface_albedo_opacity() {
+  vec3 albedo = object.albedo_opacity.rgb;
+  if (object.flags.x != 0) albedo *= texture(albedo_texture, texcoord).rgb;
+  float opacity = object.albedo_opacity.a;
+  if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
+  return vec4(albedo, opacity);
+}
+// The normal towards the viewer: only double-sided materials show back faces (culling).
+vec3 facing_normal() { return gl_FrontFacing ? normalize(world_normal) : -normalize(world_normal); }
+#endif
+
+#if defined(MSM_SURFACES)
+void main() {
+  bool cut_out = !alpha_test_passes(object, opacity_texture, texcoord);
+  out_position = vec4(world_position, 1.0f);
+  out_normal = vec4(facing_normal(), 0.0f);
+  out_albedo = surface_albedo_opacity();
   if (cut_out) discard;
 }
+#elif defined(MSM_DEFERRED_SHADOWS)
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  vec4 position = texelFetch(surface_position, p, 0);
+  if (position.w == 0.0f) discard; // the background keeps its clear values
+  world_position = position.xyz;
+  vec3 direct, visibility;
+  direct_light(texelFetch(surface_normal, p, 0).xyz, direct, visibility);
+  write_shaded(texelFetch(surface_albedo, p, 0), direct, visibility);
+}
+#else
+void main() {
+  // Cut-outs (alpha mask) are discarded at the end: the lookups' derivatives need the whole quad.
+  bool cut_out = !alpha_test_passes(object, opacity_texture, texcoord);
+  vec3 direct, visibility;
+  direct_light(facing_normal(), direct, visibility);
+  write_shaded(surface_albedo_opacity(), direct, visibility);
+  if (cut_out) discard;
+}
+#endif
