@@ -366,7 +366,8 @@ TEST(CubeInputs, BadLayoutsAreRefusedClearly) {
   std::filesystem::create_directories(dir);
   const std::filesystem::path odd = dir / "odd.exr", cross = dir / "cross.exr";
   msm::image::write_exr(odd, msm::image::Image(30, 20, std::vector<std::string>{"R", "G", "B"}, 1.0f));
-  EXPECT_NE(message_of([&] { load_probe_file(odd, 4); }).find("is neither an equirectangular panorama"), std::string::npos);
+  EXPECT_NE(message_of([&] { load_probe_file(odd, 4); }).find("is neither an equirectangular panorama"),
+            std::string::npos);
   msm::image::write_exr(cross, msm::image::Image(16, 12, std::vector<std::string>{"R", "G", "B"}, 1.0f));
   EXPECT_NE(message_of([&] { load_probe_file(cross, 4, 30.0f); }).find("cannot be rotated"), std::string::npos);
   EXPECT_NE(message_of([&] { load_probe_file(cross, 3); }).find("not a divisor"), std::string::npos);

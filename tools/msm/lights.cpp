@@ -177,8 +177,9 @@ void run(const LightsOptions& o) {
 } // namespace
 
 void add_lights(CLI::App& app) {
-  const std::string probe_help = "An equirectangular or cube-map cross (4:3, 3:4) EXR (e.g. /usr/share/blender/datafiles/studiolights/world/"
-                                 "studio.exr), or 'sky' for the procedural sky with a sun";
+  const std::string probe_help =
+      "An equirectangular or cube-map cross (4:3, 3:4) EXR (e.g. /usr/share/blender/datafiles/studiolights/world/"
+      "studio.exr), or 'sky' for the procedural sky with a sun";
   const std::string scene_lights_help = "Write the lights as a scene's \"lights\" list (JSON: direction, irradiance "
                                         "on a facing surface, angular diameter)";
   const std::string picture_help = "Write the cube map as a cross with the regions outlined (.png or .exr)";

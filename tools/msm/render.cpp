@@ -32,7 +32,7 @@ void add_render(CLI::App& app) {
     FrameOptions frame;
     std::string techniques = "msm-hamburger-64";
     std::string out = "msm-render";
-    std::string view;          // a view file (msm view)
+    std::string view; // a view file (msm view)
     ProbeFrames probe_frames;
     std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
   };
