@@ -5,7 +5,10 @@
 //     marching (32, 128 samples), CSM-32 and four and six moments, errors in the visible fraction
 //     of each view ray against the ray-traced scattering;
 //  3. soft shadows: the `models` scene (JCGT Fig. 8) with moment soft shadows (four and six
-//     moments) and their baselines VSSM and PCSS, errors against the ray-traced area light.
+//     moments) and their baselines VSSM and PCSS, errors against the ray-traced area light;
+//  4. image-based lighting (Kneiphof): the `sky_probe` scene at a third of the width and height,
+//     its probe cut into 16, 32 and 64 area lights with mssm6, 32 with pcss and 256 point lights
+//     with hard shadows, errors against the full probe's Monte Carlo ground truth.
 // Each part writes one labelled image with magnified insets where the techniques differ, and
 // prints a table of the errors and the GPU time per pass.
 #include "render_common.h"
@@ -140,6 +143,79 @@ void scatter_part(render::Renderer& renderer, const vk::Context& ctx, const Fram
                      true);
 }
 
+// The ray tracer's radiance in the renderer's look: ACES after the exposure, its sky where no surface is.
+image::Image truth_look(const reference::Result& truth, float exposure) {
+  image::Image rgb = image::tone_map(truth.radiance, {std::log2(exposure), image::ToneCurve::aces});
+  for (int y = 0; y < rgb.height(); ++y)
+    for (int x = 0; x < rgb.width(); ++x)
+      if (truth.visibility.at(x, y, 1) > 0.5f)
+        for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = MSM_SKY_RADIANCE[c];
+  return rgb;
+}
+
+// The luminance (msm_luminance) of an RGB image, one channel.
+image::Image luminance_of(const image::Image& rgb) {
+  image::Image y(rgb.width(), rgb.height(), 1);
+  for (int j = 0; j < rgb.height(); ++j)
+    for (int i = 0; i < rgb.width(); ++i)
+      y.at(i, j, 0) = msm_luminance(glm::vec3(rgb.at(i, j, 0), rgb.at(i, j, 1), rgb.at(i, j, 2)));
+  return y;
+}
+
+// One configuration of the image-based-lighting part: a technique and the probe's light count.
+struct IblCase {
+  std::string technique;
+  int lights;
+};
+const std::vector<IblCase> kIblCases = {
+    {"mssm6", 16}, {"mssm6", 32}, {"mssm6", 64}, {"pcss", 32}, {"msm-hamburger-64", 256}};
+
+// Part 4: image-based lighting against the full probe's ground truth (`samples` per pixel). Each
+// light count is its own cut of the probe (scene::set_probe_light_count) and so its own renderer.
+// The error is in the luminance of the tone-mapped images (the look, as scripts/ibl-compare.sh
+// measures it), background excluded; it adds the lights' extraction and the shadows.
+void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Scene& scene, int samples,
+              const std::string& out) {
+  const render::RenderSettings& fs = frame.settings;
+  fmt::print("\nmsm demo: image-based lighting, scene '{}' at {}x{}, probe {} cut into area lights, shadow map "
+             "{}², ray traced from the whole probe with {} samples per pixel\n",
+             scene.name, fs.width, fs.height, scene.probe->file.string(), fs.shadow_size, samples);
+  reference::Settings rs;
+  rs.effect = reference::Effect::environment;
+  rs.width = fs.width;
+  rs.height = fs.height;
+  rs.samples = samples;
+  reference::Result truth = reference::render(scene, rs);
+  image::Image truth_rgb = truth_look(truth, fs.exposure);
+  image::Image truth_y = luminance_of(truth_rgb);
+  image::Image mask = truth.visibility.channel("background");
+  std::vector<image::Panel> panels = {{"ray traced, whole probe", truth_rgb, "reference"}};
+  fmt::print("\n{:<20} {:>6} {:>8} {:>7} {:>12}\n", "technique", "lights", "MAE", ">3%", "GPU ms");
+  for (const IblCase& c : kIblCases) {
+    scene::Scene lit = scene;
+    scene::set_probe_light_count(lit, c.lights);
+    render::Renderer renderer(ctx, lit);
+    render::RenderSettings s = settings_for(frame, c.technique);
+    render::RenderResult r = renderer.render(s);
+    const std::string name = fmt::format("ibl-{}-{}", c.technique, c.lights);
+    write_render(out, name, r, render_json(s, lit, ctx, r));
+    image::Metrics m = image::compute_metrics(luminance_of(r.color), truth_y, {.mask = &mask});
+    fmt::print("{:<20} {:>6} {:>8.5f} {:>6.2f}% {:>12.3f}\n", c.technique, c.lights, m.mae, 100 * m.share_above_3pct,
+               r.total_ms);
+    panels.push_back({fmt::format("{}, {} lights", c.technique, c.lights), r.color, fmt::format("MAE {:.4f}", m.mae)});
+  }
+  image::ComposeOptions options;
+  options.columns = 3;
+  image::Image figure = image::compose_comparison(panels, options);
+  std::filesystem::path file = std::filesystem::path(out) / "ibl-comparison.png";
+  try {
+    image::write_png(file, figure);
+  } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+  fmt::print("\nErrors are in the luminance of the tone-mapped image against the ray-traced whole probe, background "
+             "excluded; times are GPU timestamps of one frame.\nWrote {} ({}x{})\n",
+             file.string(), figure.width(), figure.height());
+}
+
 } // namespace
 
 void add_demo(CLI::App& app) {
@@ -155,6 +231,8 @@ void add_demo(CLI::App& app) {
     std::vector<std::string> scatter_techniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
                                                    "scatter-msm4-64", "scatter-msm6-96"};
     int scatter_samples = 32;
+    std::string ibl_scene = "sky_probe";
+    int ibl_samples = 256;
   };
   auto opt = std::make_shared<Options>();
   opt->frame.settings.width = 960;
@@ -165,7 +243,8 @@ void add_demo(CLI::App& app) {
               "non-linear MSM 64/32 into one comparison image, then soft shadows (mssm4, "
               "mssm6, vssm, pcss) against the ray-traced area light; print the errors and "
               "the time per pass; single scattering (ray marching, CSM, four and six moments) against the ray-traced "
-              "scattering in between");
+              "scattering, and image-based lighting (a probe cut into 16-256 area lights) against the whole "
+              "probe, in between");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
       ->delimiter(',');
@@ -182,6 +261,12 @@ void add_demo(CLI::App& app) {
       ->delimiter(',');
   cmd->add_option("--scatter-samples", opt->scatter_samples, "Ray-traced samples per pixel of the scattering reference")
       ->capture_default_str();
+  cmd->add_option("--ibl-scene", opt->ibl_scene,
+                  "Scene of the image-based-lighting part (needs a \"probe\"; rendered at a third of the width and "
+                  "height; \"\": skip the part)")
+      ->capture_default_str();
+  cmd->add_option("--ibl-samples", opt->ibl_samples, "Ray-traced samples per pixel of the whole probe's ground truth")
+      ->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
@@ -194,6 +279,7 @@ void add_demo(CLI::App& app) {
     if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
     if (opt->scatter_samples < 1 || opt->scatter_samples > 4096)
       throw UsageError("--scatter-samples must be in [1, 4096]");
+    if (opt->ibl_samples < 1 || opt->ibl_samples > 4096) throw UsageError("--ibl-samples must be in [1, 4096]");
     validate_techniques(opt->frame, opt->techniques);
     FrameOptions soft = opt->frame;
     soft.scene = opt->soft_scene;
@@ -219,6 +305,25 @@ void add_demo(CLI::App& app) {
       if (!scatter_scene->medium)
         throw UsageError(
             fmt::format("--scatter-scene {}: the scene has no \"medium\" (scenes/README.md)", scatter.scene));
+    }
+    FrameOptions ibl = scatter;
+    ibl.scene = opt->ibl_scene;
+    // One shadow map per light, up to 256 of them: the paper's 256² (Kneiphof §6), not the hard part's size.
+    ibl.settings.shadow_size = std::min(ibl.settings.shadow_size, 256);
+    std::optional<scene::Scene> ibl_scene;
+    if (!opt->ibl_scene.empty()) {
+      ibl_scene = load_scene_or_fail(ibl.scene);
+      if (!ibl_scene->probe)
+        throw UsageError(fmt::format("--ibl-scene {}: the scene has no \"probe\" (scenes/README.md)", ibl.scene));
+      for (const IblCase& c : kIblCases) {
+        validate_techniques(ibl, {c.technique});
+        scene::Scene lit = *ibl_scene;
+        try {
+          scene::set_probe_light_count(lit, c.lights);
+        } catch (const scene::SceneError& e) {
+          throw UsageError(fmt::format("--ibl-scene {}: {}", ibl.scene, e.what()));
+        }
+      }
     }
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     // Both parts' renderers first: what the device cannot do is refused before the output
@@ -247,6 +352,10 @@ void add_demo(CLI::App& app) {
     else
       fmt::print("\nmsm demo: scattering part skipped (no --scatter-techniques)\n");
     scatter_renderer.reset();
+    if (ibl_scene)
+      ibl_part(*ctx, ibl, *ibl_scene, opt->ibl_samples, opt->out);
+    else
+      fmt::print("\nmsm demo: image-based-lighting part skipped (--ibl-scene \"\")\n");
     if (!soft_scene) {
       fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
       return;
@@ -266,12 +375,7 @@ void add_demo(CLI::App& app) {
       if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
     };
     reference::Result truth = reference::render(*soft_scene, rs);
-    // The renderer's look: ACES after the exposure, its sky colour where no surface is.
-    image::Image truth_rgb = image::tone_map(truth.radiance, {std::log2(fs.exposure), image::ToneCurve::aces});
-    for (int y = 0; y < truth_rgb.height(); ++y)
-      for (int x = 0; x < truth_rgb.width(); ++x)
-        if (truth.visibility.at(x, y, 1) > 0.5f)
-          for (int c = 0; c < 3; ++c) truth_rgb.at(x, y, c) = MSM_SKY_RADIANCE[c];
+    image::Image truth_rgb = truth_look(truth, fs.exposure);
     compare_techniques(*soft_renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
                        "soft-comparison.png");
   });
