@@ -207,7 +207,7 @@ TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
                              R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
     const Scene scene = msm::scene::load_scene_json(json, std::filesystem::current_path(), "t.json");
     const msm::probe::CubeMap cube = msm::probe::load_probe("sky", 32);
-    for (const glm::dvec3 n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)), glm::dvec3(0, 0, 1)}) {
+    for (const glm::dvec3& n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)), glm::dvec3(0, 0, 1)}) {
       const glm::dvec3 probe = quadrature(
           cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
       glm::dvec3 lights(0.0);

@@ -609,7 +609,7 @@ TEST(reference_soft, RadianceIntegratesTheCosineOverTheLightAndItsHorizon) {
         sum += direct;
         sum2 += direct * direct;
         worst = std::max(worst, std::abs(direct - lit));
-        if (elevation > 30.0) ASSERT_NEAR(direct, towards.y, 1e-5 * towards.y) << x << "," << y;
+        if (elevation > 30.0) { ASSERT_NEAR(direct, towards.y, 1e-5 * towards.y) << x << "," << y; }
       }
     const double mean = sum / n, se = std::sqrt(std::max(sum2 / n - mean * mean, 0.0) / (n - 1));
     std::printf("[reference soft, 60° disc %+.0f° above the ground] msm_cone_cosine %.5f, image mean %.5f (standard "
@@ -936,7 +936,7 @@ TEST(reference_scattering, BuiltinScenesHaveShafts) {
     // Measured (64 x 36, 16 spp): partly lit tower 0.91, trees 0.56, gate 0.92, room 0.06 (the
     // shaft); dark room 0.94.
     EXPECT_GT(partial, n / 25);
-    if (std::string(name) == "room") EXPECT_GT(dark, n / 2);
+    if (std::string(name) == "room") { EXPECT_GT(dark, n / 2); }
     if (std::string(name) == "tower") {
       // Around the pixel through which the camera sees the light (a pixel here spans 1.4 degrees;
       // the light lies 0.5 degrees below the parapet's top edge): a dark ray, while the image is

@@ -242,7 +242,7 @@ TEST(BuiltinScenes, ScatteringScenes) {
     const Scene s = builtin_scene(name);
     const bool expected = std::find(scattering.begin(), scattering.end(), name) != scattering.end();
     EXPECT_EQ(s.medium.has_value(), expected) << name;
-    if (s.medium) EXPECT_GT(s.medium->extinction, 0.0f) << name;
+    if (s.medium) { EXPECT_GT(s.medium->extinction, 0.0f) << name; }
   }
   const auto in_view = [](const Scene& s, glm::vec3 direction) {
     const glm::vec4 c = s.camera_view_projection(16.0f / 9.0f) * glm::vec4(s.camera.position + direction, 1.0f);

@@ -71,7 +71,9 @@ double copy_ms(const vk::Context& ctx, uint32_t size, int runs) {
       timer.reset(cmd);
       timer.begin(cmd, "copy");
       VkImageCopy region{.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                         .srcOffset = {0, 0, 0},
                          .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
+                         .dstOffset = {0, 0, 0},
                          .extent = {size, size, 1}};
       vkCmdCopyImage(cmd, from.handle(), VK_IMAGE_LAYOUT_GENERAL, to.handle(), VK_IMAGE_LAYOUT_GENERAL, 1, &region);
       timer.end(cmd);

@@ -167,7 +167,7 @@ void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk:
 
 DeviceCut DeviceProbe::read() const {
   ResultOut out;
-  std::memcpy(&out, result_.data(), sizeof(out));
+  std::memcpy(static_cast<void*>(&out), result_.data(), sizeof(out)); // glm members: no trivial assignment, same bytes
   DeviceCut cut;
   const int n = std::min(int(out.region_count), kMaxDeviceLights);
   for (int k = 0; k < n; ++k) {

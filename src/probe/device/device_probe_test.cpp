@@ -205,7 +205,7 @@ TEST_F(DeviceProbeTest, BadInputIsAProbeError) {
   EXPECT_THROW(probe.set_cube(sky_probe(8)), ProbeError);
   EXPECT_THROW(probe.set_panorama(Panorama{4, 2, std::vector<glm::vec3>(7)}), ProbeError);
   // Texels the tables cannot hold: NaN, infinite, negative.
-  for (const glm::vec3 bad : {glm::vec3(std::nanf(""), 0, 0), glm::vec3(0, INFINITY, 0), glm::vec3(0, 0, -1)}) {
+  for (const glm::vec3& bad : {glm::vec3(std::nanf(""), 0, 0), glm::vec3(0, INFINITY, 0), glm::vec3(0, 0, -1)}) {
     Panorama p{4, 2, std::vector<glm::vec3>(8, glm::vec3(1.0f))};
     p.rgb[5] = bad;
     EXPECT_THROW(probe.set_panorama(p), ProbeError);
