@@ -11,6 +11,7 @@
 //     with hard shadows, errors against the full probe's Monte Carlo ground truth.
 // Each part writes one labelled image with magnified insets where the techniques differ, and
 // prints a table of the errors and the GPU time per pass.
+#include "reference_look.h"
 #include "render_common.h"
 
 #include "msm/image/compose.h"
@@ -122,7 +123,17 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
              file.string(), figure.width(), figure.height(), out);
 }
 
-// Part 3: single scattering against the ray-traced ground truth (stratified, `samples` per pixel),
+// The ray tracer's settings of a part: its effect at the part's image size, `samples` per pixel.
+reference::Settings reference_settings(reference::Effect effect, const render::RenderSettings& fs, int samples) {
+  reference::Settings rs;
+  rs.effect = effect;
+  rs.width = fs.width;
+  rs.height = fs.height;
+  rs.samples = samples;
+  return rs;
+}
+
+// Part 2: single scattering against the ray-traced ground truth (stratified, `samples` per pixel),
 // the reference's composite of surface and in-scattered radiance as the first panel (tone mapped
 // like the renderer; its background has no sky behind the haze, which the medium hides anyway).
 void scatter_part(render::Renderer& renderer, const vk::Context& ctx, const FrameOptions& frame,
@@ -132,34 +143,10 @@ void scatter_part(render::Renderer& renderer, const vk::Context& ctx, const Fram
   fmt::print("\nmsm demo: single scattering, scene '{}' at {}x{}, medium σt {}, shadow map {}², ray traced with {} "
              "samples per pixel\n",
              scene.name, fs.width, fs.height, scene.medium->extinction, fs.shadow_size, samples);
-  reference::Settings rs;
-  rs.effect = reference::Effect::scattering;
-  rs.width = fs.width;
-  rs.height = fs.height;
-  rs.samples = samples;
-  reference::Result truth = reference::render(scene, rs);
+  reference::Result truth = reference::render(scene, reference_settings(reference::Effect::scattering, fs, samples));
   image::Image truth_rgb = image::tone_map(truth.radiance, {std::log2(fs.exposure), image::ToneCurve::aces});
   compare_techniques(renderer, ctx, frame, techniques, &truth.visibility, &truth_rgb, out, "scatter-comparison.png",
                      true);
-}
-
-// The ray tracer's radiance in the renderer's look: ACES after the exposure, its sky where no surface is.
-image::Image truth_look(const reference::Result& truth, float exposure) {
-  image::Image rgb = image::tone_map(truth.radiance, {std::log2(exposure), image::ToneCurve::aces});
-  for (int y = 0; y < rgb.height(); ++y)
-    for (int x = 0; x < rgb.width(); ++x)
-      if (truth.visibility.at(x, y, 1) > 0.5f)
-        for (int c = 0; c < 3; ++c) rgb.at(x, y, c) = MSM_SKY_RADIANCE[c];
-  return rgb;
-}
-
-// The luminance (msm_luminance) of an RGB image, one channel.
-image::Image luminance_of(const image::Image& rgb) {
-  image::Image y(rgb.width(), rgb.height(), 1);
-  for (int j = 0; j < rgb.height(); ++j)
-    for (int i = 0; i < rgb.width(); ++i)
-      y.at(i, j, 0) = msm_luminance(glm::vec3(rgb.at(i, j, 0), rgb.at(i, j, 1), rgb.at(i, j, 2)));
-  return y;
 }
 
 // One configuration of the image-based-lighting part: a technique and the probe's light count.
@@ -180,14 +167,8 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
   fmt::print("\nmsm demo: image-based lighting, scene '{}' at {}x{}, probe {} cut into area lights, shadow map "
              "{}², ray traced from the whole probe with {} samples per pixel\n",
              scene.name, fs.width, fs.height, scene.probe->file.string(), fs.shadow_size, samples);
-  reference::Settings rs;
-  rs.effect = reference::Effect::environment;
-  rs.width = fs.width;
-  rs.height = fs.height;
-  rs.samples = samples;
-  reference::Result truth = reference::render(scene, rs);
-  image::Image truth_rgb = truth_look(truth, fs.exposure);
-  image::Image truth_y = luminance_of(truth_rgb);
+  reference::Result truth = reference::render(scene, reference_settings(reference::Effect::environment, fs, samples));
+  image::Image truth_rgb = reference_look(truth, fs.exposure);
   image::Image mask = truth.visibility.channel("background");
   std::vector<image::Panel> panels = {{"ray traced, whole probe", truth_rgb, "reference"}};
   fmt::print("\n{:<20} {:>6} {:>8} {:>7} {:>12}\n", "technique", "lights", "MAE", ">3%", "GPU ms");
@@ -199,7 +180,8 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
     render::RenderResult r = renderer.render(s);
     const std::string name = fmt::format("ibl-{}-{}", c.technique, c.lights);
     write_render(out, name, r, render_json(s, lit, ctx, r));
-    image::Metrics m = image::compute_metrics(luminance_of(r.color), truth_y, {.mask = &mask});
+    // Both images are R, G, B: the metrics compare their luminance (msm/image/metrics.h).
+    image::Metrics m = image::compute_metrics(r.color, truth_rgb, {.mask = &mask});
     fmt::print("{:<20} {:>6} {:>8.5f} {:>6.2f}% {:>12.3f}\n", c.technique, c.lights, m.mae, 100 * m.share_above_3pct,
                r.total_ms);
     panels.push_back({fmt::format("{}, {} lights", c.technique, c.lights), r.color, fmt::format("MAE {:.4f}", m.mae)});
@@ -364,18 +346,14 @@ void add_demo(CLI::App& app) {
     fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
                "samples per pixel\n",
                soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, opt->soft_samples);
-    reference::Settings rs;
-    rs.effect = reference::Effect::soft;
-    rs.width = fs.width;
-    rs.height = fs.height;
-    rs.samples = opt->soft_samples;
+    reference::Settings rs = reference_settings(reference::Effect::soft, fs, opt->soft_samples);
     rs.light_extent_deg = extent;
     rs.progress = [lines = std::make_shared<util::ProgressLines>("msm demo: ray tracing ", " rows")](
                       const reference::Progress& p) {
       if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
     };
     reference::Result truth = reference::render(*soft_scene, rs);
-    image::Image truth_rgb = truth_look(truth, fs.exposure);
+    image::Image truth_rgb = reference_look(truth, fs.exposure);
     compare_techniques(*soft_renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
                        "soft-comparison.png");
   });

@@ -27,6 +27,7 @@
 #include "msm/shading.h"
 #include "msm/util/limits.h"
 #include "msm/util/progress.h"
+#include "reference_look.h"
 
 namespace msm::tool {
 namespace {
@@ -210,12 +211,7 @@ void add_reference(CLI::App& app) {
         files.add_exr(out / "irradiance.exr", result.irradiance);
         // environment: the renderer's look (ACES at exposure 1, its sky where no surface is), to
         // compare with msm render's PNG (msm compare radiance.png TECHNIQUE.png).
-        msm::image::Image look = msm::image::tone_map(result.radiance, {0.0, msm::image::ToneCurve::aces});
-        for (int y = 0; y < look.height(); ++y)
-          for (int x = 0; x < look.width(); ++x)
-            if (result.visibility.at(x, y, 1) > 0.5f)
-              for (int c = 0; c < 3; ++c) look.at(x, y, c) = msm::MSM_SKY_RADIANCE[c];
-        files.add_png(out / "radiance.png", look);
+        files.add_png(out / "radiance.png", reference_look(result, 1.0f));
       } else {
         files.remove(out / "irradiance.exr");
         files.remove(out / "radiance.png");

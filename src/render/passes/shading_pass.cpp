@@ -77,7 +77,8 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
 const VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 
 // The shading's bindings 0-10 but the per-draw textures (1 and 5): the uniforms, the shadow maps of
-// the technique (placeholders of the declared kind where unused), the blue noise and the lights.
+// the technique (a white image of the declared kind in the bindings it does not read: every
+// declared binding needs a valid descriptor), the blue noise and the lights.
 std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameConfig& config, bool shadow_maps) {
   const GpuScene& scene = c.frame.scene;
   int id = config.technique->id;
