@@ -6,6 +6,11 @@
 
 #include <gtest/gtest.h>
 
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfTiledOutputFile.h>
+
 #include <bit>
 #include <cmath>
 #include <cstdlib>
@@ -324,6 +329,54 @@ TEST_F(ImageTest, ExrAttributeSizeBeyondTheFileIsRefusedFirst) {
     EXPECT_NE(e.reason().find("attribute 'compression' claims 1912602625 bytes"), std::string::npos) << e.reason();
   }
   EXPECT_EQ(read_image(dir / "good.exr"), ramp(4, 3, {"Y"}));
+}
+
+// A header of a few hundred bytes may claim a 16384² mip-mapped image of 1x1 tiles: 358 million
+// chunks, whose offsets alone would fill 2.9 GB (io.cpp, check_exr_header). A real tiled file (here one of 1x1 tiles, 341 chunks over its five levels) holds that table and
+// reads as before; the same header with a larger data window is refused, naming the chunks.
+TEST_F(ImageTest, ExrHeaderImplyingMoreChunksThanTheFileHoldsIsRefused) {
+  const Image image = ramp(16, 16, {"Y"});
+  {
+    Imf::Header header(16, 16);
+    header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    header.setTileDescription(Imf::TileDescription(1, 1, Imf::MIPMAP_LEVELS));
+    Imf::TiledOutputFile file((dir / "tiled.exr").c_str(), header);
+    for (int level = 0; level < file.numLevels(); ++level) {
+      const int w = file.levelWidth(level), h = file.levelHeight(level);
+      Imf::FrameBuffer fb;
+      fb.insert("Y", Imf::Slice(Imf::FLOAT, (char*)image.pixels().data(), sizeof(float), sizeof(float) * 16));
+      file.setFrameBuffer(fb);
+      file.writeTiles(0, file.numXTiles(level) - 1, 0, file.numYTiles(level) - 1, level);
+      EXPECT_LE(w, 16);
+      EXPECT_LE(h, 16);
+    }
+  }
+  EXPECT_EQ(read_image(dir / "tiled.exr"), image);
+  std::string exr = slurp(dir / "tiled.exr");
+  const std::size_t at = exr.find("dataWindow");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t value = at + std::string("dataWindow").size() + std::string("box2i").size() + 2 + 4;
+  for (std::size_t corner : {value + 8, value + 12}) { // xMax, yMax: 15 -> 16383
+    exr[corner] = char(0xff);
+    exr[corner + 1] = char(0x3f);
+  }
+  spit(dir / "claims.exr", exr);
+  try {
+    read_image(dir / "claims.exr");
+    ADD_FAILURE() << "no error";
+  } catch (const ImageError& e) {
+    EXPECT_NE(e.reason().find("header implies 357913941 chunks"), std::string::npos) << e.reason();
+  }
+  // A side beyond max_side is refused from the header too (OpenEXR would size a line of it).
+  exr[value + 8] = char(0x6f), exr[value + 9] = char(0x11), exr[value + 10] = char(0x01); // xMax 69999
+  exr[value + 12] = char(15), exr[value + 13] = char(0);                                  // yMax 15
+  spit(dir / "wide.exr", exr);
+  try {
+    read_image(dir / "wide.exr");
+    ADD_FAILURE() << "no error";
+  } catch (const ImageError& e) {
+    EXPECT_NE(e.reason().find("image size 70000x16 is outside"), std::string::npos) << e.reason();
+  }
 }
 
 // Found by the image fuzzer (tests/fuzz/crashes/image): stb copies an empty IDAT chunk before

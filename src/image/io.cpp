@@ -1,12 +1,14 @@
 #include "msm/image/io.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include <fcntl.h>
@@ -107,9 +109,70 @@ void check_memory(const fs::path& path, long long width, long long height, long 
   } catch (const limits::LimitError& e) { throw ImageError(path, e.what()); }
 }
 
+// Scan lines per chunk of each compression (OpenEXR's order: none, RLE, ZIPS, ZIP, PIZ, PXR24,
+// B44, B44A, DWAA, DWAB); an unknown one counts as the most (OpenEXR refuses it anyway).
+std::uint64_t exr_lines_per_chunk(std::uint8_t compression) {
+  static constexpr std::uint16_t lines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+  return compression < 10 ? lines[compression] : 256;
+}
+
+// Chunks (scan-line blocks or tiles, over all levels of a tiled file) that a header's data window
+// and tile description make, or 0 where they do not say (OpenEXR then refuses the header itself).
+std::uint64_t exr_chunk_count(const std::optional<std::array<std::int32_t, 4>>& window,
+                              const std::optional<std::array<std::uint32_t, 2>>& tile, std::uint8_t tile_mode,
+                              std::uint8_t compression) {
+  if (!window) return 0;
+  const std::int64_t w = std::int64_t((*window)[2]) - (*window)[0] + 1,
+                     h = std::int64_t((*window)[3]) - (*window)[1] + 1;
+  if (w < 1 || h < 1) return 0;
+  if (!tile) {
+    const std::uint64_t per_chunk = exr_lines_per_chunk(compression);
+    return (std::uint64_t(h) + per_chunk - 1) / per_chunk;
+  }
+  const std::uint64_t tx = (*tile)[0], ty = (*tile)[1];
+  if (tx == 0 || ty == 0) return 0;
+  const bool round_up = (tile_mode >> 4) == 1;
+  auto level_size = [&](std::int64_t size, int level) {
+    const std::int64_t scaled = round_up ? (size + (std::int64_t(1) << level) - 1) >> level : size >> level;
+    return std::max<std::int64_t>(scaled, 1);
+  };
+  auto level_count = [&](std::int64_t size) {
+    int levels = 1;
+    while (level_size(size, levels - 1) > 1) ++levels;
+    return levels;
+  };
+  auto tiles = [](std::int64_t size, std::uint64_t tile_size) {
+    return (std::uint64_t(size) + tile_size - 1) / tile_size;
+  };
+  // Saturating: 2^32 tiles a side (a data window of 2^32 pixels, 1x1 tiles) overflow 64 bits.
+  auto times = [](std::uint64_t a, std::uint64_t b) { return b != 0 && a > UINT64_MAX / b ? UINT64_MAX : a * b; };
+  auto plus = [](std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; };
+  switch (tile_mode & 0x0f) {
+  case 0: return times(tiles(w, tx), tiles(h, ty)); // one level
+  case 1: {                                         // mip-map: levels of both sides together
+    std::uint64_t n = 0;
+    for (int l = 0, levels = level_count(std::max(w, h)); l < levels; ++l)
+      n = plus(n, times(tiles(level_size(w, l), tx), tiles(level_size(h, l), ty)));
+    return n;
+  }
+  case 2: { // rip-map: every pair of an x level and a y level
+    std::uint64_t nx = 0, ny = 0;
+    for (int l = 0, levels = level_count(w); l < levels; ++l) nx += tiles(level_size(w, l), tx);
+    for (int l = 0, levels = level_count(h); l < levels; ++l) ny += tiles(level_size(h, l), ty);
+    return times(nx, ny);
+  }
+  default: return 0;
+  }
+}
+
 // The attributes of an EXR header (each: name, type, 32-bit size, value) before OpenEXR reads
 // them: OpenEXR 3.1 allocates an attribute's claimed size before reading it (gigabytes for a
-// corrupt size field in a file of a kilobyte).
+// corrupt size field in a file of a kilobyte), and sizes its line and tile buffers by the data
+// window, the tile size and the channels before it reads a pixel. Those are checked here first:
+// the side, the channel count, one chunk's bytes against the memory limit, and the chunk count
+// (scan-line blocks or tiles over all levels): a real file stores 8 bytes of offset per chunk, so
+// a header implying more chunks than its file has room for is refused. (CI's image fuzzer once
+// reported a 2.86 GB allocation whose input was not kept; these bound what a header can claim.)
 void check_exr_header(const fs::path& path, std::span<const std::uint8_t> b) {
   std::size_t p = 8; // magic and version
   auto string_at = [&](std::size_t& at) {
@@ -119,21 +182,75 @@ void check_exr_header(const fs::path& path, std::span<const std::uint8_t> b) {
     at = std::size_t(end - b.begin()) + 1;
     return text;
   };
+  auto u32_at = [&](std::size_t at) {
+    return std::uint32_t(b[at]) | std::uint32_t(b[at + 1]) << 8 | std::uint32_t(b[at + 2]) << 16 |
+           std::uint32_t(b[at + 3]) << 24;
+  };
   const bool multipart = b.size() > 5 && (b[5] & 0x10) != 0;
-  for (int header = 0;; ++header) {
+  const bool single_part_tiled = b.size() > 5 && (b[5] & 0x02) != 0;
+  std::uint64_t chunks = 0;
+  for (;;) {
+    std::optional<std::array<std::int32_t, 4>> window;
+    std::optional<std::array<std::uint32_t, 2>> tile;
+    std::uint8_t tile_mode = 0, compression = 0;
+    std::uint64_t chunk_count = 0; // a part's own claim (OpenEXR sizes its table by it)
+    std::uint64_t channel_count = 0, pixel_bytes = 0;
     for (;;) {
       const std::string name = string_at(p);
       if (name.empty()) break;
       const std::string type = string_at(p);
       if (b.size() - p < 4) throw ImageError(path, "malformed or truncated EXR: header cut short");
-      const std::int64_t size = std::int32_t(std::uint32_t(b[p]) | std::uint32_t(b[p + 1]) << 8 |
-                                             std::uint32_t(b[p + 2]) << 16 | std::uint32_t(b[p + 3]) << 24);
+      const std::int64_t size = std::int32_t(u32_at(p));
       p += 4;
       if (size < 0 || std::uint64_t(size) > b.size() - p)
         throw ImageError(path, fmt::format("malformed or truncated EXR: attribute '{}' claims {} bytes, {} are left",
                                            name, size, b.size() - p));
+      if (name == "dataWindow" && type == "box2i" && size == 16)
+        window = {std::int32_t(u32_at(p)), std::int32_t(u32_at(p + 4)), std::int32_t(u32_at(p + 8)),
+                  std::int32_t(u32_at(p + 12))};
+      if (name == "compression" && type == "compression" && size == 1) compression = b[p];
+      if (name == "chunkCount" && type == "int" && size == 4)
+        chunk_count = std::uint32_t(std::int32_t(u32_at(p)) < 0 ? 0 : u32_at(p));
+      if (name == "channels" && type == "chlist") {
+        // name, pixel type (int32: UINT, HALF, FLOAT), pLinear, 3 reserved, x and y sampling.
+        for (std::size_t c = p, end = p + std::size_t(size); c < end && b[c] != 0;) {
+          const auto name_end = std::find(b.begin() + std::ptrdiff_t(c), b.begin() + std::ptrdiff_t(end), 0);
+          c = std::size_t(name_end - b.begin()) + 1;
+          if (end < 16 || c > end - 16) break; // cut short: OpenEXR says so
+          ++channel_count;
+          pixel_bytes += u32_at(c) == 1 ? 2 : 4;
+          c += 16;
+        }
+      }
+      if (name == "tiles" && type == "tiledesc" && size == 9) {
+        tile = {u32_at(p), u32_at(p + 4)};
+        tile_mode = b[p + 8];
+      }
       p += std::size_t(size);
     }
+    // A multi-part file's parts say themselves whether they are tiled (their "type"); a
+    // single-part file says it in the version field, and OpenEXR ignores a stray "tiles" otherwise.
+    if (!multipart && !single_part_tiled) tile.reset();
+    if (channel_count > std::uint64_t(max_channels))
+      throw ImageError(path, fmt::format("{} channels (1..{} supported)", channel_count, max_channels));
+    if (window) {
+      const long long w = (long long)(*window)[2] - (*window)[0] + 1, h = (long long)(*window)[3] - (*window)[1] + 1;
+      check_size(path, w, h);
+      // One chunk's pixels: a tile, or the scan lines of one block.
+      const std::uint64_t chunk_pixels =
+          tile ? std::uint64_t((*tile)[0]) * (*tile)[1] : std::uint64_t(w) * exr_lines_per_chunk(compression);
+      try {
+        limits::check_bytes(tile ? fmt::format("a tile of {}x{}", (*tile)[0], (*tile)[1]) : "a block of scan lines",
+                            chunk_pixels * std::max<std::uint64_t>(pixel_bytes, 1));
+      } catch (const limits::LimitError& e) { throw ImageError(path, e.what()); }
+    }
+    // Saturating at the file's size: the sum over parts cannot overflow.
+    const std::uint64_t implied = std::max(chunk_count, exr_chunk_count(window, tile, tile_mode, compression));
+    chunks += std::min<std::uint64_t>(implied, b.size());
+    if (chunks > b.size() / 8)
+      throw ImageError(path, fmt::format("malformed or truncated EXR: its {} {} chunks, whose offset table alone "
+                                         "needs more than the file's {} bytes",
+                                         multipart ? "headers imply" : "header implies", implied, b.size()));
     // A multi-part file: headers until an empty one.
     if (!multipart || (p < b.size() && b[p] == 0)) break;
   }
