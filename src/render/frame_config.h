@@ -2,6 +2,7 @@
 // images of the frame graph. A new configuration builds a new graph; pipelines stay cached.
 #pragma once
 
+#include "msm/render/frame.h"
 #include "msm/render/renderer.h"
 
 #include <vulkan/vulkan.h>
@@ -25,9 +26,10 @@ struct FrameConfig {
   // blended with the channel's opacity α (1 − transmission colour); only with translucent.
   bool coloured = false;
   int soft_kernel = 0; // soft techniques: the tables' largest kernel width W (n_t = W²)
-  // Non-linear maps read with MSM_LOOKUP_BILINEAR (four decodes and Φ): a specialization constant of
-  // their shading, because lavapipe runs both sides of a branch on a uniform (issue 18).
-  bool nonlinear_bilinear = false;
+  // The shading's lookup (MSM_LOOKUP_*, as resolved for the technique): a specialization constant of
+  // the shading (kLookup), because lavapipe runs both sides of a branch on a uniform and recompiles
+  // a shader whose branches test uniforms (issue 18).
+  int lookup = MSM_LOOKUP_BILINEAR;
   // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
   // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).
   bool deferred = false;

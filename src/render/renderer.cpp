@@ -93,6 +93,17 @@ bool has_features(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags 
 
 } // namespace
 
+// The shading's lookup (MSM_LOOKUP_*): the settings', else dithered for the non-linear maps (their
+// texels are decoded before any interpolation) and bilinear for the others.
+int resolved_lookup(const RenderSettings& s, const Technique& technique) {
+  switch (s.lookup) {
+  case RenderSettings::Lookup::nearest: return MSM_LOOKUP_NEAREST;
+  case RenderSettings::Lookup::dither: return MSM_LOOKUP_DITHER;
+  case RenderSettings::Lookup::bilinear: return MSM_LOOKUP_BILINEAR;
+  default: return msm_technique_is_nonlinear(technique.id) ? MSM_LOOKUP_DITHER : MSM_LOOKUP_BILINEAR;
+  }
+}
+
 std::vector<float> filter_weights(const RenderSettings& s) {
   std::vector<float> w(size_t(s.filter_size));
   for (int k = 0; k < s.filter_size; ++k) w[size_t(k)] = msm_gaussian_weight(k, s.filter_size, s.filter_sigma);
@@ -177,12 +188,7 @@ struct Renderer::Impl {
     for (int k = 0; k < s.filter_size; ++k) u.filter_weights[k / 4][k % 4] = weights[size_t(k)];
     std::vector<glm::vec2> offsets =
         ctx.properties().limits.standardSampleLocations ? standard_sample_offsets(s.msaa) : std::vector<glm::vec2>(8);
-    bool nonlinear = msm_technique_is_nonlinear(technique.id);
-    int lookup = s.lookup == RenderSettings::Lookup::nearest    ? MSM_LOOKUP_NEAREST
-                 : s.lookup == RenderSettings::Lookup::dither   ? MSM_LOOKUP_DITHER
-                 : s.lookup == RenderSettings::Lookup::bilinear ? MSM_LOOKUP_BILINEAR
-                 : nonlinear                                    ? MSM_LOOKUP_DITHER
-                                                                : MSM_LOOKUP_BILINEAR;
+    int lookup = resolved_lookup(s, technique);
     // A different blue-noise layer and offset each frame (a fixed hash of the frame number).
     uint32_t h = uint32_t(s.frame) * 2654435761u + 0x9e3779b9u;
     h ^= h >> 15;
@@ -274,7 +280,7 @@ struct Renderer::Impl {
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
                   .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0,
-                  .nonlinear_bilinear = msm_technique_is_nonlinear(id) && s.lookup == RenderSettings::Lookup::bilinear,
+                  .lookup = resolved_lookup(s, technique),
 
                   .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
                               supports_deferred_shading(technique)};

@@ -33,21 +33,27 @@ std::string fragment_shader(const FrameConfig& config, Stage stage) {
 
 vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
   const Technique& technique = *config.technique;
-  vk::GraphicsDesc d{
-      .name = std::string(stage == Stage::surfaces ? "surfaces " : "shading ") + std::string(technique.name),
-      .vertex_shader = "shading.vert",
-      .fragment_shader = fragment_shader(config, stage),
-      .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image},
-      .push_constant_size = sizeof(ObjectPush),
-      .vertex_stride = sizeof(Vertex),
-      .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
-                     {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
-                     {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
-      .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
-      .depth_format = VK_FORMAT_D32_SFLOAT,
-      .depth_write = stage == Stage::opaque || stage == Stage::surfaces,
-      .constants = {{0, uint32_t(technique.id)}, {3, config.split_rg() ? 1u : 0u}, {4, config.lights == 1 ? 1u : 0u}}};
-  if (msm_technique_is_nonlinear(technique.id)) d.constants.push_back({9, config.nonlinear_bilinear ? 1u : 0u});
+  vk::GraphicsDesc d{.name =
+                         std::string(stage == Stage::surfaces ? "surfaces " : "shading ") + std::string(technique.name),
+                     .vertex_shader = "shading.vert",
+                     .fragment_shader = fragment_shader(config, stage),
+                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image},
+                     .push_constant_size = sizeof(ObjectPush),
+                     .vertex_stride = sizeof(Vertex),
+                     .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                                    {1, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
+                                    {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+                     .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
+                     .depth_format = VK_FORMAT_D32_SFLOAT,
+                     .depth_write = stage == Stage::opaque || stage == Stage::surfaces,
+                     // What steers the shading's loops and branches is compiled in (frame.glsl, shading.glsl,
+                     // shading_depth.glsl): the technique, the lights, the lookup, the MSAA samples, the PCF taps.
+                     .constants = {{0, uint32_t(technique.id)},
+                                   {3, config.split_rg() ? 1u : 0u},
+                                   {4, uint32_t(config.lights)},
+                                   {7, uint32_t(config.msaa)},
+                                   {8, uint32_t(config.taps)},
+                                   {9, uint32_t(config.lookup)}}};
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
   if (msm_technique_is_scattering(technique.id)) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;

@@ -5,7 +5,7 @@ layout(binding = 4) uniform sampler2DArray blue_noise;
 // Texel-centre coordinate t (texel i covers [i - 0.5, i + 0.5)) -> the texel a nearest or
 // dithered lookup reads, clamped to the map.
 ivec2 lookup_texel(vec2 t) {
-  if (frame.lookup.x == MSM_LOOKUP_DITHER) {
+  if (kLookup == MSM_LOOKUP_DITHER) {
     ivec2 n = (ivec2(gl_FragCoord.xy) + frame.lookup.zw) & 63;
     t += texelFetch(blue_noise, ivec3(n, frame.lookup.y), 0).xy - 0.5f;
   }
@@ -46,9 +46,11 @@ Bilinear bilinear_texels(vec2 t) {
 // depth at the texel it reads (receiver_depth_at): its kernel is the blur's.
 float receiver_plane_bias(ShadowLookup s, float lod) {
   float variance = frame.receiver_bias.x;
-  if (!(frame.receiver_bias.y > 0.0f)) return 0.0f; // off (or NaN)
-  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) variance += exp2(2.0f * lod) * 0.25f - 1.0f / 12.0f;
-  float sigma = frame.receiver_bias.y * msm_receiver_depth_sigma(s.depth_per_texel, variance); // [0,1] depth
+  // Off (or NaN): a multiplier of 0 (finite σ), selected rather than branched on, because lavapipe
+  // recompiles a shader per frame for some branches on a uniform (kLightCount, shading.glsl).
+  float multiplier = frame.receiver_bias.y > 0.0f ? frame.receiver_bias.y : 0.0f;
+  if (kLookup == MSM_LOOKUP_BILINEAR) variance += exp2(2.0f * lod) * 0.25f - 1.0f / 12.0f;
+  float sigma = multiplier * msm_receiver_depth_sigma(s.depth_per_texel, variance); // [0,1] depth
   if (msm_technique_is_six_moments(kTechnique)) return MSM_RECEIVER_SIGMAS6 * sigma;
   if (kTechnique == MSM_TECH_EVSM4_64 || kTechnique == MSM_TECH_EVSM4_128)
     return 0.5f * msm_receiver_plane_bias_negative_warp(2.0f * sigma, frame.technique_params.z); // [-1,1] warp

@@ -9,10 +9,15 @@
 #define MSM_LIGHT_BINDING 10
 #include "frame.glsl"
 
-// The light whose shadow map the lookups read: its layer of the frame's shadow-map arrays. Frames
-// with one light specialize it to the constant 0 (kOneLight): lavapipe fetches from a constant
-// layer several times faster than from a variable one.
-layout(constant_id = 4) const bool kOneLight = false;
+// The frame's lights (FrameConfig::lights): a specialization constant, not frame.lights.x, because
+// lavapipe (Mesa 22.3) re-optimizes and recompiles a shader at every bind whose loop bound is a
+// uniform (it inlines the value to unroll the loop): about 0.8 s per frame of MSM-64 shading with
+// Mesa's shader cache off, and a cache lookup per frame with it on (docs/results.md, issue 18).
+// The light whose shadow map the lookups read is its layer of the frame's shadow-map arrays;
+// frames with one light specialize it to the constant 0 (kOneLight): lavapipe fetches from a
+// constant layer several times faster than from a variable one.
+layout(constant_id = 4) const int kLightCount = 1;
+const bool kOneLight = kLightCount == 1;
 // Scattering techniques: the colour attachment takes linear radiance (before exposure and tone
 // mapping), which the scattering pass composites with the medium's in-scattering.
 layout(constant_id = 5) const bool kLinearRadiance = false;
@@ -95,9 +100,10 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
 #else
   vec3 shadow = vec3(inside ? shadow_intensity(s) : 0.0f);
 #endif
-  if (frame.shading.x < 1.0f)
-    shadow = vec3(msm_overdarken(shadow.x, frame.shading.x), msm_overdarken(shadow.y, frame.shading.x),
-                  msm_overdarken(shadow.z, frame.shading.x));
+  // Unconditional (the factor 1, no overdarkening, only clamps to [0, 1]): a branch on a uniform
+  // makes lavapipe recompile the shader per frame, see kLightCount.
+  shadow = vec3(msm_overdarken(shadow.x, frame.shading.x), msm_overdarken(shadow.y, frame.shading.x),
+                msm_overdarken(shadow.z, frame.shading.x));
   return 1.0f - shadow;
 }
 
@@ -109,7 +115,7 @@ void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
   vec3 weighted = vec3(0.0f), first = vec3(0.0f);
   direct = vec3(0.0f);
   float weight_sum = 0.0f;
-  int light_count = kOneLight ? 1 : frame.lights.x;
+  const int light_count = kLightCount;
   MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
   for (int l = 0; l < light_count; ++l) {
     float n_dot_l = dot(n, lights[l].towards_light.xyz);

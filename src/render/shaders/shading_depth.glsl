@@ -8,6 +8,12 @@
 #define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
 
+// The depth map's MSAA samples and the PCF kernel's taps (FrameConfig::msaa, ::taps), compiled in:
+// as loop bounds read from the uniforms they made lavapipe recompile the shader per frame (see
+// kLightCount in shading.glsl).
+layout(constant_id = 7) const int kSamples = 1;
+layout(constant_id = 8) const int kTaps = 1;
+
 vec2 sample_offset(int k) {
   vec4 pair = frame.sample_offsets[k / 2];
   return (k & 1) == 0 ? vec2(pair.x, pair.y) : vec2(pair.z, pair.w);
@@ -17,7 +23,8 @@ vec2 sample_offset(int k) {
 // own position (the rasterizer wrote the occluder's depth there): x their number, y the sum of
 // their depths (PCSS's blocker search).
 vec2 texel_blockers(ivec2 i, ShadowLookup s) {
-  int size = int(frame.shadow_map.x), samples = frame.kernel.y;
+  int size = int(frame.shadow_map.x);
+  const int samples = kSamples;
   ivec2 c = clamp(i, ivec2(0), ivec2(size - 1));
   float plane = s.z + dot(s.depth_per_texel, vec2(i) - s.t);
   vec2 blockers = vec2(0.0f);
@@ -29,7 +36,7 @@ vec2 texel_blockers(ivec2 i, ShadowLookup s) {
 }
 
 // Fraction of the texel's samples in front of the receiver plane.
-float texel_occlusion(ivec2 i, ShadowLookup s) { return texel_blockers(i, s).x / float(frame.kernel.y); }
+float texel_occlusion(ivec2 i, ShadowLookup s) { return texel_blockers(i, s).x / float(kSamples); }
 
 // Percentage-closer soft shadows (soft.h): every sample of the grid-aligned search rectangle is
 // tested against the receiver plane, those in front average to the blocker depth; the penumbra
@@ -38,7 +45,8 @@ float texel_occlusion(ivec2 i, ShadowLookup s) { return texel_blockers(i, s).x /
 // frame.soft_kernel.x, 15 by default), so the two differ only in what they read.
 float pcss_shadow(ShadowLookup s) {
   ivec2 map = ivec2(int(frame.shadow_map.x));
-  int width = frame.soft_kernel.x, samples = frame.kernel.y;
+  int width = frame.soft_kernel.x;
+  const int samples = kSamples;
   vec2 spread = vec2(lights[shadow_layer].soft.x, lights[shadow_layer].soft.y);
   float zf = msm_signed_depth(s.z);
   vec2 position = s.t + 0.5f; // texel i covers [i, i + 1) in soft.h
@@ -66,7 +74,7 @@ float pcss_shadow(ShadowLookup s) {
 float shadow_intensity(ShadowLookup s) {
   if (kTechnique == MSM_TECH_PCSS) return pcss_shadow(s);
   if (kTechnique == MSM_TECH_PLAIN) return texel_occlusion(ivec2(floor(s.t + 0.5f)), s);
-  int taps = frame.kernel.x, radius = frame.kernel.z;
+  const int taps = kTaps, radius = kTaps / 2;
   ivec2 i0 = ivec2(floor(s.t));
   vec2 f = s.t - vec2(i0);
   float shadow = 0.0f;

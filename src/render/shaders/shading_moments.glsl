@@ -23,7 +23,7 @@ float shadow_from(sampler2DArray first, sampler2DArray second_image, ShadowLooku
   MsmTexel texel = MsmTexel(vec4(0.0f), vec4(0.0f));
   vec2 uv = (s.t + 0.5f) * frame.shadow_map.y;
   vec2 duv_dx = s.dt_dx * frame.shadow_map.y, duv_dy = s.dt_dy * frame.shadow_map.y;
-  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
+  if (kLookup == MSM_LOOKUP_BILINEAR) {
     // The mip the lookup reads (textureQueryLod's x, from the same derivatives).
     float lod = log2(max(length(s.dt_dx), length(s.dt_dy)));
     s.z -= receiver_plane_bias(s, clamp(lod, 0.0f, float(textureQueryLevels(first) - 1)));
@@ -31,7 +31,7 @@ float shadow_from(sampler2DArray first, sampler2DArray second_image, ShadowLooku
     s.z -= receiver_plane_bias(s, 0.0f);
   }
   float zf = s.z;
-  if (frame.lookup.x == MSM_LOOKUP_BILINEAR) {
+  if (kLookup == MSM_LOOKUP_BILINEAR) {
     texel.a = textureGrad(first, vec3(uv, shadow_layer), duv_dx, duv_dy);
     if (second) texel.b = textureGrad(second_image, vec3(uv, shadow_layer), duv_dx, duv_dy);
   } else {

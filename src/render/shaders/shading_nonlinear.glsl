@@ -11,11 +11,11 @@ layout(binding = 3) uniform sampler2DArray unused_second_image; // the shading l
 #include "shading.glsl"
 #include "lookup.glsl"
 
-// frame.lookup.x == MSM_LOOKUP_BILINEAR, compiled in (FrameConfig::nonlinear_bilinear): llvmpipe
-// executes both sides of a branch on a uniform under a mask, so with the branch the nearest and
-// dithered lookups paid for the four decodes and Φ of the bilinear one (1416 instructions per
-// pixel of NL64 shading instead of 645, docs/results.md).
-layout(constant_id = 9) const bool kBilinearLookup = false;
+// The lookup compiled in (kLookup, frame.glsl): llvmpipe executes both sides of a branch on a
+// uniform under a mask, so with the branch the nearest and dithered lookups paid for the four
+// decodes and Φ of the bilinear one (1416 instructions per pixel of NL64 shading instead of 645,
+// docs/results.md).
+const bool kBilinearLookup = kLookup == MSM_LOOKUP_BILINEAR;
 
 NonLinearMoments decode(ivec2 i) {
 #ifdef MSM_NL32
