@@ -1,8 +1,9 @@
 // Single scattering in a homogeneous medium (JCGT 2017 §5.1.1), written once for the renderer's
 // shaders, the ray tracer's ground truth and the tests. Radiance reaching the camera through a
-// view ray of length s that starts at the camera p and runs along the unit direction ω_p:
-//   exp(−σt s) L_s + f(ω_l, ω_p) E_l ∫₀ˢ exp(−σt t) V(p + t ω_p) dt
-// with L_s the surface radiance at the end of the ray, E_l the light's irradiance, V the light's
+// view ray of length s that starts at the camera p and runs along the unit direction ω_p, lit by
+// the directional lights l:
+//   exp(−σt s) L_s + Σ_l f(ω_l, ω_p) E_l ∫₀ˢ exp(−σt t) V_l(p + t ω_p) dt
+// with L_s the surface radiance at the end of the ray, E_l light l's irradiance, V_l its
 // visibility and f(ω_l, ω_p) = ρ σt p(cos θ): the scattering coefficient σs = ρ σt (ρ the
 // scattering albedo) times a phase function p normalized over the sphere (∫ p dω = 1, units 1/sr).
 // θ is the scattering angle between the light's direction of travel and the direction the
@@ -16,6 +17,7 @@
 #include "msm/hamburger4.h"
 #include "msm/hamburger6.h"
 #include "msm/quantize.h"
+#include "msm/shading.h"
 #include "msm/shared.h"
 
 MSM_BEGIN
@@ -54,6 +56,46 @@ MSM_FN vec3 msm_scattered_radiance(vec3 surface_radiance, vec3 irradiance, float
                                    float visible_fraction) {
   return exp(-extinction * s) * surface_radiance +
          (phase_term * visible_fraction * msm_transmittance_integral(extinction, 0.0f, s)) * irradiance;
+}
+
+// ---- Several lights: the sum over l of the radiance above ----
+// Each light's in-scattering is msm_scattered_radiance's second term with its own phase term and
+// visible fraction; the surface's attenuated radiance is counted once. The ray's visible fraction
+// over all lights is the mean of the lights' visible fractions weighted by what each scatters into
+// an unshadowed ray, the luminance of f(ω_l, ω_p) E_l (the factor ∫₀ˢ exp(−σt t) dt is common):
+// the in-scattered luminance is this fraction times the unshadowed one. With one light it is that
+// light's visible fraction (up to a rounding of w V / w); with no light that scatters (every
+// weight 0) it is 1, as for a ray of length 0.
+struct ScatteringSum {
+  vec3 inscattered;       // Σ_l f_l E_l V_l ∫₀ˢ exp(−σt t) dt
+  float weighted_visible; // Σ_l w_l V_l, w_l = luminance(f_l E_l)
+  float weight;           // Σ_l w_l
+};
+
+MSM_FN ScatteringSum msm_scattering_sum_none() { return ScatteringSum(vec3(0.0f), 0.0f, 0.0f); }
+
+// Light l's weight w_l in the visible fraction of several lights: the luminance of f_l E_l.
+MSM_FN float msm_scattering_light_weight(vec3 irradiance, float phase_term) {
+  return phase_term * msm_luminance(irradiance);
+}
+
+// Adds light l (irradiance E_l, phase term f_l, the ray's visible fraction V_l) to the sum.
+MSM_FN ScatteringSum msm_scattering_add_light(ScatteringSum sum, vec3 irradiance, float extinction, float phase_term,
+                                              float s, float visible_fraction) {
+  const float w = msm_scattering_light_weight(irradiance, phase_term);
+  return ScatteringSum(sum.inscattered +
+                           msm_scattered_radiance(vec3(0.0f), irradiance, extinction, phase_term, s, visible_fraction),
+                       sum.weighted_visible + w * visible_fraction, sum.weight + w);
+}
+
+// The ray's visible fraction over the lights of the sum (see above).
+MSM_FN float msm_scattering_sum_visible(ScatteringSum sum) {
+  return sum.weight > 0.0f ? msm_saturate(sum.weighted_visible / sum.weight) : 1.0f;
+}
+
+// The radiance at the camera: the surface's radiance attenuated plus every light's in-scattering.
+MSM_FN vec3 msm_scattering_sum_radiance(vec3 surface_radiance, float extinction, float s, ScatteringSum sum) {
+  return exp(-extinction * s) * surface_radiance + sum.inscattered;
 }
 
 // ---- Prefiltered single scattering (JCGT §5.3-5.4): the visible fraction of a view ray ----

@@ -112,7 +112,8 @@ MSM_FN int msm_technique_scatter_representation6(int t) {
 // Bytes per rectified texel of a prefiltered technique's two maps (src/render/passes/
 // prefiltered_scattering_passes.cpp): x the float rectified map (RGBA32F; six moments two; CSM
 // eight RGBA16F layers), y the stored prefix sums (Θ4* RGBA16; Θ6* 2 x RGB10A2, RGBA16 + RG16,
-// RGBA32F + RG32F; CSM eight RGBA8). The prefix sums read x and write y per texel.
+// RGBA32F + RG32F; CSM eight RGBA8). The prefix sums read x and write y per texel. Per light: every
+// light of the frame has its own two maps (the renderer's memory estimate counts them per light).
 MSM_FN ivec2 msm_technique_scatter_map_bytes(int t) {
   return t == MSM_TECH_SCATTER_MSM6_64    ? ivec2(32, 8)
          : t == MSM_TECH_SCATTER_MSM6_96  ? ivec2(32, 12)

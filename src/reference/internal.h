@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -184,15 +185,24 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 EffectResult effect_translucent(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 
-// scattering (effect_scattering.cpp): the transmittance-weighted visible fraction of the light
-// along camera + t dir, t in [0, s] (dir unit), with ctx.settings.samples shadow rays.
+// scattering (effect_scattering.cpp): the transmittance-weighted visible fraction of each light
+// along camera + t dir, t in [0, s] (dir unit), from ctx.settings.samples distances t with one
+// shadow ray per light each; `visible` combines the lights with the weights w_l
+// (msm_scattering_light_weight; all 0: 1), and its std_error is that of the combined samples
+// Σ w_l V_l(t) / Σ w_l. With one light, visible is that light's.
+struct ScatteringLight {
+  glm::dvec3 towards_light{0.0, 1.0, 0.0}; // unit
+  double weight = 1.0;                     // w_l
+};
 struct ScatteringSample {
   double visible = 1.0, std_error = 0.0;
+  std::vector<double> light_visible; // per light
   int samples = 0;
   std::uint64_t rays = 0;
 };
 ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Medium& medium, const glm::dvec3& camera,
-                                      const glm::dvec3& dir, double s, Rng& rng);
+                                      const glm::dvec3& dir, double s, std::span<const ScatteringLight> lights,
+                                      Rng& rng);
 
 // environment (effect_environment.cpp): the lights of a scene's image-based lighting, built once
 // per render. Throws std::invalid_argument for a scene without a "probe".

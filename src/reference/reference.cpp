@@ -205,6 +205,13 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   };
   const glm::dvec3 irradiance(scene.light().irradiance);
   const glm::dvec3 camera(scene.camera.position);
+  // scattering: every light of the scene (the first is ctx's), its direction and irradiance.
+  std::vector<glm::dvec3> light_towards, light_irradiance;
+  if (scattering)
+    for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+      light_towards.push_back(l == 0 ? ctx.towards_light : scene.light_frame(l).towards_light);
+      light_irradiance.emplace_back(scene.lights[l].irradiance);
+    }
 
   std::vector<double> row_sum(H, 0.0);
   std::vector<std::size_t> row_background(H, 0);
@@ -218,25 +225,34 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   float* rad = result.radiance.pixels().data();
   float* surf = result.surface.pixels().data();
   float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
-  // scattering: the visible fraction of the ray from the camera to `end` (std_error, samples into
-  // the visibility image), the in-scattered radiance, and the composite over surface_radiance.
+  // scattering: the visible fraction of the ray from the camera to `end` over every light
+  // (std_error, samples into the visibility image), the in-scattered radiance summed over the
+  // lights, and the composite over surface_radiance (msm/scattering.h's sum over the lights).
   const auto add_scattering = [&](int x, int y, const glm::dvec3& dir, const glm::dvec3& end,
                                   const glm::vec3& surface_radiance, std::uint64_t& row_rays) {
     const scene::Medium& m = *scene.medium;
     const double s = glm::length(end - camera);
     Rng rng = pixel_rng(settings.seed, x, y, Effect::scattering);
-    const ScatteringSample e = scattering_along_ray(ctx, m, camera, dir, s, rng);
+    std::vector<float> phase(light_towards.size());
+    std::vector<ScatteringLight> lights(light_towards.size());
+    for (std::size_t l = 0; l < lights.size(); ++l) {
+      phase[l] =
+          msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, float(glm::dot(light_towards[l], dir)));
+      lights[l] = {light_towards[l], double(msm_scattering_light_weight(glm::vec3(light_irradiance[l]), phase[l]))};
+    }
+    const ScatteringSample e = scattering_along_ray(ctx, m, camera, dir, s, lights, rng);
     row_rays += e.rays;
     row_sum[y] += e.visible;
     float* v = result.visibility.pixels().data() + (std::size_t(y) * W + x) * result.visibility.channels();
     v[0] = float(e.visible);
     v[2] = float(e.samples);
     v[3] = float(e.std_error);
-    const float f =
-        msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, float(glm::dot(ctx.towards_light, dir)));
-    const glm::vec3 e_l(irradiance);
-    const glm::vec3 in = msm_scattered_radiance(glm::vec3(0.0f), e_l, m.extinction, f, float(s), float(e.visible));
-    const glm::vec3 all = msm_scattered_radiance(surface_radiance, e_l, m.extinction, f, float(s), float(e.visible));
+    ScatteringSum sum = msm_scattering_sum_none();
+    for (std::size_t l = 0; l < lights.size(); ++l)
+      sum = msm_scattering_add_light(sum, glm::vec3(light_irradiance[l]), m.extinction, phase[l], float(s),
+                                     float(e.light_visible[l]));
+    const glm::vec3 in = sum.inscattered;
+    const glm::vec3 all = msm_scattering_sum_radiance(surface_radiance, m.extinction, float(s), sum);
     float* q = result.scattering.pixels().data() + (std::size_t(y) * W + x) * 4;
     q[0] = in.r, q[1] = in.g, q[2] = in.b, q[3] = float(s);
     float* c = result.radiance.pixels().data() + (std::size_t(y) * W + x) * 3;
@@ -317,8 +333,17 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         if (!scattering) row_sum[y] += e.value;
         // Per channel where the effect gives a visibility per channel (translucent).
         const float n_dot_l = float(glm::dot(n, ctx.towards_light));
-        const glm::vec3 direct = e.lit ? msm_direct_light(glm::vec3(irradiance), float(*e.lit), glm::vec3(1.0f))
-                                       : msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);
+        glm::vec3 direct = e.lit ? msm_direct_light(glm::vec3(irradiance), float(*e.lit), glm::vec3(1.0f))
+                                 : msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);
+        // scattering: the surface lit by every light, each with its exact (hard) shadow, as the
+        // renderer shades it (msm/shading.h's sum over the lights); the first light's is e.
+        for (std::size_t l = 1; scattering && l < light_towards.size(); ++l) {
+          const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, light_towards[l]);
+          const float lit = tracer.occluded(origin, light_towards[l]) ? 0.0f : 1.0f;
+          ++row_rays;
+          direct +=
+              msm_direct_light(glm::vec3(light_irradiance[l]), float(glm::dot(n, light_towards[l])), glm::vec3(lit));
+        }
         const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), direct, MSM_AMBIENT);
         float* q = surf + (std::size_t(y) * W + x) * 2;
         q[0] = n_dot_l;

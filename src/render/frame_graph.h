@@ -112,7 +112,7 @@ struct FrameResources {
   const vk::Sampler& linear_sampler;
   glm::vec3 camera_position{0.0f};
   ScatteringPush scattering{};                 // the scattering pass's (scattering techniques)
-  const vk::Buffer* rectification = nullptr;   // RectificationUniforms (render/rectification_uniforms.h)
+  const vk::Buffer* rectification = nullptr;   // RectificationUniforms per light (render/rectification_uniforms.h)
   const vk::Sampler* repeat_sampler = nullptr; // linear, repeat: the prefix sums (v wraps on the circle)
 };
 

@@ -3,6 +3,7 @@
 // ray tracer refuse the same scene the same way. No device needed: the estimates are arithmetic.
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
+#include "msm/techniques.h"
 #include "msm/util/limits.h"
 #include "msm/util/progress.h"
 
@@ -50,6 +51,28 @@ TEST(Limits, ShadowMemoryGrowsWithTexelsLightsAndColourChannels) {
   s.shadow_size = 8192;
   s.coloured_translucency = true;
   EXPECT_GT(double(render::estimated_bytes(s, 0, 1)), 2.0 * base); // three moment maps, one depth
+}
+
+// Prefiltered scattering: every light has its own rectified map and prefix sums (issue 14), shadow
+// size² texels of msm_technique_scatter_map_bytes each; ray marching has neither (the techniques
+// store no moment maps, so the rest of the estimate is the same).
+TEST(Limits, RectifiedMapsAreCountedPerLight) {
+  render::RenderSettings s;
+  s.shadow_size = 2048;
+  s.technique = "scatter-march-128";
+  const std::uint64_t march[3] = {0, render::estimated_bytes(s, 0, 1), render::estimated_bytes(s, 0, 2)};
+  for (const char* name :
+       {"scatter-msm4-64", "scatter-msm6-64", "scatter-msm6-96", "scatter-msm6-192", "scatter-csm-32"}) {
+    SCOPED_TRACE(name);
+    s.technique = name;
+    const glm::ivec2 bytes = msm_technique_scatter_map_bytes(render::find_rendered_technique(name).id);
+    const std::uint64_t per_light = std::uint64_t(2048) * 2048 * std::uint64_t(bytes.x + bytes.y);
+    EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], per_light);
+    EXPECT_EQ(render::estimated_bytes(s, 0, 2) - march[2], 2 * per_light);
+    s.lights.resize(3); // the frame's lights instead of the scene's
+    EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], 3 * per_light + (march[2] - march[1]) * 2);
+    s.lights.clear();
+  }
 }
 
 TEST(Limits, RenderAndReferenceRefuseTheSameScene) {

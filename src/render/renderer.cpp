@@ -38,6 +38,7 @@ static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 32);
 static_assert(sizeof(LightUniforms) == 2 * 64 + 3 * 16);
 static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
 static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
+static_assert(sizeof(RectificationUniforms) == 11 * 16); // the std430 array stride of the passes' rects[]
 
 namespace {
 
@@ -115,7 +116,7 @@ struct Renderer::Impl {
   scene::Scene scene;
   GpuScene gpu;
   vk::Buffer uniforms, lights;
-  vk::Buffer rectification; // RectificationUniforms (prefiltered scattering)
+  vk::Buffer rectification; // RectificationUniforms per light (prefiltered scattering)
   vk::GpuTimer timer;
   vk::Image noise;
   vk::Sampler point_sampler, linear_sampler;
@@ -135,8 +136,8 @@ struct Renderer::Impl {
         uniforms(vk::create_buffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
         lights(vk::create_buffer(c, sizeof(LightUniforms) * MSM_MAX_LIGHTS, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                  vk::Memory::host)),
-        rectification(
-            vk::create_buffer(c, sizeof(RectificationUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
+        rectification(vk::create_buffer(c, sizeof(RectificationUniforms) * MSM_MAX_LIGHTS,
+                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host)),
         timer(c, 32), noise(upload_blue_noise(c)), point_sampler(vk::create_sampler(c, VK_FILTER_NEAREST)),
         linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)),
         repeat_sampler(vk::create_sampler(c, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT)), programs(c),
@@ -315,8 +316,10 @@ struct Renderer::Impl {
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
     scattering = scattering_push(s, technique);
     if (msm_technique_is_prefiltered_scattering(technique.id)) {
-      RectificationUniforms r = rectification_uniforms(s, frame_lights.front());
-      std::memcpy(rectification.data(), &r, sizeof(r)); // NOLINT(bugprone-undefined-memory-manipulation)
+      std::vector<RectificationUniforms> r;
+      for (const scene::DirectionalLight& light : frame_lights) r.push_back(rectification_uniforms(s, light));
+      // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout (vec4 members only)
+      std::memcpy(rectification.data(), r.data(), r.size() * sizeof(RectificationUniforms));
     }
     return technique;
   }
@@ -336,8 +339,8 @@ struct Renderer::Impl {
     return p;
   }
 
-  // The rectification of the first light for this camera (rectification.h, JCGT Appendix A): the
-  // bounds cover the pyramid from the camera to its far plane.
+  // The rectification of one light for this camera (rectification.h, JCGT Appendix A): the bounds
+  // cover the pyramid from the camera to its far plane. The passes read one per light (std430 array).
   RectificationUniforms rectification_uniforms(const RenderSettings& s, const scene::DirectionalLight& light) {
     glm::dmat4 inverse = glm::inverse(glm::dmat4(scene.camera_view_projection(float(s.width) / float(s.height))));
     glm::mat4x3 corners;

@@ -168,12 +168,12 @@ std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, 
   const std::uint64_t moment_bytes =
       (texel_bytes(t.formats[0]) + texel_bytes(t.formats[1])) * std::uint64_t(msm_technique_tiles(t.id));
   const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
-  // Prefiltered scattering: the rectified map and its prefix sums, shadow size² each.
+  // Prefiltered scattering: every light's rectified map and prefix sums, shadow size² each.
   const glm::ivec2 scatter =
       msm_technique_is_prefiltered_scattering(t.id) ? msm_technique_scatter_map_bytes(t.id) : glm::ivec2(0);
   return triangles * limits::kRendererBytesPerTriangle +
          std::uint64_t(s.width) * std::uint64_t(s.height) * limits::kRendererBytesPerPixel +
-         std::uint64_t(s.shadow_size) * std::uint64_t(s.shadow_size) * std::uint64_t(scatter.x + scatter.y) +
+         std::uint64_t(s.shadow_size) * std::uint64_t(s.shadow_size) * std::uint64_t(scatter.x + scatter.y) * lights +
          limits::shadow_map_bytes(std::uint64_t(s.shadow_size), lights, std::uint64_t(s.msaa), moment_bytes, s.mipmaps,
                                   s.coloured_translucency ? 3 : 1);
 }

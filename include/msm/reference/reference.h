@@ -81,15 +81,19 @@
 //               from the camera position c (not the near plane: scattering accumulates from the
 //               eye, as the paper has it) along the primary ray's unit direction d to the visible
 //               surface (s = |p - c|) or, where the ray hits nothing, to the far plane (s = |far
-//               point - c|, what a depth buffer cleared to 1 gives). The visible fraction
-//                 V = integral_0^s exp(-st t) V(c + t d) dt / integral_0^s exp(-st t) dt
-//               (V(q) = 1 if the ray q -> L reaches infinity, every surface blocking it) is
-//               estimated with `samples` shadow rays from t drawn in proportion to
-//               st exp(-st t) on [0, s] (inverse CDF; `stratified`: one per stratum of [0, 1)),
-//               whose plain mean estimates V; std_error as below. The radiance is
-//               msm_scattered_radiance: exp(-st s) L_s + f E V integral_0^s exp(-st t) dt, with
-//               f = msm_scattering_phase_term(st, albedo, g, dot(L, d)) and L_s the surface's
-//               radiance with its exact (hard) shadow, 0 on background. A camera inside an
+//               point - c|, what a depth buffer cleared to 1 gives). Every light l of the scene
+//               scatters: its visible fraction
+//                 V_l = integral_0^s exp(-st t) V_l(c + t d) dt / integral_0^s exp(-st t) dt
+//               (V_l(q) = 1 if the ray q -> L_l reaches infinity, every surface blocking it) is
+//               estimated with `samples` distances t drawn in proportion to st exp(-st t) on
+//               [0, s] (inverse CDF; `stratified`: one per stratum of [0, 1)) and one shadow ray
+//               per light from each, whose plain mean estimates V_l. The radiance is
+//               msm/scattering.h's sum over the lights: exp(-st s) L_s + sum_l f_l E_l V_l
+//               integral_0^s exp(-st t) dt, with f_l = msm_scattering_phase_term(st, albedo, g,
+//               dot(L_l, d)) and L_s the surface's radiance lit by every light with its exact
+//               (hard) shadow, 0 on background; "visibility" is V = sum_l w_l V_l / sum_l w_l
+//               (w_l = msm_scattering_light_weight: the luminance of f_l E_l; one light: V_1),
+//               its std_error that of the samples sum_l w_l V_l(t) / sum_l w_l. A camera inside an
 //               occluder: the points inside are shadowed (their shadow rays hit its inside), its
 //               back faces are looked through as above; nothing special, never NaN.
 //
@@ -138,8 +142,8 @@
 //                "visibility_b" = T_r, T_g, T_b; 1 on background.
 //                scattering: "visibility" is the visible fraction V of the view ray (on background
 //                pixels too), with "sample_count" and "std_error".
-//   scattering   scattering only: "R", "G", "B" the in-scattered radiance f E V integral_0^s
-//                exp(-st t) dt alone, "length" the ray's length s.
+//   scattering   scattering only: "R", "G", "B" the in-scattered radiance sum_l f_l E_l V_l
+//                integral_0^s exp(-st t) dt alone, "length" the ray's length s.
 //   radiance     "R", "G", "B" (linear): msm/shading.h's radiance at the visible surface, 0 on background;
 //                scattering: that radiance attenuated plus the in-scattered (msm_scattered_radiance);
 //                for translucent with the visibility of each channel (T_r, T_g, T_b) in its

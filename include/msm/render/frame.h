@@ -77,10 +77,10 @@ struct ObjectPush {
 
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {
-  ivec4 size; // xy: image size in texels, z: pass-specific, w: unused
+  ivec4 size; // xy: image size in texels, z: pass-specific (rectify, prefix_sums: the light), w: unused
 };
 
-// The scattering pass (push constants): single scattering of the frame's first light in the
+// The scattering pass (push constants): single scattering of every light of the frame in the
 // scene's medium, composited over the linear surface radiance (scattering.h).
 struct ScatteringPush {
   mat4 inverse_view_projection; // camera clip space -> world (pixels' rays and far-plane ends)

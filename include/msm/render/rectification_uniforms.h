@@ -1,6 +1,7 @@
 // The rectification of prefiltered single scattering (rectification.h) as the renderer's passes
-// receive it: one uniform block per frame (vec4 members only, so that std140 and C++ agree), and
-// the functions that turn it back into the shared structs on both sides.
+// receive it: one per light of the frame, in a storage buffer (an std430 array; vec4 members only,
+// so that std430 and C++ agree), and the functions that turn it back into the shared structs on
+// both sides.
 #ifndef MSM_RENDER_RECTIFICATION_UNIFORMS_H
 #define MSM_RENDER_RECTIFICATION_UNIFORMS_H
 #include "msm/rectification.h"

@@ -175,9 +175,10 @@ class ShadingPass : public Pass {
   FrameConfig config_;
 };
 
-// Scattering techniques: camera_depth + surface_radiance + the first light's shadow map -> color
-// (sRGB) and scattering (in-scattered radiance, visible fraction): single scattering in the scene's
-// medium composited over the surfaces, tone mapped (a full-screen triangle, JCGT §5.5's deferred pass).
+// Scattering techniques: camera_depth + surface_radiance + every light's shadow map (ray marching) or
+// prefix sums (prefiltered) -> color (sRGB) and scattering (in-scattered radiance, visible fraction):
+// single scattering of every light in the scene's medium, summed, composited over the surfaces, tone
+// mapped (a full-screen triangle, JCGT §5.5's deferred pass).
 class ScatteringPass : public Pass {
  public:
   explicit ScatteringPass(const FrameConfig& config) : config_(config) {}
@@ -193,8 +194,8 @@ class ScatteringPass : public Pass {
   FrameConfig config_;
 };
 
-// Prefiltered scattering (JCGT §5.1.1, §5.2): the first light's depth map resampled without filtering
-// into the rectified map (compute, rectify.glsl): moments of the rectified depth in float.
+// Prefiltered scattering (JCGT §5.1.1, §5.2): each light's depth map resampled into its rectified map
+// (its layer; compute, rectify.glsl, one dispatch per light): moments of the rectified depth in float.
 class RectifyPass : public Pass {
  public:
   explicit RectifyPass(const FrameConfig& config) : config_(config) {}
@@ -208,8 +209,8 @@ class RectifyPass : public Pass {
   FrameConfig config_;
 };
 
-// The rectified map -> transmittance-weighted prefix sums along its rows (JCGT Appendix C's 8 x 8
-// scheme, prefix_sums.comp), in the technique's storage format.
+// Each light's rectified map -> transmittance-weighted prefix sums along its rows (JCGT Appendix C's
+// 8 x 8 scheme, prefix_sums.comp; one dispatch per light), in the technique's storage format.
 class PrefixSumPass : public Pass {
  public:
   explicit PrefixSumPass(const FrameConfig& config) : config_(config) {}

@@ -2,6 +2,8 @@
 
 #include "msm/techniques.h"
 
+#include <span>
+
 namespace msm::render {
 namespace {
 constexpr VkPipelineStageFlags2 kCompute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
@@ -32,23 +34,26 @@ void RectifyPass::prepare(const PassResources& r) {
                                    : six        ? "rectify6"
                                                 : "rectify") +
                        (config_.msaa == 1 ? "_1x.comp" : ".comp");
-  std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::uniform_buffer,
+  std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::storage_buffer,
                                        vk::Binding::storage_buffer, vk::Binding::sampled_image,
                                        vk::Binding::storage_image};
   if (six) bindings.push_back(vk::Binding::storage_image);
-  program_ = &r.programs.compute(shader, bindings, 0);
+  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush));
 }
 
 void RectifyPass::reflect(PassBuilder& b) const {
   b.read(kShadowDepth, use::sampled(kCompute));
-  ImageSpec spec{.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = size(config_), .height = size(config_)};
-  // CSM: eight layers of coefficients in [0,1] for 8-bit storage; half floats lose nothing of that.
+  // A layer per light (every light its own rectified map).
+  const uint32_t lights = uint32_t(config_.lights);
+  ImageSpec spec{
+      .format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = size(config_), .height = size(config_), .layers = lights};
+  // CSM: eight layers of coefficients in [0,1] per light for 8-bit storage; half floats lose nothing of that.
   if (csm(config_))
     b.create(kRectified,
              {.format = VK_FORMAT_R16G16B16A16_SFLOAT,
               .width = size(config_),
               .height = size(config_),
-              .layers = kCsmLayers},
+              .layers = kCsmLayers * lights},
              use::compute_general());
   else
     b.create(kRectified, spec, use::compute_general());
@@ -57,14 +62,20 @@ void RectifyPass::reflect(PassBuilder& b) const {
 
 void RectifyPass::execute(const PassContext& c) const {
   uint32_t groups = vk::group_count(size(config_), 8);
-  std::vector<vk::Descriptor> d = {
-      vk::Descriptor(c.frame.uniforms), vk::Descriptor(*c.frame.rectification), vk::Descriptor(c.frame.lights),
-      vk::Descriptor(c.image(kShadowDepth).layer_views[0], kReadOnly, c.frame.point_sampler), // the first light
-      csm(config_) ? vk::Descriptor(c.image(kRectified).array_view, VK_IMAGE_LAYOUT_GENERAL)
-                   : vk::Descriptor(c.image(kRectified).layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
-  if (prefix_sums_have_two_images(config_))
-    d.emplace_back(c.image(kRectified1).layer_views[0], VK_IMAGE_LAYOUT_GENERAL);
-  vk::dispatch(c.cmd, *program_, groups, groups, 1, d);
+  for (int l = 0; l < config_.lights; ++l) {
+    c.begin_light(name(), l);
+    const size_t layer = size_t(l);
+    std::vector<vk::Descriptor> d = {
+        vk::Descriptor(c.frame.uniforms), vk::Descriptor(*c.frame.rectification), vk::Descriptor(c.frame.lights),
+        vk::Descriptor(c.image(kShadowDepth).layer_views[layer], kReadOnly, c.frame.point_sampler),
+        csm(config_) ? vk::Descriptor(c.image(kRectified).array_view, VK_IMAGE_LAYOUT_GENERAL) // layers 8 l + t
+                     : vk::Descriptor(c.image(kRectified).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)};
+    if (prefix_sums_have_two_images(config_))
+      d.emplace_back(c.image(kRectified1).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL);
+    const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, 0)};
+    vk::dispatch(c.cmd, *program_, groups, groups, 1, d, std::as_bytes(std::span(&push, 1)));
+    c.end_light();
+  }
 }
 
 void PrefixSumPass::prepare(const PassResources& r) {
@@ -74,39 +85,49 @@ void PrefixSumPass::prepare(const PassResources& r) {
                        : rep == MSM_REP6_FLOAT   ? "prefix_sums6_32.comp"
                        : csm(config_)            ? "prefix_sums_csm.comp"
                                                  : "prefix_sums.comp";
-  std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image,
+  std::vector<vk::Binding> bindings = {vk::Binding::storage_buffer, vk::Binding::sampled_image,
                                        vk::Binding::storage_image};
   if (rep >= 0) bindings.insert(bindings.end(), {vk::Binding::sampled_image, vk::Binding::storage_image});
-  program_ = &r.programs.compute(shader, bindings, 0);
+  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush));
 }
 
 void PrefixSumPass::reflect(PassBuilder& b) const {
   std::array<VkFormat, 2> formats = prefix_formats(config_);
+  const uint32_t lights = uint32_t(config_.lights); // a layer per light (CSM: eight)
   b.read(kRectified, use::sampled(kCompute));
-  b.create(
-      kPrefixSums,
-      {.format = formats[0], .width = size(config_), .height = size(config_), .layers = csm(config_) ? kCsmLayers : 1},
-      use::compute_general());
+  b.create(kPrefixSums,
+           {.format = formats[0],
+            .width = size(config_),
+            .height = size(config_),
+            .layers = (csm(config_) ? kCsmLayers : 1) * lights},
+           use::compute_general());
   if (prefix_sums_have_two_images(config_)) {
     b.read(kRectified1, use::sampled(kCompute));
-    b.create(kPrefixSums1, {.format = formats[1], .width = size(config_), .height = size(config_)},
+    b.create(kPrefixSums1, {.format = formats[1], .width = size(config_), .height = size(config_), .layers = lights},
              use::compute_general());
   }
 }
 
 void PrefixSumPass::execute(const PassContext& c) const {
-  // CSM: the whole arrays, one layer per dispatch z.
+  // CSM: the whole arrays, the light's eight layers one per dispatch z; the others the light's layer.
   const bool array = csm(config_);
   const GraphImage &rectified = c.image(kRectified), &prefix_sums = c.image(kPrefixSums);
-  std::vector<vk::Descriptor> d = {
-      vk::Descriptor(*c.frame.rectification),
-      vk::Descriptor(array ? rectified.array_view : rectified.layer_views[0], kReadOnly, c.frame.point_sampler),
-      vk::Descriptor(array ? prefix_sums.array_view : prefix_sums.layer_views[0], VK_IMAGE_LAYOUT_GENERAL)};
-  if (prefix_sums_have_two_images(config_)) {
-    d.emplace_back(c.image(kRectified1).layer_views[0], kReadOnly, c.frame.point_sampler);
-    d.emplace_back(c.image(kPrefixSums1).layer_views[0], VK_IMAGE_LAYOUT_GENERAL);
+  for (int l = 0; l < config_.lights; ++l) {
+    c.begin_light(name(), l);
+    const size_t layer = size_t(l);
+    std::vector<vk::Descriptor> d = {
+        vk::Descriptor(*c.frame.rectification),
+        vk::Descriptor(array ? rectified.array_view : rectified.layer_views[layer], kReadOnly, c.frame.point_sampler),
+        vk::Descriptor(array ? prefix_sums.array_view : prefix_sums.layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)};
+    if (prefix_sums_have_two_images(config_)) {
+      d.emplace_back(c.image(kRectified1).layer_views[layer], kReadOnly, c.frame.point_sampler);
+      d.emplace_back(c.image(kPrefixSums1).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL);
+    }
+    const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, 0)};
+    vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, array ? kCsmLayers : 1, d,
+                 std::as_bytes(std::span(&push, 1)));
+    c.end_light();
   }
-  vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, array ? kCsmLayers : 1, d);
 }
 
 } // namespace msm::render

@@ -18,10 +18,12 @@ void ScatteringPass::prepare(const PassResources& r) {
                                                             : "scatter_march.frag",
                      .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
                                   vk::Binding::sampled_image, vk::Binding::sampled_image, vk::Binding::storage_buffer,
-                                  vk::Binding::uniform_buffer, vk::Binding::sampled_image},
+                                  vk::Binding::storage_buffer, vk::Binding::sampled_image},
                      .push_constant_size = sizeof(ScatteringPush),
                      .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
-                     .depth_write = false};
+                     .depth_write = false,
+                     // One light: the loop over the lights and its layer folded to 0 (scatter.glsl).
+                     .constants = {{4, config_.lights == 1 ? 1u : 0u}}};
   program_ = &r.programs.graphics(d);
 }
 
@@ -29,7 +31,7 @@ void ScatteringPass::reflect(PassBuilder& b) const {
   const VkPipelineStageFlags2 fragment = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
   b.read(kCameraDepth, use::sampled(fragment));
   b.read(kSurfaceRadiance, use::sampled(fragment));
-  // Ray marching reads the depth map, the prefiltered techniques their prefix sums.
+  // Ray marching reads the depth map, the prefiltered techniques their prefix sums (every light's layer).
   b.read(prefiltered() ? kPrefixSums : kShadowDepth, use::sampled(fragment));
   if (six_moments()) b.read(kPrefixSums1, use::sampled(fragment));
   uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
@@ -48,17 +50,14 @@ void ScatteringPass::execute(const PassContext& c) const {
       c.cmd, *program_,
       {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, point),
        vk::Descriptor(c.image(kCameraDepth).layer_views[0], read_only, point),
-       // CSM: the eight layers as one array.
-       prefiltered()
-           ? vk::Descriptor(config_.technique->id == MSM_TECH_SCATTER_CSM32 ? c.image(kPrefixSums).array_view
-                                                                            : c.image(kPrefixSums).layer_views[0],
-                            read_only, *c.frame.repeat_sampler)
-           : vk::Descriptor(c.image(kShadowDepth).layer_views[0], read_only, point), // light 0
+       // Every light's layers as one array (CSM: eight per light).
+       prefiltered() ? vk::Descriptor(c.image(kPrefixSums).array_view, read_only, *c.frame.repeat_sampler)
+                     : vk::Descriptor(c.image(kShadowDepth).array_view, read_only, point),
        vk::Descriptor(c.frame.blue_noise.view(), read_only, point), vk::Descriptor(c.frame.lights),
        vk::Descriptor(*c.frame.rectification),
        // The second image of six moments (the others: any 2D image, unused).
-       vk::Descriptor(c.image(six_moments() ? kPrefixSums1 : kSurfaceRadiance).layer_views[0], read_only,
-                      *c.frame.repeat_sampler)},
+       six_moments() ? vk::Descriptor(c.image(kPrefixSums1).array_view, read_only, *c.frame.repeat_sampler)
+                     : vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, *c.frame.repeat_sampler)},
       c.frame.scattering);
   vkCmdDraw(c.cmd, 3, 1, 0, 0);
   vkCmdEndRendering(c.cmd);

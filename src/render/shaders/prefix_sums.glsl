@@ -6,16 +6,19 @@
 // The including file defines the storage: MSM_PREFIX_FORMAT0 (and, with MSM_SIX_MOMENTS, the second
 // image's MSM_PREFIX_FORMAT1 and MSM_PREFIX_ODD_EVEN for two RGB10A2 images holding the odd and the
 // even moments; otherwise (odd, even.x) and (even.y, even.z) as in the rectified map). With MSM_CSM
-// both are eight-layer arrays (the convolution shadow map's 32 coefficients), one layer per
-// dispatch z.
+// both are arrays of eight layers per light (the convolution shadow map's 32 coefficients), one
+// layer per dispatch z. One dispatch per light (the push constant's size.z: its rectification
+// rects[light]; CSM: its layers 8 light + z; the others bind the light's layer).
+#include "msm/render/frame.h"
 #include "msm/render/rectification_uniforms.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, binding = 0) uniform RectificationBlock { RectificationUniforms rect; };
+layout(std430, binding = 0) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+layout(push_constant) uniform Push { ImagePassPush pass; }; // size.z: the light
 #ifdef MSM_CSM
 layout(binding = 1) uniform sampler2DArray rectified; // float coefficients, texelFetch only
 layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2DArray prefix_sums;
-#define MSM_TEXEL(x, y) ivec3(x, y, int(gl_WorkGroupID.z))
+#define MSM_TEXEL(x, y) ivec3(x, y, MSM_CSM_MAX_TEXELS * pass.size.z + int(gl_WorkGroupID.z))
 #else
 layout(binding = 1) uniform sampler2D rectified; // float moments, texelFetch only
 layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2D prefix_sums;
@@ -27,6 +30,7 @@ layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2D prefix_sums1;
 #endif
 
 void main() {
+  RectificationUniforms rect = rects[pass.size.z];
   ivec2 size = ivec2(int(rect.map.x), int(rect.map.y));
   int row = int(gl_WorkGroupID.x) * 8 + int(gl_LocalInvocationID.y);
   int column = int(gl_LocalInvocationID.x);

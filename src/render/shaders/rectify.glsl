@@ -1,5 +1,7 @@
-// Resampling of the first light's shadow map into the rectified map of prefiltered single
-// scattering (JCGT §5.1.1, §5.2; rectification.h): per rectified texel, the light ray at (r, φ) is
+// Resampling of one light's shadow map into its rectified map of prefiltered single scattering
+// (JCGT §5.1.1, §5.2; rectification.h), one dispatch per light (the push constant's size.z: the
+// light, its rectification rects[light] and its layer of the rectified images; the depth map bound
+// is that light's layer): per rectified texel, the light ray at (r, φ) is
 // looked up in the light's depth map, without filtering (the nearest texel, sample 0), or, where
 // the technique's parameter x is 1, with filtering (§5.2): a bilinear sample of the map's four
 // moments (each texel the mean of its MSAA samples' moments: the resolved, unblurred moment map of
@@ -7,7 +9,8 @@
 // depth π − θ and turned into the technique's moments in its storage basis
 // (Θ4*; with MSM_SIX_MOMENTS Θ6* over two images: (odd, even.x) and (even.y, even.z); with MSM_CSM
 // Klehm et al.'s 16 sin/cos terms of [0,1] depth mapped to [0,1] (msm_csm_to_unorm), four per layer
-// of an eight-layer RGBA16F array: the 8-bit storage comes after the prefix sums), written as
+// of the light's eight layers 8 light .. 8 light + 7 of an RGBA16F array: the 8-bit storage comes
+// after the prefix sums), written as
 // float for the prefix sums. A light ray outside the map, or over a texel without
 // a caster, gets the farthest rectified depth: nothing on it shadows any view ray.
 #include "msm/render/rectification_uniforms.h"
@@ -18,7 +21,8 @@
 #include "depth_map.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std140, binding = 1) uniform RectificationBlock { RectificationUniforms rect; };
+layout(std430, binding = 1) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+layout(push_constant) uniform Push { ImagePassPush pass; }; // size.z: the light
 #ifdef MSM_CSM
 layout(binding = 4, rgba16f) uniform writeonly image2DArray rectified;
 #else
@@ -30,6 +34,8 @@ layout(binding = 5, rgba32f) uniform writeonly image2D rectified1;
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  int light = pass.size.z;
+  RectificationUniforms rect = rects[light];
   ivec2 size = ivec2(int(rect.map.x), int(rect.map.y));
   if (texel.x >= size.x || texel.y >= size.y) return;
   RectificationFrame f = msm_rectification_frame_of(rect);
@@ -37,7 +43,7 @@ void main() {
   vec2 uv = (vec2(texel) + 0.5f) / vec2(size);
   vec3 p = msm_rectified_light_ray_point(f, b, uv);
   float r = msm_rectified_r_phi(b, uv).x;
-  vec4 clip = lights[0].view_projection * vec4(p, 1.0f);
+  vec4 clip = lights[light].view_projection * vec4(p, 1.0f);
   // The map's depth d lies at rectification z = extent (d − d(p)) on this light ray.
   vec2 depth_to_z = vec2(rect.map.z, -clip.z * rect.map.z);
   TwoDepths d = TwoDepths(vec2(1.0f), vec2(1.0f, 0.0f));
@@ -66,7 +72,7 @@ void main() {
   }
 #if defined(MSM_CSM)
   CsmMoments m = msm_rectified_csm(d, MSM_CSM_MAX_TERMS);
-  for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) imageStore(rectified, ivec3(texel, t), msm_csm_to_unorm(msm_csm_texel(m, t)));
+  for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) imageStore(rectified, ivec3(texel, MSM_CSM_MAX_TEXELS * light + t), msm_csm_to_unorm(msm_csm_texel(m, t)));
 #elif defined(MSM_SIX_MOMENTS)
   Moments6 m = msm_theta6_star(msm_rectified_moments6(d));
   imageStore(rectified, texel, vec4(m.odd, m.even.x));

@@ -1,30 +1,37 @@
 // The scattering pass (JCGT §5.5: a deferred pass after the shading): per pixel, the view ray from
 // the camera to the visible surface (to the far plane where there is none), the visible fraction
-// of its in-scattering, and the composite over the surface radiance (scattering.h), tone mapped.
-// The visible fraction:
+// of its in-scattering from every light of the frame, and the composite over the surface radiance
+// (scattering.h: the sum over the lights), tone mapped. Light l's visible fraction:
 //  - ray marching (JCGT §5.5.1's baseline): equidistant jittered samples (scattering.h, ray_march.h)
-//    against the first light's hard depth map (sample 0 of each texel). Samples outside the map's
-//    x, y range count as lit (nothing there casts into the map); below its far plane they compare
-//    at depth 1.
-//  - prefiltered (MSM_SCATTER_PREFILTERED, JCGT §5.1.1, §5.3, §5.4): one bilinear lookup in the
-//    prefix-summed rectified map (rectification.h), four (or, MSM_SIX_MOMENTS, six) moments with
-//    adaptive β (or a fixed one: parameters y, z); with MSM_CSM (Klehm et al. 2014) the eight layers of a convolution shadow map
-//    with 32 coefficients at 8 bits, reconstructed at the ray's [0,1] rectified depth.
+//    against light l's hard depth map (its layer of the depth array, sample 0 of each texel). Samples
+//    outside the map's x, y range count as lit (nothing there casts into the map); below its far
+//    plane they compare at depth 1.
+//  - prefiltered (MSM_SCATTER_PREFILTERED, JCGT §5.1.1, §5.3, §5.4): one bilinear lookup in light l's
+//    prefix-summed rectified map (its layer; its rectification rects[l], rectification.h), four (or,
+//    MSM_SIX_MOMENTS, six) moments with adaptive β (or a fixed one: parameters y, z); with MSM_CSM
+//    (Klehm et al. 2014) the eight layers 8 l .. 8 l + 7 of a convolution shadow map with 32
+//    coefficients at 8 bits, reconstructed at the ray's [0,1] rectified depth.
+// The scattering attachment's alpha is the visible fraction over all lights (msm_scattering_sum_visible).
 #include "msm/ray_march.h"
 #include "msm/render/rectification_uniforms.h"
 #include "msm/shading.h"
 #define MSM_LIGHT_BINDING 5
 #include "frame.glsl"
+// Frames with one light specialize the loop over the lights and its layer to the constant 0 (as the
+// shading does: lavapipe fetches from a constant layer several times faster than from a variable one).
+layout(constant_id = 4) const bool kOneLight = false;
+int current_layer = 0;
+#define shadow_layer (kOneLight ? 0 : current_layer)
 #ifdef MSM_SCATTER_PREFILTERED
-#ifdef MSM_CSM
-layout(binding = 3) uniform sampler2DArray prefix_sums; // 8 layers of RGBA8: msm_csm_to_unorm
-#else
-layout(binding = 3) uniform sampler2D prefix_sums; // Θ4* (16-bit) or Θ6* image 0, bilinear
+// A layer per light (CSM: eight per light, light l's from 8 l).
+layout(binding = 3) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
+layout(std430, binding = 6) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+#ifdef MSM_SIX_MOMENTS
+layout(binding = 7) uniform sampler2DArray prefix_sums1; // Θ6* image 1
 #endif
-layout(std140, binding = 6) uniform RectificationBlock { RectificationUniforms rect; };
-layout(binding = 7) uniform sampler2D prefix_sums1; // Θ6* image 1
 #else
 #define MSM_DEPTH_BINDING 3
+#define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
 #endif
 
@@ -37,9 +44,9 @@ layout(location = 0) out vec4 out_color;      // tone mapped; the attachment is 
 layout(location = 1) out vec4 out_scattering; // rgb: in-scattered radiance, a: visible fraction
 
 #ifndef MSM_SCATTER_PREFILTERED
-// 1 where the first light reaches p, 0 where its depth map has an occluder in front of p.
+// 1 where light shadow_layer reaches p, 0 where its depth map has an occluder in front of p.
 float light_reaches(vec3 p) {
-  vec4 clip = lights[0].view_projection * vec4(p, 1.0f);
+  vec4 clip = lights[shadow_layer].view_projection * vec4(p, 1.0f);
   if (any(lessThan(vec2(clip.x, clip.y), vec2(-1.0f))) || any(greaterThan(vec2(clip.x, clip.y), vec2(1.0f))))
     return 1.0f;
   int size = int(frame.shadow_map.x);
@@ -48,7 +55,8 @@ float light_reaches(vec3 p) {
   return depth_sample(texel, 0) < min(clip.z, 1.0f) - frame.shadow_map.w ? 0.0f : 1.0f;
 }
 
-float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
+float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  current_layer = l;
   float extinction = scatter.medium.x;
   int count = scatter.march.x;
   // One blue-noise jitter per pixel (the frame's layer and offset), strictly below 1.
@@ -62,9 +70,11 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
   return msm_ray_march_visible_fraction(weighted, extinction, s);
 }
 #else
-// One lookup in the prefix sums at the ray's row and reach, reconstructed at the ray's rectified
-// depth with adaptive overestimation (§5.3.1).
-float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
+// One lookup in light l's prefix sums at the ray's row and reach, reconstructed at the ray's
+// rectified depth with adaptive overestimation (§5.3.1).
+float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  current_layer = l;
+  RectificationUniforms rect = rects[shadow_layer];
   RectificationFrame f = msm_rectification_frame_of(rect);
   RectifiedBounds b = msm_rectified_bounds_of(rect);
   vec3 lookup = msm_rectified_view_lookup(f, b, camera + s * direction, rect.map.x);
@@ -77,7 +87,7 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
 #ifdef MSM_CSM
   CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
   for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
-    vec4 texel = msm_csm_from_unorm(textureLod(prefix_sums, vec3(uv, float(t)), 0.0f));
+    vec4 texel = msm_csm_from_unorm(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), 0.0f));
     if (t < 4)
       m.lo[t] = texel;
     else
@@ -85,15 +95,16 @@ float visible_fraction(ivec2 pixel, vec3 camera, vec3 direction, float s) {
   }
   return msm_scattering_visibility_csm(m, msm_saturate(lookup.z), msm_csm_scattering_params());
 #else
-  vec4 stored = textureLod(prefix_sums, uv, 0.0f);
+  vec4 stored = textureLod(prefix_sums, vec3(uv, float(shadow_layer)), 0.0f);
   // The technique's parameter z = 1 fixes β to its y (§5.3.1's constant overestimation), else adaptive.
-  float beta = frame.technique_params.z == 1.0f ? msm_saturate(frame.technique_params.y)
-                                                : msm_scattering_beta_adaptive(lights[0].towards_light.xyz, direction);
+  float beta = frame.technique_params.z == 1.0f
+                   ? msm_saturate(frame.technique_params.y)
+                   : msm_scattering_beta_adaptive(lights[shadow_layer].towards_light.xyz, direction);
   float zf = msm_signed_depth(lookup.z);
 #ifdef MSM_SIX_MOMENTS
   // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
   int representation = scatter.march.y;
-  vec4 stored1 = textureLod(prefix_sums1, uv, 0.0f);
+  vec4 stored1 = textureLod(prefix_sums1, vec3(uv, float(shadow_layer)), 0.0f);
   Moments6 m = representation == MSM_REP6_UNORM10
                    ? Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored1.x, stored1.y, stored1.z))
                    : Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored.w, stored1.x, stored1.y));
@@ -120,12 +131,17 @@ void main() {
   float visible = 1.0f;
   if (scatter.medium.w != 0.0f) {
     float extinction = scatter.medium.x;
-    visible = visible_fraction(pixel, camera, direction, s);
-    float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
-                                            dot(lights[0].towards_light.xyz, direction));
-    vec3 irradiance = lights[0].irradiance.rgb;
-    radiance = msm_scattered_radiance(surface, irradiance, extinction, phase, s, visible);
-    inscattered = msm_scattered_radiance(vec3(0.0f), irradiance, extinction, phase, s, visible);
+    ScatteringSum sum = msm_scattering_sum_none();
+    int light_count = kOneLight ? 1 : frame.lights.x;
+    for (int l = 0; l < light_count; ++l) {
+      float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
+                                              dot(lights[l].towards_light.xyz, direction));
+      sum = msm_scattering_add_light(sum, lights[l].irradiance.rgb, extinction, phase, s,
+                                     visible_fraction(l, pixel, camera, direction, s));
+    }
+    radiance = msm_scattering_sum_radiance(surface, extinction, s, sum);
+    inscattered = sum.inscattered;
+    visible = msm_scattering_sum_visible(sum);
   }
   out_color = vec4(msm_aces(radiance * frame.shading.y), 1.0f);
   out_scattering = vec4(inscattered, visible);
