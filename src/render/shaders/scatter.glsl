@@ -19,7 +19,8 @@
 #include "frame.glsl"
 // Frames with one light specialize the loop over the lights and its layer to the constant 0 (as the
 // shading does: lavapipe fetches from a constant layer several times faster than from a variable one).
-layout(constant_id = 4) const bool kOneLight = false;
+layout(constant_id = 4) const int kLightCount = 1; // a constant, not frame.lights.x: see shading.glsl
+const bool kOneLight = kLightCount == 1;
 int current_layer = 0;
 #define shadow_layer (kOneLight ? 0 : current_layer)
 #ifdef MSM_SCATTER_PREFILTERED
@@ -132,7 +133,7 @@ void main() {
   if (scatter.medium.w != 0.0f) {
     float extinction = scatter.medium.x;
     ScatteringSum sum = msm_scattering_sum_none();
-    int light_count = kOneLight ? 1 : frame.lights.x;
+    const int light_count = kLightCount;
     for (int l = 0; l < light_count; ++l) {
       float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
                                               dot(lights[l].towards_light.xyz, direction));
