@@ -28,8 +28,8 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
     if (size < 1 || size > probe::kMaxDeviceCubeSize)
       throw UsageError(fmt::format("--probe-sizes: {} outside 1..{}", size, probe::kMaxDeviceCubeSize));
   for (int n : o.lights)
-    if (n < 6 || n > probe::kMaxDeviceLights)
-      throw UsageError(fmt::format("--probe-lights: {} outside 6..{}", n, probe::kMaxDeviceLights));
+    if (n < 1 || n > probe::kMaxDeviceLights)
+      throw UsageError(fmt::format("--probe-lights: {} outside 1..{}", n, probe::kMaxDeviceLights));
   const bool sky = o.probe == "sky";
   probe::Panorama panorama;
   if (!sky) {
