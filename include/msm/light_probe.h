@@ -209,16 +209,15 @@ MSM_FN MsmAreaLight msm_area_light_from_region(int face, MsmRegionSums sums) {
 // order). Each part r of energy E_r = Σ w Y is taken as its light: a direction z_r with a uniform
 // spread of tangent variances σ² = t² / 3 along x_r, y_r (the inverse of d = sqrt(3σ²)). ---
 struct MsmMergedSums {
-  vec3 xyz;          // Σ of the parts' Σ w L_XYZ: the region's M_e (Eq. 11) in XYZ
-  vec3 mean;         // Σ E_r z_r
-  mat3 second;       // Σ E_r (z_r z_rᵀ + σ_x² x_r x_rᵀ + σ_y² y_r y_rᵀ)
-  float solid_angle; // Σ of the parts' cones' solid angles 4π sin²(α_r / 2)
-  float dominant;    // E_r of the most energetic part so far (ties: the first)
+  vec3 xyz;       // Σ of the parts' Σ w L_XYZ: the region's M_e (Eq. 11) in XYZ
+  vec3 mean;      // Σ E_r z_r
+  mat3 second;    // Σ E_r (z_r z_rᵀ + σ_x² x_r x_rᵀ + σ_y² y_r y_rᵀ)
+  float dominant; // E_r of the most energetic part so far (ties: the first)
   vec3 dominant_z, dominant_x, dominant_y;
 };
 MSM_FN MsmMergedSums msm_merged_sums_empty() {
-  return MsmMergedSums(vec3(0.0f), vec3(0.0f), mat3(0.0f), 0.0f, 0.0f, vec3(0.0f, 0.0f, 1.0f),
-                       vec3(1.0f, 0.0f, 0.0f), vec3(0.0f, 1.0f, 0.0f));
+  return MsmMergedSums(vec3(0.0f), vec3(0.0f), mat3(0.0f), 0.0f, vec3(0.0f, 0.0f, 1.0f), vec3(1.0f, 0.0f, 0.0f),
+                       vec3(0.0f, 1.0f, 0.0f));
 }
 MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSums part) {
   s.xyz += part.xyz;
@@ -229,8 +228,6 @@ MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSum
   s.mean += e * l.direction;
   s.second += e * (outerProduct(l.direction, l.direction) + variance.x * outerProduct(l.x_axis, l.x_axis) +
                    variance.y * outerProduct(l.y_axis, l.y_axis));
-  float h = sin(0.5f * l.cone_half_angle);
-  s.solid_angle += 4.0f * MSM_PI * h * h;
   if (e > s.dominant) {
     s.dominant = e;
     s.dominant_z = l.direction;
@@ -246,9 +243,10 @@ MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSum
 // part's x axis projected off z (§4.1.2; its y axis crossed with z where x_r is along z), y = z × x;
 // half extents d = sqrt(3σ²) from the variances about z, σ_x² = xᵀ second x / Σ E_r (an offset of a
 // part counts by the sine of its angle to z, its spread by its own tangents: the same for small
-// angles); the cone of the summed solid angle Ω, α = 2 asin(sqrt(Ω / 4π)), at most a hemisphere
-// (msm_cone_cosine and Eqs. 15–18 hold for α <= π/2); irradiance the summed M_e. One lit part
-// alone gives its own direction, x axis and x extent.
+// angles); the cone, as a face's, of the area of the extents' rectangle, π tan² α = 4 t_x t_y
+// (below π/2, where msm_cone_cosine and Eqs. 15–18 hold; the parts' solid angles summed instead
+// measured worse, docs/techniques.md); irradiance the summed M_e. One lit part alone gives its
+// own direction, x axis and x extent.
 MSM_FN MsmAreaLight msm_area_light_from_merged(MsmMergedSums s) {
   float total = s.xyz.y;
   float mean_length = length(s.mean);
@@ -259,7 +257,7 @@ MSM_FN MsmAreaLight msm_area_light_from_merged(MsmMergedSums s) {
   vec3 y = cross(z, x);
   vec2 variance = vec2(dot(x, s.second * x), dot(y, s.second * y)) / total;
   vec2 t = sqrt(3.0f * max(variance, vec2(0.0f)));
-  float cone = 2.0f * asin(sqrt(clamp(s.solid_angle / (4.0f * MSM_PI), 0.0f, 0.5f)));
+  float cone = atan(sqrt(4.0f * t.x * t.y / MSM_PI));
   return MsmAreaLight(z, x, y, t, cone, max(msm_xyz_to_rgb(s.xyz), vec3(0.0f)));
 }
 

@@ -381,8 +381,7 @@ std::vector<Region> merge_faces(const ProbeTables& tables, std::vector<Region> r
 } // namespace
 
 std::vector<Region> median_cut(const ProbeTables& tables, int count) {
-  if (count < 1 || count > 256)
-    throw ProbeError(fmt::format("{} lights: the median cut makes 1 to 256", count));
+  if (count < 1 || count > 256) throw ProbeError(fmt::format("{} lights: the median cut makes 1 to 256", count));
   std::vector<Region> regions;
   for (int face = 0; face < 6; ++face) {
     Region r{face, 0, 0, tables.size(), tables.size()};
@@ -442,7 +441,8 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
   for (const Region& r : regions) {
     if (r.faces != 0) { // a group of faces
       MsmMergedSums s = msm_merged_sums_empty();
-      for (const Region& part : region_parts(r, tables.size())) s = msm_merged_sums_add(s, part.face, tables.sums(part));
+      for (const Region& part : region_parts(r, tables.size()))
+        s = msm_merged_sums_add(s, part.face, tables.sums(part));
       if (s.xyz.y > 0.0f) lights.push_back(msm_area_light_from_merged(s));
       continue;
     }

@@ -188,8 +188,8 @@ TEST(MedianCut, FewLightsMergeTheLeastEnergeticNeighbours) {
   const auto neighbours = [](std::uint32_t a, std::uint32_t b) { // a face of a next to a face of b
     for (int f = 0; f < 6; ++f)
       for (int g = 0; g < 6; ++g)
-        if ((a >> f & 1u) && (b >> g & 1u) && msm::msm_dot_in_order(msm::msm_cube_direction(f, 0, 0),
-                                                                    msm::msm_cube_direction(g, 0, 0)) == 0.0f)
+        if ((a >> f & 1u) && (b >> g & 1u) &&
+            msm::msm_dot_in_order(msm::msm_cube_direction(f, 0, 0), msm::msm_cube_direction(g, 0, 0)) == 0.0f)
           return true;
     return false;
   };
@@ -218,15 +218,11 @@ TEST(MedianCut, FewLightsMergeTheLeastEnergeticNeighbours) {
       EXPECT_EQ(r.face, std::countr_zero(mask(r))); // the lowest face names the group
       // Edge-connected: every face of a group of several has a neighbour in it.
       for (int f = 0; f < 6; ++f) {
-        if (r.faces >> f & 1u) {
-          EXPECT_TRUE(neighbours(1u << f, r.faces & ~(1u << f))) << count;
-        }
+        if (r.faces >> f & 1u) { EXPECT_TRUE(neighbours(1u << f, r.faces & ~(1u << f))) << count; }
       }
     }
     EXPECT_EQ(got, expected) << count << " lights";
-    if (count >= 2) {
-      EXPECT_TRUE(std::find(got.begin(), got.end(), 1u << sun_face) != got.end()) << count;
-    }
+    if (count >= 2) { EXPECT_TRUE(std::find(got.begin(), got.end(), 1u << sun_face) != got.end()) << count; }
     finer = cut;
   }
   EXPECT_EQ(median_cut(tables, 1)[0].faces, 63u);
@@ -302,7 +298,7 @@ TEST(AreaLights, GroupOfFacesMakesOneLight) {
     return cube;
   };
   // One lit face in a group: the group's light is that face's light (direction, x axis and extent,
-  // irradiance), the cone that of the same solid angle.
+  // irradiance; here, the lit rectangle centred in u, also its cone).
   {
     CubeMap cube = black();
     for (int j = 10; j < 30; ++j)
@@ -316,12 +312,12 @@ TEST(AreaLights, GroupOfFacesMakesOneLight) {
     EXPECT_LT(glm::length(merged.x_axis - face.x_axis), 1e-6f);
     EXPECT_NEAR(merged.half_extent.x, face.half_extent.x, 1e-6f * face.half_extent.x);
     EXPECT_EQ(merged.irradiance, face.irradiance);
-    EXPECT_NEAR(merged.cone_half_angle, face.cone_half_angle, 1e-6f);
+    EXPECT_NEAR(merged.cone_half_angle, face.cone_half_angle, 1e-5f * face.cone_half_angle);
   }
   // Two equal small spots at the centres of +X and +Z: the light lies half way, (1, 0, 1)/√2; along
   // the axis joining them the offsets are sin 45° (σ² = 1/2 plus the spots' own spread), so the half
   // extent is sqrt(3/2) = 1.22 there, and across it the spots' own, sqrt(3) / 64 (2 texels at
-  // ±1/64); the irradiances add; the solid angles add (each spot's cone from its extents).
+  // ±1/64); the irradiances add.
   {
     CubeMap cube = black();
     for (int f : {0, 4})
@@ -339,11 +335,9 @@ TEST(AreaLights, GroupOfFacesMakesOneLight) {
     EXPECT_NEAR(t.y, std::sqrt(3.0f) / 64.0f, 1e-4f);
     const msm::MsmAreaLight spot = msm::msm_area_light_from_region(0, tables.sums(Region{0, 0, 0, m, m}));
     EXPECT_NEAR(l.irradiance.x, 2.0f * spot.irradiance.x, 1e-6f * l.irradiance.x);
-    const double spot_omega = 4 * kPi * std::pow(std::sin(0.5 * spot.cone_half_angle), 2);
-    EXPECT_NEAR(4 * kPi * std::pow(std::sin(0.5 * l.cone_half_angle), 2), 2 * spot_omega, 1e-5 * spot_omega);
   }
   // The whole uniform sphere in one light: its directions cancel out (the most energetic face's,
-  // +X of the equal ones, is taken), its cone is capped at a hemisphere, its irradiance is 4π L.
+  // +X of the equal ones, is taken), its cone is below a hemisphere, its irradiance is 4π L.
   {
     CubeMap cube = black();
     for (auto& f : cube.faces) f.assign(std::size_t(m) * m, glm::vec3(0.5f));
@@ -352,7 +346,7 @@ TEST(AreaLights, GroupOfFacesMakesOneLight) {
     ASSERT_EQ(one.size(), 1u);
     const msm::MsmAreaLight l = area_lights(tables, one).at(0);
     EXPECT_LT(glm::length(l.direction - glm::vec3(1, 0, 0)), 1e-6f);
-    EXPECT_NEAR(l.cone_half_angle, kPi / 2, 1e-6);
+    EXPECT_TRUE(l.cone_half_angle > 0.0f && l.cone_half_angle < kPi / 2) << l.cone_half_angle;
     EXPECT_NEAR(l.irradiance.x, 0.5 * 4 * kPi, 2e-3 * 0.5 * 4 * kPi);
     EXPECT_TRUE(std::isfinite(l.half_extent.x) && std::isfinite(l.half_extent.y));
   }

@@ -200,19 +200,14 @@ namespace {
 // msm_cone_cosine, what --probe-lights integrates) against the probe's irradiance by quadrature.
 // The issue asks for 1% at every count; measured on the sky (32² faces), the worst relative error
 // over three normals is 12.3% at 6 lights (a vertical plane facing +Z), 2.4% at 16, 1.1% at 32,
-// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Asserted: 1% at 256, and
+// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Below six lights (groups
+// of faces, one cone standing for the sun and much of the sky) it is far worse: 77.8% at 1 light,
+// 53.2% at 2, 22.5% at 3 (all +Z), 5.3% at 4 (45°), 13.3% at 5 (+Z). Asserted: 1% at 256, and
 // 1.5x the measured error below (a bound against regressions, not the issue's claim).
 TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
-  const std::map<int, double> bound = {{1, 9.0},
-                                       {2, 9.0},
-                                       {3, 9.0},
-                                       {4, 9.0},
-                                       {5, 9.0},
-                                       {6, 1.5 * 0.123},
-                                       {16, 1.5 * 0.024},
-                                       {32, 1.5 * 0.0113},
-                                       {64, 1.5 * 0.012},
-                                       {256, 0.01}};
+  const std::map<int, double> bound = {{1, 1.5 * 0.778},  {2, 1.5 * 0.532}, {3, 1.5 * 0.225},  {4, 1.5 * 0.0526},
+                                       {5, 1.5 * 0.133},  {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113},
+                                       {64, 1.5 * 0.012}, {256, 0.01}};
   for (const auto& [count, tolerance] : bound) {
     const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "lights": )" +
                              std::to_string(count) +

@@ -132,7 +132,7 @@ class ProbeTables {
   explicit ProbeTables(const CubeMap& cube, float scale = 0.0f);
   int size() const { return size_; }
   float scale() const { return scale_; }
-  MsmRegionSums sums(const Region& r) const;        // of the rectangle of r.face (one part of a group)
+  MsmRegionSums sums(const Region& r) const;         // of the rectangle of r.face (one part of a group)
   double energy(const Region& r) const;              // Σ w Y (of every face of a group)
   std::uint64_t fixed_energy(const Region& r) const; // Σ w Y times scale, as the tables hold it
   // Entry (x, y) of table k (0..6, the order above) of a face: the sum over texels [0, x) x [0, y).

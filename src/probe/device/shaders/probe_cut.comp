@@ -17,7 +17,7 @@ layout(binding = 0, std430) readonly buffer Tables { uint64_t tables[]; };
 struct RegionOut {
   ivec4 rect; // x0, y0, x1, y1: texels [x0, x1) x [y0, y1)
   int face;
-  uint lit;   // 1: the region has energy and lights[t] is its light
+  uint lit; // 1: the region has energy and lights[t] is its light
   uint64_t fixed_energy;
   uint faces; // a group of whole faces: bit f per face f (face: the lowest); 0: the rectangle of face
   uint pad0, pad1, pad2;
@@ -33,7 +33,8 @@ layout(binding = 1, std430) writeonly buffer Result {
   uint pad0, pad1, pad2;
   RegionOut regions[MAX_REGIONS];
   LightOut lights[MAX_REGIONS];
-} result;
+}
+result;
 
 shared ivec4 s_rect[MAX_REGIONS];
 shared int s_face[MAX_REGIONS];
@@ -66,7 +67,8 @@ int64_t abs64(int64_t a) { return a < 0l ? -a : a; }
 MsmRegionSums region_sums(int face, ivec4 r) {
   uint64_t y = rect_sum(face, 1, r);
   vec3 xyz = vec3(float(rect_sum(face, 0, r)), float(y), float(rect_sum(face, 2, r)));
-  vec2 first = vec2(float(int64_t(rect_sum(face, 3, r)) - int64_t(y)), float(int64_t(rect_sum(face, 4, r)) - int64_t(y)));
+  vec2 first =
+      vec2(float(int64_t(rect_sum(face, 3, r)) - int64_t(y)), float(int64_t(rect_sum(face, 4, r)) - int64_t(y)));
   vec2 second = vec2(float(rect_sum(face, 5, r)), float(rect_sum(face, 6, r)));
   return msm_region_sums_from_fixed(xyz, first, second, pc.inv_scale);
 }
