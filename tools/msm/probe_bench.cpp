@@ -92,7 +92,9 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
     const double area_ratio = double(r.size) * r.size / (double(base_size) * base_size);
     const double base_cut = cut_at(r.size, base_n);
     const double cut_ratio = base_cut > 0.0 ? r.cut / base_cut : 0.0;
-    const double lights_ratio = double(r.lights) / base_n, log_ratio = std::log2(double(r.lights)) / std::log2(base_n);
+    // log2 N against the first count's; 0 where that is one light (log2 1 = 0), as the ratios above do.
+    const double lights_ratio = double(r.lights) / base_n,
+                 log_ratio = base_n > 1 ? std::log2(double(r.lights)) / std::log2(double(base_n)) : 0.0;
     table += fmt::format(
         "| {}² | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:.2f} | {:.0f} | {:.2f} |\n", r.size,
         r.lights, r.cube, r.tables, r.cut, tables_ratio, cube_ratio, area_ratio, cut_ratio, lights_ratio, log_ratio);
