@@ -238,15 +238,16 @@ MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSum
 }
 
 // The light of a region of several parts (precondition: s.xyz.y > 0): Eq. 9 in 3D, the normalised
-// luminance-weighted mean direction z (the most energetic part's when the parts' directions cancel
-// out, |Σ E_r z_r| < 10^-3 Σ E_r: light from all around has no direction); x the most energetic
-// part's x axis projected off z (§4.1.2; its y axis crossed with z where x_r is along z), y = z × x;
-// half extents d = sqrt(3σ²) from the variances about z, σ_x² = xᵀ second x / Σ E_r (an offset of a
-// part counts by the sine of its angle to z, its spread by its own tangents: the same for small
-// angles); the cone, as a face's, of the area of the extents' rectangle, π tan² α = 4 t_x t_y
-// (below π/2, where msm_cone_cosine and Eqs. 15–18 hold; the parts' solid angles summed instead
-// measured worse, docs/techniques.md); irradiance the summed M_e. One lit part alone gives its
-// own direction, x axis and x extent.
+// luminance-weighted mean z of the parts' directions (per texel it would take three more tables of
+// unit directions; within a face the part's own centroid stands for its texels), or the most
+// energetic part's direction where they cancel out (|Σ E_r z_r| < 10^-3 Σ E_r: light from all
+// around has no direction); x the most energetic part's x axis projected off z (§4.1.2; its y axis
+// crossed with z where x_r is along z), y = z × x; half extents d = sqrt(3σ²) from the variances
+// about z, σ_x² = xᵀ second x / Σ E_r (an offset of a part counts by the sine of its angle to z, its
+// spread by its own tangents: the same for small angles); the cone, as a face's, of the area of the
+// extents' rectangle, π tan² α = 4 t_x t_y (below π/2, where msm_cone_cosine and Eqs. 15–18 hold;
+// the parts' solid angles summed instead measured worse, docs/techniques.md); irradiance the summed
+// M_e. One lit part alone gives its own direction, x axis and x extent.
 MSM_FN MsmAreaLight msm_area_light_from_merged(MsmMergedSums s) {
   float total = s.xyz.y;
   float mean_length = length(s.mean);
