@@ -202,6 +202,66 @@ MSM_FN MsmAreaLight msm_area_light_from_region(int face, MsmRegionSums sums) {
   return MsmAreaLight(z, x / x_length, y / y_length, t, cone, max(msm_xyz_to_rgb(sums.xyz), vec3(0.0f)));
 }
 
+// --- Regions of several faces (N < 6: msm::probe::median_cut merges the six face regions, see
+// docs/techniques.md). The light of such a region is made from the lights of its parts, one per
+// face (msm_area_light_from_region of the part's sums), added in increasing face order by
+// msm_merged_sums_add (the CPU's area_lights and probe_cut.comp call the same functions in the same
+// order). Each part r of energy E_r = Σ w Y is taken as its light: a direction z_r with a uniform
+// spread of tangent variances σ² = t² / 3 along x_r, y_r (the inverse of d = sqrt(3σ²)). ---
+struct MsmMergedSums {
+  vec3 xyz;       // Σ of the parts' Σ w L_XYZ: the region's M_e (Eq. 11) in XYZ
+  vec3 mean;      // Σ E_r z_r
+  mat3 second;    // Σ E_r (z_r z_rᵀ + σ_x² x_r x_rᵀ + σ_y² y_r y_rᵀ)
+  float dominant; // E_r of the most energetic part so far (ties: the first)
+  vec3 dominant_z, dominant_x, dominant_y;
+};
+MSM_FN MsmMergedSums msm_merged_sums_empty() {
+  return MsmMergedSums(vec3(0.0f), vec3(0.0f), mat3(0.0f), 0.0f, vec3(0.0f, 0.0f, 1.0f), vec3(1.0f, 0.0f, 0.0f),
+                       vec3(0.0f, 1.0f, 0.0f));
+}
+MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSums part) {
+  s.xyz += part.xyz;
+  float e = part.xyz.y;
+  if (!(e > 0.0f)) return s; // no light: no direction, no extent
+  MsmAreaLight l = msm_area_light_from_region(face, part);
+  vec2 variance = l.half_extent * l.half_extent / 3.0f;
+  s.mean += e * l.direction;
+  s.second += e * (outerProduct(l.direction, l.direction) + variance.x * outerProduct(l.x_axis, l.x_axis) +
+                   variance.y * outerProduct(l.y_axis, l.y_axis));
+  if (e > s.dominant) {
+    s.dominant = e;
+    s.dominant_z = l.direction;
+    s.dominant_x = l.x_axis;
+    s.dominant_y = l.y_axis;
+  }
+  return s;
+}
+
+// The light of a region of several parts (precondition: s.xyz.y > 0): Eq. 9 in 3D, the normalised
+// luminance-weighted mean z of the parts' directions (per texel it would take three more tables of
+// unit directions; within a face the part's own centroid stands for its texels), or the most
+// energetic part's direction where they cancel out (|Σ E_r z_r| < 10^-3 Σ E_r: light from all
+// around has no direction); x the most energetic part's x axis projected off z (§4.1.2; its y axis
+// crossed with z where x_r is along z), y = z × x; half extents d = sqrt(3σ²) from the variances
+// about z, σ_x² = xᵀ second x / Σ E_r (an offset of a part counts by the sine of its angle to z, its
+// spread by its own tangents: the same for small angles); the cone, as a face's, of the area of the
+// extents' rectangle, π tan² α = 4 t_x t_y (below π/2, where msm_cone_cosine and Eqs. 15–18 hold;
+// the parts' solid angles summed instead measured worse, docs/techniques.md); irradiance the summed
+// M_e. One lit part alone gives its own direction, x axis and x extent.
+MSM_FN MsmAreaLight msm_area_light_from_merged(MsmMergedSums s) {
+  float total = s.xyz.y;
+  float mean_length = length(s.mean);
+  vec3 z = mean_length >= 1e-3f * total ? s.mean / mean_length : s.dominant_z;
+  vec3 x = s.dominant_x - z * dot(s.dominant_x, z);
+  if (length(x) < 1e-3f) x = cross(s.dominant_y, z);
+  x = normalize(x);
+  vec3 y = cross(z, x);
+  vec2 variance = vec2(dot(x, s.second * x), dot(y, s.second * y)) / total;
+  vec2 t = sqrt(3.0f * max(variance, vec2(0.0f)));
+  float cone = atan(sqrt(4.0f * t.x * t.y / MSM_PI));
+  return MsmAreaLight(z, x, y, t, cone, max(msm_xyz_to_rgb(s.xyz), vec3(0.0f)));
+}
+
 // ∫ over the cone of half-angle α around a light direction of max(cos, 0) dω, divided by the
 // cone's π sin² α: the factor that replaces max(n·l, 0) for a uniform circular light, where
 // cos_angle = n·l for the cone's axis l. Eq. (15) of the paper, π sin² α cos, holds while the whole

@@ -317,9 +317,22 @@ std::uint64_t ProbeTables::rect(int face, int k, const Region& r) const {
   return t[r.y1 * stride + r.x1] - t[r.y0 * stride + r.x1] - t[r.y1 * stride + r.x0] + t[r.y0 * stride + r.x0];
 }
 
-std::uint64_t ProbeTables::fixed_energy(const Region& r) const { return rect(r.face, 1, r); }
+std::vector<Region> region_parts(const Region& r, int size) {
+  if (r.faces == 0) return {r};
+  std::vector<Region> parts;
+  for (int face = 0; face < 6; ++face)
+    if (r.faces & (1u << face)) parts.push_back(Region{face, 0, 0, size, size});
+  return parts;
+}
 
-double ProbeTables::energy(const Region& r) const { return double(rect(r.face, 1, r)) / double(scale_); }
+std::uint64_t ProbeTables::fixed_energy(const Region& r) const {
+  if (r.faces == 0) return rect(r.face, 1, r);
+  std::uint64_t sum = 0; // six faces stay below 4π 2^60 < 2^64 (table_scale)
+  for (const Region& part : region_parts(r, size_)) sum += rect(part.face, 1, part);
+  return sum;
+}
+
+double ProbeTables::energy(const Region& r) const { return double(fixed_energy(r)) / double(scale_); }
 
 MsmRegionSums ProbeTables::sums(const Region& r) const {
   const auto rect_float = [&](int k) { return float(rect(r.face, k, r)); };
@@ -330,11 +343,45 @@ MsmRegionSums ProbeTables::sums(const Region& r) const {
                                     glm::vec2(rect_float(5), rect_float(6)), 1.0f / scale_);
 }
 
+namespace {
+
+std::uint32_t face_mask(const Region& r) { return r.faces != 0 ? r.faces : 1u << r.face; }
+
+// Some face of group a shares a cube edge with some face of group b: faces f and g do unless they
+// are opposite (f / 2 == g / 2, the same axis).
+bool share_an_edge(std::uint32_t a, std::uint32_t b) {
+  for (int f = 0; f < 6; ++f)
+    for (int g = 0; g < 6; ++g)
+      if ((a & (1u << f)) && (b & (1u << g)) && f / 2 != g / 2) return true;
+  return false;
+}
+
+// count < 6: the six face regions merged pairwise (median_cut's comment; probe_cut.comp does the same).
+std::vector<Region> merge_faces(const ProbeTables& tables, std::vector<Region> regions, int count) {
+  while (int(regions.size()) > count) {
+    int best_i = -1, best_j = -1;
+    std::uint64_t best = 0;
+    for (int i = 0; i < int(regions.size()); ++i)
+      for (int j = i + 1; j < int(regions.size()); ++j) {
+        if (!share_an_edge(face_mask(regions[i]), face_mask(regions[j]))) continue;
+        const std::uint64_t e = regions[i].fixed_energy + regions[j].fixed_energy;
+        if (best_i < 0 || e < best) best_i = i, best_j = j, best = e;
+      }
+    // Two or more groups of faces always have a pair sharing an edge (only two single opposite faces
+    // share none, and they are not all six).
+    Region& merged = regions[best_i];
+    merged.faces = face_mask(merged) | face_mask(regions[best_j]);
+    merged.fixed_energy = best;
+    merged.energy = double(best) / double(tables.scale());
+    regions.erase(regions.begin() + best_j);
+  }
+  return regions;
+}
+
+} // namespace
+
 std::vector<Region> median_cut(const ProbeTables& tables, int count) {
-  if (count < 6 || count > 256)
-    throw ProbeError(fmt::format("{} lights: the median cut makes 6 to 256 (one region per cube face at least; "
-                                 "regions never straddle faces)",
-                                 count));
+  if (count < 1 || count > 256) throw ProbeError(fmt::format("{} lights: the median cut makes 1 to 256", count));
   std::vector<Region> regions;
   for (int face = 0; face < 6; ++face) {
     Region r{face, 0, 0, tables.size(), tables.size()};
@@ -342,6 +389,7 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count) {
     r.energy = tables.energy(r);
     regions.push_back(r);
   }
+  if (count < 6) return merge_faces(tables, std::move(regions), count);
   while (int(regions.size()) < count) {
     // The most energetic region that can be split (ties: the first, so the result is deterministic).
     int best = -1;
@@ -391,6 +439,13 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count) {
 std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vector<Region>& regions) {
   std::vector<MsmAreaLight> lights;
   for (const Region& r : regions) {
+    if (r.faces != 0) { // a group of faces
+      MsmMergedSums s = msm_merged_sums_empty();
+      for (const Region& part : region_parts(r, tables.size()))
+        s = msm_merged_sums_add(s, part.face, tables.sums(part));
+      if (s.xyz.y > 0.0f) lights.push_back(msm_area_light_from_merged(s));
+      continue;
+    }
     const MsmRegionSums s = tables.sums(r);
     if (!(s.xyz.y > 0.0f)) continue;
     lights.push_back(msm_area_light_from_region(r.face, s));

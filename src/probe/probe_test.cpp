@@ -2,11 +2,16 @@
 // (4π), resampling, the procedural probe against its closed form, the median cut's invariants,
 // the area lights of known regions, the cone's cosine integral against quadrature, and a real
 // probe of blender-data; cube-map crosses and faces.
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <numeric>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -132,17 +137,23 @@ TEST(MedianCut, PartitionsTheProbeAndKeepsItsEnergy) {
   const CubeMap cube = make_sky_sun_probe(64, glm::vec3(0.4f, 0.5f, 0.7f), glm::vec3(3000.0f),
                                           glm::vec3(-0.2f, 0.9f, 0.3f), glm::radians(3.0f));
   const ProbeTables tables(cube);
-  for (int count : {6, 7, 16, 64, 256}) {
+  for (int count : {1, 2, 3, 4, 5, 6, 7, 16, 64, 256}) {
     const std::vector<Region> regions = median_cut(tables, count);
     ASSERT_EQ(int(regions.size()), count);
     std::vector<int> cover(6 * 64 * 64, 0);
     double energy = 0.0;
-    for (const Region& r : regions) {
-      ASSERT_TRUE(r.x0 < r.x1 && r.y0 < r.y1 && r.x0 >= 0 && r.y0 >= 0 && r.x1 <= 64 && r.y1 <= 64);
-      for (int y = r.y0; y < r.y1; ++y)
-        for (int x = r.x0; x < r.x1; ++x) ++cover[(r.face * 64 + y) * 64 + x];
-      EXPECT_NEAR(r.energy, tables.energy(r), 1e-9 * r.energy + 1e-12);
-      energy += r.energy;
+    for (const Region& region : regions) {
+      EXPECT_EQ(region.faces != 0, count < 6 && region_parts(region, 64).size() > 1) << count;
+      double parts_energy = 0.0;
+      for (const Region& r : region_parts(region, 64)) {
+        ASSERT_TRUE(r.x0 < r.x1 && r.y0 < r.y1 && r.x0 >= 0 && r.y0 >= 0 && r.x1 <= 64 && r.y1 <= 64);
+        for (int y = r.y0; y < r.y1; ++y)
+          for (int x = r.x0; x < r.x1; ++x) ++cover[(r.face * 64 + y) * 64 + x];
+        parts_energy += tables.energy(r);
+      }
+      EXPECT_NEAR(region.energy, tables.energy(region), 1e-9 * region.energy + 1e-12);
+      EXPECT_NEAR(region.energy, parts_energy, 1e-9 * region.energy + 1e-12);
+      energy += region.energy;
     }
     EXPECT_TRUE(std::all_of(cover.begin(), cover.end(), [](int c) { return c == 1; })) << count;
     const glm::dvec3 total = integrate(cube);
@@ -152,6 +163,69 @@ TEST(MedianCut, PartitionsTheProbeAndKeepsItsEnergy) {
     for (const msm::MsmAreaLight& l : area_lights(tables, regions)) light_sum += glm::dvec3(l.irradiance);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(light_sum[c] / total[c], 1.0, 1e-3) << count;
   }
+}
+
+// Below six lights the face regions are merged: the N cut is the N + 1 cut with the two regions
+// of least energy together among those sharing a cube edge merged (checked here from the face
+// energies alone), every group's faces are edge-connected, and the sun's face (the most energetic)
+// stays a light of its own down to two lights.
+TEST(MedianCut, FewLightsMergeTheLeastEnergeticNeighbours) {
+  const CubeMap cube = sky_probe(32);
+  const ProbeTables tables(cube);
+  std::array<std::uint64_t, 6> face_energy{};
+  int sun_face = 0;
+  for (int f = 0; f < 6; ++f) {
+    face_energy[f] = tables.fixed_energy(Region{f, 0, 0, 32, 32});
+    if (face_energy[f] > face_energy[sun_face]) sun_face = f;
+  }
+  const auto mask = [](const Region& r) { return r.faces != 0 ? r.faces : 1u << r.face; };
+  const auto energy_of = [&](std::uint32_t m) {
+    std::uint64_t e = 0;
+    for (int f = 0; f < 6; ++f)
+      if (m & (1u << f)) e += face_energy[f];
+    return e;
+  };
+  const auto neighbours = [](std::uint32_t a, std::uint32_t b) { // a face of a next to a face of b
+    for (int f = 0; f < 6; ++f)
+      for (int g = 0; g < 6; ++g)
+        if ((a >> f & 1u) && (b >> g & 1u) &&
+            msm::msm_dot_in_order(msm::msm_cube_direction(f, 0, 0), msm::msm_cube_direction(g, 0, 0)) == 0.0f)
+          return true;
+    return false;
+  };
+  std::vector<Region> finer = median_cut(tables, 6);
+  for (int count = 5; count >= 1; --count) {
+    const std::vector<Region> cut = median_cut(tables, count);
+    ASSERT_EQ(int(cut.size()), count);
+    // The expected merge: the adjacent pair of least energy together (ties: the first pair).
+    int bi = -1, bj = -1;
+    for (int i = 0; i < int(finer.size()); ++i)
+      for (int j = i + 1; j < int(finer.size()); ++j)
+        if (neighbours(mask(finer[i]), mask(finer[j])) &&
+            (bi < 0 || energy_of(mask(finer[i]) | mask(finer[j])) < energy_of(mask(finer[bi]) | mask(finer[bj]))))
+          bi = i, bj = j;
+    ASSERT_GE(bi, 0);
+    std::vector<std::uint32_t> expected;
+    for (int k = 0; k < int(finer.size()); ++k)
+      if (k == bi)
+        expected.push_back(mask(finer[bi]) | mask(finer[bj]));
+      else if (k != bj)
+        expected.push_back(mask(finer[k]));
+    std::vector<std::uint32_t> got;
+    for (const Region& r : cut) {
+      got.push_back(mask(r));
+      EXPECT_EQ(r.fixed_energy, energy_of(mask(r)));
+      EXPECT_EQ(r.face, std::countr_zero(mask(r))); // the lowest face names the group
+      // Edge-connected: every face of a group of several has a neighbour in it.
+      for (int f = 0; f < 6; ++f) {
+        if (r.faces >> f & 1u) { EXPECT_TRUE(neighbours(1u << f, r.faces & ~(1u << f))) << count; }
+      }
+    }
+    EXPECT_EQ(got, expected) << count << " lights";
+    if (count >= 2) { EXPECT_TRUE(std::find(got.begin(), got.end(), 1u << sun_face) != got.end()) << count; }
+    finer = cut;
+  }
+  EXPECT_EQ(median_cut(tables, 1)[0].faces, 63u);
 }
 
 TEST(MedianCut, SplitsAtTheEnergyMedian) {
@@ -214,6 +288,70 @@ TEST(AreaLights, UniformSquareRegionRecoversItsExtent) {
   EXPECT_LT(glm::length(l.y_axis - glm::vec3(0, -1, 0)), 1e-5f); // v along −Y
 }
 
+// The light of a group of faces (N < 6) against hand-computed answers.
+TEST(AreaLights, GroupOfFacesMakesOneLight) {
+  const int m = 64;
+  const auto black = [&] {
+    CubeMap cube;
+    cube.size = m;
+    for (auto& f : cube.faces) f.assign(std::size_t(m) * m, glm::vec3(0.0f));
+    return cube;
+  };
+  // One lit face in a group: the group's light is that face's light (direction, x axis and extent,
+  // irradiance; here, the lit rectangle centred in u, also its cone).
+  {
+    CubeMap cube = black();
+    for (int j = 10; j < 30; ++j)
+      for (int i = 20; i < 44; ++i) cube.at(2, i, j) = glm::vec3(1.0f, 2.0f, 3.0f);
+    const ProbeTables tables(cube);
+    Region group{0, 0, 0, m, m};
+    group.faces = 0b000111; // +X, −X, +Y
+    const msm::MsmAreaLight merged = area_lights(tables, {group}).at(0);
+    const msm::MsmAreaLight face = msm::msm_area_light_from_region(2, tables.sums(Region{2, 0, 0, m, m}));
+    EXPECT_LT(glm::length(merged.direction - face.direction), 1e-6f);
+    EXPECT_LT(glm::length(merged.x_axis - face.x_axis), 1e-6f);
+    EXPECT_NEAR(merged.half_extent.x, face.half_extent.x, 1e-6f * face.half_extent.x);
+    EXPECT_EQ(merged.irradiance, face.irradiance);
+    EXPECT_NEAR(merged.cone_half_angle, face.cone_half_angle, 1e-5f * face.cone_half_angle);
+  }
+  // Two equal small spots at the centres of +X and +Z: the light lies half way, (1, 0, 1)/√2; along
+  // the axis joining them the offsets are sin 45° (σ² = 1/2 plus the spots' own spread), so the half
+  // extent is sqrt(3/2) = 1.22 there, and across it the spots' own, sqrt(3) / 64 (2 texels at
+  // ±1/64); the irradiances add.
+  {
+    CubeMap cube = black();
+    for (int f : {0, 4})
+      for (int j = m / 2 - 1; j < m / 2 + 1; ++j)
+        for (int i = m / 2 - 1; i < m / 2 + 1; ++i) cube.at(f, i, j) = glm::vec3(1000.0f);
+    const ProbeTables tables(cube);
+    Region group{0, 0, 0, m, m};
+    group.faces = 0b010001; // +X, +Z
+    const msm::MsmAreaLight l = area_lights(tables, {group}).at(0);
+    EXPECT_LT(glm::length(l.direction - glm::normalize(glm::vec3(1, 0, 1))), 1e-5f);
+    const glm::vec2 t = glm::abs(glm::dot(l.x_axis, glm::normalize(glm::vec3(1, 0, -1)))) > 0.99f
+                            ? l.half_extent
+                            : glm::vec2(l.half_extent.y, l.half_extent.x); // (along the pair, across)
+    EXPECT_NEAR(t.x, std::sqrt(1.5f), 2e-3f);
+    EXPECT_NEAR(t.y, std::sqrt(3.0f) / 64.0f, 1e-4f);
+    const msm::MsmAreaLight spot = msm::msm_area_light_from_region(0, tables.sums(Region{0, 0, 0, m, m}));
+    EXPECT_NEAR(l.irradiance.x, 2.0f * spot.irradiance.x, 1e-6f * l.irradiance.x);
+  }
+  // The whole uniform sphere in one light: its directions cancel out (the most energetic face's,
+  // +X of the equal ones, is taken), its cone is below a hemisphere, its irradiance is 4π L.
+  {
+    CubeMap cube = black();
+    for (auto& f : cube.faces) f.assign(std::size_t(m) * m, glm::vec3(0.5f));
+    const ProbeTables tables(cube);
+    const std::vector<Region> one = median_cut(tables, 1);
+    ASSERT_EQ(one.size(), 1u);
+    const msm::MsmAreaLight l = area_lights(tables, one).at(0);
+    EXPECT_LT(glm::length(l.direction - glm::vec3(1, 0, 0)), 1e-6f);
+    EXPECT_TRUE(l.cone_half_angle > 0.0f && l.cone_half_angle < kPi / 2) << l.cone_half_angle;
+    EXPECT_NEAR(l.irradiance.x, 0.5 * 4 * kPi, 2e-3 * 0.5 * 4 * kPi);
+    EXPECT_TRUE(std::isfinite(l.half_extent.x) && std::isfinite(l.half_extent.y));
+  }
+}
+
 TEST(AreaLights, ConeCosineIsTheIntegralOverTheVisibleCone) {
   // ∫_cone max(n·ω, 0) dω / (π sin² α) by quadrature in double (θ, φ about the cone's axis).
   for (double alpha : {0.02, 0.3, 0.8, 1.3}) {
@@ -260,7 +398,8 @@ TEST(Probes, BadInputIsAnError) {
   EXPECT_THROW(load_equirect_probe("/nonexistent/probe.exr", 16), ProbeError);
   EXPECT_THROW(load_equirect_probe(std::filesystem::path(MSM_STUDIOLIGHTS_DIR) / "license.txt", 16), ProbeError);
   const ProbeTables tables(make_sky_sun_probe(8, glm::vec3(1), glm::vec3(2), glm::vec3(0, 1, 0), 0.1f));
-  EXPECT_THROW(median_cut(tables, 5), ProbeError);
+  EXPECT_THROW(median_cut(tables, 0), ProbeError);
+  EXPECT_THROW(median_cut(tables, -3), ProbeError);
   EXPECT_THROW(median_cut(tables, 257), ProbeError);
   EXPECT_THROW(make_sky_sun_probe(0, glm::vec3(1), glm::vec3(1), glm::vec3(0, 1, 0), 0.1f), ProbeError);
   // A 1² cube map cannot be split past its six texels: six regions.

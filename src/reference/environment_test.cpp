@@ -4,6 +4,7 @@
 // (--probe-lights, msm_cone_cosine), and a box's shadow that takes the sun's share away.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -175,16 +176,19 @@ TEST(Environment, ProbeLightCountMatchesTheSceneFilesCount) {
     return msm::scene::load_scene_json(sky + std::to_string(n) + rest, std::filesystem::current_path(), "t.json");
   };
   Scene scene = load(32);
-  msm::scene::set_probe_light_count(scene, 16);
-  const Scene expected = load(16);
-  ASSERT_EQ(scene.lights.size(), expected.lights.size());
-  EXPECT_EQ(scene.probe->lights, 16);
-  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
-    EXPECT_EQ(scene.lights[k].towards_light, expected.lights[k].towards_light) << k;
-    EXPECT_EQ(scene.lights[k].irradiance, expected.lights[k].irradiance) << k;
-    EXPECT_EQ(scene.lights[k].angular_extent_deg, expected.lights[k].angular_extent_deg) << k;
+  for (int count : {16, 3}) { // 3: groups of faces (N < 6)
+    msm::scene::set_probe_light_count(scene, count);
+    const Scene expected = load(count);
+    ASSERT_EQ(scene.lights.size(), expected.lights.size());
+    EXPECT_EQ(scene.lights.size(), 1u + std::size_t(count)); // the directional light and the probe's
+    EXPECT_EQ(scene.probe->lights, count);
+    for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+      EXPECT_EQ(scene.lights[k].towards_light, expected.lights[k].towards_light) << k;
+      EXPECT_EQ(scene.lights[k].irradiance, expected.lights[k].irradiance) << k;
+      EXPECT_EQ(scene.lights[k].angular_extent_deg, expected.lights[k].angular_extent_deg) << k;
+    }
   }
-  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 5), msm::scene::SceneError);
+  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 0), msm::scene::SceneError);
   EXPECT_THROW(msm::scene::set_probe_light_count(scene, 256), msm::scene::SceneError); // + the directional light
 }
 
@@ -196,11 +200,14 @@ namespace {
 // msm_cone_cosine, what --probe-lights integrates) against the probe's irradiance by quadrature.
 // The issue asks for 1% at every count; measured on the sky (32² faces), the worst relative error
 // over three normals is 12.3% at 6 lights (a vertical plane facing +Z), 2.4% at 16, 1.1% at 32,
-// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Asserted: 1% at 256, and
+// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Below six lights (groups
+// of faces, one cone standing for the sun and much of the sky) it is far worse: 77.8% at 1 light,
+// 53.2% at 2, 22.5% at 3 (all +Z), 5.3% at 4 (45°), 13.3% at 5 (+Z). Asserted: 1% at 256, and
 // 1.5x the measured error below (a bound against regressions, not the issue's claim).
 TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
-  const std::map<int, double> bound = {
-      {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113}, {64, 1.5 * 0.012}, {256, 0.01}};
+  const std::map<int, double> bound = {{1, 1.5 * 0.778},  {2, 1.5 * 0.532}, {3, 1.5 * 0.225},  {4, 1.5 * 0.0526},
+                                       {5, 1.5 * 0.133},  {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113},
+                                       {64, 1.5 * 0.012}, {256, 0.01}};
   for (const auto& [count, tolerance] : bound) {
     const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "lights": )" +
                              std::to_string(count) +
@@ -215,6 +222,8 @@ TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
         lights +=
             glm::dvec3(l.irradiance) * double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)),
                                                                    glm::radians(l.angular_extent_deg) / 2.0f));
+      std::printf("[energy] %d lights, n = (%.3f, %.3f, %.3f): lights %.4f, probe %.4f, relative error %+.4f\n", count,
+                  n.x, n.y, n.z, lum(lights), lum(probe), lum(lights) / lum(probe) - 1.0);
       EXPECT_NEAR(lum(lights), lum(probe), tolerance * lum(probe)) << count << " lights, n = " << n.x << ", " << n.y;
     }
   }

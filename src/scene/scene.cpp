@@ -230,8 +230,7 @@ class Parser {
     const std::string name = string(*file, ptr + "/file");
     p.file = name == "sky" ? fs::path("sky") : existing_file(name, ptr + "/file", "light probe");
     if (const json* v = find(j, "lights")) p.lights = integer(*v, ptr + "/lights");
-    if (p.lights < 6 || p.lights > 256)
-      fail(ptr + "/lights", "must be in [6, 256] (one region per cube face at least)");
+    if (p.lights < 1 || p.lights > 256) fail(ptr + "/lights", "must be in [1, 256]");
     if (s.lights.size() + std::size_t(p.lights) > std::size_t(kMaxLights))
       fail(ptr + "/lights", fmt::format("{} directional lights and {} of the probe exceed {} lights", s.lights.size(),
                                         p.lights, kMaxLights));
@@ -652,9 +651,8 @@ void set_probe_light_count(Scene& scene, int count) {
   const std::string file = scene.source.string();
   if (!scene.probe) throw SceneError(file, "/probe", "the scene has no probe, so no probe lights to count");
   ProbeLighting p = *scene.probe;
-  if (count < 6 || count > 256)
-    throw SceneError(file, "/probe/lights",
-                     fmt::format("{} lights: must be in [6, 256] (one region per cube face at least)", count));
+  if (count < 1 || count > 256)
+    throw SceneError(file, "/probe/lights", fmt::format("{} lights: must be in [1, 256]", count));
   const std::size_t old_end = std::min(scene.lights.size(), p.first_light + std::size_t(p.lights));
   const std::size_t others = scene.lights.size() - (old_end - p.first_light);
   if (others + std::size_t(count) > std::size_t(kMaxLights))

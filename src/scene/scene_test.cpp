@@ -901,6 +901,18 @@ TEST(Probe, LightsFollowTheDirectionalOnes) {
   ASSERT_TRUE(alone.probe.has_value());
   EXPECT_EQ(alone.lights.size(), 8u);
   EXPECT_EQ(alone.probe->first_light, 0u);
+  // Fewer than six: one light per group of faces (median_cut merges the face regions).
+  for (int n = 1; n <= 5; ++n) {
+    const Scene few = load_scene_json(R"({"msm_scene": 1, "probe": {"file": "sky", "size": 8, "lights": )" +
+                                          std::to_string(n) + R"(}, "objects": [)" + box + "]}",
+                                      fs::current_path(), "t");
+    ASSERT_EQ(few.lights.size(), std::size_t(n));
+    for (const auto& l : few.lights) {
+      EXPECT_NEAR(glm::length(l.towards_light), 1.0f, 1e-5f) << n;
+      EXPECT_TRUE(std::isfinite(l.irradiance.x) && l.irradiance.y > 0.0f && std::isfinite(l.irradiance.z)) << n;
+      EXPECT_TRUE(l.angular_extent_deg > 0.0f && l.angular_extent_deg < 90.0f) << n;
+    }
+  }
   // Beside a directional light: it stays first.
   const Scene both =
       load_scene_json(scene_with_object(box, R"("probe": {"file": "sky", "lights": 6, "size": 8, "intensity": 2},)"),
@@ -920,7 +932,7 @@ TEST(Probe, BadValuesNameTheirPointer) {
   const auto with = [&](const std::string& probe) { return scene_with_object(box, R"("probe": )" + probe + ","); };
   expect_json_error(with("{}"), {"/probe/file", "required"});
   expect_json_error(with(R"({"file": "none.exr"})"), {"/probe/file", "does not exist"});
-  expect_json_error(with(R"({"file": "sky", "lights": 5})"), {"/probe/lights", "[6, 256]"});
+  expect_json_error(with(R"({"file": "sky", "lights": 0})"), {"/probe/lights", "[1, 256]"});
   expect_json_error(with(R"({"file": "sky", "lights": 256})"), {"/probe/lights", "exceed 256"});
   expect_json_error(with(R"({"file": "sky", "size": 0})"), {"/probe/size"});
   expect_json_error(with(R"({"file": "sky", "intensity": -1})"), {"/probe/intensity"});

@@ -30,8 +30,15 @@ struct LightsOptions {
   std::string scene_lights, picture;
 };
 
+// The face across each edge of a face: [face][edge], edges u = −1, u = +1, v = −1, v = +1.
+int face_across(int face, int edge) {
+  const float u = edge == 0 ? -1.5f : edge == 1 ? 1.5f : 0.0f, v = edge == 2 ? -1.5f : edge == 3 ? 1.5f : 0.0f;
+  return msm_cube_coord(msm_cube_direction(face, u, v)).face;
+}
+
 // The horizontal cross (−X faces... laid out as  . +Y . . / −X +Z +X −Z / . −Y . .), tone mapped,
-// with each region's border drawn in red.
+// with each region's border drawn in red (a group of faces: the edges of its faces that it does not
+// share with another of its faces).
 image::Image cross_picture(const probe::CubeMap& cube, const std::vector<probe::Region>& regions) {
   const int m = cube.size;
   image::Image out(4 * m, 3 * m, 3);
@@ -43,23 +50,31 @@ image::Image cross_picture(const probe::CubeMap& cube, const std::vector<probe::
         const glm::vec3 c = cube.at(f, i, j);
         for (int k = 0; k < 3; ++k) out.at(cells[f][0] * m + i, cells[f][1] * m + j, k) = msm::msm_aces(c[k]);
       }
-  for (const probe::Region& r : regions)
-    for (int j = r.y0; j < r.y1; ++j)
-      for (int i = r.x0; i < r.x1; ++i)
-        if (i == r.x0 || j == r.y0 || i == r.x1 - 1 || j == r.y1 - 1) {
+  for (const probe::Region& region : regions)
+    for (const probe::Region& r : probe::region_parts(region, m)) {
+      bool edge[4] = {true, true, true, true}; // u = −1, u = +1, v = −1, v = +1
+      if (region.faces != 0)
+        for (int e = 0; e < 4; ++e) edge[e] = !(region.faces & (1u << face_across(r.face, e)));
+      for (int j = r.y0; j < r.y1; ++j)
+        for (int i = r.x0; i < r.x1; ++i) {
+          if (!((i == r.x0 && edge[0]) || (i == r.x1 - 1 && edge[1]) || (j == r.y0 && edge[2]) ||
+                (j == r.y1 - 1 && edge[3])))
+            continue;
           const int x = cells[r.face][0] * m + i, y = cells[r.face][1] * m + j;
           out.at(x, y, 0) = 1.0f;
           out.at(x, y, 1) = out.at(x, y, 2) = 0.0f;
         }
+    }
   return out;
 }
 
 // Σ of the texels' solid angles (msm_cube_texel_weight) over a region.
-double solid_angle(const probe::Region& r, int size) {
+double solid_angle(const probe::Region& region, int size) {
   double sum = 0.0;
-  for (int j = r.y0; j < r.y1; ++j)
-    for (int i = r.x0; i < r.x1; ++i)
-      sum += msm_cube_texel_weight((2.0f * i + 1.0f) / size - 1.0f, (2.0f * j + 1.0f) / size - 1.0f, float(size));
+  for (const probe::Region& r : probe::region_parts(region, size))
+    for (int j = r.y0; j < r.y1; ++j)
+      for (int i = r.x0; i < r.x1; ++i)
+        sum += msm_cube_texel_weight((2.0f * i + 1.0f) / size - 1.0f, (2.0f * j + 1.0f) / size - 1.0f, float(size));
   return sum;
 }
 
@@ -76,11 +91,7 @@ nlohmann::json vec(glm::vec3 v) { return {v.x, v.y, v.z}; }
 void run(const LightsOptions& o) {
   // Checked here, not by CLI11, so that a bad value is a failed command (exit 2) naming the range.
   if (o.count < 1 || o.count > 256)
-    throw UsageError(fmt::format("--count {}: the median cut makes 6 to 256 lights", o.count));
-  if (o.count < 6)
-    throw UsageError(fmt::format("--count {}: the median cut makes at least 6 lights (one region per cube face: "
-                                 "regions never straddle faces)",
-                                 o.count));
+    throw UsageError(fmt::format("--count {}: the median cut makes 1 to 256 lights", o.count));
   if (o.size < 1 || o.size > probe::kMaxCubeSize)
     throw UsageError(
         fmt::format("--size {}: the cube map's faces are 1 to {} texels wide", o.size, probe::kMaxCubeSize));
@@ -103,10 +114,11 @@ void run(const LightsOptions& o) {
   try {
     regions = probe::median_cut(tables, o.count);
   } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-  // The lights with their regions (area_lights skips regions without energy: a black probe has none).
+  // The lights with their regions (area_lights skips regions without energy, Σ w Y = 0 in the
+  // tables: a black probe has none).
   std::vector<probe::Region> lit;
   for (const probe::Region& r : regions)
-    if (tables.sums(r).xyz.y > 0.0f) lit.push_back(r);
+    if (r.fixed_energy > 0) lit.push_back(r);
   const std::vector<MsmAreaLight> lights = probe::area_lights(tables, lit);
   const glm::dvec3 total = probe::integrate(cube);
   nlohmann::ordered_json doc;
@@ -139,6 +151,12 @@ void run(const LightsOptions& o) {
     list.push_back(
         {{"towards_light", vec(l.direction)}, {"irradiance", vec(facing)}, {"angular_extent_deg", diameter}});
     const probe::Region& r = lit[k];
+    nlohmann::json region = {{"face", r.face}, {"x", {r.x0, r.x1}}, {"y", {r.y0, r.y1}}};
+    if (r.faces != 0) { // a group of whole faces (N < 6)
+      nlohmann::json faces = nlohmann::json::array();
+      for (const probe::Region& part : probe::region_parts(r, cube.size)) faces.push_back(part.face);
+      region["faces"] = faces;
+    }
     table.push_back({{"direction", vec(l.direction)},
                      {"x_axis", vec(l.x_axis)},
                      {"y_axis", vec(l.y_axis)},
@@ -147,7 +165,7 @@ void run(const LightsOptions& o) {
                      {"solid_angle_sr", omega},
                      {"irradiance", vec(l.irradiance)},
                      {"facing_irradiance", vec(facing)},
-                     {"region", {{"face", r.face}, {"x", {r.x0, r.x1}}, {"y", {r.y0, r.y1}}}}});
+                     {"region", region}});
   }
   doc["lights"] = table;
   // Files first (each written whole under a temporary name, then renamed), then the JSON.
@@ -189,7 +207,7 @@ void add_lights(CLI::App& app) {
         "lights", "A light probe's area lights by the median cut (Kneiphof 2017): direction, extents, solid angle, "
                   "irradiance; a picture of the regions");
     cmd->add_option("--probe", o->probe, probe_help)->required();
-    cmd->add_option("--count", o->count, "Number of area lights (median-cut regions), 6 to 256 (default 32)");
+    cmd->add_option("--count", o->count, "Number of area lights (median-cut regions), 1 to 256 (default 32)");
     cmd->add_flag("--json", o->json, "Print the lights as JSON");
     cmd->add_option("--size", o->size, "Cube-map face size in texels (default 128)");
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
@@ -203,7 +221,7 @@ void add_lights(CLI::App& app) {
     auto* cmd = app.add_subcommand("probe", "The first name of msm lights: msm probe PROBE --lights N [--cross F]");
     cmd->add_option("probe", o->probe, probe_help)->required();
     cmd->add_option("--size", o->size, "Cube-map face size in texels");
-    cmd->add_option("--lights", o->count, "Number of area lights (median-cut regions), 6 to 256");
+    cmd->add_option("--lights", o->count, "Number of area lights (median-cut regions), 1 to 256");
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
     cmd->add_option("--intensity", o->intensity, "Radiance scale");
     cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);

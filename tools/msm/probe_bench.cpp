@@ -28,8 +28,8 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
     if (size < 1 || size > probe::kMaxDeviceCubeSize)
       throw UsageError(fmt::format("--probe-sizes: {} outside 1..{}", size, probe::kMaxDeviceCubeSize));
   for (int n : o.lights)
-    if (n < 6 || n > probe::kMaxDeviceLights)
-      throw UsageError(fmt::format("--probe-lights: {} outside 6..{}", n, probe::kMaxDeviceLights));
+    if (n < 1 || n > probe::kMaxDeviceLights)
+      throw UsageError(fmt::format("--probe-lights: {} outside 1..{}", n, probe::kMaxDeviceLights));
   const bool sky = o.probe == "sky";
   probe::Panorama panorama;
   if (!sky) {
@@ -92,7 +92,9 @@ void bench_probe(const ProbeBench& o, const std::string& device_name, int frames
     const double area_ratio = double(r.size) * r.size / (double(base_size) * base_size);
     const double base_cut = cut_at(r.size, base_n);
     const double cut_ratio = base_cut > 0.0 ? r.cut / base_cut : 0.0;
-    const double lights_ratio = double(r.lights) / base_n, log_ratio = std::log2(double(r.lights)) / std::log2(base_n);
+    // log2 N against the first count's; 0 where that is one light (log2 1 = 0), as the ratios above do.
+    const double lights_ratio = double(r.lights) / base_n,
+                 log_ratio = base_n > 1 ? std::log2(double(r.lights)) / std::log2(double(base_n)) : 0.0;
     table += fmt::format(
         "| {}² | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.0f} | {:.2f} | {:.0f} | {:.2f} |\n", r.size,
         r.lights, r.cube, r.tables, r.cut, tables_ratio, cube_ratio, area_ratio, cut_ratio, lights_ratio, log_ratio);

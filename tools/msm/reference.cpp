@@ -105,7 +105,7 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
   cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
   cmd->add_option("--lights", opt->lights,
-                  "Image-based lighting: the number of area lights the scene's probe is cut into, 6 to 256 (default: "
+                  "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
                   "the scene's)");
   cmd->add_flag("--probe-lights", opt->probe_lights,
                 "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");

@@ -54,7 +54,7 @@ void add_render(CLI::App& app) {
   cmd->add_option("--probe-rotation-speed", opt->probe_frames.rotation_speed_deg,
                   "Degrees the scene's light probe turns about +Y per frame (with --frames)");
   cmd->add_option("--lights", opt->lights,
-                  "Image-based lighting: the number of area lights the scene's probe is cut into, 6 to 256 (default: "
+                  "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
                   "the scene's)");
   cmd->callback([opt, cmd] {
     const bool probe_frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;

@@ -1,6 +1,6 @@
 // msm::probe::DeviceProbe: the light-probe pipeline of Kneiphof 2017 §5 in compute, run every
 // frame when a scene's probe changes (a rotation): panorama → cube map → fixed-point summed-area
-// tables → median cut in one workgroup → area lights. It makes the same regions as the CPU
+// tables → median cut in one workgroup (or the merge of faces below six) → area lights. It makes the same regions as the CPU
 // reference (probe.h's ProbeTables and median_cut) region for region: both build the same integer
 // tables bit for bit from the same cube map (light_probe.h, msm_probe_texel) and run the same cut.
 //
@@ -56,8 +56,8 @@ class DeviceProbe {
   void set_cube(const CubeMap& cube);
 
   // Records the passes for a cut into `count` regions of the probe turned by rotation_deg about +Y
-  // (outside a render pass; the caller submits). Throws ProbeError for count outside
-  // [6, kMaxDeviceLights] or no probe set.
+  // (outside a render pass; the caller submits); below 6, groups of faces (median_cut). Throws
+  // ProbeError for count outside [1, kMaxDeviceLights] or no probe set.
   void record(VkCommandBuffer cmd, int count, float rotation_deg = 0.0f, vk::GpuTimer* timer = nullptr) const;
   // After the recorded work completed: the cut (read from host-visible memory, no copy).
   DeviceCut read() const;

@@ -94,14 +94,21 @@ CubeMap make_sky_sun_probe(int size, glm::vec3 sky, glm::vec3 sun, glm::vec3 tow
 // Σ over all texels of weight x radiance: the probe's ∫ L dω, linear RGB.
 glm::dvec3 integrate(const CubeMap& cube);
 
-// A rectangle of texels [x0, x1) x [y0, y1) of one face.
+// A rectangle of texels [x0, x1) x [y0, y1) of one face; or, for cuts into fewer than six regions
+// (median_cut), a group of whole faces: `faces` has bit f set for each face f of the group, `face`
+// is its lowest face and the rectangle that face's whole square (region_parts lists the faces).
 struct Region {
   int face = 0;
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   double energy = 0.0;            // Σ w Y over its texels (illuminance from luminance)
   std::uint64_t fixed_energy = 0; // the same in the tables' fixed point (ProbeTables::scale), what the cut compares
+  std::uint32_t faces = 0;        // a group of whole faces (N < 6): bit f per face f; 0: the rectangle of `face`
   bool operator==(const Region&) const = default;
 };
+
+// The rectangles a region is made of: itself, or one whole face (of size² texels) per face of a
+// group, in increasing face order (energies not set).
+std::vector<Region> region_parts(const Region& r, int size);
 
 // The solid-angle weights msm_cube_texel_weight of one face's texels (row-major, the same on every
 // face) and the coordinates of the texel centres msm_cube_face_coordinate (u of column i = v of row
@@ -125,8 +132,8 @@ class ProbeTables {
   explicit ProbeTables(const CubeMap& cube, float scale = 0.0f);
   int size() const { return size_; }
   float scale() const { return scale_; }
-  MsmRegionSums sums(const Region& r) const;
-  double energy(const Region& r) const;              // Σ w Y
+  MsmRegionSums sums(const Region& r) const;         // of the rectangle of r.face (one part of a group)
+  double energy(const Region& r) const;              // Σ w Y (of every face of a group)
   std::uint64_t fixed_energy(const Region& r) const; // Σ w Y times scale, as the tables hold it
   // Entry (x, y) of table k (0..6, the order above) of a face: the sum over texels [0, x) x [0, y).
   std::uint64_t at(int face, int k, int x, int y) const {
@@ -144,11 +151,17 @@ class ProbeTables {
 // The median cut (Kneiphof §3.1 after Debevec's): one region per face, then the region with the
 // largest energy (fixed_energy; ties: the earliest in the list) is split across its longer side (the other side where the longer is one texel)
 // where the energy of the two parts is closest to equal, until there are `count` regions; regions
-// of one texel are not split. Regions never straddle faces, so count must be in [6, 256]
-// (ProbeError otherwise); a probe with fewer splittable texels than needed returns fewer regions.
+// of one texel are not split. A probe with fewer splittable texels than needed returns fewer
+// regions. count must be in [1, 256] (ProbeError otherwise). Below 6, the six face regions are
+// merged instead: while there are more than `count`, the two regions with the least energy
+// together (fixed_energy, exact integers) among those that share a cube edge (a face of one next
+// to a face of the other: not opposite faces) become one (ties: the first pair (i, j), i < j, in
+// the list's order; the merged region takes the first's place, the second leaves the list), so a
+// region is a group of whole, edge-connected faces (Region::faces; docs/techniques.md says why).
 std::vector<Region> median_cut(const ProbeTables& tables, int count);
 
-// The area lights of the regions (msm_area_light_from_region), regions without energy skipped.
+// The area lights of the regions (msm_area_light_from_region; a group of faces:
+// msm_area_light_from_merged of its faces in increasing order), regions without energy skipped.
 std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vector<Region>& regions);
 
 // The whole CPU pipeline: the probe (an equirectangular or cross EXR, load_probe_file, or "sky" for

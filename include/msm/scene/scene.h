@@ -24,7 +24,7 @@
 //                                          "lights" (which become optional); msm::probe
 //     "file": "studio.exr" | "sky",        REQUIRED equirectangular EXR (relative to the scene file),
 //                                          or the procedural sky with a sun ("msm probe sky")
-//     "lights": 32,                        area lights, 6..256 (all lights together <= kMaxLights)
+//     "lights": 32,                        area lights, 1..256 (all lights together <= kMaxLights)
 //     "intensity": 1,                      radiance scale, [0, 1e6]
 //     "rotation_deg": 0,                   about +Y, counter-clockwise seen from above
 //     "size": 128                          cube-map face size, 1..1024
@@ -424,7 +424,7 @@ std::string_view builtin_scene_json(std::string_view name); // throws SceneError
 Scene builtin_scene(std::string_view name);
 // A built-in name, or else a path to a scene file.
 Scene load_scene(std::string_view name_or_path);
-// Replaces the probe's area lights by a median cut into `count` (6..256), as "probe": {"lights":
+// Replaces the probe's area lights by a median cut into `count` (1..256), as "probe": {"lights":
 // count} would have made them (`msm render --lights`). SceneError without a probe, for a count out of
 // range or beyond kMaxLights with the other lights.
 void set_probe_light_count(Scene& scene, int count);

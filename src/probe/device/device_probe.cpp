@@ -31,6 +31,8 @@ struct RegionOut {
   int face;
   uint32_t lit;
   uint64_t fixed_energy;
+  uint32_t faces; // Region::faces
+  uint32_t pad[3];
 };
 struct LightOut {
   glm::vec4 direction_cone, x_axis_half_x, y_axis_half_y, irradiance;
@@ -40,7 +42,7 @@ struct ResultOut {
   RegionOut regions[kMaxDeviceLights];
   LightOut lights[kMaxDeviceLights];
 };
-static_assert(sizeof(RegionOut) == 32 && sizeof(LightOut) == 64 && offsetof(ResultOut, lights) == 16 + 32 * 256,
+static_assert(sizeof(RegionOut) == 48 && sizeof(LightOut) == 64 && offsetof(ResultOut, lights) == 16 + 48 * 256,
               "the output layout must match probe_cut.comp");
 
 constexpr int kSupersampling = 4; // cube_from_equirect's default
@@ -124,10 +126,8 @@ void DeviceProbe::set_cube(const CubeMap& cube) {
 }
 
 void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk::GpuTimer* timer) const {
-  if (count < 6 || count > kMaxDeviceLights)
-    throw ProbeError(fmt::format("{} lights: the median cut makes 6 to {} (one region per cube face at least; "
-                                 "regions never straddle faces)",
-                                 count, kMaxDeviceLights));
+  if (count < 1 || count > kMaxDeviceLights)
+    throw ProbeError(fmt::format("{} lights: the median cut makes 1 to {}", count, kMaxDeviceLights));
   if (!has_probe_) throw ProbeError("DeviceProbe::record: no probe set");
   ProbePush push;
   push.panorama = glm::ivec2(panorama_width_, panorama_height_);
@@ -174,6 +174,7 @@ DeviceCut DeviceProbe::read() const {
     const RegionOut& r = out.regions[k];
     Region region{r.face, r.rect.x, r.rect.y, r.rect.z, r.rect.w};
     region.fixed_energy = r.fixed_energy;
+    region.faces = r.faces;
     region.energy = double(r.fixed_energy) / double(scale_);
     cut.regions.push_back(region);
     if (!r.lit) continue;

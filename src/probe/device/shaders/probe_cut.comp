@@ -4,7 +4,9 @@
 // Invocation t holds region t. Each step: a tree reduction finds the splittable region of the
 // largest energy (ties: the lowest index, the CPU's "first"), then invocation 0 splits it at the
 // energy median by a binary search through the tables; the first part replaces it, the second
-// part is appended — the CPU's order.
+// part is appended — the CPU's order. Below six regions, invocation 0 merges the six face regions
+// pairwise instead (median_cut's rule: the least energy together among groups sharing a cube edge),
+// and a group's light adds its faces' lights (msm_merged_sums_add, msm_area_light_from_merged).
 #extension GL_GOOGLE_include_directive : require
 #include "probe_common.glsl"
 
@@ -15,8 +17,10 @@ layout(binding = 0, std430) readonly buffer Tables { uint64_t tables[]; };
 struct RegionOut {
   ivec4 rect; // x0, y0, x1, y1: texels [x0, x1) x [y0, y1)
   int face;
-  uint lit;   // 1: the region has energy and lights[t] is its light
+  uint lit; // 1: the region has energy and lights[t] is its light
   uint64_t fixed_energy;
+  uint faces; // a group of whole faces: bit f per face f (face: the lowest); 0: the rectangle of face
+  uint pad0, pad1, pad2;
 };
 struct LightOut {
   vec4 direction_cone; // direction, cone_half_angle
@@ -29,11 +33,13 @@ layout(binding = 1, std430) writeonly buffer Result {
   uint pad0, pad1, pad2;
   RegionOut regions[MAX_REGIONS];
   LightOut lights[MAX_REGIONS];
-} result;
+}
+result;
 
 shared ivec4 s_rect[MAX_REGIONS];
 shared int s_face[MAX_REGIONS];
 shared uint64_t s_energy[MAX_REGIONS];
+shared uint s_faces[MAX_REGIONS];
 shared uint64_t s_key[MAX_REGIONS];
 shared uint s_index[MAX_REGIONS];
 
@@ -55,6 +61,53 @@ int64_t twice_minus_whole(int face, ivec4 r, uint64_t energy, bool along_x, int 
   return int64_t(2ul * rect_sum(face, 1, first_part(r, along_x, cut))) - int64_t(energy);
 }
 int64_t abs64(int64_t a) { return a < 0l ? -a : a; }
+
+// The sums of a rectangle of a face (ProbeTables::sums): converted to float after the integer
+// differences; the first moments are stored shifted by the energy.
+MsmRegionSums region_sums(int face, ivec4 r) {
+  uint64_t y = rect_sum(face, 1, r);
+  vec3 xyz = vec3(float(rect_sum(face, 0, r)), float(y), float(rect_sum(face, 2, r)));
+  vec2 first =
+      vec2(float(int64_t(rect_sum(face, 3, r)) - int64_t(y)), float(int64_t(rect_sum(face, 4, r)) - int64_t(y)));
+  vec2 second = vec2(float(rect_sum(face, 5, r)), float(rect_sum(face, 6, r)));
+  return msm_region_sums_from_fixed(xyz, first, second, pc.inv_scale);
+}
+
+uint face_mask(int k) { return s_faces[k] != 0u ? s_faces[k] : (1u << uint(s_face[k])); }
+// Some face of group a shares a cube edge with some face of group b (not opposite faces).
+bool share_an_edge(uint a, uint b) {
+  for (int f = 0; f < 6; ++f)
+    for (int g = 0; g < 6; ++g)
+      if ((a & (1u << uint(f))) != 0u && (b & (1u << uint(g))) != 0u && f / 2 != g / 2) return true;
+  return false;
+}
+// Invocation 0, count < 6: the six face regions merged down to count (the CPU's merge_faces).
+void merge_faces(int count) {
+  int n = 6;
+  while (n > count) {
+    int bi = -1, bj = -1;
+    uint64_t best = 0ul;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) {
+        if (!share_an_edge(face_mask(i), face_mask(j))) continue;
+        uint64_t e = s_energy[i] + s_energy[j]; // six faces < 4π 2^60 < 2^64
+        if (bi < 0 || e < best) {
+          bi = i;
+          bj = j;
+          best = e;
+        }
+      }
+    s_faces[bi] = face_mask(bi) | face_mask(bj);
+    s_energy[bi] = best;
+    for (int k = bj; k + 1 < n; ++k) {
+      s_rect[k] = s_rect[k + 1];
+      s_face[k] = s_face[k + 1];
+      s_energy[k] = s_energy[k + 1];
+      s_faces[k] = s_faces[k + 1];
+    }
+    --n;
+  }
+}
 
 void split(uint best, int n) {
   ivec4 r = s_rect[best];
@@ -80,6 +133,7 @@ void split(uint best, int n) {
   s_energy[best] = rect_sum(face, 1, first);
   s_rect[n] = second;
   s_face[n] = face;
+  s_faces[n] = 0u;
   s_energy[n] = rect_sum(face, 1, second);
 }
 
@@ -91,9 +145,15 @@ void main() {
     s_face[t] = int(t);
     s_energy[t] = rect_sum(int(t), 1, ivec4(0, 0, m, m));
   }
+  s_faces[t] = 0u;
   barrier();
   int n = 6;
-  int count = min(pc.count, MAX_REGIONS);
+  int count = clamp(pc.count, 1, MAX_REGIONS);
+  if (count < 6) {
+    if (t == 0u) merge_faces(count);
+    barrier();
+    n = count;
+  }
   while (n < count) {
     // Splittable regions (more than one texel) have key energy + 1, the others 0.
     uint64_t key = 0ul;
@@ -126,19 +186,24 @@ void main() {
   if (t < uint(n)) {
     ivec4 r = s_rect[t];
     int face = s_face[t];
-    uint64_t y = s_energy[t];
-    vec3 xyz = vec3(float(rect_sum(face, 0, r)), float(y), float(rect_sum(face, 2, r)));
-    // The first moments are stored shifted by the energy: the difference in integers first.
-    vec2 first = vec2(float(int64_t(rect_sum(face, 3, r)) - int64_t(y)), float(int64_t(rect_sum(face, 4, r)) - int64_t(y)));
-    vec2 second = vec2(float(rect_sum(face, 5, r)), float(rect_sum(face, 6, r)));
-    MsmRegionSums sums = msm_region_sums_from_fixed(xyz, first, second, pc.inv_scale);
-    bool lit = sums.xyz.y > 0.0f;
-    result.regions[t] = RegionOut(r, face, lit ? 1u : 0u, y);
-    if (lit) {
-      MsmAreaLight l = msm_area_light_from_region(face, sums);
+    uint faces = s_faces[t];
+    bool lit;
+    MsmAreaLight l;
+    if (faces != 0u) { // a group of whole faces, in increasing face order (the CPU's area_lights)
+      MsmMergedSums merged = msm_merged_sums_empty();
+      for (int f = 0; f < 6; ++f)
+        if ((faces & (1u << uint(f))) != 0u) merged = msm_merged_sums_add(merged, f, region_sums(f, ivec4(0, 0, m, m)));
+      lit = merged.xyz.y > 0.0f;
+      if (lit) l = msm_area_light_from_merged(merged);
+    } else {
+      MsmRegionSums sums = region_sums(face, r);
+      lit = sums.xyz.y > 0.0f;
+      if (lit) l = msm_area_light_from_region(face, sums);
+    }
+    result.regions[t] = RegionOut(r, face, lit ? 1u : 0u, s_energy[t], faces, 0u, 0u, 0u);
+    if (lit)
       result.lights[t] = LightOut(vec4(l.direction, l.cone_half_angle), vec4(l.x_axis, l.half_extent.x),
                                   vec4(l.y_axis, l.half_extent.y), vec4(l.irradiance, 0.0f));
-    }
   }
   if (t == 0u) result.region_count = uint(n);
 }
