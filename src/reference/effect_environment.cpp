@@ -1,7 +1,7 @@
 // environment: image-based lighting with exact visibility (reference.h, "environment"). The full
 // probe is sampled in proportion to luminance x solid angle and the cosine-weighted hemisphere,
 // combined by the balance heuristic; the extracted area lights (--probe-lights) and the scene's
-// other directional lights are uniform cones. The texel geometry is msm/light_probe.h's.
+// other directional lights are uniform cones (discs) or rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -23,9 +23,28 @@ void basis(const glm::dvec3& n, glm::dvec3& x, glm::dvec3& y) {
   y = glm::cross(n, x);
 }
 
-ConeLight cone_light(const scene::DirectionalLight& l) {
+ConeLight cone_light(const scene::Scene& scene, const scene::DirectionalLight& l) {
   ConeLight c;
   c.axis = glm::normalize(glm::dvec3(l.towards_light));
+  if (l.rectangular()) {
+    // The rectangle on the axes of the light's shadow-map frame (the renderer's spreads are
+    // along them), made exactly orthonormal to the axis. Radiance L = E_f / F uniform in solid
+    // angle: a uniform point of the plane rectangle (area A) has the density 1 / (A cos³ θ) in
+    // solid angle, so f / pdf = E_f (A / F) cos³ θ (n·d).
+    const scene::LightFrame f = scene.light_frame(l);
+    c.rectangle = true;
+    c.x = glm::normalize(f.x_axis - glm::dot(f.x_axis, c.axis) * c.axis);
+    c.y = glm::cross(c.axis, c.x);
+    const glm::vec2 t = l.tan_half_extents();
+    c.half_x = t.x;
+    c.half_y = t.y;
+    // A / F is continuous down to a line or a point (a region one texel wide has no variance
+    // along that axis), where both vanish: taken at extents of at least 1e-4 (off by ~1e-8).
+    const glm::vec2 tf = glm::max(t, glm::vec2(1e-4f));
+    c.estimate =
+        glm::dvec3(l.irradiance) * (4.0 * double(tf.x) * double(tf.y) / double(msm_rect_light_facing_integral(tf)));
+    return c;
+  }
   basis(c.axis, c.x, c.y);
   c.cos_alpha = std::cos(glm::radians(double(l.angular_extent_deg)) / 2.0);
   // Radiance L = E_f / (π sin² α) over a cone of 2π (1 − cos α) sr: L / pdf = E_f 2 / (1 + cos α),
@@ -44,7 +63,7 @@ EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_l
   const scene::ProbeLighting& p = *scene.probe;
   const std::size_t first = p.first_light, last = std::min(scene.lights.size(), first + std::size_t(p.lights));
   for (std::size_t k = 0; k < scene.lights.size(); ++k)
-    if (probe_lights || k < first || k >= last) cones.push_back(cone_light(scene.lights[k]));
+    if (probe_lights || k < first || k >= last) cones.push_back(cone_light(scene, scene.lights[k]));
   if (probe_lights) return;
   msm::probe::CubeMap cube;
   try {
@@ -128,6 +147,14 @@ EnvironmentSample environment_irradiance(const EffectContext& ctx, const Environ
     }
     for (const ConeLight& l : lighting.cones) {
       const glm::dvec2 a = set.point(i, rng);
+      if (l.rectangle) {
+        const glm::dvec3 p = l.axis + (2.0 * a.x - 1.0) * l.half_x * l.x + (2.0 * a.y - 1.0) * l.half_y * l.y;
+        const double r = glm::length(p);
+        const glm::dvec3 d = p / r;
+        const double c = glm::dot(n, d);
+        if (c > 0.0) add(l.estimate * (c / (r * r * r)), d); // cos θ = 1 / r
+        continue;
+      }
       const double cos_t = 1.0 - a.x * (1.0 - l.cos_alpha), sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
       const double phi = 2.0 * kPi * a.y;
       const glm::dvec3 d = glm::normalize(cos_t * l.axis + sin_t * (std::cos(phi) * l.x + std::sin(phi) * l.y));

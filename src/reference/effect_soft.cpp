@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "internal.h"
+#include "msm/light_probe.h"
 
 namespace msm::reference::detail {
 
@@ -13,14 +14,13 @@ namespace {
 
 // ∫ (d·L) dω over the light, the irradiance of radiance 1 on a surface facing it: π sin² α for the
 // disc of radius tan α, and for the rectangle [−X, X] x [−Y, Y] at unit distance the integral of
-// (1 + a² + b²)^−2 da db in closed form (checked against a midpoint rule to 1e-7).
+// (1 + a² + b²)^−2 da db in closed form (msm/light_probe.h; checked against a midpoint rule).
 double facing_integral(bool disc, double half_x, double half_y) {
   if (disc) {
     const double s = std::sin(std::atan(half_x));
     return std::numbers::pi * s * s;
   }
-  const double rx = std::sqrt(1.0 + half_x * half_x), ry = std::sqrt(1.0 + half_y * half_y);
-  return 2.0 * (half_x / rx * std::atan(half_y / rx) + half_y / ry * std::atan(half_x / ry));
+  return double(msm_rect_light_facing_integral(glm::vec2(float(half_x), float(half_y))));
 }
 
 } // namespace

@@ -1,7 +1,7 @@
 // Tests of the environment effect (image-based lighting with exact visibility) against answers
 // that do not use its sampler: a plane under the procedural sky-and-sun probe against quadrature
-// over the cube's texels (full probe) and against the closed form of the uniform cones
-// (--probe-lights, msm_cone_cosine), and a box's shadow that takes the sun's share away.
+// over the cube's texels (full probe) and against quadrature over the extracted rectangles
+// (--probe-lights), and a box's shadow that takes the sun's share away.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -100,6 +100,27 @@ TEST(Environment, UnoccludedPlaneReceivesTheProbesIrradiance) {
   EXPECT_NEAR(r.mean_visibility, 1.0, 1e-12); // nothing occludes
 }
 
+// ∫ max(n·d, 0) dω / F over a rectangular light (its frame's axes, Scene::light_frame) by the
+// midpoint rule on its plane at unit distance (dω = dA / r³): what --probe-lights integrates for
+// it, without its sampler; the same as msm_cone_cosine where the whole light is above the horizon.
+double rectangle_cosine(const Scene& scene, const msm::scene::DirectionalLight& l, const glm::dvec3& n) {
+  const msm::scene::LightFrame f = scene.light_frame(l);
+  const glm::dvec3 z = glm::normalize(glm::dvec3(l.towards_light));
+  const glm::dvec3 x = glm::normalize(f.x_axis - glm::dot(f.x_axis, z) * z), y = glm::cross(z, x);
+  // Lines and points (a region one texel wide has no variance along that axis) as their limit.
+  const glm::vec2 t = glm::max(l.tan_half_extents(), glm::vec2(1e-4f));
+  const int k = 400;
+  double sum = 0.0;
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) {
+      const double a = ((i + 0.5) / k * 2.0 - 1.0) * t.x, b = ((j + 0.5) / k * 2.0 - 1.0) * t.y;
+      const glm::dvec3 p = z + a * x + b * y;
+      const double r = glm::length(p);
+      sum += std::max(glm::dot(n, p) / r, 0.0) / (r * r * r);
+    }
+  return sum * (4.0 * t.x * t.y / (double(k) * k)) / double(msm::msm_rect_light_facing_integral(t));
+}
+
 TEST(Environment, UnoccludedPlaneUnderTheAreaLightsMatchesTheirClosedForm) {
   const Scene scene = sky_scene(kTopCamera, kPlane);
   Settings s = environment_settings(64);
@@ -107,9 +128,15 @@ TEST(Environment, UnoccludedPlaneUnderTheAreaLightsMatchesTheirClosedForm) {
   const Result r = render(scene, s);
   const Mean m = mean_irradiance(r);
   glm::dvec3 expected(0.0);
-  for (const auto& l : scene.lights)
-    expected += glm::dvec3(l.irradiance) *
-                double(msm::msm_cone_cosine(l.towards_light.y, glm::radians(l.angular_extent_deg) / 2.0f));
+  for (const auto& l : scene.lights) {
+    ASSERT_TRUE(l.rectangular()); // the probe's lights (Kneiphof §4.1.2)
+    expected += glm::dvec3(l.irradiance) * rectangle_cosine(scene, l, {0.0, 1.0, 0.0});
+    // Wholly above the horizon (its corners too), the shading's cone gives the same: n·l.
+    const glm::vec2 t = l.tan_half_extents();
+    if (l.towards_light.y > std::sin(std::atan(glm::length(t))))
+      EXPECT_NEAR(msm::msm_cone_cosine(l.towards_light.y, l.cone_half_angle()),
+                  rectangle_cosine(scene, l, {0.0, 1.0, 0.0}), 1e-4);
+  }
   EXPECT_LT(std::abs(lum(m.irradiance) - lum(expected)), 3.0 * m.std_error + 1e-4 * lum(expected));
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.irradiance[c], expected[c], 0.01 * expected[c]) << "channel " << c;
 }
@@ -219,9 +246,8 @@ TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
           cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
       glm::dvec3 lights(0.0);
       for (const auto& l : scene.lights)
-        lights +=
-            glm::dvec3(l.irradiance) * double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)),
-                                                                   glm::radians(l.angular_extent_deg) / 2.0f));
+        lights += glm::dvec3(l.irradiance) *
+                  double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)), l.cone_half_angle()));
       std::printf("[energy] %d lights, n = (%.3f, %.3f, %.3f): lights %.4f, probe %.4f, relative error %+.4f\n", count,
                   n.x, n.y, n.z, lum(lights), lum(probe), lum(lights) / lum(probe) - 1.0);
       EXPECT_NEAR(lum(lights), lum(probe), tolerance * lum(probe)) << count << " lights, n = " << n.x << ", " << n.y;

@@ -206,17 +206,24 @@ ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Med
 
 // environment (effect_environment.cpp): the lights of a scene's image-based lighting, built once
 // per render. Throws std::invalid_argument for a scene without a "probe".
+// A light of the environment effect: a uniform cone (a disc light), or a rectangle (x, y: the
+// light frame's axes, as the renderer's shadow map has them) sampled uniformly on its plane at
+// unit distance: a sample of direction d stands for area / cos³ θ of solid angle (θ off the axis).
 struct ConeLight {
   glm::dvec3 axis{0.0, 1.0, 0.0}, x{1.0, 0.0, 0.0}, y{0.0, 0.0, 1.0}; // orthonormal, axis towards the light
-  double cos_alpha = 1.0;                                             // of the half-angle
-  glm::dvec3 estimate{0.0}; // irradiance on a facing surface x 2 / (1 + cos α): f / pdf of a uniform cone sample
+  double cos_alpha = 1.0;                                             // of the half-angle (cone)
+  bool rectangle = false;
+  double half_x = 0.0, half_y = 0.0; // rectangle: tangents of the half extents along x, y
+  // cone: irradiance on a facing surface x 2 / (1 + cos α), f / pdf of a uniform cone sample;
+  // rectangle: that irradiance x area / F (msm_rect_light_facing_integral), times cos³ θ per sample.
+  glm::dvec3 estimate{0.0};
 };
 struct EnvironmentLighting {
   EnvironmentLighting(const scene::Scene& scene, bool probe_lights);
   int size = 0;                    // of the probe's faces; 0 with probe_lights (no probe sampled)
   std::vector<glm::vec3> radiance; // 6 size² texels, face-major, rows along +v
   std::vector<double> cdf;         // of luminance x texel weight, normalized, cdf.back() = 1
-  std::vector<ConeLight> cones;    // lights sampled as uniform cones
+  std::vector<ConeLight> cones;    // lights sampled as uniform cones or rectangles
 };
 struct EnvironmentSample {
   glm::dvec3 irradiance{0.0}, unoccluded{0.0};

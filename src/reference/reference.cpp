@@ -175,8 +175,12 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   if (settings.light_shape == LightShape::disc) {
     result.light_width_deg = result.light_height_deg = extent;
   } else {
+    // A rectangular scene light (angular_height_deg) gives its own height unless --light-extent
+    // replaces the light.
+    const std::optional<float> scene_height =
+        settings.light_extent_deg ? std::nullopt : scene.light().angular_height_deg;
     result.light_width_deg = settings.light_width_deg.value_or(extent);
-    result.light_height_deg = settings.light_height_deg.value_or(extent);
+    result.light_height_deg = settings.light_height_deg.value_or(scene_height ? double(*scene_height) : extent);
   }
   const auto half_tan = [](double deg) { return std::tan(deg * std::numbers::pi / 360.0); };
   ctx.half_x = half_tan(result.light_width_deg);

@@ -129,7 +129,8 @@ struct Renderer::Impl {
   std::vector<LightUniforms> light_data;
   ScatteringPush scattering{}; // scattering techniques
   // Fitting a light's frustum visits every vertex: one fit per light direction, kept.
-  std::vector<std::pair<glm::vec3, scene::LightFrame>> frames;
+  // The fitted frame of each light, by its direction and x axis (light_frame).
+  std::vector<std::pair<std::pair<glm::vec3, std::optional<glm::vec3>>, scene::LightFrame>> frames;
 
   Impl(const vk::Context& c, const scene::Scene& s)
       : ctx(c), scene(s), gpu(c, s),
@@ -157,10 +158,11 @@ struct Renderer::Impl {
   }
 
   const scene::LightFrame& light_frame(const scene::DirectionalLight& light) {
-    for (const auto& [towards, frame] : frames)
-      if (towards == light.towards_light) return frame;
-    if (frames.size() >= 64) frames.clear();                            // a light dragged around in a viewer
-    frames.emplace_back(light.towards_light, scene.light_frame(light)); // depends on the direction only
+    const std::pair<glm::vec3, std::optional<glm::vec3>> key(light.towards_light, light.x_axis);
+    for (const auto& [k, frame] : frames)
+      if (k == key) return frame;
+    if (frames.size() >= 64) frames.clear();            // a light dragged around in a viewer
+    frames.emplace_back(key, scene.light_frame(light)); // depends on the direction and x axis only
     return frames.back().second;
   }
 
@@ -222,13 +224,19 @@ struct Renderer::Impl {
     u.towards_light = glm::vec4(light.towards_light, s.normal_offset * float(texel.x));
     u.irradiance = glm::vec4(light.irradiance, 0.0f);
     if (msm_technique_is_area_light(technique.id)) {
-      float extent = s.light_extent_deg ? *s.light_extent_deg : light.angular_extent_deg;
-      float tan_half = std::tan(glm::radians(extent) * 0.5f);
+      // The light's two half extents along the frame's axes (a disc: its radius both; --light-extent
+      // makes every light that disc), the search region and filter per axis from them.
+      scene::DirectionalLight drawn = light;
+      if (s.light_extent_deg) {
+        drawn.angular_extent_deg = *s.light_extent_deg;
+        drawn.angular_height_deg.reset();
+      }
       // soft.h: texels of reach per unit of [-1,1] depth.
-      vec2 spread = msm_soft_spread(vec2(tan_half), float(0.5 * f.depth_extent), vec2(texel));
-      // The shading integrates the cosine over the disc (msm_cone_cosine); the other techniques
-      // shade their lights as points (soft.z = 0: max(n·l, 0)), as their shadows are hard.
-      u.soft = glm::vec4(spread, glm::radians(extent) * 0.5f, 0.0f);
+      vec2 spread = msm_soft_spread(drawn.tan_half_extents(), float(0.5 * f.depth_extent), vec2(texel));
+      // The shading integrates the cosine over the disc, or over the cone of the rectangle's solid
+      // angle (msm_cone_cosine); the other techniques shade their lights as points (soft.z = 0:
+      // max(n·l, 0)), as their shadows are hard.
+      u.soft = glm::vec4(spread, drawn.cone_half_angle(), 0.0f);
     }
     return u;
   }

@@ -207,7 +207,7 @@ class Parser {
   }
 
   DirectionalLight light(const json& j, const std::string& ptr) const {
-    keys(j, ptr, {"towards_light", "irradiance", "angular_extent_deg"});
+    keys(j, ptr, {"towards_light", "irradiance", "angular_extent_deg", "angular_height_deg", "x_axis"});
     DirectionalLight l;
     const json* d = find(j, "towards_light");
     if (!d) fail(ptr + "/towards_light", "required key missing (direction from the scene towards the light)");
@@ -218,6 +218,15 @@ class Parser {
     }
     if (const json* v = find(j, "angular_extent_deg"))
       l.angular_extent_deg = number_in(*v, ptr + "/angular_extent_deg", 0.0f, 90.0f, false, true);
+    if (const json* v = find(j, "angular_height_deg"))
+      l.angular_height_deg = number_in(*v, ptr + "/angular_height_deg", 0.0f, 90.0f, false, true);
+    if (const json* v = find(j, "x_axis")) {
+      const glm::vec3 x = direction(*v, ptr + "/x_axis");
+      // Within 0.1° of towards_light the projection orthogonal to it is mostly rounding.
+      if (glm::length(glm::cross(x, l.towards_light)) < 1.75e-3f)
+        fail(ptr + "/x_axis", "must not be parallel to towards_light (it is the light's width direction across it)");
+      l.x_axis = x;
+    }
     return l;
   }
 
@@ -535,9 +544,22 @@ class Parser {
 DirectionalLight light_of_area_light(const msm::MsmAreaLight& area) {
   DirectionalLight l;
   l.towards_light = area.direction;
-  l.irradiance = msm::msm_area_light_facing_irradiance(area);
-  l.angular_extent_deg = std::min(2.0f * glm::degrees(area.cone_half_angle), 89.0f);
+  l.x_axis = area.x_axis;
+  l.angular_extent_deg = std::min(2.0f * glm::degrees(std::atan(area.half_extent.x)), 89.0f);
+  l.angular_height_deg = std::min(2.0f * glm::degrees(std::atan(area.half_extent.y)), 89.0f);
+  // Eq. 18 for the rectangle that is drawn (the extents kept below 90°): M_e F / Ω.
+  l.irradiance = area.irradiance * msm::msm_rect_light_facing_fraction(l.tan_half_extents());
   return l;
+}
+
+glm::vec2 DirectionalLight::tan_half_extents() const {
+  const auto half_tan = [](float deg) { return std::tan(glm::radians(deg) * 0.5f); };
+  return {half_tan(angular_extent_deg), half_tan(angular_height_deg.value_or(angular_extent_deg))};
+}
+
+float DirectionalLight::cone_half_angle() const {
+  return rectangular() ? msm::msm_rect_light_cone_half_angle(tan_half_extents())
+                       : glm::radians(angular_extent_deg) * 0.5f;
 }
 
 SceneError::SceneError(std::string file, std::string where, std::string problem)
@@ -575,7 +597,13 @@ std::size_t Scene::vertex_count() const {
 
 glm::mat4 Scene::light_view(const DirectionalLight& light) const {
   const glm::vec3 d = light.travel();
-  const glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  // The light's own x axis (its width's direction, Kneiphof §4.1.2): lookAt's first axis is
+  // normalize(cross(d, up)), which is x projected orthogonal to d for up = cross(x, d).
+  if (light.x_axis) {
+    const glm::vec3 x_up = glm::cross(*light.x_axis, d);
+    if (glm::length(x_up) > 1e-3f * glm::length(*light.x_axis)) up = glm::normalize(x_up);
+  }
   const Bounds b = bounds();
   const glm::vec3 c =
       shadow.mode == ShadowFraming::Mode::given ? shadow.center : (b.empty() ? glm::vec3(0.0f) : b.center());

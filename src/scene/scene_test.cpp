@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "msm/light_probe.h"
 #include "msm/scene/scene.h"
 #include "msm/test/temp_dir.h"
 
@@ -940,4 +941,67 @@ TEST(Probe, BadValuesNameTheirPointer) {
   const std::string license = std::string(MSM_STUDIOLIGHTS_DIR) + "/license.txt";
   expect_json_error(with(R"({"file": ")" + license + R"("})"), {"/probe/file", "not an EXR"});
   expect_json_error(R"({"msm_scene": 1, "objects": [)" + box + "]}", {"/light", "\"probe\""});
+}
+
+// ---- Rectangular lights (Kneiphof §4.1.2) ----
+
+// A light with one extent is the disc it always was; a second extent makes it a rectangle along
+// its x_axis, whose shadow-map frame takes that axis (the probe's lights take their face's u axis).
+TEST(Lights, RectangularLightsCarryTwoExtentsAndTheirFrame) {
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  const auto with_light = [&](const std::string& light) {
+    return load_scene_json(R"({"msm_scene": 1, "light": )" + light + R"(, "objects": [)" + box + "]}",
+                           fs::current_path(), "t");
+  };
+  const Scene disc = with_light(R"({"towards_light": [0, 1, 0], "angular_extent_deg": 10})");
+  EXPECT_FALSE(disc.light().rectangular());
+  EXPECT_FALSE(disc.light().x_axis.has_value());
+  EXPECT_EQ(disc.light().tan_half_extents(), glm::vec2(std::tan(glm::radians(5.0f))));
+  EXPECT_FLOAT_EQ(disc.light().cone_half_angle(), glm::radians(5.0f));
+
+  const Scene rect = with_light(
+      R"({"towards_light": [0, 1, 1], "angular_extent_deg": 20, "angular_height_deg": 8, "x_axis": [1, 0, 0.5]})");
+  const DirectionalLight& l = rect.light();
+  ASSERT_TRUE(l.rectangular());
+  EXPECT_FLOAT_EQ(l.tan_half_extents().x, std::tan(glm::radians(10.0f)));
+  EXPECT_FLOAT_EQ(l.tan_half_extents().y, std::tan(glm::radians(4.0f)));
+  EXPECT_NEAR(l.cone_half_angle(), msm::msm_rect_light_cone_half_angle(l.tan_half_extents()), 1e-7f);
+  // The frame's x axis is x_axis projected orthogonal to the light (up to its sign).
+  const LightFrame f = rect.light_frame();
+  const glm::dvec3 z = glm::normalize(glm::dvec3(0, 1, 1));
+  const glm::dvec3 x = glm::normalize(glm::dvec3(1, 0, 0.5) - glm::dot(glm::dvec3(1, 0, 0.5), z) * z);
+  EXPECT_NEAR(std::abs(glm::dot(f.x_axis, x)), 1.0, 1e-6);
+  EXPECT_NEAR(glm::dot(f.y_axis, z), 0.0, 1e-6);
+
+  // The probe's lights: rectangles on their faces' u axes, below 90° each way.
+  const Scene probe = load_scene_json(scene_with_object(box, R"("probe": {"file": "sky", "lights": 6, "size": 8},)"),
+                                      fs::current_path(), "t");
+  for (std::size_t k = 1; k < probe.lights.size(); ++k) {
+    const DirectionalLight& p = probe.lights[k];
+    ASSERT_TRUE(p.rectangular() && p.x_axis.has_value()) << k;
+    EXPECT_LT(*p.angular_height_deg, 90.0f);
+    EXPECT_NEAR(glm::dot(*p.x_axis, p.towards_light), 0.0f, 1e-5f) << k;
+    EXPECT_NEAR(std::abs(glm::dot(probe.light_frame(p).x_axis, glm::dvec3(*p.x_axis))), 1.0, 1e-5) << k;
+  }
+}
+
+TEST(Lights, BadSecondExtentOrAxisNamesItsPointer) {
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  const auto scene_of = [&](const std::string& light) {
+    return R"({"msm_scene": 1, "light": )" + light + R"(, "objects": [)" + box + "]}";
+  };
+  expect_json_error(scene_of(R"({"towards_light": [0, 1, 0], "angular_height_deg": 90})"),
+                    {"test.json", "/light/angular_height_deg", "must be in [0, 90)"});
+  expect_json_error(scene_of(R"({"towards_light": [0, 1, 0], "angular_height_deg": -1})"),
+                    {"/light/angular_height_deg", "must be in [0, 90)"});
+  expect_json_error(scene_of(R"({"towards_light": [0, 1, 0], "angular_height_deg": "wide"})"),
+                    {"/light/angular_height_deg"});
+  expect_json_error(scene_of(R"({"towards_light": [0, 1, 0], "x_axis": [0, 0, 0]})"),
+                    {"/light/x_axis", "non-zero direction"});
+  expect_json_error(scene_of(R"({"towards_light": [0, 1, 0], "x_axis": [0, -2, 0]})"),
+                    {"/light/x_axis", "must not be parallel to towards_light"});
+  expect_json_error(R"({"msm_scene": 1, "lights": [{"towards_light": [0, 1, 0]}, {"towards_light": [1, 1, 0],
+                      "angular_height_deg": 1e9}], "objects": [)" +
+                        box + "]}",
+                    {"/lights/1/angular_height_deg"});
 }

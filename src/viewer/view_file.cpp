@@ -212,10 +212,15 @@ json view_json(const View& v) {
   json settings = json::object();
   for (const std::string& key : setting_keys()) settings[key] = setting_json(v.settings, key);
   json lights = json::array();
-  for (const scene::DirectionalLight& l : v.settings.lights)
-    lights.push_back({{"towards_light", to_json(l.towards_light)},
-                      {"irradiance", to_json(l.irradiance)},
-                      {"angular_extent_deg", l.angular_extent_deg}});
+  for (const scene::DirectionalLight& l : v.settings.lights) {
+    json light = {{"towards_light", to_json(l.towards_light)},
+                  {"irradiance", to_json(l.irradiance)},
+                  {"angular_extent_deg", l.angular_extent_deg}};
+    // A rectangular light (a probe's): its height and width direction (scene.h).
+    if (l.angular_height_deg) light["angular_height_deg"] = *l.angular_height_deg;
+    if (l.x_axis) light["x_axis"] = to_json(*l.x_axis);
+    lights.push_back(light);
+  }
   json out = {{"msm_view", 1}, {"scene", v.scene}};
   if (v.camera)
     out["camera"] = {{"position", to_json(v.camera->position)},
@@ -271,7 +276,8 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
       std::vector<scene::DirectionalLight> lights_read;
       for (size_t i = 0; i < lights.size(); ++i) {
         std::string where = fmt::format("/lights/{}", i);
-        check_keys(lights[i], where, {"towards_light", "irradiance", "angular_extent_deg"});
+        check_keys(lights[i], where,
+                   {"towards_light", "irradiance", "angular_extent_deg", "angular_height_deg", "x_axis"});
         scene::DirectionalLight l;
         if (!lights[i].contains("towards_light")) fail(where + "/towards_light", "required");
         glm::vec3 t = vec3(where + "/towards_light", lights[i]["towards_light"]);
@@ -280,6 +286,17 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
         if (lights[i].contains("irradiance")) l.irradiance = vec3(where + "/irradiance", lights[i]["irradiance"]);
         if (lights[i].contains("angular_extent_deg"))
           l.angular_extent_deg = number(where + "/angular_extent_deg", lights[i]["angular_extent_deg"]);
+        if (lights[i].contains("angular_height_deg")) {
+          l.angular_height_deg = number(where + "/angular_height_deg", lights[i]["angular_height_deg"]);
+          if (!(*l.angular_height_deg >= 0.0f && *l.angular_height_deg < 90.0f))
+            fail(where + "/angular_height_deg", "must be in [0, 90)");
+        }
+        if (lights[i].contains("x_axis")) {
+          const glm::vec3 x = vec3(where + "/x_axis", lights[i]["x_axis"]);
+          if (!(glm::length(glm::cross(x, l.towards_light)) > 1e-3f * glm::length(x)))
+            fail(where + "/x_axis", "must be non-zero and not parallel to towards_light");
+          l.x_axis = glm::normalize(x);
+        }
         lights_read.push_back(l);
       }
       v.settings.lights = lights_read;

@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "msm/image/io.h"
 #include "msm/probe/probe.h"
+#include "msm/scene/scene.h"
 
 namespace msm::tool {
 namespace {
@@ -146,10 +147,13 @@ void run(const LightsOptions& o) {
                  k, l.direction.x, l.direction.y, l.direction.z, half_deg.x, half_deg.y, omega,
                  glm::degrees(l.cone_half_angle), l.irradiance.x, l.irradiance.y, l.irradiance.z);
     const glm::vec3 facing = msm_area_light_facing_irradiance(l);
-    // The scene's lights are discs of an angular diameter below 90°.
-    const float diameter = std::min(2.0f * glm::degrees(l.cone_half_angle), 89.0f);
-    list.push_back(
-        {{"towards_light", vec(l.direction)}, {"irradiance", vec(facing)}, {"angular_extent_deg", diameter}});
+    // The scene's lights are rectangles of angular width and height below 90° (light_of_area_light).
+    const scene::DirectionalLight drawn = scene::light_of_area_light(l);
+    list.push_back({{"towards_light", vec(drawn.towards_light)},
+                    {"irradiance", vec(drawn.irradiance)},
+                    {"angular_extent_deg", drawn.angular_extent_deg},
+                    {"angular_height_deg", *drawn.angular_height_deg},
+                    {"x_axis", vec(*drawn.x_axis)}});
     const probe::Region& r = lit[k];
     nlohmann::json region = {{"face", r.face}, {"x", {r.x0, r.x1}}, {"y", {r.y0, r.y1}}};
     if (r.faces != 0) { // a group of whole faces (N < 6)

@@ -50,7 +50,9 @@
 //               normalize(L + a * x_axis + b * y_axis) with (a, b) uniform over a disc of radius
 //               tan(extent / 2) (extent = angular DIAMETER; default the scene's
 //               angular_extent_deg) or over the rectangle [-tan(w/2), tan(w/2)] x
-//               [-tan(h/2), tan(h/2)] (angular width w along light-space x, height h along y).
+//               [-tan(h/2), tan(h/2)] (angular width w along light-space x, height h along y;
+//               defaults: the scene light's angular_extent_deg and, for a rectangular light,
+//               angular_height_deg; the axes are its shadow-map frame's, Scene::light_frame).
 //               This is the light model of shadow-map soft shadows (penumbra width in light
 //               space = 2 tan(extent/2) x distance to the blocker); it differs from a disc that
 //               is uniform in solid angle by a density of cos^3 of the angle off L (relative
@@ -104,17 +106,21 @@
 //               L the scene's probe exactly as its median cut saw it (msm::probe::load_probe: the
 //               same file, size, rotation and intensity; piecewise constant over the texels of the
 //               cube's faces) plus the scene's directional lights that are not the probe's, as
-//               uniform cones (below). Each of the `samples` samples draws one direction from the
+//               uniform cones or rectangles (below). Each of the `samples` samples draws one direction from the
 //               probe (a texel chosen in proportion to luminance x solid angle, msm_cube_texel_weight,
 //               then a uniform point of it on the face plane: density p_texel / msm_cube_texel_weight
 //               at that point) and one from the cosine-weighted hemisphere around n_s (Shirley-Chiu
 //               disc), combined by the balance heuristic: each adds f / (p_probe + p_cosine).
 //               --probe-lights (Settings::probe_lights): every light of the scene, the probe's
-//               extracted area lights included, is a cone of uniform radiance of half-angle
-//               alpha = angular_extent_deg / 2 whose irradiance on a facing surface is the light's
-//               `irradiance` (scene.cpp: msm_area_light_facing_irradiance), sampled uniformly in the
-//               cone (one direction per light per sample): the ground truth of the area lights,
-//               whose difference from the probe's is the error of the light extraction.
+//               extracted area lights included, is a light of uniform radiance whose irradiance on
+//               a facing surface is the light's `irradiance` (scene.cpp: Eq. 18 for the rectangle,
+//               msm_rect_light_facing_fraction): a disc light a cone of half-angle alpha =
+//               angular_extent_deg / 2 sampled uniformly in the cone, a rectangular one (the
+//               probe's: Kneiphof §4.1.2) its rectangle on the axes of its shadow-map frame
+//               (Scene::light_frame, as the renderer's spreads) sampled uniformly on its plane at
+//               unit distance, weighted by cos³ θ (one direction per light per sample): the ground
+//               truth of the area lights, whose difference from the probe's is the error of the
+//               light extraction. The scene's other directional lights are drawn the same way.
 //               The radiance is msm/shading.h's with this E: msm_surface_radiance(albedo,
 //               msm_direct_light(E, 1, 1), MSM_AMBIENT). "visibility" = E_Y / E0_Y, the luminance of
 //               E over that of the unoccluded E0 from the same samples (0 where E0_Y = 0);

@@ -34,6 +34,13 @@
 //                                          (normalized on load; the light travels along -this)
 //     "irradiance": [r,g,b],               >= 0, default [3,3,3]
 //     "angular_extent_deg": 0              angular diameter of the light, [0, 90); 0 = hard
+//     "angular_height_deg": h              optional: the light is a rectangle (Kneiphof §4.1.2) of
+//                                          angular width angular_extent_deg along x_axis and height h,
+//                                          [0, 90), along the third axis; without it, a disc whose
+//                                          shadow kernel is the square box covering it
+//     "x_axis": [x,y,z]                    optional: the direction of the width, projected orthogonal
+//                                          to towards_light (not parallel to it); default: the light
+//                                          frame's horizontal axis (Scene::light_view)
 //   },
 //   "shadow_map": {
 //     "framing": "fit"                     default: orthographic light frustum fitted to what the
@@ -281,9 +288,24 @@ struct Camera {
 
 struct DirectionalLight {
   glm::vec3 towards_light{0.0f, 1.0f, 0.0f}; // unit, from the scene towards the light
-  glm::vec3 irradiance{3.0f};
+  glm::vec3 irradiance{3.0f};                // on a surface facing the light
+  // The light's angular size, both in [0, 90). Without angular_height_deg: a disc of angular
+  // diameter angular_extent_deg (its soft-shadow kernel the square box covering it: both spreads
+  // equal). With it: a rectangle of angular width angular_extent_deg along the light frame's x axis
+  // and height angular_height_deg along its y axis (the probe's area lights, Kneiphof §4.1.2).
   float angular_extent_deg = 0.0f; // 0 = hard shadows
+  std::optional<float> angular_height_deg;
+  // The direction of the width (the light frame's x axis once projected orthogonal to
+  // towards_light); unset: the frame's default, horizontal (Scene::light_view). The probe's lights:
+  // the u axis of their cube face (§4.1.2).
+  std::optional<glm::vec3> x_axis;
   glm::vec3 travel() const { return -towards_light; }
+  bool rectangular() const { return angular_height_deg.has_value(); }
+  // tan of the half extents along the frame's x and y axes (a disc: its radius, both).
+  glm::vec2 tan_half_extents() const;
+  // The half-angle in radians of the cone the shading integrates (msm_cone_cosine): a disc's own,
+  // a rectangle's the cone of its solid angle (msm_rect_light_cone_half_angle).
+  float cone_half_angle() const;
 };
 
 // A homogeneous medium (JCGT 2017 §5.1.1): extinction σt, scattering albedo ρ and a Henyey–
@@ -295,9 +317,10 @@ struct Medium {
   float g = 0.0f;                 // in (-1, 1)
 };
 
-// The disc light that the renderer and the ray tracer draw for an area light of a probe: its
-// direction, the irradiance a facing surface receives (Eq. 18), and its cone's angular diameter
-// kept below 90° (their limit on angular_extent_deg).
+// The rectangular light that the renderer and the ray tracer draw for an area light of a probe:
+// its direction, its face's u axis, its angular width and height (each kept below 90°, their limit
+// on the extents) and the irradiance a facing surface receives (Eq. 18 for the rectangle:
+// msm_rect_light_facing_fraction of the kept extents).
 DirectionalLight light_of_area_light(const msm::MsmAreaLight& area);
 
 // Image-based lighting: the probe the scene's area lights were made from (Scene::lights holds them).

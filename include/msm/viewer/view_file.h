@@ -7,6 +7,7 @@
 //   "scene": "fence",                               built-in name or scene file (relative: to the view file)
 //   "camera": {"position": [x,y,z], "target": [x,y,z], "up": [0,1,0], "fov_y_deg": 45, "near": 0.1, "far": 1000},
 //   "lights": [{"towards_light": [x,y,z], "irradiance": [r,g,b], "angular_extent_deg": 0}],  absent: the scene's
+//             (a rectangular light also "angular_height_deg": h, "x_axis": [x,y,z], as in a scene file)
 //   "settings": {"technique": "msm-hamburger-64", "width": 1280, ...}   the keys of setting_keys()
 // }
 // Every key is optional but msm_view; unknown keys are errors naming the key (ViewError).
