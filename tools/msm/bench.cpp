@@ -1,6 +1,9 @@
 // `msm bench`: GPU time per pass over repeated frames (median and spread), and per technique the
 // cost relative to PCF with the same kernel: shading per pixel at the given resolutions, shadow
 // map (depth, resolve, blur, mips) per texel at the given sizes. JSON and a markdown table.
+// `--scattering`: the scattering techniques alone (JCGT §5): the scattering pass per pixel against
+// ray marching, the rectified map's passes per texel against a copy of the same bytes, timed by the
+// host clock on a CPU device, whose compute timestamps are not the passes' time (results.md).
 #include "probe_bench.h"
 #include "render_common.h"
 
@@ -12,6 +15,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <map>
 #include <unistd.h>
@@ -46,41 +50,107 @@ Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const s
   return stats(sums);
 }
 
-// The device's copy bandwidth, the bound of the prefix sums (JCGT App. C): vkCmdCopyImage of an
-// RGBA32F image of size² texels (16 B read and 16 B written per texel), median over `runs`
-// submissions after one warm-up. Returns the copy's milliseconds.
-double copy_ms(const vk::Context& ctx, uint32_t size, int runs) {
-  const VkImageUsageFlags usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-  vk::Image from = vk::create_image(
-      ctx, vk::ImageDesc{.width = size, .height = size, .format = VK_FORMAT_R32G32B32A32_SFLOAT, .usage = usage});
-  vk::Image to = vk::create_image(
-      ctx, vk::ImageDesc{.width = size, .height = size, .format = VK_FORMAT_R32G32B32A32_SFLOAT, .usage = usage});
-  // Written once from the host (an image never written may not be copied at full cost).
-  std::vector<float> zeros(size_t(size) * size * 4, 0.5f);
-  vk::upload_image(ctx, from, std::as_bytes(std::span(zeros)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+// The copy-bandwidth bound of the prefix sums (JCGT App. C): a vkCmdCopyBuffer of `bytes`, half of
+// what the prefix sums read and write per frame, so that the copy reads and writes as many bytes
+// as they do. Timed three ways, median over `repeats` after one untimed round:
+//  - host: the host clock around a submission with the copy, minus one without it (the submission
+//    and the wait cancel);
+//  - timestamps: a timer scope around the copy, as the frame's passes are timed;
+//  - timestamps_flushed: the same with a pipeline barrier right after the scope's begin.
+// On lavapipe only the first two agree with each other when the third does (results.md: llvmpipe
+// writes a timestamp when the binned scene it was put in is rasterized, at the next flush; a
+// compute dispatch or a copy runs on the spot, before it, unless a barrier flushes it first).
+struct CopyTimes {
+  double host_ms = 0, timestamp_ms = 0, timestamp_flushed_ms = 0;
+};
+CopyTimes copy_times(const vk::Context& ctx, VkDeviceSize bytes, int repeats) {
+  const VkBufferUsageFlags usage = VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+  vk::Buffer from = vk::create_buffer(ctx, bytes, usage), to = vk::create_buffer(ctx, bytes, usage);
+  // Both written once (memory never written may cost nothing to read).
+  vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+    vkCmdFillBuffer(cmd, from.handle(), 0, VK_WHOLE_SIZE, 0x3f000000u);
+    vkCmdFillBuffer(cmd, to.handle(), 0, VK_WHOLE_SIZE, 0u);
+  });
   vk::GpuTimer timer(ctx);
-  std::vector<double> times;
-  for (int r = 0; r <= runs; ++r) {
+  const VkMemoryBarrier2 before = vk::memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                                                     VK_PIPELINE_STAGE_2_TRANSFER_BIT,
+                                                     VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT);
+  const VkMemoryBarrier2 flush =
+      vk::memory_barrier(VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0);
+  const VkBufferCopy region{.srcOffset = 0, .dstOffset = 0, .size = bytes};
+  auto copy = [&](VkCommandBuffer cmd) { vkCmdCopyBuffer(cmd, from.handle(), to.handle(), 1, &region); };
+  std::vector<double> host, stamps, flushed;
+  for (int r = -1; r < repeats; ++r) {
+    Clock::time_point t0 = Clock::now();
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) { vk::pipeline_barrier(cmd, before); });
+    double empty = ms_since(t0);
+    t0 = Clock::now();
     vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-      for (const vk::Image* image : {&to})
-        vk::pipeline_barrier(cmd, vk::image_barrier(image->handle(), image->aspect(),
-                                                    VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                                                    VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_TRANSFER_BIT,
-                                                    VK_ACCESS_2_TRANSFER_READ_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT,
-                                                    VK_IMAGE_LAYOUT_GENERAL));
+      vk::pipeline_barrier(cmd, before);
+      copy(cmd);
+    });
+    double full = ms_since(t0);
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+      vk::pipeline_barrier(cmd, before);
       timer.reset(cmd);
       timer.begin(cmd, "copy");
-      VkImageCopy region{.srcSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-                         .srcOffset = {0, 0, 0},
-                         .dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1},
-                         .dstOffset = {0, 0, 0},
-                         .extent = {size, size, 1}};
-      vkCmdCopyImage(cmd, from.handle(), VK_IMAGE_LAYOUT_GENERAL, to.handle(), VK_IMAGE_LAYOUT_GENERAL, 1, &region);
+      copy(cmd);
       timer.end(cmd);
     });
-    if (r > 0) times.push_back(timer.read().total("copy"));
+    double stamp = timer.read().total("copy");
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+      vk::pipeline_barrier(cmd, before);
+      timer.reset(cmd);
+      timer.begin(cmd, "copy");
+      vk::pipeline_barrier(cmd, flush);
+      copy(cmd);
+      timer.end(cmd);
+      vk::pipeline_barrier(cmd, flush);
+    });
+    if (r < 0) continue;
+    host.push_back(full - empty);
+    stamps.push_back(stamp);
+    flushed.push_back(timer.read().total("copy"));
   }
-  return util::median(times);
+  return {util::median(host), util::median(stamps), util::median(flushed)};
+}
+
+// Host-clock time of the named passes of a frame: pass k (frame_passes order) costs the difference
+// of the frame's prefixes of k + 1 and k passes, each submitted and waited for (the submission and
+// the wait cancel; whatever a driver defers within the pass is counted in it). The prefixes of a
+// repeat run back to back; median over `repeats` after one untimed round. Names the frame lacks
+// are left out.
+std::map<std::string, double> host_pass_ms(render::Renderer& renderer, const render::RenderSettings& s,
+                                           const std::vector<std::string>& names, int repeats) {
+  std::vector<std::string> passes = renderer.frame_passes(s);
+  std::map<std::string, size_t> index;
+  std::vector<size_t> counts;
+  for (const std::string& name : names)
+    if (auto it = std::find(passes.begin(), passes.end(), name); it != passes.end()) {
+      size_t k = size_t(it - passes.begin());
+      index[name] = k;
+      counts.push_back(k);
+      counts.push_back(k + 1);
+    }
+  std::sort(counts.begin(), counts.end());
+  counts.erase(std::unique(counts.begin(), counts.end()), counts.end());
+  std::map<std::string, std::vector<double>> differences;
+  for (int r = -1; r < repeats; ++r) {
+    std::map<size_t, double> ms;
+    for (size_t k : counts) {
+      Clock::time_point t0 = Clock::now();
+      renderer.submit_frame_prefix(s, k);
+      ms[k] = ms_since(t0);
+    }
+    if (r >= 0)
+      for (const auto& [name, k] : index) differences[name].push_back(ms[k + 1] - ms[k]);
+  }
+  std::map<std::string, double> out;
+  for (const auto& [name, v] : differences) out[name] = util::median(v);
+  return out;
 }
 
 std::pair<int, int> parse_resolution(const std::string& text) {
@@ -137,6 +207,118 @@ void check_callgrind() {
 #endif
 }
 
+// The scattering part of the markdown, and the ratios it adds to the JSON: the scattering pass per
+// pixel against ray marching in the same run; the same with the rectified map's passes at the
+// frames' shadow size; the rectified map per texel with the prefix sums against the copy; the
+// timestamps of the passes against the host clock.
+std::string scattering_markdown(nlohmann::json& results, const std::vector<std::pair<int, int>>& resolutions,
+                                int shadow_size, const std::string& clock) {
+  std::string md;
+  auto find = [&](const std::string& technique) -> const nlohmann::json* {
+    for (const nlohmann::json& e : results)
+      if (e["technique"] == technique && e.contains("scattering")) return &e;
+    return nullptr;
+  };
+  auto header = [&](const std::string& title) {
+    std::string h = "\n" + title + "\n\n| technique |";
+    for (auto [w, h2] : resolutions) h += fmt::format(" {}x{} |", w, h2);
+    h += "\n|---|";
+    for (size_t i = 0; i < resolutions.size(); ++i) h += "---:|";
+    return h + "\n";
+  };
+  bool any = false, with_maps = false, rectified = false;
+  const std::string map = std::to_string(shadow_size);
+  for (const nlohmann::json& e : results) {
+    any = any || e.contains("scattering");
+    rectified = rectified || e.contains("rectified");
+    with_maps = with_maps || (e.contains("rectified") && e["rectified"].contains(map));
+  }
+  if (!any) return md;
+  const nlohmann::json* march128 = find("scatter-march-128");
+  md += header("Single scattering, the scattering pass alone (timestamps): ms (ns per pixel; × scatter-march-128; "
+               "× scatter-march-32, where they ran)");
+  for (nlohmann::json& entry : results) {
+    if (!entry.contains("scattering")) continue;
+    md += fmt::format("| {} |", entry["technique"].get<std::string>());
+    for (auto [w, h] : resolutions) {
+      std::string key = fmt::format("{}x{}", w, h);
+      nlohmann::json& v = entry["scattering"][key];
+      double ns = v["ns_per_pixel"].get<double>();
+      md += fmt::format(" {:.3f} ({:.1f}", v["median_ms"].get<double>(), ns);
+      for (const char* march : {"scatter-march-128", "scatter-march-32"})
+        if (const nlohmann::json* m = find(march)) {
+          double ratio = ns / (*m)["scattering"][key]["ns_per_pixel"].get<double>();
+          v[std::string("ratio_to_") + march] = ratio;
+          md += fmt::format("; {:.3f}", ratio);
+        }
+      md += ") |";
+    }
+    md += "\n";
+  }
+  if (with_maps) {
+    md += header(fmt::format("With the rectified map: the scattering pass + rectify + prefix sums at {}² ({}), ms "
+                             "(× scatter-march-128's scattering pass)",
+                             shadow_size, clock));
+    for (nlohmann::json& entry : results) {
+      if (!entry.contains("scattering")) continue;
+      md += fmt::format("| {} |", entry["technique"].get<std::string>());
+      const bool prefiltered = msm_technique_is_prefiltered_scattering(
+          render::find_rendered_technique(entry["technique"].get<std::string>()).id);
+      for (auto [w, h] : resolutions) {
+        std::string key = fmt::format("{}x{}", w, h);
+        nlohmann::json& v = entry["scattering"][key];
+        if (prefiltered && !(entry.contains("rectified") && entry["rectified"].contains(map))) {
+          md += " – |";
+          continue;
+        }
+        double ms = v["median_ms"].get<double>();
+        if (prefiltered)
+          ms += entry["rectified"][map]["rectify_ms"].get<double>() +
+                entry["rectified"][map]["prefix_sums_ms"].get<double>();
+        v["with_rectified_map_ms"] = ms;
+        md += fmt::format(" {:.3f}", ms);
+        if (march128) {
+          double ratio = ms / (*march128)["scattering"][key]["median_ms"].get<double>();
+          v["with_rectified_map_ratio_to_scatter-march-128"] = ratio;
+          md += fmt::format(" ({:.3f})", ratio);
+        }
+        md += " |";
+      }
+      md += "\n";
+    }
+  }
+  if (rectified) {
+    md +=
+        fmt::format("\nThe rectified map per texel ({}), the prefix sums against a copy of the bytes they read and "
+                    "write\n\n| technique | map | rectify ms (ns per texel) | prefix sums ms (ns per texel) | copy ms "
+                    "(GB/s) | copy / prefix sums | timestamps: rectify, prefix sums, copy, copy after a barrier "
+                    "(ms) |\n|---|---|---:|---:|---:|---:|---|\n",
+                    clock);
+    std::string check;
+    for (const nlohmann::json& entry : results) {
+      if (!entry.contains("rectified")) continue;
+      const std::string name = entry["technique"].get<std::string>();
+      std::vector<int> sizes; // in numeric order (the JSON object's keys sort as text)
+      for (const auto& [key, value] : entry["rectified"].items()) sizes.push_back(std::stoi(key));
+      std::sort(sizes.begin(), sizes.end());
+      for (int size : sizes) {
+        const nlohmann::json &v = entry["rectified"][std::to_string(size)], &t = v["timestamps"], &hc = v["host_clock"];
+        md += fmt::format(
+            "| {} | {}² | {:.3f} ({:.1f}) | {:.3f} ({:.1f}) | {:.3f} ({:.1f}) | {:.3f} | {:.3f}, {:.3f}, "
+            "{:.3f}, {:.3f} |\n",
+            name, size, v["rectify_ms"].get<double>(), v["rectify_ns_per_texel"].get<double>(),
+            v["prefix_sums_ms"].get<double>(), v["prefix_sums_ns_per_texel"].get<double>(), v["copy_ms"].get<double>(),
+            v["copy_gb_s"].get<double>(), v["fraction_of_bound"].get<double>(), t["rectify_ms"].get<double>(),
+            t["prefix_sums_ms"].get<double>(), t["copy_ms"].get<double>(), t["copy_after_barrier_ms"].get<double>());
+        check += fmt::format(" {} {}²: {:.3f} / {:.3f};", name, size, t["scattering_320x180_ms"].get<double>(),
+                             hc["scattering_320x180_ms"].get<double>());
+      }
+    }
+    md += "\nThe scattering pass at 320x180, timestamps / host clock (ms):" + check + "\n";
+  }
+  return md;
+}
+
 } // namespace
 
 void add_bench(CLI::App& app) {
@@ -145,9 +327,9 @@ void add_bench(CLI::App& app) {
     std::vector<std::string> techniques;
     std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
     std::vector<int> shadow_sizes = {1024, 2048};
-    int frames = 20, warmup = 2;
+    int frames = 20, warmup = 2, repeats = 5;
     std::string json, markdown;
-    bool callgrind = false;
+    bool callgrind = false, scattering = false, quick = false;
     ProbeBench probe;
   };
   auto opt = std::make_shared<Options>();
@@ -162,6 +344,18 @@ void add_bench(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--frames", opt->frames, "Timed frames per configuration")->capture_default_str();
   cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str();
+  cmd->add_option("--repeats", opt->repeats,
+                  "Host-clock repeats (median) of the frame prefixes and of the copy that time the rectified map's "
+                  "passes")
+      ->capture_default_str();
+  cmd->add_flag("--scattering", opt->scattering,
+                "Single scattering (JCGT §5): the scattering pass per pixel against ray marching, the rectified "
+                "map's passes per texel against a copy of the same bytes; unless given: techniques "
+                "scatter-march-32,scatter-march-128,scatter-msm4-64,scatter-msm6-96,scatter-csm-32, scene tower, "
+                "shadow sizes 512,1024,2048; no PCF table");
+  cmd->add_flag("--quick", opt->quick,
+                "A short run, to check that it works (not for recorded numbers): unless given, resolution 320x180, "
+                "shadow size and sizes 256, 1 frame after 1 warm-up, 2 repeats");
   cmd->add_option("--json", opt->json, "Write the results as JSON here");
   cmd->add_option("--markdown", opt->markdown, "Write the results as a markdown table here");
   cmd->add_flag("--callgrind", opt->callgrind,
@@ -176,10 +370,28 @@ void add_bench(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   add_frame_options(cmd, opt->frame);
-  cmd->callback([opt] {
+  cmd->callback([opt, cmd] {
+    auto given = [cmd](const char* option) { return cmd->get_option(option)->count() > 0; };
+    if (opt->quick) {
+      if (!given("--resolutions")) opt->resolutions = {"320x180"};
+      if (!given("--shadow-sizes")) opt->shadow_sizes = {256};
+      if (!given("--shadow-size")) opt->frame.settings.shadow_size = 256;
+      if (!given("--frames")) opt->frames = 1;
+      if (!given("--warmup")) opt->warmup = 1; // lavapipe compiles shader variants in a configuration's first frame
+      if (!given("--repeats")) opt->repeats = 2;
+    }
+    if (opt->scattering) {
+      if (!opt->probe.probe.empty()) throw UsageError("--scattering and --probe: one at a time");
+      if (!given("--scene")) opt->frame.scene = "tower";
+      if (!given("--shadow-sizes") && !opt->quick) opt->shadow_sizes = {512, 1024, 2048};
+      if (opt->techniques.empty())
+        opt->techniques = {"scatter-march-32", "scatter-march-128", "scatter-msm4-64", "scatter-msm6-96",
+                           "scatter-csm-32"};
+    }
     finish_frame_options(opt->frame);
     if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
     if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
+    if (opt->repeats < 1 || opt->repeats > 1000) throw UsageError("--repeats must be in [1, 1000]");
     if (!opt->probe.probe.empty()) {
       bench_probe(opt->probe, opt->frame.device, opt->frames, opt->warmup, opt->json, opt->markdown);
       return;
@@ -188,7 +400,11 @@ void add_bench(CLI::App& app) {
     std::vector<std::string> names = canonical_technique_names(opt->techniques);
     if (names.empty())
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
-    if (!opt->callgrind && std::find(names.begin(), names.end(), "pcf") == names.end())
+    if (opt->scattering)
+      for (const std::string& name : names)
+        if (!msm_technique_is_scattering(render::find_rendered_technique(name).id))
+          throw UsageError(fmt::format("--scattering: '{}' is not a scattering technique (msm techniques)", name));
+    if (!opt->callgrind && !opt->scattering && std::find(names.begin(), names.end(), "pcf") == names.end())
       names.insert(names.begin(), "pcf");
     std::vector<std::pair<int, int>> resolutions;
     for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
@@ -208,6 +424,9 @@ void add_bench(CLI::App& app) {
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
     }
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    if (opt->scattering && !scene.medium)
+      throw UsageError(
+          fmt::format("--scattering: scene '{}' has no medium (tower, trees, gate and room have one)", scene.name));
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     render::Renderer renderer(*ctx, scene);
     check_on_device(renderer, opt->frame, names); // before the first frame, not after some
@@ -217,6 +436,9 @@ void add_bench(CLI::App& app) {
     }
     const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve",  "translucent", "blur",
                                                     "mipmaps",      "one_pass_filter", "sat"};
+    // The rectified map's compute passes and the copy: on a CPU device (lavapipe) their timestamps
+    // are not the time they take (results.md), so there the host clock times them.
+    const bool host_clock = ctx->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
 
     // A progress line: rewritten in place on a terminal, one line per step in a log.
     bool tty = isatty(fileno(stderr));
@@ -230,9 +452,15 @@ void add_bench(CLI::App& app) {
       if (opt->warmup) renderer.time_frames(s, opt->warmup);
       return renderer.time_frames(s, opt->frames);
     };
+    // --scattering: the shadow-map sizes only for the rectified map of the prefiltered techniques.
+    auto sizes_for = [&](int id) {
+      return opt->scattering && !msm_technique_is_prefiltered_scattering(id) ? std::vector<int>{} : opt->shadow_sizes;
+    };
     nlohmann::json results = nlohmann::json::array();
     std::map<std::string, std::map<std::string, double>> per_unit; // technique -> config -> ns per unit
-    size_t total = names.size() * (resolutions.size() + opt->shadow_sizes.size()), done = 0;
+    size_t total = 0, done = 0;
+    for (const std::string& name : names)
+      total += resolutions.size() + sizes_for(render::find_rendered_technique(name).id).size();
     for (const std::string& name : names) {
       nlohmann::json entry = {{"technique", name},
                               {"shading", nlohmann::json::object()},
@@ -265,7 +493,7 @@ void add_bench(CLI::App& app) {
             entry["passes"][p.name] = {{"median_ms", ps.median}, {"p10_ms", ps.p10}, {"p90_ms", ps.p90}};
           }
       }
-      for (int size : opt->shadow_sizes) {
+      for (int size : sizes_for(id)) {
         render::RenderSettings s = settings_for(opt->frame, name);
         s.width = 320; // the shadow-map passes do not depend on the image size
         s.height = 180;
@@ -274,16 +502,41 @@ void add_bench(CLI::App& app) {
         auto frames = run(s);
         Stats st = pass_sum(frames, shadow_passes);
         if (prefiltered) {
-          // The rectified map and its prefix sums per texel, the prefix sums against the copy bound:
-          // the bytes they read and write per texel over the copy's 32.
-          Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"});
-          double copy = copy_ms(*ctx, uint32_t(size), std::max(opt->frames, 3));
+          // The rectified map and its prefix sums per texel, and the prefix sums against a copy of
+          // the bytes they read and write, both by the host clock on a CPU device. The scattering
+          // pass (320x180) both ways too: a check of the timestamps the per-pixel table uses.
+          Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"}),
+                scatter = pass_sum(frames, {"scattering"});
+          std::map<std::string, double> host =
+              host_pass_ms(renderer, s, {"rectify", "prefix_sums", "scattering"}, opt->repeats);
           const glm::ivec2 bytes = msm_technique_scatter_map_bytes(id);
-          double bound = copy * double(bytes.x + bytes.y) / 32.0;
-          entry["rectified"][std::to_string(size)] = {
-              {"rectify_ms", rect.median},     {"prefix_sums_ms", prefix.median},
-              {"copy_rgba32f_ms", copy},       {"bandwidth_gb_s", 32.0 * size * size / (copy * 1e6)},
-              {"prefix_sums_bound_ms", bound}, {"fraction_of_bound", bound / prefix.median}};
+          const double texels = double(size) * size;
+          const auto copy_bytes = VkDeviceSize(texels * (bytes.x + bytes.y) / 2);
+          CopyTimes copy = copy_times(*ctx, copy_bytes, opt->repeats);
+          const double rect_ms = host_clock ? host["rectify"] : rect.median,
+                       prefix_ms = host_clock ? host["prefix_sums"] : prefix.median,
+                       copy_ms = host_clock ? copy.host_ms : copy.timestamp_ms;
+          entry["rectified"][std::to_string(size)] = {{"clock", host_clock ? "host" : "timestamps"},
+                                                      {"rectify_ms", rect_ms},
+                                                      {"prefix_sums_ms", prefix_ms},
+                                                      {"rectify_ns_per_texel", rect_ms * 1e6 / texels},
+                                                      {"prefix_sums_ns_per_texel", prefix_ms * 1e6 / texels},
+                                                      {"bytes_read_per_texel", bytes.x},
+                                                      {"bytes_written_per_texel", bytes.y},
+                                                      {"copy_ms", copy_ms},
+                                                      {"copy_gb_s", 2.0 * double(copy_bytes) / (copy_ms * 1e6)},
+                                                      {"fraction_of_bound", copy_ms / prefix_ms},
+                                                      {"host_clock",
+                                                       {{"rectify_ms", host["rectify"]},
+                                                        {"prefix_sums_ms", host["prefix_sums"]},
+                                                        {"scattering_320x180_ms", host["scattering"]},
+                                                        {"copy_ms", copy.host_ms}}},
+                                                      {"timestamps",
+                                                       {{"rectify_ms", rect.median},
+                                                        {"prefix_sums_ms", prefix.median},
+                                                        {"scattering_320x180_ms", scatter.median},
+                                                        {"copy_ms", copy.timestamp_ms},
+                                                        {"copy_after_barrier_ms", copy.timestamp_flushed_ms}}}};
         }
         std::string key = std::to_string(size);
         double ns = st.median * 1e6 / (double(size) * size);
@@ -294,40 +547,44 @@ void add_bench(CLI::App& app) {
       results.push_back(entry);
     }
     if (tty) fmt::print(stderr, "\r{:<70}\r", "");
-    // Ratios to PCF; the soft techniques' shading also to PCSS where it ran (JCGT §4: two table
-    // queries against hundreds of taps).
-    bool with_pcss = per_unit.count("pcss") > 0;
+    // Ratios to PCF where it ran; the soft techniques' shading also to PCSS where it ran (JCGT §4:
+    // two table queries against hundreds of taps).
+    bool with_pcf = per_unit.count("pcf") > 0, with_pcss = per_unit.count("pcss") > 0;
     for (nlohmann::json& entry : results) {
       const std::string name = entry["technique"];
       for (auto& [key, value] : entry["shading"].items()) {
-        value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
+        if (with_pcf) value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
         if (with_pcss && msm_technique_is_area_light(render::find_rendered_technique(name).id))
           value["ratio_to_pcss"] = per_unit[name]["shading " + key] / per_unit["pcss"]["shading " + key];
       }
-      for (auto& [key, value] : entry["shadow_map"].items())
-        value["ratio_to_pcf"] = per_unit[name]["shadow " + key] / per_unit["pcf"]["shadow " + key];
+      if (with_pcf)
+        for (auto& [key, value] : entry["shadow_map"].items())
+          value["ratio_to_pcf"] = per_unit[name]["shadow " + key] / per_unit["pcf"]["shadow " + key];
     }
 
     std::string md = fmt::format("Device: {}. Scene '{}', {} frames per configuration (median; p10–p90 in JSON), "
-                                 "{}x MSAA, {}² Gaussian.\n\n| technique |",
+                                 "{}x MSAA, {}² Gaussian.\n",
                                  ctx->info().describe(), scene.name, opt->frames, opt->frame.settings.msaa,
                                  opt->frame.settings.filter_size);
-    for (auto [w, h] : resolutions) md += fmt::format(" shading {}x{} ms (× PCF) |", w, h);
-    for (int size : opt->shadow_sizes) md += fmt::format(" shadow map {}² ms (× PCF) |", size);
-    md += "\n|---|";
-    for (size_t i = 0; i < resolutions.size() + opt->shadow_sizes.size(); ++i) md += "---:|";
-    md += "\n";
-    for (const nlohmann::json& entry : results) {
-      md += fmt::format("| {} |", entry["technique"].get<std::string>());
-      for (auto [w, h] : resolutions) {
-        const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
-        md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
-      }
-      for (int size : opt->shadow_sizes) {
-        const auto& v = entry["shadow_map"][std::to_string(size)];
-        md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
-      }
+    if (with_pcf) {
+      md += "\n| technique |";
+      for (auto [w, h] : resolutions) md += fmt::format(" shading {}x{} ms (× PCF) |", w, h);
+      for (int size : opt->shadow_sizes) md += fmt::format(" shadow map {}² ms (× PCF) |", size);
+      md += "\n|---|";
+      for (size_t i = 0; i < resolutions.size() + opt->shadow_sizes.size(); ++i) md += "---:|";
       md += "\n";
+      for (const nlohmann::json& entry : results) {
+        md += fmt::format("| {} |", entry["technique"].get<std::string>());
+        for (auto [w, h] : resolutions) {
+          const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
+          md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
+        }
+        for (int size : opt->shadow_sizes) {
+          const auto& v = entry["shadow_map"][std::to_string(size)];
+          md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
+        }
+        md += "\n";
+      }
     }
     if (with_pcss) {
       md += fmt::format("\nSoft shadows, shading time relative to pcss ({}² search):",
@@ -341,59 +598,18 @@ void add_bench(CLI::App& app) {
         }
       md += "\n";
     }
-    // Scattering: the deferred pass per pixel against ray marching in the same run, and the prefiltered
-    // maps per texel with the prefix sums against the copy bound.
-    bool any_scattering = false;
-    for (const nlohmann::json& entry : results) any_scattering = any_scattering || entry.contains("scattering");
-    if (any_scattering) {
-      md += "\nSingle scattering, the scattering pass alone: ms (ns per pixel; × scatter-march-128, × scatter-march-32 "
-            "where they ran)\n\n| technique |";
-      for (auto [w, h] : resolutions) md += fmt::format(" {}x{} |", w, h);
-      md += "\n|---|";
-      for (size_t i = 0; i < resolutions.size(); ++i) md += "---:|";
-      md += "\n";
-      auto pass_ns = [&](const std::string& technique, const std::string& key) {
-        for (const nlohmann::json& e : results)
-          if (e["technique"] == technique && e.contains("scattering"))
-            return e["scattering"][key]["ns_per_pixel"].get<double>();
-        return 0.0;
-      };
-      for (nlohmann::json& entry : results) {
-        if (!entry.contains("scattering")) continue;
-        md += fmt::format("| {} |", entry["technique"].get<std::string>());
-        for (auto [w, h] : resolutions) {
-          std::string key = fmt::format("{}x{}", w, h);
-          nlohmann::json& v = entry["scattering"][key];
-          double ns = v["ns_per_pixel"].get<double>();
-          md += fmt::format(" {:.3f} ({:.1f}", v["median_ms"].get<double>(), ns);
-          for (const char* march : {"scatter-march-128", "scatter-march-32"})
-            if (double m = pass_ns(march, key); m > 0.0) {
-              v[std::string("ratio_to_") + march] = ns / m;
-              md += fmt::format("; {:.3f}", ns / m);
-            }
-          md += ") |";
-        }
-        md += "\n";
-      }
-      for (const nlohmann::json& entry : results) {
-        if (!entry.contains("rectified")) continue;
-        md += fmt::format("\n{}: rectified map per size: rectify ms, prefix sums ms, bound ms (copy bandwidth), "
-                          "fraction of the bound:",
-                          entry["technique"].get<std::string>());
-        for (auto& [size, v] : entry["rectified"].items())
-          md += fmt::format(" {}²: {:.3f}, {:.3f}, {:.3f} ({:.1f} GB/s), {:.2f};", size, v["rectify_ms"].get<double>(),
-                            v["prefix_sums_ms"].get<double>(), v["prefix_sums_bound_ms"].get<double>(),
-                            v["bandwidth_gb_s"].get<double>(), v["fraction_of_bound"].get<double>());
-        md += "\n";
-      }
-    }
+    md += scattering_markdown(results, resolutions, opt->frame.settings.shadow_size,
+                              host_clock ? fmt::format("host clock, median of {} repeats", opt->repeats)
+                                         : fmt::format("timestamps, median of {} frames", opt->frames));
     fmt::print("{}", md);
     nlohmann::json doc = {{"device", ctx->info().describe()},
                           {"scene", scene.name},
                           {"frames", opt->frames},
                           {"warmup", opt->warmup},
+                          {"repeats", opt->repeats},
                           {"msaa", opt->frame.settings.msaa},
                           {"filter_size", opt->frame.settings.filter_size},
+                          {"shadow_size", opt->frame.settings.shadow_size},
                           {"results", results}};
     auto write = [](const std::string& path, const std::string& text) {
       try {
