@@ -11,26 +11,58 @@
 # SAMPLES (default 1024) per pixel for the full probe's truth, a quarter for the area lights' (one
 # direction per light each), a sixteenth for 256 lights: at 64 the probe's truth alone is off its
 # 1024-sample self by MAE 0.010 on sky_probe, as much as the whole "lights" error.
+# Environment (all optional):
+#   PROBE=FILE      light the scene with this equirectangular EXR instead of its own probe: the
+#                   scene's JSON (scenes/SCENE.json) with the probe's "file" replaced, written to
+#                   OUT/scene.json (lights, size, intensity and rotation kept)
+#   TECHNIQUES=...  the techniques below 256 lights (default mssm6,mssm4,pcss,vssm,cssm16,msm-hamburger-64;
+#                   256 lights: msm-hamburger-64 alone, the point-light limit)
+#   COUNTS="..."    light counts (default "16 32 64 256")
+#   SEED=N          seed of the ground truths (default 1)
+#   NOISE=1         also the full-probe truth with seed SEED+1, and the MAE between the two (the
+#                   truth's own noise, which the other MAEs carry too)
+#   ERROR_IMAGES=1  OUT/render-N/T-error.png against the full-probe truth (msm compare --error-image)
 set -euo pipefail
 scene=$1 out=$2 width=${3:-160} height=${4:-90} samples=${5:-1024} shadow=${6:-256}
 msm=${MSM:-build/tools/msm/msm}
+techniques_all=${TECHNIQUES:-mssm6,mssm4,pcss,vssm,cssm16,msm-hamburger-64}
+counts=${COUNTS:-16 32 64 256}
+seed=${SEED:-1}
 mkdir -p "$out"
+if [ -n "${PROBE:-}" ]; then
+  json="$(dirname "$0")/../scenes/$scene.json"
+  [ -f "$json" ] || { echo "ibl-compare.sh: PROBE needs a built-in scene with a file scenes/$scene.json" >&2; exit 1; }
+  [ -f "$PROBE" ] || { echo "ibl-compare.sh: PROBE=$PROBE: no such file" >&2; exit 1; }
+  probe=$(realpath "$PROBE")
+  grep -q '"probe": {' "$json" || { echo "ibl-compare.sh: $json has no probe" >&2; exit 1; }
+  sed "/\"probe\": {/ s#\"file\": \"[^\"]*\"#\"file\": \"$probe\"#" "$json" >"$out/scene.json"
+  scene="$out/scene.json"
+fi
 size=(--width "$width" --height "$height")
-mae() { "$msm" compare --json "$1" "$2" --mask "$out/truth/visibility.exr" --mask-channel background |
+mae() { "$msm" compare --json "$1" "$2" --mask "$out/truth/visibility.exr" --mask-channel background "${@:3}" |
   sed -n 's/.*"mae": \([0-9.e+-]*\).*/\1/p'; }
-"$msm" reference --scene "$scene" --effect environment "${size[@]}" --samples "$samples" --out "$out/truth" >/dev/null
+"$msm" reference --scene "$scene" --effect environment "${size[@]}" --samples "$samples" --seed "$seed" \
+  --out "$out/truth" >/dev/null
+if [ "${NOISE:-0}" = 1 ]; then
+  "$msm" reference --scene "$scene" --effect environment "${size[@]}" --samples "$samples" --seed $((seed + 1)) \
+    --out "$out/truth-seed2" >/dev/null
+  printf 'truth noise (MAE between seeds %s and %s, %s samples): %.4f\n' "$seed" $((seed + 1)) "$samples" \
+    "$(mae "$out/truth/radiance.png" "$out/truth-seed2/radiance.png")"
+fi
 printf '%-18s %6s %8s %8s %8s\n' technique lights total lights shadows
-for n in 16 32 64 256; do
-  "$msm" reference --scene "$scene" --effect environment --probe-lights --lights "$n" "${size[@]}" \
+for n in $counts; do
+  "$msm" reference --scene "$scene" --effect environment --probe-lights --lights "$n" "${size[@]}" --seed "$seed" \
     --samples "$([ "$n" = 256 ] && echo $((samples / 16 > 4 ? samples / 16 : 4)) || echo $((samples / 4 > 4 ? samples / 4 : 4)))" \
     --out "$out/lights-$n" >/dev/null
   lights=$(mae "$out/truth/radiance.png" "$out/lights-$n/radiance.png")
-  techniques="mssm6,mssm4,pcss,msm-hamburger-64"
+  techniques=$techniques_all
   [ "$n" = 256 ] && techniques="msm-hamburger-64"
   "$msm" render --scene "$scene" --lights "$n" -t "$techniques" "${size[@]}" --shadow-size "$shadow" \
     --device "${MSM_DEVICE:-cpu}" -o "$out/render-$n" >/dev/null 2>&1
   for t in ${techniques//,/ }; do
-    printf '%-18s %6s %8.4f %8.4f %8.4f\n' "$t" "$n" "$(mae "$out/truth/radiance.png" "$out/render-$n/$t.png")" \
+    error=()
+    [ "${ERROR_IMAGES:-0}" = 1 ] && error=(--error-image "$out/render-$n/$t-error.png")
+    printf '%-18s %6s %8.4f %8.4f %8.4f\n' "$t" "$n" "$(mae "$out/truth/radiance.png" "$out/render-$n/$t.png" "${error[@]}")" \
       "$lights" "$(mae "$out/lights-$n/radiance.png" "$out/render-$n/$t.png")"
   done
 done
