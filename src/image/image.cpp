@@ -159,14 +159,16 @@ std::uint8_t linear_to_srgb8(float x) {
   return static_cast<std::uint8_t>(k + (t.steps[k + 1] <= x ? 1 : 0));
 }
 
-float srgb8_to_linear(std::uint8_t code) {
+const std::array<float, 256>& srgb8_to_linear_table() {
   static const std::array<float, 256> table = [] {
     std::array<float, 256> t{};
     for (int i = 0; i < 256; ++i) t[size_t(i)] = srgb_to_linear(float(i) / 255.0f);
     return t;
   }();
-  return table[code];
+  return table;
 }
+
+float srgb8_to_linear(std::uint8_t code) { return srgb8_to_linear_table()[code]; }
 
 float luminance(float r, float g, float b) { return msm::msm_luminance(glm::vec3(r, g, b)); }
 

@@ -206,6 +206,59 @@ TEST_F(ImageTest, PngRoundTripWithinOneCode) {
   }
 }
 
+// A PNG of 8-bit values as read back from an sRGB target (encode_png8) is the PNG of the float
+// path (the values decoded with srgb8_to_linear, then encode_png): the same file, for all 256
+// levels in every colour channel, and reading it gives the levels back exactly.
+TEST_F(ImageTest, Png8FromSrgbBytesEqualsTheFloatPath) {
+  for (int n : {1, 2, 3, 4}) {
+    const int w = 256, h = 3; // row y: level (x + 85 y) mod 256 in channel c shifted by 37 c
+    const bool has_alpha = n == 2 || n == 4;
+    std::vector<std::uint8_t> bytes(std::size_t(w) * h * n);
+    Image decoded(w, h, n);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < n; ++c) {
+          const auto v = std::uint8_t((x + 85 * y + 37 * c) % 256);
+          bytes[(std::size_t(y) * w + std::size_t(x)) * n + std::size_t(c)] = v;
+          decoded.at(x, y, c) = has_alpha && c == n - 1 ? float(v) / 255.0f : srgb8_to_linear(v);
+        }
+    const std::vector<std::uint8_t> png8 = encode_png8(dir / "a.png", w, h, n, bytes);
+    EXPECT_EQ(png8, encode_png(dir / "a.png", decoded)) << n;
+    write_file_atomic(dir / "a.png", png8);
+    const Image back = read_png(dir / "a.png");
+    ASSERT_EQ(back.channels(), n);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < n; ++c) {
+          const std::uint8_t v = bytes[(std::size_t(y) * w + std::size_t(x)) * n + std::size_t(c)];
+          if (has_alpha && c == n - 1)
+            ASSERT_EQ(std::lround(255.0f * back.at(x, y, c)), v) << n;
+          else
+            ASSERT_EQ(linear_to_srgb8(back.at(x, y, c)), v) << n;
+        }
+  }
+  // Each level's decode encodes back to it with the shared sRGB function itself.
+  for (int i = 0; i <= 255; ++i)
+    EXPECT_EQ(std::lround(255.0 * double(linear_to_srgb(srgb8_to_linear(std::uint8_t(i))))), i) << i;
+}
+
+TEST_F(ImageTest, Png8RejectsBadSizes) {
+  const std::vector<std::uint8_t> six(6, 100);
+  EXPECT_NO_THROW(encode_png8(dir / "ok.png", 2, 1, 3, six));
+  EXPECT_THROW(encode_png8(dir / "short.png", 2, 2, 3, six), ImageError); // 12 bytes needed
+  EXPECT_THROW(encode_png8(dir / "long.png", 1, 1, 3, six), ImageError);
+  EXPECT_THROW(encode_png8(dir / "zero.png", 0, 1, 3, {}), ImageError);
+  EXPECT_THROW(encode_png8(dir / "channels.png", 1, 1, 6, six), ImageError);
+  EXPECT_THROW(encode_png8(dir / "huge.png", max_side + 1, 1, 1, six), ImageError);
+  try {
+    encode_png8(dir / "short.png", 2, 2, 3, six);
+  } catch (const ImageError& e) {
+    EXPECT_EQ(e.path(), dir / "short.png");
+    EXPECT_NE(e.reason().find("6 bytes for a 2x2 image of 3 channels"), std::string::npos) << e.reason();
+  }
+  EXPECT_TRUE(entries().empty()); // encoding writes nothing
+}
+
 TEST_F(ImageTest, AtomicWriteFailureLeavesNoTraceAndKeepsTheOldFile) {
   // Tests may run as root, where permissions do not stop writes: the parent is a regular file.
   spit(dir / "blocker", "not a directory");

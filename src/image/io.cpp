@@ -39,17 +39,27 @@
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
 // stb's own deflate was 10% of a one-shot msm render at 1920x1080; zlib's fastest level is a
-// fraction of that (PNG is lossless: only the file size changes, by a few percent).
+// fraction of that (PNG is lossless: only the file size changes, by a few percent). Z_RLE (matches
+// at distance 1 only) deflates the Up-filtered rows of a render in 10% fewer instructions than the
+// default strategy and into a smaller file (155 kB against 168 kB for the fence at 1080p).
 #include <zlib.h>
 namespace {
 unsigned char* msm_zlib_compress(unsigned char* data, int length, int* out_length, int /*quality*/) {
-  uLongf size = compressBound(uLong(length));
+  z_stream s{};
+  if (deflateInit2(&s, Z_BEST_SPEED, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK) return nullptr;
+  const uLong size = deflateBound(&s, uLong(length));
   auto* out = static_cast<unsigned char*>(std::malloc(size));
-  if (!out || compress2(out, &size, data, uLong(length), Z_BEST_SPEED) != Z_OK) {
+  s.next_in = data;
+  s.avail_in = uInt(length);
+  s.next_out = out;
+  s.avail_out = uInt(size);
+  const bool done = out && deflate(&s, Z_FINISH) == Z_STREAM_END;
+  *out_length = int(s.total_out);
+  deflateEnd(&s);
+  if (!done) {
     std::free(out);
     return nullptr;
   }
-  *out_length = int(size);
   return out;
 }
 } // namespace
@@ -58,9 +68,11 @@ unsigned char* msm_zlib_compress(unsigned char* data, int length, int* out_lengt
 #include <stb/stb_image_write.h>
 
 namespace {
-// stb tries all five PNG row filters on every row and keeps the best; Paeth alone compresses the
-// renders nearly as well at a fifth of the filtering work. Set once, before any thread writes.
-[[maybe_unused]] const bool kPaethOnly = (stbi_write_force_png_filter = 4, true);
+// stb tries all five PNG row filters on every row and keeps the best. One filter for every row:
+// Up (the row above subtracted) costs a sixth of Paeth's instructions (37 M against 206 M for a
+// 1920x1080 RGB render) and, deflated with Z_RLE, gives a smaller file than Paeth with the default
+// strategy did. Set once, before any thread writes.
+[[maybe_unused]] const bool kUpOnly = (stbi_write_force_png_filter = 2, true);
 } // namespace
 
 namespace msm::image {
@@ -533,10 +545,27 @@ void FileSet::commit() {
 
 // ---- PNG -------------------------------------------------------------------------------------
 
+std::vector<std::uint8_t> encode_png8(const fs::path& path, int width, int height, int channels,
+                                      std::span<const std::uint8_t> values) {
+  if (width < 1 || height < 1 || width > max_side || height > max_side)
+    throw ImageError(path, fmt::format("cannot write a {}x{} image: sides are 1..{}", width, height, max_side));
+  if (channels < 1 || channels > max_channels)
+    throw ImageError(path, fmt::format("cannot write {} channels: a PNG has 1..{}", channels, max_channels));
+  if (values.size() != std::size_t(width) * std::size_t(height) * std::size_t(channels))
+    throw ImageError(path,
+                     fmt::format("{} bytes for a {}x{} image of {} channels", values.size(), width, height, channels));
+  std::vector<std::uint8_t> encoded;
+  // stb only reads the values (its signature predates const).
+  if (!stbi_write_png_to_func(append_bytes, &encoded, width, height, channels, const_cast<std::uint8_t*>(values.data()),
+                              width * channels))
+    throw ImageError(path, "PNG encoding failed");
+  return encoded;
+}
+
 std::vector<std::uint8_t> encode_png(const fs::path& path, const Image& image) {
   require_image(path, image);
   const int n = image.channels();
-  const int alpha = (n == 2 || n == 4) ? n - 1 : -1;
+  const int alpha = (n == 2 || n == 4) ? n - 1 : -1; // by position, whatever the channel's name
   auto px = image.pixels();
   std::vector<std::uint8_t> data(px.size());
   for (std::size_t i = 0; i < px.size(); ++i) {
@@ -547,10 +576,7 @@ std::vector<std::uint8_t> encode_png(const fs::path& path, const Image& image) {
       data[i] = linear_to_srgb8(px[i]);
     }
   }
-  std::vector<std::uint8_t> encoded;
-  if (!stbi_write_png_to_func(append_bytes, &encoded, image.width(), image.height(), n, data.data(), image.width() * n))
-    throw ImageError(path, "PNG encoding failed");
-  return encoded;
+  return encode_png8(path, image.width(), image.height(), n, data);
 }
 
 void write_png(const fs::path& path, const Image& image) { write_file_atomic(path, encode_png(path, image)); }

@@ -4,6 +4,7 @@
 #include "msm/render/renderer.h"
 
 #include "msm/image/compare.h"
+#include "msm/image/io.h"
 #include "msm/image/metrics.h"
 #include "msm/nonlinear.h"
 #include "msm/render/frame.h"
@@ -271,6 +272,20 @@ TEST_F(RenderTest, FlatReceiverFacingTheLightIsLit) {
       EXPECT_GT(darkest, 0.99) << t.name << ", post " << height;
     }
   }
+}
+
+// The colour target's bytes as read back (what msm render's PNG stores, encode_png8) are the float
+// colour encoded with the shared sRGB function: the PNG from them equals the PNG of the float path.
+TEST_F(RenderTest, ColourBytesAreTheFloatColourEncoded) {
+  Renderer renderer(ctx(), scene::builtin_scene("fence"));
+  RenderResult r = renderer.render(small("msm-hamburger-64"));
+  ASSERT_EQ(r.color_srgb8.size(), 3 * r.color.pixel_count());
+  EXPECT_EQ(image::to_srgb8(r.color), r.color_srgb8);
+  std::array<bool, 256> seen{};
+  for (std::uint8_t v : r.color_srgb8) seen[v] = true;
+  EXPECT_GT(std::count(seen.begin(), seen.end(), true), 100); // a range of levels, not a flat image
+  EXPECT_EQ(image::encode_png8("c.png", r.color.width(), r.color.height(), 3, r.color_srgb8),
+            image::encode_png("c.png", r.color));
 }
 
 // The blur (bilinear pairs of taps, msm/filter.h, compiled in) is the separable Gaussian of the

@@ -24,6 +24,7 @@
 #include <fmt/format.h>
 #include <glm/gtc/packing.hpp>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -466,9 +467,15 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
 
   std::vector<std::byte> color = vk::readback_image(m.ctx, g.image(kColor).image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   r.color = image::Image(s.width, s.height, 3);
+  r.color_srgb8.resize(3 * r.color.pixel_count());
   std::span<float> c = r.color.pixels();
+  const std::array<float, 256>& decode = image::srgb8_to_linear_table(); // one lookup a value
   for (size_t i = 0; i < r.color.pixel_count(); ++i)
-    for (size_t k = 0; k < 3; ++k) c[3 * i + k] = image::srgb8_to_linear(uint8_t(color[4 * i + k]));
+    for (size_t k = 0; k < 3; ++k) {
+      const auto code = uint8_t(color[4 * i + k]);
+      r.color_srgb8[3 * i + k] = code;
+      c[3 * i + k] = decode[code];
+    }
 
   if (g.has_image(kScattering)) {
     image::Image rgba =

@@ -224,10 +224,16 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
       if (!result.scattering.empty()) bytes[2] = image::encode_exr(scattering, result.scattering);
       return bytes;
     });
-    std::vector<std::uint8_t> png = image::encode_png(dir / (stem + ".png"), result.color);
+    // The PNG from the sRGB target's bytes themselves (no float encode; the same file as
+    // encode_png of `color`, the bytes decoded: ImageTest.Png8FromSrgbBytesEqualsTheFloatPath).
+    const std::filesystem::path png_path = dir / (stem + ".png");
+    std::vector<std::uint8_t> png =
+        result.color_srgb8.empty()
+            ? image::encode_png(png_path, result.color)
+            : image::encode_png8(png_path, result.color.width(), result.color.height(), 3, result.color_srgb8);
     const std::array<std::vector<std::uint8_t>, 3> exr_bytes = exrs.get(); // rethrows its ImageError
     image::FileSet files;
-    files.add(dir / (stem + ".png"), png);
+    files.add(png_path, png);
     files.add(exr, exr_bytes[0]);
     if (!result.shadow_rgb.empty())
       files.add(rgb, exr_bytes[1]);

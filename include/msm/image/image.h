@@ -8,6 +8,7 @@
 // "sample_count", "std_error"), and EXR files keep them.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -91,6 +92,8 @@ float srgb_to_linear(float encoded);
 std::uint8_t linear_to_srgb8(float linear);
 // srgb_to_linear(code / 255) from a table of the 256 values (the decode of 8-bit images).
 float srgb8_to_linear(std::uint8_t code);
+// That table: srgb8_to_linear_table()[code] == srgb8_to_linear(code), for decoding many codes.
+const std::array<float, 256>& srgb8_to_linear_table();
 
 // Rec. 709 / sRGB relative luminance of linear RGB: 0.2126 R + 0.7152 G + 0.0722 B.
 float luminance(float r, float g, float b);

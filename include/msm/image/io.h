@@ -44,6 +44,13 @@ void write_image(const std::filesystem::path& path, const Image& image);
 void write_file_atomic(const std::filesystem::path& path, std::span<const std::uint8_t> bytes);
 // The encoded files of write_png and write_exr (path: for the messages).
 std::vector<std::uint8_t> encode_png(const std::filesystem::path& path, const Image& image);
+// The PNG of 8-bit values stored as they are: width x height pixels of `channels` (1..4)
+// interleaved bytes, row-major, colour channels already sRGB-encoded (a renderer's R8G8B8A8_SRGB
+// target read back). encode_png(image) is encode_png8 of the image's values encoded as write_png
+// says, so 8-bit values decoded with srgb8_to_linear give the same file either way. ImageError for a size outside
+// 1..max_side, a channel count outside 1..4 or a byte count other than width * height * channels.
+std::vector<std::uint8_t> encode_png8(const std::filesystem::path& path, int width, int height, int channels,
+                                      std::span<const std::uint8_t> values);
 std::vector<std::uint8_t> encode_exr(const std::filesystem::path& path, const Image& image);
 
 // Files that appear together or not at all (a render's PNG, EXR and JSON; a reference's EXRs and

@@ -167,6 +167,8 @@ struct LightPassTime {
 
 struct RenderResult {
   image::Image color;                      // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
+  std::vector<std::uint8_t> color_srgb8;   // the sRGB target's bytes as read back, R,G,B (alpha dropped): what
+                                           // encode_png8 stores, the same PNG as encode_png of `color`
   image::Image shadow;                     // "visibility" (of the light at the visible surface, 0 where the surface
                                            // faces away from the light) and "background" (1 where no surface)
   image::Image shadow_rgb;                 // coloured translucency only: "visibility_r", "_g", "_b" (shadow's
