@@ -14,12 +14,12 @@
 //     horizontally filtered rows (`window`, shifted by one row per row: after unrolling a renaming,
 //     no copies), and writes the output row whose 2R + 1 rows are all there.
 // A texel is resolved (32 kColumns + 2R) / (32 kColumns) x (128 + 2R) / 128 times (1.13 at 9 taps,
-// 1.23 at 15, kColumns = 4). Same arithmetic, same order as the three-pass filter: horizontal
+// 1.25 at 15, kColumns = 4). Same arithmetic, same order as the three-pass filter: horizontal
 // sums over k = 0 .. 2R, then vertical over k = 0 .. 2R. The radius and kColumns are
 // specialization constants, so every loop below except the walk unrolls.
 #extension GL_GOOGLE_include_directive : require
-#include "frame.glsl"
 #include "msm/techniques.h"
+#include "frame.glsl"
 
 layout(constant_id = 1) const int kRadius = 4;  // taps = 2 kRadius + 1; frame.filter_weights
 layout(constant_id = 2) const int kColumns = 4; // adjacent columns per thread
