@@ -453,7 +453,7 @@ TEST_F(RenderTest, OnePassFilterEqualsTheThreePassFilter) {
       SCOPED_TRACE(fmt::format("{} at {}x MSAA", name, msaa));
       RenderSettings s = small(name);
       s.msaa = msaa;
-      s.shadow_size = 200; // not a multiple of the 32 x 128 strips: partial strips at the edges
+      s.shadow_size = 200; // not a multiple of the 128 x 128 strips: partial strips at the edges
       s.one_pass = false;
       Intermediates three, one;
       renderer.render(s, &three);

@@ -7,12 +7,16 @@
 namespace msm::render {
 namespace {
 
+// Adjacent columns per thread of one_pass_filter.glsl: a workgroup of 32 threads makes strips of
+// 32 kOnePassColumns x kOnePassStripH texels.
+constexpr int kOnePassColumns = 4;
+constexpr int kOnePassStripH = 128;
+
 const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& config) {
   const vk::Context& ctx = programs.context();
   int radius = config.taps / 2;
-  // Four resolved rows of 32 + 2R texels and a ring of 4 (1 + ceil(2R / 4)) horizontal rows of 32,
-  // four floats each (one_pass_filter.glsl).
-  uint32_t shared = uint32_t((4 * (32 + 2 * radius) + 4 * (1 + (2 * radius + 3) / 4) * 32) * 16);
+  // Four resolved rows of 32 kOnePassColumns + 2R texels, four floats each (one_pass_filter.glsl).
+  uint32_t shared = uint32_t(4 * (32 * kOnePassColumns + 2 * radius) * 16);
   if (shared > ctx.properties().limits.maxComputeSharedMemorySize)
     throw RenderError(fmt::format("the one-pass filter with {} taps needs {} bytes of shared memory; {} has {}",
                                   config.taps, shared, ctx.info().name,
@@ -21,7 +25,11 @@ const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& c
   std::string shader =
       std::string(nl32 ? "one_pass_filter_nl32" : "one_pass_filter") + (config.msaa == 1 ? "_1x.comp" : ".comp");
   return programs.compute(shader, {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
-                          sizeof(ImagePassPush), {{0, uint32_t(config.technique->id)}, {1, uint32_t(radius)}});
+                          sizeof(ImagePassPush),
+                          {{0, uint32_t(config.technique->id)},
+                           {1, uint32_t(radius)},
+                           {2, uint32_t(kOnePassColumns)},
+                           {4, uint32_t(config.msaa)}});
 }
 
 } // namespace
@@ -40,7 +48,7 @@ void OnePassFilterPass::execute(const PassContext& c) const {
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     vk::dispatch(
-        c.cmd, *program_, vk::group_count(size, 32), vk::group_count(size, 128), 1,
+        c.cmd, *program_, vk::group_count(size, 32 * kOnePassColumns), vk::group_count(size, kOnePassStripH), 1,
         {vk::Descriptor(c.frame.uniforms),
          vk::Descriptor(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler),
          vk::Descriptor(moments.layer_mip0_views[size_t(l)], VK_IMAGE_LAYOUT_GENERAL)},

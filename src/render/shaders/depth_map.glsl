@@ -30,8 +30,13 @@ float depth_sample(ivec2 p, int s) {
 #ifdef MSM_TECHNIQUES_H
 // The technique's channels of every sample of texel p, averaged: the MSAA resolve (a box filter,
 // linear like everything before storage). Depths are clamped: NaN never reaches the moments.
+// The sample count is the frame's, or MSM_RESOLVE_SAMPLES where the including file defines it (a
+// specialization constant: the loop over the samples unrolls, and so can loops around it).
+#ifndef MSM_RESOLVE_SAMPLES
+#define MSM_RESOLVE_SAMPLES frame.kernel.y
+#endif
 MsmTexel resolved_texel(ivec2 p) {
-  int samples = frame.kernel.y;
+  int samples = MSM_RESOLVE_SAMPLES;
   MsmTexel sum = MsmTexel(vec4(0.0f), vec4(0.0f));
   for (int s = 0; s < samples; ++s) {
     MsmTexel t = msm_technique_generate(kTechnique, msm_saturate(depth_sample(p, s)), frame.technique_params);
