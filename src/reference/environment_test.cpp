@@ -133,9 +133,10 @@ TEST(Environment, UnoccludedPlaneUnderTheAreaLightsMatchesTheirClosedForm) {
     expected += glm::dvec3(l.irradiance) * rectangle_cosine(scene, l, {0.0, 1.0, 0.0});
     // Wholly above the horizon (its corners too), the shading's cone gives the same: n·l.
     const glm::vec2 t = l.tan_half_extents();
-    if (l.towards_light.y > std::sin(std::atan(glm::length(t))))
+    if (l.towards_light.y > std::sin(std::atan(glm::length(t)))) {
       EXPECT_NEAR(msm::msm_cone_cosine(l.towards_light.y, l.cone_half_angle()),
                   rectangle_cosine(scene, l, {0.0, 1.0, 0.0}), 1e-4);
+    }
   }
   EXPECT_LT(std::abs(lum(m.irradiance) - lum(expected)), 3.0 * m.std_error + 1e-4 * lum(expected));
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.irradiance[c], expected[c], 0.01 * expected[c]) << "channel " << c;
