@@ -196,10 +196,27 @@ std::uint64_t glb_triangles(const fs::path& file, std::uint64_t size) {
   if (!in) return 0;
   const std::uint32_t length = std::uint32_t(head[12]) | std::uint32_t(head[13]) << 8 | std::uint32_t(head[14]) << 16 |
                                std::uint32_t(head[15]) << 24;
-  if (std::memcmp(head + 16, "JSON", 4) != 0 || length > size - 20) return 0;
+  if (std::memcmp(head + 16, "JSON", 4) != 0) return 0;
+  // Assimp allocates a chunk's claimed length before reading it (4 GB for a corrupt length field
+  // in a file of a kilobyte, a fuzzer find, tests/fuzz/crashes/mesh_import): the JSON chunk and the
+  // binary chunk after it must fit in the file.
+  if (length > size - 20)
+    refuse(file, fmt::format("truncated GLB: its JSON chunk claims {} bytes, the file has {} after the headers",
+                             limits::with_commas(length), limits::with_commas(size - 20)));
   std::string json_text(length, '\0');
   in.read(json_text.data(), std::streamsize(length));
-  return in ? gltf_triangles(json_text) : 0;
+  if (!in) return 0;
+  const std::uint64_t body = 20 + std::uint64_t(length) + (4 - length % 4) % 4; // chunks are 4-byte aligned
+  unsigned char chunk[8] = {};
+  in.seekg(std::streamoff(body));
+  if (body + 8 <= size && in.read(reinterpret_cast<char*>(chunk), sizeof chunk)) {
+    const std::uint32_t bin = std::uint32_t(chunk[0]) | std::uint32_t(chunk[1]) << 8 | std::uint32_t(chunk[2]) << 16 |
+                              std::uint32_t(chunk[3]) << 24;
+    if (bin > size - body - 8)
+      refuse(file, fmt::format("truncated GLB: its binary chunk claims {} bytes, the file has {} after its header",
+                               limits::with_commas(bin), limits::with_commas(size - body - 8)));
+  }
+  return gltf_triangles(json_text);
 }
 
 } // namespace

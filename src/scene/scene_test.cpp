@@ -672,6 +672,31 @@ TEST(Import, ImpossiblePlyAndOffHeadersAreErrorsNotHangs) {
   expect_error([&] { (void)import_mesh(many); }, {"many.ply", "48,000,000,000 bytes", "truncated or corrupt"});
   const fs::path off = dir.write("many.off", "OFF\n1000000 3 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   expect_error([&] { (void)import_mesh(off); }, {"many.off", "1,000,000 vertices", "truncated or corrupt"});
+  // A GLB whose JSON chunk, or the binary chunk after it, claims more than the file holds: Assimp
+  // would allocate the claim first (4.1 GB from a file of a few hundred bytes: the fuzzer's find,
+  // tests/fuzz/crashes/mesh_import). The same file with honest lengths still loads.
+  auto glb = [](std::uint32_t json_claim, std::uint32_t bin_claim) {
+    const std::string json = R"({"asset":{"version":"2.0"}})"; // 27 bytes, padded to 28
+    auto u32 = [](std::uint32_t v) {
+      return std::string{char(v & 0xff), char((v >> 8) & 0xff), char((v >> 16) & 0xff), char(v >> 24)};
+    };
+    const std::string body = json + " ";
+    return std::string("glTF") + u32(2) + u32(20 + 28 + 8 + 4) + u32(json_claim) + "JSON" + body + u32(bin_claim) +
+           std::string("BIN\0", 4) + std::string(4, '\0');
+  };
+  const fs::path json_claim = dir.write("json_claim.glb", glb(0xf4620100u, 4));
+  expect_error([&] { (void)import_mesh(json_claim); },
+               {"json_claim.glb", "truncated GLB: its JSON chunk claims 4,100,063,488 bytes"});
+  const fs::path bin_claim = dir.write("bin_claim.glb", glb(28, 0x7fffffffu));
+  expect_error([&] { (void)import_mesh(bin_claim); },
+               {"bin_claim.glb", "truncated GLB: its binary chunk claims 2,147,483,647 bytes, the file has 4"});
+  // Honest lengths: past the header check (Assimp then finds no mesh in it, a different error).
+  const fs::path honest = dir.write("honest.glb", glb(28, 4));
+  try {
+    (void)import_mesh(honest);
+  } catch (const SceneError& e) {
+    EXPECT_EQ(std::string(e.what()).find("truncated GLB"), std::string::npos) << e.what();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
