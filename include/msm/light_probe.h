@@ -276,9 +276,9 @@ MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSum
 // around has no direction); x the most energetic part's x axis projected off z (§4.1.2; its y axis
 // crossed with z where x_r is along z), y = z × x; half extents d = sqrt(3σ²) from the variances
 // about z, σ_x² = xᵀ second x / Σ E_r (an offset of a part counts by the sine of its angle to z, its
-// spread by its own tangents: the same for small angles); the cone, as a face's, of the area of the
-// extents' rectangle, π tan² α = 4 t_x t_y (below π/2, where msm_cone_cosine and Eqs. 15–18 hold;
-// the parts' solid angles summed instead measured worse, docs/techniques.md); irradiance the summed
+// spread by its own tangents: the same for small angles); the cone, as a face's, of the extents'
+// rectangle's solid angle (msm_rect_light_cone_half_angle: below π/2, where msm_cone_cosine and
+// Eqs. 15–18 hold; the parts' solid angles summed instead measured worse, docs/techniques.md); irradiance the summed
 // M_e. One lit part alone gives its own direction, x axis and x extent.
 MSM_FN MsmAreaLight msm_area_light_from_merged(MsmMergedSums s) {
   float total = s.xyz.y;
@@ -290,7 +290,7 @@ MSM_FN MsmAreaLight msm_area_light_from_merged(MsmMergedSums s) {
   vec3 y = cross(z, x);
   vec2 variance = vec2(dot(x, s.second * x), dot(y, s.second * y)) / total;
   vec2 t = sqrt(3.0f * max(variance, vec2(0.0f)));
-  float cone = atan(sqrt(4.0f * t.x * t.y / MSM_PI));
+  float cone = msm_rect_light_cone_half_angle(t);
   return MsmAreaLight(z, x, y, t, cone, max(msm_xyz_to_rgb(s.xyz), vec3(0.0f)));
 }
 
