@@ -360,7 +360,7 @@ TEST(AreaLights, GroupOfFacesMakesOneLight) {
 // the point-light limit and against the disc of Eq. (18) (the paper's circular lights).
 TEST(AreaLights, RectangleClosedFormsMatchQuadrature) {
   for (const glm::dvec2& t : {glm::dvec2(1e-3, 2e-3), glm::dvec2(0.05, 0.3), glm::dvec2(0.25, 0.25),
-                             glm::dvec2(0.98, 0.1), glm::dvec2(0.98, 0.98)}) {
+                              glm::dvec2(0.98, 0.1), glm::dvec2(0.98, 0.98)}) {
     const int k = 1000;
     double omega = 0.0, facing = 0.0;
     for (int j = 0; j < k; ++j)
