@@ -1,6 +1,8 @@
 // What a mesh file declares, read before Assimp imports it (detail::check_mesh_header).
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <sstream>
@@ -36,6 +38,78 @@ std::uint64_t count_of(const fs::path& file, const std::string& token, const cha
   return std::stoull(token);
 }
 
+// An ASCII PLY body as the format has it: one element per line, in the header's order, each line
+// exactly its properties' numbers (a list: its count, then that many), face indices within the
+// vertices. Assimp 5.2 reads past its buffers on some bodies that break this (a bus error from a
+// 657-byte file: a fuzzer find, tests/fuzz/crashes/mesh_import); they are refused here instead.
+template <class Element>
+void check_ply_ascii_body(const fs::path& file, std::uint64_t size, std::uint64_t start,
+                          const std::vector<Element>& elements) {
+  const std::string text = read_all(file, size);
+  std::size_t at = std::size_t(std::min<std::uint64_t>(start, text.size()));
+  if (at < text.size() && text[at] == '\r') ++at;
+  if (at < text.size() && text[at] == '\n') ++at;
+  std::uint64_t vertices = 0, line_number = 0;
+  for (const Element& e : elements) {
+    if (e.name == "vertex") vertices = e.count;
+    for (std::uint64_t i = 0; i < e.count; ++i) {
+      std::vector<std::string> tokens;
+      do { // a line, blank ones skipped
+        if (at >= text.size())
+          refuse(file,
+                 fmt::format("the PLY body ends in element '{}' ({} of {} read; truncated?)", e.name, i, e.count));
+        const std::size_t eol = std::min(text.find('\n', at), text.size());
+        std::istringstream words(text.substr(at, eol - at));
+        tokens.clear();
+        for (std::string w; words >> w;) tokens.push_back(w);
+        at = eol + 1;
+        ++line_number;
+      } while (tokens.empty());
+      auto number = [&](std::size_t k) {
+        char* stop = nullptr;
+        const double v = std::strtod(tokens[k].c_str(), &stop);
+        if (*stop != '\0' || !std::isfinite(v))
+          refuse(file, fmt::format("line {} of the PLY body: '{}' is not a number", line_number, tokens[k]));
+        return v;
+      };
+      std::size_t k = 0;
+      for (bool list : e.lists) {
+        if (k >= tokens.size()) break;
+        if (!list) {
+          (void)number(k++);
+          continue;
+        }
+        const double n = number(k++);
+        if (n < 0 || n != std::floor(n) || n > double(tokens.size()))
+          refuse(file, fmt::format("line {} of the PLY body: a list of {} values", line_number, tokens[k - 1]));
+        for (std::size_t j = 0; j < std::size_t(n) && k < tokens.size(); ++j) {
+          const double v = number(k++);
+          if (e.name == "face" && (v < 0 || v >= double(vertices)))
+            refuse(file, fmt::format("line {} of the PLY body: vertex index {} of {} vertices", line_number,
+                                     tokens[k - 1], vertices));
+        }
+      }
+      std::size_t expected = 0;
+      {
+        std::size_t j = 0;
+        for (bool list : e.lists) {
+          if (j >= tokens.size()) {
+            expected = SIZE_MAX;
+            break;
+          }
+          const std::size_t n = list ? std::size_t(std::strtod(tokens[j].c_str(), nullptr)) : 0;
+          expected += 1 + n;
+          j += 1 + n;
+        }
+      }
+      if (expected != tokens.size())
+        refuse(file, fmt::format("line {} of the PLY body has {} values; element '{}' declares {} (corrupt?)",
+                                 line_number, tokens.size(), e.name,
+                                 expected == SIZE_MAX ? std::string("more") : std::to_string(expected)));
+    }
+  }
+}
+
 // PLY: "ply", "format <ascii|binary_*> 1.0", "element <name> <count>" with its "property" lines,
 // "end_header". Assimp 5.2 reads a header without end_header forever (a fuzzer's find), so a
 // header must end within the first 64 KiB; the elements' smallest encoding must fit the file.
@@ -58,6 +132,13 @@ std::uint64_t ply_triangles(const fs::path& file, std::uint64_t size) {
   std::string line;
   bool ascii = true;
   std::uint64_t faces = 0, minimum_bytes = 0, count = 0, element_bytes = 0;
+  // ASCII: each element's properties in order (true: a list), for the check of the body below.
+  struct Element {
+    std::string name;
+    std::uint64_t count = 0;
+    std::vector<bool> lists;
+  };
+  std::vector<Element> elements;
   auto close_element = [&] {
     // Every property takes at least 2 characters in ASCII ("0 "); lists at least their count.
     minimum_bytes = std::min<std::uint64_t>(minimum_bytes + count * element_bytes, UINT64_MAX / 2);
@@ -79,6 +160,7 @@ std::uint64_t ply_triangles(const fs::path& file, std::uint64_t size) {
       close_element();
       count = count_of(file, b, fmt::format("PLY element '{}'", a).c_str());
       if (a == "face") faces += count;
+      elements.push_back({a, count, {}});
     } else if (keyword == "property") {
       static const std::pair<const char*, int> kSizes[] = {{"char", 1},  {"uchar", 1},   {"int8", 1},   {"uint8", 1},
                                                            {"short", 2}, {"ushort", 2},  {"int16", 2},  {"uint16", 2},
@@ -89,6 +171,7 @@ std::uint64_t ply_triangles(const fs::path& file, std::uint64_t size) {
       for (const auto& [name, n] : kSizes)
         if (type == name) bytes = n;
       element_bytes += ascii ? 2 : std::uint64_t(bytes);
+      if (!elements.empty()) elements.back().lists.push_back(a == "list");
     }
   }
   close_element();
@@ -97,6 +180,7 @@ std::uint64_t ply_triangles(const fs::path& file, std::uint64_t size) {
     refuse(file, fmt::format("the PLY header declares elements of at least {} bytes, the file has {} after its header "
                              "(truncated or corrupt?)",
                              limits::with_commas(minimum_bytes), limits::with_commas(body)));
+  if (ascii) check_ply_ascii_body(file, size, end + 11, elements);
   return faces;
 }
 
