@@ -68,7 +68,8 @@ void check_ply_ascii_body(const fs::path& file, std::uint64_t size, std::uint64_
       auto number = [&](std::size_t k) {
         char* stop = nullptr;
         const double v = std::strtod(tokens[k].c_str(), &stop);
-        if (*stop != '\0' || !std::isfinite(v))
+        // NaN and inf are numbers here: the loader names non-finite vertices itself, afterwards.
+        if (*stop != '\0' || stop == tokens[k].c_str())
           refuse(file, fmt::format("line {} of the PLY body: '{}' is not a number", line_number, tokens[k]));
         return v;
       };
@@ -84,7 +85,7 @@ void check_ply_ascii_body(const fs::path& file, std::uint64_t size, std::uint64_
           refuse(file, fmt::format("line {} of the PLY body: a list of {} values", line_number, tokens[k - 1]));
         for (std::size_t j = 0; j < std::size_t(n) && k < tokens.size(); ++j) {
           const double v = number(k++);
-          if (e.name == "face" && (v < 0 || v >= double(vertices)))
+          if (e.name == "face" && !(v >= 0 && v < double(vertices)))
             refuse(file, fmt::format("line {} of the PLY body: vertex index {} of {} vertices", line_number,
                                      tokens[k - 1], vertices));
         }
