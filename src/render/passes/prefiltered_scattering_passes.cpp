@@ -85,9 +85,14 @@ void PrefixSumPass::prepare(const PassResources& r) {
                        : rep == MSM_REP6_FLOAT   ? "prefix_sums6_32.comp"
                        : csm(config_)            ? "prefix_sums_csm.comp"
                                                  : "prefix_sums.comp";
-  std::vector<vk::Binding> bindings = {vk::Binding::storage_buffer, vk::Binding::sampled_image,
-                                       vk::Binding::storage_image};
-  if (rep >= 0) bindings.insert(bindings.end(), {vk::Binding::sampled_image, vk::Binding::storage_image});
+  // Six moments read and write a second image pair. Two lists rather than an insert into one: GCC 12
+  // reports a false -Warray-bounds on vector<enum>::insert of an initializer list.
+  const std::vector<vk::Binding> bindings =
+      rep >= 0
+          ? std::vector<vk::Binding>{vk::Binding::storage_buffer, vk::Binding::sampled_image,
+                                     vk::Binding::storage_image, vk::Binding::sampled_image, vk::Binding::storage_image}
+          : std::vector<vk::Binding>{vk::Binding::storage_buffer, vk::Binding::sampled_image,
+                                     vk::Binding::storage_image};
   program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush));
 }
 
