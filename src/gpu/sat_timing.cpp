@@ -78,8 +78,17 @@ int main(int argc, char** argv) {
       callgrind = true;
     else if (a == "--repeat" && i + 1 < argc)
       repeat = std::max(1, std::atoi(argv[++i]));
-    else
-      sizes.push_back(std::atoi(a.c_str()));
+    else {
+      int n = std::atoi(a.c_str());
+      if (n < 1 || n > 16384 || a.find_first_not_of("0123456789") != std::string::npos) {
+        fmt::print(stderr,
+                   "msm_sat_timing: '{}' is not a size (1 to 16384) nor an option; usage: msm_sat_timing "
+                   "[sizes...] [--repeat N] [--callgrind]\n",
+                   a);
+        return 1;
+      }
+      sizes.push_back(n);
+    }
   }
   if (sizes.empty()) sizes = {1024, 2048};
 #ifndef MSM_SAT_CALLGRIND
