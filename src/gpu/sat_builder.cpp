@@ -3,6 +3,7 @@
 #include "msm/sat.h"
 #include "msm/vk/commands.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -45,6 +46,27 @@ void check(const SatImage& moments, const SatImage& table, int max_kernel_texels
   if (max_kernel_texels < 1) throw std::invalid_argument(std::string(where) + "max_kernel_texels < 1");
 }
 
+// Subgroup arithmetic (with the basic and shuffle operations the subgroup shaders use) in compute
+// shaders; the device's subgroup size, or 0 where it lacks them.
+uint32_t subgroup_size_with_arithmetic(const vk::Context& ctx) {
+  VkPhysicalDeviceVulkan11Properties v11{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES};
+  VkPhysicalDeviceProperties2 p2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &v11};
+  vkGetPhysicalDeviceProperties2(ctx.physical_device(), &p2);
+  const VkSubgroupFeatureFlags needed =
+      VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
+  if (!(v11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT) ||
+      (v11.subgroupSupportedOperations & needed) != needed || v11.subgroupSize == 0)
+    return 0;
+  return v11.subgroupSize;
+}
+
+vk::Program subgroup_program(const vk::Context& ctx, bool supported, const char* name, bool sampled) {
+  if (!supported) return {};
+  if (sampled)
+    return vk::create_program(ctx, name, {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush));
+  return vk::create_program(ctx, name, {vk::Binding::storage_image}, sizeof(SatPush));
+}
+
 } // namespace
 
 SatImage::SatImage(const vk::Image& image)
@@ -76,7 +98,19 @@ SatBuilder::SatBuilder(const vk::Context& ctx)
                                     sizeof(SatPush))),
       scan_rows_rg_(vk::create_program(ctx, "sat_scan_rows_rg.comp",
                                        {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
-      sampler_(vk::create_sampler(ctx, VK_FILTER_NEAREST)) {}
+      sampler_(vk::create_sampler(ctx, VK_FILTER_NEAREST)) {
+  subgroup_size_ = subgroup_size_with_arithmetic(ctx);
+  const bool sg = subgroup_size_ != 0;
+  subgroup_rows_ = subgroup_program(ctx, sg, "sat_subgroup_rows.comp", true);
+  subgroup_rows_rg_ = subgroup_program(ctx, sg, "sat_subgroup_rows_rg.comp", true);
+  subgroup_columns_ = subgroup_program(ctx, sg, "sat_subgroup_columns.comp", false);
+  subgroup_columns_rg_ = subgroup_program(ctx, sg, "sat_subgroup_columns_rg.comp", false);
+}
+
+SatBuilder::Scheme SatBuilder::effective(Scheme scheme) const noexcept {
+  bool subgroup = scheme == Scheme::subgroup_rows_then_columns || scheme == Scheme::subgroup_rows_and_columns;
+  return subgroup && !subgroup_arithmetic() ? Scheme::scan_rows_then_columns : scheme;
+}
 
 void SatBuilder::record(VkCommandBuffer cmd, const SatImage& moments, const SatImage& table, int max_kernel_texels,
                         Scheme scheme, vk::GpuTimer* timer, VkImageLayout moments_layout) const {
@@ -89,6 +123,7 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, 
     throw std::invalid_argument("msm::gpu::SatBuilder::record: as many tables as moment images");
   for (size_t i = 0; i < moments.size(); ++i) check(moments[i], tables[i], max_kernel_texels);
   if (moments.empty()) return;
+  scheme = effective(scheme);
   const uint32_t scale = msm_sat_scale(max_kernel_texels);
   const VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
   auto push = [&](size_t i) {
@@ -114,19 +149,36 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, 
                          VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                          VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
 
-  if (scheme == Scheme::rows_then_columns || scheme == Scheme::scan_rows_then_columns) {
-    bool scan = scheme == Scheme::scan_rows_then_columns;
+  if (scheme != Scheme::blocks) {
+    const bool scan = scheme == Scheme::scan_rows_then_columns;
+    const bool subgroup_rows =
+        scheme == Scheme::subgroup_rows_then_columns || scheme == Scheme::subgroup_rows_and_columns;
+    const bool subgroup_columns = scheme == Scheme::subgroup_rows_and_columns;
+    // The subgroup passes: 64 / subgroup size rows (columns) per workgroup of 64 (their loops cover
+    // the rest, should the shader get other subgroups than the device reports).
+    auto subgroup_groups = [&](uint32_t lines) {
+      return vk::group_count(lines, std::max(1u, 64u / std::min(64u, subgroup_size_)));
+    };
     if (timer) timer->begin(cmd, "sat_rows");
-    for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, scan ? program(i, scan_rows_, scan_rows_rg_) : program(i, rows_, rows_rg_),
-                   scan ? moments[i].height : vk::group_count(moments[i].height, 64), 1, 1,
+    for (size_t i = 0; i < moments.size(); ++i) {
+      const vk::Program& p = subgroup_rows ? program(i, subgroup_rows_, subgroup_rows_rg_)
+                             : scan        ? program(i, scan_rows_, scan_rows_rg_)
+                                           : program(i, rows_, rows_rg_);
+      uint32_t groups = subgroup_rows ? subgroup_groups(moments[i].height)
+                        : scan        ? moments[i].height
+                                      : vk::group_count(moments[i].height, 64);
+      vk::dispatch(cmd, p, groups, 1, 1,
                    {vk::Descriptor(moments[i].view, moments_layout, sampler_), vk::Descriptor(tables[i].view, general)},
                    push(i));
+    }
     if (timer) timer->end(cmd);
     vk::pipeline_barrier(cmd, between);
     if (timer) timer->begin(cmd, "sat_columns");
     for (size_t i = 0; i < moments.size(); ++i)
-      vk::dispatch(cmd, program(i, columns_, columns_rg_), vk::group_count(moments[i].width, 64), 1, 1,
+      vk::dispatch(cmd,
+                   subgroup_columns ? program(i, subgroup_columns_, subgroup_columns_rg_)
+                                    : program(i, columns_, columns_rg_),
+                   subgroup_columns ? subgroup_groups(moments[i].width) : vk::group_count(moments[i].width, 64), 1, 1,
                    {vk::Descriptor(tables[i].view, general)}, push(i));
     if (timer) timer->end(cmd);
   } else {

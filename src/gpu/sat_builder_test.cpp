@@ -1,9 +1,10 @@
 // msm::gpu::SatBuilder on the Vulkan device (MSM_DEVICE; lavapipe here), validation and
 // synchronization validation on (VulkanTest: any message fails):
-//  - both schemes (rows then columns; JCGT Appendix C blocks) produce exactly build_sat_cpu's
+//  - every scheme (rows then columns, scan rows, subgroup rows, subgroup rows and columns; JCGT
+//    Appendix C blocks) produces exactly build_sat_cpu's
 //    table, bitwise, for float and UNORM16 moment images, two- and four-channel formats, sizes
 //    that are not multiples of the 8 × 8 blocks nor of the 64-thread groups (61 × 47, 250 × 3),
-//    256², 1024² (blocks), small and large n_t; and build_sat_cpu itself equals 64-bit running
+//    256², 1024² (blocks and subgroup schemes), small and large n_t; and build_sat_cpu itself equals 64-bit running
 //    sums taken modulo 2^32;
 //  - the six-moment overload (two images, RGBA32F + RG32F) fills both tables;
 //  - the shared queries (sat.h's 4- and 16-lookup queries, soft.h's whole per-pixel flow) in a
@@ -128,10 +129,10 @@ std::vector<uvec4> read_table(vk::Context& ctx, const vk::Image& table) {
 struct Case {
   int width, height, nt;
   VkFormat format;
-  bool rows_then_columns; // the block scheme always runs
+  bool rows_then_columns; // the block and subgroup schemes always run
 };
 
-// Bitwise equality with the CPU table, both schemes.
+// Bitwise equality with the CPU table, every scheme.
 TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
   SatBuilder builder(ctx());
   std::mt19937_64 rng(31);
@@ -150,8 +151,10 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
     std::vector<vec4> seen = upload(ctx(), moments, m);
     std::vector<uvec4> cpu = gpu::build_sat_cpu(seen, c.width, c.height, c.nt);
     ASSERT_EQ(cpu, reference_table(seen, c.width, c.height, c.nt)) << c.width << "x" << c.height;
-    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks}) {
-      if (scheme != Scheme::blocks && !c.rows_then_columns) continue;
+    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::subgroup_rows_then_columns,
+                          Scheme::subgroup_rows_and_columns, Scheme::blocks}) {
+      bool subgroup = scheme == Scheme::subgroup_rows_then_columns || scheme == Scheme::subgroup_rows_and_columns;
+      if (scheme != Scheme::blocks && !subgroup && !c.rows_then_columns) continue;
       vk::Image table = table_image(ctx(), c.width, c.height);
       vk::GpuTimer timer(ctx());
       vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
@@ -172,9 +175,11 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
       EXPECT_EQ(times.count("sat_columns"), blocks ? 0u : 1u);
       std::printf("[sat-builder] %dx%d n_t %d format %d %s: %zu of %zu texels differ\n", c.width, c.height, c.nt,
                   int(c.format),
-                  blocks                                     ? "blocks"
-                  : scheme == Scheme::scan_rows_then_columns ? "scan rows+columns"
-                                                             : "rows+columns",
+                  blocks                                         ? "blocks"
+                  : scheme == Scheme::scan_rows_then_columns     ? "scan rows+columns"
+                  : scheme == Scheme::subgroup_rows_then_columns ? "subgroup rows+columns"
+                  : scheme == Scheme::subgroup_rows_and_columns  ? "subgroup rows+subgroup columns"
+                                                                 : "rows+columns",
                   mismatches, gpu.size());
       EXPECT_EQ(mismatches, 0u) << "first at texel " << first % size_t(c.width) << "," << first / size_t(c.width);
     }
@@ -196,7 +201,8 @@ TEST_F(SatBuilderTest, SixMomentTablesInOneCall) {
   vk::Image ma = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
   vk::Image mb = moment_image(ctx(), VK_FORMAT_R32G32_SFLOAT, w, h);
   std::vector<vec4> sa = upload(ctx(), ma, a), sb = upload(ctx(), mb, b);
-  for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks}) {
+  for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::subgroup_rows_then_columns,
+                        Scheme::subgroup_rows_and_columns, Scheme::blocks}) {
     vk::Image ta = table_image(ctx(), w, h), tb = table_image(ctx(), w, h);
     const gpu::SatImage moments[] = {ma, mb};
     const gpu::SatImage tables[] = {ta, tb};
@@ -218,7 +224,8 @@ TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
     std::vector<vec4> m = random_moments(rng, c.width, c.height);
     vk::Image moments = moment_image(ctx(), c.format, c.width, c.height);
     std::vector<uvec4> cpu = gpu::build_sat_cpu(upload(ctx(), moments, m), c.width, c.height, c.nt);
-    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks}) {
+    for (Scheme scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::subgroup_rows_then_columns,
+                          Scheme::subgroup_rows_and_columns, Scheme::blocks}) {
       vk::Image table = table_image(ctx(), c.width, c.height, VK_FORMAT_R32G32_UINT);
       vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { builder.record(cmd, moments, table, c.nt, scheme); });
       std::vector<std::byte> bytes = vk::readback_image(ctx(), table, VK_IMAGE_LAYOUT_GENERAL);
@@ -232,6 +239,27 @@ TEST_F(SatBuilderTest, RgTablesHoldTheRgOfTheCpuTable) {
       EXPECT_EQ(mismatches, 0u) << c.width << "x" << c.height << ", scheme " << int(scheme);
     }
   }
+}
+
+// The subgroup schemes run as themselves exactly where the device reports subgroup arithmetic (with
+// the basic and shuffle operations) in compute shaders, else as scan_rows_then_columns. On lavapipe
+// (subgroup size 8, arithmetic in compute) they run: the bitwise tests above test the subgroup shaders.
+TEST_F(SatBuilderTest, SubgroupSchemesRunWhereTheDeviceHasSubgroupArithmetic) {
+  SatBuilder builder(ctx());
+  VkPhysicalDeviceVulkan11Properties v11{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_1_PROPERTIES};
+  VkPhysicalDeviceProperties2 p2{.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &v11};
+  vkGetPhysicalDeviceProperties2(ctx().physical_device(), &p2);
+  const bool has = (v11.subgroupSupportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                   (v11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT) &&
+                   (v11.subgroupSupportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT);
+  std::printf("[sat-builder] %s: subgroup size %u, arithmetic in compute: %s\n", ctx().info().name.c_str(),
+              v11.subgroupSize, has ? "yes" : "no");
+  EXPECT_EQ(builder.subgroup_arithmetic(), has);
+  for (Scheme s : {Scheme::subgroup_rows_then_columns, Scheme::subgroup_rows_and_columns})
+    EXPECT_EQ(builder.effective(s), has ? s : Scheme::scan_rows_then_columns);
+  for (Scheme s : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::blocks})
+    EXPECT_EQ(builder.effective(s), s);
+  if (ctx().info().driver_name == "llvmpipe") { EXPECT_TRUE(has) << "lavapipe has subgroup arithmetic in compute"; }
 }
 
 TEST_F(SatBuilderTest, RejectsBadImages) {

@@ -50,10 +50,29 @@ class SatBuilder {
     // of 64 neighbouring texels (shared memory), then the column pass. Every texel read and
     // written once per pass. Timer scopes "sat_rows" and "sat_columns".
     scan_rows_then_columns,
+    // rows_then_columns with subgroup rows (Vulkan 1.1 subgroup arithmetic): one subgroup per row
+    // walks it in chunks of subgroup-size neighbouring texels, subgroupInclusiveAdd plus a running
+    // carry (the last lane's sum); no barriers, no shared memory. Every texel read and written once
+    // per pass. Where the device lacks subgroup arithmetic in compute shaders
+    // (subgroup_arithmetic()), record() runs scan_rows_then_columns instead. Timer scopes
+    // "sat_rows" and "sat_columns".
+    subgroup_rows_then_columns,
+    // subgroup_rows_then_columns whose column pass is the same subgroup scan down each column (its
+    // lanes a row pitch apart: no coalescing on a GPU; measured against the thread-per-column pass
+    // on lavapipe, docs/results.md). Same fallback and timer scopes.
+    subgroup_rows_and_columns,
   };
 
   // Creates the compute pipelines and a nearest sampler.
   explicit SatBuilder(const vk::Context& ctx);
+
+  // Whether the device has subgroup arithmetic in compute shaders (VkPhysicalDeviceVulkan11Properties:
+  // subgroupSupportedStages has COMPUTE, subgroupSupportedOperations has ARITHMETIC, BASIC and
+  // SHUFFLE), i.e. whether the subgroup schemes run as themselves.
+  bool subgroup_arithmetic() const noexcept { return bool(subgroup_rows_); }
+  // The scheme record() runs for `scheme`: the scheme itself, or scan_rows_then_columns for a
+  // subgroup scheme on a device without subgroup arithmetic.
+  Scheme effective(Scheme scheme) const noexcept;
 
   // Records the passes that fill `table` with the summed-area table of `moments` for kernels of
   // at most max_kernel_texels texels (n_t; sat.h: quantization scale floor((2^32 - 1) / n_t)).
@@ -82,6 +101,9 @@ class SatBuilder {
   vk::Program rows_, columns_, block_rows_, block_columns_;
   vk::Program rows_rg_, columns_rg_, block_rows_rg_, block_columns_rg_; // RG32_UINT tables
   vk::Program scan_rows_, scan_rows_rg_;
+  // Null where the device lacks subgroup arithmetic in compute shaders.
+  vk::Program subgroup_rows_, subgroup_rows_rg_, subgroup_columns_, subgroup_columns_rg_;
+  uint32_t subgroup_size_ = 0; // the device's (VkPhysicalDeviceVulkan11Properties::subgroupSize)
   vk::Sampler sampler_;
 };
 

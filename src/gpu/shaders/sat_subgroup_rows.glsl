@@ -1,0 +1,35 @@
+// Summed-area table, subgroup scheme, pass 1: one subgroup per row walks it in chunks of as many
+// neighbouring texels as the subgroup has lanes (coalesced loads and stores on a GPU). The chunk's
+// inclusive prefix sums come from subgroupInclusiveAdd on the uvec4 (wrapping modulo 2^32, as the
+// CPU's sums), plus the running carry of the chunks before it; the carry then grows by the chunk's
+// total, the last lane's sum (subgroupShuffle). No barriers, no shared memory. Pass 2 is
+// sat_columns.glsl, whose neighbouring threads already walk neighbouring columns.
+// Correct for any subgroup size and partial subgroups: the chunk width is the number of active
+// lanes and a lane's place in the chunk its rank among them; rows are spread over the subgroups of
+// the whole dispatch (a grid-stride loop), so the host's group count only has to be about right.
+// Included by sat_subgroup_rows.comp (RGBA32_UINT tables) and sat_subgroup_rows_rg.comp (RG32_UINT).
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_KHR_shader_subgroup_shuffle : require
+#include "sat_common.glsl"
+
+layout(local_size_x = 64) in;
+layout(binding = 0) uniform sampler2D moments;
+layout(binding = 1, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
+
+void main() {
+  const int lanes = int(subgroupAdd(1u));           // active lanes: the chunk width
+  const int rank = int(subgroupExclusiveAdd(1u));   // this lane's texel in the chunk
+  const uint last = subgroupMax(gl_SubgroupInvocationID); // the lane holding the chunk's total
+  const int subgroups = int(gl_NumWorkGroups.x * gl_NumSubgroups);
+  for (int y = int(gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID); y < pc.size.y; y += subgroups) {
+    uvec4 carry = uvec4(0u); // wraps modulo 2^32, as the CPU's sums
+    for (int x0 = 0; x0 < pc.size.x; x0 += lanes) {
+      int x = x0 + rank;
+      uvec4 v = x < pc.size.x ? sat_quantized_texel(moments, ivec2(x, y)) : uvec4(0u);
+      v = carry + subgroupInclusiveAdd(v);
+      if (x < pc.size.x) imageStore(table, ivec2(x, y), v);
+      carry = subgroupShuffle(v, last);
+    }
+  }
+}
