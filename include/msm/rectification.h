@@ -38,6 +38,7 @@
 // Resampling (§5.2), per rectified texel, from the scene's shadow map:
 //   msm_rectified_one_depth(bounds, r, depth_to_z, map_depth)           without filtering
 //   msm_rectified_two_depths(bounds, r, depth_to_z, map_moments)        filtered (Algorithm 2)
+//   msm_rectified_resampling_lod(r_phi, step, map_per_x, map_per_y)     the filtered sample's mip level
 //   msm_rectified_moments4 / msm_rectified_moments6 / msm_rectified_csm(two_depths[, terms])
 // then the storage transform of the technique (msm_theta4_star, msm_theta6_star, msm_csm_to_unorm
 // per texel; quantize.h, baselines.h), which commutes with the prefix sums (both are affine).
@@ -298,6 +299,25 @@ MSM_FN TwoDepths msm_rectified_two_depths(RectifiedBounds b, float r, vec2 depth
   return TwoDepths(vec2(msm_rectified_signed_depth_of_map_depth(b, r, depth_to_z, d.z.x),
                         msm_rectified_signed_depth_of_map_depth(b, r, depth_to_z, d.z.y)),
                    d.w);
+}
+
+// The level of detail of the filtered sample (§5.2: the scene's blurred, mipmapped moment map read
+// with the footprint of one rectified texel). A rectified texel at (r, φ) = r_phi stands for the
+// light rays of its cell: the rectification's Jacobian maps one texel step in u and in v to the
+// displacements (in rectification space, across the light)
+//   ∂p/∂u = step.x (cos φ, sin φ),   ∂p/∂v = r step.y (−sin φ, cos φ),
+// step = (r_max / width, φ_span / height). The shadow map is orthographic along the light (the z
+// axis), so its texel coordinates are affine in (p.x, p.y): map_per_x and map_per_y are the
+// shadow-map texels per unit of rectification x and y (the light's projection of the frame's x
+// and y axes, times half the map's size). The footprint's axes in shadow-map texels are then
+// J_u = step.x (cos φ map_per_x + sin φ map_per_y) and J_v = r step.y (−sin φ map_per_x + cos φ map_per_y),
+// and the level is the usual isotropic one of the longer axis, log2 max(|J_u|, |J_v|), never below
+// 0 (a footprint within one texel reads the blurred mip 0).
+MSM_FN float msm_rectified_resampling_lod(vec2 r_phi, vec2 step, vec2 map_per_x, vec2 map_per_y) {
+  float c = cos(r_phi.y), s = sin(r_phi.y);
+  vec2 ju = step.x * (c * map_per_x + s * map_per_y);
+  vec2 jv = (r_phi.x * step.y) * (c * map_per_y - s * map_per_x);
+  return log2(max(max(length(ju), length(jv)), 1.0f));
 }
 
 // The moments of w.x δ(z.x) + w.y δ(z.y): what a rectified texel stores before its transform.

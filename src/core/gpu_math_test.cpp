@@ -213,6 +213,10 @@ const Spec kSpecs[] = {
     // lavapipe (emulated fma): four 6.1e-5 / 3.1e-5, six 4.9e-4 / 2.4e-4.
     {MSM_K_SCATTERING4, "scattering_visibility4", Metric::abs, A1, Layout::none, 0.01, 2e-4},
     {MSM_K_SCATTERING6, "scattering_visibility6", Metric::abs, A1, Layout::none, 5e-3, 1e-3},
+    // The resampling's mip level: cos, sin, a length and log2 (Vulkan: log2 within 3 ulp outside
+    // [0.5, 2], 2^-21 absolute inside; cos/sin 2^-11 absolute on [-π, π], here φ in [0, 2π):
+    // up to ~1e-3 in the level on such a device). Measured on lavapipe 4.2e-7 / 2.2e-7.
+    {MSM_K_RESAMPLING_LOD, "rectified_resampling_lod", Metric::abs, A1, Layout::none, 2e-3, 2e-4},
 };
 
 // The functions whose outputs are shadows, bounds or blocker depths: finite on every input,
@@ -818,6 +822,17 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       x.a = vec4(q.odd, g.receiver(float(t.surface), -1.0f, 1.0f));
       x.b = vec4(q.even, g.uni(0.0f, 1.0f));
       x.u[0] = uint32_t(rep);
+      break;
+    }
+    case MSM_K_RESAMPLING_LOD: {
+      // A texel of a 256²..4096² rectified map over r_max up to 1000, the shadow map 1..64 texels
+      // per unit in any orientation (a rotation and scale, as an orthographic light's).
+      const float width = float(1 << g.integer(8, 12)), r_max = g.log_uniform(1.0f, 1000.0f);
+      const float phi_span = g.chance(0.5) ? MSM_TWO_PI : g.uni(0.01f, 3.0f);
+      x.a = vec4(g.uni(0.0f, r_max), g.uni(0.0f, MSM_TWO_PI), r_max / width, phi_span / width);
+      const float scale = g.log_uniform(1.0f, 64.0f), angle = g.uni(0.0f, MSM_TWO_PI);
+      const float sx = g.chance(0.5) ? scale : -scale; // either handedness
+      x.b = vec4(sx * std::cos(angle), scale * std::sin(angle), -sx * std::sin(angle), scale * std::cos(angle));
       break;
     }
     case MSM_K_RAISE_D2:

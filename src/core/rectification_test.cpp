@@ -287,3 +287,45 @@ TEST(Rectification, PrefixSumLookupIntegratesAStepAlongAViewRay) {
     EXPECT_NEAR(read, exact, 2e-3) << "s " << s;
   }
 }
+
+TEST(Rectification, ResamplingLevelIsTheTexelsFootprintInTheShadowMap) {
+  // The mip level of the filtered resampling (§5.2) against the footprint measured directly: the
+  // shadow-map texel coordinates of the light rays through the neighbouring texel centres (an
+  // orthographic light along z: any rotation and scale across it, an offset), in double; the level
+  // is log2 of the longer central difference, never below 0.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int above_zero = 0;
+  for (const View& view : configurations()) {
+    const msm::RectificationFrame f =
+        msm::msm_rectification_frame(glm::vec3(view.camera), glm::vec3(view.towards_light));
+    const msm::RectifiedBounds b = msm::msm_rectification_bounds(f, view.far_corners());
+    const int width = 1 << (8 + int(4.0 * u(rng))), height = width;
+    // Shadow-map texels per world unit, the light's x axis at angle a to the frame's, either hand.
+    const double scale = std::exp(std::log(0.05) + u(rng) * std::log(4000.0)), a = 2.0 * M_PI * u(rng);
+    const double hand = u(rng) < 0.5 ? -1.0 : 1.0;
+    const glm::dvec2 per_x = scale * glm::dvec2(hand * std::cos(a), std::sin(a));
+    const glm::dvec2 per_y = scale * glm::dvec2(-hand * std::sin(a), std::cos(a));
+    const glm::dvec2 offset(100.0 * u(rng), 100.0 * u(rng));
+    auto map_texel = [&](double i, double j) { // of the light ray through texel coordinates (i, j)
+      const double r = (i + 0.5) / width * double(b.r_max);
+      const double phi = double(b.phi_min) + (j + 0.5) / height * double(b.phi_span);
+      return offset + r * std::cos(phi) * per_x + r * std::sin(phi) * per_y;
+    };
+    for (int k = 0; k < 16; ++k) {
+      const double i = 1.0 + u(rng) * (width - 2), j = 1.0 + u(rng) * (height - 2);
+      const double fu = glm::length(map_texel(i + 0.5, j) - map_texel(i - 0.5, j));
+      // Along v the rays turn on a circle: the chord of one texel step, 2 r sin(Δφ/2), is the
+      // tangent r Δφ to within (Δφ)²/24 relative.
+      const double fv = glm::length(map_texel(i, j + 0.5) - map_texel(i, j - 0.5));
+      const double expected = std::log2(std::max({fu, fv, 1.0}));
+      const glm::vec2 uv(float((i + 0.5) / width), float((j + 0.5) / height));
+      const float lod = msm::msm_rectified_resampling_lod(msm::msm_rectified_r_phi(b, uv),
+                                                          glm::vec2(b.r_max / float(width), b.phi_span / float(height)),
+                                                          glm::vec2(per_x), glm::vec2(per_y));
+      EXPECT_NEAR(lod, expected, 1e-4) << "texel " << i << ", " << j << " of " << width;
+      above_zero += expected > 0.5;
+    }
+  }
+  EXPECT_GT(above_zero, 64 * 16 / 4); // the test reaches the mips, not only the floor at 0
+}

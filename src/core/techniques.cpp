@@ -429,7 +429,8 @@ constexpr Technique kTechniques[] = {
      64,
      4,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
+     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
      "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
@@ -443,7 +444,8 @@ constexpr Technique kTechniques[] = {
      64,
      6,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
+     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
      "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
@@ -457,7 +459,8 @@ constexpr Technique kTechniques[] = {
      96,
      6,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
+     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
      "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
@@ -471,7 +474,8 @@ constexpr Technique kTechniques[] = {
      192,
      6,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default); "
+     "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
+     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
      "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
      true,
      nullptr,
@@ -486,7 +490,8 @@ constexpr Technique kTechniques[] = {
      256,
      32,
      {TexelFormat::none, TexelFormat::none},
-     "x: 1 = resampling with filtering (JCGT §5.2: a bilinear moment sample, Algorithm 2), 0 = without (default)",
+     "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
+     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default)",
      true,
      nullptr,
      nullptr,

@@ -1,5 +1,7 @@
 #include "frame_config.h"
 
+#include "msm/techniques.h"
+
 #include <fmt/format.h>
 
 namespace msm::render {
@@ -47,6 +49,20 @@ std::array<VkFormat, 2> FrameConfig::formats() const {
 int FrameConfig::moment_images() const {
   std::array<VkFormat, 2> f = formats();
   return (f[0] != VK_FORMAT_UNDEFINED) + (f[1] != VK_FORMAT_UNDEFINED);
+}
+
+FrameConfig FrameConfig::resampling_moments() const {
+  FrameConfig m;
+  m.technique = &technique_by_id(MSM_TECH_HAMBURGER_128_UNIT);
+  m.width = width;
+  m.height = height;
+  m.shadow_size = shadow_size;
+  m.msaa = msaa;
+  m.taps = taps;
+  m.sigma = sigma;
+  m.lights = lights;
+  m.mip_levels = resampling_mips;
+  return m;
 }
 
 std::string moment_image(int channel, int i) {

@@ -33,6 +33,11 @@ struct FrameConfig {
   // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
   // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).
   bool deferred = false;
+  // Prefiltered scattering, resampling with filtering (JCGT §5.2; technique parameter x = 1): the
+  // frame also makes each light's blurred, mipmapped 4-moment map (moment_resolve, blur and mipmaps
+  // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).
+  bool filtered_resampling = false;
+  uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                            // translucent and four channels in one image
@@ -41,6 +46,12 @@ struct FrameConfig {
   int channels() const { return coloured ? 3 : 1; } // sets of moment images
   // The vertical blur writes mip 1 too (three-pass filter with mips and an even size): one pass
   // fewer reads mip 0; the mipmap pass starts at mip 2.
+  // The configuration of the moment passes that make the filtered resampling's map: the technique
+  // msm-hamburger-128-unit (plain moments (z, z², z³, z⁴) of [0,1] depth in RGBA32F: Algorithm 2
+  // reads b1..b3 as they are, without an inverse transform, and a flat occluder's variance after
+  // the blur, b2 − b1², keeps the float's precision where 16 bits would round it to a few units of
+  // 2^-16 and need a bias), the frame's size, samples, lights and filter; no translucency.
+  FrameConfig resampling_moments() const;
   bool blur_writes_mip1() const { return !one_pass && taps > 1 && mip_levels > 1 && shadow_size % 2 == 0; }
 };
 

@@ -7,6 +7,7 @@
 
 #include "msm/image/metrics.h"
 #include "msm/render/renderer.h"
+#include "msm/techniques.h"
 #include "msm/test/vulkan_test.h"
 
 #include <gtest/gtest.h>
@@ -52,6 +53,35 @@ TEST(FrameGraph, RecipesListTheirPassesInOrder) {
   EXPECT_EQ(technique_passes(find_rendered_technique("msm-nl64")), (V{"shadow_depth", "one_pass_filter", "shading"}));
   EXPECT_EQ(technique_passes(find_rendered_technique("mssm6")),
             (V{"shadow_depth", "moment_resolve", "sat", "surfaces", "shading"}));
+}
+
+// Prefiltered scattering with filtered resampling (JCGT §5.2, FrameConfig::filtered_resampling):
+// the frame adds the blurred, mipmapped moment map that rectify reads; without it, rectify reads
+// the depth map.
+TEST(FrameGraph, FilteredResamplingAddsTheMomentMapPasses) {
+  using V = std::vector<std::string>;
+  for (std::string_view technique : {"scatter-msm4-64", "scatter-msm6-96", "scatter-csm-32"}) {
+    FrameConfig c = config_of(technique);
+    c.mip_levels = 1;
+    auto names = [&] {
+      std::vector<std::unique_ptr<Pass>> passes = recipe(c);
+      std::vector<std::string> n;
+      for (size_t i : order_passes(passes, {}, frame_outputs(c))) n.emplace_back(passes[i]->name());
+      return n;
+    };
+    EXPECT_EQ(names(), (V{"shadow_depth", "shading", "rectify", "prefix_sums", "scattering"})) << technique;
+    c.filtered_resampling = true;
+    c.resampling_mips = 7;
+    EXPECT_EQ(names(), (V{"shadow_depth", "shading", "moment_resolve", "blur", "mipmaps", "rectify", "prefix_sums",
+                          "scattering"}))
+        << technique;
+    EXPECT_EQ(c.resampling_moments().technique->id, msm::MSM_TECH_HAMBURGER_128_UNIT);
+    EXPECT_EQ(c.resampling_moments().mip_levels, 7u);
+    c.taps = 1; // --filter 1: no blur
+    c.resampling_mips = 1;
+    EXPECT_EQ(names(), (V{"shadow_depth", "shading", "moment_resolve", "rectify", "prefix_sums", "scattering"}))
+        << technique;
+  }
 }
 
 // The order comes from the declarations, not from the list: a shuffled recipe runs in the same

@@ -31,6 +31,12 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
   if (c.deferred) passes.push_back(std::make_unique<SurfacesPass>(c));
   passes.push_back(std::make_unique<ShadingPass>(c));
   if (msm_technique_is_prefiltered_scattering(id)) {
+    if (c.filtered_resampling) { // the blurred, mipmapped 4-moment map that rectify samples (§5.2)
+      const FrameConfig m = c.resampling_moments();
+      passes.push_back(std::make_unique<MomentResolvePass>(m));
+      if (m.taps > 1) passes.push_back(std::make_unique<BlurPass>(m, 0));
+      if (m.mip_levels > 1) passes.push_back(std::make_unique<MipmapPass>(m, 0));
+    }
     passes.push_back(std::make_unique<RectifyPass>(c));
     passes.push_back(std::make_unique<PrefixSumPass>(c));
   }

@@ -308,6 +308,21 @@ struct Renderer::Impl {
         if (!has_features(ctx, c.formats()[size_t(i)], VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
           throw RenderError(fmt::format("{} cannot filter format {} linearly ({})", ctx.info().name,
                                         int(c.formats()[size_t(i)]), technique.name));
+    // Resampling with filtering (JCGT §5.2) from the frame's blurred, mipmapped 4-moment map: the
+    // prefiltered techniques' parameter x = 1 adds its passes (recipe, FrameConfig::resampling_moments).
+    const glm::vec4 params = s.params ? *s.params : technique.default_params();
+    if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
+      c.filtered_resampling = true;
+      const VkFormat f = c.resampling_moments().formats()[0];
+      if (!has_features(ctx, f, VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+        throw RenderError(fmt::format("{} cannot filter RGBA32F linearly: the filtered resampling of {} needs it "
+                                      "(--param 0,0,0,0 resamples without filtering)",
+                                      ctx.info().name, technique.name));
+      c.resampling_mips =
+          s.mipmaps && has_features(ctx, f, VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT)
+              ? uint32_t(std::bit_width(uint32_t(s.shadow_size)))
+              : 1u;
+    }
     if (!graph || !(config == c)) {
       graph.reset();
       graph = std::make_unique<FrameGraph>(ctx, recipe(c), std::vector<std::string>{}, frame_outputs(c),

@@ -20,6 +20,7 @@
 #include "msm/moments.h"
 #include "msm/nonlinear.h"
 #include "msm/quantize.h"
+#include "msm/rectification.h"
 #include "msm/roots.h"
 #include "msm/scattering.h"
 #include "msm/shared.h"
@@ -117,7 +118,9 @@ const int MSM_K_RAISE_D2 = 60; // a = b4, b.x = min D2 -> a
 // scattering.h: the visible fraction of a view ray from a prefix-summed rectified texel
 const int MSM_K_SCATTERING4 = 61; // a = stored texel, b.xy = (zf, beta), u.x = representation -> a.x
 const int MSM_K_SCATTERING6 = 62; // a.xyz, b.xyz = stored Θ6* (odd, even), a.w = zf, b.w = beta, u.x = rep -> a.x
-const int MSM_K_COUNT = 63;
+// rectification.h: the mip level of the filtered resampling (§5.2)
+const int MSM_K_RESAMPLING_LOD = 63; // a = (r, φ, r step, φ step), b = (map_per_x, map_per_y) -> a.x
+const int MSM_K_COUNT = 64;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
 MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
@@ -231,6 +234,10 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
   case MSM_K_RAISE_D2: r.a = msm_raise_d2(x.a, x.b[0]); break;
   case MSM_K_SCATTERING4: r.a[0] = msm_scattering_visibility4(x.a, int(x.u[0]), x.b[0], x.b[1]); break;
   case MSM_K_SCATTERING6: r.a[0] = msm_scattering_visibility6(b6, int(x.u[0]), x.a[3], x.b[3]); break;
+  case MSM_K_RESAMPLING_LOD:
+    r.a[0] = msm_rectified_resampling_lod(vec2(x.a[0], x.a[1]), vec2(x.a[2], x.a[3]), vec2(x.b[0], x.b[1]),
+                                          vec2(x.b[2], x.b[3]));
+    break;
   default: break;
   }
   return r;

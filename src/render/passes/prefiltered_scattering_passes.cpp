@@ -33,7 +33,10 @@ void RectifyPass::prepare(const PassResources& r) {
   std::string shader = std::string(csm(config_) ? "rectify_csm"
                                    : six        ? "rectify6"
                                                 : "rectify") +
-                       (config_.msaa == 1 ? "_1x.comp" : ".comp");
+                       // Filtered resampling reads the moment map, whatever the depth map's samples.
+                       (config_.filtered_resampling ? "_filtered.comp"
+                        : config_.msaa == 1         ? "_1x.comp"
+                                                    : ".comp");
   std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::storage_buffer,
                                        vk::Binding::storage_buffer, vk::Binding::sampled_image,
                                        vk::Binding::storage_image};
@@ -42,7 +45,8 @@ void RectifyPass::prepare(const PassResources& r) {
 }
 
 void RectifyPass::reflect(PassBuilder& b) const {
-  b.read(kShadowDepth, use::sampled(kCompute));
+  // Filtered resampling (§5.2): the blurred, mipmapped moment map; else the depth map.
+  b.read(config_.filtered_resampling ? moment_image(0, 0) : std::string(kShadowDepth), use::sampled(kCompute));
   // A layer per light (every light its own rectified map).
   const uint32_t lights = uint32_t(config_.lights);
   ImageSpec spec{
@@ -67,7 +71,9 @@ void RectifyPass::execute(const PassContext& c) const {
     const size_t layer = size_t(l);
     std::vector<vk::Descriptor> d = {
         vk::Descriptor(c.frame.uniforms), vk::Descriptor(*c.frame.rectification), vk::Descriptor(c.frame.lights),
-        vk::Descriptor(c.image(kShadowDepth).layer_views[layer], kReadOnly, c.frame.point_sampler),
+        config_.filtered_resampling // every mip, trilinear
+            ? vk::Descriptor(c.image(moment_image(0, 0)).layer_views[layer], kReadOnly, c.frame.linear_sampler)
+            : vk::Descriptor(c.image(kShadowDepth).layer_views[layer], kReadOnly, c.frame.point_sampler),
         csm(config_) ? vk::Descriptor(c.image(kRectified).array_view, VK_IMAGE_LAYOUT_GENERAL) // layers 8 l + t
                      : vk::Descriptor(c.image(kRectified).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)};
     if (prefix_sums_have_two_images(config_))

@@ -3,10 +3,14 @@
 // light, its rectification rects[light] and its layer of the rectified images; the depth map bound
 // is that light's layer): per rectified texel, the light ray at (r, φ) is
 // looked up in the light's depth map, without filtering (the nearest texel, sample 0), or, where
-// the technique's parameter x is 1, with filtering (§5.2): a bilinear sample of the map's four
-// moments (each texel the mean of its MSAA samples' moments: the resolved, unblurred moment map of
-// [0,1] depth) turned into two depths by JCGT Algorithm 2. Each depth is mapped to the rectified
-// depth π − θ and turned into the technique's moments in its storage basis
+// the technique's parameter x is 1, with filtering (§5.2; the _filtered variants, MSM_FILTERED_MAP):
+// a trilinear sample of the frame's blurred, mipmapped 4-moment map of [0,1] depth (moment_resolve,
+// blur and mipmaps of msm-hamburger-128-unit; FrameConfig::resampling_moments) at the level of the
+// texel's footprint in the shadow map (msm_rectified_resampling_lod), turned into two depths by
+// JCGT Algorithm 2; or, where x is another non-zero value (2), the earlier on-the-fly filter kept
+// for comparison: a bilinear sample of the four moments of the depth map's texels (each the mean
+// of its MSAA samples' moments: the resolved moment map without blur and mips). Each depth is
+// mapped to the rectified depth π − θ and turned into the technique's moments in its storage basis
 // (Θ4*; with MSM_SIX_MOMENTS Θ6* over two images: (odd, even.x) and (even.y, even.z); with MSM_CSM
 // Klehm et al.'s 16 sin/cos terms of [0,1] depth mapped to [0,1] (msm_csm_to_unorm), four per layer
 // of the light's eight layers 8 light .. 8 light + 7 of an RGBA16F array: the 8-bit storage comes
@@ -17,8 +21,12 @@
 #include "msm/quantize.h"
 #define MSM_LIGHT_BINDING 2
 #include "frame.glsl"
+#ifdef MSM_FILTERED_MAP
+layout(binding = 3) uniform sampler2D resampling_moments; // the light's layer, every mip, trilinear
+#else
 #define MSM_DEPTH_BINDING 3
 #include "depth_map.glsl"
+#endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 1) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
@@ -50,6 +58,17 @@ void main() {
   bool inside = all(greaterThanEqual(vec2(clip.x, clip.y), vec2(-1.0f))) &&
                 all(lessThanEqual(vec2(clip.x, clip.y), vec2(1.0f)));
   if (inside) {
+#ifdef MSM_FILTERED_MAP
+    // The texel's footprint: the light's (orthographic) projection of the frame's axes across the
+    // light, in shadow-map texels per unit, through the rectification's Jacobian.
+    float half_map = 0.5f * frame.shadow_map.x;
+    vec2 per_x = half_map * vec2(lights[light].view_projection * vec4(f.x_axis, 0.0f));
+    vec2 per_y = half_map * vec2(lights[light].view_projection * vec4(f.y_axis, 0.0f));
+    float lod = msm_rectified_resampling_lod(msm_rectified_r_phi(b, uv),
+                                             vec2(b.r_max / float(size.x), b.phi_span / float(size.y)), per_x, per_y);
+    vec4 moments = textureLod(resampling_moments, vec2(clip.x, clip.y) * 0.5f + 0.5f, lod);
+    d = msm_rectified_two_depths(b, r, depth_to_z, moments);
+#else
     int map = int(frame.shadow_map.x);
     ivec2 t = clamp(ivec2(floor((vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0), ivec2(map - 1));
     if (frame.technique_params.x != 0.0f) {
@@ -69,6 +88,7 @@ void main() {
       float depth = depth_sample(t, 0);
       if (depth < 1.0f) d = msm_rectified_one_depth(b, r, depth_to_z, depth);
     }
+#endif
   }
 #if defined(MSM_CSM)
   CsmMoments m = msm_rectified_csm(d, MSM_CSM_MAX_TERMS);
