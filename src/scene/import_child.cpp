@@ -29,6 +29,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -50,11 +51,12 @@
 
 namespace msm::scene::detail {
 
-// 300 s: Assimp reads a 1,000,000-triangle PLY in 3.1 s and a 1,000,000-triangle OBJ in 7.9 s on
-// the 2-core test machine under load (docs/results.md "Mesh import in a child process"); a file at
-// the triangle limit (32 M, MSM_MAX_TRIANGLES) would take minutes, so a larger machine's largest
-// models fit, while an endless loop still ends.
-inline constexpr double kImportTimeoutSeconds = 300.0;
+// 600 s: Assimp reads a 1,000,000-triangle OBJ in 3.5 s of CPU (10.2 s of wall time on the 2-core
+// test machine under the load of parallel work; a binary PLY: 1.3 s, 3.8 s), so a file at the
+// triangle limit (32 M, MSM_MAX_TRIANGLES) takes about 110 s of CPU, 330 s at that load
+// (docs/results.md "Mesh import in a child process"); an endless loop or a deadlock in the child
+// still ends, in 10 minutes.
+inline constexpr double kImportTimeoutSeconds = 600.0;
 
 void (*import_child_hook)() = nullptr;
 
@@ -448,15 +450,29 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
       bytes.append(buffer.data(), std::size_t(n));
     }
   }
-  // Both pipes closed: the child has ended or is ending.
+  // Both pipes closed: the child has ended or is ending. Its end is awaited through a pidfd
+  // (polled until the deadline), or where there is none by polling waitpid every millisecond.
   int status = 0;
+  const int pidfd = int(::syscall(SYS_pidfd_open, pid, 0));
   for (;;) {
     const pid_t done = ::waitpid(pid, &status, WNOHANG);
     if (done == pid) break;
-    if (done < 0 && errno != EINTR) throw fail(fmt::format("waitpid: {}", std::strerror(errno)));
-    if (Clock::now() >= deadline) throw timed_out();
-    ::usleep(1000);
+    if (done < 0 && errno != EINTR) {
+      if (pidfd >= 0) ::close(pidfd);
+      throw fail(fmt::format("waitpid: {}", std::strerror(errno)));
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (left <= 0) {
+      if (pidfd >= 0) ::close(pidfd);
+      throw timed_out();
+    }
+    pollfd ended{pidfd, POLLIN, 0};
+    if (pidfd >= 0)
+      ::poll(&ended, 1, int(std::min<long long>(left, 1000)));
+    else
+      ::usleep(1000);
   }
+  if (pidfd >= 0) ::close(pidfd);
   const std::string said = detail::first_line(printed);
   if (WIFSIGNALED(status))
     throw SceneError(file.string(), "",
