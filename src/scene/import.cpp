@@ -3,9 +3,11 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <new>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
 
 #include <assimp/GltfMaterial.h>
@@ -198,9 +200,9 @@ void aiAssertViolation(const char* expression, const char* file, int line) {
 
 namespace msm::scene {
 
-std::vector<ModelPart> import_model(const std::filesystem::path& file) {
-  check_regular_file(file, "mesh");
-  detail::check_mesh_header(file);
+// Assimp and the conversion to parts, in this process: the child's half of import_model
+// (import_child.cpp), after the parent's checks of the file and its header.
+std::vector<ModelPart> detail::import_model_in_process(const std::filesystem::path& file) {
   Assimp::Importer importer;
   // Points and lines are removed; only triangles are kept.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
@@ -219,6 +221,10 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
     throw SceneError(file.string(), "",
                      fmt::format("Assimp cannot read the mesh (truncated or corrupt?): its internal check {} failed",
                                  assimp_assertion));
+  // Assimp catches std::bad_alloc (the child's address-space limit, import_child.cpp) and keeps
+  // only its what(): it is raised again, for the caller's message naming the memory limit.
+  if (!s && std::string_view(importer.GetErrorString()).find("bad_alloc") != std::string_view::npos)
+    throw std::bad_alloc();
   if (!s || (s->mFlags & AI_SCENE_FLAGS_INCOMPLETE) || !s->mRootNode)
     throw SceneError(file.string(), "", fmt::format("Assimp cannot read the mesh: {}", importer.GetErrorString()));
   // One part per distinct material: Assimp repeats a glTF material for every mesh that uses it.
@@ -285,6 +291,11 @@ std::vector<ModelPart> import_model(const std::filesystem::path& file) {
   if (parts.empty()) throw SceneError(file.string(), "", "the mesh file contains no triangles");
   if (kept.empty()) throw SceneError(file.string(), "", "the mesh has no triangles with a non-zero area");
   return kept;
+}
+
+void detail::check_mesh_file(const std::filesystem::path& file) {
+  check_regular_file(file, "mesh");
+  check_mesh_header(file);
 }
 
 Mesh import_mesh(const std::filesystem::path& file) {

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "msm/scene/scene.h"
 
@@ -19,5 +21,27 @@ void fix_winding(Mesh& mesh, std::size_t first_triangle);
 // allocates for them) and for PLY and OFF headers that cannot be right (no end_header; more
 // elements than the file's size can hold: truncated).
 void check_mesh_header(const std::filesystem::path& file);
+
+// What import_model checks in its own process before Assimp runs: a regular file, its header
+// (check_mesh_header).
+void check_mesh_file(const std::filesystem::path& file);
+
+// import_model runs Assimp in a child process (import_child.cpp; docs/architecture.md "Mesh import
+// in a child process"); these are its parts.
+// Assimp and the conversion to parts in this process (import.cpp), after check_mesh_file.
+std::vector<ModelPart> import_model_in_process(const std::filesystem::path& file);
+// The parts as the child sends them to the parent (embedded images once each, shared as before).
+std::string serialize_model(const std::vector<ModelPart>& parts);
+// A SceneError as the child sends it.
+std::string serialize_error(const SceneError& error);
+// The child's bytes back to parts, or its SceneError rethrown; every count and size is checked
+// against the bytes there are and every index against what it indexes (SceneError naming `file`
+// for anything inconsistent or truncated: the child's bytes are not trusted either).
+std::vector<ModelPart> deserialize_model(std::string_view bytes, const std::filesystem::path& file);
+// Seconds the child may take: MSM_IMPORT_TIMEOUT_S, default kImportTimeoutSeconds.
+double import_timeout_seconds();
+// Test hook (tests only, null otherwise): called in the child before Assimp, to make it crash,
+// hang or allocate without end.
+extern void (*import_child_hook)();
 
 } // namespace msm::scene::detail
