@@ -262,9 +262,13 @@ TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
 }
 
 // The same check with the horizon split (median_cut's horizon_split, "horizon_split": true: no
-// region across the horizon y = 0), N = 10 (the fewest it makes) to 256. Bounds: BOUNDS_TBD.
+// region across the horizon y = 0), N = 10 (the fewest it makes) to 256. Measured, worst over the
+// three normals (docs/results.md, "The horizon split"): 19.0% at 10 lights and 9.6% at 16 (both
+// the +Z plane, whose horizon the split does not follow; +Y: 1.7% and 1.3%), 0.73% at 32, 0.58%
+// at 64, 0.09% at 256. Asserted: the 1% from 32 lights on (without the split it holds
+// from 32 with 0.94%), 1.5x the measured error at 10 and 16.
 TEST(Environment, AreaLightsKeepThePlanesIrradianceWithTheHorizonSplit) {
-  const std::map<int, double> bound = {{10, 1.0}, {16, 1.0}, {32, 1.0}, {64, 1.0}, {256, 1.0}};
+  const std::map<int, double> bound = {{10, 1.5 * 0.190}, {16, 1.5 * 0.096}, {32, 0.01}, {64, 0.01}, {256, 0.01}};
   for (const auto& [count, tolerance] : bound) expect_plane_energy(count, tolerance, true);
 }
 
