@@ -380,11 +380,24 @@ std::vector<Region> merge_faces(const ProbeTables& tables, std::vector<Region> r
 
 } // namespace
 
-std::vector<Region> median_cut(const ProbeTables& tables, int count) {
+void check_cut(int count, int size, bool horizon_split) {
   if (count < 1 || count > 256) throw ProbeError(fmt::format("{} lights: the median cut makes 1 to 256", count));
+  if (!horizon_split) return;
+  if (count < kHorizonSplitMinLights)
+    throw ProbeError(fmt::format("{} lights: the horizon split starts from {} regions (the side faces' halves), so it "
+                                 "makes {} to 256 lights",
+                                 count, kHorizonSplitMinLights, kHorizonSplitMinLights));
+  if (size % 2 != 0)
+    throw ProbeError(
+        fmt::format("cube faces of {}²: the horizon split halves the side faces, so the size must be even", size));
+}
+
+std::vector<Region> median_cut(const ProbeTables& tables, int count, bool horizon_split) {
+  check_cut(count, tables.size(), horizon_split);
   std::vector<Region> regions;
-  for (int face = 0; face < 6; ++face) {
-    Region r{face, 0, 0, tables.size(), tables.size()};
+  for (int k = 0; k < msm_first_region_count(horizon_split); ++k) {
+    const MsmFirstRegion first = msm_first_region(k, tables.size(), horizon_split);
+    Region r{first.face, first.rect.x, first.rect.y, first.rect.z, first.rect.w};
     r.fixed_energy = tables.fixed_energy(r);
     r.energy = tables.energy(r);
     regions.push_back(r);
@@ -468,9 +481,10 @@ CubeMap load_probe(const std::string& probe, int size, float rotation_deg, float
 }
 
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg,
-                                            float intensity) {
+                                            float intensity, bool horizon_split) {
+  check_cut(count, size, horizon_split); // before loading the probe
   const ProbeTables tables(load_probe(probe, size, rotation_deg, intensity));
-  return area_lights(tables, median_cut(tables, count));
+  return area_lights(tables, median_cut(tables, count, horizon_split));
 }
 
 } // namespace msm::probe

@@ -165,6 +165,71 @@ TEST(MedianCut, PartitionsTheProbeAndKeepsItsEnergy) {
   }
 }
 
+// The horizon split (median_cut's horizon_split): the cut starts from the ten regions of
+// msm_first_region (the side faces halved at their middle row, the world's horizon), and every
+// region of the cut stays on one side of the horizon: on a side face, rows [0, m/2) look above it
+// (v < 0 is +Y) and rows [m/2, m) below; so every lit region's light points to its own side. The
+// cut still partitions the cube and keeps the energy. Without the split, the same probe's cut has
+// regions across the horizon (the property is not trivially true).
+TEST(MedianCut, HorizonSplitKeepsEveryRegionOnOneSideOfTheHorizon) {
+  const int m = 64;
+  for (float rotation : {0.0f, 37.0f}) {
+    const CubeMap cube = sky_probe(m, rotation);
+    const ProbeTables tables(cube);
+    const auto straddles = [&](const Region& r) {
+      const bool side = r.face != 2 && r.face != 3;
+      return side && r.y0 < m / 2 && r.y1 > m / 2;
+    };
+    const std::vector<Region> plain = median_cut(tables, 16);
+    EXPECT_GT(std::count_if(plain.begin(), plain.end(), straddles), 0);
+    const std::vector<Region> first = median_cut(tables, kHorizonSplitMinLights, true);
+    ASSERT_EQ(int(first.size()), kHorizonSplitMinLights);
+    for (int k = 0; k < kHorizonSplitMinLights; ++k) {
+      const msm::MsmFirstRegion f = msm::msm_first_region(k, m, true);
+      EXPECT_EQ(first[k], (Region{f.face, f.rect.x, f.rect.y, f.rect.z, f.rect.w, tables.energy(first[k]),
+                                  tables.fixed_energy(first[k]), 0u}))
+          << k;
+    }
+    for (int count : {10, 11, 16, 32, 64, 256}) {
+      const std::vector<Region> regions = median_cut(tables, count, true);
+      ASSERT_EQ(int(regions.size()), count);
+      std::vector<int> cover(6 * m * m, 0);
+      double energy = 0.0;
+      for (const Region& r : regions) {
+        EXPECT_EQ(r.faces, 0u);
+        EXPECT_FALSE(straddles(r)) << count << " lights, face " << r.face << " rows " << r.y0 << ".." << r.y1;
+        for (int y = r.y0; y < r.y1; ++y)
+          for (int x = r.x0; x < r.x1; ++x) ++cover[(r.face * m + y) * m + x];
+        EXPECT_NEAR(r.energy, tables.energy(r), 1e-9 * r.energy + 1e-12);
+        energy += r.energy;
+        if (r.fixed_energy == 0) continue;
+        // Its light points to its side of the horizon (±Y faces: above / below by construction).
+        const bool above = r.face == 2 || (r.face != 3 && r.y1 <= m / 2);
+        const msm::MsmAreaLight l = area_lights(tables, {r}).at(0);
+        EXPECT_EQ(l.direction.y > 0.0f, above) << count << " lights, face " << r.face << " rows " << r.y0;
+      }
+      EXPECT_TRUE(std::all_of(cover.begin(), cover.end(), [](int c) { return c == 1; })) << count;
+      EXPECT_NEAR(energy, msm::msm_luminance(glm::vec3(integrate(cube))), 1e-5 * energy) << count;
+    }
+  }
+}
+
+TEST(MedianCut, HorizonSplitRefusesFewLightsAndOddFaces) {
+  const ProbeTables tables(sky_probe(16));
+  for (int count : {1, 5, 6, 9}) {
+    try {
+      median_cut(tables, count, true);
+      ADD_FAILURE() << count << " lights with the horizon split: no error";
+    } catch (const ProbeError& e) { EXPECT_NE(std::string(e.what()).find("10 to 256"), std::string::npos) << e.what(); }
+  }
+  EXPECT_THROW(median_cut(tables, 257, true), ProbeError);
+  EXPECT_EQ(median_cut(tables, 10, true).size(), 10u);
+  const ProbeTables odd(sky_probe(15));
+  EXPECT_THROW(median_cut(odd, 32, true), ProbeError);
+  EXPECT_EQ(median_cut(odd, 32).size(), 32u); // without the split an odd size is fine
+  EXPECT_THROW(probe_area_lights("sky", 15, 32, 0.0f, 1.0f, true), ProbeError);
+}
+
 // Below six lights the face regions are merged: the N cut is the N + 1 cut with the two regions
 // of least energy together among those sharing a cube edge merged (checked here from the face
 // energies alone), every group's faces are edge-connected, and the sun's face (the most energetic)

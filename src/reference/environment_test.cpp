@@ -224,6 +224,28 @@ TEST(Environment, ProbeLightCountMatchesTheSceneFilesCount) {
 
 namespace {
 
+// The lights' msm_cone_cosine sum on an unoccluded plane against quadrature of the sky (32²
+// faces) for the normals +Y, 45° and +Z, printed, within tolerance (relative).
+void expect_plane_energy(int count, double tolerance, bool horizon_split) {
+  const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "horizon_split": )" +
+                           std::string(horizon_split ? "true" : "false") + R"(, "lights": )" + std::to_string(count) +
+                           R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
+  const Scene scene = msm::scene::load_scene_json(json, std::filesystem::current_path(), "t.json");
+  const msm::probe::CubeMap cube = msm::probe::load_probe("sky", 32);
+  for (const glm::dvec3& n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)), glm::dvec3(0, 0, 1)}) {
+    const glm::dvec3 probe = quadrature(
+        cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
+    glm::dvec3 lights(0.0);
+    for (const auto& l : scene.lights)
+      lights += glm::dvec3(l.irradiance) *
+                double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)), l.cone_half_angle()));
+    std::printf("[energy%s] %d lights, n = (%.3f, %.3f, %.3f): lights %.4f, probe %.4f, relative error %+.4f\n",
+                horizon_split ? " split" : "", count, n.x, n.y, n.z, lum(lights), lum(probe),
+                lum(lights) / lum(probe) - 1.0);
+    EXPECT_NEAR(lum(lights), lum(probe), tolerance * lum(probe)) << count << " lights, n = " << n.x << ", " << n.y;
+  }
+}
+
 // The issue's energy check: on an unoccluded plane, the area lights' closed form (uniform cones,
 // msm_cone_cosine, what --probe-lights integrates) against the probe's irradiance by quadrature.
 // The issue asks for 1% at every count; measured on the sky (32² faces), the worst relative error
@@ -236,24 +258,18 @@ TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
   const std::map<int, double> bound = {{1, 1.5 * 0.778},  {2, 1.5 * 0.532}, {3, 1.5 * 0.225},  {4, 1.5 * 0.0526},
                                        {5, 1.5 * 0.133},  {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113},
                                        {64, 1.5 * 0.012}, {256, 0.01}};
-  for (const auto& [count, tolerance] : bound) {
-    const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "lights": )" +
-                             std::to_string(count) +
-                             R"(}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
-    const Scene scene = msm::scene::load_scene_json(json, std::filesystem::current_path(), "t.json");
-    const msm::probe::CubeMap cube = msm::probe::load_probe("sky", 32);
-    for (const glm::dvec3& n : {glm::dvec3(0, 1, 0), glm::normalize(glm::dvec3(1, 1, 0)), glm::dvec3(0, 0, 1)}) {
-      const glm::dvec3 probe = quadrature(
-          cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
-      glm::dvec3 lights(0.0);
-      for (const auto& l : scene.lights)
-        lights += glm::dvec3(l.irradiance) *
-                  double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)), l.cone_half_angle()));
-      std::printf("[energy] %d lights, n = (%.3f, %.3f, %.3f): lights %.4f, probe %.4f, relative error %+.4f\n", count,
-                  n.x, n.y, n.z, lum(lights), lum(probe), lum(lights) / lum(probe) - 1.0);
-      EXPECT_NEAR(lum(lights), lum(probe), tolerance * lum(probe)) << count << " lights, n = " << n.x << ", " << n.y;
-    }
-  }
+  for (const auto& [count, tolerance] : bound) expect_plane_energy(count, tolerance, false);
+}
+
+// The same check with the horizon split (median_cut's horizon_split, "horizon_split": true: no
+// region across the horizon y = 0), N = 10 (the fewest it makes) to 256. Measured, worst over the
+// three normals (docs/results.md, "The horizon split"): 19.0% at 10 lights and 9.6% at 16 (both
+// the +Z plane, whose horizon the split does not follow; +Y: 1.7% and 1.3%), 0.73% at 32, 0.58%
+// at 64, 0.09% at 256. Asserted: the issue's 1% from 32 lights on (without the split it holds
+// from 32 with 0.94%), 1.5x the measured error at 10 and 16.
+TEST(Environment, AreaLightsKeepThePlanesIrradianceWithTheHorizonSplit) {
+  const std::map<int, double> bound = {{10, 1.5 * 0.190}, {16, 1.5 * 0.096}, {32, 0.01}, {64, 0.01}, {256, 0.01}};
+  for (const auto& [count, tolerance] : bound) expect_plane_energy(count, tolerance, true);
 }
 
 } // namespace

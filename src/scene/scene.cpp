@@ -39,8 +39,8 @@ std::string compose(const std::string& file, const std::string& where, const std
 // cone with the irradiance a facing surface receives (Eq. 18). Throws msm::probe::ProbeError.
 std::vector<DirectionalLight> probe_directional_lights(const ProbeLighting& p) {
   std::vector<DirectionalLight> out;
-  for (const msm::MsmAreaLight& a : msm::probe::probe_area_lights(p.file == "sky" ? "sky" : p.file.string(), p.size,
-                                                                  p.lights, p.rotation_deg, p.intensity))
+  for (const msm::MsmAreaLight& a : msm::probe::probe_area_lights(
+           p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights, p.rotation_deg, p.intensity, p.horizon_split))
     out.push_back(light_of_area_light(a));
   return out;
 }
@@ -232,7 +232,7 @@ class Parser {
 
   // The probe's area lights (probe_directional_lights), appended to s.lights.
   void probe_lighting(const json& j, const std::string& ptr, Scene& s) const {
-    keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size"});
+    keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size", "horizon_split"});
     ProbeLighting p;
     const json* file = find(j, "file");
     if (!file) fail(ptr + "/file", "required key missing (an equirectangular EXR, or \"sky\")");
@@ -248,6 +248,14 @@ class Parser {
       p.rotation_deg = number_in(*v, ptr + "/rotation_deg", -360.0f, 360.0f, false, false);
     if (const json* v = find(j, "size")) p.size = integer(*v, ptr + "/size");
     if (p.size < 1 || p.size > 1024) fail(ptr + "/size", "must be in [1, 1024]");
+    if (const json* v = find(j, "horizon_split")) p.horizon_split = boolean(*v, ptr + "/horizon_split");
+    if (p.horizon_split) {
+      try {
+        msm::probe::check_cut(p.lights, p.size, true);
+      } catch (const msm::probe::ProbeError& e) {
+        fail(ptr + (p.lights < msm::probe::kHorizonSplitMinLights ? "/lights" : "/size"), e.what());
+      }
+    }
     p.first_light = s.lights.size();
     try {
       for (const DirectionalLight& l : probe_directional_lights(p)) s.lights.push_back(l);
@@ -688,6 +696,9 @@ void set_probe_light_count(Scene& scene, int count) {
         file, "/probe/lights",
         fmt::format("{} directional lights and {} of the probe exceed {} lights", others, count, kMaxLights));
   p.lights = count;
+  try {
+    msm::probe::check_cut(count, p.size, p.horizon_split);
+  } catch (const msm::probe::ProbeError& e) { throw SceneError(file, "/probe/lights", e.what()); }
   std::vector<DirectionalLight> lights;
   try {
     lights = probe_directional_lights(p);

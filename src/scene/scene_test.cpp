@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "msm/light_probe.h"
+#include "msm/probe/probe.h"
 #include "msm/scene/scene.h"
 #include "msm/test/temp_dir.h"
 
@@ -968,6 +969,30 @@ TEST(Probe, LightsFollowTheDirectionalOnes) {
   }
 }
 
+// "horizon_split": the probe's lights come from median_cut with the split, and --lights N
+// (set_probe_light_count) keeps it (a count below ten is refused at /probe/lights).
+TEST(Probe, HorizonSplitReachesTheCut) {
+  const std::string head = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 16, "lights": 16)";
+  const std::string tail = R"(}, "objects": [{"primitive": {"type": "box"}}]})";
+  Scene split = load_scene_json(head + R"(, "horizon_split": true)" + tail, fs::current_path(), "t");
+  const Scene plain = load_scene_json(head + tail, fs::current_path(), "t");
+  ASSERT_TRUE(split.probe && split.probe->horizon_split);
+  EXPECT_FALSE(plain.probe->horizon_split);
+  const auto expected = msm::probe::probe_area_lights("sky", 16, 16, 0.0f, 1.0f, true);
+  ASSERT_EQ(split.lights.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k)
+    EXPECT_EQ(split.lights[k].towards_light, msm::scene::light_of_area_light(expected[k]).towards_light) << k;
+  bool differs = false;
+  for (std::size_t k = 0; k < plain.lights.size(); ++k)
+    differs |= plain.lights[k].towards_light != split.lights[k].towards_light;
+  EXPECT_TRUE(differs);
+  msm::scene::set_probe_light_count(split, 12);
+  EXPECT_EQ(split.lights.size(), 12u);
+  EXPECT_TRUE(split.probe->horizon_split);
+  EXPECT_THROW(msm::scene::set_probe_light_count(split, 9), msm::scene::SceneError);
+  EXPECT_EQ(split.lights.size(), 12u); // unchanged by the refused count
+}
+
 TEST(Probe, BadValuesNameTheirPointer) {
   const std::string box = R"({"primitive": {"type": "box"}})";
   const auto with = [&](const std::string& probe) { return scene_with_object(box, R"("probe": )" + probe + ","); };
@@ -978,6 +1003,9 @@ TEST(Probe, BadValuesNameTheirPointer) {
   expect_json_error(with(R"({"file": "sky", "size": 0})"), {"/probe/size"});
   expect_json_error(with(R"({"file": "sky", "intensity": -1})"), {"/probe/intensity"});
   expect_json_error(with(R"({"file": "sky", "spin": 1})"), {"/probe/spin", "unknown key"});
+  expect_json_error(with(R"({"file": "sky", "horizon_split": 1})"), {"/probe/horizon_split", "true or false"});
+  expect_json_error(with(R"({"file": "sky", "horizon_split": true, "lights": 9})"), {"/probe/lights", "10 to 256"});
+  expect_json_error(with(R"({"file": "sky", "horizon_split": true, "size": 15})"), {"/probe/size", "even"});
   const std::string license = std::string(MSM_STUDIOLIGHTS_DIR) + "/license.txt";
   expect_json_error(with(R"({"file": ")" + license + R"("})"), {"/probe/file", "not an EXR"});
   expect_json_error(R"({"msm_scene": 1, "objects": [)" + box + "]}", {"/light", "\"probe\""});

@@ -28,6 +28,7 @@ struct LightsOptions {
   float rotation_deg = 0.0f;
   float intensity = 1.0f;
   bool json = false;
+  bool horizon_split = false;
   std::string scene_lights, picture;
 };
 
@@ -106,6 +107,9 @@ void run(const LightsOptions& o) {
     if (ext != ".png" && ext != ".exr")
       throw UsageError(fmt::format("--picture {}: expected a .png or .exr", o.picture));
   }
+  try {
+    probe::check_cut(o.count, o.size, o.horizon_split); // --horizon-split: count >= 10, size even
+  } catch (const probe::ProbeError& e) { throw UsageError(fmt::format("--horizon-split: {}", e.what())); }
   probe::CubeMap cube;
   try {
     cube = probe::load_probe(o.probe, o.size, o.rotation_deg, o.intensity);
@@ -113,7 +117,7 @@ void run(const LightsOptions& o) {
   const probe::ProbeTables tables(cube);
   std::vector<probe::Region> regions;
   try {
-    regions = probe::median_cut(tables, o.count);
+    regions = probe::median_cut(tables, o.count, o.horizon_split);
   } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
   // The lights with their regions (area_lights skips regions without energy, Σ w Y = 0 in the
   // tables: a black probe has none).
@@ -127,6 +131,7 @@ void run(const LightsOptions& o) {
   doc["size"] = cube.size;
   doc["rotation_deg"] = o.rotation_deg;
   doc["intensity"] = o.intensity;
+  doc["horizon_split"] = o.horizon_split;
   doc["regions"] = regions.size();
   doc["integral"] = {total.x, total.y, total.z};
   if (!o.json)
@@ -217,6 +222,9 @@ void add_lights(CLI::App& app) {
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
     cmd->add_option("--intensity", o->intensity, "Radiance scale (default 1)");
     cmd->add_option("--picture", o->picture, picture_help);
+    cmd->add_flag("--horizon-split", o->horizon_split,
+                  "Start the cut from the side faces halved at the horizon (10 regions: --count 10 to 256, even "
+                  "--size), so that no light straddles the horizon");
     cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
     cmd->callback([o] { run(*o); });
   }

@@ -29,6 +29,7 @@ void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, con
   const scene::ProbeLighting& p = *scene.probe;
   const bool sky = p.file == "sky";
   probe::DeviceProbe device(ctx, p.size);
+  device.set_horizon_split(p.horizon_split); // the scene's probe checked its lights and size for it
   probe::Panorama panorama;
   if (!sky) {
     try {

@@ -253,8 +253,9 @@ void add_reference(CLI::App& app) {
       j["files"]["radiance_png"] = "radiance.png";
       j["channels"]["irradiance"] = result.irradiance.channel_names();
       const msm::scene::ProbeLighting& p = *scene.probe;
-      j["probe"] = {{"file", p.file.string()},        {"lights", p.lights}, {"intensity", p.intensity},
-                    {"rotation_deg", p.rotation_deg}, {"size", p.size},     {"probe_lights", settings.probe_lights}};
+      j["probe"] = {{"file", p.file.string()},         {"lights", p.lights}, {"intensity", p.intensity},
+                    {"rotation_deg", p.rotation_deg},  {"size", p.size},     {"probe_lights", settings.probe_lights},
+                    {"horizon_split", p.horizon_split}};
     }
     if (!result.visibility_rgb.empty()) {
       j["files"]["visibility_rgb"] = "visibility_rgb.exr";

@@ -55,6 +55,11 @@ class DeviceProbe {
   void set_panorama(const Panorama& panorama);
   void set_cube(const CubeMap& cube);
 
+  // The cut's horizon split (median_cut's horizon_split; off by default): record() then needs
+  // count >= kHorizonSplitMinLights and an even size() (ProbeError otherwise).
+  void set_horizon_split(bool on) { horizon_split_ = on; }
+  bool horizon_split() const { return horizon_split_; }
+
   // Records the passes for a cut into `count` regions of the probe turned by rotation_deg about +Y
   // (outside a render pass; the caller submits); below 6, groups of faces (median_cut). Throws
   // ProbeError for count outside [1, kMaxDeviceLights] or no probe set.
@@ -73,7 +78,7 @@ class DeviceProbe {
   const vk::Context* ctx_;
   int size_;
   float scale_ = 1.0f;
-  bool has_probe_ = false, resample_ = false;
+  bool has_probe_ = false, resample_ = false, horizon_split_ = false;
   int panorama_width_ = 0, panorama_height_ = 0;
   vk::Program cube_, rows_, columns_, cut_;
   vk::Buffer panorama_, cube_buffer_, weights_, tables_, result_;

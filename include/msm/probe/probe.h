@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "msm/light_probe.h"
+#include "msm/median_cut.h"
 
 namespace msm::probe {
 
@@ -158,7 +159,15 @@ class ProbeTables {
 // to a face of the other: not opposite faces) become one (ties: the first pair (i, j), i < j, in
 // the list's order; the merged region takes the first's place, the second leaves the list), so a
 // region is a group of whole, edge-connected faces (Region::faces; docs/techniques.md says why).
-std::vector<Region> median_cut(const ProbeTables& tables, int count);
+//
+// horizon_split: the cut starts from ten regions instead of six, each side face (±X, ±Z) halved at
+// its middle row, the world's horizon (msm_first_region, whatever the probe's rotation about +Y), so
+// that no region, and no light's region, straddles the horizon of an upward-facing receiver
+// (docs/techniques.md). It needs count >= kHorizonSplitMinLights and an even face size
+// (ProbeError otherwise: fewer lights would merge halves across the horizon again).
+inline constexpr int kHorizonSplitMinLights = 10;
+void check_cut(int count, int size, bool horizon_split); // the ProbeErrors of median_cut's arguments
+std::vector<Region> median_cut(const ProbeTables& tables, int count, bool horizon_split = false);
 
 // The area lights of the regions (msm_area_light_from_region; a group of faces:
 // msm_area_light_from_merged of its faces in increasing order), regions without energy skipped.
@@ -166,9 +175,9 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
 
 // The whole CPU pipeline: the probe (an equirectangular or cross EXR, load_probe_file, or "sky" for
 // make_sky_sun_probe's default sky: see sky_probe) as a cube map of size², scaled by intensity, cut into `count`
-// regions, and their area lights.
+// regions (median_cut, horizon_split as there), and their area lights.
 std::vector<MsmAreaLight> probe_area_lights(const std::string& probe, int size, int count, float rotation_deg = 0.0f,
-                                            float intensity = 1.0f);
+                                            float intensity = 1.0f, bool horizon_split = false);
 // The cube map probe_area_lights cuts: the probe ("sky" or an EXR, load_probe_file) at size²,
 // turned by rotation_deg about +Y and scaled by intensity. The ray tracer's environment ground
 // truth lights the scene with exactly this (msm::reference, effect environment).

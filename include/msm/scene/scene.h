@@ -330,6 +330,7 @@ struct ProbeLighting {
   float intensity = 1.0f;
   float rotation_deg = 0.0f;
   int size = 128;
+  bool horizon_split = false;  // the median cut's horizon split (msm::probe::median_cut): lights >= 10, size even
   std::size_t first_light = 0; // index of its first light in Scene::lights
 };
 

@@ -21,7 +21,8 @@ struct ProbePush {
   float scale = 1.0f;
   float inv_scale = 1.0f;
   int count = 0;
-  int pad[3] = {0, 0, 0};
+  int horizon_split = 0; // median_cut's horizon_split: ten first regions
+  int pad[2] = {0, 0};
 };
 static_assert(sizeof(ProbePush) == 48, "ProbePush must match probe_common.glsl");
 
@@ -128,6 +129,7 @@ void DeviceProbe::set_cube(const CubeMap& cube) {
 void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk::GpuTimer* timer) const {
   if (count < 1 || count > kMaxDeviceLights)
     throw ProbeError(fmt::format("{} lights: the median cut makes 1 to {}", count, kMaxDeviceLights));
+  check_cut(count, size_, horizon_split_);
   if (!has_probe_) throw ProbeError("DeviceProbe::record: no probe set");
   ProbePush push;
   push.panorama = glm::ivec2(panorama_width_, panorama_height_);
@@ -137,6 +139,7 @@ void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk:
   push.scale = scale_;
   push.inv_scale = 1.0f / scale_;
   push.count = count;
+  push.horizon_split = horizon_split_ ? 1 : 0;
   const uint32_t m = uint32_t(size_);
   // Earlier reads and writes of these buffers (the last frame's passes, the host's read of the
   // result) before this frame's writes.

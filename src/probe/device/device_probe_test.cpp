@@ -69,14 +69,14 @@ bool partitions(const std::vector<Region>& regions, int size) {
 }
 
 // The device's cut of its own cube map against the CPU's cut of the same cube map with the same
-// scale, region for region, and their lights.
+// scale (and the probe's horizon split), region for region, and their lights.
 void expect_cut_equals_cpu(const DeviceProbe& probe, const char* what, float rotation_deg,
                            std::span<const int> counts = kCounts) {
   const CubeMap cube = probe.read_cube();
   const ProbeTables tables(cube, probe.scale());
   for (int n : counts) {
     const DeviceCut device = probe.run(n, rotation_deg);
-    const std::vector<Region> cpu = median_cut(tables, n);
+    const std::vector<Region> cpu = median_cut(tables, n, probe.horizon_split());
     ASSERT_EQ(device.regions.size(), cpu.size()) << what << " N " << n;
     std::size_t differing = 0;
     for (std::size_t k = 0; k < cpu.size(); ++k) differing += !(device.regions[k] == cpu[k]);
@@ -167,6 +167,33 @@ TEST_F(DeviceProbeTest, CutAtTheLargestBenchedFaceEqualsTheCpuCut) {
   probe.run(6, 45.0f);
   const int counts[] = {1, 3, 32, 256};
   expect_cut_equals_cpu(probe, "studio.exr 512 rotated 45°", 45.0f, counts);
+}
+
+// The horizon split (ten first regions) on the device: region for region the CPU's, on the sky,
+// on studio.exr turned by 100° and at 512² faces; a count below ten is refused before recording.
+TEST_F(DeviceProbeTest, CutWithTheHorizonSplitEqualsTheCpuCut) {
+  const int counts[] = {10, 11, 16, 32, 64, 256};
+  {
+    DeviceProbe probe(ctx(), 64);
+    probe.set_horizon_split(true);
+    probe.set_cube(sky_probe(64, 30.0f));
+    expect_cut_equals_cpu(probe, "sky 64 rotated 30°, horizon split", 0.0f, counts);
+    EXPECT_THROW(probe.run(9), ProbeError);
+    probe.set_horizon_split(false);
+    EXPECT_EQ(probe.run(9).regions.size(), 9u); // the same probe without the split
+  }
+  const Panorama studio = load_equirect(kStudio);
+  DeviceProbe probe(ctx(), 64);
+  probe.set_horizon_split(true);
+  probe.set_panorama(studio);
+  probe.run(10, 100.0f);
+  expect_cut_equals_cpu(probe, "studio.exr 64 rotated 100°, horizon split", 100.0f, counts);
+  DeviceProbe large(ctx(), 512);
+  large.set_horizon_split(true);
+  large.set_panorama(studio);
+  large.run(10, 45.0f);
+  const int large_counts[] = {10, 32, 256};
+  expect_cut_equals_cpu(large, "studio.exr 512 rotated 45°, horizon split", 45.0f, large_counts);
 }
 
 TEST_F(DeviceProbeTest, DeviceLightsAgreeWithTheCpuPipeline) {

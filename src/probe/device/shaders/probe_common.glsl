@@ -13,7 +13,8 @@ layout(push_constant) uniform Push {
   float scale;        // the tables' fixed-point scale (msm::probe::table_scale)
   float inv_scale;
   int count;          // regions of the cut
-  int pad0, pad1, pad2;
+  int horizon_split;  // 1: the cut starts from ten regions (msm_first_region)
+  int pad1, pad2;
 } pc;
 
 // Table k (0..6, msm_probe_texel's order) of a face: m² uint64 of inclusive sums, row-major;

@@ -1,7 +1,8 @@
 #version 460
 // The median cut in one workgroup (Kneiphof §5), region for region the CPU's msm::probe::median_cut
 // on the same fixed-point tables, then the area light of every region (msm_area_light_from_region).
-// Invocation t holds region t. Each step: a tree reduction finds the splittable region of the
+// Invocation t holds region t, from the six faces (or, with the horizon split, the ten regions of
+// msm_first_region). Each step: a tree reduction finds the splittable region of the
 // largest energy (ties: the lowest index, the CPU's "first"), then invocation 0 splits it at the
 // energy median by a binary search through the tables; the first part replaces it, the second
 // part is appended — the CPU's order. Below six regions, invocation 0 merges the six face regions
@@ -9,6 +10,7 @@
 // and a group's light adds its faces' lights (msm_merged_sums_add, msm_area_light_from_merged).
 #extension GL_GOOGLE_include_directive : require
 #include "probe_common.glsl"
+#include "msm/median_cut.h"
 
 const int MAX_REGIONS = 256; // msm::probe::kMaxDeviceLights
 layout(local_size_x = 256) in;
@@ -140,16 +142,18 @@ void split(uint best, int n) {
 void main() {
   uint t = gl_LocalInvocationID.x;
   int m = pc.size;
-  if (t < 6u) {
-    s_rect[t] = ivec4(0, 0, m, m);
-    s_face[t] = int(t);
-    s_energy[t] = rect_sum(int(t), 1, ivec4(0, 0, m, m));
+  bool horizon_split = pc.horizon_split != 0;
+  int n = msm_first_region_count(horizon_split); // the host checked count >= n with the split
+  if (t < uint(n)) {
+    MsmFirstRegion first = msm_first_region(int(t), m, horizon_split);
+    s_rect[t] = first.rect;
+    s_face[t] = first.face;
+    s_energy[t] = rect_sum(first.face, 1, first.rect);
   }
   s_faces[t] = 0u;
   barrier();
-  int n = 6;
   int count = clamp(pc.count, 1, MAX_REGIONS);
-  if (count < 6) {
+  if (count < 6 && !horizon_split) {
     if (t == 0u) merge_faces(count);
     barrier();
     n = count;
