@@ -571,6 +571,40 @@ TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
   }
 }
 
+// RenderSettings::light_height_deg (msm render --light-height, the viewer's height slider): with
+// light_extent_deg 20 and height 8 the scene's own 20° x 8° rectangle renders bit-identically; with
+// the extent alone the light is a disc (both ramps the wide one); 8 by 20 swaps the two ramps. mssm4,
+// the setting of RectangularLightsPenumbraeFollowTheirTwoExtents, its ramp fraction within 5%.
+TEST_F(SoftShadowTest, LightHeightSettingMakesEveryLightARectangle) {
+  const scene::Scene scene = rectangle_edge_scene();
+  const double wide = 3.0 * std::tan(glm::radians(10.0)), narrow = 3.0 * std::tan(glm::radians(4.0));
+  const double fraction = kRectangleRampFraction.at("mssm4");
+  Renderer renderer(ctx(), scene);
+  const auto render = [&](std::optional<float> extent, std::optional<float> height) {
+    RenderSettings s;
+    s.technique = "mssm4";
+    s.width = s.height = 240;
+    s.shadow_size = 512;
+    s.soft_kernel = 27;
+    s.light_extent_deg = extent;
+    s.light_height_deg = height;
+    return renderer.render(s).shadow.channel("visibility");
+  };
+  const image::Image own = render({}, {}), same = render(20.0f, 8.0f);
+  int different = 0;
+  for (int y = 0; y < own.height(); ++y)
+    for (int x = 0; x < own.width(); ++x) different += own.at(x, y, 0) != same.at(x, y, 0);
+  EXPECT_EQ(different, 0);
+  const RampWidths disc = rectangle_ramps(scene, render(20.0f, {}));
+  const RampWidths swapped = rectangle_ramps(scene, render(8.0f, 20.0f));
+  fmt::print("--light-extent 20: ramps {:.4f} m, {:.4f} m; --light-extent 8 --light-height 20: {:.4f} m, {:.4f} m\n",
+             disc.across_width, disc.across_height, swapped.across_width, swapped.across_height);
+  EXPECT_NEAR(disc.across_width, fraction * wide, 0.05 * fraction * wide);
+  EXPECT_NEAR(disc.across_height, fraction * wide, 0.05 * fraction * wide);
+  EXPECT_NEAR(swapped.across_width, fraction * narrow, 0.05 * fraction * narrow);
+  EXPECT_NEAR(swapped.across_height, fraction * wide, 0.05 * fraction * wide);
+}
+
 // CSSM on receivers at the far plane of the fitted map (cssm.h, MSM_CSSM_BASIS_RANGE): the ground
 // of rectangle_edge_scene lies at depth 1 under the plate at depth 0, a blocker a whole depth range
 // away. On CSM's unscaled basis the series gave S = 1/2 there (the square wave's jump back at a

@@ -129,6 +129,11 @@ struct RenderSettings {
   // 27 for the tables (JCGT's 27² search region), 15 for PCSS (its 15² search: 225 taps, and up to
   // 256 more for the filter). Tables take 3..255, PCSS 3..kMaxPcssKernel.
   std::optional<float> light_extent_deg;
+  // A rectangular light's angular height in degrees (Kneiphof §4.1.2; the width is
+  // light_extent_deg or each light's own angular_extent_deg): set, every light is a rectangle of
+  // that height along its frame's y axis; unset, each keeps its own height, except that
+  // light_extent_deg alone makes every light a disc of that diameter.
+  std::optional<float> light_height_deg;
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default
   float translucent_alpha_threshold = 0.01f;
