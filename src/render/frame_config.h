@@ -33,6 +33,9 @@ struct FrameConfig {
   // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
   // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).
   bool deferred = false;
+  // Kneiphof §4.2.3 (RenderSettings::front_back_depth): a second depth pass keeps the nearest back
+  // face, and the moment resolve stores the mean of the front- and back-face depth.
+  bool front_back = false;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                            // translucent and four channels in one image
@@ -48,6 +51,7 @@ VkFormat vk_format(TexelFormat format);
 
 // Names of the frame's images (the frame graph's resources).
 inline constexpr const char* kShadowDepth = "shadow_depth";
+inline constexpr const char* kShadowDepthBack = "shadow_depth_back"; // FrameConfig::front_back
 inline constexpr const char* kColor = "color";
 inline constexpr const char* kShadowBuffer = "shadow_buffer";
 inline constexpr const char* kCameraDepth = "camera_depth";

@@ -295,7 +295,8 @@ struct Renderer::Impl {
                   .lookup = resolved_lookup(s, technique),
 
                   .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
-                              supports_deferred_shading(technique)};
+                              supports_deferred_shading(technique),
+                  .front_back = s.front_back_depth};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     bool can_mip =
