@@ -38,6 +38,9 @@ struct FrameConfig {
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).
   bool filtered_resampling = false;
   uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
+  // Kneiphof §4.2.3 (RenderSettings::front_back_depth): a second depth pass keeps the nearest back
+  // face, and the moment resolve stores the mean of the front- and back-face depth.
+  bool front_back = false;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                            // translucent and four channels in one image
@@ -59,6 +62,7 @@ VkFormat vk_format(TexelFormat format);
 
 // Names of the frame's images (the frame graph's resources).
 inline constexpr const char* kShadowDepth = "shadow_depth";
+inline constexpr const char* kShadowDepthBack = "shadow_depth_back"; // FrameConfig::front_back
 inline constexpr const char* kColor = "color";
 inline constexpr const char* kShadowBuffer = "shadow_buffer";
 inline constexpr const char* kCameraDepth = "camera_depth";

@@ -9,6 +9,7 @@ namespace msm::render {
 std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
   std::vector<std::unique_ptr<Pass>> passes;
   passes.push_back(std::make_unique<ShadowDepthPass>(c));
+  if (c.front_back) passes.push_back(std::make_unique<ShadowDepthPass>(c, true)); // Kneiphof §4.2.3
   int id = c.technique->id;
   if (msm_technique_is_depth_based(id)) {
     // plain, pcf, pcss read the depth map itself.

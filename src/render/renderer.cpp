@@ -226,12 +226,14 @@ struct Renderer::Impl {
     u.irradiance = glm::vec4(light.irradiance, 0.0f);
     if (msm_technique_is_area_light(technique.id)) {
       // The light's two half extents along the frame's axes (a disc: its radius both; --light-extent
-      // makes every light that disc), the search region and filter per axis from them.
+      // alone makes every light that disc, with light_height_deg a rectangle), the search region
+      // and filter per axis from them.
       scene::DirectionalLight drawn = light;
       if (s.light_extent_deg) {
         drawn.angular_extent_deg = *s.light_extent_deg;
         drawn.angular_height_deg.reset();
       }
+      if (s.light_height_deg) drawn.angular_height_deg = *s.light_height_deg;
       // soft.h: texels of reach per unit of [-1,1] depth.
       vec2 spread = msm_soft_spread(drawn.tan_half_extents(), float(0.5 * f.depth_extent), vec2(texel));
       // The shading integrates the cosine over the disc, or over the cone of the rectangle's solid
@@ -293,7 +295,8 @@ struct Renderer::Impl {
                   .lookup = resolved_lookup(s, technique),
 
                   .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
-                              supports_deferred_shading(technique)};
+                              supports_deferred_shading(technique),
+                  .front_back = s.front_back_depth};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     bool can_mip =

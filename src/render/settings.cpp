@@ -91,6 +91,11 @@ void RenderSettings::validate() const {
   if (uses_one_pass && msm_technique_is_soft(t.id))
     throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
   if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
+  if (light_height_deg) finite("light height", *light_height_deg, 0.0f, 89.0f);
+  if (front_back_depth && !msm_technique_is_soft(t.id))
+    throw RenderError(fmt::format("front-and-back-face depth applies to the moment soft shadows (mssm4, mssm6, "
+                                  "vssm, cssm8, cssm16), not to {}",
+                                  technique));
   if (soft_kernel != 0) {
     if (t.id == MSM_TECH_PCSS)
       range("soft kernel", soft_kernel, 3, kMaxPcssKernel);

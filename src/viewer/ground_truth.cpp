@@ -32,6 +32,12 @@ void GroundTruth::start(scene::Scene scene, const render::RenderSettings& s, int
   if (msm_technique_is_area_light(t.id)) {
     rs.effect = reference::Effect::soft;
     if (s.light_extent_deg) rs.light_extent_deg = *s.light_extent_deg;
+    // A rectangle where the renderer draws one (RenderSettings::light_height_deg, or the scene
+    // light's own height unless light_extent_deg alone makes it a disc).
+    if (s.light_height_deg || (!s.light_extent_deg && scene.light().rectangular())) {
+      rs.light_shape = reference::LightShape::rectangle;
+      if (s.light_height_deg) rs.light_height_deg = *s.light_height_deg;
+    }
   } else {
     rs.effect = reference::Effect::filtered;
   }

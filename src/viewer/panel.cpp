@@ -259,8 +259,26 @@ void Viewer::panel() {
     if (choose("lookup", lookup, {"auto", "bilinear", "nearest", "dither"})) set(s, "lookup", lookup);
     if (msm_technique_is_soft(t.id) || msm_technique_is_area_light(t.id)) {
       ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.id == MSM_TECH_PCSS ? render::kMaxPcssKernel : 255);
+      // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
+      // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
       float extent = s.light_extent_deg.value_or(scene.light().angular_extent_deg);
-      if (ImGui::SliderFloat("light extent (deg)", &extent, 0.0f, 20.0f)) s.light_extent_deg = extent;
+      bool rectangle = s.light_height_deg || (!s.light_extent_deg && scene.light().rectangular());
+      float height = s.light_height_deg.value_or(scene.light().angular_height_deg.value_or(extent));
+      if (ImGui::Checkbox("rectangular light", &rectangle)) {
+        s.light_extent_deg = extent;
+        if (rectangle)
+          s.light_height_deg = height;
+        else
+          s.light_height_deg.reset();
+      }
+      if (ImGui::SliderFloat(rectangle ? "light width (deg)" : "light extent (deg)", &extent, 0.0f, 20.0f)) {
+        s.light_extent_deg = extent;
+        if (rectangle) s.light_height_deg = height;
+      }
+      if (rectangle && ImGui::SliderFloat("light height (deg)", &height, 0.0f, 20.0f)) {
+        s.light_extent_deg = extent;
+        s.light_height_deg = height;
+      }
     }
     ImGui::Checkbox("translucent occluders", &s.translucent_occluders);
     ImGui::Checkbox("coloured translucency", &s.coloured_translucency);

@@ -91,6 +91,7 @@ std::vector<std::string> setting_keys() {
           "coloured_translucency",
           "alpha_threshold",
           "light_extent_deg",
+          "light_height_deg",
           "soft_kernel"};
 }
 
@@ -169,6 +170,11 @@ void apply_setting(render::RenderSettings& s, std::string_view key, const json& 
       s.light_extent_deg.reset();
     else
       s.light_extent_deg = number(key, v);
+  } else if (key == "light_height_deg") {
+    if (v.is_null())
+      s.light_height_deg.reset();
+    else
+      s.light_height_deg = number(key, v);
   } else if (key == "soft_kernel")
     s.soft_kernel = integer(key, v);
   else
@@ -197,6 +203,7 @@ json setting_json(const render::RenderSettings& s, std::string_view key) {
   if (key == "coloured_translucency") return s.coloured_translucency;
   if (key == "alpha_threshold") return s.translucent_alpha_threshold;
   if (key == "light_extent_deg") return s.light_extent_deg ? json(*s.light_extent_deg) : json();
+  if (key == "light_height_deg") return s.light_height_deg ? json(*s.light_height_deg) : json();
   if (key == "soft_kernel") return s.soft_kernel;
   fail(key, "unknown setting");
 }

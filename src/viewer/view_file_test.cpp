@@ -51,6 +51,7 @@ TEST(ViewFile, RoundTripIsExact) {
   s.frame = 7;
   s.coloured_translucency = true;
   s.light_extent_deg = 2.5f;
+  s.light_height_deg = 1.25f;
   s.soft_kernel = 11;
 
   nlohmann::json j = view_json(v);
@@ -65,6 +66,7 @@ TEST(ViewFile, RoundTripIsExact) {
   EXPECT_EQ(back.settings.lookup, s.lookup);
   EXPECT_EQ(back.settings.one_pass, s.one_pass);
   EXPECT_EQ(back.settings.filter_sigma, s.filter_sigma);
+  EXPECT_EQ(back.settings.light_height_deg, s.light_height_deg);
 }
 
 TEST(ViewFile, DefaultsStayDefaults) {
@@ -74,6 +76,8 @@ TEST(ViewFile, DefaultsStayDefaults) {
   EXPECT_TRUE(v.settings.lights.empty());
   EXPECT_FALSE(v.settings.params);
   EXPECT_FALSE(v.settings.depth_bias);
+  EXPECT_FALSE(v.settings.light_extent_deg);
+  EXPECT_FALSE(v.settings.light_height_deg);
 }
 
 TEST(ViewFile, RelativeScenePathsFollowTheFile) {

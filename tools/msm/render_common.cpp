@@ -61,6 +61,12 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--light-extent", s.light_extent_deg,
                   "Angular diameter of the light in degrees, for soft "
                   "shadows (default: the scene's)");
+  cmd->add_option("--light-height", s.light_height_deg,
+                  "Angular height in degrees of a rectangular light, for soft shadows: every light becomes a "
+                  "rectangle of this height and --light-extent's width (default: each light's own)");
+  cmd->add_flag("--front-back-depth", s.front_back_depth,
+                "Moment soft shadows: the map stores the mean of the nearest front- and back-face depth "
+                "(Kneiphof §4.2.3; for closed occluders)");
   cmd->add_option("--soft-kernel", s.soft_kernel,
                   "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15");
   cmd->add_option("--frame", s.frame, "Frame number (blue-noise layer and offset)")->capture_default_str();
@@ -200,6 +206,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
           {"frame", s.frame},
           {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light().angular_extent_deg},
+          {"light_height_deg", s.light_height_deg ? nlohmann::json(*s.light_height_deg) : nlohmann::json()},
+          {"front_back_depth", s.front_back_depth},
           {"soft_kernel", s.resolved_soft_kernel()},
           {"translucent_occluders", s.translucent_occluders},
           {"translucent_alpha_threshold", s.translucent_alpha_threshold},

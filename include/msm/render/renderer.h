@@ -129,6 +129,17 @@ struct RenderSettings {
   // 27 for the tables (JCGT's 27² search region), 15 for PCSS (its 15² search: 225 taps, and up to
   // 256 more for the filter). Tables take 3..255, PCSS 3..kMaxPcssKernel.
   std::optional<float> light_extent_deg;
+  // A rectangular light's angular height in degrees (Kneiphof §4.1.2; the width is
+  // light_extent_deg or each light's own angular_extent_deg): set, every light is a rectangle of
+  // that height along its frame's y axis; unset, each keeps its own height, except that
+  // light_extent_deg alone makes every light a disc of that diameter.
+  std::optional<float> light_height_deg;
+  // Kneiphof §4.2.3, the moment soft shadows (mssm4, mssm6, vssm, cssm8, cssm16) only: the map
+  // stores the mean of the nearest front-face and back-face depth (a second depth pass culling the
+  // faces towards the light; double-sided materials count as both), a depth inside closed
+  // occluders instead of on their surface. Meant for closed, convex occluders (the paper's
+  // condition); an open, single-sided surface has no back face and averages with what lies behind.
+  bool front_back_depth = false;
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default
   float translucent_alpha_threshold = 0.01f;

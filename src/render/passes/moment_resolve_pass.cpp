@@ -19,18 +19,23 @@ void MomentResolvePass::prepare(const PassResources& r) {
   const FrameConfig& config = config_;
   program_ = &r.programs.compute(
       config.msaa == 1 ? "moment_resolve_1x.comp" : "moment_resolve.comp",
-      {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image, vk::Binding::storage_image},
-      sizeof(ImagePassPush), {{0, uint32_t(config.technique->id)}, {3, config.split_rg() ? 1u : 0u}});
+      {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image, vk::Binding::storage_image,
+       vk::Binding::sampled_image},
+      sizeof(ImagePassPush),
+      {{0, uint32_t(config.technique->id)}, {3, config.split_rg() ? 1u : 0u}, {4, config.front_back ? 1u : 0u}});
 }
 
 void MomentResolvePass::reflect(PassBuilder& b) const {
   b.read(kShadowDepth, use::sampled(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT));
+  if (config_.front_back) b.read(kShadowDepthBack, use::sampled(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT));
   for (int i = 0; i < config_.moment_images(); ++i)
     b.create(moment_image(0, i), moment_image_spec(config_, i), use::compute_general());
 }
 
 void MomentResolvePass::execute(const PassContext& c) const {
   const GraphImage& depth = c.image(kShadowDepth);
+  // Without front_back the shader reads no back-face map: the front one fills its binding.
+  const GraphImage& back = c.image(config_.front_back ? kShadowDepthBack : kShadowDepth);
   int images = config_.moment_images();
   ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, 0, 0)};
   uint32_t groups = vk::group_count(uint32_t(config_.shadow_size), 8);
@@ -43,7 +48,8 @@ void MomentResolvePass::execute(const PassContext& c) const {
         c.cmd, *program_, groups, groups, 1,
         {vk::Descriptor(c.frame.uniforms),
          vk::Descriptor(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler),
-         vk::Descriptor(first, VK_IMAGE_LAYOUT_GENERAL), vk::Descriptor(second, VK_IMAGE_LAYOUT_GENERAL)},
+         vk::Descriptor(first, VK_IMAGE_LAYOUT_GENERAL), vk::Descriptor(second, VK_IMAGE_LAYOUT_GENERAL),
+         vk::Descriptor(back.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler)},
         push);
     c.end_light();
   }

@@ -18,10 +18,12 @@
 namespace msm::render {
 
 // Scene -> shadow_depth (D16, MSAA, one layer per light): orthographic depth, depth clamp, both faces.
+// back: shadow_depth_back, the nearest back face (Kneiphof §4.2.3, FrameConfig::front_back): the
+// faces towards the light are culled, except on double-sided materials, which count as both.
 class ShadowDepthPass : public Pass {
  public:
-  explicit ShadowDepthPass(const FrameConfig& config) : config_(config) {}
-  std::string_view name() const override { return "shadow_depth"; }
+  explicit ShadowDepthPass(const FrameConfig& config, bool back = false) : config_(config), back_(back) {}
+  std::string_view name() const override { return back_ ? "shadow_depth_back" : "shadow_depth"; }
   void prepare(const PassResources& r) override;
   void reflect(PassBuilder& b) const override;
   void execute(const PassContext& c) const override;
@@ -30,6 +32,7 @@ class ShadowDepthPass : public Pass {
   const vk::Program* program_ = nullptr;
   const vk::Program* masked_program_ = nullptr; // alpha-tested draws: a fragment stage discards cut-outs
   FrameConfig config_;
+  bool back_ = false;
 };
 
 // shadow_depth -> moment images (mip 0) of channel 0: per sample msm_technique_generate, averaged,

@@ -37,7 +37,7 @@ void ShadowDepthPass::prepare(const PassResources& r) {
 
 void ShadowDepthPass::reflect(PassBuilder& b) const {
   // Single-sampled depth is read back by copy (Renderer::Intermediates), MSAA depth by a shader.
-  b.create(kShadowDepth,
+  b.create(back_ ? kShadowDepthBack : kShadowDepth,
            {.format = VK_FORMAT_D16_UNORM,
             .width = uint32_t(config_.shadow_size),
             .height = uint32_t(config_.shadow_size),
@@ -48,17 +48,25 @@ void ShadowDepthPass::reflect(PassBuilder& b) const {
 }
 
 void ShadowDepthPass::execute(const PassContext& c) const {
-  const GraphImage& depth = c.image(kShadowDepth);
+  const GraphImage& depth = c.image(back_ ? kShadowDepthBack : kShadowDepth);
   VkExtent2D size{uint32_t(config_.shadow_size), uint32_t(config_.shadow_size)};
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     vk::begin_rendering(c.cmd, size, {}, vk::DepthAttachment{depth.layer_views[size_t(l)], 1.0f});
     vk::set_viewport_scissor(c.cmd, size);
-    vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE); // both sides cast: thin walls, planes, open meshes
+    // Both sides cast: thin walls, planes, open meshes. The back-face map culls the faces towards
+    // the light (counter-clockwise in the light's clip space, as the camera's front faces).
+    vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
+    VkCullModeFlags cull = VK_CULL_MODE_NONE;
     bind_scene(c.cmd, c.frame.scene);
     const GpuScene& scene = c.frame.scene;
     const vk::Program* bound = nullptr;
     for (const Draw& d : scene.draws) {
+      if (back_) {
+        VkCullModeFlags want = d.double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_FRONT_BIT;
+        if (want != cull) vkCmdSetCullMode(c.cmd, want);
+        cull = want;
+      }
       if (d.masked) { // its own opacity texture and cutoff
         const vk::Image& opacity =
             d.opacity_texture >= 0 ? scene.opacity_textures[size_t(d.opacity_texture)] : scene.white;

@@ -18,13 +18,31 @@ layout(binding = MSM_DEPTH_BINDING) uniform sampler2DMS depth_map;
 #define MSM_DEPTH_TEXEL(p) (p)
 #endif
 
+// Kneiphof §4.2.3 (FrameConfig::front_back): where the including file defines
+// MSM_BACK_DEPTH_BINDING, the back-face depth map of the same layout (the nearest back face of each
+// sample) at that binding, averaged with the front's when kFrontBack (its specialization constant).
+#ifdef MSM_BACK_DEPTH_BINDING
+#ifdef MSM_SINGLE_SAMPLE
+layout(binding = MSM_BACK_DEPTH_BINDING) uniform sampler2D back_depth_map;
+#else
+layout(binding = MSM_BACK_DEPTH_BINDING) uniform sampler2DMS back_depth_map;
+#endif
+#endif
+
 // Depth of sample s of texel p (sample 0 where single-sampled).
 float depth_sample(ivec2 p, int s) {
 #ifdef MSM_SINGLE_SAMPLE
-  return texelFetch(depth_map, MSM_DEPTH_TEXEL(p), 0).x;
-#else
-  return texelFetch(depth_map, MSM_DEPTH_TEXEL(p), s).x;
+  float front = texelFetch(depth_map, MSM_DEPTH_TEXEL(p), 0).x;
+#ifdef MSM_BACK_DEPTH_BINDING
+  if (kFrontBack) return 0.5f * (front + texelFetch(back_depth_map, MSM_DEPTH_TEXEL(p), 0).x);
 #endif
+#else
+  float front = texelFetch(depth_map, MSM_DEPTH_TEXEL(p), s).x;
+#ifdef MSM_BACK_DEPTH_BINDING
+  if (kFrontBack) return 0.5f * (front + texelFetch(back_depth_map, MSM_DEPTH_TEXEL(p), s).x);
+#endif
+#endif
+  return front;
 }
 
 #ifdef MSM_TECHNIQUES_H

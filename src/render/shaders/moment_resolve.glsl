@@ -7,7 +7,10 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
+// The mean of the front- and back-face depth (Kneiphof §4.2.3; FrameConfig::front_back).
+layout(constant_id = 4) const bool kFrontBack = false;
 #define MSM_DEPTH_BINDING 1
+#define MSM_BACK_DEPTH_BINDING 4
 #include "depth_map.glsl"
 layout(binding = 2) writeonly uniform image2D moments0;
 layout(binding = 3) writeonly uniform image2D moments1; // second half of 6MSM; else moments0 again
