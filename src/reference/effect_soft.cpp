@@ -44,38 +44,64 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
   // for area / cos³ θ of solid angle (θ its angle off L).
   const double area = disc ? std::numbers::pi * ctx.half_x * ctx.half_x : 4.0 * ctx.half_x * ctx.half_y;
   const double facing = facing_integral(disc, ctx.half_x, ctx.half_y);
-  RunningStats stats;
-  double deviation = 0.0;
-  // Directions of a batch first, then the rays (as effect_filtered, and why: kSampleBatch).
-  glm::dvec3 dirs[kSampleBatch], origins[kSampleBatch];
+  // Directions of a batch first, then the rays (as effect_filtered, and why: kSampleBatch). The
+  // points come from the generator in double precision (the same random numbers in the same
+  // order), the directions in single precision, which is what Embree traces: the loops over a
+  // whole batch have no branch and no call, and the compiler vectorizes them (issue 18).
+  const float half_x = float(ctx.half_x), half_y = float(ctx.half_y);
+  const glm::vec3 towards(ctx.towards_light), light_x(ctx.light_x), light_y(ctx.light_y);
+  alignas(64) float ux[kSampleBatch], uy[kSampleBatch], dx[kSampleBatch], dy[kSampleBatch], dz[kSampleBatch];
   bool blocked[kSampleBatch], lit_blocked[kSampleBatch];
+  int unblocked = 0;
+  double deviation = 0.0;
   for (int first = 0; first < set.count(); first += kSampleBatch) {
     const int count = std::min(kSampleBatch, set.count() - first);
     for (int k = 0; k < count; ++k) {
       const glm::dvec2 u = set.point(first + k, rng);
-      const glm::dvec2 ab = disc ? ctx.half_x * concentric_disc(u)
-                                 : glm::dvec2((2.0 * u.x - 1.0) * ctx.half_x, (2.0 * u.y - 1.0) * ctx.half_y);
-      dirs[k] = glm::normalize(ctx.towards_light + ab.x * ctx.light_x + ab.y * ctx.light_y);
-      origins[k] = origin;
+      ux[k] = float(u.x);
+      uy[k] = float(u.y);
     }
-    ctx.tracer.occluded(origins, dirs, count, blocked);
+    std::fill(ux + count, ux + kSampleBatch, 0.5f); // a last, partial batch: directions not traced
+    std::fill(uy + count, uy + kSampleBatch, 0.5f);
+    if (disc) {
+      for (int k = 0; k < kSampleBatch; ++k) {
+        const glm::vec2 p = concentric_disc(glm::vec2(ux[k], uy[k]));
+        ux[k] = half_x * p.x;
+        uy[k] = half_x * p.y;
+      }
+    } else {
+      for (int k = 0; k < kSampleBatch; ++k) {
+        ux[k] = (2.0f * ux[k] - 1.0f) * half_x;
+        uy[k] = (2.0f * uy[k] - 1.0f) * half_y;
+      }
+    }
+    for (int k = 0; k < kSampleBatch; ++k) {
+      // The frame is orthonormal, so |d|² = 1 + a² + b² (and a light of no area traces exactly
+      // towards_light, as `hard` does).
+      const glm::vec3 d = towards + ux[k] * light_x + uy[k] * light_y;
+      const float inverse_length = 1.0f / std::sqrt(1.0f + ux[k] * ux[k] + uy[k] * uy[k]);
+      dx[k] = d.x * inverse_length;
+      dy[k] = d.y * inverse_length;
+      dz[k] = d.z * inverse_length;
+    }
+    ctx.tracer.occluded(origin, dx, dy, dz, count, blocked);
     if (same_side) {
       std::copy(blocked, blocked + count, lit_blocked);
     } else {
-      for (int k = 0; k < count; ++k) origins[k] = viewer_side;
-      ctx.tracer.occluded(origins, dirs, count, lit_blocked);
+      ctx.tracer.occluded(viewer_side, dx, dy, dz, count, lit_blocked);
       extra_rays += std::uint64_t(count);
     }
     for (int k = 0; k < count; ++k) {
-      stats.add(blocked[k] ? 0.0 : 1.0);
+      unblocked += blocked[k] ? 0 : 1;
       // ∫ max(n·d, 0) V dω = (n·L) ∫ (d·L) dω + ∫ (max(n·d, 0) V − n·d) dω (the light is symmetric
       // about L, so ∫ d dω is along L): only the second integral is sampled, and it is exactly 0
       // where the whole light is visible and above the horizon.
-      const double cos_n = glm::dot(n, dirs[k]), cos_l = glm::dot(ctx.towards_light, dirs[k]);
+      const glm::dvec3 d(dx[k], dy[k], dz[k]);
+      const double cos_n = glm::dot(n, d), cos_l = glm::dot(ctx.towards_light, d);
       deviation += ((lit_blocked[k] ? 0.0 : std::max(cos_n, 0.0)) - cos_n) * cos_l * cos_l * cos_l;
     }
   }
-  EffectResult r = monte_carlo_result(stats);
+  EffectResult r = monte_carlo_result(BinaryStats{set.count(), unblocked});
   r.rays += extra_rays;
   // A light of no area is the point light of `hard`.
   r.lit = facing > 0.0 ? std::max(n_dot_l + area * deviation / (set.count() * facing), 0.0)

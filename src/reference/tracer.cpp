@@ -225,6 +225,37 @@ void Tracer::occluded(const glm::dvec3* origins, const glm::dvec3* dirs, int n, 
   }
 }
 
+void Tracer::occluded(const glm::dvec3& origin, const float* dir_x, const float* dir_y, const float* dir_z, int n,
+                      bool* blocked) const {
+  const glm::vec3 o(origin);
+  for (int first = 0; first < n; first += 8) {
+    const int m = std::min(8, n - first);
+    alignas(32) int valid[8];
+    alignas(32) RTCRay8 rays;
+    for (int j = 0; j < 8; ++j) {
+      const int i = first + std::min(j, m - 1);
+      valid[j] = j < m ? -1 : 0;
+      rays.org_x[j] = o.x;
+      rays.org_y[j] = o.y;
+      rays.org_z[j] = o.z;
+      rays.tnear[j] = 0.0f;
+      rays.dir_x[j] = dir_x[i];
+      rays.dir_y[j] = dir_y[i];
+      rays.dir_z[j] = dir_z[i];
+      rays.time[j] = 0.0f;
+      rays.tfar[j] = std::numeric_limits<float>::infinity();
+      rays.mask[j] = 0xFFFFFFFFu;
+      rays.id[j] = 0;
+      rays.flags[j] = 0;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded8(valid, impl_->scene, &context, &rays);
+    for (int j = 0; j < m; ++j) blocked[first + j] = rays.tfar[j] < 0.0f; // -inf on a hit
+  }
+}
+
 Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const {
   Transmission result;
   glm::dvec3 o = origin;
