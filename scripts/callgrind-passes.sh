@@ -15,6 +15,7 @@
 # Defaults: MSM = build/tools/msm/msm, DIR = a temporary directory (kept with -o). Needs valgrind
 # (scripts/bootstrap.sh installs it). A 1024² MSM-64 frame takes about a minute on this machine.
 set -euo pipefail
+source "$(dirname "$0")/lib/callgrind.sh"
 
 msm=build/tools/msm/msm
 out=
@@ -26,7 +27,6 @@ while [[ $# -gt 0 ]]; do
   *) break ;;
   esac
 done
-command -v valgrind >/dev/null || { echo "callgrind-passes.sh: valgrind is not installed (scripts/bootstrap.sh)" >&2; exit 2; }
 [[ -x $msm ]] || { echo "callgrind-passes.sh: no msm at '$msm' (build it, or -m PATH)" >&2; exit 2; }
 if [[ -z $out ]]; then
   out=$(mktemp -d)
@@ -34,22 +34,9 @@ if [[ -z $out ]]; then
 else
   mkdir -p "$out"
 fi
-icd=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
-[[ -f $icd ]] && export VK_ICD_FILENAMES=$icd
-
-MESA_SHADER_CACHE_DISABLE=true LP_NUM_THREADS=0 valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file="$out/callgrind.out" \
-  "$msm" bench --callgrind "$@" >"$out/log" 2>&1 || {
-  echo "callgrind-passes.sh: msm bench --callgrind failed:" >&2
-  tail -n 20 "$out/log" >&2
-  exit 2
-}
-
-# Each dump: "desc: Trigger: Client Request: msm-prefix TECH WxH SIZE K PASS" and "totals: Ir".
-for f in "$out"/callgrind.out.*; do
-  awk '/^desc: Trigger: Client Request: msm-prefix/ { label = $0; sub(/.*msm-prefix /, "", label) }
-       /^totals:/ { ir = $2 }
-       END { if (label != "") print label, ir }' "$f"
-done | sort -k1,1 -k2,2 -k3,3n -k4,4n | awk '
+callgrind_run callgrind-passes.sh "$out" "$msm" bench --callgrind "$@"
+# Each dump's trigger: "msm-prefix TECH WxH SIZE K PASS".
+callgrind_totals "$out" msm-prefix | sort -k1,1 -k2,2 -k3,3n -k4,4n | awk '
   BEGIN { printf "%-26s %-10s %6s %-16s %14s %10s\n", "technique", "image", "map", "pass", "instructions", "per unit" }
   {
     key = $1 " " $2 " " $3
