@@ -128,7 +128,9 @@ class Reader {
   template <class T>
   std::vector<T> array(std::uint64_t n, const char* what) {
     std::vector<T> v(static_cast<std::size_t>(n));
-    std::memcpy(static_cast<void*>(v.data()), take(n * sizeof(T), what), std::size_t(n) * sizeof(T));
+    const char* from = take(n * sizeof(T), what);
+    // An empty vector's data() may be null, which memcpy may not be given even for zero bytes (UBSan).
+    if (n > 0) std::memcpy(static_cast<void*>(v.data()), from, std::size_t(n) * sizeof(T));
     return v;
   }
   bool at_end() const { return at_ == bytes_.size(); }
