@@ -9,6 +9,7 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfTiledOutputFile.h>
 
 #include <bit>
@@ -170,6 +171,58 @@ TEST_F(ImageTest, ExrRoundTripIsExact) {
     Image again = read_image(p); // by content, same result
     again.at(2, 0, 0) = 0.0f;
     EXPECT_TRUE(again == im);
+  }
+}
+
+// A channel whose every value is a half (masks, 8-bit values) is stored as HALF, in half the
+// bytes; one value that is not keeps its channel FLOAT. Either way the round trip is exact.
+TEST_F(ImageTest, ExrStoresExactHalfChannelsAsHalfLosslessly) {
+  const float halfs[] = {0.0f,
+                         -0.0f,
+                         1.0f,
+                         65504.0f,
+                         -65504.0f,
+                         std::ldexp(1.0f, -24),
+                         std::ldexp(3.0f, -24),
+                         std::ldexp(1.5f, -15),
+                         std::ldexp(1.0f, -14),
+                         0.5f + std::ldexp(1.0f, -11)};
+  const float not_halfs[] = {1.0f + std::ldexp(1.0f, -11),
+                             65520.0f,
+                             std::ldexp(1.0f, -25),
+                             std::ldexp(1.5f, -24),
+                             std::ldexp(1.0f + std::ldexp(1.0f, -10), -15),
+                             0.1f,
+                             std::numeric_limits<float>::infinity()};
+  const int w = int(std::size(not_halfs)) + 1;
+  Image im(w, 2, {"mask", "halfs", "mixed"});
+  for (int x = 0; x < w; ++x) {
+    im.at(x, 0, 0) = float(x % 2);
+    im.at(x, 1, 0) = 1.0f - float(x % 2);
+    im.at(x, 0, 1) = halfs[std::size_t(x) % std::size(halfs)];
+    im.at(x, 1, 1) = -halfs[std::size_t(x + 3) % std::size(halfs)];
+    im.at(x, 0, 2) = 0.25f;
+    im.at(x, 1, 2) = x + 1 < w ? not_halfs[std::size_t(x)] : 0.75f;
+  }
+  const fs::path p = dir / "halfs.exr";
+  write_exr(p, im);
+  const Image back = read_exr(p);
+  ASSERT_EQ(back.channel_names(), im.channel_names());
+  for (std::size_t i = 0; i < im.pixels().size(); ++i) {
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(back.pixels()[i]), std::bit_cast<std::uint32_t>(im.pixels()[i]))
+        << "value " << i << ": " << im.pixels()[i];
+  }
+  Imf::InputFile file(p.c_str());
+  EXPECT_EQ(file.header().channels().findChannel("mask")->type, Imf::HALF);
+  EXPECT_EQ(file.header().channels().findChannel("halfs")->type, Imf::HALF);
+  EXPECT_EQ(file.header().channels().findChannel("mixed")->type, Imf::FLOAT);
+  // Each value that is not a half alone keeps a channel FLOAT.
+  for (float v : not_halfs) {
+    Image one(1, 1, {"Y"});
+    one.at(0, 0, 0) = v;
+    write_exr(p, one);
+    EXPECT_EQ(Imf::InputFile(p.c_str()).header().channels().findChannel("Y")->type, Imf::FLOAT) << v;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(read_exr(p).at(0, 0, 0)), std::bit_cast<std::uint32_t>(v)) << v;
   }
 }
 

@@ -589,6 +589,40 @@ Image read_png(const fs::path& path) {
 
 // ---- EXR -------------------------------------------------------------------------------------
 
+// Channel c as halves (IEEE binary16 bits) if every value is a half exactly (±0, normal and
+// subnormal halves), else nothing. Such a channel is stored as HALF, lossless, in half the bytes:
+// masks (0/1) and 8-bit-derived values are; a filtered visibility is not and stays FLOAT, as do
+// infinities and NaNs. (OpenEXR converts only on reading: the halves are made here, bit-exactly.)
+namespace {
+std::optional<std::vector<std::uint16_t>> exact_halves(const Image& image, std::size_t c) {
+  const std::span<const float> px = image.pixels();
+  const std::size_t n = std::size_t(image.channels());
+  std::vector<std::uint16_t> halves(image.pixel_count());
+  for (std::size_t i = c, k = 0; i < px.size(); i += n, ++k) {
+    std::uint32_t bits;
+    std::memcpy(&bits, &px[i], sizeof bits);
+    const auto sign = std::uint16_t((bits >> 16) & 0x8000u);
+    const std::uint32_t magnitude = bits & 0x7fffffffu;
+    const int exponent = int(magnitude >> 23) - 127;
+    const std::uint32_t mantissa = magnitude & 0x7fffffu;
+    if (magnitude == 0) {
+      halves[k] = sign;
+    } else if (exponent >= -14 && exponent <= 15) { // a normal half keeps 10 of the 23 mantissa bits
+      if (mantissa & 0x1fffu) return std::nullopt;
+      halves[k] = std::uint16_t(sign | std::uint32_t(exponent + 15) << 10 | mantissa >> 13);
+    } else if (exponent >= -24 && exponent < -14) { // a subnormal half: k 2^-24, k < 1024
+      const std::uint32_t significand = 0x800000u | mantissa;
+      const int shift = -1 - exponent;
+      if (significand & ((1u << shift) - 1u)) return std::nullopt;
+      halves[k] = std::uint16_t(sign | significand >> shift);
+    } else {
+      return std::nullopt;
+    }
+  }
+  return halves;
+}
+} // namespace
+
 std::vector<std::uint8_t> encode_exr(const fs::path& path, const Image& image) {
   require_image(path, image);
   MemoryOStream stream;
@@ -597,14 +631,24 @@ std::vector<std::uint8_t> encode_exr(const fs::path& path, const Image& image) {
     header.compression() = Imf::ZIP_COMPRESSION;
     header.zipCompressionLevel() = 1; // lossless either way; the default level took 10% of msm render
     const std::size_t n = std::size_t(image.channels());
-    for (const std::string& name : image.channel_names()) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
+    std::vector<std::optional<std::vector<std::uint16_t>>> halves(n);
+    for (std::size_t c = 0; c < n; ++c) {
+      halves[c] = exact_halves(image, c);
+      header.channels().insert(image.channel_names()[c], Imf::Channel(halves[c] ? Imf::HALF : Imf::FLOAT));
+    }
     header.insert(channel_order_attribute, Imf::StringVectorAttribute(image.channel_names()));
     Imf::FrameBuffer fb;
     // OpenEXR only reads through the slices of an OutputFile.
     char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels().data()));
-    for (std::size_t c = 0; c < n; ++c)
-      fb.insert(image.channel_names()[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), sizeof(float) * n,
-                                                     sizeof(float) * n * std::size_t(image.width())));
+    for (std::size_t c = 0; c < n; ++c) {
+      if (halves[c])
+        fb.insert(image.channel_names()[c],
+                  Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c]->data()), sizeof(std::uint16_t),
+                             sizeof(std::uint16_t) * std::size_t(image.width())));
+      else
+        fb.insert(image.channel_names()[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), sizeof(float) * n,
+                                                       sizeof(float) * n * std::size_t(image.width())));
+    }
     Imf::OutputFile file(stream, header);
     file.setFrameBuffer(fb);
     file.writePixels(image.height());
