@@ -4,5 +4,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build}
-exec xvfb-run -a "$build/tools/msm/msm" view --device cpu --width 1280 --height 720 \
+exec scripts/xvfb-exec.sh "$build/tools/msm/msm" view --device cpu --width 1280 --height 720 \
   --script docs/viewer/screenshot.script
