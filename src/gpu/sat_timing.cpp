@@ -182,6 +182,19 @@ int main(int argc, char** argv) {
 #endif
     fmt::print("| {}² | copy: image {:.2f} ms ({:.2f} GB/s), two-thread CPU {:.2f} ms ({:.2f} GB/s) | | | | | |\n", n,
                copy_ms, bandwidth * 1e-9, cpu_ms, 32.0 * texels / (cpu_ms * 1e-3) * 1e-9);
+    if (!callgrind) { // for comparison, not a device scheme: the same table by host code (one thread)
+      std::vector<double> host;
+      for (int r = 0; r <= repeat; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        std::vector<glm::uvec4> t = gpu::build_sat_cpu(m, n, n, 27 * 27);
+        if (r > 0)
+          host.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      }
+      const double ms = median(host);
+      fmt::print(
+          "| {}² | build_sat_cpu (host code, one thread; not a device scheme) | {:.2f} | | | {:.3f} | {:.3f} |\n", n,
+          ms, 2.0 * cpu_ms / ms, cpu_ms / ms);
+    }
     // The copy shaders: RGBA32_UINT images (the tables' format) and storage buffers of the same size.
     vk::Image copy_src = vk::create_image(ctx, vk::ImageDesc{.width = size,
                                                              .height = size,
