@@ -7,7 +7,8 @@
 # Runs `msm_sat_timing --callgrind --repeat 1 SIZES` under valgrind --tool=callgrind
 # --instr-atstart=no with LP_NUM_THREADS=0 (llvmpipe dispatches on the submitting thread) and
 # VK_ICD_FILENAMES on lavapipe; msm_sat_timing dumps one submission of each scheme alone (after an
-# uncounted warm-up). Needs valgrind (scripts/bootstrap.sh installs it).
+# uncounted warm-up), each copy shader of src/gpu/sat_copy.h alike, and one two-thread CPU copy (the
+# bound). Needs valgrind (scripts/bootstrap.sh installs it).
 set -euo pipefail
 source "$(dirname "$0")/lib/callgrind.sh"
 
@@ -23,6 +24,11 @@ callgrind_totals "$out" msm-sat | sort -k1,1n -k2,2n | awk '
   BEGIN {
     name[0] = "rows + columns"; name[1] = "blocks (App. C)"; name[2] = "scan rows + columns"
     name[3] = "subgroup rows + columns"; name[4] = "subgroup rows + subgroup columns"
-    printf "%-6s %-34s %14s %10s\n", "size", "scheme", "instructions", "per texel"
+    name[10] = "copy shader: image, texel"; name[11] = "copy shader: image, row"
+    name[12] = "copy shader: image, column"; name[13] = "copy shader: texelFetch -> image, row"
+    name[14] = "copy shader: buffer, texel"; name[15] = "copy shader: buffer, 4 texels"
+    name[16] = "copy shader: buffer, row"; name[17] = "copy shader: buffer, column"
+    name[20] = "two-thread CPU copy (memcpy)"
+    printf "%-6s %-38s %14s %10s\n", "size", "scheme", "instructions", "per texel"
   }
-  { printf "%-6s %-34s %14d %10.1f\n", $1, name[$2], $3, $3 / ($1 * $1) }'
+  { printf "%-6s %-38s %14d %10.1f\n", $1, name[$2], $3, $3 / ($1 * $1) }'

@@ -7,12 +7,15 @@
 //    256², 1024² (blocks and subgroup schemes), small and large n_t; and build_sat_cpu itself equals 64-bit running
 //    sums taken modulo 2^32;
 //  - the six-moment overload (two images, RGBA32F + RG32F) fills both tables;
+//  - the copy shaders that msm_sat_timing times beside the schemes (sat_copy.h) copy every texel,
+//    bitwise, and touch nothing else, at sizes that are not multiples of their groups;
 //  - the shared queries (sat.h's 4- and 16-lookup queries, soft.h's whole per-pixel flow) in a
 //    shader (shaders/test/sat_queries.comp, via soft_flow.h) agree with the same code on the CPU.
 #include "msm/gpu/sat_builder.h"
 #include "msm/quantize.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
+#include "sat_copy.h"
 
 #include <gtest/gtest.h>
 
@@ -182,6 +185,64 @@ TEST_F(SatBuilderTest, BothSchemesEqualTheCpuTableBitwise) {
                                                                  : "rows+columns",
                   mismatches, gpu.size());
       EXPECT_EQ(mismatches, 0u) << "first at texel " << first % size_t(c.width) << "," << first / size_t(c.width);
+    }
+  }
+}
+
+// The copy shaders of msm_sat_timing (sat_copy.h): each writes exactly its source into its
+// destination, every texel (a sentinel elsewhere would show), at sizes that are not multiples of
+// their groups of 64 or 256 texels: their times are those of whole copies.
+TEST_F(SatBuilderTest, CopyShadersCopyEveryTexel) {
+  namespace sc = gpu::sat_copy;
+  const std::vector<vk::Program> programs = sc::create_programs(ctx());
+  const vk::Sampler nearest = vk::create_sampler(ctx(), VK_FILTER_NEAREST);
+  std::mt19937_64 rng(18);
+  std::uniform_real_distribution<float> value(-1e3f, 1e3f); // finite floats: texelFetch returns their bits
+  for (auto [w, h] : {std::pair{61, 47}, std::pair{300, 3}, std::pair{13, 70}}) {
+    const size_t texels = size_t(w) * size_t(h);
+    std::vector<vec4> floats(texels);
+    for (vec4& f : floats) f = vec4(value(rng), value(rng), value(rng), value(rng));
+    std::vector<uvec4> expected(texels), sentinel(texels, uvec4(0xDEADBEEFu));
+    std::memcpy(static_cast<void*>(expected.data()), floats.data(), texels * sizeof(uvec4));
+    const auto bytes = std::as_bytes(std::span(expected));
+    const auto sentinel_bytes = std::as_bytes(std::span(sentinel));
+    auto image = [&](VkFormat format, VkImageUsageFlags usage) {
+      return vk::create_image(
+          ctx(), vk::ImageDesc{.width = uint32_t(w),
+                               .height = uint32_t(h),
+                               .format = format,
+                               .usage = usage | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT});
+    };
+    vk::Image src_image = image(VK_FORMAT_R32G32B32A32_UINT, VK_IMAGE_USAGE_STORAGE_BIT);
+    vk::Image src_floats = image(VK_FORMAT_R32G32B32A32_SFLOAT, VK_IMAGE_USAGE_SAMPLED_BIT);
+    vk::upload_image(ctx(), src_image, bytes, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+    vk::upload_image(ctx(), src_floats, bytes, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+    vk::Buffer src_buffer = vk::create_buffer(ctx(), bytes.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::upload_buffer(ctx(), src_buffer, bytes);
+    for (int i = 0; i < sc::count; ++i) {
+      const sc::Shader& s = sc::shaders[i];
+      vk::Image dst_image = image(VK_FORMAT_R32G32B32A32_UINT, VK_IMAGE_USAGE_STORAGE_BIT);
+      vk::Buffer dst_buffer = vk::create_buffer(ctx(), bytes.size(), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+      const bool buffer = s.kind == sc::Kind::buffer;
+      if (buffer)
+        vk::upload_buffer(ctx(), dst_buffer, sentinel_bytes);
+      else
+        vk::upload_image(ctx(), dst_image, sentinel_bytes, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+      vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+        const vk::Descriptor src = buffer ? vk::Descriptor(src_buffer)
+                                   : s.kind == sc::Kind::fetch
+                                       ? vk::Descriptor(src_floats, VK_IMAGE_LAYOUT_GENERAL, nearest)
+                                       : vk::Descriptor(src_image, VK_IMAGE_LAYOUT_GENERAL);
+        const vk::Descriptor dst =
+            buffer ? vk::Descriptor(dst_buffer) : vk::Descriptor(dst_image, VK_IMAGE_LAYOUT_GENERAL);
+        sc::record(cmd, programs[size_t(i)], s, uint32_t(w), uint32_t(h), src, dst);
+      });
+      std::vector<uvec4> got =
+          buffer ? vk::readback_buffer<uvec4>(ctx(), dst_buffer, texels) : read_table(ctx(), dst_image);
+      ASSERT_EQ(got.size(), texels);
+      size_t wrong = 0;
+      for (size_t t = 0; t < texels; ++t) wrong += got[t] != expected[t];
+      EXPECT_EQ(wrong, 0u) << s.name << ", " << w << "x" << h;
     }
   }
 }

@@ -18,10 +18,17 @@
 // warm-up that touches both buffers): its time is the 32 B bound (one read, one write per texel),
 // twice its time the 64 B bound. Every scheme's fraction of both bounds is printed beside the
 // fraction of the vkCmdCopyImage bound.
+//
+// The copy shaders (sat_copy.h, shaders/sat_copy.glsl; issue 18): shaders that only read and write
+// every texel once, on RGBA32_UINT storage images (imageLoad → imageStore), on storage buffers of
+// uvec4, and from the RGBA32F moment image (texelFetch → imageStore), one texel / four texels / a
+// row / a column per invocation. Each is one pass moving 32 B per texel: its fraction of the 32 B
+// two-thread bound is what any scheme built of such passes can reach on the device.
 #include "msm/gpu/sat_builder.h"
 #include "msm/moments.h"
 #include "msm/quantize.h"
 #include "msm/vk/vk.h"
+#include "sat_copy.h"
 
 #include <fmt/core.h>
 
@@ -66,6 +73,10 @@ double two_thread_copy_ms(const std::vector<std::byte>& src, std::vector<std::by
   return best;
 }
 
+// Callgrind labels: the schemes are 0-4 (SatBuilder::Scheme), the copy shaders 10 + their index in
+// sat_copy::shaders, the two-thread CPU copy 20.
+constexpr int copy_label = 10, cpu_copy_label = 20;
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -101,11 +112,15 @@ int main(int argc, char** argv) {
   vk::Context ctx;
   fmt::print("device: {}\n\n", ctx.info().describe());
   gpu::SatBuilder builder(ctx);
+  const std::vector<vk::Program> copy_programs = gpu::sat_copy::create_programs(ctx);
+  const vk::Sampler nearest = vk::create_sampler(ctx, VK_FILTER_NEAREST);
   if (!builder.subgroup_arithmetic())
     fmt::print("no subgroup arithmetic in compute shaders: the subgroup schemes run as scan rows + columns\n\n");
   fmt::print("Per size: vkCmdCopyImage of the moment image and a two-thread CPU copy of its bytes (ms, GB/s at 32 B "
              "per texel). Per scheme: time (ms) and the fraction of the 64 B per texel bound (two passes) by the "
-             "image copy / by the two-thread copy, and of the 32 B bound (one fused pass) by the two-thread copy.\n\n"
+             "image copy / by the two-thread copy, and of the 32 B bound (one fused pass) by the two-thread copy. "
+             "Per copy shader (one pass, 32 B per texel): time and its fraction of the 32 B bound by the "
+             "two-thread copy.\n\n"
              "| size | scheme | time (ms) | rows + columns (ms) | fraction of 64 B, image copy | fraction of 64 B, "
              "2-thread copy | fraction of 32 B, 2-thread copy |\n|---|---|---|---|---|---|---|\n");
   for (int n : sizes) {
@@ -155,8 +170,99 @@ int main(int argc, char** argv) {
     std::vector<std::byte> src(size_t(size) * size * sizeof(vec4)), dst(src.size());
     std::memcpy(src.data(), m.data(), src.size());
     const double cpu_ms = two_thread_copy_ms(src, dst, 2 * repeat + 1);
+#ifdef MSM_SAT_CALLGRIND
+    if (callgrind) { // the bound's own instructions: one two-thread copy (both threads counted)
+      CALLGRIND_START_INSTRUMENTATION;
+      CALLGRIND_ZERO_STATS;
+      two_thread_copy_ms(src, dst, 0);
+      std::string label = fmt::format("msm-sat {} {}", n, cpu_copy_label);
+      CALLGRIND_DUMP_STATS_AT(label.c_str());
+      CALLGRIND_STOP_INSTRUMENTATION;
+    }
+#endif
     fmt::print("| {}² | copy: image {:.2f} ms ({:.2f} GB/s), two-thread CPU {:.2f} ms ({:.2f} GB/s) | | | | | |\n", n,
                copy_ms, bandwidth * 1e-9, cpu_ms, 32.0 * texels / (cpu_ms * 1e-3) * 1e-9);
+    if (!callgrind) { // for comparison, not a device scheme: the same table by host code (one thread)
+      std::vector<double> host;
+      for (int r = 0; r <= repeat; ++r) {
+        auto t0 = std::chrono::steady_clock::now();
+        std::vector<glm::uvec4> t = gpu::build_sat_cpu(m, n, n, 27 * 27);
+        if (r > 0)
+          host.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      }
+      const double ms = median(host);
+      fmt::print(
+          "| {}² | build_sat_cpu (host code, one thread; not a device scheme) | {:.2f} | | | {:.3f} | {:.3f} |\n", n,
+          ms, 2.0 * cpu_ms / ms, cpu_ms / ms);
+    }
+    // The copy shaders: RGBA32_UINT images (the tables' format) and storage buffers of the same size.
+    vk::Image copy_src = vk::create_image(ctx, vk::ImageDesc{.width = size,
+                                                             .height = size,
+                                                             .format = VK_FORMAT_R32G32B32A32_UINT,
+                                                             .usage = VK_IMAGE_USAGE_STORAGE_BIT});
+    vk::Image copy_dst = vk::create_image(ctx, vk::ImageDesc{.width = size,
+                                                             .height = size,
+                                                             .format = VK_FORMAT_R32G32B32A32_UINT,
+                                                             .usage = VK_IMAGE_USAGE_STORAGE_BIT});
+    const VkDeviceSize table_bytes = VkDeviceSize(size) * size * 16;
+    vk::Buffer buffer_src =
+        vk::create_buffer(ctx, table_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    vk::Buffer buffer_dst = vk::create_buffer(ctx, table_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+      for (const vk::Image* image : {&copy_src, &copy_dst})
+        vk::pipeline_barrier(
+            cmd, vk::image_barrier(image->handle(), image->aspect(), VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                   VK_ACCESS_2_MEMORY_WRITE_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                   VK_IMAGE_LAYOUT_GENERAL));
+      vkCmdFillBuffer(cmd, buffer_src.handle(), 0, VK_WHOLE_SIZE, 0x3f800000u);
+      vk::pipeline_barrier(cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                                                   VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                                   VK_ACCESS_2_SHADER_STORAGE_READ_BIT));
+    });
+    for (int c = 0; c < gpu::sat_copy::count; ++c) {
+      const gpu::sat_copy::Shader& cs = gpu::sat_copy::shaders[c];
+      auto record = [&](VkCommandBuffer cmd) {
+        using gpu::sat_copy::Kind;
+        const vk::Descriptor src = cs.kind == Kind::buffer ? vk::Descriptor(buffer_src)
+                                   : cs.kind == Kind::fetch
+                                       ? vk::Descriptor(moments, VK_IMAGE_LAYOUT_GENERAL, nearest.get())
+                                       : vk::Descriptor(copy_src, VK_IMAGE_LAYOUT_GENERAL);
+        const vk::Descriptor dst =
+            cs.kind == Kind::buffer ? vk::Descriptor(buffer_dst) : vk::Descriptor(copy_dst, VK_IMAGE_LAYOUT_GENERAL);
+        gpu::sat_copy::record(cmd, copy_programs[size_t(c)], cs, size, size, src, dst);
+      };
+#ifdef MSM_SAT_CALLGRIND
+      if (callgrind) {
+        for (int pass = 0; pass < 2; ++pass) { // pass 0 warms the driver up, uncounted
+          if (pass == 1) {
+            CALLGRIND_START_INSTRUMENTATION;
+            CALLGRIND_ZERO_STATS;
+          }
+          vk::submit_and_wait(ctx, record);
+        }
+        std::string label = fmt::format("msm-sat {} {}", n, copy_label + int(c));
+        CALLGRIND_DUMP_STATS_AT(label.c_str());
+        CALLGRIND_STOP_INSTRUMENTATION;
+        continue;
+      }
+#endif
+      std::vector<double> times;
+      for (int r = 0; r <= repeat; ++r) {
+        vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+          timer.reset(cmd);
+          timer.begin(cmd, "copy");
+          record(cmd);
+          timer.end(cmd);
+        });
+        if (r > 0) times.push_back(timer.read().total("copy"));
+      }
+      const double ms = median(times);
+      // One read and one write of 16 B per texel: the 32 B bound.
+      fmt::print("| {}² | copy shader: {} | {:.2f} | | | | {:.3f} |\n", n, cs.name, ms, cpu_ms / ms);
+    }
+
     using Scheme = gpu::SatBuilder::Scheme;
     for (auto scheme : {Scheme::rows_then_columns, Scheme::scan_rows_then_columns, Scheme::subgroup_rows_then_columns,
                         Scheme::subgroup_rows_and_columns, Scheme::blocks}) {
