@@ -286,6 +286,25 @@ MSM_FN vec4 msm_csm_from_unorm(vec4 u) { return 2.0f * u - vec4(1.0f); }
 // The receiver depth the series is evaluated at.
 MSM_FN float msm_csm_receiver(float zf, CsmParams p) { return max(zf - p.offset, 0.0f); }
 
+// The depth range the basis tiles, for the shadow map techniques: the hard CSM technique (csm-4,
+// src/core/techniques.cpp) and CSSM (cssm.h) store the basis at u = MSM_CSM_BASIS_RANGE z and
+// evaluate the series at the receiver's u (msm_csm_ranged_receiver). Why: the series in the depth
+// difference t = x - z is a square wave of period 2 (c_k = (2k - 1) π), 1 on (0, 1), 0 on (-1, 0),
+// and, damped, it falls back through 1/2 at t = 1 as it rises through 1/2 at t = 0 (S(1 - t) =
+// S(t)). On the unscaled basis a receiver on the fitted map's far plane (depth 1) behind a blocker
+// on its near plane (0) gets S = 1/2, shadow 0 after the scale 2: no shadow at all where the lowest
+// receivers of a scene lie under its highest blockers. Scaled by 3/4 the differences stay within
+// [-3/4, 3/4], and the far end t = 3/4 is as far from the next jump as t = 1/4 from the first (the
+// best worst case over differences in [1/3, 1], R = 1 / (1 + 1/3)). The price: the ramp near
+// contact is 4/3 as wide in depth (more light leaking where receivers are near their blockers).
+// msm_csm_moments / msm_csm_shadow and the scattering CSM (scattering.h, rectification.h: a
+// rectified map with a guard band) keep the unscaled basis.
+const float MSM_CSM_BASIS_RANGE = 0.75f;
+// The depth the basis sees for a depth z in [0,1].
+MSM_FN float msm_csm_basis_depth(float z) { return MSM_CSM_BASIS_RANGE * z; }
+// The receiver depth the series is evaluated at, on the basis's scale, for a receiver at zf in [0,1].
+MSM_FN float msm_csm_ranged_receiver(float zf, CsmParams p) { return msm_csm_basis_depth(msm_csm_receiver(zf, p)); }
+
 // Contribution of term k to S_M, from the filtered (E sin c_k z, E cos c_k z) and the receiver
 // depth xf = msm_csm_receiver(zf, p); 0 for k > p.terms.
 MSM_FN float msm_csm_term(vec2 sin_cos, float xf, int k, CsmParams p) {

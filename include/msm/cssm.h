@@ -16,17 +16,12 @@
 // [m/4, m/2) the same times z, tile m/2 (z, 0, 0, 0). Every value is mapped to [0,1]
 // (msm_csm_to_unorm) for the table. cssm8: 5 tiles (17 values), cssm16: 9 tiles (33 values).
 //
-// The basis sees depth scaled by MSM_CSSM_BASIS_RANGE (msm_cssm_basis_depth; E[z f] and the
-// depth tile keep z itself). CSM's series in the depth difference t = x - z is a square wave of
-// period 2 (c_k = (2k - 1) π): 1 for t in (0, 1), 0 for t in (-1, 0), and, damped, it falls back
-// through 1/2 at t = 1 as it rises through 1/2 at t = 0 (S(1 - t) = S(t)). On the unscaled basis
-// a receiver on the fitted map's far plane (depth 1) behind a blocker on its near plane (0) got
-// S = 1/2, shadow 0: no shadow at all where the lowest receivers of a scene lie under its highest
-// blockers. Scaled by 3/4 the differences stay within [-3/4, 3/4], and the far end t = 3/4 is as
-// far from the next jump as t = 1/4 from the first: the shadow of a blocker a whole depth range
-// away is that of one a quarter range away on the unscaled basis (cssm8 0.90, cssm16 0.97: the
-// best worst case over differences in [1/3, 1], R = 1 / (1 + 1/3)). The price: the ramp near
-// contact is 4/3 as wide in depth (more leaking where receivers are near their blockers).
+// The basis sees depth scaled by MSM_CSM_BASIS_RANGE (baselines.h, msm_csm_basis_depth; shared
+// with the hard CSM technique): E[z f] and the depth tile keep z itself. On the unscaled basis a
+// receiver on the fitted map's far plane behind a blocker on its near plane got no shadow at all
+// (CSM's square wave falls back through 1/2 at a depth difference of 1); scaled by 3/4 the shadow
+// of a blocker a whole depth range away is that of one a quarter range away on the unscaled basis
+// (cssm8 0.90, cssm16 0.97), for a ramp near contact 4/3 as wide in depth.
 #ifndef MSM_CSSM_H
 #define MSM_CSSM_H
 #include "msm/baselines.h"
@@ -35,13 +30,6 @@
 MSM_BEGIN
 
 const int MSM_CSSM_MAX_TILES = 9;
-const float MSM_CSSM_BASIS_RANGE = 0.75f;
-
-// The depth the basis sees for a depth z in [0,1] (see above).
-MSM_FN float msm_cssm_basis_depth(float z) { return MSM_CSSM_BASIS_RANGE * z; }
-// The receiver depth the series is evaluated at (msm_csm_receiver on the basis's scale), for a
-// receiver at zf in [0,1].
-MSM_FN float msm_cssm_receiver(float zf, CsmParams p) { return msm_cssm_basis_depth(msm_csm_receiver(zf, p)); }
 
 // Frequencies (CsmParams::terms) of "CSSM m", and its tiles.
 MSM_FN int msm_cssm_frequencies(int values) { return values / 2; }
@@ -51,7 +39,7 @@ MSM_FN int msm_cssm_basis_tiles(int frequencies) { return frequencies / 2; }
 // Tile `tile` of one depth sample z in [0,1], in [0,1] for the table.
 MSM_FN vec4 msm_cssm_generate(float z, int tile, int frequencies) {
   int half_tiles = msm_cssm_basis_tiles(frequencies);
-  float u = msm_cssm_basis_depth(z);
+  float u = msm_csm_basis_depth(z);
   if (tile < half_tiles) return msm_csm_to_unorm(msm_csm_basis_texel(u, tile));
   if (tile < 2 * half_tiles) return msm_csm_to_unorm(z * msm_csm_basis_texel(u, tile - half_tiles));
   return vec4(z, 0.0f, 0.0f, 0.0f);
@@ -60,7 +48,7 @@ MSM_FN vec4 msm_cssm_generate(float z, int tile, int frequencies) {
 // The contribution of averaged tile `tile` (as the table returns it, in [0,1]) to the sums of the
 // blocker search: x the series E[f] (basis tiles), y the series E[z f] (depth-weighted tiles and
 // the depth tile), both without their constant parts (msm_cssm_blocker adds them); xf the
-// receiver as msm_cssm_receiver gives it.
+// receiver as msm_csm_ranged_receiver gives it.
 MSM_FN vec2 msm_cssm_search_terms(vec4 average, int tile, float xf, CsmParams p) {
   int half_tiles = msm_cssm_basis_tiles(p.terms);
   if (tile < half_tiles) return vec2(msm_csm_texel_terms(msm_csm_from_unorm(average), xf, tile, p), 0.0f);

@@ -58,15 +58,18 @@ Texel nl64_store(const Texel& t) { return from(msm_nl_quantize64(msm_nl_from_fil
 Texel nl32_store(const Texel& t) { return from(msm_nl_quantize32(msm_nl_from_filtered(to_vec4(t)))); }
 float nl_shade(const Texel& t, float zf) { return msm_nl_shadow(to_nl(t), msm_signed_depth(zf)); }
 
-// Convolution shadow map with 4 Fourier terms (8 float channels), damped and scaled to a lower bound.
+// Convolution shadow map with 4 Fourier terms (8 float channels), damped and scaled to a lower bound;
+// the basis on MSM_CSM_BASIS_RANGE of the depth range, as CSSM's (baselines.h: on the whole range a
+// receiver at depth 1 behind an occluder at depth 0 got no shadow).
 Texel csm4(float d) {
-  vec4 a = msm_csm_basis_texel(d, 0), b = msm_csm_basis_texel(d, 1);
+  const float u = msm_csm_basis_depth(d);
+  vec4 a = msm_csm_basis_texel(u, 0), b = msm_csm_basis_texel(u, 1);
   return {a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w};
 }
 float csm4_shade(const Texel& t, float zf) {
   CsmParams p = msm_csm_default_params();
   p.terms = 4;
-  float xf = msm_csm_receiver(zf, p);
+  float xf = msm_csm_ranged_receiver(zf, p);
   float sum = msm_csm_texel_terms(vec4(t[0], t[1], t[2], t[3]), xf, 0, p) +
               msm_csm_texel_terms(vec4(t[4], t[5], t[6], t[7]), xf, 1, p);
   return msm_csm_resolve(sum, p);

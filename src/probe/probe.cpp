@@ -114,9 +114,14 @@ Panorama load_equirect(const std::filesystem::path& file) {
   const float* p = picture.pixels().data();
   for (std::size_t k = 0; k < rgb.size(); ++k, p += n) {
     const glm::vec3 value(p[index[0]], p[index[1]], p[index[2]]);
-    if (!glm::all(glm::lessThan(glm::abs(value), glm::vec3(3e38f)))) // also NaN
+    if (!(std::isfinite(value.x) && std::isfinite(value.y) && std::isfinite(value.z)))
       throw ProbeError(fmt::format("{}: texel ({}, {}) has a non-finite radiance", file.string(), k % picture.width(),
                                    k / picture.width()));
+    const float largest = std::max({value.x, value.y, value.z});
+    if (largest > kMaxProbeRadiance)
+      throw ProbeError(fmt::format("{}: texel ({}, {}) has a radiance of {:g}, above the {:g} a probe may hold",
+                                   file.string(), k % picture.width(), k / picture.width(), largest,
+                                   kMaxProbeRadiance));
     // Lossy compression (DWAA/DWAB, as blender-data's probes use) rings slightly below zero next to
     // dark texels: no light is negative.
     rgb[k] = glm::max(value, glm::vec3(0.0f));
@@ -475,8 +480,15 @@ CubeMap sky_probe(int size, float rotation_deg) {
 
 CubeMap load_probe(const std::string& probe, int size, float rotation_deg, float intensity) {
   CubeMap cube = probe == "sky" ? sky_probe(size, rotation_deg) : load_probe_file(probe, size, rotation_deg);
+  float brightest = 0.0f;
   for (auto& face : cube.faces)
-    for (glm::vec3& t : face) t *= intensity;
+    for (glm::vec3& t : face) {
+      t *= intensity;
+      brightest = std::max({brightest, t.x, t.y, t.z});
+    }
+  if (!(brightest <= kMaxProbeRadiance))
+    throw ProbeError(fmt::format("{}: a radiance of {:g} at intensity {:g}, above the {:g} a probe may hold", probe,
+                                 brightest, intensity, kMaxProbeRadiance));
   return cube;
 }
 

@@ -166,7 +166,7 @@ TEST_F(SoftShadowTest, UpperBoundBlockerDepthLeaksLessThanEquation4) {
 // 512². Measured on lavapipe (MAE, nearly all of it light leaking: CSM's scaled series is a lower
 // bound, baselines.h); bound as expect_near_measured. More frequencies leak less: cssm16 <= cssm8
 // on every scene; and moment soft shadows (mssm4: 0.0019, 0.0063, 0.0053) beat both. Measured with
-// the basis on 3/4 of the depth range (cssm.h, MSM_CSSM_BASIS_RANGE; before: 0.0112 / 0.0083,
+// the basis on 3/4 of the depth range (baselines.h, MSM_CSM_BASIS_RANGE; before: 0.0112 / 0.0083,
 // 0.0177 / 0.0143, 0.0185 / 0.0113).
 const std::map<std::string, std::map<std::string, double>> kMeasuredCssmMae = {
     {"column", {{"cssm8", 0.0127}, {"cssm16", 0.0087}}},
@@ -605,7 +605,7 @@ TEST_F(SoftShadowTest, LightHeightSettingMakesEveryLightARectangle) {
   EXPECT_NEAR(swapped.across_height, fraction * wide, 0.05 * fraction * wide);
 }
 
-// CSSM on receivers at the far plane of the fitted map (cssm.h, MSM_CSSM_BASIS_RANGE): the ground
+// CSSM on receivers at the far plane of the fitted map (baselines.h, MSM_CSM_BASIS_RANGE): the ground
 // of rectangle_edge_scene lies at depth 1 under the plate at depth 0, a blocker a whole depth range
 // away. On CSM's unscaled basis the series gave S = 1/2 there (the square wave's jump back at a
 // depth difference of 1): visibility 1 in the umbra, no shadow at all, with the rectangle and a

@@ -67,6 +67,10 @@ void Viewer::set_technique(const std::string& name) {
   if (canonical == view.settings.technique) return;
   set(view.settings, "technique", canonical);
   view.settings.params.reset(); // another technique's parameters mean something else
+  // Front- and back-face averaged depth (Kneiphof §4.2.3) is for the soft techniques only
+  // (RenderSettings::validate): off for any other, which would refuse it.
+  if (!msm_technique_is_soft(render::find_rendered_technique(view.settings.technique).id))
+    view.settings.front_back_depth = false;
 }
 
 void Viewer::set_split(const std::string& name) {
@@ -280,6 +284,11 @@ void Viewer::panel() {
         s.light_height_deg = height;
       }
     }
+    // Kneiphof §4.2.3: the moments of the mean of the nearest front- and back-face depth (a second
+    // depth pass); the soft techniques only, greyed out for the others.
+    ImGui::BeginDisabled(!msm_technique_is_soft(t.id));
+    ImGui::Checkbox("front+back face depth", &s.front_back_depth);
+    ImGui::EndDisabled();
     ImGui::Checkbox("translucent occluders", &s.translucent_occluders);
     ImGui::Checkbox("coloured translucency", &s.coloured_translucency);
     ImGui::SliderFloat("alpha threshold", &s.translucent_alpha_threshold, 0.0f, 0.5f);

@@ -92,7 +92,8 @@ std::vector<std::string> setting_keys() {
           "alpha_threshold",
           "light_extent_deg",
           "light_height_deg",
-          "soft_kernel"};
+          "soft_kernel",
+          "front_back_depth"};
 }
 
 void apply_setting(render::RenderSettings& s, std::string_view key, const json& v) {
@@ -177,6 +178,8 @@ void apply_setting(render::RenderSettings& s, std::string_view key, const json& 
       s.light_height_deg = number(key, v);
   } else if (key == "soft_kernel")
     s.soft_kernel = integer(key, v);
+  else if (key == "front_back_depth")
+    s.front_back_depth = boolean(key, v);
   else
     fail(key, fmt::format("unknown setting{}", util::did_you_mean(key, setting_keys())));
 }
@@ -205,6 +208,7 @@ json setting_json(const render::RenderSettings& s, std::string_view key) {
   if (key == "light_extent_deg") return s.light_extent_deg ? json(*s.light_extent_deg) : json();
   if (key == "light_height_deg") return s.light_height_deg ? json(*s.light_height_deg) : json();
   if (key == "soft_kernel") return s.soft_kernel;
+  if (key == "front_back_depth") return s.front_back_depth;
   fail(key, "unknown setting");
 }
 

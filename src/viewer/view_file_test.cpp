@@ -78,6 +78,37 @@ TEST(ViewFile, DefaultsStayDefaults) {
   EXPECT_FALSE(v.settings.depth_bias);
   EXPECT_FALSE(v.settings.light_extent_deg);
   EXPECT_FALSE(v.settings.light_height_deg);
+  EXPECT_FALSE(v.settings.front_back_depth);
+}
+
+// front_back_depth (Kneiphof §4.2.3, RenderSettings::front_back_depth): written, read back, off by
+// default, a boolean, and refused with a technique that does not take it (a soft one only).
+TEST(ViewFile, FrontBackDepthRoundTripsAndIsValidated) {
+  View v;
+  v.settings.technique = "mssm4";
+  v.settings.front_back_depth = true;
+  nlohmann::json j = view_json(v);
+  EXPECT_EQ(j["settings"]["front_back_depth"], true);
+  View back = parse_view(j.dump(2), "v.json");
+  EXPECT_TRUE(back.settings.front_back_depth);
+  EXPECT_EQ(view_json(back), j);
+  v.settings.front_back_depth = false;
+  EXPECT_FALSE(parse_view(view_json(v).dump(), "v.json").settings.front_back_depth);
+  EXPECT_FALSE(
+      parse_view(R"({"msm_view": 1, "settings": {"technique": "mssm6"}})", "v.json").settings.front_back_depth);
+  EXPECT_TRUE(parse_view(R"({"msm_view": 1, "settings": {"technique": "cssm16", "front_back_depth": true}})", "v.json")
+                  .settings.front_back_depth);
+
+  auto bad = [](const std::string& text) { return error_of<ViewError>([&] { parse_view(text, "v.json"); }); };
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"technique": "mssm4", "front_back_depth": 1}})")
+                .find("v.json: /settings/front_back_depth: expected true or false, got 1"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"technique": "pcf", "front_back_depth": true}})")
+                .find("v.json: /settings: front-and-back-face depth applies to the moment soft shadows"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"front_back_dept": true}})")
+                .find("/settings/front_back_dept: unknown setting (did you mean front_back_depth"),
+            std::string::npos);
 }
 
 TEST(ViewFile, RelativeScenePathsFollowTheFile) {

@@ -202,6 +202,8 @@ render::Renderer::DeviceFrame Viewer::render_side(render::Renderer& r, render::R
 render::RenderSettings Viewer::split_settings() const {
   render::RenderSettings s = view.settings;
   s.technique = split_technique;
+  // The right side takes front- and back-face depth where its technique does (a soft one).
+  if (!msm_technique_is_soft(render::find_rendered_technique(split_technique).id)) s.front_back_depth = false;
   return s;
 }
 

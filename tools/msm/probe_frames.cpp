@@ -21,6 +21,16 @@ void check_probe_frames(const scene::Scene& scene, const ProbeFrames& o) {
   if (scene.probe->size > probe::kMaxDeviceCubeSize)
     throw UsageError(fmt::format("the probe's size {} exceeds the device pipeline's {}", scene.probe->size,
                                  probe::kMaxDeviceCubeSize));
+  // A cube-map cross cannot be turned (load_probe_file): refused before the device is opened.
+  if (o.rotation_speed_deg != 0.0f && scene.probe->file != "sky") {
+    probe::Panorama panorama;
+    try {
+      panorama = probe::load_equirect(scene.probe->file);
+    } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+    if (panorama.width != 2 * panorama.height)
+      throw UsageError(fmt::format("--probe-rotation-speed {}: {} is a cube-map cross, which cannot be rotated",
+                                   o.rotation_speed_deg, scene.probe->file.string()));
+  }
 }
 
 void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, const scene::Scene& scene,
@@ -35,8 +45,17 @@ void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, con
     try {
       panorama = probe::load_equirect(p.file);
     } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-    for (glm::vec3& t : panorama.rgb) t *= p.intensity;
-    device.set_panorama(panorama);
+    if (panorama.width == 2 * panorama.height) {
+      for (glm::vec3& t : panorama.rgb) t *= p.intensity;
+      device.set_panorama(panorama);
+    } else {
+      // A cube-map cross (the scene's loader took it as one, 4:3 or 3:4): its faces box-filtered
+      // on the host (load_probe) and uploaded once; it does not turn (check_probe_frames). The
+      // device's resampling is for panoramas: it read a cross as one (wrong lights) before.
+      try {
+        device.set_cube(probe::load_probe(p.file.string(), p.size, 0.0f, p.intensity));
+      } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+    }
   }
   // The directional lights that the scene has beside its probe come first and stay.
   const std::vector<scene::DirectionalLight> fixed(scene.lights.begin(),

@@ -32,6 +32,12 @@ struct CubeMap {
 
 // Largest face size accepted (a 6 x 4096² RGB float cube map is 1.2 GB).
 inline constexpr int kMaxCubeSize = 4096;
+// Largest radiance a probe texel may hold, after its intensity (load_equirect, load_probe: a
+// ProbeError above it). The cut's float sums (luminance times solid angle, over the cube) and the
+// lights' irradiance must stay finite: a probe of 1e37 everywhere gave lights towards (0, 0, 0)
+// and an infinite integral (read as "the probe is black"). 1e20 is far above any real probe (a
+// sun of 1e9) and leaves the renderer's products in float.
+inline constexpr float kMaxProbeRadiance = 1e20f;
 
 // An equirectangular (latitude-longitude) panorama of width x height RGB texels, row 0 at the
 // zenith (+Y), column 0 at azimuth −π (direction −Z... see direction_of_equirect), resampled onto a

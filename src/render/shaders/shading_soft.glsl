@@ -41,7 +41,7 @@ float cssm_intensity(ShadowLookup s, ivec2 map, int width, uint scale, vec2 spre
   // The receiver's own surface lies at zf: it is kept out of the search by the bias its plane needs
   // over the search region (soft.h), as the filter below keeps it out of the penumbra.
   float zs = zf - msm_soft_depth_bias(hs, 2.0f * s.depth_per_texel, frame.soft.z);
-  float xs = msm_cssm_receiver(0.5f * (zs + 1.0f), p);
+  float xs = msm_csm_ranged_receiver(0.5f * (zs + 1.0f), p);
   vec2 sums = vec2(0.0f);
   for (int tile = 0; tile < tiles; ++tile) {
     uvec4 sum = msm_sat_rect_sum(table_tile(r.hi.x, r.hi.y, tile), table_tile(r.lo.x - 1, r.hi.y, tile),
@@ -55,7 +55,7 @@ float cssm_intensity(ShadowLookup s, ivec2 map, int width, uint scale, vec2 spre
   SoftRegion region = msm_soft_region(position, hp, map);
   SatFilter f = msm_sat_filter(region.lo, region.hi);
   float zb = zf - msm_soft_depth_bias(hp, 2.0f * s.depth_per_texel, frame.soft.z);
-  float xf = msm_cssm_receiver(0.5f * (zb + 1.0f), p);
+  float xf = msm_csm_ranged_receiver(0.5f * (zb + 1.0f), p);
   float series = 0.0f;
   for (int tile = 0; tile < basis; ++tile) {
     SatSamples16 t;

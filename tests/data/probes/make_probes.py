@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the small light probes of the `msm lights` command-line tests (tools/msm/CMakeLists.txt):
 uncompressed scanline OpenEXR files of 16x8 float RGB texels, made by hand so that they may hold
-what no image editor writes (NaN, infinity, negative radiance). Run it in this folder to remake them."""
+what no image editor writes (NaN, infinity, negative radiance, radiance too large to sum); and
+4:3 cube-map crosses of 16x12 (faces of 4²). Run it in this folder to remake them."""
 import math
 import struct
 
@@ -12,7 +13,7 @@ def attribute(name, kind, value):
     return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
 
 
-def exr(path, texel):
+def exr(path, texel, W=W, H=H):
     channels = b"".join(c.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in "BGR") + b"\0"
     box = struct.pack("<iiii", 0, 0, W - 1, H - 1)
     header = (attribute("channels", "chlist", channels) + attribute("compression", "compression", b"\0") +
@@ -43,3 +44,17 @@ exr("inf.exr", lambda x, y: (0, math.inf, 0) if (x, y) == (3, 4) else lamp(x, y)
 exr("negative.exr", lambda x, y: (-1.0, -1.0, -1.0) if y >= 4 else lamp(x, y))
 with open("truncated.exr", "wb") as f:
     f.write(good[: len(good) // 2])
+# Radiance above msm::probe::kMaxProbeRadiance (1e20): refused; a lamp of 1e15, refused only at
+# --intensity 1e6 (1e21 after it).
+exr("bright.exr", lambda x, y: (1e30, 1e30, 1e30) if (x, y) == (5, 2) else lamp(x, y))
+exr("sunny.exr", lambda x, y: (1e15, 1e15, 1e15) if (x, y) == (5, 2) else lamp(x, y))
+
+
+def cross_lamp(x, y):  # a horizontal cross (4s x 3s, s = 4): the lamp on the +Y face's cell
+    return (50.0, 45.0, 40.0) if (x, y) == (5, 1) else (0.2, 0.2, 0.25)
+
+
+exr("cross.exr", cross_lamp, 16, 12)
+exr("cross_nan.exr", lambda x, y: (math.nan, 0, 0) if (x, y) == (5, 5) else cross_lamp(x, y), 16, 12)
+exr("cross_negative.exr", lambda x, y: (-1.0, -1.0, -1.0) if y >= 6 else cross_lamp(x, y), 16, 12)
+exr("cross_black.exr", lambda x, y: (0.0, 0.0, 0.0), 16, 12)
