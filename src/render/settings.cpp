@@ -1,5 +1,6 @@
 // The renderer's view of the technique table (msm/cpu/techniques.h) and the validation of its
 // settings.
+#include "msm/rectification.h"
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
@@ -117,6 +118,12 @@ void RenderSettings::validate() const {
     if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
       throw RenderError(
           fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
+    // Prefiltered scattering: w = the transmittance layers K (0: the default).
+    if (msm_technique_is_prefiltered_scattering(t.id) &&
+        !(p.w >= 0.0f && p.w <= float(MSM_RECT_MAX_LAYERS) && p.w == std::floor(p.w)))
+      throw RenderError(fmt::format("{}: parameter w = transmittance layers = {} must be an integer in 0..{} (0: the "
+                                    "default)",
+                                    technique, p.w, MSM_RECT_MAX_LAYERS));
     if (msm_technique_is_cssm(t.id) &&
         !(p.x >= 0.0f && p.y >= 1.0f && p.z >= 0.0f && p.z < 1.0f && p.w >= 0.0f && p.w < 1.0f))
       throw RenderError(fmt::format("{}: parameters need damping x >= 0, scale y >= 1, offset z in [0, 1) and least "
