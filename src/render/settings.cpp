@@ -1,5 +1,6 @@
 // The renderer's view of the technique table (msm/cpu/techniques.h) and the validation of its
 // settings.
+#include "frame_config.h"
 #include "msm/rectification.h"
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
@@ -175,14 +176,23 @@ std::uint64_t texel_bytes(TexelFormat f) {
 
 } // namespace
 
+int transmittance_layers(const RenderSettings& s) {
+  const Technique& t = find_rendered_technique(s.technique);
+  if (!msm_technique_is_prefiltered_scattering(t.id)) return 1;
+  const float w = s.params ? s.params->w : t.default_params().w;
+  return w == 0.0f ? kDefaultTransmittanceLayers : int(w);
+}
+
 std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights) {
   const Technique& t = find_rendered_technique(s.technique);
   const std::uint64_t moment_bytes =
       (texel_bytes(t.formats[0]) + texel_bytes(t.formats[1])) * std::uint64_t(msm_technique_tiles(t.id));
   const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
-  // Prefiltered scattering: every light's rectified map and prefix sums, shadow size² each.
-  const glm::ivec2 scatter =
+  // Prefiltered scattering: every light's rectified map and prefix sums (K transmittance layers),
+  // shadow size² each.
+  glm::ivec2 scatter =
       msm_technique_is_prefiltered_scattering(t.id) ? msm_technique_scatter_map_bytes(t.id) : glm::ivec2(0);
+  scatter.y *= transmittance_layers(s);
   return triangles * limits::kRendererBytesPerTriangle +
          std::uint64_t(s.width) * std::uint64_t(s.height) * limits::kRendererBytesPerPixel +
          std::uint64_t(s.shadow_size) * std::uint64_t(s.shadow_size) * std::uint64_t(scatter.x + scatter.y) * lights +
