@@ -64,9 +64,11 @@ struct FrameConfig {
 VkFormat vk_format(TexelFormat format);
 
 // Names of the frame's images (the frame graph's resources).
-// Prefiltered scattering's transmittance layers when the technique's parameter w is 0 (measured:
-// docs/results.md, "Single scattering: transmittance layers").
-inline constexpr int kDefaultTransmittanceLayers = 4;
+// Prefiltered scattering's transmittance layers when the technique's parameter w is 0: the paper's
+// single Δ(v). 4 layers have 0.4-0.6x its error on the tower and the gate, but on lavapipe they make
+// the scattering pass 1.4-2x as costly, below the 10x margin to ray marching (docs/results.md,
+// "Single scattering: transmittance layers").
+inline constexpr int kDefaultTransmittanceLayers = 1;
 inline constexpr const char* kShadowDepth = "shadow_depth";
 inline constexpr const char* kShadowDepthBack = "shadow_depth_back"; // FrameConfig::front_back
 inline constexpr const char* kColor = "color";
