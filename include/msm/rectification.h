@@ -33,6 +33,9 @@
 //   msm_slice_inclination_range(bounds, φ)                   θ range of the view in slice φ
 //   msm_rectified_row_step(bounds, v, width)                 Δ(v) of §5.1.1
 //   msm_prefix_sum_weight(σt, Δ, j)                          w(j, v) of §5.1.1
+//   msm_rectified_ray_step / msm_rectified_view_ray_step     a view ray's own step Δ
+//   msm_transmittance_layer_range / _step / _lookup          K transmittance layers (Δ_k, the mix)
+//   msm_prefix_sum_step(bounds, v, width, σt, k, K)          the step of layer k of row v
 //   msm_prefix_sum_lookup_u(bounds, r, width)                where a view ray of reach r reads
 //   msm_rectified_view_lookup(frame, bounds, end_world, width)  a pixel's (u, v, depth) lookup
 // Resampling (§5.2), per rectified texel, from the scene's shadow map:
@@ -256,6 +259,73 @@ MSM_FN float msm_rectified_row_step(RectifiedBounds b, float v, float width) {
 // b_Σ(j) = Σ_{i <= j} w_i b_i / Σ_{i <= j} w_i then average the texels over [0, (j + 1) Δ].
 MSM_FN float msm_prefix_sum_weight(float extinction, float delta, float j) {
   return msm_transmittance_integral(extinction, j * delta, (j + 1.0f) * delta);
+}
+
+// ---- Transmittance layers (issue 14, branch scatter-delta) ----
+// Δ(v) above is one step per row, the paper's heuristic; a view ray of inclination θ has its own
+// step Δ = (r_max / width) / sin θ, and the normalized prefix sums depend on Δ only through the
+// ratio e^(−σt Δ) of successive weights. K "transmittance layers" are K prefix sums of the same
+// rectified map with K steps Δ_k spread geometrically over the view's range of steps; a pixel mixes
+// the two layers that bracket its own Δ (linearly in log Δ), which keeps one (bilinear) lookup per
+// layer, two per pixel. The mix is of the stored vectors (moments after the affine Θ* or the CSM
+// coefficients): a convex combination of two prefix sums is the prefix sum with the convex
+// combination of their weights, a valid distribution whose weights lie between the two layers'.
+// K = 1 is the paper's single Δ(v) per row (msm_rectified_row_step).
+const int MSM_RECT_MAX_LAYERS = 16;
+// The layers' range is clamped to where the weights differ: above σt Δ = MAX_TAU the first texel
+// holds at least 1 − 1/e of a row's weight (larger steps read nearly the same), below a row's optical
+// thickness σt Δ width = MIN_TAU the weights are uniform within 1% (every smaller step reads the same).
+const float MSM_RECT_LAYER_MAX_TAU = 1.0f;
+const float MSM_RECT_LAYER_MIN_TAU = 0.01f;
+
+// The step along a view ray between successive texels of a row `width` texels wide, for a ray
+// whose inclination has the sine sin_theta (floored at MSM_RECT_MIN_SIN like Δ(v)).
+MSM_FN float msm_rectified_ray_step(RectifiedBounds b, float sin_theta, float width) {
+  return b.r_max / (width * max(sin_theta, MSM_RECT_MIN_SIN));
+}
+// ... of the view ray along the unit world direction `direction` (sin θ from its rectification
+// space components across the light).
+MSM_FN float msm_rectified_view_ray_step(RectificationFrame f, RectifiedBounds b, vec3 direction, float width) {
+  float sin_theta = length(vec2(dot(f.x_axis, direction), dot(f.y_axis, direction)));
+  return msm_rectified_ray_step(b, sin_theta, width);
+}
+
+// The range (Δ_lo, Δ_hi) of the layers: the steps of the view's inclinations [view_theta_min,
+// view_theta_max] (sin θ largest at π/2 if inside, smallest at an end), clamped by the optical
+// thickness bounds above (extinction <= 0: no clamp). Δ_lo <= Δ_hi.
+MSM_FN vec2 msm_transmittance_layer_range(RectifiedBounds b, float extinction, float width) {
+  float s0 = sin(b.view_theta_min), s1 = sin(b.view_theta_max);
+  bool right_angle = b.view_theta_min <= 0.5f * MSM_PI && b.view_theta_max >= 0.5f * MSM_PI;
+  float hi = msm_rectified_ray_step(b, min(s0, s1), width);
+  float lo = msm_rectified_ray_step(b, right_angle ? 1.0f : max(s0, s1), width);
+  float sigma = max(extinction, 1.0e-30f);
+  hi = min(hi, MSM_RECT_LAYER_MAX_TAU / sigma);
+  lo = min(max(lo, MSM_RECT_LAYER_MIN_TAU / (sigma * width)), hi);
+  return vec2(lo, hi);
+}
+
+// Δ_k of layer k in [0, K): Δ_lo (Δ_hi / Δ_lo)^(k / (K − 1)); K = 1: Δ_lo.
+MSM_FN float msm_transmittance_layer_step(vec2 range, float layer, float layers) {
+  return layers > 1.0f ? range.x * pow(range.y / range.x, layer / (layers - 1.0f)) : range.x;
+}
+
+// The layers a ray of step delta reads: (k0, t), the mix (1 − t) layer k0 + t layer k0 + 1, with t
+// linear in log Δ between the bracketing steps Δ_k0 <= delta <= Δ_k0+1 (geometrically spaced, so
+// x = (K − 1) log(delta / Δ_lo) / log(Δ_hi / Δ_lo) and k0 = floor(x)); steps outside the range
+// read its end layer. K = 1 or an empty range: (0, 0). (Measured against a mix that keeps the ray's
+// mean distance: that one is worse with few layers, docs/results.md.)
+MSM_FN vec2 msm_transmittance_layer_lookup(vec2 range, float delta, float layers) {
+  float span = log(range.y / range.x);
+  float x = span > 0.0f && layers > 1.0f ? msm_saturate(log(delta / range.x) / span) * (layers - 1.0f) : 0.0f;
+  float k0 = min(floor(x), max(layers - 2.0f, 0.0f));
+  return vec2(k0, x - k0);
+}
+
+// The step of layer k of row v in a map of `layers` layers: the paper's Δ(v) for one layer, else Δ_k.
+MSM_FN float msm_prefix_sum_step(RectifiedBounds b, float v, float width, float extinction, float layer, float layers) {
+  return layers > 1.0f
+             ? msm_transmittance_layer_step(msm_transmittance_layer_range(b, extinction, width), layer, layers)
+             : msm_rectified_row_step(b, v, width);
 }
 
 // The texture coordinate u at which to sample the prefix sums for a view ray ending at distance

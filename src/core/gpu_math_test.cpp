@@ -217,6 +217,10 @@ const Spec kSpecs[] = {
     // [0.5, 2], 2^-21 absolute inside; cos/sin 2^-11 absolute on [-π, π], here φ in [0, 2π):
     // up to ~1e-3 in the level on such a device). Measured on lavapipe 4.2e-7 / 2.2e-7.
     {MSM_K_RESAMPLING_LOD, "rectified_resampling_lod", Metric::abs, A1, Layout::none, 2e-3, 2e-4},
+    // The layer position (K − 1) log(Δ / Δ_lo) / log(Δ_hi / Δ_lo) and a layer's step over Δ_lo
+    // (pow): measured 7.3e-7 / 4.6e-7 on lavapipe. Bounds from Vulkan's log (2^-21 absolute near 1)
+    // times (K − 1) = 15 over the smallest span log 1.5: 3.5e-5.
+    {MSM_K_TRANSMITTANCE_LAYERS, "transmittance_layers", Metric::abs, A2, Layout::none, 1e-4, 2e-5},
 };
 
 // The functions whose outputs are shadows, bounds or blocker depths: finite on every input,
@@ -833,6 +837,13 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       const float scale = g.log_uniform(1.0f, 64.0f), angle = g.uni(0.0f, MSM_TWO_PI);
       const float sx = g.chance(0.5) ? scale : -scale; // either handedness
       x.b = vec4(sx * std::cos(angle), scale * std::sin(angle), -sx * std::sin(angle), scale * std::cos(angle));
+      break;
+    }
+    case MSM_K_TRANSMITTANCE_LAYERS: {
+      // A range of up to four decades of steps (the epipole in view), a step anywhere in and around
+      // it, K = 1..16; both ends equal at times (a clamped range).
+      const float lo = g.log_uniform(1e-3f, 10.0f), hi = g.chance(0.05) ? lo : lo * g.log_uniform(1.5f, 1e4f);
+      x.a = vec4(lo, hi, g.log_uniform(0.5f * lo, 2.0f * hi), float(g.integer(1, 16)));
       break;
     }
     case MSM_K_RAISE_D2:

@@ -434,7 +434,8 @@ constexpr Technique kTechniques[] = {
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
      nullptr,
@@ -449,7 +450,8 @@ constexpr Technique kTechniques[] = {
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
      nullptr,
@@ -464,7 +466,8 @@ constexpr Technique kTechniques[] = {
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
      nullptr,
@@ -479,7 +482,8 @@ constexpr Technique kTechniques[] = {
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default)",
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
      nullptr,
@@ -494,7 +498,8 @@ constexpr Technique kTechniques[] = {
      32,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
-     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default)",
+     "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
+     "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
      nullptr,

@@ -38,6 +38,9 @@ struct FrameConfig {
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).
   bool filtered_resampling = false;
   uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
+  // Prefiltered scattering: K transmittance layers (rectification.h; technique parameter w): K prefix
+  // sums per light with the steps Δ_k, mixed per pixel at its own Δ; 1 = the paper's Δ(v) per row.
+  int transmittance_layers = 1;
   // Kneiphof §4.2.3 (RenderSettings::front_back_depth): a second depth pass keeps the nearest back
   // face, and the moment resolve stores the mean of the front- and back-face depth.
   bool front_back = false;
@@ -61,6 +64,11 @@ struct FrameConfig {
 VkFormat vk_format(TexelFormat format);
 
 // Names of the frame's images (the frame graph's resources).
+// Prefiltered scattering's transmittance layers when the technique's parameter w is 0: the paper's
+// single Δ(v). 4 layers have 0.4-0.6x its error on the tower and the gate, but on lavapipe they make
+// the scattering pass 1.4-2x as costly, below the 10x margin to ray marching (docs/results.md,
+// "Single scattering: transmittance layers").
+inline constexpr int kDefaultTransmittanceLayers = 1;
 inline constexpr const char* kShadowDepth = "shadow_depth";
 inline constexpr const char* kShadowDepthBack = "shadow_depth_back"; // FrameConfig::front_back
 inline constexpr const char* kColor = "color";

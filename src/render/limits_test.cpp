@@ -54,8 +54,9 @@ TEST(Limits, ShadowMemoryGrowsWithTexelsLightsAndColourChannels) {
 }
 
 // Prefiltered scattering: every light has its own rectified map and prefix sums (issue 14), shadow
-// size² texels of msm_technique_scatter_map_bytes each; ray marching has neither (the techniques
-// store no moment maps, so the rest of the estimate is the same).
+// size² texels of msm_technique_scatter_map_bytes each, the prefix sums once per transmittance
+// layer (default 1; parameter w); ray marching has neither (the techniques store no moment maps,
+// so the rest of the estimate is the same).
 TEST(Limits, RectifiedMapsAreCountedPerLight) {
   render::RenderSettings s;
   s.shadow_size = 2048;
@@ -66,12 +67,17 @@ TEST(Limits, RectifiedMapsAreCountedPerLight) {
     SCOPED_TRACE(name);
     s.technique = name;
     const glm::ivec2 bytes = msm_technique_scatter_map_bytes(render::find_rendered_technique(name).id);
+    EXPECT_EQ(render::transmittance_layers(s), 1);
     const std::uint64_t per_light = std::uint64_t(2048) * 2048 * std::uint64_t(bytes.x + bytes.y);
     EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], per_light);
     EXPECT_EQ(render::estimated_bytes(s, 0, 2) - march[2], 2 * per_light);
     s.lights.resize(3); // the frame's lights instead of the scene's
     EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], 3 * per_light + (march[2] - march[1]) * 2);
     s.lights.clear();
+    s.params = glm::vec4(0.0f, 0.0f, 0.0f, 4.0f); // four transmittance layers: four prefix sums
+    EXPECT_EQ(render::transmittance_layers(s), 4);
+    EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], std::uint64_t(2048) * 2048 * (bytes.x + 4 * bytes.y));
+    s.params.reset();
   }
 }
 

@@ -1,5 +1,7 @@
 // The renderer's view of the technique table (msm/cpu/techniques.h) and the validation of its
 // settings.
+#include "frame_config.h"
+#include "msm/rectification.h"
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
@@ -117,6 +119,12 @@ void RenderSettings::validate() const {
     if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
       throw RenderError(
           fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
+    // Prefiltered scattering: w = the transmittance layers K (0: the default).
+    if (msm_technique_is_prefiltered_scattering(t.id) &&
+        !(p.w >= 0.0f && p.w <= float(MSM_RECT_MAX_LAYERS) && p.w == std::floor(p.w)))
+      throw RenderError(fmt::format("{}: parameter w = transmittance layers = {} must be an integer in 0..{} (0: the "
+                                    "default)",
+                                    technique, p.w, MSM_RECT_MAX_LAYERS));
     if (msm_technique_is_cssm(t.id) &&
         !(p.x >= 0.0f && p.y >= 1.0f && p.z >= 0.0f && p.z < 1.0f && p.w >= 0.0f && p.w < 1.0f))
       throw RenderError(fmt::format("{}: parameters need damping x >= 0, scale y >= 1, offset z in [0, 1) and least "
@@ -168,14 +176,23 @@ std::uint64_t texel_bytes(TexelFormat f) {
 
 } // namespace
 
+int transmittance_layers(const RenderSettings& s) {
+  const Technique& t = find_rendered_technique(s.technique);
+  if (!msm_technique_is_prefiltered_scattering(t.id)) return 1;
+  const float w = s.params ? s.params->w : t.default_params().w;
+  return w == 0.0f ? kDefaultTransmittanceLayers : int(w);
+}
+
 std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights) {
   const Technique& t = find_rendered_technique(s.technique);
   const std::uint64_t moment_bytes =
       (texel_bytes(t.formats[0]) + texel_bytes(t.formats[1])) * std::uint64_t(msm_technique_tiles(t.id));
   const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
-  // Prefiltered scattering: every light's rectified map and prefix sums, shadow size² each.
-  const glm::ivec2 scatter =
+  // Prefiltered scattering: every light's rectified map and prefix sums (K transmittance layers),
+  // shadow size² each.
+  glm::ivec2 scatter =
       msm_technique_is_prefiltered_scattering(t.id) ? msm_technique_scatter_map_bytes(t.id) : glm::ivec2(0);
+  scatter.y *= transmittance_layers(s);
   return triangles * limits::kRendererBytesPerTriangle +
          std::uint64_t(s.width) * std::uint64_t(s.height) * limits::kRendererBytesPerPixel +
          std::uint64_t(s.shadow_size) * std::uint64_t(s.shadow_size) * std::uint64_t(scatter.x + scatter.y) * lights +

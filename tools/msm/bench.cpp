@@ -511,7 +511,8 @@ void add_bench(CLI::App& app) {
               host_pass_ms(renderer, s, {"rectify", "prefix_sums", "scattering"}, opt->repeats);
           const glm::ivec2 bytes = msm_technique_scatter_map_bytes(id);
           const double texels = double(size) * size;
-          const auto copy_bytes = VkDeviceSize(texels * (bytes.x + bytes.y) / 2);
+          // The prefix sums read the rectified map and write their layer once per transmittance layer.
+          const auto copy_bytes = VkDeviceSize(texels * (bytes.x + bytes.y) / 2 * render::transmittance_layers(s));
           CopyTimes copy = copy_times(*ctx, copy_bytes, opt->repeats);
           const double rect_ms = host_clock ? host["rectify"] : rect.median,
                        prefix_ms = host_clock ? host["prefix_sums"] : prefix.median,

@@ -77,7 +77,8 @@ struct ObjectPush {
 
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {
-  ivec4 size; // xy: image size in texels, z: pass-specific (rectify, prefix_sums: the light), w: unused
+  ivec4 size; // xy: image size in texels, z: pass-specific (rectify, prefix_sums: the light),
+              // w: pass-specific (prefix_sums: the transmittance layers K), else unused
 };
 
 // The scattering pass (push constants): single scattering of every light of the frame in the

@@ -155,6 +155,9 @@ struct RenderSettings {
 // constants: msm/util/limits.h), for a scene of `triangles` triangles; the frame's lights are
 // s.lights or the scene's `scene_lights`.
 std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights);
+// Prefiltered scattering: the transmittance layers K of these settings (the technique's parameter
+// w, 0 = the default; rectification.h); 1 for every other technique.
+int transmittance_layers(const RenderSettings& s);
 // limits::LimitError (msm/util/limits.h) when the scene or the estimate exceeds its limit; the
 // message names the technique, the sizes and the limit.
 void check_limits(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights);

@@ -13,6 +13,8 @@ int representation6(const FrameConfig& c) { return msm_technique_scatter_represe
 // Klehm et al.'s convolution shadow map: 32 coefficients in the layers of one array image.
 bool csm(const FrameConfig& c) { return c.technique->id == MSM_TECH_SCATTER_CSM32; }
 constexpr uint32_t kCsmLayers = MSM_CSM_MAX_TEXELS;
+// Transmittance layers (rectification.h): K prefix sums per light, with K steps Δ_k.
+uint32_t layers(const FrameConfig& c) { return uint32_t(c.transmittance_layers); }
 
 // The prefix sums' storage formats (JCGT §5.3, §5.4.3): Θ4* in RGBA16; Θ6* in two RGB10A2 (odd,
 // even), RGBA16 + RG16 or RGBA32F + RG32F ((odd, even.x), (even.y, even.z)).
@@ -104,23 +106,27 @@ void PrefixSumPass::prepare(const PassResources& r) {
 
 void PrefixSumPass::reflect(PassBuilder& b) const {
   std::array<VkFormat, 2> formats = prefix_formats(config_);
-  const uint32_t lights = uint32_t(config_.lights); // a layer per light (CSM: eight)
+  // K transmittance layers per light (CSM: eight image layers each), light l's from K l.
+  const uint32_t prefix_layers = uint32_t(config_.lights) * layers(config_);
   b.read(kRectified, use::sampled(kCompute));
   b.create(kPrefixSums,
            {.format = formats[0],
             .width = size(config_),
             .height = size(config_),
-            .layers = (csm(config_) ? kCsmLayers : 1) * lights},
+            .layers = (csm(config_) ? kCsmLayers : 1) * prefix_layers},
            use::compute_general());
   if (prefix_sums_have_two_images(config_)) {
     b.read(kRectified1, use::sampled(kCompute));
-    b.create(kPrefixSums1, {.format = formats[1], .width = size(config_), .height = size(config_), .layers = lights},
+    b.create(kPrefixSums1,
+             {.format = formats[1], .width = size(config_), .height = size(config_), .layers = prefix_layers},
              use::compute_general());
   }
 }
 
 void PrefixSumPass::execute(const PassContext& c) const {
-  // CSM: the whole arrays, the light's eight layers one per dispatch z; the others the light's layer.
+  // CSM: the whole rectified array, the light's eight layers (times K transmittance layers) one per
+  // dispatch z; the others read the light's layer and write its K layers, one per dispatch z. The
+  // prefix sums are written through the whole array (prefix_sums.glsl picks the layer).
   const bool array = csm(config_);
   const GraphImage &rectified = c.image(kRectified), &prefix_sums = c.image(kPrefixSums);
   for (int l = 0; l < config_.lights; ++l) {
@@ -129,13 +135,13 @@ void PrefixSumPass::execute(const PassContext& c) const {
     std::vector<vk::Descriptor> d = {
         vk::Descriptor(*c.frame.rectification),
         vk::Descriptor(array ? rectified.array_view : rectified.layer_views[layer], kReadOnly, c.frame.point_sampler),
-        vk::Descriptor(array ? prefix_sums.array_view : prefix_sums.layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)};
+        vk::Descriptor(prefix_sums.array_view, VK_IMAGE_LAYOUT_GENERAL)};
     if (prefix_sums_have_two_images(config_)) {
       d.emplace_back(c.image(kRectified1).layer_views[layer], kReadOnly, c.frame.point_sampler);
-      d.emplace_back(c.image(kPrefixSums1).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL);
+      d.emplace_back(c.image(kPrefixSums1).array_view, VK_IMAGE_LAYOUT_GENERAL);
     }
-    const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, 0)};
-    vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, array ? kCsmLayers : 1, d,
+    const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, int(layers(config_)))};
+    vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, (array ? kCsmLayers : 1) * layers(config_), d,
                  std::as_bytes(std::span(&push, 1)));
     c.end_light();
   }

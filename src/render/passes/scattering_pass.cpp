@@ -23,7 +23,9 @@ void ScatteringPass::prepare(const PassResources& r) {
                      .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
                      .depth_write = false,
                      // One light: the loop over the lights and its layer folded to 0 (scatter.glsl).
-                     .constants = {{4, uint32_t(config_.lights)}}};
+                     .constants = {{4, uint32_t(config_.lights)},
+                                   // The transmittance layers per light (scatter.glsl; 1: the paper's Δ(v)).
+                                   {5, uint32_t(config_.transmittance_layers)}}};
   program_ = &r.programs.graphics(d);
 }
 

@@ -8,25 +8,32 @@
 // even moments; otherwise (odd, even.x) and (even.y, even.z) as in the rectified map). With MSM_CSM
 // both are arrays of eight layers per light (the convolution shadow map's 32 coefficients), one
 // layer per dispatch z. One dispatch per light (the push constant's size.z: its rectification
-// rects[light]; CSM: its layers 8 light + z; the others bind the light's layer).
+// rects[light]; CSM: its layers 8 light + t; the others bind the light's layer).
+// Transmittance layers (rectification.h): size.w = K prefix sums of the light's map, with the steps
+// Δ_k (K = 1: the paper's Δ(v) per row); dispatch z = k (CSM: 8 k + t) writes output layer
+// K light + k (CSM: 8 (K light + k) + t).
 #include "msm/render/frame.h"
 #include "msm/render/rectification_uniforms.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = 0) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 layout(push_constant) uniform Push { ImagePassPush pass; }; // size.z: the light
+layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2DArray prefix_sums; // every light's layers
 #ifdef MSM_CSM
 layout(binding = 1) uniform sampler2DArray rectified; // float coefficients, texelFetch only
-layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2DArray prefix_sums;
-#define MSM_TEXEL(x, y) ivec3(x, y, MSM_CSM_MAX_TEXELS * pass.size.z + int(gl_WorkGroupID.z))
+#define kTerm (int(gl_WorkGroupID.z) % MSM_CSM_MAX_TEXELS)
+#define kLayer (int(gl_WorkGroupID.z) / MSM_CSM_MAX_TEXELS)
+#define MSM_TEXEL(x, y) ivec3(x, y, MSM_CSM_MAX_TEXELS * pass.size.z + kTerm)
+#define MSM_OUT(x, y) ivec3(x, y, MSM_CSM_MAX_TEXELS * (pass.size.w * pass.size.z + kLayer) + kTerm)
 #else
 layout(binding = 1) uniform sampler2D rectified; // float moments, texelFetch only
-layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2D prefix_sums;
+#define kLayer int(gl_WorkGroupID.z)
 #define MSM_TEXEL(x, y) ivec2(x, y)
+#define MSM_OUT(x, y) ivec3(x, y, pass.size.w * pass.size.z + kLayer)
 #endif
 #ifdef MSM_SIX_MOMENTS
 layout(binding = 3) uniform sampler2D rectified1;
-layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2D prefix_sums1;
+layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2DArray prefix_sums1;
 #endif
 
 void main() {
@@ -36,8 +43,9 @@ void main() {
   int column = int(gl_LocalInvocationID.x);
   if (row >= size.y) return;
   RectifiedBounds b = msm_rectified_bounds_of(rect);
-  float delta = msm_rectified_row_step(b, (float(row) + 0.5f) / float(size.y), float(size.x));
   float extinction = rect.map.w;
+  float delta = msm_prefix_sum_step(b, (float(row) + 0.5f) / float(size.y), float(size.x), extinction, float(kLayer),
+                                    float(pass.size.w));
   vec4 sum = vec4(0.0f), sum1 = vec4(0.0f);
   float weight_sum = 0.0f;
   for (int x0 = 0; x0 < size.x; x0 += 8) {
@@ -55,9 +63,9 @@ void main() {
       }
     }
     if (x0 + column >= size.x) continue;
-    ivec2 texel = ivec2(x0 + column, row);
+    ivec3 texel = MSM_OUT(x0 + column, row);
 #if defined(MSM_CSM)
-    imageStore(prefix_sums, MSM_TEXEL(texel.x, texel.y), mine);
+    imageStore(prefix_sums, texel, mine);
 #elif defined(MSM_SIX_MOMENTS) && defined(MSM_PREFIX_ODD_EVEN)
     imageStore(prefix_sums, texel, vec4(mine.x, mine.y, mine.z, 0.0f));
     imageStore(prefix_sums1, texel, vec4(mine.w, mine1.x, mine1.y, 0.0f));

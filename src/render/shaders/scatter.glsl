@@ -24,7 +24,9 @@ const bool kOneLight = kLightCount == 1;
 int current_layer = 0;
 #define shadow_layer (kOneLight ? 0 : current_layer)
 #ifdef MSM_SCATTER_PREFILTERED
-// A layer per light (CSM: eight per light, light l's from 8 l).
+// K transmittance layers per light (rectification.h; 1: the paper's Δ(v)), light l's from K l (CSM:
+// eight image layers each, light l's layer k from 8 (K l + k)).
+layout(constant_id = 5) const int kLayers = 1;
 layout(binding = 3) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
 layout(std430, binding = 6) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 #ifdef MSM_SIX_MOMENTS
@@ -85,10 +87,29 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   bool full_circle = b.phi_span >= MSM_TWO_PI;
   vec2 uv = vec2(clamp(lookup.x, half_texel.x, 1.0f - half_texel.x),
                  full_circle ? lookup.y : clamp(lookup.y, half_texel.y, 1.0f - half_texel.y));
+  // Transmittance layers: the two that bracket the ray's own step, mixed (1 − t, t) as stored vectors
+  // (a convex combination of prefix sums; the affine storage transforms commute with it).
+  float layer0 = float(shadow_layer * kLayers), mix_t = 0.0f;
+  if (kLayers > 1) {
+    vec2 range = msm_transmittance_layer_range(b, scatter.medium.x, rect.map.x);
+    vec2 k = msm_transmittance_layer_lookup(range, msm_rectified_view_ray_step(f, b, direction, rect.map.x),
+                                            float(kLayers));
+    layer0 += k.x;
+    mix_t = k.y;
+  }
+#define MSM_LAYERED_LOOKUP(image, layer)                                                                           \
+  (kLayers > 1 ? mix(textureLod(image, vec3(uv, (layer)), 0.0f), textureLod(image, vec3(uv, (layer) + 1.0f), 0.0f), \
+                     mix_t)                                                                                        \
+               : textureLod(image, vec3(uv, (layer)), 0.0f))
 #ifdef MSM_CSM
   CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
   for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
-    vec4 texel = msm_csm_from_unorm(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), 0.0f));
+    // Layer k + 1's term t is 8 image layers after layer k's.
+    vec4 texel = msm_csm_from_unorm(
+        kLayers > 1 ? mix(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * layer0 + float(t)), 0.0f),
+                          textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * (layer0 + 1.0f) + float(t)), 0.0f),
+                          mix_t)
+                    : textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), 0.0f));
     if (t < 4)
       m.lo[t] = texel;
     else
@@ -96,7 +117,7 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   }
   return msm_scattering_visibility_csm(m, msm_saturate(lookup.z), msm_csm_scattering_params());
 #else
-  vec4 stored = textureLod(prefix_sums, vec3(uv, float(shadow_layer)), 0.0f);
+  vec4 stored = MSM_LAYERED_LOOKUP(prefix_sums, layer0);
   // The technique's parameter z = 1 fixes β to its y (§5.3.1's constant overestimation), else adaptive.
   float beta = frame.technique_params.z == 1.0f
                    ? msm_saturate(frame.technique_params.y)
@@ -105,7 +126,7 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
 #ifdef MSM_SIX_MOMENTS
   // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
   int representation = scatter.march.y;
-  vec4 stored1 = textureLod(prefix_sums1, vec3(uv, float(shadow_layer)), 0.0f);
+  vec4 stored1 = MSM_LAYERED_LOOKUP(prefix_sums1, layer0);
   Moments6 m = representation == MSM_REP6_UNORM10
                    ? Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored1.x, stored1.y, stored1.z))
                    : Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored.w, stored1.x, stored1.y));
