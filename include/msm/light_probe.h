@@ -194,9 +194,10 @@ MSM_FN float msm_rect_light_facing_fraction(vec2 t) {
   return msm_rect_light_facing_integral(t) / omega;
 }
 
-// The half-angle α of the cone of the rectangle's solid angle, 2π (1 − cos α) = Ω: the cone the
-// shading integrates (msm_cone_cosine) for the horizon. α = 2 asin(sqrt(Ω / 4π)), which keeps its
-// digits for small lights (acos(1 − Ω / 2π) would not).
+// The half-angle α of the cone of the rectangle's solid angle, 2π (1 − cos α) = Ω: the disc of the
+// rectangle's size (MsmAreaLight::cone_half_angle, LightUniforms::soft.z); the shading integrates
+// the rectangle itself at the horizon (msm_rect_light_cosine). α = 2 asin(sqrt(Ω / 4π)), which
+// keeps its digits for small lights (acos(1 − Ω / 2π) would not).
 MSM_FN float msm_rect_light_cone_half_angle(vec2 t) {
   return 2.0f * asin(min(sqrt(msm_rect_light_solid_angle(t) / (4.0f * MSM_PI)), 1.0f));
 }
@@ -206,7 +207,8 @@ struct MsmAreaLight {
   vec3 direction;        // unit, from the scene towards the light: the luminance-weighted centroid (Eq. 9)
   vec3 x_axis, y_axis;   // unit, orthogonal to direction: the face's u and v axes projected (§4.1.2)
   vec2 half_extent;      // half extents along x_axis / y_axis as tangents of angles
-  float cone_half_angle; // α_A of the circular light of the same solid angle as the rectangle
+  float cone_half_angle; // α_A of the circular light of the same solid angle as the rectangle (not
+                         // what the shading integrates: msm_rect_light_cosine clips the rectangle)
   vec3 irradiance;       // M_e (Eq. 11), linear RGB: the light's Σ w L over its region
 };
 
@@ -216,7 +218,10 @@ struct MsmAreaLight {
 // The paper scales them by the length of the projected face axis; here they are also divided by
 // the distance of the centroid's point of the face plane from the centre, so that they are
 // tangents of angles wherever on the face the region lies. The circular light has the solid angle
-// of the rectangle (msm_rect_light_cone_half_angle).
+// of the rectangle (msm_rect_light_cone_half_angle). Where the light dips below a receiver's
+// horizon (Eq. 15's π sin² α cos no longer holds, and would go negative), the shading integrates
+// the cosine over the part of the rectangle above the horizon (msm_rect_light_cosine: the rectangle
+// clipped by the horizon plane, Lambert's edge formula), n·ℓ where it is all above, 0 all below.
 MSM_FN MsmAreaLight msm_area_light_from_region(int face, MsmRegionSums sums) {
   float total = sums.xyz.y;
   vec2 mean = sums.first / total;
@@ -386,7 +391,7 @@ MSM_FN float msm_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t, float cone_ha
 }
 
 // Outgoing radiance factor of Eq. (18) for the rectangle: a diffuse surface of albedo ρ under the
-// light reflects ρ / π · (irradiance on a facing surface) · msm_cone_cosine; that irradiance is
+// light reflects ρ / π · (irradiance on a facing surface) · msm_rect_light_cosine; that irradiance is
 // L_e^A F with L_e^A = M_e / Ω (Eq. 16 over the rectangle), i.e. M_e F / Ω
 // (msm_rect_light_facing_fraction). For the disc of the paper it is L_e^A π sin² α with Ω = 2π (1 −
 // cos α): M_e (1 + cos α) / 2, Eq. (18)'s fraction; for a square and the disc of its solid angle the
