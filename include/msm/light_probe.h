@@ -342,7 +342,6 @@ MSM_FN float msm_rect_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t_in) {
   float x_length = length(x);
   if (!(max(t_in.x, t_in.y) > 0.0f && x_length > 1e-6f)) return max(n_dot_l, 0.0f);
   vec2 t = max(t_in, vec2(1e-4f));
-  float facing = msm_rect_light_facing_integral(t);
   x /= x_length;
   vec3 y = cross(l, x);
   // The height of the point (a, b) of the rectangle's plane over the horizon: h = n·ℓ + a n·x + b n·y.
@@ -350,6 +349,7 @@ MSM_FN float msm_rect_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t_in) {
   float reach = t.x * abs(n_x) + t.y * abs(n_y);
   if (n_dot_l >= reach) return n_dot_l; // every corner above the horizon
   if (n_dot_l <= -reach) return 0.0f;   // every corner below
+  float facing = msm_rect_light_facing_integral(t);
   vec2 corner[4];
   corner[0] = vec2(-t.x, -t.y);
   corner[1] = vec2(t.x, -t.y);
