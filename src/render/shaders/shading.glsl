@@ -123,9 +123,14 @@ void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
     // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
     // the rectangle clipped by the horizon plane (msm_rect_light_cosine) or the disc's cone
     // (msm_cone_cosine); max(n·l, 0) for point lights (rect_extent = 0, soft.z = 0) and wherever
-    // the whole light is above the horizon; 0 where it is all below.
-    float lit = msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz, lights[l].rect_extent.xy,
-                                 lights[l].soft.z);
+    // the whole light is above the horizon; 0 where it is all below. The other techniques shade
+    // points (the renderer leaves soft.z and rect_extent 0): a branch on the specialization
+    // constant, as llvmpipe runs both sides of a branch on a uniform under a mask, and the
+    // rectangle's clipping would cost every pixel of every light.
+    float lit = msm_technique_is_area_light(kTechnique)
+                    ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz,
+                                       lights[l].rect_extent.xy, lights[l].soft.z)
+                    : msm_cone_cosine(n_dot_l, 0.0f);
     vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
     direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
     float w = msm_luminance(lights[l].irradiance.rgb) * lit;
