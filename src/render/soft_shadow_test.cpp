@@ -340,8 +340,8 @@ scene::Scene rectangle_horizon_scene(float elevation_deg, bool turned) {
 // Carlo noise), as for the disc above. The cone of the rectangle's solid angle (msm_cone_cosine,
 // the shading before) gives factors off by +14.7%, +55%, +210% and -10.4%, -21.7%, -36.5%; its
 // radiance (ambient included) must differ by more than 5%, or the test could not tell the two
-// apart. (pcss, not asserted: 1.48% and 2.05% at 10° and -8° turned, where its blocker search on
-// the grazing map finds the plane itself: the shadow, not the shading.)
+// apart. (pcss, not asserted: 1.48% and 2.05% at 10° and -8° turned, with the same shading factor:
+// its shadow on the unoccluded plane, cause not isolated.)
 TEST_F(SoftShadowTest, RectangularLightAcrossTheHorizonMatchesTheRayTracer) {
   for (bool turned : {false, true})
     for (float elevation : {10.0f, 0.0f, -8.0f}) {
