@@ -194,9 +194,10 @@ MSM_FN float msm_rect_light_facing_fraction(vec2 t) {
   return msm_rect_light_facing_integral(t) / omega;
 }
 
-// The half-angle α of the cone of the rectangle's solid angle, 2π (1 − cos α) = Ω: the cone the
-// shading integrates (msm_cone_cosine) for the horizon. α = 2 asin(sqrt(Ω / 4π)), which keeps its
-// digits for small lights (acos(1 − Ω / 2π) would not).
+// The half-angle α of the cone of the rectangle's solid angle, 2π (1 − cos α) = Ω: the disc of the
+// rectangle's size (MsmAreaLight::cone_half_angle, LightUniforms::soft.z); the shading integrates
+// the rectangle itself at the horizon (msm_rect_light_cosine). α = 2 asin(sqrt(Ω / 4π)), which
+// keeps its digits for small lights (acos(1 − Ω / 2π) would not).
 MSM_FN float msm_rect_light_cone_half_angle(vec2 t) {
   return 2.0f * asin(min(sqrt(msm_rect_light_solid_angle(t) / (4.0f * MSM_PI)), 1.0f));
 }
@@ -206,7 +207,8 @@ struct MsmAreaLight {
   vec3 direction;        // unit, from the scene towards the light: the luminance-weighted centroid (Eq. 9)
   vec3 x_axis, y_axis;   // unit, orthogonal to direction: the face's u and v axes projected (§4.1.2)
   vec2 half_extent;      // half extents along x_axis / y_axis as tangents of angles
-  float cone_half_angle; // α_A of the circular light of the same solid angle as the rectangle
+  float cone_half_angle; // α_A of the circular light of the same solid angle as the rectangle (not
+                         // what the shading integrates: msm_rect_light_cosine clips the rectangle)
   vec3 irradiance;       // M_e (Eq. 11), linear RGB: the light's Σ w L over its region
 };
 
@@ -216,7 +218,10 @@ struct MsmAreaLight {
 // The paper scales them by the length of the projected face axis; here they are also divided by
 // the distance of the centroid's point of the face plane from the centre, so that they are
 // tangents of angles wherever on the face the region lies. The circular light has the solid angle
-// of the rectangle (msm_rect_light_cone_half_angle).
+// of the rectangle (msm_rect_light_cone_half_angle). Where the light dips below a receiver's
+// horizon (Eq. 15's π sin² α cos no longer holds, and would go negative), the shading integrates
+// the cosine over the part of the rectangle above the horizon (msm_rect_light_cosine: the rectangle
+// clipped by the horizon plane, Lambert's edge formula), n·ℓ where it is all above, 0 all below.
 MSM_FN MsmAreaLight msm_area_light_from_region(int face, MsmRegionSums sums) {
   float total = sums.xyz.y;
   vec2 mean = sums.first / total;
@@ -315,8 +320,78 @@ MSM_FN float msm_cone_cosine(float cos_angle, float cone_half_angle) {
   return max(integral, 0.0f) / (MSM_PI * sin2);
 }
 
+// ∫ over the rectangular light (the directions ℓ + a x + b y, |a| <= t.x, |b| <= t.y; radiance
+// uniform in solid angle) of max(n·ω, 0) dω, divided by F = msm_rect_light_facing_integral(t): the
+// factor that replaces max(n·l, 0) for the rectangle, exact at the horizon as msm_cone_cosine is
+// for a disc. Where the whole rectangle is above the receiver's horizon it is n·ℓ (∫ ω dω over the
+// rectangle is F ℓ by symmetry), where it is all below 0. Where it straddles the horizon, the
+// rectangle is clipped in its own plane (the points ℓ + a x + b y) by the horizon plane n·p >= 0
+// (Sutherland–Hodgman: a convex polygon of at most 5 vertices) and the clipped part integrated
+// with Lambert's edge formula for a spherical polygon: ∫_P (n·ω) dω = ½ Σ_i Θ_i n·normalize(p_i ×
+// p_{i+1}), Θ_i the angle between p_i and p_{i+1}, vertices counter-clockwise about ℓ (a towards b
+// with (x, y = ℓ × x, ℓ) right-handed). Θ_i is atan(|p_i × p_{i+1}|, p_i·p_{i+1}) (acos of the
+// normalized dot product, which loses half its digits for the short edges of small lights), and
+// Θ_i n·normalize(c) = (Θ_i / |c|) n·c with Θ / |c| -> 1 / (|p_i| |p_{i+1}|) as an edge degenerates
+// (no division by zero; such an edge adds nothing). n, ℓ unit; x need not be orthogonal to ℓ (it
+// is projected off ℓ here: the light frame's axis as the ray tracer takes it). The point-light
+// limit (t = 0, or x along ℓ): max(n·ℓ, 0). A line (a region one texel wide has no variance along
+// that axis) is taken 1e-4 wide, as the ray tracer's estimate takes it (effect_environment.cpp).
+MSM_FN float msm_rect_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t_in) {
+  float n_dot_l = dot(n, l);
+  vec3 x = x_axis - l * dot(x_axis, l);
+  float x_length = length(x);
+  if (!(max(t_in.x, t_in.y) > 0.0f && x_length > 1e-6f)) return max(n_dot_l, 0.0f);
+  vec2 t = max(t_in, vec2(1e-4f));
+  x /= x_length;
+  vec3 y = cross(l, x);
+  // The height of the point (a, b) of the rectangle's plane over the horizon: h = n·ℓ + a n·x + b n·y.
+  float n_x = dot(n, x), n_y = dot(n, y);
+  float reach = t.x * abs(n_x) + t.y * abs(n_y);
+  if (n_dot_l >= reach) return n_dot_l; // every corner above the horizon
+  if (n_dot_l <= -reach) return 0.0f;   // every corner below
+  float facing = msm_rect_light_facing_integral(t);
+  vec2 corner[4];
+  corner[0] = vec2(-t.x, -t.y);
+  corner[1] = vec2(t.x, -t.y);
+  corner[2] = vec2(t.x, t.y);
+  corner[3] = vec2(-t.x, t.y);
+  vec2 clipped[5];
+  int count = 0;
+  for (int i = 0; i < 4; ++i) {
+    vec2 p = corner[i], q = corner[(i + 1) % 4];
+    float hp = n_dot_l + p.x * n_x + p.y * n_y, hq = n_dot_l + q.x * n_x + q.y * n_y;
+    if (hp >= 0.0f) {
+      clipped[count] = p;
+      count += 1;
+    }
+    if ((hp >= 0.0f) != (hq >= 0.0f)) {
+      clipped[count] = p + (q - p) * (hp / (hp - hq));
+      count += 1;
+    }
+  }
+  float sum = 0.0f;
+  for (int i = 0; i < count; ++i) {
+    vec2 a = clipped[i], b = clipped[(i + 1) % count];
+    vec3 p = l + a.x * x + a.y * y, q = l + b.x * x + b.y * y;
+    vec3 c = cross(p, q);
+    float s = length(c), d = dot(p, q);
+    float theta_per_s = s > 1e-12f ? atan(s, d) / s : 1.0f / (length(p) * length(q));
+    sum += theta_per_s * dot(n, c);
+  }
+  return clamp(0.5f * sum / facing, 0.0f, max(n_dot_l + reach, 0.0f));
+}
+
+// The factor that replaces max(n·l, 0) for any directional light of the renderer: the rectangle's
+// exact integral (msm_rect_light_cosine) where the light has half extents t (either > 0), else the
+// disc's (msm_cone_cosine with its half-angle; 0: a point light, max(n·l, 0)). What the shading
+// (shading.glsl, direct_light) and the energy tests evaluate.
+MSM_FN float msm_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t, float cone_half_angle) {
+  if (max(t.x, t.y) > 0.0f) return msm_rect_light_cosine(n, l, x_axis, t);
+  return msm_cone_cosine(dot(n, l), cone_half_angle);
+}
+
 // Outgoing radiance factor of Eq. (18) for the rectangle: a diffuse surface of albedo ρ under the
-// light reflects ρ / π · (irradiance on a facing surface) · msm_cone_cosine; that irradiance is
+// light reflects ρ / π · (irradiance on a facing surface) · msm_rect_light_cosine; that irradiance is
 // L_e^A F with L_e^A = M_e / Ω (Eq. 16 over the rectangle), i.e. M_e F / Ω
 // (msm_rect_light_facing_fraction). For the disc of the paper it is L_e^A π sin² α with Ω = 2π (1 −
 // cos α): M_e (1 + cos α) / 2, Eq. (18)'s fraction; for a square and the disc of its solid angle the

@@ -121,6 +121,13 @@ double rectangle_cosine(const Scene& scene, const msm::scene::DirectionalLight& 
   return sum * (4.0 * t.x * t.y / (double(k) * k)) / double(msm::msm_rect_light_facing_integral(t));
 }
 
+// The factor the renderer's shading gives light l on a surface of normal n (shading.glsl,
+// direct_light: msm_light_cosine with the light frame's x axis and the rectangle's extents).
+double light_cosine(const Scene& scene, const msm::scene::DirectionalLight& l, const glm::dvec3& n) {
+  return double(msm::msm_light_cosine(glm::vec3(n), l.towards_light, glm::vec3(scene.light_frame(l).x_axis),
+                                      l.rectangle_extents(), l.cone_half_angle()));
+}
+
 TEST(Environment, UnoccludedPlaneUnderTheAreaLightsMatchesTheirClosedForm) {
   const Scene scene = sky_scene(kTopCamera, kPlane);
   Settings s = environment_settings(64);
@@ -130,8 +137,12 @@ TEST(Environment, UnoccludedPlaneUnderTheAreaLightsMatchesTheirClosedForm) {
   glm::dvec3 expected(0.0);
   for (const auto& l : scene.lights) {
     ASSERT_TRUE(l.rectangular()); // the probe's lights (Kneiphof §4.1.2)
-    expected += glm::dvec3(l.irradiance) * rectangle_cosine(scene, l, {0.0, 1.0, 0.0});
-    // Wholly above the horizon (its corners too), the shading's cone gives the same: n·l.
+    const double truth = rectangle_cosine(scene, l, {0.0, 1.0, 0.0});
+    expected += glm::dvec3(l.irradiance) * truth;
+    // The shading's factor (msm_light_cosine: the rectangle clipped by the horizon) is this
+    // integral for every light, straddling the horizon or not (quadrature error < 2e-5).
+    EXPECT_NEAR(light_cosine(scene, l, {0.0, 1.0, 0.0}), truth, 1e-4) << l.towards_light.y;
+    // Wholly above the horizon (its corners too), the cone of its solid angle gives the same: n·l.
     const glm::vec2 t = l.tan_half_extents();
     if (l.towards_light.y > std::sin(std::atan(glm::length(t)))) {
       EXPECT_NEAR(msm::msm_cone_cosine(l.towards_light.y, l.cone_half_angle()),
@@ -224,7 +235,7 @@ TEST(Environment, ProbeLightCountMatchesTheSceneFilesCount) {
 
 namespace {
 
-// The lights' msm_cone_cosine sum on an unoccluded plane against quadrature of the sky (32²
+// The lights' sum on an unoccluded plane (light_cosine: the renderer's msm_light_cosine) against quadrature of the sky (32²
 // faces) for the normals +Y, 45° and +Z, printed, within tolerance (relative).
 void expect_plane_energy(int count, double tolerance, bool horizon_split) {
   const std::string json = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 32, "horizon_split": )" +
@@ -236,9 +247,7 @@ void expect_plane_energy(int count, double tolerance, bool horizon_split) {
     const glm::dvec3 probe = quadrature(
         cube, n, [](glm::vec3) { return true; }, glm::vec3(0.0f));
     glm::dvec3 lights(0.0);
-    for (const auto& l : scene.lights)
-      lights += glm::dvec3(l.irradiance) *
-                double(msm::msm_cone_cosine(float(glm::dot(glm::dvec3(l.towards_light), n)), l.cone_half_angle()));
+    for (const auto& l : scene.lights) lights += glm::dvec3(l.irradiance) * light_cosine(scene, l, n);
     std::printf("[energy%s] %d lights, n = (%.3f, %.3f, %.3f): lights %.4f, probe %.4f, relative error %+.4f\n",
                 horizon_split ? " split" : "", count, n.x, n.y, n.z, lum(lights), lum(probe),
                 lum(lights) / lum(probe) - 1.0);
@@ -246,29 +255,33 @@ void expect_plane_energy(int count, double tolerance, bool horizon_split) {
   }
 }
 
-// The issue's energy check: on an unoccluded plane, the area lights' closed form (uniform cones,
-// msm_cone_cosine, what --probe-lights integrates) against the probe's irradiance by quadrature.
-// The issue asks for 1% at every count; measured on the sky (32² faces), the worst relative error
-// over three normals is 12.3% at 6 lights (a vertical plane facing +Z), 2.4% at 16, 1.1% at 32,
-// 1.2% at 64 and 0.15% at 256 (docs/results.md): 1% holds at 256 only. Below six lights (groups
-// of faces, one cone standing for the sun and much of the sky) it is far worse: 77.8% at 1 light,
-// 53.2% at 2, 22.5% at 3 (all +Z), 5.3% at 4 (45°), 13.3% at 5 (+Z). Asserted: 1% at 256, and
-// 1.5x the measured error below (a bound against regressions, not the issue's claim).
+// The issue's energy check: on an unoccluded plane, the area lights' closed form (light_cosine:
+// the renderer's msm_light_cosine, the rectangle clipped by each plane's horizon) against the
+// probe's irradiance by quadrature. The issue asks for 1% at every count. Measured on the sky (32²
+// faces), worst relative error over the three normals (docs/results.md, "Rectangles shaded as
+// rectangles at the horizon"; before, with the cone of the rectangle's solid angle, in brackets):
+// 77.9% at 1 light (+Z) [78.3%], 44.7% at 2 [45.8%], 19.0% at 3 [18.9%], 4.7% at 4 (45°) [5.0%],
+// 11.9% at 5 [11.8%], 11.7% at 6 [12.4%] (+Z: groups of faces, one light standing for the sun and
+// much of the sky), 0.53% at 16 (+Y) [2.8%], 1.11% at 32 (+Z) [0.94%], 0.35% at 64 [0.58%], 0.08%
+// at 256 [0.09%]: 1% holds at 16, 64 and 256, not at 32. Asserted: the issue's 1% where the
+// measured error is at most 2/3 of it, else 1.5x the measured error (N = 1: the bound before,
+// 1.5 x 77.8%, which 1.5x the new 77.9% would loosen).
 TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
-  const std::map<int, double> bound = {{1, 1.5 * 0.778},  {2, 1.5 * 0.532}, {3, 1.5 * 0.225},  {4, 1.5 * 0.0526},
-                                       {5, 1.5 * 0.133},  {6, 1.5 * 0.123}, {16, 1.5 * 0.024}, {32, 1.5 * 0.0113},
-                                       {64, 1.5 * 0.012}, {256, 0.01}};
+  const std::map<int, double> bound = {{1, 1.5 * 0.778}, {2, 1.5 * 0.448}, {3, 1.5 * 0.190}, {4, 1.5 * 0.0467},
+                                       {5, 1.5 * 0.119}, {6, 1.5 * 0.117}, {16, 0.01},       {32, 1.5 * 0.0111},
+                                       {64, 0.01},       {256, 0.01}};
   for (const auto& [count, tolerance] : bound) expect_plane_energy(count, tolerance, false);
 }
 
 // The same check with the horizon split (median_cut's horizon_split, "horizon_split": true: no
 // region across the horizon y = 0), N = 10 (the fewest it makes) to 256. Measured, worst over the
-// three normals (docs/results.md, "The horizon split"): 19.0% at 10 lights and 9.6% at 16 (both
-// the +Z plane, whose horizon the split does not follow; +Y: 1.7% and 1.3%), 0.73% at 32, 0.58%
-// at 64, 0.09% at 256. Asserted: the issue's 1% from 32 lights on (without the split it holds
-// from 32 with 0.94%), 1.5x the measured error at 10 and 16.
+// three normals (docs/results.md, "Rectangles shaded as rectangles at the horizon"; before, with
+// the cone, in brackets): 13.1% at 10 lights [19.0%] and 2.65% at 16 [9.6%] (both the +Z plane,
+// whose horizon the split does not follow; +Y: 1.3% and 0.94%), 0.90% at 32 [0.73%], 0.35% at 64
+// [0.58%], 0.08% at 256 [0.09%]. Asserted: the issue's 1% from 32 lights on, 1.5x the measured
+// error at 10 and 16.
 TEST(Environment, AreaLightsKeepThePlanesIrradianceWithTheHorizonSplit) {
-  const std::map<int, double> bound = {{10, 1.5 * 0.190}, {16, 1.5 * 0.096}, {32, 0.01}, {64, 0.01}, {256, 0.01}};
+  const std::map<int, double> bound = {{10, 1.5 * 0.132}, {16, 1.5 * 0.0265}, {32, 0.01}, {64, 0.01}, {256, 0.01}};
   for (const auto& [count, tolerance] : bound) expect_plane_energy(count, tolerance, true);
 }
 

@@ -36,7 +36,7 @@ namespace msm::render {
 static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 3 * 16);
 static_assert(offsetof(FrameUniforms, filter_weights) == 64 + 4 * 16);
 static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 32);
-static_assert(sizeof(LightUniforms) == 2 * 64 + 3 * 16);
+static_assert(sizeof(LightUniforms) == 2 * 64 + 5 * 16);
 static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
 static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
 static_assert(sizeof(RectificationUniforms) == 11 * 16); // the std430 array stride of the passes' rects[]
@@ -236,10 +236,13 @@ struct Renderer::Impl {
       if (s.light_height_deg) drawn.angular_height_deg = *s.light_height_deg;
       // soft.h: texels of reach per unit of [-1,1] depth.
       vec2 spread = msm_soft_spread(drawn.tan_half_extents(), float(0.5 * f.depth_extent), vec2(texel));
-      // The shading integrates the cosine over the disc, or over the cone of the rectangle's solid
-      // angle (msm_cone_cosine); the other techniques shade their lights as points (soft.z = 0:
+      // The shading integrates the cosine over the disc (msm_cone_cosine), or over the rectangle
+      // clipped by the horizon (msm_rect_light_cosine, on the frame's x axis as the ray tracer
+      // samples it); the other techniques shade their lights as points (soft.z = 0, rect_extent = 0:
       // max(n·l, 0)), as their shadows are hard.
       u.soft = glm::vec4(spread, drawn.cone_half_angle(), 0.0f);
+      u.rect_x_axis = glm::vec4(glm::vec3(f.x_axis), 0.0f);
+      u.rect_extent = glm::vec4(drawn.rectangle_extents(), 0.0f, 0.0f);
     }
     return u;
   }

@@ -303,9 +303,12 @@ struct DirectionalLight {
   bool rectangular() const { return angular_height_deg.has_value(); }
   // tan of the half extents along the frame's x and y axes (a disc: its radius, both).
   glm::vec2 tan_half_extents() const;
-  // The half-angle in radians of the cone the shading integrates (msm_cone_cosine): a disc's own,
-  // a rectangle's the cone of its solid angle (msm_rect_light_cone_half_angle).
+  // The half-angle in radians of the cone of a disc (msm_cone_cosine shades it) or of a rectangle's
+  // solid angle (msm_rect_light_cone_half_angle; the rectangle itself is shaded as one).
   float cone_half_angle() const;
+  // What the shading takes for msm_light_cosine (msm/light_probe.h): a rectangle's
+  // tan_half_extents(), 0 for a disc or a point (shaded by the cone of cone_half_angle()).
+  glm::vec2 rectangle_extents() const { return rectangular() ? tan_half_extents() : glm::vec2(0.0f); }
 };
 
 // A homogeneous medium (JCGT 2017 §5.1.1): extinction σt, scattering albedo ρ and a Henyey–

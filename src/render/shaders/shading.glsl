@@ -109,8 +109,8 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
 
 // Direct light of every light at world_position with normal n (towards the viewer), and the
 // shadow buffer's visibility of the direct light: with one light its visibility, with several the
-// mean weighted by the irradiance each one brings (luminance of E max(n·l, 0), the cone's integral
-// for area lights).
+// mean weighted by the irradiance each one brings (luminance of E max(n·l, 0), for area lights
+// msm_light_cosine: the same factor as the shading).
 void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
   vec3 weighted = vec3(0.0f), first = vec3(0.0f);
   direct = vec3(0.0f);
@@ -119,9 +119,18 @@ void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
   MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
   for (int l = 0; l < light_count; ++l) {
     float n_dot_l = dot(n, lights[l].towards_light.xyz);
-    // Area lights: the cone's cosine integral with the horizon (msm/light_probe.h), which is
-    // max(n·l, 0) for point lights (soft.z = 0) and where the whole cone is above the horizon.
-    float lit = msm_cone_cosine(n_dot_l, lights[l].soft.z);
+    // Area lights: the cosine integrated over the part of the light above the surface's horizon
+    // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
+    // the rectangle clipped by the horizon plane (msm_rect_light_cosine) or the disc's cone
+    // (msm_cone_cosine); max(n·l, 0) for point lights (rect_extent = 0, soft.z = 0) and wherever
+    // the whole light is above the horizon; 0 where it is all below. The other techniques shade
+    // points (the renderer leaves soft.z and rect_extent 0): a branch on the specialization
+    // constant, as llvmpipe runs both sides of a branch on a uniform under a mask, and the
+    // rectangle's clipping would cost every pixel of every light.
+    float lit = msm_technique_is_area_light(kTechnique)
+                    ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz,
+                                       lights[l].rect_extent.xy, lights[l].soft.z)
+                    : msm_cone_cosine(n_dot_l, 0.0f);
     vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
     direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
     float w = msm_luminance(lights[l].irradiance.rgb) * lit;
