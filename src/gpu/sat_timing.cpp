@@ -139,10 +139,14 @@ int main(int argc, char** argv) {
                                                          .height = size,
                                                          .format = VK_FORMAT_R32G32B32A32_SFLOAT,
                                                          .usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-    vk::Image table = vk::create_image(ctx, vk::ImageDesc{.width = size,
-                                                          .height = size,
-                                                          .format = VK_FORMAT_R32G32B32A32_UINT,
-                                                          .usage = VK_IMAGE_USAGE_STORAGE_BIT});
+    // A storage image of the tables' format (RGBA32_UINT) and size: the table and the copy shaders' images.
+    const auto table_image = [&] {
+      return vk::create_image(ctx, vk::ImageDesc{.width = size,
+                                                 .height = size,
+                                                 .format = VK_FORMAT_R32G32B32A32_UINT,
+                                                 .usage = VK_IMAGE_USAGE_STORAGE_BIT});
+    };
+    vk::Image table = table_image();
     vk::upload_image(ctx, moments, std::as_bytes(std::span(m)), VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
     vk::GpuTimer timer(ctx);
 
@@ -196,14 +200,8 @@ int main(int argc, char** argv) {
           ms, 2.0 * cpu_ms / ms, cpu_ms / ms);
     }
     // The copy shaders: RGBA32_UINT images (the tables' format) and storage buffers of the same size.
-    vk::Image copy_src = vk::create_image(ctx, vk::ImageDesc{.width = size,
-                                                             .height = size,
-                                                             .format = VK_FORMAT_R32G32B32A32_UINT,
-                                                             .usage = VK_IMAGE_USAGE_STORAGE_BIT});
-    vk::Image copy_dst = vk::create_image(ctx, vk::ImageDesc{.width = size,
-                                                             .height = size,
-                                                             .format = VK_FORMAT_R32G32B32A32_UINT,
-                                                             .usage = VK_IMAGE_USAGE_STORAGE_BIT});
+    vk::Image copy_src = table_image();
+    vk::Image copy_dst = table_image();
     const VkDeviceSize table_bytes = VkDeviceSize(size) * size * 16;
     vk::Buffer buffer_src =
         vk::create_buffer(ctx, table_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT);

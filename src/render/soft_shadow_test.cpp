@@ -32,13 +32,16 @@ class SoftShadowTest : public vk::test::VulkanTest {};
 
 const std::vector<std::string> kSoftTechniques = {"mssm4", "mssm6", "vssm", "pcss"};
 
-reference::Result area_light_truth(const scene::Scene& scene, int width, int height, double extent_deg) {
+// The ray-traced soft shadow of the scene's light (its own extent where extent_deg is empty).
+reference::Result area_light_truth(const scene::Scene& scene, int width, int height, std::optional<double> extent_deg,
+                                   int samples = 64, reference::LightShape shape = reference::LightShape::disc) {
   reference::Settings rs;
   rs.effect = reference::Effect::soft;
+  rs.light_shape = shape;
   rs.light_extent_deg = extent_deg;
   rs.width = width;
   rs.height = height;
-  rs.samples = 64;
+  rs.samples = samples;
   return reference::render(scene, rs);
 }
 
@@ -294,12 +297,7 @@ TEST_F(SoftShadowTest, AreaLightBelowTheHorizonMatchesTheRayTracer) {
   for (float elevation : {10.0f, -10.0f}) {
     scene::Scene scene = horizon_scene(elevation);
     const int width = 160, height = 90;
-    reference::Settings rs;
-    rs.effect = reference::Effect::soft;
-    rs.width = width;
-    rs.height = height;
-    rs.samples = 256;
-    reference::Result truth = reference::render(scene, rs);
+    reference::Result truth = area_light_truth(scene, width, height, std::nullopt, 256);
     image::Image background = truth.visibility.channel("background");
     Renderer renderer(ctx(), scene);
     for (const std::string t : {"mssm4", "mssm6", "pcss", "msm-hamburger-64"}) {
@@ -352,13 +350,8 @@ TEST_F(SoftShadowTest, RectangularLightAcrossTheHorizonMatchesTheRayTracer) {
                                           light.rectangle_extents(), light.cone_half_angle());
       const float cone = msm_cone_cosine(light.towards_light.y, light.cone_half_angle());
       const int width = 160, height = 90;
-      reference::Settings rs;
-      rs.effect = reference::Effect::soft;
-      rs.light_shape = reference::LightShape::rectangle;
-      rs.width = width;
-      rs.height = height;
-      rs.samples = 256;
-      reference::Result truth = reference::render(scene, rs);
+      reference::Result truth =
+          area_light_truth(scene, width, height, std::nullopt, 256, reference::LightShape::rectangle);
       image::Image background = truth.visibility.channel("background");
       Renderer renderer(ctx(), scene);
       const auto radiance = [](float factor) {
