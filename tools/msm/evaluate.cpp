@@ -20,6 +20,7 @@
 #include "msm/evaluate/report.h"
 #include "msm/evaluate/run.h"
 #include "msm/util/progress.h"
+#include "usage.h"
 
 namespace msm::tool {
 namespace {
@@ -171,9 +172,16 @@ void add_evaluate(CLI::App& app) {
       }
     } catch (const std::invalid_argument& e) {
       // The same error on every rank at the same point (run.h): end normally, rank 0 says why.
-      if (rank == 0) throw UsageError(e.what());
+      if (size == 1) throw UsageError(e.what());
+      // Rank 0 says it before any rank exits: the launcher kills the job at the first non-zero
+      // exit, which lost rank 0's message when another rank ended first (seen in a fresh clone).
+      if (rank == 0) {
+        fmt::print(stderr, "msm: error: {}\n", e.what());
+        std::fflush(stderr);
+      }
+      comm->barrier();
       comm.reset(); // MPI_Finalize
-      std::exit(2);
+      std::exit(kExitFailure);
     } catch (const std::exception& e) {
       if (size > 1) {
         fmt::print(stderr, "msm: error: rank {} of {}: {}\n", rank, size, e.what());
