@@ -261,7 +261,7 @@ MSM_FN float msm_prefix_sum_weight(float extinction, float delta, float j) {
   return msm_transmittance_integral(extinction, j * delta, (j + 1.0f) * delta);
 }
 
-// ---- Transmittance layers (issue 14, branch scatter-delta) ----
+// ---- Transmittance layers (beyond the paper: a step per ray instead of one per row) ----
 // Δ(v) above is one step per row, the paper's heuristic; a view ray of inclination θ has its own
 // step Δ = (r_max / width) / sin θ, and the normalized prefix sums depend on Δ only through the
 // ratio e^(−σt Δ) of successive weights. K "transmittance layers" are K prefix sums of the same
