@@ -41,6 +41,8 @@ struct FrameConfig {
   // Prefiltered scattering: K transmittance layers (rectification.h; technique parameter w): K prefix
   // sums per light with the steps Δ_k, mixed per pixel at its own Δ; 1 = the paper's Δ(v) per row.
   int transmittance_layers = 1;
+  // RenderSettings::prefix_sums: the row sweep instead of the Appendix C scheme (prefix_sums.glsl).
+  bool prefix_sums_appendix_c = false;
   // Kneiphof §4.2.3 (RenderSettings::front_back_depth): a second depth pass keeps the nearest back
   // face, and the moment resolve stores the mean of the front- and back-face depth.
   bool front_back = false;

@@ -318,7 +318,10 @@ struct Renderer::Impl {
     // prefiltered techniques' parameter x = 1 adds its passes (recipe, FrameConfig::resampling_moments).
     const glm::vec4 params = s.params ? *s.params : technique.default_params();
     // Transmittance layers (rectification.h): parameter w = K in 1..8, 0 the default.
-    if (msm_technique_is_prefiltered_scattering(id)) c.transmittance_layers = transmittance_layers(s);
+    if (msm_technique_is_prefiltered_scattering(id)) {
+      c.transmittance_layers = transmittance_layers(s);
+      c.prefix_sums_appendix_c = s.prefix_sums == RenderSettings::PrefixSums::appendix_c;
+    }
     if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
       c.filtered_resampling = true;
       const VkFormat f = c.resampling_moments().formats()[0];

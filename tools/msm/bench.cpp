@@ -288,12 +288,15 @@ std::string scattering_markdown(nlohmann::json& results, const std::vector<std::
     }
   }
   if (rectified) {
-    md +=
-        fmt::format("\nThe rectified map per texel ({}), the prefix sums against a copy of the bytes they read and "
-                    "write\n\n| technique | map | rectify ms (ns per texel) | prefix sums ms (ns per texel) | copy ms "
-                    "(GB/s) | copy / prefix sums | timestamps: rectify, prefix sums, copy, copy after a barrier "
-                    "(ms) |\n|---|---|---:|---:|---:|---:|---|\n",
-                    clock);
+    md += fmt::format(
+        "\nThe rectified map per texel ({}), the prefix sums against a copy of the bytes they read and "
+        "write, for the frame's scheme and then\nfor each scheme (rows: a thread per row; App. C: JCGT's Appendix "
+        "C)\n\n| "
+        "technique | map | rectify ms (ns per texel) | prefix sums ms (ns per texel) | copy ms "
+        "(GB/s) | copy / prefix sums | rows ms (copy / rows) | App. C ms (copy / App. C) | timestamps: "
+        "rectify, prefix sums, copy, copy after a barrier (ms) |\n|---|---|---:|---:|---:|---:|---:|---:|---|"
+        "\n",
+        clock);
     std::string check;
     for (const nlohmann::json& entry : results) {
       if (!entry.contains("rectified")) continue;
@@ -304,11 +307,13 @@ std::string scattering_markdown(nlohmann::json& results, const std::vector<std::
       for (int size : sizes) {
         const nlohmann::json &v = entry["rectified"][std::to_string(size)], &t = v["timestamps"], &hc = v["host_clock"];
         md += fmt::format(
-            "| {} | {}² | {:.3f} ({:.1f}) | {:.3f} ({:.1f}) | {:.3f} ({:.1f}) | {:.3f} | {:.3f}, {:.3f}, "
-            "{:.3f}, {:.3f} |\n",
+            "| {} | {}² | {:.3f} ({:.1f}) | {:.3f} ({:.1f}) | {:.3f} ({:.1f}) | {:.3f} | {:.3f} ({:.3f}) | {:.3f} "
+            "({:.3f}) | {:.3f}, {:.3f}, {:.3f}, {:.3f} |\n",
             name, size, v["rectify_ms"].get<double>(), v["rectify_ns_per_texel"].get<double>(),
             v["prefix_sums_ms"].get<double>(), v["prefix_sums_ns_per_texel"].get<double>(), v["copy_ms"].get<double>(),
-            v["copy_gb_s"].get<double>(), v["fraction_of_bound"].get<double>(), t["rectify_ms"].get<double>(),
+            v["copy_gb_s"].get<double>(), v["fraction_of_bound"].get<double>(), v["schemes"]["rows_ms"].get<double>(),
+            v["schemes"]["rows_fraction_of_bound"].get<double>(), v["schemes"]["appendix_c_ms"].get<double>(),
+            v["schemes"]["appendix_c_fraction_of_bound"].get<double>(), t["rectify_ms"].get<double>(),
             t["prefix_sums_ms"].get<double>(), t["copy_ms"].get<double>(), t["copy_after_barrier_ms"].get<double>());
         check += fmt::format(" {} {}²: {:.3f} / {:.3f};", name, size, t["scattering_320x180_ms"].get<double>(),
                              hc["scattering_320x180_ms"].get<double>());
@@ -517,6 +522,16 @@ void add_bench(CLI::App& app) {
           const double rect_ms = host_clock ? host["rectify"] : rect.median,
                        prefix_ms = host_clock ? host["prefix_sums"] : prefix.median,
                        copy_ms = host_clock ? copy.host_ms : copy.timestamp_ms;
+          // The other scheme of the prefix sums (RenderSettings::prefix_sums), by the same clock.
+          render::RenderSettings other = s;
+          other.prefix_sums = s.prefix_sums == render::RenderSettings::PrefixSums::rows
+                                  ? render::RenderSettings::PrefixSums::appendix_c
+                                  : render::RenderSettings::PrefixSums::rows;
+          const double other_ms = host_clock
+                                      ? host_pass_ms(renderer, other, {"prefix_sums"}, opt->repeats)["prefix_sums"]
+                                      : pass_sum(run(other), {"prefix_sums"}).median;
+          const bool rows = s.prefix_sums == render::RenderSettings::PrefixSums::rows;
+          const double rows_ms = rows ? prefix_ms : other_ms, appendix_c_ms = rows ? other_ms : prefix_ms;
           entry["rectified"][std::to_string(size)] = {{"clock", host_clock ? "host" : "timestamps"},
                                                       {"rectify_ms", rect_ms},
                                                       {"prefix_sums_ms", prefix_ms},
@@ -527,6 +542,11 @@ void add_bench(CLI::App& app) {
                                                       {"copy_ms", copy_ms},
                                                       {"copy_gb_s", 2.0 * double(copy_bytes) / (copy_ms * 1e6)},
                                                       {"fraction_of_bound", copy_ms / prefix_ms},
+                                                      {"schemes",
+                                                       {{"rows_ms", rows_ms},
+                                                        {"appendix_c_ms", appendix_c_ms},
+                                                        {"rows_fraction_of_bound", copy_ms / rows_ms},
+                                                        {"appendix_c_fraction_of_bound", copy_ms / appendix_c_ms}}},
                                                       {"host_clock",
                                                        {{"rectify_ms", host["rectify"]},
                                                         {"prefix_sums_ms", host["prefix_sums"]},

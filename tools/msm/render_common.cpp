@@ -58,6 +58,10 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
          "auto (deferred for pcf, pcss and the soft techniques), forward (shadows per shaded fragment), "
          "deferred (a surfaces pass, then shadows once per visible pixel; depth-based and soft techniques only)")
       ->capture_default_str();
+  cmd->add_option("--prefix-sums", o.prefix_sums,
+                  "prefiltered scattering's prefix sums: rows (a thread per row, each texel once) or appendix-c "
+                  "(JCGT's 8 x 8 scheme; the same sums)")
+      ->capture_default_str();
   cmd->add_option("--light-extent", s.light_extent_deg,
                   "Angular diameter of the light in degrees, for soft "
                   "shadows (default: the scene's)");
@@ -103,6 +107,12 @@ void finish_frame_options(FrameOptions& o) {
     o.settings.deferred_shading = true;
   else if (o.shading != "auto")
     throw UsageError(fmt::format("--shading {}: use auto, forward or deferred", o.shading));
+  if (o.prefix_sums == "rows")
+    o.settings.prefix_sums = render::RenderSettings::PrefixSums::rows;
+  else if (o.prefix_sums == "appendix-c")
+    o.settings.prefix_sums = render::RenderSettings::PrefixSums::appendix_c;
+  else
+    throw UsageError(fmt::format("--prefix-sums {}: use rows or appendix-c", o.prefix_sums));
 }
 
 render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique) {

@@ -24,6 +24,7 @@ struct FrameOptions {
   std::string lookup = "auto";      // auto, bilinear, nearest, dither
   std::string filter_mode = "auto"; // auto, one-pass, three-pass
   std::string shading = "auto";     // auto, forward, deferred
+  std::string prefix_sums = "rows"; // rows, appendix-c
 };
 
 // --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --param,

@@ -77,6 +77,9 @@ struct ObjectPush {
 // is true for bilinear fetches, false for each pair's two texels (exact: the 32-bit float maps).
 #define MSM_BLUR_SPEC_ID 10
 #define MSM_BLUR_MAX_PAIRS 16
+// The prefix sums' scheme (prefix_sums.glsl, RenderSettings::prefix_sums): true for the row sweep
+// (64 rows per group of 8 x 8 threads), false for Appendix C's (8 rows per group).
+#define MSM_PREFIX_ROWS_SPEC_ID 0
 
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {

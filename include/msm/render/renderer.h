@@ -140,6 +140,12 @@ struct RenderSettings {
   // occluders instead of on their surface. Meant for closed, convex occluders (the paper's
   // condition); an open, single-sided surface has no back face and averages with what lies behind.
   bool front_back_depth = false;
+  // Prefiltered scattering's transmittance-weighted prefix sums along the rectified rows (JCGT
+  // §5.1.1): rows = one thread per row walks it once, each texel read and written once (on lavapipe
+  // 3-6x faster than the other, docs/results.md); appendix_c = the paper's Appendix C, 8 x 8 threads,
+  // eight threads per row each summing the whole row so that a block's writes coalesce. The same
+  // sums in the same order: the images agree (ScatteringTest.PrefixSumSchemesAgree).
+  enum class PrefixSums { rows, appendix_c } prefix_sums = PrefixSums::rows;
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default
   float translucent_alpha_threshold = 0.01f;

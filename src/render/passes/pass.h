@@ -212,8 +212,9 @@ class RectifyPass : public Pass {
   FrameConfig config_;
 };
 
-// Each light's rectified map -> transmittance-weighted prefix sums along its rows (JCGT Appendix C's
-// 8 x 8 scheme, prefix_sums.comp; one dispatch per light), in the technique's storage format.
+// Each light's rectified map -> transmittance-weighted prefix sums along its rows (a thread per row,
+// or JCGT Appendix C's 8 x 8 scheme: prefix_sums.glsl; one dispatch per light), in the technique's
+// storage format.
 class PrefixSumPass : public Pass {
  public:
   explicit PrefixSumPass(const FrameConfig& config) : config_(config) {}

@@ -101,7 +101,8 @@ void PrefixSumPass::prepare(const PassResources& r) {
                                      vk::Binding::storage_image, vk::Binding::sampled_image, vk::Binding::storage_image}
           : std::vector<vk::Binding>{vk::Binding::storage_buffer, vk::Binding::sampled_image,
                                      vk::Binding::storage_image};
-  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush));
+  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush),
+                                 {{MSM_PREFIX_ROWS_SPEC_ID, config_.prefix_sums_appendix_c ? 0u : 1u}});
 }
 
 void PrefixSumPass::reflect(PassBuilder& b) const {
@@ -128,6 +129,7 @@ void PrefixSumPass::execute(const PassContext& c) const {
   // dispatch z; the others read the light's layer and write its K layers, one per dispatch z. The
   // prefix sums are written through the whole array (prefix_sums.glsl picks the layer).
   const bool array = csm(config_);
+  const uint32_t rows_per_group = config_.prefix_sums_appendix_c ? 8 : 64; // prefix_sums.glsl
   const GraphImage &rectified = c.image(kRectified), &prefix_sums = c.image(kPrefixSums);
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
@@ -141,8 +143,8 @@ void PrefixSumPass::execute(const PassContext& c) const {
       d.emplace_back(c.image(kPrefixSums1).array_view, VK_IMAGE_LAYOUT_GENERAL);
     }
     const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, int(layers(config_)))};
-    vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), 8), 1, (array ? kCsmLayers : 1) * layers(config_), d,
-                 std::as_bytes(std::span(&push, 1)));
+    vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), rows_per_group), 1,
+                 (array ? kCsmLayers : 1) * layers(config_), d, std::as_bytes(std::span(&push, 1)));
     c.end_light();
   }
 }

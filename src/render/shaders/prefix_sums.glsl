@@ -1,8 +1,12 @@
-// Transmittance-weighted prefix sums along the rows of the rectified map (JCGT §5.1.1, the scheme of
-// Appendix C): groups of 8 x 8 threads, eight rows per group and eight threads per row; walking the
-// row in blocks of eight texels, every thread sums the whole row (eight times the reads, which the
-// texture cache absorbs) and writes the one normalized prefix sum of its column in the block, so
-// that the writes of a block are coalesced. Weights w(j, v) and Δ(v) are rectification.h's.
+// Transmittance-weighted prefix sums along the rows of the rectified map (JCGT §5.1.1), in one of
+// two schemes (the specialization constant kRowSweep, RenderSettings::prefix_sums):
+// - the row sweep: every thread of a group of 8 x 8 takes a row (64 rows per group) and walks it
+//   once, reading and writing each texel once;
+// - the scheme of Appendix C: eight rows per group and eight threads per row; walking the row in
+//   blocks of eight texels, every thread sums the whole row (eight times the reads, which the
+//   texture cache absorbs) and writes the one normalized prefix sum of its column in the block, so
+//   that the writes of a block are coalesced.
+// Both add the same terms in the same order. Weights w(j, v) and Δ(v) are rectification.h's.
 // The including file defines the storage: MSM_PREFIX_FORMAT0 (and, with MSM_SIX_MOMENTS, the second
 // image's MSM_PREFIX_FORMAT1 and MSM_PREFIX_ODD_EVEN for two RGB10A2 images holding the odd and the
 // even moments; otherwise (odd, even.x) and (even.y, even.z) as in the rectified map). With MSM_CSM
@@ -36,10 +40,29 @@ layout(binding = 3) uniform sampler2D rectified1;
 layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2DArray prefix_sums1;
 #endif
 
+layout(constant_id = MSM_PREFIX_ROWS_SPEC_ID) const bool kRowSweep = true;
+
+void store_prefix_sum(int x, int row, vec4 mine, vec4 mine1) {
+  ivec3 texel = MSM_OUT(x, row);
+#if defined(MSM_CSM)
+  imageStore(prefix_sums, texel, mine);
+#elif defined(MSM_SIX_MOMENTS) && defined(MSM_PREFIX_ODD_EVEN)
+  imageStore(prefix_sums, texel, vec4(mine.x, mine.y, mine.z, 0.0f));
+  imageStore(prefix_sums1, texel, vec4(mine.w, mine1.x, mine1.y, 0.0f));
+#else
+  imageStore(prefix_sums, texel, mine);
+#ifdef MSM_SIX_MOMENTS
+  imageStore(prefix_sums1, texel, mine1);
+#endif
+#endif
+}
+
 void main() {
   RectificationUniforms rect = rects[pass.size.z];
   ivec2 size = ivec2(int(rect.map.x), int(rect.map.y));
-  int row = int(gl_WorkGroupID.x) * 8 + int(gl_LocalInvocationID.y);
+  int rows_per_group = kRowSweep ? 64 : 8;
+  int row = int(gl_WorkGroupID.x) * rows_per_group + int(gl_LocalInvocationID.y) * (kRowSweep ? 8 : 1) +
+            (kRowSweep ? int(gl_LocalInvocationID.x) : 0);
   int column = int(gl_LocalInvocationID.x);
   if (row >= size.y) return;
   RectifiedBounds b = msm_rectified_bounds_of(rect);
@@ -48,6 +71,18 @@ void main() {
                                     float(pass.size.w));
   vec4 sum = vec4(0.0f), sum1 = vec4(0.0f);
   float weight_sum = 0.0f;
+  if (kRowSweep) {
+    for (int x = 0; x < size.x; ++x) {
+      float w = msm_prefix_sum_weight(extinction, delta, float(x));
+      sum += w * texelFetch(rectified, MSM_TEXEL(x, row), 0);
+#ifdef MSM_SIX_MOMENTS
+      sum1 += w * texelFetch(rectified1, ivec2(x, row), 0);
+#endif
+      weight_sum += w;
+      store_prefix_sum(x, row, sum / weight_sum, sum1 / weight_sum);
+    }
+    return;
+  }
   for (int x0 = 0; x0 < size.x; x0 += 8) {
     vec4 mine = vec4(0.0f), mine1 = vec4(0.0f);
     for (int k = 0; k < 8 && x0 + k < size.x; ++k) {
@@ -62,18 +97,6 @@ void main() {
         mine1 = sum1 / weight_sum;
       }
     }
-    if (x0 + column >= size.x) continue;
-    ivec3 texel = MSM_OUT(x0 + column, row);
-#if defined(MSM_CSM)
-    imageStore(prefix_sums, texel, mine);
-#elif defined(MSM_SIX_MOMENTS) && defined(MSM_PREFIX_ODD_EVEN)
-    imageStore(prefix_sums, texel, vec4(mine.x, mine.y, mine.z, 0.0f));
-    imageStore(prefix_sums1, texel, vec4(mine.w, mine1.x, mine1.y, 0.0f));
-#else
-    imageStore(prefix_sums, texel, mine);
-#ifdef MSM_SIX_MOMENTS
-    imageStore(prefix_sums1, texel, mine1);
-#endif
-#endif
+    if (x0 + column < size.x) store_prefix_sum(x0 + column, row, mine, mine1);
   }
 }
