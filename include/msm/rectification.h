@@ -33,6 +33,7 @@
 //   msm_slice_inclination_range(bounds, φ)                   θ range of the view in slice φ
 //   msm_rectified_row_step(bounds, v, width)                 Δ(v) of §5.1.1
 //   msm_prefix_sum_weight(σt, Δ, j)                          w(j, v) of §5.1.1
+//   msm_prefix_sum_lod(du, dv, size, full_circle)            App. D.5's mip level of a pixel's lookup
 //   msm_rectified_ray_step / msm_rectified_view_ray_step     a view ray's own step Δ
 //   msm_transmittance_layer_range / _step / _lookup          K transmittance layers (Δ_k, the mix)
 //   msm_prefix_sum_step(bounds, v, width, σt, k, K)          the step of layer k of row v
@@ -326,6 +327,19 @@ MSM_FN float msm_prefix_sum_step(RectifiedBounds b, float v, float width, float 
   return layers > 1.0f
              ? msm_transmittance_layer_step(msm_transmittance_layer_range(b, extinction, width), layer, layers)
              : msm_rectified_row_step(b, v, width);
+}
+
+// JCGT App. D.5: the mip level at which a pixel reads the prefix sums of a width x height map, from
+// the screen derivatives du = (du/dx, du/dy) and dv of its lookup: the smaller of the footprints
+// along the rows and across them, each the larger derivative in texels, log2, >= 0. dv wraps where
+// φ spans the full circle (the seam between v = 1 and v = 0 is no jump). The smaller one, because
+// a mip averages both ways: near the epipole the rows converge (a large footprint across them) while
+// u barely moves, and at silhouettes u jumps with the ray's length while v does not; the larger
+// footprint would average prefix sums of other ray lengths or other slices into the pixel.
+MSM_FN float msm_prefix_sum_lod(vec2 du, vec2 dv, vec2 size, bool full_circle) {
+  vec2 d = full_circle ? dv - floor(dv + 0.5f) : dv;
+  float along = max(abs(du.x), abs(du.y)) * size.x, across = max(abs(d.x), abs(d.y)) * size.y;
+  return log2(max(min(along, across), 1.0f));
 }
 
 // The texture coordinate u at which to sample the prefix sums for a view ray ending at distance

@@ -257,6 +257,23 @@ TEST(Rectification, PrefixSumWeightsIntegrateTheTransmittance) {
     }
 }
 
+// App. D.5's level: log2 of the smaller footprint (along and across the rows, each the larger
+// derivative in texels), none below one texel; where φ spans the full circle a derivative across
+// the seam (v from 0.99 to 0.01 between neighbours) is the short way round, else the long way.
+TEST(Rectification, PrefixSumLevelFollowsTheSmallerFootprint) {
+  const glm::vec2 size(512.0f, 256.0f), wide(1.0f); // wide: a footprint of 512 texels along the rows
+  using msm::msm_prefix_sum_lod;
+  EXPECT_FLOAT_EQ(msm_prefix_sum_lod(wide, glm::vec2(1.0f / 256.0f, 0.0f), size, false), 0.0f);
+  EXPECT_FLOAT_EQ(msm_prefix_sum_lod(wide, glm::vec2(0.1f / 256.0f, 0.0f), size, false), 0.0f);
+  EXPECT_NEAR(msm_prefix_sum_lod(wide, glm::vec2(-2.0f / 256.0f, 8.0f / 256.0f), size, false), 3.0f, 1e-5f);
+  EXPECT_NEAR(msm_prefix_sum_lod(wide, glm::vec2(-0.98f, 0.0f), size, true), std::log2(0.02f * 256.0f), 1e-3f);
+  EXPECT_NEAR(msm_prefix_sum_lod(wide, glm::vec2(-0.98f, 0.0f), size, false), std::log2(0.98f * 256.0f), 1e-4f);
+  EXPECT_NEAR(msm_prefix_sum_lod(wide, glm::vec2(0.0f, 0.75f), size, true), 6.0f, 1e-5f); // a quarter of 256 rows
+  // The footprint along the rows bounds it: 4 texels of u against 64 rows, and the other way round.
+  EXPECT_NEAR(msm_prefix_sum_lod(glm::vec2(0.0f, -4.0f / 512.0f), glm::vec2(0.25f, 0.0f), size, false), 2.0f, 1e-5f);
+  EXPECT_NEAR(msm_prefix_sum_lod(glm::vec2(0.25f, 0.0f), glm::vec2(0.0f, 4.0f / 256.0f), size, false), 2.0f, 1e-5f);
+}
+
 TEST(Rectification, PrefixSumLookupIntegratesAStepAlongAViewRay) {
   // One row: texel j holds visibility 1 while the view ray is lit (t < T), else 0; the prefix
   // sums read at a ray of length s with linear filtering give ∫_0^s e^{−σ t} V dt / ∫_0^s e^{−σ t} dt.

@@ -43,13 +43,16 @@ struct FrameConfig {
   int transmittance_layers = 1;
   // RenderSettings::prefix_sums: the row sweep instead of the Appendix C scheme (prefix_sums.glsl).
   bool prefix_sums_appendix_c = false;
+  uint32_t prefix_sum_mips = 1; // RenderSettings::prefix_sum_mips: the prefix sums' levels (1: none)
   // Kneiphof §4.2.3 (RenderSettings::front_back_depth): a second depth pass keeps the nearest back
   // face, and the moment resolve stores the mean of the front- and back-face depth.
   bool front_back = false;
   bool operator==(const FrameConfig&) const = default;
 
-  bool split_rg() const;                            // translucent and four channels in one image
-  std::array<VkFormat, 2> formats() const;          // of the moment images as allocated
+  bool split_rg() const;                   // translucent and four channels in one image
+  std::array<VkFormat, 2> formats() const; // of the moment images as allocated
+  // Prefiltered scattering: of prefix_sums and prefix_sums1 (UNDEFINED: none; passes/prefiltered_scattering_passes.cpp).
+  std::array<VkFormat, 2> prefix_sum_formats() const;
   int moment_images() const;                        // 0 (depth-based), 1 or 2 (6MSM, split_rg)
   int channels() const { return coloured ? 3 : 1; } // sets of moment images
   // The vertical blur writes mip 1 too (three-pass filter with mips and an even size): one pass

@@ -261,6 +261,9 @@ FrameGraph::FrameGraph(const vk::Context& ctx, std::vector<std::unique_ptr<Pass>
                    VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT)) {
         g.array_view = vk::create_image_view(ctx, g.image.handle(), s.format, aspect, VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0,
                                              s.mips, 0, s.layers);
+        if (s.mips > 1)
+          g.array_mip0_view = vk::create_image_view(ctx, g.image.handle(), s.format, aspect,
+                                                    VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, 1, 0, s.layers);
         for (uint32_t l = 0; l < s.layers; ++l) {
           g.layer_views.push_back(
               vk::create_image_view(ctx, g.image.handle(), s.format, aspect, VK_IMAGE_VIEW_TYPE_2D, 0, s.mips, l, 1));

@@ -121,6 +121,7 @@ struct FrameResources {
 struct GraphImage {
   vk::Image image;
   vk::ImageView array_view;
+  vk::ImageView array_mip0_view; // images with mips: every layer's mip 0 (a storage target)
   std::vector<vk::ImageView> layer_views, layer_mip0_views;
   std::vector<vk::ImageView> layer_mip1_views; // images with mips: mip 1 alone (a storage target)
   ImageSpec spec;

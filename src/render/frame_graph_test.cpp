@@ -81,6 +81,11 @@ TEST(FrameGraph, FilteredResamplingAddsTheMomentMapPasses) {
     c.resampling_mips = 1;
     EXPECT_EQ(names(), (V{"shadow_depth", "shading", "moment_resolve", "rectify", "prefix_sums", "scattering"}))
         << technique;
+    // App. D.5's mips of the prefix sums: blitted after the sums, before the scattering reads them.
+    c.prefix_sum_mips = 10;
+    EXPECT_EQ(names(), (V{"shadow_depth", "shading", "moment_resolve", "rectify", "prefix_sums", "prefix_sum_mips",
+                          "scattering"}))
+        << technique;
   }
 }
 

@@ -40,6 +40,7 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
     }
     passes.push_back(std::make_unique<RectifyPass>(c));
     passes.push_back(std::make_unique<PrefixSumPass>(c));
+    if (c.prefix_sum_mips > 1) passes.push_back(std::make_unique<PrefixSumMipmapPass>(c));
   }
   if (msm_technique_is_scattering(id)) passes.push_back(std::make_unique<ScatteringPass>(c));
   return passes;

@@ -321,6 +321,14 @@ struct Renderer::Impl {
     if (msm_technique_is_prefiltered_scattering(id)) {
       c.transmittance_layers = transmittance_layers(s);
       c.prefix_sums_appendix_c = s.prefix_sums == RenderSettings::PrefixSums::appendix_c;
+      // Mips by linear blits, where the device can blit and filter the storage formats.
+      bool can_mip = s.prefix_sum_mips;
+      for (VkFormat f : c.prefix_sum_formats())
+        can_mip = can_mip && (f == VK_FORMAT_UNDEFINED ||
+                              has_features(ctx, f,
+                                           VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
+                                               VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT));
+      c.prefix_sum_mips = can_mip ? uint32_t(std::bit_width(uint32_t(s.shadow_size))) : 1u;
     }
     if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
       c.filtered_resampling = true;

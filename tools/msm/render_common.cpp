@@ -62,6 +62,9 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
                   "prefiltered scattering's prefix sums: rows (a thread per row, each texel once) or appendix-c "
                   "(JCGT's 8 x 8 scheme; the same sums)")
       ->capture_default_str();
+  cmd->add_flag("--prefix-sum-mips", s.prefix_sum_mips,
+                "prefiltered scattering: a mip chain of the prefix sums, read at the pixel's footprint across the rows "
+                "(JCGT App. D.5)");
   cmd->add_option("--light-extent", s.light_extent_deg,
                   "Angular diameter of the light in degrees, for soft "
                   "shadows (default: the scene's)");

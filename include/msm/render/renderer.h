@@ -146,6 +146,10 @@ struct RenderSettings {
   // eight threads per row each summing the whole row so that a block's writes coalesce. The same
   // sums in the same order: the images agree (ScatteringTest.PrefixSumSchemesAgree).
   enum class PrefixSums { rows, appendix_c } prefix_sums = PrefixSums::rows;
+  // JCGT Appendix D.5: a mip chain of the prefix sums (2 x 2 box averages), read by the scattering
+  // pass at the level of the pixel's footprint across the rows (epipolar slices), against the
+  // aliasing of thin shafts where neighbouring pixels skip rows. Off by default (docs/results.md).
+  bool prefix_sum_mips = false;
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default
   float translucent_alpha_threshold = 0.01f;

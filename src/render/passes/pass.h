@@ -117,6 +117,11 @@ class BlurPass : public Pass {
   int channel_;
 };
 
+// Mips first_mip .. mips - 1 of every layer of a square image of side `size`, each the linear blit
+// (2 x 2 box average) of the previous one; the image's mips are all in TRANSFER_SRC before and after.
+void record_mip_chain(VkCommandBuffer cmd, VkImage image, int32_t size, uint32_t first_mip, uint32_t mips,
+                      uint32_t layers);
+
 // Moment images of one channel: mips 1.. (2.. where the blur wrote mip 1) by linear blits of the
 // previous mip (averages of moments are moments).
 class MipmapPass : public Pass {
@@ -230,6 +235,19 @@ class PrefixSumPass : public Pass {
 
 // Six-moment prefiltered scattering: two images per map (rectified, prefix sums).
 bool prefix_sums_have_two_images(const FrameConfig& config);
+
+// JCGT App. D.5: the prefix sums' mip chain (FrameConfig::prefix_sum_mips > 1), linear blits of every
+// layer (a 2 x 2 box average of prefix sums is the prefix sum of the averaged rows at the mean end).
+class PrefixSumMipmapPass : public Pass {
+ public:
+  explicit PrefixSumMipmapPass(const FrameConfig& config) : config_(config) {}
+  std::string_view name() const override { return "prefix_sum_mips"; }
+  void reflect(PassBuilder& b) const override;
+  void execute(const PassContext& c) const override;
+
+ private:
+  FrameConfig config_;
+};
 
 // The images every shadow-map pass creates.
 ImageSpec moment_image_spec(const FrameConfig& config, int i);

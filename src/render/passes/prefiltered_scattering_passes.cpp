@@ -15,18 +15,21 @@ bool csm(const FrameConfig& c) { return c.technique->id == MSM_TECH_SCATTER_CSM3
 constexpr uint32_t kCsmLayers = MSM_CSM_MAX_TEXELS;
 // Transmittance layers (rectification.h): K prefix sums per light, with K steps Δ_k.
 uint32_t layers(const FrameConfig& c) { return uint32_t(c.transmittance_layers); }
+// The prefix sums are stored into mip 0 of every layer (App. D.5's mips follow: PrefixSumMipmapPass).
+const vk::ImageView& mip0(const GraphImage& g) { return g.spec.mips > 1 ? g.array_mip0_view : g.array_view; }
+
+} // namespace
 
 // The prefix sums' storage formats (JCGT §5.3, §5.4.3): Θ4* in RGBA16; Θ6* in two RGB10A2 (odd,
 // even), RGBA16 + RG16 or RGBA32F + RG32F ((odd, even.x), (even.y, even.z)).
-std::array<VkFormat, 2> prefix_formats(const FrameConfig& c) {
-  switch (representation6(c)) {
+std::array<VkFormat, 2> FrameConfig::prefix_sum_formats() const {
+  switch (representation6(*this)) {
   case MSM_REP6_UNORM10: return {VK_FORMAT_A2B10G10R10_UNORM_PACK32, VK_FORMAT_A2B10G10R10_UNORM_PACK32};
   case MSM_REP6_UNORM16: return {VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_R16G16_UNORM};
   case MSM_REP6_FLOAT: return {VK_FORMAT_R32G32B32A32_SFLOAT, VK_FORMAT_R32G32_SFLOAT};
-  default: return {csm(c) ? VK_FORMAT_R8G8B8A8_UNORM : VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_UNDEFINED};
+  default: return {csm(*this) ? VK_FORMAT_R8G8B8A8_UNORM : VK_FORMAT_R16G16B16A16_UNORM, VK_FORMAT_UNDEFINED};
   }
 }
-} // namespace
 
 bool prefix_sums_have_two_images(const FrameConfig& c) { return representation6(c) >= 0; }
 
@@ -106,7 +109,7 @@ void PrefixSumPass::prepare(const PassResources& r) {
 }
 
 void PrefixSumPass::reflect(PassBuilder& b) const {
-  std::array<VkFormat, 2> formats = prefix_formats(config_);
+  std::array<VkFormat, 2> formats = config_.prefix_sum_formats();
   // K transmittance layers per light (CSM: eight image layers each), light l's from K l.
   const uint32_t prefix_layers = uint32_t(config_.lights) * layers(config_);
   b.read(kRectified, use::sampled(kCompute));
@@ -114,12 +117,17 @@ void PrefixSumPass::reflect(PassBuilder& b) const {
            {.format = formats[0],
             .width = size(config_),
             .height = size(config_),
+            .mips = config_.prefix_sum_mips,
             .layers = (csm(config_) ? kCsmLayers : 1) * prefix_layers},
            use::compute_general());
   if (prefix_sums_have_two_images(config_)) {
     b.read(kRectified1, use::sampled(kCompute));
     b.create(kPrefixSums1,
-             {.format = formats[1], .width = size(config_), .height = size(config_), .layers = prefix_layers},
+             {.format = formats[1],
+              .width = size(config_),
+              .height = size(config_),
+              .mips = config_.prefix_sum_mips,
+              .layers = prefix_layers},
              use::compute_general());
   }
 }
@@ -137,15 +145,31 @@ void PrefixSumPass::execute(const PassContext& c) const {
     std::vector<vk::Descriptor> d = {
         vk::Descriptor(*c.frame.rectification),
         vk::Descriptor(array ? rectified.array_view : rectified.layer_views[layer], kReadOnly, c.frame.point_sampler),
-        vk::Descriptor(prefix_sums.array_view, VK_IMAGE_LAYOUT_GENERAL)};
+        vk::Descriptor(mip0(prefix_sums), VK_IMAGE_LAYOUT_GENERAL)};
     if (prefix_sums_have_two_images(config_)) {
       d.emplace_back(c.image(kRectified1).layer_views[layer], kReadOnly, c.frame.point_sampler);
-      d.emplace_back(c.image(kPrefixSums1).array_view, VK_IMAGE_LAYOUT_GENERAL);
+      d.emplace_back(mip0(c.image(kPrefixSums1)), VK_IMAGE_LAYOUT_GENERAL);
     }
     const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, int(layers(config_)))};
     vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), rows_per_group), 1,
                  (array ? kCsmLayers : 1) * layers(config_), d, std::as_bytes(std::span(&push, 1)));
     c.end_light();
+  }
+}
+
+void PrefixSumMipmapPass::reflect(PassBuilder& b) const {
+  for (const char* name : {kPrefixSums, kPrefixSums1}) {
+    if (name == kPrefixSums1 && !prefix_sums_have_two_images(config_)) continue;
+    b.modify(name, use::transfer_source());
+    b.internally(name, use::transfer_destination());
+  }
+}
+
+void PrefixSumMipmapPass::execute(const PassContext& c) const {
+  for (const char* name : {kPrefixSums, kPrefixSums1}) {
+    if (name == kPrefixSums1 && !prefix_sums_have_two_images(config_)) continue;
+    const GraphImage& g = c.image(name);
+    record_mip_chain(c.cmd, g.image.handle(), config_.shadow_size, 1, g.spec.mips, g.spec.layers);
   }
 }
 

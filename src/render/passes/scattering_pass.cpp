@@ -25,7 +25,9 @@ void ScatteringPass::prepare(const PassResources& r) {
                      // One light: the loop over the lights and its layer folded to 0 (scatter.glsl).
                      .constants = {{4, uint32_t(config_.lights)},
                                    // The transmittance layers per light (scatter.glsl; 1: the paper's Δ(v)).
-                                   {5, uint32_t(config_.transmittance_layers)}}};
+                                   {5, uint32_t(config_.transmittance_layers)},
+                                   // App. D.5's mips of the prefix sums: the level per pixel only with them.
+                                   {6, config_.prefix_sum_mips > 1 ? 1u : 0u}}};
   program_ = &r.programs.graphics(d);
 }
 

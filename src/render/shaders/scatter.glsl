@@ -27,6 +27,7 @@ int current_layer = 0;
 // K transmittance layers per light (rectification.h; 1: the paper's Δ(v)), light l's from K l (CSM:
 // eight image layers each, light l's layer k from 8 (K l + k)).
 layout(constant_id = 5) const int kLayers = 1;
+layout(constant_id = 6) const bool kPrefixSumMips = false; // FrameConfig::prefix_sum_mips > 1
 layout(binding = 3) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
 layout(std430, binding = 6) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 #ifdef MSM_SIX_MOMENTS
@@ -83,8 +84,16 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   vec3 lookup = msm_rectified_view_lookup(f, b, camera + s * direction, rect.map.x);
   // The sampler repeats: u and, unless φ spans the full circle (rows 0 and height − 1 neighbours,
   // rectification.h), v are clamped to the texel centres at the edges here.
-  vec2 half_texel = 0.5f / vec2(rect.map.x, rect.map.y);
   bool full_circle = b.phi_span >= MSM_TWO_PI;
+  // App. D.5, where the prefix sums have mips: the level of the pixel's footprint (derivatives here,
+  // in uniform control flow: the lights' loop and the medium's test are uniform).
+  float lod = 0.0f;
+  if (kPrefixSumMips)
+    lod = min(msm_prefix_sum_lod(vec2(dFdx(lookup.x), dFdy(lookup.x)), vec2(dFdx(lookup.y), dFdy(lookup.y)),
+                                 vec2(rect.map.x, rect.map.y), full_circle),
+              float(textureQueryLevels(prefix_sums) - 1));
+  // Clamped to the texel centres of the coarser of the two levels read (trilinear).
+  vec2 half_texel = 0.5f * exp2(ceil(lod)) / vec2(rect.map.x, rect.map.y);
   vec2 uv = vec2(clamp(lookup.x, half_texel.x, 1.0f - half_texel.x),
                  full_circle ? lookup.y : clamp(lookup.y, half_texel.y, 1.0f - half_texel.y));
   // Transmittance layers: the two that bracket the ray's own step, mixed (1 − t, t) as stored vectors
@@ -98,18 +107,18 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
     mix_t = k.y;
   }
 #define MSM_LAYERED_LOOKUP(image, layer)                                                                           \
-  (kLayers > 1 ? mix(textureLod(image, vec3(uv, (layer)), 0.0f), textureLod(image, vec3(uv, (layer) + 1.0f), 0.0f), \
+  (kLayers > 1 ? mix(textureLod(image, vec3(uv, (layer)), lod), textureLod(image, vec3(uv, (layer) + 1.0f), lod), \
                      mix_t)                                                                                        \
-               : textureLod(image, vec3(uv, (layer)), 0.0f))
+               : textureLod(image, vec3(uv, (layer)), lod))
 #ifdef MSM_CSM
   CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
   for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
     // Layer k + 1's term t is 8 image layers after layer k's.
     vec4 texel = msm_csm_from_unorm(
-        kLayers > 1 ? mix(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * layer0 + float(t)), 0.0f),
-                          textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * (layer0 + 1.0f) + float(t)), 0.0f),
+        kLayers > 1 ? mix(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * layer0 + float(t)), lod),
+                          textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * (layer0 + 1.0f) + float(t)), lod),
                           mix_t)
-                    : textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), 0.0f));
+                    : textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), lod));
     if (t < 4)
       m.lo[t] = texel;
     else
