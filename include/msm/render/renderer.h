@@ -142,13 +142,15 @@ struct RenderSettings {
   bool front_back_depth = false;
   // Prefiltered scattering's transmittance-weighted prefix sums along the rectified rows (JCGT
   // §5.1.1): rows = one thread per row walks it once, each texel read and written once (on lavapipe
-  // 3-6x faster than the other, docs/results.md); appendix_c = the paper's Appendix C, 8 x 8 threads,
+  // 3.6-6.8x faster than the other, docs/results.md); appendix_c = the paper's Appendix C, 8 x 8 threads,
   // eight threads per row each summing the whole row so that a block's writes coalesce. The same
   // sums in the same order: the images agree (ScatteringTest.PrefixSumSchemesAgree).
   enum class PrefixSums { rows, appendix_c } prefix_sums = PrefixSums::rows;
   // JCGT Appendix D.5: a mip chain of the prefix sums (2 x 2 box averages), read by the scattering
-  // pass at the level of the pixel's footprint across the rows (epipolar slices), against the
-  // aliasing of thin shafts where neighbouring pixels skip rows. Off by default (docs/results.md).
+  // pass at the level of the pixel's smaller footprint along or across the rows (msm_prefix_sum_lod),
+  // against the aliasing of thin shafts where neighbouring pixels skip rows; where the device can
+  // blit and filter the storage formats (else none). Off by default: little gain measured
+  // (docs/results.md).
   bool prefix_sum_mips = false;
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default
