@@ -221,6 +221,9 @@ const Spec kSpecs[] = {
     // (pow): measured 7.3e-7 / 4.6e-7 on lavapipe. Bounds from Vulkan's log (2^-21 absolute near 1)
     // times (K − 1) = 15 over the smallest span log 1.5: 3.5e-5.
     {MSM_K_TRANSMITTANCE_LAYERS, "transmittance_layers", Metric::abs, A2, Layout::none, 1e-4, 2e-5},
+    // App. D.5's level: a wrap (floor), products, a min and log2 (Vulkan: 3 ulp outside [0.5, 2],
+    // 2^-21 absolute inside): bounds 1e-4 / 2e-5 as the layers'. Measured on lavapipe 1.8e-7 / 1.2e-7.
+    {MSM_K_PREFIX_SUM_LOD, "prefix_sum_lod", Metric::abs, A1, Layout::none, 1e-4, 2e-5},
 };
 
 // The functions whose outputs are shadows, bounds or blocker depths: finite on every input,
@@ -837,6 +840,14 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       const float scale = g.log_uniform(1.0f, 64.0f), angle = g.uni(0.0f, MSM_TWO_PI);
       const float sx = g.chance(0.5) ? scale : -scale; // either handedness
       x.b = vec4(sx * std::cos(angle), scale * std::sin(angle), -sx * std::sin(angle), scale * std::cos(angle));
+      break;
+    }
+    case MSM_K_PREFIX_SUM_LOD: {
+      // Derivatives of u and v from a hundredth of a texel to the whole map, either sign, in a
+      // 256..4096-texel map; v across the seam (|dv| near 1) at times; φ a full circle or not.
+      const auto derivative = [&] { return (g.chance(0.5) ? -1.0f : 1.0f) * g.log_uniform(1e-5f, 1.0f); };
+      x.a = vec4(derivative(), derivative(), derivative(), g.chance(0.2) ? g.uni(-1.0f, 1.0f) : derivative());
+      x.b = vec4(float(1 << g.integer(8, 12)), float(1 << g.integer(8, 12)), g.chance(0.5) ? 1.0f : 0.0f, 0.0f);
       break;
     }
     case MSM_K_TRANSMITTANCE_LAYERS: {

@@ -122,7 +122,9 @@ const int MSM_K_SCATTERING6 = 62; // a.xyz, b.xyz = stored Θ6* (odd, even), a.w
 const int MSM_K_RESAMPLING_LOD = 63; // a = (r, φ, r step, φ step), b = (map_per_x, map_per_y) -> a.x
 // rectification.h: the transmittance layers (issue 14, branch scatter-delta)
 const int MSM_K_TRANSMITTANCE_LAYERS = 64; // a = (Δ_lo, Δ_hi, delta, K) -> a.xy = (k0 + t, Δ_(K/2) / Δ_lo)
-const int MSM_K_COUNT = 65;
+// rectification.h: the prefix sums' mip level of a pixel (App. D.5)
+const int MSM_K_PREFIX_SUM_LOD = 65; // a = (du/dx, du/dy, dv/dx, dv/dy), b = (width, height, full circle) -> a.x
+const int MSM_K_COUNT = 66;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
 MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
@@ -239,6 +241,9 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
   case MSM_K_RESAMPLING_LOD:
     r.a[0] = msm_rectified_resampling_lod(vec2(x.a[0], x.a[1]), vec2(x.a[2], x.a[3]), vec2(x.b[0], x.b[1]),
                                           vec2(x.b[2], x.b[3]));
+    break;
+  case MSM_K_PREFIX_SUM_LOD:
+    r.a[0] = msm_prefix_sum_lod(vec2(x.a[0], x.a[1]), vec2(x.a[2], x.a[3]), vec2(x.b[0], x.b[1]), x.b[2] != 0.0f);
     break;
   case MSM_K_TRANSMITTANCE_LAYERS: {
     vec2 k = msm_transmittance_layer_lookup(vec2(x.a[0], x.a[1]), x.a[2], x.a[3]);
