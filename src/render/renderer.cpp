@@ -93,6 +93,19 @@ bool has_features(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags 
   return (props.optimalTilingFeatures & features) == features;
 }
 
+// The levels of a full mip chain of a size² image when it is wanted and the device can make it by
+// linear blits and filter it in each of `formats` (VK_FORMAT_UNDEFINED: no image); else 1.
+template <size_t N>
+uint32_t mip_chain_levels(const vk::Context& ctx, bool wanted, const std::array<VkFormat, N>& formats, int count,
+                          int size) {
+  for (int i = 0; i < count && wanted; ++i)
+    wanted = formats[size_t(i)] == VK_FORMAT_UNDEFINED ||
+             has_features(ctx, formats[size_t(i)],
+                          VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
+                              VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
+  return wanted ? uint32_t(std::bit_width(uint32_t(size))) : 1u;
+}
+
 } // namespace
 
 // The shading's lookup (MSM_LOOKUP_*): the settings', else dithered for the non-linear maps (their
@@ -302,13 +315,10 @@ struct Renderer::Impl {
                   .front_back = s.front_back_depth};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
-    bool can_mip =
-        s.mipmaps && !msm_technique_is_depth_based(id) && !msm_technique_is_nonlinear(id) && !msm_technique_is_soft(id);
-    for (int i = 0; i < c.moment_images(); ++i)
-      can_mip = can_mip && has_features(ctx, c.formats()[size_t(i)],
-                                        VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
-                                            VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT);
-    c.mip_levels = can_mip ? uint32_t(std::bit_width(uint32_t(s.shadow_size))) : 1u;
+    c.mip_levels = mip_chain_levels(ctx,
+                                    s.mipmaps && !msm_technique_is_depth_based(id) && !msm_technique_is_nonlinear(id) &&
+                                        !msm_technique_is_soft(id),
+                                    c.formats(), c.moment_images(), s.shadow_size);
     if (!msm_technique_is_nonlinear(id))
       for (int i = 0; i < c.moment_images(); ++i)
         if (!has_features(ctx, c.formats()[size_t(i)], VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
@@ -321,14 +331,7 @@ struct Renderer::Impl {
     if (msm_technique_is_prefiltered_scattering(id)) {
       c.transmittance_layers = transmittance_layers(s);
       c.prefix_sums_appendix_c = s.prefix_sums == RenderSettings::PrefixSums::appendix_c;
-      // Mips by linear blits, where the device can blit and filter the storage formats.
-      bool can_mip = s.prefix_sum_mips;
-      for (VkFormat f : c.prefix_sum_formats())
-        can_mip = can_mip && (f == VK_FORMAT_UNDEFINED ||
-                              has_features(ctx, f,
-                                           VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
-                                               VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT));
-      c.prefix_sum_mips = can_mip ? uint32_t(std::bit_width(uint32_t(s.shadow_size))) : 1u;
+      c.prefix_sum_mips = mip_chain_levels(ctx, s.prefix_sum_mips, c.prefix_sum_formats(), 2, s.shadow_size);
     }
     if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
       c.filtered_resampling = true;
@@ -337,10 +340,7 @@ struct Renderer::Impl {
         throw RenderError(fmt::format("{} cannot filter RGBA32F linearly: the filtered resampling of {} needs it "
                                       "(--param 0,0,0,0 resamples without filtering)",
                                       ctx.info().name, technique.name));
-      c.resampling_mips =
-          s.mipmaps && has_features(ctx, f, VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT)
-              ? uint32_t(std::bit_width(uint32_t(s.shadow_size)))
-              : 1u;
+      c.resampling_mips = mip_chain_levels(ctx, s.mipmaps, std::array<VkFormat, 1>{f}, 1, s.shadow_size);
     }
     if (!graph || !(config == c)) {
       graph.reset();

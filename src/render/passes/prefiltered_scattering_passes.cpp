@@ -157,17 +157,21 @@ void PrefixSumPass::execute(const PassContext& c) const {
   }
 }
 
+// The prefix-sum images of the frame: one, or two for six moments.
+static std::span<const char* const> prefix_sum_images(const FrameConfig& c) {
+  static constexpr const char* kNames[] = {kPrefixSums, kPrefixSums1};
+  return std::span(kNames, prefix_sums_have_two_images(c) ? 2 : 1);
+}
+
 void PrefixSumMipmapPass::reflect(PassBuilder& b) const {
-  for (const char* name : {kPrefixSums, kPrefixSums1}) {
-    if (name == kPrefixSums1 && !prefix_sums_have_two_images(config_)) continue;
+  for (const char* name : prefix_sum_images(config_)) {
     b.modify(name, use::transfer_source());
     b.internally(name, use::transfer_destination());
   }
 }
 
 void PrefixSumMipmapPass::execute(const PassContext& c) const {
-  for (const char* name : {kPrefixSums, kPrefixSums1}) {
-    if (name == kPrefixSums1 && !prefix_sums_have_two_images(config_)) continue;
+  for (const char* name : prefix_sum_images(config_)) {
     const GraphImage& g = c.image(name);
     record_mip_chain(c.cmd, g.image.handle(), config_.shadow_size, 1, g.spec.mips, g.spec.layers);
   }

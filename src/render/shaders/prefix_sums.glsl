@@ -57,6 +57,16 @@ void store_prefix_sum(int x, int row, vec4 mine, vec4 mine1) {
 #endif
 }
 
+// Adds texel x of the row with its weight w(x, v) to the running sums (both schemes, in order).
+void add_texel(int x, int row, float extinction, float delta, inout vec4 sum, inout vec4 sum1, inout float weight_sum) {
+  float w = msm_prefix_sum_weight(extinction, delta, float(x));
+  sum += w * texelFetch(rectified, MSM_TEXEL(x, row), 0);
+#ifdef MSM_SIX_MOMENTS
+  sum1 += w * texelFetch(rectified1, ivec2(x, row), 0);
+#endif
+  weight_sum += w;
+}
+
 void main() {
   RectificationUniforms rect = rects[pass.size.z];
   ivec2 size = ivec2(int(rect.map.x), int(rect.map.y));
@@ -73,12 +83,7 @@ void main() {
   float weight_sum = 0.0f;
   if (kRowSweep) {
     for (int x = 0; x < size.x; ++x) {
-      float w = msm_prefix_sum_weight(extinction, delta, float(x));
-      sum += w * texelFetch(rectified, MSM_TEXEL(x, row), 0);
-#ifdef MSM_SIX_MOMENTS
-      sum1 += w * texelFetch(rectified1, ivec2(x, row), 0);
-#endif
-      weight_sum += w;
+      add_texel(x, row, extinction, delta, sum, sum1, weight_sum);
       store_prefix_sum(x, row, sum / weight_sum, sum1 / weight_sum);
     }
     return;
@@ -86,12 +91,7 @@ void main() {
   for (int x0 = 0; x0 < size.x; x0 += 8) {
     vec4 mine = vec4(0.0f), mine1 = vec4(0.0f);
     for (int k = 0; k < 8 && x0 + k < size.x; ++k) {
-      float w = msm_prefix_sum_weight(extinction, delta, float(x0 + k));
-      sum += w * texelFetch(rectified, MSM_TEXEL(x0 + k, row), 0);
-#ifdef MSM_SIX_MOMENTS
-      sum1 += w * texelFetch(rectified1, ivec2(x0 + k, row), 0);
-#endif
-      weight_sum += w;
+      add_texel(x0 + k, row, extinction, delta, sum, sum1, weight_sum);
       if (k == column) {
         mine = sum / weight_sum;
         mine1 = sum1 / weight_sum;
