@@ -204,7 +204,8 @@ MSM_FN float msm_rect_light_cone_half_angle(vec2 t) {
 
 // A rectangular area light made from a region (Kneiphof §4.1.2–4.1.3).
 struct MsmAreaLight {
-  vec3 direction;        // unit, from the scene towards the light: the luminance-weighted centroid (Eq. 9)
+  vec3 direction;        // unit, from the scene towards the light: the luminance-weighted mean direction
+                         // (Eq. 9 on the sphere, msm_region_mean_direction)
   vec3 x_axis, y_axis;   // unit, orthogonal to direction: the face's u and v axes projected (§4.1.2)
   vec2 half_extent;      // half extents along x_axis / y_axis as tangents of angles
   float cone_half_angle; // α_A of the circular light of the same solid angle as the rectangle (not
@@ -212,12 +213,39 @@ struct MsmAreaLight {
   vec3 irradiance;       // M_e (Eq. 11), linear RGB: the light's Σ w L over its region
 };
 
-// The area light of a region of `face` from its sums (precondition: sums.xyz.y > 0). The centroid
-// (μ_u, μ_v) and variances σ² = E[u²] − μ² give half extents d = sqrt(3 σ²) (the uniform
+// The luminance-weighted mean of a region's unit directions, E[(u, v, 1) / r] with r = sqrt(1 +
+// u² + v²) in the face's frame (u axis, v axis, face normal), up to a positive factor: the
+// direction whose cosine law n·z gives a region above a receiver's horizon its exact irradiance
+// (∫ L n·ω dω = n·∫ L ω dω). The tables hold the luminance-weighted moments of u and v, not of the
+// unit directions, so it is Taylor's expansion to second order about the centroid (μ_u, μ_v) with
+// the variances σ_u², σ_v² (the covariance is not tabulated: taken 0, as §4.1.2 takes the axes
+// independent), times r⁵ (a positive factor; the caller normalizes):
+// r⁴ (μ_u, μ_v, 1) + ½ σ_u² r⁵ ∂²/∂u² + ½ σ_v² r⁵ ∂²/∂v², with
+// r⁵ ∂²/∂u² (u, v, 1) / r = (−3u (1 + v²), v (2u² − v² − 1), 2u² − v² − 1) and ∂²/∂v² alike.
+// Eq. (9)'s centroid on the face plane, projected, lies outwards of it (the plane's points
+// spread further than their directions): 1.4° for a quarter of a face, 4% of that light's
+// irradiance on a receiver it grazes; this estimate comes within 0.1° of the exact mean
+// (docs/results.md, "The sphere's centroid").
+MSM_FN vec3 msm_region_mean_direction(int face, vec2 mean, vec2 variance) {
+  float u = mean.x, v = mean.y;
+  float r2 = 1.0f + u * u + v * v;
+  vec3 second_u = vec3(-3.0f * u * (1.0f + v * v), v * (2.0f * u * u - v * v - 1.0f), 2.0f * u * u - v * v - 1.0f);
+  vec3 second_v = vec3(u * (2.0f * v * v - u * u - 1.0f), -3.0f * v * (1.0f + u * u), 2.0f * v * v - u * u - 1.0f);
+  vec3 f = r2 * r2 * vec3(u, v, 1.0f) + 0.5f * (variance.x * second_u + variance.y * second_v);
+  // The mean of directions through a face lies in the face's cone |x|, |y| <= z; the truncated
+  // series can leave it for light spread to opposite edges (f.z -> 0 at σ² = 1): kept inside.
+  f.z = max(f.z, max(max(abs(f.x), abs(f.y)), 1e-3f));
+  return f.x * msm_cube_u_axis(face) + f.y * msm_cube_v_axis(face) + f.z * msm_cube_direction(face, 0.0f, 0.0f);
+}
+
+// The area light of a region of `face` from its sums (precondition: sums.xyz.y > 0). Its
+// direction is the region's mean direction (msm_region_mean_direction: Eq. (9)'s luminance-
+// weighted centroid taken on the sphere rather than on the face plane). The variances
+// σ² = E[u²] − μ² about the centroid (μ_u, μ_v) give half extents d = sqrt(3 σ²) (the uniform
 // distribution of the same variance; ERRATA.md corrects the text's σ² = d / 3) on the face plane.
 // The paper scales them by the length of the projected face axis; here they are also divided by
-// the distance of the centroid's point of the face plane from the centre, so that they are
-// tangents of angles wherever on the face the region lies. The circular light has the solid angle
+// the distance from the centre of the face plane's point in the light's direction, so that they
+// are tangents of angles wherever on the face the region lies. The circular light has the solid angle
 // of the rectangle (msm_rect_light_cone_half_angle). Where the light dips below a receiver's
 // horizon (Eq. 15's π sin² α cos no longer holds, and would go negative), the shading integrates
 // the cosine over the part of the rectangle above the horizon (msm_rect_light_cosine: the rectangle
@@ -227,9 +255,8 @@ MSM_FN MsmAreaLight msm_area_light_from_region(int face, MsmRegionSums sums) {
   vec2 mean = sums.first / total;
   vec2 variance = max(sums.second / total - mean * mean, vec2(0.0f));
   vec2 d = sqrt(3.0f * variance);
-  vec3 p = msm_cube_direction(face, mean.x, mean.y);
-  float distance = length(p);
-  vec3 z = p / distance;
+  vec3 z = normalize(msm_region_mean_direction(face, mean, variance));
+  float distance = 1.0f / dot(z, msm_cube_direction(face, 0.0f, 0.0f));
   vec3 x = msm_cube_u_axis(face), y = msm_cube_v_axis(face);
   x -= z * dot(x, z);
   y -= z * dot(y, z);
@@ -274,9 +301,9 @@ MSM_FN MsmMergedSums msm_merged_sums_add(MsmMergedSums s, int face, MsmRegionSum
   return s;
 }
 
-// The light of a region of several parts (precondition: s.xyz.y > 0): Eq. 9 in 3D, the normalised
-// luminance-weighted mean z of the parts' directions (per texel it would take three more tables of
-// unit directions; within a face the part's own centroid stands for its texels), or the most
+// The light of a region of several parts (precondition: s.xyz.y > 0): the normalised
+// luminance-weighted mean z of the parts' directions (each part's msm_region_mean_direction
+// standing for its texels), or the most
 // energetic part's direction where they cancel out (|Σ E_r z_r| < 10^-3 Σ E_r: light from all
 // around has no direction); x the most energetic part's x axis projected off z (§4.1.2; its y axis
 // crossed with z where x_r is along z), y = z × x; half extents d = sqrt(3σ²) from the variances
