@@ -224,6 +224,10 @@ const Spec kSpecs[] = {
     // App. D.5's level: a wrap (floor), products, a min and log2 (Vulkan: 3 ulp outside [0.5, 2],
     // 2^-21 absolute inside): bounds 1e-4 / 2e-5 as the layers'. Measured on lavapipe 1.8e-7 / 1.2e-7.
     {MSM_K_PREFIX_SUM_LOD, "prefix_sum_lod", Metric::abs, A1, Layout::none, 1e-4, 2e-5},
+    // The proportional β: a ratio of the bounds (a division: 2.5 ulp in Vulkan) and the epipole's
+    // ramp from a dot product (slope 20 at the epipole: a few 1e-6). Bounds as the layers'. Measured
+    // on lavapipe: 0 (the same operations in the same order).
+    {MSM_K_SCATTERING_BETA, "scattering_beta_proportional", Metric::abs, A1, Layout::none, 1e-4, 2e-5},
 };
 
 // The functions whose outputs are shadows, bounds or blocker depths: finite on every input,
@@ -848,6 +852,23 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       const auto derivative = [&] { return (g.chance(0.5) ? -1.0f : 1.0f) * g.log_uniform(1e-5f, 1.0f); };
       x.a = vec4(derivative(), derivative(), derivative(), g.chance(0.2) ? g.uni(-1.0f, 1.0f) : derivative());
       x.b = vec4(float(1 << g.integer(8, 12)), float(1 << g.integer(8, 12)), g.chance(0.5) ? 1.0f : 0.0f, 0.0f);
+      break;
+    }
+    case MSM_K_SCATTERING_BETA: {
+      // Shadow bounds lower <= upper in [0, 1] (at times equal, at times a bound at 0 or 1), a
+      // light direction and a view direction, a fifth of them within 40° of the epipole.
+      float lower = g.chance(0.1) ? 0.0f : g.uni(0.0f, 1.0f), upper = g.chance(0.1) ? 1.0f : g.uni(lower, 1.0f);
+      if (g.chance(0.05)) upper = lower;
+      const auto unit = [&] {
+        glm::vec3 d(g.uni(-1.0f, 1.0f), g.uni(-1.0f, 1.0f), g.uni(-1.0f, 1.0f));
+        return glm::length(d) > 1e-3f ? glm::normalize(d) : glm::vec3(0.0f, 1.0f, 0.0f);
+      };
+      const glm::vec3 light = unit();
+      glm::vec3 view = unit();
+      if (g.chance(0.2))
+        view = glm::normalize(light + g.uni(0.0f, 0.7f) * unit()); // the epipole: view towards the light
+      x.a = vec4(lower, upper, view.x, view.y);
+      x.b = vec4(view.z, light.x, light.y, light.z);
       break;
     }
     case MSM_K_TRANSMITTANCE_LAYERS: {

@@ -177,6 +177,48 @@ TEST(PrefilteredScattering, AdaptiveBetaUnderestimatesIntoTheLight) {
   EXPECT_GT(msm_scattering_visibility4(b, MSM_REP_SIGNED_FLOAT, 0.2f, 1.0f), 0.99f);
 }
 
+// The proportional β against hand-computed answers: the undecided weight w0 = upper − lower is
+// shared as the rest is, so the visible fraction is the surely lit mass over the decided mass,
+// (1 − upper) / ((1 − upper) + lower); towards the epipole it ramps to 0 (cone 36.87°, where
+// (1 − cos θ) / 2 = 0.1).
+TEST(PrefilteredScattering, ProportionalBetaSharesTheUndecidedWeightAsTheRest) {
+  const vec3 l = normalize(vec3(0.3f, 0.8f, -0.2f));
+  const vec3 across = normalize(cross(l, vec3(0.0f, 0.0f, 1.0f)));
+  // Shadow bounds (0.2, 0.6): surely lit 0.4, surely shadowed 0.2, β = 2/3, visible 0.4 / 0.6.
+  EXPECT_NEAR(msm_scattering_beta_mass_ratio(vec2(0.2f, 0.6f)), 2.0f / 3.0f, 1e-6f);
+  // β of the bounds for a view direction (from the camera outwards).
+  const auto beta = [&](vec2 bounds, vec3 view) {
+    return msm_scattering_beta_proportional(bounds, msm_scattering_beta_adaptive(l, view));
+  };
+  EXPECT_NEAR(beta(vec2(0.2f, 0.6f), across), 2.0f / 3.0f, 1e-6f);
+  EXPECT_NEAR(msm_scattering_visibility_between(vec2(0.2f, 0.6f), 2.0f / 3.0f), 2.0f / 3.0f, 1e-6f);
+  // Nothing surely shadowed: the upper bound of the visible fraction; nothing surely lit: the
+  // lower; nothing decided: ½.
+  EXPECT_NEAR(msm_scattering_beta_mass_ratio(vec2(0.0f, 0.3f)), 1.0f, 1e-6f);
+  EXPECT_NEAR(msm_scattering_beta_mass_ratio(vec2(0.4f, 1.0f)), 0.0f, 1e-5f);
+  EXPECT_EQ(msm_scattering_beta_mass_ratio(vec2(0.0f, 1.0f)), 0.5f);
+  // The visible fraction is lit / (lit + shadowed) for any bounds (a sweep).
+  for (float lower = 0.0f; lower <= 1.0f; lower += 0.125f)
+    for (float upper = lower; upper <= 1.0f; upper += 0.125f) {
+      const float lit = 1.0f - upper, decided = lit + lower;
+      if (decided <= 0.0f) continue;
+      const float visible = msm_scattering_visibility_between(vec2(lower, upper), beta(vec2(lower, upper), across));
+      EXPECT_NEAR(visible, lit / decided, 1e-5f) << lower << ", " << upper;
+    }
+  // The epipole: looking into the light β = 0 whatever the bounds; 20° off it the ramp at
+  // a = (1 − cos 20°) / 2 = 0.0302: x = 0.302, x (2 − x) = 0.513; from 36.87° on, the ratio alone.
+  EXPECT_EQ(msm_scattering_beta_proportional(vec2(0.0f, 0.3f), msm_scattering_beta_adaptive(l, l)), 0.0f);
+  const auto towards = [&](float degrees) {
+    const float t = glm::radians(degrees);
+    return std::cos(t) * l + std::sin(t) * across;
+  };
+  const float a20 = 0.5f * (1.0f - std::cos(glm::radians(20.0f))), x20 = a20 / MSM_SCATTERING_EPIPOLE_CONE;
+  EXPECT_NEAR(beta(vec2(0.0f, 0.3f), towards(20.0f)), x20 * (2.0f - x20), 1e-5f);
+  EXPECT_NEAR(x20 * (2.0f - x20), 0.513f, 1e-3f);
+  EXPECT_NEAR(beta(vec2(0.0f, 0.3f), towards(37.0f)), 1.0f, 1e-6f);
+  EXPECT_LT(beta(vec2(0.0f, 0.3f), towards(36.0f)), 0.999f);
+}
+
 // Algorithm 2 then the map of §5.1.1: a filtered texel over two surfaces comes back as those two
 // surfaces' rectified depths with their weights (exact for two depths: b0..b3 determine them).
 // Rectified depths computed independently in double.

@@ -427,14 +427,16 @@ constexpr Technique kTechniques[] = {
     {"scatter-msm4-64",
      "Prefiltered single scattering with four moments (JCGT §5.3): the depth map resampled without filtering into "
      "the rectified map (§5.1.1), transmittance-weighted prefix sums along its rows stored as Θ4* in 4 x 16 bits, "
-     "one bilinear lookup per pixel, sharp bounds blended by the adaptive β of §5.3.1; surfaces shaded with PCF",
+     "one bilinear lookup per pixel, sharp bounds blended by the proportional β (§5.3.1 adapted); surfaces shaded with "
+     "PCF",
      MSM_TECH_SCATTER_MSM4_64,
      64,
      4,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 2 = the adaptive β of §5.3.1, 0 = the proportional β (default: the "
+     "undecided weight shared as the bounds share the rest, falling to 0 towards the epipole); "
      "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
@@ -443,14 +445,15 @@ constexpr Technique kTechniques[] = {
     {"scatter-msm6-64",
      "Prefiltered single scattering with six moments (JCGT §5.4): as scatter-msm4-64, Θ6* prefix sums in 6 x 10 bits "
      "(two RGB10A2 images, alpha 4e-3), "
-     "Blinn's cubic and the divided-difference weights, adaptive β",
+     "Blinn's cubic and the divided-difference weights, proportional β",
      MSM_TECH_SCATTER_MSM6_64,
      64,
      6,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 2 = the adaptive β of §5.3.1, 0 = the proportional β (default: the "
+     "undecided weight shared as the bounds share the rest, falling to 0 towards the epipole); "
      "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
@@ -459,14 +462,15 @@ constexpr Technique kTechniques[] = {
     {"scatter-msm6-96",
      "Prefiltered single scattering with six moments (JCGT §5.4): as scatter-msm4-64, Θ6* prefix sums in 2 + 4 x 16 "
      "bits (alpha 8e-5), "
-     "Blinn's cubic and the divided-difference weights, adaptive β",
+     "Blinn's cubic and the divided-difference weights, proportional β",
      MSM_TECH_SCATTER_MSM6_96,
      96,
      6,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 2 = the adaptive β of §5.3.1, 0 = the proportional β (default: the "
+     "undecided weight shared as the bounds share the rest, falling to 0 towards the epipole); "
      "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,
@@ -475,14 +479,15 @@ constexpr Technique kTechniques[] = {
     {"scatter-msm6-192",
      "Prefiltered single scattering with six moments (JCGT §5.4): as scatter-msm4-64, Θ6* prefix sums in 6 x 32-bit "
      "float (alpha 5e-6), "
-     "Blinn's cubic and the divided-difference weights, adaptive β",
+     "Blinn's cubic and the divided-difference weights, proportional β",
      MSM_TECH_SCATTER_MSM6_192,
      192,
      6,
      {TexelFormat::none, TexelFormat::none},
      "x: 1 = resampling with filtering (JCGT §5.2: a trilinear sample of the blurred, mipmapped 4-moment map at the "
      "texel's footprint, Algorithm 2), 2 = from the unblurred depth map's bilinear moments, 0 = without (default); "
-     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 0 = the adaptive β (default); "
+     "z: 1 = a fixed β = y in [0, 1] (§5.3.1), 2 = the adaptive β of §5.3.1, 0 = the proportional β (default: the "
+     "undecided weight shared as the bounds share the rest, falling to 0 towards the epipole); "
      "w: transmittance layers K = 1..16 (1 = the paper's single Δ per row), 0 = the default",
      true,
      nullptr,

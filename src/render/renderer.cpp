@@ -16,6 +16,7 @@
 #include "msm/render/frame.h"
 #include "msm/render/rectification_uniforms.h"
 #include "msm/sat.h"
+#include "msm/scattering.h"
 #include "msm/shading.h"
 #include "msm/soft.h"
 #include "msm/techniques.h"
@@ -332,6 +333,7 @@ struct Renderer::Impl {
       c.transmittance_layers = transmittance_layers(s);
       c.prefix_sums_appendix_c = s.prefix_sums == RenderSettings::PrefixSums::appendix_c;
       c.prefix_sum_mips = mip_chain_levels(ctx, s.prefix_sum_mips, c.prefix_sum_formats(), 2, s.shadow_size);
+      c.scattering_beta = msm_scattering_beta_mode(params.z);
     }
     if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
       c.filtered_resampling = true;

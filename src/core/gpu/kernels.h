@@ -124,7 +124,9 @@ const int MSM_K_RESAMPLING_LOD = 63; // a = (r, φ, r step, φ step), b = (map_p
 const int MSM_K_TRANSMITTANCE_LAYERS = 64; // a = (Δ_lo, Δ_hi, delta, K) -> a.xy = (k0 + t, Δ_(K/2) / Δ_lo)
 // rectification.h: the prefix sums' mip level of a pixel (App. D.5)
 const int MSM_K_PREFIX_SUM_LOD = 65; // a = (du/dx, du/dy, dv/dx, dv/dy), b = (width, height, full circle) -> a.x
-const int MSM_K_COUNT = 66;
+// scattering.h: the proportional β from the shadow's bounds and the view and light directions
+const int MSM_K_SCATTERING_BETA = 66; // a = (lower, upper, view.xy), b = (view.z, towards_light) -> a.x
+const int MSM_K_COUNT = 67;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
 MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
@@ -241,6 +243,10 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
   case MSM_K_RESAMPLING_LOD:
     r.a[0] = msm_rectified_resampling_lod(vec2(x.a[0], x.a[1]), vec2(x.a[2], x.a[3]), vec2(x.b[0], x.b[1]),
                                           vec2(x.b[2], x.b[3]));
+    break;
+  case MSM_K_SCATTERING_BETA:
+    r.a[0] = msm_scattering_beta_proportional(
+        vec2(x.a[0], x.a[1]), msm_scattering_beta_adaptive(vec3(x.b[1], x.b[2], x.b[3]), vec3(x.a[2], x.a[3], x.b[0])));
     break;
   case MSM_K_PREFIX_SUM_LOD:
     r.a[0] = msm_prefix_sum_lod(vec2(x.a[0], x.a[1]), vec2(x.a[2], x.a[3]), vec2(x.b[0], x.b[1]), x.b[2] != 0.0f);

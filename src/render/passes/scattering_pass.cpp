@@ -27,7 +27,9 @@ void ScatteringPass::prepare(const PassResources& r) {
                                    // The transmittance layers per light (scatter.glsl; 1: the paper's Δ(v)).
                                    {5, uint32_t(config_.transmittance_layers)},
                                    // App. D.5's mips of the prefix sums: the level per pixel only with them.
-                                   {6, config_.prefix_sum_mips > 1 ? 1u : 0u}}};
+                                   {6, config_.prefix_sum_mips > 1 ? 1u : 0u},
+                                   // β: proportional, fixed or §5.3.1's adaptive (scattering.h).
+                                   {7, uint32_t(config_.scattering_beta)}}};
   program_ = &r.programs.graphics(d);
 }
 

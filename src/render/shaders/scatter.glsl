@@ -28,6 +28,7 @@ int current_layer = 0;
 // eight image layers each, light l's layer k from 8 (K l + k)).
 layout(constant_id = 5) const int kLayers = 1;
 layout(constant_id = 6) const bool kPrefixSumMips = false; // FrameConfig::prefix_sum_mips > 1
+layout(constant_id = 7) const int kBetaMode = 0; // FrameConfig::scattering_beta: MSM_SCATTERING_BETA_*
 layout(binding = 3) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
 layout(std430, binding = 6) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 #ifdef MSM_SIX_MOMENTS
@@ -127,10 +128,12 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   return msm_scattering_visibility_csm(m, msm_saturate(lookup.z), msm_csm_scattering_params());
 #else
   vec4 stored = MSM_LAYERED_LOOKUP(prefix_sums, layer0);
-  // The technique's parameter z = 1 fixes β to its y (§5.3.1's constant overestimation), else adaptive.
-  float beta = frame.technique_params.z == 1.0f
-                   ? msm_saturate(frame.technique_params.y)
-                   : msm_scattering_beta_adaptive(lights[shadow_layer].towards_light.xyz, direction);
+  // kBetaMode (the technique's parameter z): a fixed β = y (§5.3.1's constant overestimation),
+  // §5.3.1's adaptive β, or the proportional β (scattering.h), which needs the bounds first.
+  vec3 towards_light = lights[shadow_layer].towards_light.xyz;
+  bool proportional = kBetaMode == MSM_SCATTERING_BETA_PROPORTIONAL;
+  float beta = kBetaMode == MSM_SCATTERING_BETA_FIXED ? msm_saturate(frame.technique_params.y)
+                                                      : msm_scattering_beta_adaptive(towards_light, direction);
   float zf = msm_signed_depth(lookup.z);
 #ifdef MSM_SIX_MOMENTS
   // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
@@ -139,10 +142,13 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   Moments6 m = representation == MSM_REP6_UNORM10
                    ? Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored1.x, stored1.y, stored1.z))
                    : Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored.w, stored1.x, stored1.y));
-  return msm_scattering_visibility6(m, representation, zf, beta);
+  if (!proportional) return msm_scattering_visibility6(m, representation, zf, beta);
+  vec2 bounds = msm_scattering_shadow_bounds6(m, representation, zf);
 #else
-  return msm_scattering_visibility4(stored, MSM_REP_SIGNED_THETA4, zf, beta);
+  vec2 bounds = msm_scattering_shadow_bounds4(stored, MSM_REP_SIGNED_THETA4, zf);
+  if (!proportional) return msm_scattering_visibility_between(bounds, beta);
 #endif
+  return msm_scattering_visibility_between(bounds, msm_scattering_beta_proportional(bounds, beta));
 #endif // MSM_CSM
 }
 #endif
