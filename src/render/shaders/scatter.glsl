@@ -76,7 +76,7 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
 }
 #else
 // One lookup in light l's prefix sums at the ray's row and reach, reconstructed at the ray's
-// rectified depth with adaptive overestimation (§5.3.1).
+// rectified depth with the technique's β (kBetaMode: proportional, fixed or §5.3.1's adaptive).
 float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
   current_layer = l;
   RectificationUniforms rect = rects[shadow_layer];
