@@ -170,6 +170,14 @@ MSM_FN float msm_scattering_visibility_between(vec2 shadow_bounds, float beta) {
   return 1.0f - msm_saturate(mix(shadow_bounds.x, shadow_bounds.y, 1.0f - beta));
 }
 
+// β of a ray by the technique's choice (msm_scattering_beta_mode): the fixed β, §5.3.1's adaptive
+// β, or the proportional β of the shadow's bounds.
+MSM_FN float msm_scattering_beta(int mode, vec2 shadow_bounds, float fixed_beta, float adaptive_beta) {
+  if (mode == MSM_SCATTERING_BETA_FIXED) return msm_saturate(fixed_beta);
+  if (mode == MSM_SCATTERING_BETA_ADAPTIVE) return adaptive_beta;
+  return msm_scattering_beta_proportional(shadow_bounds, adaptive_beta);
+}
+
 // Four moments. stored: the prefix-summed texel as sampled; representation MSM_REP_SIGNED_THETA4
 // (Θ4* in 4 x 16-bit UNORM, 64 bits, α = 6e-5: the 64-bit Θ4*) or MSM_REP_SIGNED_FLOAT
 // (canonical moments in 4 x 32-bit float, α = 3e-7). Sharp lower and upper bounds of
@@ -189,16 +197,13 @@ MSM_FN float msm_scattering_visibility4(vec4 stored, int representation, float z
 // MSM_REP6_UNORM10 (6 x 10 bits, α = 4e-3), MSM_REP6_UNORM16 (2 + 4 x 16 bits, α = 8e-5) or
 // MSM_REP6_FLOAT (6 x 32-bit float, α = 5e-6), biased towards the b* of §5.4.3 (config.h).
 // Blinn's cubic and the divided-difference weights of §5.4.2 are hamburger6.h's.
-MSM_FN float msm_scattering_visibility6(Moments6 stored, int representation, float zf, float beta) {
-  Moments6 b = msm_apply_bias6(msm_theta6_star_inverse(stored), msm_moment_bias6(representation));
-  return 1.0f - msm_hamburger6_blend(b, zf, 1.0f - beta);
-}
-// The shadow's sharp (lower, upper) bounds of the same (for msm_scattering_beta_proportional and
-// msm_scattering_visibility_between, which clamps the upper bound before the blend where
-// msm_hamburger6_blend clamps after it: equal wherever lower + w0 <= 1).
+// msm_scattering_shadow_bounds6: the shadow's sharp (lower, upper) bounds, as for four moments.
 MSM_FN vec2 msm_scattering_shadow_bounds6(Moments6 stored, int representation, float zf) {
   Moments6 b = msm_apply_bias6(msm_theta6_star_inverse(stored), msm_moment_bias6(representation));
   return msm_hamburger6_bounds(b, zf);
+}
+MSM_FN float msm_scattering_visibility6(Moments6 stored, int representation, float zf, float beta) {
+  return msm_scattering_visibility_between(msm_scattering_shadow_bounds6(stored, representation, zf), beta);
 }
 
 // Klehm et al. 2014: a convolution shadow map of 32 coefficients (16 sin/cos terms) at 8 bits.

@@ -128,12 +128,6 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   return msm_scattering_visibility_csm(m, msm_saturate(lookup.z), msm_csm_scattering_params());
 #else
   vec4 stored = MSM_LAYERED_LOOKUP(prefix_sums, layer0);
-  // kBetaMode (the technique's parameter z): a fixed β = y (§5.3.1's constant overestimation),
-  // §5.3.1's adaptive β, or the proportional β (scattering.h), which needs the bounds first.
-  vec3 towards_light = lights[shadow_layer].towards_light.xyz;
-  bool proportional = kBetaMode == MSM_SCATTERING_BETA_PROPORTIONAL;
-  float beta = kBetaMode == MSM_SCATTERING_BETA_FIXED ? msm_saturate(frame.technique_params.y)
-                                                      : msm_scattering_beta_adaptive(towards_light, direction);
   float zf = msm_signed_depth(lookup.z);
 #ifdef MSM_SIX_MOMENTS
   // march.y: the storage (MSM_REP6_*); 10 bits keep the odd and the even moments in one image each.
@@ -142,13 +136,14 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   Moments6 m = representation == MSM_REP6_UNORM10
                    ? Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored1.x, stored1.y, stored1.z))
                    : Moments6(vec3(stored.x, stored.y, stored.z), vec3(stored.w, stored1.x, stored1.y));
-  if (!proportional) return msm_scattering_visibility6(m, representation, zf, beta);
   vec2 bounds = msm_scattering_shadow_bounds6(m, representation, zf);
 #else
   vec2 bounds = msm_scattering_shadow_bounds4(stored, MSM_REP_SIGNED_THETA4, zf);
-  if (!proportional) return msm_scattering_visibility_between(bounds, beta);
 #endif
-  return msm_scattering_visibility_between(bounds, msm_scattering_beta_proportional(bounds, beta));
+  // kBetaMode (the technique's parameter z): a fixed β = y, §5.3.1's adaptive β or the proportional β.
+  float adaptive = msm_scattering_beta_adaptive(lights[shadow_layer].towards_light.xyz, direction);
+  return msm_scattering_visibility_between(bounds,
+                                           msm_scattering_beta(kBetaMode, bounds, frame.technique_params.y, adaptive));
 #endif // MSM_CSM
 }
 #endif
