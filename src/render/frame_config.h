@@ -38,6 +38,11 @@ struct FrameConfig {
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).
   bool filtered_resampling = false;
   uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
+  // Prefiltered scattering, parameter x = 2: the earlier on-the-fly filter of rectify (a bilinear
+  // sample of the depth map's texels' moments). A specialization constant of rectify, as lavapipe
+  // runs both sides of a branch on a uniform: the unfiltered resampling paid for this path (18% of
+  // the pass, docs/results.md).
+  bool on_the_fly_resampling = false;
   // Prefiltered scattering: K transmittance layers (rectification.h; technique parameter w): K prefix
   // sums per light with the steps Δ_k, mixed per pixel at its own Δ; 1 = the paper's Δ(v) per row.
   int transmittance_layers = 1;

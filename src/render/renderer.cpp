@@ -334,6 +334,7 @@ struct Renderer::Impl {
       c.prefix_sums_appendix_c = s.prefix_sums == RenderSettings::PrefixSums::appendix_c;
       c.prefix_sum_mips = mip_chain_levels(ctx, s.prefix_sum_mips, c.prefix_sum_formats(), 2, s.shadow_size);
       c.scattering_beta = msm_scattering_beta_mode(params.z);
+      c.on_the_fly_resampling = params.x != 0.0f && params.x != 1.0f;
     }
     if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
       c.filtered_resampling = true;

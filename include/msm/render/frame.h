@@ -80,6 +80,9 @@ struct ObjectPush {
 // The prefix sums' scheme (prefix_sums.glsl, RenderSettings::prefix_sums): true for the row sweep
 // (64 rows per group of 8 x 8 threads), false for Appendix C's (8 rows per group).
 #define MSM_PREFIX_ROWS_SPEC_ID 0
+// Rectify's resampling without the moment map (rectify.glsl, FrameConfig::on_the_fly_resampling):
+// true for the on-the-fly filter of the depth map's moments, false for its nearest texel.
+#define MSM_RECTIFY_ON_THE_FLY_SPEC_ID 1
 
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {

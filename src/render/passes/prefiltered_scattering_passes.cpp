@@ -46,7 +46,8 @@ void RectifyPass::prepare(const PassResources& r) {
                                        vk::Binding::storage_buffer, vk::Binding::sampled_image,
                                        vk::Binding::storage_image};
   if (six) bindings.push_back(vk::Binding::storage_image);
-  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush));
+  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush),
+                                 {{MSM_RECTIFY_ON_THE_FLY_SPEC_ID, config_.on_the_fly_resampling ? 1u : 0u}});
 }
 
 void RectifyPass::reflect(PassBuilder& b) const {

@@ -7,7 +7,7 @@
 // a trilinear sample of the frame's blurred, mipmapped 4-moment map of [0,1] depth (moment_resolve,
 // blur and mipmaps of msm-hamburger-128-unit; FrameConfig::resampling_moments) at the level of the
 // texel's footprint in the shadow map (msm_rectified_resampling_lod), turned into two depths by
-// JCGT Algorithm 2; or, where x is another non-zero value (2), the earlier on-the-fly filter kept
+// JCGT Algorithm 2; or, where x is 2 (kOnTheFlyFilter), the earlier on-the-fly filter kept
 // for comparison: a bilinear sample of the four moments of the depth map's texels (each the mean
 // of its MSAA samples' moments: the resolved moment map without blur and mips). Each depth is
 // mapped to the rectified depth π − θ and turned into the technique's moments in its storage basis
@@ -26,6 +26,7 @@ layout(binding = 3) uniform sampler2D resampling_moments; // the light's layer, 
 #else
 #define MSM_DEPTH_BINDING 3
 #include "depth_map.glsl"
+layout(constant_id = MSM_RECTIFY_ON_THE_FLY_SPEC_ID) const bool kOnTheFlyFilter = false; // parameter x = 2
 #endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -71,7 +72,7 @@ void main() {
 #else
     int map = int(frame.shadow_map.x);
     ivec2 t = clamp(ivec2(floor((vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0), ivec2(map - 1));
-    if (frame.technique_params.x != 0.0f) {
+    if (kOnTheFlyFilter) {
       vec2 p = (vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
       ivec2 i0 = ivec2(floor(p));
       vec2 f = p - vec2(i0);

@@ -17,12 +17,7 @@
 #include "msm/shading.h"
 #define MSM_LIGHT_BINDING 5
 #include "frame.glsl"
-// Frames with one light specialize the loop over the lights and its layer to the constant 0 (as the
-// shading does: lavapipe fetches from a constant layer several times faster than from a variable one).
-layout(constant_id = 4) const int kLightCount = 1; // a constant, not frame.lights.x: see shading.glsl
-const bool kOneLight = kLightCount == 1;
-int current_layer = 0;
-#define shadow_layer (kOneLight ? 0 : current_layer)
+#include "light_loop.glsl"
 #ifdef MSM_SCATTER_PREFILTERED
 // K transmittance layers per light (rectification.h; 1: the paper's Δ(v)), light l's from K l (CSM:
 // eight image layers each, light l's layer k from 8 (K l + k)).
@@ -148,6 +143,15 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
 }
 #endif
 
+// Light l's in-scattering along the view ray, added to sum.
+ScatteringSum add_light(ScatteringSum sum, int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  float extinction = scatter.medium.x;
+  float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
+                                          dot(lights[l].towards_light.xyz, direction));
+  return msm_scattering_add_light(sum, lights[l].irradiance.rgb, extinction, phase, s,
+                                  visible_fraction(l, pixel, camera, direction, s));
+}
+
 void main() {
   ivec2 pixel = ivec2(gl_FragCoord.xy);
   vec3 surface = texelFetch(surface_radiance, pixel, 0).rgb;
@@ -164,13 +168,10 @@ void main() {
   if (scatter.medium.w != 0.0f) {
     float extinction = scatter.medium.x;
     ScatteringSum sum = msm_scattering_sum_none();
-    const int light_count = kLightCount;
-    for (int l = 0; l < light_count; ++l) {
-      float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
-                                              dot(lights[l].towards_light.xyz, direction));
-      sum = msm_scattering_add_light(sum, lights[l].irradiance.rgb, extinction, phase, s,
-                                     visible_fraction(l, pixel, camera, direction, s));
-    }
+    if (kOneLight) // no loop: light_loop.glsl
+      sum = add_light(sum, 0, pixel, camera, direction, s);
+    else
+      for (int l = 0; l < kLightCount; ++l) sum = add_light(sum, l, pixel, camera, direction, s);
     radiance = msm_scattering_sum_radiance(surface, extinction, s, sum);
     inscattered = sum.inscattered;
     visible = msm_scattering_sum_visible(sum);

@@ -8,21 +8,10 @@
 #include "msm/techniques.h"
 #define MSM_LIGHT_BINDING 10
 #include "frame.glsl"
-
-// The frame's lights (FrameConfig::lights): a specialization constant, not frame.lights.x, because
-// lavapipe (Mesa 22.3) re-optimizes and recompiles a shader at every bind whose loop bound is a
-// uniform (it inlines the value to unroll the loop): about 0.8 s per frame of MSM-64 shading with
-// Mesa's shader cache off, and a cache lookup per frame with it on (docs/results.md, issue 18).
-// The light whose shadow map the lookups read is its layer of the frame's shadow-map arrays;
-// frames with one light specialize it to the constant 0 (kOneLight): lavapipe fetches from a
-// constant layer several times faster than from a variable one.
-layout(constant_id = 4) const int kLightCount = 1;
-const bool kOneLight = kLightCount == 1;
+#include "light_loop.glsl"
 // Scattering techniques: the colour attachment takes linear radiance (before exposure and tone
 // mapping), which the scattering pass composites with the medium's in-scattering.
 layout(constant_id = 5) const bool kLinearRadiance = false;
-int current_layer = 0;
-#define shadow_layer (kOneLight ? 0 : current_layer)
 
 layout(binding = 1) uniform sampler2D albedo_texture;
 layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
@@ -107,38 +96,45 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
   return 1.0f - shadow;
 }
 
-// Direct light of every light at world_position with normal n (towards the viewer), and the
-// shadow buffer's visibility of the direct light: with one light its visibility, with several the
-// mean weighted by the irradiance each one brings (luminance of E max(n·l, 0), for area lights
-// msm_light_cosine: the same factor as the shading).
+// Light l's direct light at the surface with normal n (towards the viewer), added to direct, and
+// its visibility, returned and added to weighted with the irradiance it brings (luminance of
+// E max(n·l, 0), for area lights msm_light_cosine: the same factor as the shading) as its weight.
+vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inout vec3 weighted, inout float weight_sum) {
+  float n_dot_l = dot(n, lights[l].towards_light.xyz);
+  // Area lights: the cosine integrated over the part of the light above the surface's horizon
+  // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
+  // the rectangle clipped by the horizon plane (msm_rect_light_cosine) or the disc's cone
+  // (msm_cone_cosine); max(n·l, 0) for point lights (rect_extent = 0, soft.z = 0) and wherever
+  // the whole light is above the horizon; 0 where it is all below. The other techniques shade
+  // points (the renderer leaves soft.z and rect_extent 0): a branch on the specialization
+  // constant, as llvmpipe runs both sides of a branch on a uniform under a mask, and the
+  // rectangle's clipping would cost every pixel of every light.
+  float lit = msm_technique_is_area_light(kTechnique)
+                  ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz,
+                                     lights[l].rect_extent.xy, lights[l].soft.z)
+                  : msm_cone_cosine(n_dot_l, 0.0f);
+  vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
+  direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
+  float w = msm_luminance(lights[l].irradiance.rgb) * lit;
+  weighted += w * v;
+  weight_sum += w;
+  return v;
+}
+
+// Direct light of every light at world_position with normal n, and the shadow buffer's visibility
+// of the direct light: with one light its visibility, with several their mean weighted by the
+// irradiance each one brings.
 void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
-  vec3 weighted = vec3(0.0f), first = vec3(0.0f);
-  direct = vec3(0.0f);
+  vec3 weighted = vec3(0.0f);
   float weight_sum = 0.0f;
-  const int light_count = kLightCount;
+  direct = vec3(0.0f);
   MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
-  for (int l = 0; l < light_count; ++l) {
-    float n_dot_l = dot(n, lights[l].towards_light.xyz);
-    // Area lights: the cosine integrated over the part of the light above the surface's horizon
-    // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
-    // the rectangle clipped by the horizon plane (msm_rect_light_cosine) or the disc's cone
-    // (msm_cone_cosine); max(n·l, 0) for point lights (rect_extent = 0, soft.z = 0) and wherever
-    // the whole light is above the horizon; 0 where it is all below. The other techniques shade
-    // points (the renderer leaves soft.z and rect_extent 0): a branch on the specialization
-    // constant, as llvmpipe runs both sides of a branch on a uniform under a mask, and the
-    // rectangle's clipping would cost every pixel of every light.
-    float lit = msm_technique_is_area_light(kTechnique)
-                    ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz,
-                                       lights[l].rect_extent.xy, lights[l].soft.z)
-                    : msm_cone_cosine(n_dot_l, 0.0f);
-    vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
-    direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
-    float w = msm_luminance(lights[l].irradiance.rgb) * lit;
-    weighted += w * v;
-    weight_sum += w;
-    if (l == 0) first = v;
+  if (kOneLight) { // no loop: light_loop.glsl
+    visibility = add_direct_light(0, n, pixel, direct, weighted, weight_sum);
+    return;
   }
-  visibility = light_count == 1 ? first : (weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f));
+  for (int l = 0; l < kLightCount; ++l) add_direct_light(l, n, pixel, direct, weighted, weight_sum);
+  visibility = weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f);
 }
 
 void write_shaded(vec4 albedo_opacity, vec3 direct, vec3 visibility) {

@@ -1,0 +1,17 @@
+// The loop over the frame's lights, shared by the shading and the scattering pass (after frame.glsl).
+//
+// The frame's lights (FrameConfig::lights): a specialization constant, not frame.lights.x, because
+// lavapipe (Mesa 22.3) re-optimizes and recompiles a shader at every bind whose loop bound is a
+// uniform (it inlines the value to unroll the loop): about 0.8 s per frame of MSM-64 shading with
+// Mesa's shader cache off, and a cache lookup per frame with it on (docs/results.md, issue 18).
+layout(constant_id = 4) const int kLightCount = 1;
+const bool kOneLight = kLightCount == 1;
+
+// Frames with one light evaluate it outside any loop (kOneLight ? body(0) : for each l body(l)):
+// NIR unrolls a one-trip loop only below a size limit, and a loop kept makes its counter, the
+// lights[l] it indexes and the layer it reads per-lane vectors in llvmpipe (gathers, a variable
+// layer). Past that limit (the four-moment scattering with the proportional β) the pass cost 45%
+// more instructions in a loop than unrolled (docs/results.md). With one light the layer is the
+// constant 0: lavapipe fetches from a constant layer several times faster than from a variable one.
+int current_layer = 0; // the light whose shadow map the lookups read, set before its lookups
+#define shadow_layer (kOneLight ? 0 : current_layer)
