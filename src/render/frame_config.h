@@ -33,6 +33,11 @@ struct FrameConfig {
   // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
   // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).
   bool deferred = false;
+  // Whether any draw of the scene reads an albedo or opacity texture (ObjectPush::flags x, z): a
+  // specialization constant of the shading (shading.glsl, kTexturedDraws), as lavapipe fetches the
+  // textures under a branch on the draw's flags for untextured draws too (67 instructions per pixel,
+  // 9-11% of MSM-64's forward shading on the fence, docs/results.md).
+  bool textured_draws = true;
   // Prefiltered scattering, resampling with filtering (JCGT §5.2; technique parameter x = 1): the
   // frame also makes each light's blurred, mipmapped 4-moment map (moment_resolve, blur and mipmaps
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).

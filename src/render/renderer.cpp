@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 #include <glm/gtc/packing.hpp>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -86,6 +87,12 @@ image::Image to_float_image(std::span<const std::byte> bytes, VkFormat format, i
     }
   }
   return out;
+}
+
+// Whether any draw, opaque or translucent, reads an albedo or opacity texture (FrameConfig::textured_draws).
+bool has_textured_draws(const GpuScene& scene) {
+  auto textured = [](const Draw& d) { return d.push.flags.x != 0 || d.push.flags.z != 0; };
+  return std::ranges::any_of(scene.draws, textured) || std::ranges::any_of(scene.translucent, textured);
 }
 
 bool has_features(const vk::Context& ctx, VkFormat format, VkFormatFeatureFlags features) {
@@ -313,6 +320,7 @@ struct Renderer::Impl {
 
                   .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
                               supports_deferred_shading(technique),
+                  .textured_draws = has_textured_draws(gpu),
                   .front_back = s.front_back_depth};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.

@@ -12,6 +12,10 @@
 // Scattering techniques: the colour attachment takes linear radiance (before exposure and tone
 // mapping), which the scattering pass composites with the medium's in-scattering.
 layout(constant_id = 5) const bool kLinearRadiance = false;
+// False where no draw of the frame has an albedo or opacity texture (FrameConfig::textured_draws):
+// lavapipe runs both sides of the branches on the draw's flags, so untextured draws paid for the
+// fetches (a GPU skips them either way).
+layout(constant_id = 10) const bool kTexturedDraws = true;
 
 layout(binding = 1) uniform sampler2D albedo_texture;
 layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
@@ -152,9 +156,9 @@ void write_shaded(vec4 albedo_opacity, vec3 direct, vec3 visibility) {
 // The surface's albedo (rgb) and opacity (a).
 vec4 surface_albedo_opacity() {
   vec3 albedo = object.albedo_opacity.rgb;
-  if (object.flags.x != 0) albedo *= texture(albedo_texture, texcoord).rgb;
+  if (kTexturedDraws && object.flags.x != 0) albedo *= texture(albedo_texture, texcoord).rgb;
   float opacity = object.albedo_opacity.a;
-  if (object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
+  if (kTexturedDraws && object.flags.z != 0) opacity *= texture(opacity_texture, texcoord).x;
   return vec4(albedo, opacity);
 }
 // The normal towards the viewer: only double-sided materials show back faces (culling).
@@ -163,7 +167,7 @@ vec3 facing_normal() { return gl_FrontFacing ? normalize(world_normal) : -normal
 
 #if defined(MSM_SURFACES)
 void main() {
-  bool cut_out = !alpha_test_passes(object, opacity_texture, texcoord);
+  bool cut_out = !alpha_test_passes(object, kTexturedDraws, opacity_texture, texcoord);
   out_position = vec4(world_position, 1.0f);
   out_normal = vec4(facing_normal(), 0.0f);
   out_albedo = surface_albedo_opacity();
@@ -182,7 +186,7 @@ void main() {
 #else
 void main() {
   // Cut-outs (alpha mask) are discarded at the end: the lookups' derivatives need the whole quad.
-  bool cut_out = !alpha_test_passes(object, opacity_texture, texcoord);
+  bool cut_out = !alpha_test_passes(object, kTexturedDraws, opacity_texture, texcoord);
   vec3 direct, visibility;
   direct_light(facing_normal(), direct, visibility);
   write_shaded(surface_albedo_opacity(), direct, visibility);

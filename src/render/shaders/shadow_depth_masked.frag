@@ -10,5 +10,5 @@ layout(push_constant) uniform Push { ObjectPush object; };
 layout(location = 0) in vec2 texcoord;
 
 void main() {
-  if (!alpha_test_passes(object, opacity_texture, texcoord)) discard;
+  if (!alpha_test_passes(object, true, opacity_texture, texcoord)) discard;
 }
