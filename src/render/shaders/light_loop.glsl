@@ -7,11 +7,13 @@
 layout(constant_id = 4) const int kLightCount = 1;
 const bool kOneLight = kLightCount == 1;
 
-// Frames with one light evaluate it outside any loop (kOneLight ? body(0) : for each l body(l)):
-// NIR unrolls a one-trip loop only below a size limit, and a loop kept makes its counter, the
-// lights[l] it indexes and the layer it reads per-lane vectors in llvmpipe (gathers, a variable
-// layer). Past that limit (the four-moment scattering with the proportional β) the pass cost 45%
-// more instructions in a loop than unrolled (docs/results.md). With one light the layer is the
-// constant 0: lavapipe fetches from a constant layer several times faster than from a variable one.
+// Frames with one light evaluate it outside any loop (kOneLight ? body(0) : for each l body(l)).
+// NIR unrolls a loop only while its instruction cost times its trip count stays within
+// max_unroll_iterations x 26 (nir_opt_loop_unroll.c), a one-trip loop too; a loop kept makes its
+// counter, the lights[l] it indexes and the layer it reads per-lane vectors in llvmpipe (gathers, a
+// variable layer). Past that limit (the four-moment scattering with the proportional β, the soft
+// shadows' shading) a pass cost up to twice the instructions in a loop (docs/results.md, "One
+// light, no loop"). With one light the layer is the constant 0: lavapipe fetches from a constant
+// layer several times faster than from a variable one.
 int current_layer = 0; // the light whose shadow map the lookups read, set before its lookups
 #define shadow_layer (kOneLight ? 0 : current_layer)
