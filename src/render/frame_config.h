@@ -35,8 +35,8 @@ struct FrameConfig {
   bool deferred = false;
   // Whether any draw of the scene reads an albedo or opacity texture (ObjectPush::flags x, z): a
   // specialization constant of the shading (shading.glsl, kTexturedDraws), as lavapipe fetches the
-  // textures under a branch on the draw's flags for untextured draws too (67 instructions per pixel,
-  // 9-11% of MSM-64's forward shading on the fence, docs/results.md).
+  // textures under a branch on the draw's flags for untextured draws too (MSM-64's forward shading
+  // on the fence: 14% of its instructions, docs/results.md).
   bool textured_draws = true;
   // Prefiltered scattering, resampling with filtering (JCGT §5.2; technique parameter x = 1): the
   // frame also makes each light's blurred, mipmapped 4-moment map (moment_resolve, blur and mipmaps
@@ -45,8 +45,8 @@ struct FrameConfig {
   uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
   // Prefiltered scattering, parameter x = 2: the earlier on-the-fly filter of rectify (a bilinear
   // sample of the depth map's texels' moments). A specialization constant of rectify, as lavapipe
-  // runs both sides of a branch on a uniform: the unfiltered resampling paid for this path (18% of
-  // the pass, docs/results.md).
+  // runs both sides of a branch on a uniform: the unfiltered resampling paid for this path (16-20%
+  // of the pass, docs/results.md).
   bool on_the_fly_resampling = false;
   // Prefiltered scattering: K transmittance layers (rectification.h; technique parameter w): K prefix
   // sums per light with the steps Δ_k, mixed per pixel at its own Δ; 1 = the paper's Δ(v) per row.
