@@ -168,10 +168,11 @@ void main() {
   if (scatter.medium.w != 0.0f) {
     float extinction = scatter.medium.x;
     ScatteringSum sum = msm_scattering_sum_none();
-    if (kOneLight) // no loop: light_loop.glsl
-      sum = add_light(sum, 0, pixel, camera, direction, s);
-    else
-      for (int l = 0; l < kLightCount; ++l) sum = add_light(sum, l, pixel, camera, direction, s);
+    // One light: one pass through the body, no loop (light_loop.glsl).
+    int l = 0;
+    do {
+      sum = add_light(sum, l, pixel, camera, direction, s);
+    } while (!kOneLight && ++l < kLightCount);
     radiance = msm_scattering_sum_radiance(surface, extinction, s, sum);
     inscattered = sum.inscattered;
     visible = msm_scattering_sum_visible(sum);

@@ -133,12 +133,12 @@ void direct_light(vec3 n, out vec3 direct, out vec3 visibility) {
   float weight_sum = 0.0f;
   direct = vec3(0.0f);
   MsmFootprint pixel = msm_surface_footprint(frame.camera_view_projection, frame.camera_viewport.xy, world_position, n);
-  if (kOneLight) { // no loop: light_loop.glsl
-    visibility = add_direct_light(0, n, pixel, direct, weighted, weight_sum);
-    return;
-  }
-  for (int l = 0; l < kLightCount; ++l) add_direct_light(l, n, pixel, direct, weighted, weight_sum);
-  visibility = weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f);
+  // One light: one pass through the body, no loop (light_loop.glsl).
+  int l = 0;
+  do {
+    visibility = add_direct_light(l, n, pixel, direct, weighted, weight_sum);
+  } while (!kOneLight && ++l < kLightCount);
+  if (!kOneLight) visibility = weight_sum > 0.0f ? weighted / weight_sum : vec3(0.0f);
 }
 
 void write_shaded(vec4 albedo_opacity, vec3 direct, vec3 visibility) {
