@@ -7,7 +7,7 @@ packages=(
   cmake ninja-build g++ make pkg-config git
   libglm-dev libeigen3-dev libglpk-dev
   libvulkan-dev glslc spirv-tools mesa-vulkan-drivers vulkan-validationlayers vulkan-tools
-  libassimp-dev libembree-dev libopenexr-dev libstb-dev libtbb-dev zlib1g-dev valgrind
+  libassimp-dev libembree-dev libopenexr-dev libstb-dev libtbb-dev zlib1g-dev libdeflate-dev valgrind
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin  # MPI ranks of msm evaluate (Open MPI)

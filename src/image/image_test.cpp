@@ -226,6 +226,55 @@ TEST_F(ImageTest, ExrStoresExactHalfChannelsAsHalfLosslessly) {
   }
 }
 
+// The writer makes OpenEXR's ZIP chunks itself (exr_encode.cpp): chunks of 16 lines and a last
+// partial one, chunks that deflate and chunks of noise that are stored as they are, HALF and FLOAT
+// channels interleaved line by line in the header's sorted order. OpenEXR's reader gets every bit.
+TEST_F(ImageTest, ExrZipChunksRoundTripBitExactly) {
+  std::uint32_t state = 12345u;
+  auto next = [&] { // xorshift32
+    state ^= state << 13, state ^= state >> 17, state ^= state << 5;
+    return state;
+  };
+  auto noise_float = [&] { // any finite float: bits that deflate cannot shrink
+    std::uint32_t bits;
+    do bits = next();
+    while ((bits & 0x7f800000u) == 0x7f800000u);
+    return std::bit_cast<float>(bits);
+  };
+  auto noise_half = [&] { // any finite half, as a float: the channel stays HALF
+    float v;
+    do v = std::ldexp(float(next() % 2048u), int(next() % 41u) - 34) * (next() % 2 ? -1.0f : 1.0f);
+    while (std::fabs(v) > 65504.0f || (v != 0.0f && std::fabs(v) < std::ldexp(1.0f, -14) &&
+                                       std::fmod(std::fabs(v), std::ldexp(1.0f, -24)) != 0.0f));
+    return v;
+  };
+  for (const bool noise : {false, true}) {
+    const int w = 1921, h = 35;
+    Image im(w, h, {"z_float", "a_mask", "m_float"});
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        im.at(x, y, 0) = noise ? noise_float() : std::sin(0.01f * float(x + 3 * y));
+        im.at(x, y, 1) = noise ? noise_half() : float((x / 7 + y) % 2);
+        im.at(x, y, 2) = noise ? noise_float() : float(x) / float(w) + 1e-7f * float(y);
+      }
+    const fs::path p = dir / (noise ? "noise.exr" : "smooth.exr");
+    write_exr(p, im);
+    const Image back = read_exr(p);
+    ASSERT_EQ(back.channel_names(), im.channel_names());
+    for (std::size_t i = 0; i < im.pixels().size(); ++i)
+      ASSERT_EQ(std::bit_cast<std::uint32_t>(back.pixels()[i]), std::bit_cast<std::uint32_t>(im.pixels()[i]))
+          << (noise ? "noise" : "smooth") << ", value " << i;
+    Imf::InputFile file(p.c_str());
+    EXPECT_EQ(file.header().compression(), Imf::ZIP_COMPRESSION);
+    EXPECT_EQ(file.header().channels().findChannel("a_mask")->type, Imf::HALF);
+    const auto raw_bytes = std::uintmax_t(w) * std::uintmax_t(h) * (4 + 2 + 4);
+    if (noise)
+      EXPECT_GT(fs::file_size(p), raw_bytes); // stored, plus the header and the chunk table
+    else
+      EXPECT_LT(fs::file_size(p), raw_bytes / 2);
+  }
+}
+
 TEST_F(ImageTest, ExrNamedChannelsKeepTheirOrder) {
   Image im = ramp(5, 4, {"visibility", "sample_count", "std_error"});
   write_image(dir / "gt.EXR", im);

@@ -16,6 +16,7 @@
 
 #include <fmt/core.h>
 
+#include "exr_names.h"
 #include "msm/util/limits.h"
 
 #include <OpenEXR/Iex.h>
@@ -26,7 +27,6 @@
 
 #include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfInputFile.h>
-#include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStringVectorAttribute.h>
 
 // stb's PNG reader and writer, compiled here with internal linkage (io.cpp is their only user):
@@ -38,28 +38,24 @@
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
-// stb's own deflate was 10% of a one-shot msm render at 1920x1080; zlib's fastest level is a
-// fraction of that (PNG is lossless: only the file size changes, by a few percent). Z_RLE (matches
-// at distance 1 only) deflates the Up-filtered rows of a render in 10% fewer instructions than the
-// default strategy and into a smaller file (155 kB against 168 kB for the fence at 1080p).
-#include <zlib.h>
+// stb's own deflate was 10% of a one-shot msm render at 1920x1080. libdeflate's level 1 deflates
+// the Up-filtered rows of that render in 126 M instructions into 131 kB, where zlib's level 1 with
+// Z_RLE (matches at distance 1 only) took 157 M for 155 kB (PNG is lossless: only the file's size
+// and the time change).
+#include <libdeflate.h>
 namespace {
 unsigned char* msm_zlib_compress(unsigned char* data, int length, int* out_length, int /*quality*/) {
-  z_stream s{};
-  if (deflateInit2(&s, Z_BEST_SPEED, Z_DEFLATED, 15, 8, Z_RLE) != Z_OK) return nullptr;
-  const uLong size = deflateBound(&s, uLong(length));
-  auto* out = static_cast<unsigned char*>(std::malloc(size));
-  s.next_in = data;
-  s.avail_in = uInt(length);
-  s.next_out = out;
-  s.avail_out = uInt(size);
-  const bool done = out && deflate(&s, Z_FINISH) == Z_STREAM_END;
-  *out_length = int(s.total_out);
-  deflateEnd(&s);
-  if (!done) {
+  libdeflate_compressor* c = libdeflate_alloc_compressor(1);
+  if (!c) return nullptr;
+  const std::size_t bound = libdeflate_zlib_compress_bound(c, std::size_t(length));
+  auto* out = static_cast<unsigned char*>(std::malloc(bound));
+  const std::size_t size = out ? libdeflate_zlib_compress(c, data, std::size_t(length), out, bound) : 0;
+  libdeflate_free_compressor(c);
+  if (size == 0) {
     std::free(out);
     return nullptr;
   }
+  *out_length = int(size);
   return out;
 }
 } // namespace
@@ -80,8 +76,6 @@ namespace msm::image {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr const char* channel_order_attribute = "msmChannelOrder";
 
 std::string errno_text(int err) { return std::strerror(err); }
 
@@ -277,22 +271,6 @@ bool is_exr(std::span<const std::uint8_t> b) {
 }
 
 // ---- EXR streams in memory -------------------------------------------------------------------
-
-class MemoryOStream : public Imf::OStream {
- public:
-  MemoryOStream() : Imf::OStream("<memory>") {}
-  void write(const char c[], int n) override {
-    if (pos_ + std::size_t(n) > bytes.size()) bytes.resize(pos_ + std::size_t(n));
-    std::memcpy(bytes.data() + pos_, c, std::size_t(n));
-    pos_ += std::size_t(n);
-  }
-  uint64_t tellp() override { return pos_; }
-  void seekp(uint64_t pos) override { pos_ = pos; }
-  std::vector<std::uint8_t> bytes;
-
- private:
-  std::size_t pos_ = 0;
-};
 
 class MemoryIStream : public Imf::IStream {
  public:
@@ -589,72 +567,7 @@ Image read_png(const fs::path& path) {
 
 // ---- EXR -------------------------------------------------------------------------------------
 
-// Channel c as halves (IEEE binary16 bits) if every value is a half exactly (±0, normal and
-// subnormal halves), else nothing. Such a channel is stored as HALF, lossless, in half the bytes:
-// masks (0/1) and 8-bit-derived values are; a filtered visibility is not and stays FLOAT, as do
-// infinities and NaNs. (OpenEXR converts only on reading: the halves are made here, bit-exactly.)
-namespace {
-std::optional<std::vector<std::uint16_t>> exact_halves(const Image& image, std::size_t c) {
-  const std::span<const float> px = image.pixels();
-  const std::size_t n = std::size_t(image.channels());
-  std::vector<std::uint16_t> halves(image.pixel_count());
-  for (std::size_t i = c, k = 0; i < px.size(); i += n, ++k) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &px[i], sizeof bits);
-    const auto sign = std::uint16_t((bits >> 16) & 0x8000u);
-    const std::uint32_t magnitude = bits & 0x7fffffffu;
-    const int exponent = int(magnitude >> 23) - 127;
-    const std::uint32_t mantissa = magnitude & 0x7fffffu;
-    if (magnitude == 0) {
-      halves[k] = sign;
-    } else if (exponent >= -14 && exponent <= 15) { // a normal half keeps 10 of the 23 mantissa bits
-      if (mantissa & 0x1fffu) return std::nullopt;
-      halves[k] = std::uint16_t(sign | std::uint32_t(exponent + 15) << 10 | mantissa >> 13);
-    } else if (exponent >= -24 && exponent < -14) { // a subnormal half: k 2^-24, k < 1024
-      const std::uint32_t significand = 0x800000u | mantissa;
-      const int shift = -1 - exponent;
-      if (significand & ((1u << shift) - 1u)) return std::nullopt;
-      halves[k] = std::uint16_t(sign | significand >> shift);
-    } else {
-      return std::nullopt;
-    }
-  }
-  return halves;
-}
-} // namespace
-
-std::vector<std::uint8_t> encode_exr(const fs::path& path, const Image& image) {
-  require_image(path, image);
-  MemoryOStream stream;
-  try {
-    Imf::Header header(image.width(), image.height());
-    header.compression() = Imf::ZIP_COMPRESSION;
-    header.zipCompressionLevel() = 1; // lossless either way; the default level took 10% of msm render
-    const std::size_t n = std::size_t(image.channels());
-    std::vector<std::optional<std::vector<std::uint16_t>>> halves(n);
-    for (std::size_t c = 0; c < n; ++c) {
-      halves[c] = exact_halves(image, c);
-      header.channels().insert(image.channel_names()[c], Imf::Channel(halves[c] ? Imf::HALF : Imf::FLOAT));
-    }
-    header.insert(channel_order_attribute, Imf::StringVectorAttribute(image.channel_names()));
-    Imf::FrameBuffer fb;
-    // OpenEXR only reads through the slices of an OutputFile.
-    char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels().data()));
-    for (std::size_t c = 0; c < n; ++c) {
-      if (halves[c])
-        fb.insert(image.channel_names()[c],
-                  Imf::Slice(Imf::HALF, reinterpret_cast<char*>(halves[c]->data()), sizeof(std::uint16_t),
-                             sizeof(std::uint16_t) * std::size_t(image.width())));
-      else
-        fb.insert(image.channel_names()[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), sizeof(float) * n,
-                                                       sizeof(float) * n * std::size_t(image.width())));
-    }
-    Imf::OutputFile file(stream, header);
-    file.setFrameBuffer(fb);
-    file.writePixels(image.height());
-  } catch (const std::exception& e) { throw ImageError(path, std::string("EXR encoding failed: ") + e.what()); }
-  return std::move(stream.bytes);
-}
+// encode_exr: exr_encode.cpp.
 
 void write_exr(const fs::path& path, const Image& image) { write_file_atomic(path, encode_exr(path, image)); }
 
