@@ -18,6 +18,8 @@
 #   TECHNIQUES=...  the techniques below 256 lights (default mssm6,mssm4,pcss,vssm,cssm16,msm-hamburger-64;
 #                   256 lights: msm-hamburger-64 alone, the point-light limit)
 #   COUNTS="..."    light counts (default "16 32 64 256")
+#   SUB_LIGHTS=M    each light's sub-lights from the cut into M regions (--sub-lights M; the area-light
+#                   truth then traces the sub-lights); unset: the scene's
 #   SEED=N          seed of the ground truths (default 1)
 #   NOISE=1         also the full-probe truth with seed SEED+1, and the MAE between the two (the
 #                   truth's own noise, which the other MAEs carry too)
@@ -28,6 +30,8 @@ msm=${MSM:-build/tools/msm/msm}
 techniques_all=${TECHNIQUES:-mssm6,mssm4,pcss,vssm,cssm16,msm-hamburger-64}
 counts=${COUNTS:-16 32 64 256}
 seed=${SEED:-1}
+sub=()
+[ -n "${SUB_LIGHTS:-}" ] && sub=(--sub-lights "$SUB_LIGHTS")
 mkdir -p "$out"
 if [ -n "${PROBE:-}" ]; then
   json="$(dirname "$0")/../scenes/$scene.json"
@@ -51,13 +55,14 @@ if [ "${NOISE:-0}" = 1 ]; then
 fi
 printf '%-18s %6s %8s %8s %8s\n' technique lights total lights shadows
 for n in $counts; do
-  "$msm" reference --scene "$scene" --effect environment --probe-lights --lights "$n" "${size[@]}" --seed "$seed" \
+  "$msm" reference --scene "$scene" --effect environment --probe-lights --lights "$n" "${sub[@]}" "${size[@]}" \
+    --seed "$seed" \
     --samples "$([ "$n" = 256 ] && echo $((samples / 16 > 4 ? samples / 16 : 4)) || echo $((samples / 4 > 4 ? samples / 4 : 4)))" \
     --out "$out/lights-$n" >/dev/null
   lights=$(mae "$out/truth/radiance.png" "$out/lights-$n/radiance.png")
   techniques=$techniques_all
   [ "$n" = 256 ] && techniques="msm-hamburger-64"
-  "$msm" render --scene "$scene" --lights "$n" -t "$techniques" "${size[@]}" --shadow-size "$shadow" \
+  "$msm" render --scene "$scene" --lights "$n" "${sub[@]}" -t "$techniques" "${size[@]}" --shadow-size "$shadow" \
     --device "${MSM_DEVICE:-cpu}" -o "$out/render-$n" >/dev/null 2>&1
   for t in ${techniques//,/ }; do
     error=()

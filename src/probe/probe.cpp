@@ -471,6 +471,66 @@ std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vect
   return lights;
 }
 
+std::vector<std::vector<int>> sub_regions(const std::vector<Region>& coarse, const std::vector<Region>& fine) {
+  std::vector<std::vector<int>> inside(coarse.size());
+  for (int j = 0; j < int(fine.size()); ++j) {
+    const Region& f = fine[j];
+    int found = -1, matches = 0;
+    for (int k = 0; k < int(coarse.size()); ++k) {
+      const Region& c = coarse[k];
+      const bool contains = c.faces != 0 ? f.faces == 0 && (c.faces >> f.face & 1u) != 0
+                                         : f.faces == 0 && f.face == c.face && f.x0 >= c.x0 && f.x1 <= c.x1 &&
+                                               f.y0 >= c.y0 && f.y1 <= c.y1;
+      if (contains) found = k, ++matches;
+    }
+    if (matches != 1)
+      throw ProbeError(
+          fmt::format("region {} of the finer cut lies in {} regions of the coarser cut, not one", j, matches));
+    inside[std::size_t(found)].push_back(j);
+  }
+  return inside;
+}
+
+CutLights cut_lights(const ProbeTables& tables, int count, bool horizon_split) {
+  CutLights cut;
+  cut.regions = median_cut(tables, count, horizon_split);
+  for (const Region& r : cut.regions) {
+    const std::vector<MsmAreaLight> light = area_lights(tables, {r});
+    cut.light_of_region.push_back(light.empty() ? -1 : int(cut.lights.size()));
+    if (!light.empty()) cut.lights.push_back(light[0]);
+  }
+  return cut;
+}
+
+std::vector<ProbeLight> with_sub_lights(const CutLights& coarse, const CutLights& fine) {
+  const std::vector<std::vector<int>> inside = sub_regions(coarse.regions, fine.regions);
+  std::vector<ProbeLight> out;
+  for (std::size_t k = 0; k < coarse.regions.size(); ++k) {
+    const int light = coarse.light_of_region[k];
+    if (light < 0) continue; // no energy: no light, as area_lights skips it
+    ProbeLight pl{coarse.lights[std::size_t(light)], {}};
+    for (int j : inside[k])
+      if (const int sub = fine.light_of_region[std::size_t(j)]; sub >= 0)
+        pl.sub_lights.push_back(fine.lights[std::size_t(sub)]);
+    out.push_back(std::move(pl));
+  }
+  return out;
+}
+
+std::vector<ProbeLight> lights_with_sub_lights(const ProbeTables& tables, int count, int sub_count,
+                                               bool horizon_split) {
+  return with_sub_lights(cut_lights(tables, count, horizon_split),
+                         cut_lights(tables, std::max(count, sub_count), horizon_split));
+}
+
+std::vector<ProbeLight> probe_lights_with_sub_lights(const std::string& probe, int size, int count, int sub_count,
+                                                     float rotation_deg, float intensity, bool horizon_split) {
+  check_cut(count, size, horizon_split); // before loading the probe
+  check_cut(std::max(count, sub_count), size, horizon_split);
+  return lights_with_sub_lights(ProbeTables(load_probe(probe, size, rotation_deg, intensity)), count, sub_count,
+                                horizon_split);
+}
+
 CubeMap sky_probe(int size, float rotation_deg) {
   // Where cube_from_equirect shows the panorama's direction p: the direction that looks p up.
   const glm::vec2 inverse = rotation_cos_sin(-rotation_deg);

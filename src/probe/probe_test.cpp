@@ -165,6 +165,34 @@ TEST(MedianCut, PartitionsTheProbeAndKeepsItsEnergy) {
   }
 }
 
+// Sub-lights (sub_regions): every region of a finer cut lies in one region of the coarser cut of the
+// same probe, and a coarse region's fine regions hold exactly its energy (fixed point, integers),
+// for every coarse count 1–256 under the finer cut into 64 (or as many as the coarse) regions,
+// with and without the horizon split; cuts of two different probes do not nest and are refused.
+TEST(MedianCut, FinerCutsNestInCoarserOnes) {
+  const CubeMap cube = make_sky_sun_probe(32, glm::vec3(0.4f, 0.5f, 0.7f), glm::vec3(3000.0f),
+                                          glm::vec3(-0.2f, 0.9f, 0.3f), glm::radians(3.0f));
+  const ProbeTables tables(cube);
+  for (const bool split : {false, true})
+    for (int count = split ? 10 : 1; count <= 256; ++count) {
+      const std::vector<Region> coarse = median_cut(tables, count, split);
+      const std::vector<Region> fine = median_cut(tables, std::max(count, 64), split);
+      const std::vector<std::vector<int>> inside = sub_regions(coarse, fine);
+      ASSERT_EQ(inside.size(), coarse.size());
+      std::vector<int> seen(fine.size(), 0);
+      for (std::size_t k = 0; k < coarse.size(); ++k) {
+        std::uint64_t sum = 0;
+        for (int j : inside[k]) sum += fine[std::size_t(j)].fixed_energy, ++seen[std::size_t(j)];
+        EXPECT_EQ(sum, coarse[k].fixed_energy) << count << " regions, region " << k;
+        if (count >= 64) EXPECT_EQ(inside[k], std::vector<int>{int(k)}) << count; // the same cut
+      }
+      EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; })) << count;
+    }
+  const ProbeTables other(make_sky_sun_probe(32, glm::vec3(0.4f, 0.5f, 0.7f), glm::vec3(3000.0f),
+                                             glm::vec3(0.7f, 0.2f, -0.3f), glm::radians(3.0f)));
+  EXPECT_THROW(sub_regions(median_cut(tables, 16), median_cut(other, 64)), ProbeError);
+}
+
 // The horizon split (median_cut's horizon_split): the cut starts from the ten regions of
 // msm_first_region (the side faces halved at their middle row, the world's horizon), and every
 // region of the cut stays on one side of the horizon: on a side face, rows [0, m/2) look above it

@@ -62,8 +62,17 @@ EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_l
     throw std::invalid_argument("the environment effect needs a scene with a \"probe\" (scenes/README.md)");
   const scene::ProbeLighting& p = *scene.probe;
   const std::size_t first = p.first_light, last = std::min(scene.lights.size(), first + std::size_t(p.lights));
-  for (std::size_t k = 0; k < scene.lights.size(); ++k)
-    if (probe_lights || k < first || k >= last) cones.push_back(cone_light(scene, scene.lights[k]));
+  // A probe light with sub-lights (the probe's "sub_lights"): the lights it stands for are its
+  // sub-lights, each traced as the rectangle it is (the renderer shades their sum, shadowed by the
+  // light's one shadow map: what this truth tells apart is that shadow).
+  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+    if (!probe_lights && k >= first && k < last) continue;
+    const scene::DirectionalLight& l = scene.lights[k];
+    if (l.sub_lights.empty())
+      cones.push_back(cone_light(scene, l));
+    else
+      for (const scene::DirectionalLight& sub : l.sub_lights) cones.push_back(cone_light(scene, sub));
+  }
   if (probe_lights) return;
   msm::probe::CubeMap cube;
   try {

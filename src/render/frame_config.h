@@ -38,6 +38,9 @@ struct FrameConfig {
   // textures under a branch on the draw's flags for untextured draws too (MSM-64's forward shading
   // on the fence: 14% of its instructions, docs/results.md).
   bool textured_draws = true;
+  // Whether any light of the frame has sub-lights (scene::DirectionalLight::sub_lights): the
+  // shading's kSubLights (shading.glsl), which sums them for the light's unshadowed irradiance.
+  bool sub_lights = false;
   // Prefiltered scattering, resampling with filtering (JCGT §5.2; technique parameter x = 1): the
   // frame also makes each light's blurred, mipmapped 4-moment map (moment_resolve, blur and mipmaps
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).

@@ -39,6 +39,8 @@ static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 +
 static_assert(offsetof(FrameUniforms, filter_weights) == 64 + 4 * 16);
 static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 32);
 static_assert(sizeof(LightUniforms) == 2 * 64 + 5 * 16);
+// The lights' storage buffer: the frame's lights, then their sub-lights (at most 256 of each).
+constexpr std::size_t kLightSlots = 2 * MSM_MAX_LIGHTS;
 static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
 static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
 static_assert(sizeof(RectificationUniforms) == 11 * 16); // the std430 array stride of the passes' rects[]
@@ -157,7 +159,7 @@ struct Renderer::Impl {
   Impl(const vk::Context& c, const scene::Scene& s)
       : ctx(c), scene(s), gpu(c, s),
         uniforms(vk::create_buffer(c, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, vk::Memory::host)),
-        lights(vk::create_buffer(c, sizeof(LightUniforms) * MSM_MAX_LIGHTS, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+        lights(vk::create_buffer(c, sizeof(LightUniforms) * kLightSlots, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                                  vk::Memory::host)),
         rectification(vk::create_buffer(c, sizeof(RectificationUniforms) * MSM_MAX_LIGHTS,
                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host)),
@@ -268,6 +270,18 @@ struct Renderer::Impl {
     return u;
   }
 
+  // A sub-light as the shading reads it: its direction, irradiance (on a surface facing it) and the
+  // rectangle of msm_light_cosine; no shadow map of its own.
+  static LightUniforms sub_light_uniforms(const scene::DirectionalLight& sub) {
+    LightUniforms u{};
+    u.towards_light = glm::vec4(sub.towards_light, 0.0f);
+    u.irradiance = glm::vec4(sub.irradiance, 0.0f);
+    u.soft = glm::vec4(0.0f, 0.0f, sub.cone_half_angle(), 0.0f);
+    u.rect_x_axis = glm::vec4(sub.x_axis.value_or(glm::vec3(0.0f)), 0.0f);
+    u.rect_extent = glm::vec4(sub.rectangle_extents(), 0.0f, 0.0f);
+    return u;
+  }
+
   // The settings are valid and this device can render them (RenderError naming what it lacks).
   void check(const RenderSettings& s) const {
     s.validate();
@@ -290,6 +304,10 @@ struct Renderer::Impl {
                                     ctx.properties().limits.maxImageDimension2D,
                                     ctx.properties().limits.maxImageDimension2D / uint32_t(tiles)));
     const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
+    std::size_t slots = frame_lights.size();
+    for (const scene::DirectionalLight& l : frame_lights) slots += l.sub_lights.size();
+    if (slots > kLightSlots)
+      throw RenderError(fmt::format("{} lights and sub-lights: the renderer holds {}", slots, kLightSlots));
     if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
       throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
                                     ctx.properties().limits.maxImageArrayLayers));
@@ -321,6 +339,8 @@ struct Renderer::Impl {
                   .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
                               supports_deferred_shading(technique),
                   .textured_draws = has_textured_draws(gpu),
+                  .sub_lights = std::ranges::any_of(
+                      lights_of(s), [](const scene::DirectionalLight& l) { return !l.sub_lights.empty(); }),
                   .front_back = s.front_back_depth};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
@@ -366,6 +386,13 @@ struct Renderer::Impl {
     std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation)
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
+    // Sub-lights after the frame's lights, each light's range in its rect_extent.zw (shading.glsl).
+    for (std::size_t i = 0; i < frame_lights.size(); ++i) {
+      const std::vector<scene::DirectionalLight>& subs = frame_lights[i].sub_lights;
+      light_data[i].rect_extent.z = float(light_data.size());
+      light_data[i].rect_extent.w = float(subs.size());
+      for (const scene::DirectionalLight& sub : subs) light_data.push_back(sub_light_uniforms(sub));
+    }
     // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
     scattering = scattering_push(s, technique);

@@ -212,7 +212,7 @@ TEST_F(ScatteringTest, PrefilteredAgreesWithRayMarching) {
       // Six moments in 96 bits have less error than four (measured: half the MAE in both scenes
       // with the adaptive β, a quarter on the wall with the proportional one; unshadowed, the
       // proportional β is exact with both).
-      if (paper || wall) EXPECT_LT(maes["scatter-msm6-96"], maes["scatter-msm4-64"]);
+      if (paper || wall) { EXPECT_LT(maes["scatter-msm6-96"], maes["scatter-msm4-64"]); }
       // Resampling with filtering (parameter x = 1, §5.2: from the blurred, mipmapped moment map):
       // adaptive β within the same bounds (measured, wall: MAE 0.0241 / 0.0133, max 0.089 / 0.073;
       // with the earlier bilinear moments 0.0230 / 0.0128, 0.092 / 0.060; unshadowed under light

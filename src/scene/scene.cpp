@@ -39,10 +39,28 @@ std::string compose(const std::string& file, const std::string& where, const std
 // cone with the irradiance a facing surface receives (Eq. 18). Throws msm::probe::ProbeError.
 std::vector<DirectionalLight> probe_directional_lights(const ProbeLighting& p) {
   std::vector<DirectionalLight> out;
-  for (const msm::MsmAreaLight& a : msm::probe::probe_area_lights(
-           p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights, p.rotation_deg, p.intensity, p.horizon_split))
-    out.push_back(light_of_area_light(a));
+  const std::string file = p.file == "sky" ? "sky" : p.file.string();
+  if (p.sub_lights <= p.lights) { // 0, or no finer cut: each light would be its own one sub-light
+    for (const msm::MsmAreaLight& a :
+         msm::probe::probe_area_lights(file, p.size, p.lights, p.rotation_deg, p.intensity, p.horizon_split))
+      out.push_back(light_of_area_light(a));
+    return out;
+  }
+  for (const msm::probe::ProbeLight& pl : msm::probe::probe_lights_with_sub_lights(
+           file, p.size, p.lights, p.sub_lights, p.rotation_deg, p.intensity, p.horizon_split))
+    out.push_back(light_of_probe_light(pl));
   return out;
+}
+
+// What is wrong with a probe's "sub_lights" (empty: nothing): 0..256, and the horizon split's cut
+// makes at least ten regions.
+std::string sub_lights_problem(const ProbeLighting& p) {
+  if (p.sub_lights < 0 || p.sub_lights > 256)
+    return fmt::format("{} sub-lights: must be in [0, 256] (0: none)", p.sub_lights);
+  if (p.horizon_split && p.sub_lights > 0 && p.sub_lights < msm::probe::kHorizonSplitMinLights)
+    return fmt::format("{} sub-lights: the horizon split makes {} to 256 regions", p.sub_lights,
+                       msm::probe::kHorizonSplitMinLights);
+  return {};
 }
 
 // Vulkan clip space: y down in NDC.
@@ -232,7 +250,7 @@ class Parser {
 
   // The probe's area lights (probe_directional_lights), appended to s.lights.
   void probe_lighting(const json& j, const std::string& ptr, Scene& s) const {
-    keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size", "horizon_split"});
+    keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size", "horizon_split", "sub_lights"});
     ProbeLighting p;
     const json* file = find(j, "file");
     if (!file) fail(ptr + "/file", "required key missing (an equirectangular EXR, or \"sky\")");
@@ -249,6 +267,8 @@ class Parser {
     if (const json* v = find(j, "size")) p.size = integer(*v, ptr + "/size");
     if (p.size < 1 || p.size > 1024) fail(ptr + "/size", "must be in [1, 1024]");
     if (const json* v = find(j, "horizon_split")) p.horizon_split = boolean(*v, ptr + "/horizon_split");
+    if (const json* v = find(j, "sub_lights")) p.sub_lights = integer(*v, ptr + "/sub_lights");
+    if (const std::string problem = sub_lights_problem(p); !problem.empty()) fail(ptr + "/sub_lights", problem);
     if (p.horizon_split) {
       try {
         msm::probe::check_cut(p.lights, p.size, true);
@@ -549,6 +569,12 @@ class Parser {
 
 } // namespace
 
+DirectionalLight light_of_probe_light(const msm::probe::ProbeLight& light) {
+  DirectionalLight l = light_of_area_light(light.light);
+  for (const msm::MsmAreaLight& a : light.sub_lights) l.sub_lights.push_back(light_of_area_light(a));
+  return l;
+}
+
 DirectionalLight light_of_area_light(const msm::MsmAreaLight& area) {
   DirectionalLight l;
   l.towards_light = area.direction;
@@ -683,7 +709,7 @@ Scene builtin_scene(std::string_view name) {
   return load_scene_json(builtin_scene_json(name), std::filesystem::path("."), source);
 }
 
-void set_probe_light_count(Scene& scene, int count) {
+void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_lights) {
   const std::string file = scene.source.string();
   if (!scene.probe) throw SceneError(file, "/probe", "the scene has no probe, so no probe lights to count");
   ProbeLighting p = *scene.probe;
@@ -699,6 +725,11 @@ void set_probe_light_count(Scene& scene, int count) {
   try {
     msm::probe::check_cut(count, p.size, p.horizon_split);
   } catch (const msm::probe::ProbeError& e) { throw SceneError(file, "/probe/lights", e.what()); }
+  if (sub_lights) {
+    p.sub_lights = *sub_lights;
+    if (const std::string problem = sub_lights_problem(p); !problem.empty())
+      throw SceneError(file, "/probe/sub_lights", problem);
+  }
   std::vector<DirectionalLight> lights;
   try {
     lights = probe_directional_lights(p);

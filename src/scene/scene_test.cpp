@@ -993,6 +993,40 @@ TEST(Probe, HorizonSplitReachesTheCut) {
   EXPECT_EQ(split.lights.size(), 12u); // unchanged by the refused count
 }
 
+// "sub_lights": each light gets the lights of the finer cut inside its region (their energies add
+// up to the light's: the probe's lights as probe_area_lights makes them), re-cut with --lights and
+// kept; at most as many as the lights: none.
+TEST(Probe, SubLightsReachTheLights) {
+  const std::string head = R"({"msm_scene": 1, "probe": {"file": "sky", "size": 16, "lights": 4)";
+  const std::string tail = R"(}, "objects": [{"primitive": {"type": "box"}}]})";
+  Scene scene = load_scene_json(head + R"(, "sub_lights": 32)" + tail, fs::current_path(), "t");
+  ASSERT_TRUE(scene.probe);
+  EXPECT_EQ(scene.probe->sub_lights, 32);
+  ASSERT_EQ(scene.lights.size(), 4u);
+  const auto expected = msm::probe::probe_area_lights("sky", 16, 4);
+  std::size_t subs = 0;
+  for (std::size_t k = 0; k < scene.lights.size(); ++k) {
+    const msm::scene::DirectionalLight& l = scene.lights[k];
+    EXPECT_EQ(l.towards_light, msm::scene::light_of_area_light(expected[k]).towards_light) << k;
+    ASSERT_FALSE(l.sub_lights.empty()) << k;
+    subs += l.sub_lights.size();
+    // Σ M_e of the sub-lights = the light's M_e (XYZ round trips: 1e-3 relative).
+    glm::dvec3 sum(0.0);
+    for (const msm::MsmAreaLight& a : msm::probe::probe_lights_with_sub_lights("sky", 16, 4, 32)[k].sub_lights)
+      sum += glm::dvec3(a.irradiance);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c] / double(expected[k].irradiance[c]), 1.0, 1e-3) << k;
+  }
+  EXPECT_EQ(subs, 32u);
+  msm::scene::set_probe_light_count(scene, 8);
+  EXPECT_EQ(scene.probe->sub_lights, 32);
+  EXPECT_FALSE(scene.lights.front().sub_lights.empty());
+  msm::scene::set_probe_light_count(scene, 32);
+  for (const auto& l : scene.lights) EXPECT_TRUE(l.sub_lights.empty()); // 32 sub-lights for 32 lights: none
+  msm::scene::set_probe_light_count(scene, 8, 0);
+  for (const auto& l : scene.lights) EXPECT_TRUE(l.sub_lights.empty());
+  EXPECT_THROW(msm::scene::set_probe_light_count(scene, 8, 300), msm::scene::SceneError);
+}
+
 TEST(Probe, BadValuesNameTheirPointer) {
   const std::string box = R"({"primitive": {"type": "box"}})";
   const auto with = [&](const std::string& probe) { return scene_with_object(box, R"("probe": )" + probe + ","); };
@@ -1006,6 +1040,11 @@ TEST(Probe, BadValuesNameTheirPointer) {
   expect_json_error(with(R"({"file": "sky", "horizon_split": 1})"), {"/probe/horizon_split", "true or false"});
   expect_json_error(with(R"({"file": "sky", "horizon_split": true, "lights": 9})"), {"/probe/lights", "10 to 256"});
   expect_json_error(with(R"({"file": "sky", "horizon_split": true, "size": 15})"), {"/probe/size", "even"});
+  expect_json_error(with(R"({"file": "sky", "sub_lights": -1})"), {"/probe/sub_lights", "[0, 256]"});
+  expect_json_error(with(R"({"file": "sky", "sub_lights": 257})"), {"/probe/sub_lights", "[0, 256]"});
+  expect_json_error(with(R"({"file": "sky", "sub_lights": 1.5})"), {"/probe/sub_lights"});
+  expect_json_error(with(R"({"file": "sky", "horizon_split": true, "lights": 10, "sub_lights": 8})"),
+                    {"/probe/sub_lights", "10 to 256"});
   const std::string license = std::string(MSM_STUDIOLIGHTS_DIR) + "/license.txt";
   expect_json_error(with(R"({"file": ")" + license + R"("})"), {"/probe/file", "not an EXR"});
   expect_json_error(R"({"msm_scene": 1, "objects": [)" + box + "]}", {"/light", "\"probe\""});

@@ -74,16 +74,27 @@ void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, con
       device.set_cube(cube);
     }
     const probe::DeviceCut cut = device.run(p.lights, rotation, &timer);
+    std::vector<scene::DirectionalLight> lights = fixed;
+    std::size_t sub_light_count = 0;
+    if (p.sub_lights > p.lights) {
+      // Sub-lights: the same probe cut again into more regions (its cube and tables made again; not
+      // in the timings below, in the wall time), grouped by the region each lies in.
+      for (const probe::ProbeLight& pl : probe::with_sub_lights(cut, device.run(p.sub_lights, rotation))) {
+        lights.push_back(scene::light_of_probe_light(pl));
+        sub_light_count += pl.sub_lights.size();
+      }
+    } else {
+      for (const MsmAreaLight& a : cut.lights) lights.push_back(scene::light_of_area_light(a));
+    }
     const double probe_wall_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     const vk::TimerResults times = timer.read();
-    std::vector<scene::DirectionalLight> lights = fixed;
-    for (const MsmAreaLight& a : cut.lights) lights.push_back(scene::light_of_area_light(a));
     const double cube_ms = times.total("probe_cube"), tables_ms = times.total("probe_tables"),
                  cut_ms = times.total("probe_cut");
     nlohmann::json entry = {{"frame", k},
                             {"rotation_deg", rotation},
                             {"lights", cut.lights.size()},
+                            {"sub_lights", sub_light_count},
                             {"probe_ms", {{"probe_cube", cube_ms}, {"probe_tables", tables_ms}, {"probe_cut", cut_ms}}},
                             {"probe_wall_ms", probe_wall_ms},
                             {"render_ms", nlohmann::json::object()}};
@@ -100,9 +111,11 @@ void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, con
       line += fmt::format("  {} {:.2f} ms", name, result.total_ms);
     }
     fmt::print(stderr,
-               "frame {:>3}/{}  rotation {:7.2f}°  {:>3} lights  probe GPU: cube {:.2f} ms, tables {:.2f} ms, cut "
+               "frame {:>3}/{}  rotation {:7.2f}°  {:>3} lights{}  probe GPU: cube {:.2f} ms, tables {:.2f} ms, cut "
                "{:.2f} ms ({:.1f} ms wall with upload and read-back) |{}\n",
-               k + 1, o.frames, rotation, cut.lights.size(), cube_ms, tables_ms, cut_ms, probe_wall_ms, line);
+               k + 1, o.frames, rotation, cut.lights.size(),
+               sub_light_count ? fmt::format(" ({} sub-lights)", sub_light_count) : "", cube_ms, tables_ms, cut_ms,
+               probe_wall_ms, line);
     list.push_back(entry);
   }
   const std::string text =

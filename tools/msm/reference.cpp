@@ -81,7 +81,8 @@ void add_reference(CLI::App& app) {
     std::uint64_t seed = 1;
     double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
     std::optional<double> light_extent, light_width, light_height;
-    std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
+    std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
+    std::optional<int> sub_lights; // and their sub-lights
     bool json = false, progress = false, probe_lights = false;
   };
   auto opt = std::make_shared<Options>();
@@ -107,6 +108,9 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--lights", opt->lights,
                   "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
                   "the scene's)");
+  cmd->add_option("--sub-lights", opt->sub_lights,
+                  "Image-based lighting: the probe lights' sub-lights, a finer cut into this many regions (0: none; "
+                  "default: the scene's); --probe-lights traces them");
   cmd->add_flag("--probe-lights", opt->probe_lights,
                 "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
@@ -150,8 +154,9 @@ void add_reference(CLI::App& app) {
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
     msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
-    if (opt->lights) try {
-        msm::scene::set_probe_light_count(scene, *opt->lights);
+    if (opt->lights || opt->sub_lights) try {
+        msm::scene::set_probe_light_count(scene, opt->lights.value_or(scene.probe ? scene.probe->lights : 1),
+                                          opt->sub_lights);
       } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
     if (settings.effect == msm::reference::Effect::scattering && !scene.medium)
       throw UsageError(fmt::format("{}: --effect scattering needs a scene with a \"medium\" (extinction, "
@@ -253,9 +258,14 @@ void add_reference(CLI::App& app) {
       j["files"]["radiance_png"] = "radiance.png";
       j["channels"]["irradiance"] = result.irradiance.channel_names();
       const msm::scene::ProbeLighting& p = *scene.probe;
-      j["probe"] = {{"file", p.file.string()},         {"lights", p.lights}, {"intensity", p.intensity},
-                    {"rotation_deg", p.rotation_deg},  {"size", p.size},     {"probe_lights", settings.probe_lights},
-                    {"horizon_split", p.horizon_split}};
+      j["probe"] = {{"file", p.file.string()},
+                    {"lights", p.lights},
+                    {"intensity", p.intensity},
+                    {"rotation_deg", p.rotation_deg},
+                    {"size", p.size},
+                    {"probe_lights", settings.probe_lights},
+                    {"horizon_split", p.horizon_split},
+                    {"sub_lights", p.sub_lights}};
     }
     if (!result.visibility_rgb.empty()) {
       j["files"]["visibility_rgb"] = "visibility_rgb.exr";

@@ -34,7 +34,8 @@ void add_render(CLI::App& app) {
     std::string out = "msm-render";
     std::string view; // a view file (msm view)
     ProbeFrames probe_frames;
-    std::optional<int> lights; // the probe's area lights (scene::set_probe_light_count)
+    std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
+    std::optional<int> sub_lights; // and their sub-lights
   };
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
@@ -56,6 +57,9 @@ void add_render(CLI::App& app) {
   cmd->add_option("--lights", opt->lights,
                   "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
                   "the scene's)");
+  cmd->add_option("--sub-lights", opt->sub_lights,
+                  "Image-based lighting: each area light's unshadowed light from the lights of a finer cut into this "
+                  "many regions inside its own (0: none; default: the scene's \"sub_lights\")");
   cmd->callback([opt, cmd] {
     const bool probe_frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
     std::optional<scene::Camera> view_camera;
@@ -85,8 +89,9 @@ void add_render(CLI::App& app) {
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;
-    if (opt->lights) try {
-        scene::set_probe_light_count(scene, *opt->lights);
+    if (opt->lights || opt->sub_lights) try {
+        scene::set_probe_light_count(scene, opt->lights.value_or(scene.probe ? scene.probe->lights : 1),
+                                     opt->sub_lights);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     const render::RenderSettings& f = opt->frame.settings;
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))

@@ -30,11 +30,8 @@ inline constexpr int kMaxDeviceCubeSize = 1024;
 inline constexpr int kMaxDeviceLights = 256;
 
 // A cut read back from the device: the regions in median_cut's order (energy and fixed_energy
-// set) and the area lights of those with energy (area_lights' order).
-struct DeviceCut {
-  std::vector<Region> regions;
-  std::vector<MsmAreaLight> lights;
-};
+// set) and the area lights of those with energy (area_lights' order), as cut_lights makes them.
+using DeviceCut = CutLights;
 
 class DeviceProbe {
  public:

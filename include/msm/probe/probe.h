@@ -179,6 +179,42 @@ std::vector<Region> median_cut(const ProbeTables& tables, int count, bool horizo
 // msm_area_light_from_merged of its faces in increasing order), regions without energy skipped.
 std::vector<MsmAreaLight> area_lights(const ProbeTables& tables, const std::vector<Region>& regions);
 
+// Sub-lights (a probe's "sub_lights", docs/techniques.md): the regions of the finer cut `fine`
+// (median_cut into more regions, the same horizon_split) that lie in each region of `coarse`, by
+// index into `fine`. The median cut only ever splits, and a cut into more regions goes through
+// the cut into fewer, so every fine region lies in exactly one coarse region (a rectangle inside
+// the coarse rectangle of its face, or a face of a coarse group of faces); ProbeError if one does
+// not (cuts of different probes or tables).
+std::vector<std::vector<int>> sub_regions(const std::vector<Region>& coarse, const std::vector<Region>& fine);
+
+// A light of the cut and the lights of the finer cut's regions inside its region: the light shades
+// its unshadowed irradiance as the sum of its sub-lights' (each a uniform rectangle of its own,
+// smaller region), its shadow stays its own.
+struct ProbeLight {
+  MsmAreaLight light;
+  std::vector<MsmAreaLight> sub_lights;
+};
+// A cut's regions in median_cut's order and the area lights of those with energy (area_lights'
+// order): light_of_region[k] is region k's light, −1 for none. The device's cut reads back the same
+// (DeviceCut).
+struct CutLights {
+  std::vector<Region> regions;
+  std::vector<MsmAreaLight> lights;
+  std::vector<int> light_of_region;
+};
+CutLights cut_lights(const ProbeTables& tables, int count, bool horizon_split = false);
+// The coarse cut's lights, each with the fine cut's lights that lie in its region (sub_regions;
+// ProbeError if the cuts do not nest).
+std::vector<ProbeLight> with_sub_lights(const CutLights& coarse, const CutLights& fine);
+// The cut into `count` regions' area lights (area_lights: regions without energy skipped), each
+// with its sub-lights from the cut into max(sub_count, count) regions (their lights likewise).
+std::vector<ProbeLight> lights_with_sub_lights(const ProbeTables& tables, int count, int sub_count,
+                                               bool horizon_split = false);
+// probe_area_lights with each light's sub-lights (lights_with_sub_lights).
+std::vector<ProbeLight> probe_lights_with_sub_lights(const std::string& probe, int size, int count, int sub_count,
+                                                     float rotation_deg = 0.0f, float intensity = 1.0f,
+                                                     bool horizon_split = false);
+
 // The whole CPU pipeline: the probe (an equirectangular or cross EXR, load_probe_file, or "sky" for
 // make_sky_sun_probe's default sky: see sky_probe) as a cube map of size², scaled by intensity, cut into `count`
 // regions (median_cut, horizon_split as there), and their area lights.

@@ -147,6 +147,9 @@
 
 namespace msm {
 struct MsmAreaLight; // msm/light_probe.h
+namespace probe {
+struct ProbeLight; // msm/probe/probe.h
+}
 } // namespace msm
 
 namespace msm::scene {
@@ -299,6 +302,11 @@ struct DirectionalLight {
   // towards_light); unset: the frame's default, horizontal (Scene::light_view). The probe's lights:
   // the u axis of their cube face (§4.1.2).
   std::optional<glm::vec3> x_axis;
+  // A probe light's sub-lights (ProbeLighting::sub_lights): the lights of a finer median cut inside
+  // its region, each a rectangle with its own direction, extents and irradiance. Where given, the
+  // shading takes the light's unshadowed irradiance as their sum (each clipped by the receiver's
+  // horizon) instead of this light's own; its shadow map and visibility stay this light's.
+  std::vector<DirectionalLight> sub_lights;
   glm::vec3 travel() const { return -towards_light; }
   bool rectangular() const { return angular_height_deg.has_value(); }
   // tan of the half extents along the frame's x and y axes (a disc: its radius, both).
@@ -325,6 +333,8 @@ struct Medium {
 // on the extents) and the irradiance a facing surface receives (Eq. 18 for the rectangle:
 // msm_rect_light_facing_fraction of the kept extents).
 DirectionalLight light_of_area_light(const msm::MsmAreaLight& area);
+// A probe light with its sub-lights (msm::probe::ProbeLight), each made by light_of_area_light.
+DirectionalLight light_of_probe_light(const msm::probe::ProbeLight& light);
 
 // Image-based lighting: the probe the scene's area lights were made from (Scene::lights holds them).
 struct ProbeLighting {
@@ -333,7 +343,11 @@ struct ProbeLighting {
   float intensity = 1.0f;
   float rotation_deg = 0.0f;
   int size = 128;
-  bool horizon_split = false;  // the median cut's horizon split (msm::probe::median_cut): lights >= 10, size even
+  bool horizon_split = false; // the median cut's horizon split (msm::probe::median_cut): lights >= 10, size even
+  // Above `lights`: every light gets the lights of the cut into sub_lights regions that lie in its
+  // region as sub-lights (DirectionalLight::sub_lights, msm::probe::sub_regions); 0 or at most
+  // `lights`: none (each light would be its own single sub-light).
+  int sub_lights = 0;
   std::size_t first_light = 0; // index of its first light in Scene::lights
 };
 
@@ -453,8 +467,9 @@ Scene builtin_scene(std::string_view name);
 Scene load_scene(std::string_view name_or_path);
 // Replaces the probe's area lights by a median cut into `count` (1..256), as "probe": {"lights":
 // count} would have made them (`msm render --lights`). SceneError without a probe, for a count out of
-// range or beyond kMaxLights with the other lights.
-void set_probe_light_count(Scene& scene, int count);
+// range or beyond kMaxLights with the other lights. sub_lights, where given, replaces the probe's
+// "sub_lights" (`msm render --sub-lights`; 0..256, at least 10 with the horizon split).
+void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_lights = std::nullopt);
 
 // Mesh import through Assimp: node transforms applied (instances repeated), triangulated, texture
 // coordinates flipped to v down where the format has v up, KHR_texture_transform baked into them,

@@ -180,6 +180,7 @@ DeviceCut DeviceProbe::read() const {
     region.faces = r.faces;
     region.energy = double(r.fixed_energy) / double(scale_);
     cut.regions.push_back(region);
+    cut.light_of_region.push_back(r.lit ? int(cut.lights.size()) : -1);
     if (!r.lit) continue;
     const LightOut& l = out.lights[k];
     cut.lights.push_back(MsmAreaLight(glm::vec3(l.direction_cone), glm::vec3(l.x_axis_half_x),

@@ -218,6 +218,32 @@ TEST_F(DeviceProbeTest, DeviceLightsAgreeWithTheCpuPipeline) {
   EXPECT_LT(glm::length(brightest(device.lights).direction - brightest(cpu).direction), 1e-2);
 }
 
+// Sub-lights from the device's cuts (what `msm render --frames` does with a scene's "sub_lights"):
+// the device's cuts into N and 64 regions grouped by with_sub_lights give each light the same
+// sub-lights as the CPU's lights_with_sub_lights on the same cube map and scale (the regions are
+// equal, so the counts per light must be; the lights agree to a few ulp as above), light_of_region
+// included; a region without energy has no light on either.
+TEST_F(DeviceProbeTest, SubLightsFromTheDeviceCutsEqualTheCpus) {
+  DeviceProbe probe(ctx(), 32);
+  probe.set_panorama(load_equirect(kStudio));
+  probe.run(1); // makes the cube map and the tables' scale
+  const ProbeTables tables(probe.read_cube(), probe.scale());
+  for (int n : {1, 3, 6, 16}) {
+    const DeviceCut coarse = probe.run(n);
+    EXPECT_EQ(coarse.light_of_region, cut_lights(tables, n).light_of_region) << n;
+    const std::vector<ProbeLight> device = with_sub_lights(coarse, probe.run(64));
+    const std::vector<ProbeLight> cpu = lights_with_sub_lights(tables, n, 64);
+    ASSERT_EQ(device.size(), cpu.size()) << n;
+    for (std::size_t k = 0; k < cpu.size(); ++k) {
+      ASSERT_EQ(device[k].sub_lights.size(), cpu[k].sub_lights.size()) << n << ", light " << k;
+      for (std::size_t j = 0; j < cpu[k].sub_lights.size(); ++j) {
+        const glm::vec3 a = device[k].sub_lights[j].irradiance, b = cpu[k].sub_lights[j].irradiance;
+        EXPECT_LT(glm::length(a - b) / std::max({b.x, b.y, b.z, 1e-30f}), 1e-5f) << n << ", " << k << ", " << j;
+      }
+    }
+  }
+}
+
 TEST_F(DeviceProbeTest, BlackProbeHasNoLights) {
   CubeMap black;
   black.size = 8;

@@ -54,7 +54,8 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
                                    {7, uint32_t(config.msaa)},
                                    {8, uint32_t(config.taps)},
                                    {9, uint32_t(config.lookup)},
-                                   {10, config.textured_draws ? 1u : 0u}}};
+                                   {10, config.textured_draws ? 1u : 0u},
+                                   {11, config.sub_lights ? 1u : 0u}}};
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
   if (msm_technique_is_scattering(technique.id)) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;

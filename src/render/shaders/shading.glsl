@@ -16,6 +16,9 @@ layout(constant_id = 5) const bool kLinearRadiance = false;
 // lavapipe runs both sides of the branches on the draw's flags, so untextured draws paid for the
 // fetches (a GPU skips them either way).
 layout(constant_id = 10) const bool kTexturedDraws = true;
+// Whether some light of the frame has sub-lights (FrameConfig::sub_lights, a probe's "sub_lights"):
+// a constant, so that frames without them compile none of their loop.
+layout(constant_id = 11) const bool kSubLights = false;
 
 layout(binding = 1) uniform sampler2D albedo_texture;
 layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
@@ -78,7 +81,8 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
   float texels_per_clip_unit = 0.5f * frame.shadow_map.x;
   s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
   s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
-  if (lit <= 0.0f) return vec3(0.0f);
+  // With sub-lights some of a light's region can be above the horizon where its rectangle is not.
+  if (lit <= 0.0f && !kSubLights) return vec3(0.0f);
   vec3 nc = mat3(lights[l].normal_matrix) * n;
   s.z = clip.z - frame.shadow_map.w;
   // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
@@ -118,8 +122,23 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
                                      lights[l].rect_extent.xy, lights[l].soft.z)
                   : msm_cone_cosine(n_dot_l, 0.0f);
   vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
-  direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
-  float w = msm_luminance(lights[l].irradiance.rgb) * lit;
+  // Sub-lights: entries [first, first + count) of lights[] after the frame's lights (the renderer
+  // puts them there, rect_extent.zw of their light): the light's unshadowed irradiance is theirs,
+  // each its rectangle's cosine integral; the light's visibility shadows them all.
+  int sub_count = kSubLights ? int(lights[l].rect_extent.w) : 0;
+  float w;
+  if (sub_count > 0) {
+    vec3 unshadowed = vec3(0.0f);
+    for (int k = int(lights[l].rect_extent.z), end = k + sub_count; k < end; ++k)
+      unshadowed += lights[k].irradiance.rgb * msm_light_cosine(n, lights[k].towards_light.xyz,
+                                                                lights[k].rect_x_axis.xyz, lights[k].rect_extent.xy,
+                                                                lights[k].soft.z);
+    direct += msm_direct_light(unshadowed, 1.0f, v);
+    w = msm_luminance(unshadowed);
+  } else {
+    direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
+    w = msm_luminance(lights[l].irradiance.rgb) * lit;
+  }
   weighted += w * v;
   weight_sum += w;
   return v;
