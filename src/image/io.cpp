@@ -44,7 +44,7 @@
 // and the time change).
 #include <libdeflate.h>
 namespace {
-unsigned char* msm_zlib_compress(unsigned char* data, int length, int* out_length, int /*quality*/) {
+unsigned char* msm_png_deflate(unsigned char* data, int length, int* out_length, int /*quality*/) {
   libdeflate_compressor* c = libdeflate_alloc_compressor(1);
   if (!c) return nullptr;
   const std::size_t bound = libdeflate_zlib_compress_bound(c, std::size_t(length));
@@ -59,7 +59,7 @@ unsigned char* msm_zlib_compress(unsigned char* data, int length, int* out_lengt
   return out;
 }
 } // namespace
-#define STBIW_ZLIB_COMPRESS msm_zlib_compress
+#define STBIW_ZLIB_COMPRESS msm_png_deflate
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 

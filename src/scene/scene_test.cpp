@@ -1004,6 +1004,8 @@ TEST(Probe, SubLightsReachTheLights) {
   EXPECT_EQ(scene.probe->sub_lights, 32);
   ASSERT_EQ(scene.lights.size(), 4u);
   const auto expected = msm::probe::probe_area_lights("sky", 16, 4);
+  const auto grouped = msm::probe::probe_lights_with_sub_lights("sky", 16, 4, 32);
+  ASSERT_EQ(grouped.size(), expected.size());
   std::size_t subs = 0;
   for (std::size_t k = 0; k < scene.lights.size(); ++k) {
     const msm::scene::DirectionalLight& l = scene.lights[k];
@@ -1012,8 +1014,7 @@ TEST(Probe, SubLightsReachTheLights) {
     subs += l.sub_lights.size();
     // Σ M_e of the sub-lights = the light's M_e (XYZ round trips: 1e-3 relative).
     glm::dvec3 sum(0.0);
-    for (const msm::MsmAreaLight& a : msm::probe::probe_lights_with_sub_lights("sky", 16, 4, 32)[k].sub_lights)
-      sum += glm::dvec3(a.irradiance);
+    for (const msm::MsmAreaLight& a : grouped[k].sub_lights) sum += glm::dvec3(a.irradiance);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c] / double(expected[k].irradiance[c]), 1.0, 1e-3) << k;
   }
   EXPECT_EQ(subs, 32u);
