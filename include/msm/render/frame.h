@@ -51,7 +51,8 @@ struct LightUniforms {
                         // shading's msm_cone_cosine (0: a point light, max(n·l, 0)), w: unused
   vec4 rect_x_axis;     // xyz: a rectangular light's x axis (its frame's, Scene::light_frame), w: unused
   vec4 rect_extent;     // xy: a rectangular light's half extents as tangents (0: a disc or a point,
-                        // shaded by soft.z), zw: unused. The shading's msm_light_cosine takes both.
+                        // shaded by soft.z); the shading's msm_light_cosine takes both. zw: its
+                        // sub-lights, entries [z, z + w) of the same array (w = 0: none; shading.glsl)
 };
 
 // How the shading reads a filtered shadow map.
