@@ -519,8 +519,11 @@ std::vector<ProbeLight> with_sub_lights(const CutLights& coarse, const CutLights
 
 std::vector<ProbeLight> lights_with_sub_lights(const ProbeTables& tables, int count, int sub_count,
                                                bool horizon_split) {
-  return with_sub_lights(cut_lights(tables, count, horizon_split),
-                         cut_lights(tables, std::max(count, sub_count), horizon_split));
+  CutLights coarse = cut_lights(tables, count, horizon_split);
+  if (sub_lights_refine(count, sub_count)) return with_sub_lights(coarse, cut_lights(tables, sub_count, horizon_split));
+  std::vector<ProbeLight> out;
+  for (MsmAreaLight& light : coarse.lights) out.push_back({light, {}});
+  return out;
 }
 
 std::vector<ProbeLight> probe_lights_with_sub_lights(const std::string& probe, int size, int count, int sub_count,

@@ -36,18 +36,13 @@ std::string compose(const std::string& file, const std::string& where, const std
 }
 
 // The probe's area lights (msm::probe: cube map, median cut, Kneiphof §4.1) as discs of the light's
-// cone with the irradiance a facing surface receives (Eq. 18). Throws msm::probe::ProbeError.
+// cone with the irradiance a facing surface receives (Eq. 18), with their sub-lights where the probe
+// asks for them (ProbeLighting::sub_lights). Throws msm::probe::ProbeError.
 std::vector<DirectionalLight> probe_directional_lights(const ProbeLighting& p) {
   std::vector<DirectionalLight> out;
-  const std::string file = p.file == "sky" ? "sky" : p.file.string();
-  if (p.sub_lights <= p.lights) { // 0, or no finer cut: each light would be its own one sub-light
-    for (const msm::MsmAreaLight& a :
-         msm::probe::probe_area_lights(file, p.size, p.lights, p.rotation_deg, p.intensity, p.horizon_split))
-      out.push_back(light_of_area_light(a));
-    return out;
-  }
-  for (const msm::probe::ProbeLight& pl : msm::probe::probe_lights_with_sub_lights(
-           file, p.size, p.lights, p.sub_lights, p.rotation_deg, p.intensity, p.horizon_split))
+  for (const msm::probe::ProbeLight& pl :
+       msm::probe::probe_lights_with_sub_lights(p.file == "sky" ? "sky" : p.file.string(), p.size, p.lights,
+                                                p.sub_lights, p.rotation_deg, p.intensity, p.horizon_split))
     out.push_back(light_of_probe_light(pl));
   return out;
 }

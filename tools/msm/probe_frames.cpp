@@ -76,7 +76,7 @@ void render_probe_frames(const vk::Context& ctx, render::Renderer& renderer, con
     const probe::DeviceCut cut = device.run(p.lights, rotation, &timer);
     std::vector<scene::DirectionalLight> lights = fixed;
     std::size_t sub_light_count = 0;
-    if (p.sub_lights > p.lights) {
+    if (probe::sub_lights_refine(p.lights, p.sub_lights)) {
       // Sub-lights: the same probe cut again into more regions (its cube and tables made again; not
       // in the timings below, in the wall time), grouped by the region each lies in.
       for (const probe::ProbeLight& pl : probe::with_sub_lights(cut, device.run(p.sub_lights, rotation))) {

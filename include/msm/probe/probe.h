@@ -206,8 +206,12 @@ CutLights cut_lights(const ProbeTables& tables, int count, bool horizon_split = 
 // The coarse cut's lights, each with the fine cut's lights that lie in its region (sub_regions;
 // ProbeError if the cuts do not nest).
 std::vector<ProbeLight> with_sub_lights(const CutLights& coarse, const CutLights& fine);
+// Whether a cut into `count` regions gets sub-lights from one into `sub_count`: only a finer cut
+// (at most `count` regions, each light would be its own single sub-light).
+inline bool sub_lights_refine(int count, int sub_count) { return sub_count > count; }
 // The cut into `count` regions' area lights (area_lights: regions without energy skipped), each
-// with its sub-lights from the cut into max(sub_count, count) regions (their lights likewise).
+// with its sub-lights from the cut into sub_count regions (their lights likewise); none unless
+// sub_lights_refine(count, sub_count).
 std::vector<ProbeLight> lights_with_sub_lights(const ProbeTables& tables, int count, int sub_count,
                                                bool horizon_split = false);
 // probe_area_lights with each light's sub-lights (lights_with_sub_lights).
