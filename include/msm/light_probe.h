@@ -417,6 +417,55 @@ MSM_FN float msm_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t, float cone_ha
   return msm_cone_cosine(dot(n, l), cone_half_angle);
 }
 
+// The half extents (A, B) of a rectangle of tangents about the unit direction l, with orthonormal
+// axes x and y, that holds the light (light_l, light_x, t, cone_half_angle) as msm_light_cosine
+// integrates it: every direction of the light is along l + a x + b y with |a| <= A, |b| <= B. Its
+// rectangle's corners (widened, on its x axis projected off light_l, as msm_rect_light_cosine takes
+// them), a disc's circumscribed square, or the point light_l, each projected onto the plane
+// through l (the light is convex there, so its corners bound it). (−1, −1) where some corner is
+// not in front of l: no such rectangle.
+MSM_FN vec2 msm_light_tangent_bounds(vec3 l, vec3 x, vec3 y, vec3 light_l, vec3 light_x, vec2 t_in,
+                                     float cone_half_angle) {
+  vec2 t = vec2(0.0f);
+  vec3 lx = light_x - light_l * dot(light_x, light_l);
+  if (max(t_in.x, t_in.y) > 0.0f) {
+    if (length(lx) > 1e-6f) t = max(t_in, vec2(1e-4f));
+  } else if (cone_half_angle > 0.0f) {
+    if (!(cone_half_angle < 0.5f * MSM_PI)) return vec2(-1.0f);
+    t = vec2(tan(cone_half_angle));
+    lx = cross(light_l, abs(light_l.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f));
+  }
+  if (t.x > 0.0f) lx = normalize(lx);
+  vec3 ly = cross(light_l, lx);
+  vec2 bounds = vec2(0.0f);
+  for (int i = 0; i < 4; ++i) {
+    vec3 corner = light_l + ((i & 1) != 0 ? t.x : -t.x) * lx + ((i & 2) != 0 ? t.y : -t.y) * ly;
+    float ahead = dot(corner, l);
+    if (!(ahead > 1e-6f * length(corner))) return vec2(-1.0f);
+    bounds = max(bounds, abs(vec2(dot(corner, x), dot(corner, y))) / ahead);
+  }
+  return bounds;
+}
+
+// Which side of the horizon of the unit normal n the rectangle of tangents (l, x, y, bounds: as
+// msm_light_tangent_bounds makes it) is on: 1 where all of it is above (n·l − A |n·x| − B |n·y| >=
+// 0: its corners' heights), −1 where all of it is below, 0 where it straddles the horizon or there
+// are no bounds (bounds.x < 0).
+MSM_FN int msm_tangent_rect_side(vec3 n, vec3 l, vec3 x, vec3 y, vec2 bounds) {
+  if (bounds.x < 0.0f) return 0;
+  float n_dot_l = dot(n, l);
+  float reach = bounds.x * abs(dot(n, x)) + bounds.y * abs(dot(n, y));
+  if (n_dot_l >= reach) return 1;
+  if (n_dot_l <= -reach) return -1;
+  return 0;
+}
+
+// Several lights' summed unshadowed irradiance Σ_k E_k msm_light_cosine_k(n) where each is wholly
+// above the horizon of n: Σ_k E_k (n·l_k) = (Σ_k E_k l_kᵀ) n, linear in n. irradiance_by_direction
+// is that sum of outer products (column j: Σ_k E_k l_k[j]); the shading's sub-lights take it
+// wherever msm_tangent_rect_side says that all of them are above the horizon (shading.glsl).
+MSM_FN vec3 msm_linear_irradiance(mat3 irradiance_by_direction, vec3 n) { return irradiance_by_direction * n; }
+
 // Outgoing radiance factor of Eq. (18) for the rectangle: a diffuse surface of albedo ρ under the
 // light reflects ρ / π · (irradiance on a facing surface) · msm_rect_light_cosine; that irradiance is
 // L_e^A F with L_e^A = M_e / Ω (Eq. 16 over the rectangle), i.e. M_e F / Ω

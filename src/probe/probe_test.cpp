@@ -184,7 +184,9 @@ TEST(MedianCut, FinerCutsNestInCoarserOnes) {
         std::uint64_t sum = 0;
         for (int j : inside[k]) sum += fine[std::size_t(j)].fixed_energy, ++seen[std::size_t(j)];
         EXPECT_EQ(sum, coarse[k].fixed_energy) << count << " regions, region " << k;
-        if (count >= 64) EXPECT_EQ(inside[k], std::vector<int>{int(k)}) << count; // the same cut
+        if (count >= 64) { // the same cut
+          EXPECT_EQ(inside[k], std::vector<int>{int(k)}) << count;
+        }
       }
       EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; })) << count;
     }

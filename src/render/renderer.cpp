@@ -39,8 +39,9 @@ static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 +
 static_assert(offsetof(FrameUniforms, filter_weights) == 64 + 4 * 16);
 static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 32);
 static_assert(sizeof(LightUniforms) == 2 * 64 + 5 * 16);
-// The lights' storage buffer: the frame's lights, then their sub-lights (at most 256 of each).
-constexpr std::size_t kLightSlots = 2 * MSM_MAX_LIGHTS;
+// The lights' storage buffer: the frame's lights, then each one's sub-lights after a summary entry
+// (at most 256 lights, 256 sub-lights and 256 summaries).
+constexpr std::size_t kLightSlots = 3 * MSM_MAX_LIGHTS;
 static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
 static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
 static_assert(sizeof(RectificationUniforms) == 11 * 16); // the std430 array stride of the passes' rects[]
@@ -282,6 +283,19 @@ struct Renderer::Impl {
     return u;
   }
 
+  // The entry before a light's sub-lights (shading.glsl, sub_lights_irradiance): their linear part
+  // (scene::sub_lights_linear_part) in view_projection's 3 x 3 and its bounds in [3].xy, the
+  // rectangle's axes in normal_matrix[0] and [1].
+  static LightUniforms sub_lights_summary(const scene::DirectionalLight& light) {
+    const scene::SubLightsLinearPart part = scene::sub_lights_linear_part(light);
+    LightUniforms summary{};
+    summary.view_projection = glm::mat4(part.irradiance_by_direction);
+    summary.view_projection[3] = glm::vec4(part.bounds, 0.0f, 1.0f);
+    summary.normal_matrix[0] = glm::vec4(part.x_axis, 0.0f);
+    summary.normal_matrix[1] = glm::vec4(part.y_axis, 0.0f);
+    return summary;
+  }
+
   // The settings are valid and this device can render them (RenderError naming what it lacks).
   void check(const RenderSettings& s) const {
     s.validate();
@@ -305,7 +319,7 @@ struct Renderer::Impl {
                                     ctx.properties().limits.maxImageDimension2D / uint32_t(tiles)));
     const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
     std::size_t slots = frame_lights.size();
-    for (const scene::DirectionalLight& l : frame_lights) slots += l.sub_lights.size();
+    for (const scene::DirectionalLight& l : frame_lights) slots += l.sub_lights.size() + (l.sub_lights.empty() ? 0 : 1);
     if (slots > kLightSlots)
       throw RenderError(fmt::format("{} lights and sub-lights: the renderer holds {}", slots, kLightSlots));
     if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
@@ -386,11 +400,14 @@ struct Renderer::Impl {
     std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation)
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
-    // Sub-lights after the frame's lights, each light's range in its rect_extent.zw (shading.glsl).
+    // Sub-lights after the frame's lights, each light's after their summary, whose index and the
+    // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {
       const std::vector<scene::DirectionalLight>& subs = frame_lights[i].sub_lights;
+      if (subs.empty()) continue;
       light_data[i].rect_extent.z = float(light_data.size());
       light_data[i].rect_extent.w = float(subs.size());
+      light_data.push_back(sub_lights_summary(frame_lights[i]));
       for (const scene::DirectionalLight& sub : subs) light_data.push_back(sub_light_uniforms(sub));
     }
     // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above

@@ -570,6 +570,27 @@ DirectionalLight light_of_probe_light(const msm::probe::ProbeLight& light) {
   return l;
 }
 
+SubLightsLinearPart sub_lights_linear_part(const DirectionalLight& light) {
+  SubLightsLinearPart part;
+  if (light.sub_lights.empty()) return part;
+  const glm::vec3 l = light.towards_light;
+  // The light frame's x axis as the shading takes it (msm_rect_light_cosine), else any.
+  glm::vec3 x = light.x_axis.value_or(glm::vec3(0.0f));
+  x -= l * glm::dot(x, l);
+  if (glm::length(x) <= 1e-6f) x = glm::cross(l, std::abs(l.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
+  part.x_axis = glm::normalize(x);
+  part.y_axis = glm::cross(l, part.x_axis);
+  part.bounds = glm::vec2(0.0f);
+  for (const DirectionalLight& sub : light.sub_lights) {
+    part.irradiance_by_direction += glm::outerProduct(sub.irradiance, sub.towards_light);
+    const glm::vec2 b =
+        msm::msm_light_tangent_bounds(l, part.x_axis, part.y_axis, sub.towards_light, sub.x_axis.value_or(glm::vec3(0.0f)),
+                                      sub.rectangle_extents(), sub.cone_half_angle());
+    part.bounds = (b.x < 0.0f || part.bounds.x < 0.0f) ? glm::vec2(-1.0f) : glm::max(part.bounds, b);
+  }
+  return part;
+}
+
 DirectionalLight light_of_area_light(const msm::MsmAreaLight& area) {
   DirectionalLight l;
   l.towards_light = area.direction;

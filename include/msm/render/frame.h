@@ -52,7 +52,8 @@ struct LightUniforms {
   vec4 rect_x_axis;     // xyz: a rectangular light's x axis (its frame's, Scene::light_frame), w: unused
   vec4 rect_extent;     // xy: a rectangular light's half extents as tangents (0: a disc or a point,
                         // shaded by soft.z); the shading's msm_light_cosine takes both. zw: its
-                        // sub-lights, entries [z, z + w) of the same array (w = 0: none; shading.glsl)
+                        // sub-lights (w of them, 0: none): entry z of the same array their summary
+                        // (renderer.cpp, sub_lights_summary), [z + 1, z + 1 + w) the sub-lights
 };
 
 // How the shading reads a filtered shadow map.

@@ -336,6 +336,19 @@ DirectionalLight light_of_area_light(const msm::MsmAreaLight& area);
 // A probe light with its sub-lights (msm::probe::ProbeLight), each made by light_of_area_light.
 DirectionalLight light_of_probe_light(const msm::probe::ProbeLight& light);
 
+// The shading's shortcut for a light's sub-lights (shading.glsl, sub_lights_irradiance): their
+// irradiance by direction Σ_k E_k l_kᵀ, and a rectangle of tangents about the light's direction
+// that holds every sub-light as msm_light_cosine shades it (the light frame's axes, bounds by
+// msm_light_tangent_bounds; −1: none). Where msm_tangent_rect_side says a unit normal n has that
+// rectangle above its horizon, every sub-light is wholly above it and their summed cosine
+// integrals are msm_linear_irradiance(irradiance_by_direction, n); where below, they are 0.
+struct SubLightsLinearPart {
+  glm::mat3 irradiance_by_direction{0.0f};
+  glm::vec3 x_axis{1.0f, 0.0f, 0.0f}, y_axis{0.0f, 1.0f, 0.0f};
+  glm::vec2 bounds{-1.0f};
+};
+SubLightsLinearPart sub_lights_linear_part(const DirectionalLight& light);
+
 // Image-based lighting: the probe the scene's area lights were made from (Scene::lights holds them).
 struct ProbeLighting {
   std::filesystem::path file; // "sky": the procedural sky

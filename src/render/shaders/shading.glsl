@@ -81,8 +81,7 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
   float texels_per_clip_unit = 0.5f * frame.shadow_map.x;
   s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
   s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
-  // With sub-lights some of a light's region can be above the horizon where its rectangle is not.
-  if (lit <= 0.0f && !kSubLights) return vec3(0.0f);
+  if (lit <= 0.0f) return vec3(0.0f);
   vec3 nc = mat3(lights[l].normal_matrix) * n;
   s.z = clip.z - frame.shadow_map.w;
   // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
@@ -104,6 +103,24 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
   return 1.0f - shadow;
 }
 
+// The unshadowed irradiance of light l's sub-lights (count of them, after their summary at entry
+// rect_extent.z of lights[]; frame.h, renderer.cpp's sub_lights_summary): where the summary's
+// rectangle about the light's direction, which holds them all, is above the horizon of n, their
+// linear part (msm_linear_irradiance: one matrix product instead of a loop that reads each
+// sub-light), where it is below, nothing; else each one's rectangle cosine integral.
+vec3 sub_lights_irradiance(int l, vec3 n, int count) {
+  int summary = int(lights[l].rect_extent.z);
+  int side = msm_tangent_rect_side(n, lights[l].towards_light.xyz, lights[summary].normal_matrix[0].xyz,
+                                   lights[summary].normal_matrix[1].xyz, lights[summary].view_projection[3].xy);
+  if (side > 0) return max(msm_linear_irradiance(mat3(lights[summary].view_projection), n), vec3(0.0f));
+  if (side < 0) return vec3(0.0f);
+  vec3 sum = vec3(0.0f);
+  for (int k = summary + 1, end = k + count; k < end; ++k)
+    sum += lights[k].irradiance.rgb * msm_light_cosine(n, lights[k].towards_light.xyz, lights[k].rect_x_axis.xyz,
+                                                       lights[k].rect_extent.xy, lights[k].soft.z);
+  return sum;
+}
+
 // Light l's direct light at the surface with normal n (towards the viewer), added to direct, and
 // its visibility, returned and added to weighted with the irradiance it brings (luminance of
 // E max(n·l, 0), for area lights msm_light_cosine: the same factor as the shading) as its weight.
@@ -117,22 +134,23 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
   // points (the renderer leaves soft.z and rect_extent 0): a branch on the specialization
   // constant, as llvmpipe runs both sides of a branch on a uniform under a mask, and the
   // rectangle's clipping would cost every pixel of every light.
-  float lit = msm_technique_is_area_light(kTechnique)
-                  ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz,
-                                     lights[l].rect_extent.xy, lights[l].soft.z)
-                  : msm_cone_cosine(n_dot_l, 0.0f);
-  vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
-  // Sub-lights: entries [first, first + count) of lights[] after the frame's lights (the renderer
-  // puts them there, rect_extent.zw of their light): the light's unshadowed irradiance is theirs,
-  // each its rectangle's cosine integral; the light's visibility shadows them all.
+  // Sub-lights (after the frame's lights in lights[], rect_extent.zw of their light): the light's
+  // unshadowed irradiance is theirs (sub_lights_irradiance); the light's visibility shadows them all.
   int sub_count = kSubLights ? int(lights[l].rect_extent.w) : 0;
+  vec3 unshadowed = vec3(0.0f);
+  float lit;
+  if (sub_count > 0) {
+    unshadowed = sub_lights_irradiance(l, n, sub_count);
+    lit = max(unshadowed.r, max(unshadowed.g, unshadowed.b));
+  } else {
+    lit = msm_technique_is_area_light(kTechnique)
+              ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz, lights[l].rect_extent.xy,
+                                 lights[l].soft.z)
+              : msm_cone_cosine(n_dot_l, 0.0f);
+  }
+  vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
   float w;
   if (sub_count > 0) {
-    vec3 unshadowed = vec3(0.0f);
-    for (int k = int(lights[l].rect_extent.z), end = k + sub_count; k < end; ++k)
-      unshadowed += lights[k].irradiance.rgb * msm_light_cosine(n, lights[k].towards_light.xyz,
-                                                                lights[k].rect_x_axis.xyz, lights[k].rect_extent.xy,
-                                                                lights[k].soft.z);
     direct += msm_direct_light(unshadowed, 1.0f, v);
     w = msm_luminance(unshadowed);
   } else {
