@@ -347,13 +347,28 @@ MSM_FN float msm_cone_cosine(float cos_angle, float cone_half_angle) {
   return max(integral, 0.0f) / (MSM_PI * sin2);
 }
 
+// Corner i (mod 4) of the rectangle of half extents t, counter-clockwise from (−t.x, −t.y).
+MSM_FN vec2 msm_rect_corner(int i, vec2 t) {
+  int k = i % 4;
+  return vec2(k == 1 || k == 2 ? t.x : -t.x, k >= 2 ? t.y : -t.y);
+}
+
+// Lambert's term of the arc from p to q (not unit) for msm_rect_light_cosine: Θ n·normalize(p × q),
+// with Θ / |p × q| -> 1 / (|p| |q|) as the arc degenerates.
+MSM_FN float msm_lambert_edge(vec3 n, vec3 p, vec3 q) {
+  vec3 c = cross(p, q);
+  float s = length(c), d = dot(p, q);
+  float theta_per_s = s > 1e-12f ? atan(s, d) / s : 1.0f / (length(p) * length(q));
+  return theta_per_s * dot(n, c);
+}
+
 // ∫ over the rectangular light (the directions ℓ + a x + b y, |a| <= t.x, |b| <= t.y; radiance
 // uniform in solid angle) of max(n·ω, 0) dω, divided by F = msm_rect_light_facing_integral(t): the
 // factor that replaces max(n·l, 0) for the rectangle, exact at the horizon as msm_cone_cosine is
 // for a disc. Where the whole rectangle is above the receiver's horizon it is n·ℓ (∫ ω dω over the
 // rectangle is F ℓ by symmetry), where it is all below 0. Where it straddles the horizon, the
 // rectangle is clipped in its own plane (the points ℓ + a x + b y) by the horizon plane n·p >= 0
-// (Sutherland–Hodgman: a convex polygon of at most 5 vertices) and the clipped part integrated
+// (a convex polygon of at most 5 vertices, taken edge by edge) and the clipped part integrated
 // with Lambert's edge formula for a spherical polygon: ∫_P (n·ω) dω = ½ Σ_i Θ_i n·normalize(p_i ×
 // p_{i+1}), Θ_i the angle between p_i and p_{i+1}, vertices counter-clockwise about ℓ (a towards b
 // with (x, y = ℓ × x, ℓ) right-handed). Θ_i is atan(|p_i × p_{i+1}|, p_i·p_{i+1}) (acos of the
@@ -377,34 +392,22 @@ MSM_FN float msm_rect_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t_in) {
   if (n_dot_l >= reach) return n_dot_l; // every corner above the horizon
   if (n_dot_l <= -reach) return 0.0f;   // every corner below
   float facing = msm_rect_light_facing_integral(t);
-  vec2 corner[4];
-  corner[0] = vec2(-t.x, -t.y);
-  corner[1] = vec2(t.x, -t.y);
-  corner[2] = vec2(t.x, t.y);
-  corner[3] = vec2(-t.x, t.y);
-  vec2 clipped[5];
-  int count = 0;
-  for (int i = 0; i < 4; ++i) {
-    vec2 p = corner[i], q = corner[(i + 1) % 4];
-    float hp = n_dot_l + p.x * n_x + p.y * n_y, hq = n_dot_l + q.x * n_x + q.y * n_y;
-    if (hp >= 0.0f) {
-      clipped[count] = p;
-      count += 1;
-    }
-    if ((hp >= 0.0f) != (hq >= 0.0f)) {
-      clipped[count] = p + (q - p) * (hp / (hp - hq));
-      count += 1;
-    }
-  }
+  // Each edge's part above the horizon, then the horizon's chord from where the boundary leaves it
+  // to where it comes back (a convex polygon crosses a line twice): the clipped polygon's edges in
+  // order without storing it (an array written at a per-lane index is a scatter on a SIMD CPU).
   float sum = 0.0f;
-  for (int i = 0; i < count; ++i) {
-    vec2 a = clipped[i], b = clipped[(i + 1) % count];
-    vec3 p = l + a.x * x + a.y * y, q = l + b.x * x + b.y * y;
-    vec3 c = cross(p, q);
-    float s = length(c), d = dot(p, q);
-    float theta_per_s = s > 1e-12f ? atan(s, d) / s : 1.0f / (length(p) * length(q));
-    sum += theta_per_s * dot(n, c);
+  vec2 leaves = vec2(0.0f), comes_back = vec2(0.0f);
+  for (int i = 0; i < 4; ++i) {
+    vec2 p = msm_rect_corner(i, t), q = msm_rect_corner(i + 1, t);
+    float hp = n_dot_l + p.x * n_x + p.y * n_y, hq = n_dot_l + q.x * n_x + q.y * n_y;
+    bool p_above = hp >= 0.0f, q_above = hq >= 0.0f;
+    vec2 crossing = p + (q - p) * (p_above != q_above ? hp / (hp - hq) : 0.0f);
+    if (p_above && !q_above) leaves = crossing;
+    if (!p_above && q_above) comes_back = crossing;
+    vec2 a = p_above ? p : crossing, b = q_above ? q : crossing;
+    if (p_above || q_above) sum += msm_lambert_edge(n, l + a.x * x + a.y * y, l + b.x * x + b.y * y);
   }
+  sum += msm_lambert_edge(n, l + leaves.x * x + leaves.y * y, l + comes_back.x * x + comes_back.y * y);
   return clamp(0.5f * sum / facing, 0.0f, max(n_dot_l + reach, 0.0f));
 }
 
