@@ -175,9 +175,7 @@ TEST_F(IblTest, SubLightsGiveAPlaneTheIrradianceOfTheirFinerCut) {
                  technique, lights, with.mean_error, with.mae, without.mean_error);
       EXPECT_EQ(with.non_finite, 0u);
       EXPECT_LT(std::abs(with.mean_error), 0.005) << technique << " " << lights;
-      if (lights == 1) {
-        EXPECT_GT(std::abs(without.mean_error), 0.02) << technique;
-      }
+      if (lights == 1) { EXPECT_GT(std::abs(without.mean_error), 0.02) << technique; }
     }
   }
 }

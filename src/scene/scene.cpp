@@ -583,9 +583,9 @@ SubLightsLinearPart sub_lights_linear_part(const DirectionalLight& light) {
   part.bounds = glm::vec2(0.0f);
   for (const DirectionalLight& sub : light.sub_lights) {
     part.irradiance_by_direction += glm::outerProduct(sub.irradiance, sub.towards_light);
-    const glm::vec2 b =
-        msm::msm_light_tangent_bounds(l, part.x_axis, part.y_axis, sub.towards_light, sub.x_axis.value_or(glm::vec3(0.0f)),
-                                      sub.rectangle_extents(), sub.cone_half_angle());
+    const glm::vec2 b = msm::msm_light_tangent_bounds(l, part.x_axis, part.y_axis, sub.towards_light,
+                                                      sub.x_axis.value_or(glm::vec3(0.0f)), sub.rectangle_extents(),
+                                                      sub.cone_half_angle());
     part.bounds = (b.x < 0.0f || part.bounds.x < 0.0f) ? glm::vec2(-1.0f) : glm::max(part.bounds, b);
   }
   return part;

@@ -1073,18 +1073,14 @@ TEST(Probe, SubLightsLinearPartIsTheirSumWhereAllAreAboveTheHorizon) {
           const glm::vec3 linear = msm::msm_linear_irradiance(part.irradiance_by_direction, n);
           for (int k = 0; k < 3; ++k) EXPECT_NEAR(linear[k], sum[k], 1e-5 * scale) << c.probe << " " << c.count;
         }
-        if (side < 0) {
-          ASSERT_TRUE(all_below) << c.probe << " " << c.count;
-        }
+        if (side < 0) { ASSERT_TRUE(all_below) << c.probe << " " << c.count; }
         one_side += (all_above || all_below) ? 1 : 0;
         taken += side != 0 ? 1 : 0;
       }
     }
     const double share = double(taken) / double(std::max(one_side, 1));
     EXPECT_GE(share, c.min_share) << c.probe << " " << c.count << ": " << taken << " of " << one_side;
-    if (c.count == 1) {
-      EXPECT_EQ(one_side, 0);
-    }
+    if (c.count == 1) { EXPECT_EQ(one_side, 0); }
   }
 }
 
