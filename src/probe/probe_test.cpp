@@ -578,6 +578,79 @@ TEST(AreaLights, RectangleCosineIsTheIntegralOverTheClippedRectangle) {
             msm::msm_rect_light_cosine(n_side, lf, xf, glm::vec2(0.5f, 0.2f)));
 }
 
+// msm_light_tangent_bounds for every kind of light msm_light_cosine shades (rectangles, lines,
+// rectangles whose x axis is along their direction, discs, points), 400 random lights within 50°
+// of the frame's direction: every direction of the light (400 samples) lies in the rectangle of
+// tangents; and msm_tangent_rect_side's verdict holds for normals on both sides of the rectangle's
+// horizon boundary, 1e-4 rad away, and for random ones (above: the light's cosine is n·ℓ_k;
+// below: 0). Lights reaching behind the frame's direction have no bounds.
+TEST(AreaLights, TangentBoundsHoldEveryKindOfLight) {
+  const glm::vec3 l = glm::normalize(glm::vec3(0.2f, 0.9f, 0.1f));
+  const glm::vec3 x = glm::normalize(glm::cross(l, glm::vec3(0.0f, 0.0f, 1.0f))), y = glm::cross(l, x);
+  msm::util::SplitMix64 rng(3);
+  const auto uniform = [&](double lo, double hi) { return float(lo + (hi - lo) * rng.uniform()); };
+  const auto around = [&](glm::vec3 axis, float max_angle) { // a direction within max_angle of axis
+    const glm::vec3 u =
+        glm::normalize(glm::cross(axis, std::abs(axis.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0)));
+    const float theta = uniform(0.0, max_angle), phi = uniform(0.0, 2 * kPi);
+    return glm::normalize(std::cos(theta) * axis +
+                          std::sin(theta) * (std::cos(phi) * u + std::sin(phi) * glm::cross(axis, u)));
+  };
+  int decided = 0;
+  for (int i = 0; i < 400; ++i) {
+    const int kind = i % 5; // rectangle, line, x along ℓ_k, disc, point
+    const glm::vec3 lk = around(l, 0.87f);
+    glm::vec3 xk = glm::normalize(glm::vec3(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)));
+    glm::vec2 t(uniform(0.0, 0.5), uniform(0.0, 0.5));
+    float cone = 0.0f;
+    if (kind == 1) t.y = 0.0f;
+    if (kind == 2) xk = lk;
+    if (kind >= 3) t = glm::vec2(0.0f);
+    if (kind == 3) cone = uniform(0.01, 0.4);
+    const glm::vec2 bounds = msm::msm_light_tangent_bounds(l, x, y, lk, xk, t, cone);
+    ASSERT_GE(bounds.x, 0.0f) << i; // within 50° + 0.4 rad (+ a rectangle's corner) of ℓ: in front
+    // Directions of the light as msm_light_cosine integrates it.
+    const glm::vec3 px = glm::normalize(xk - lk * glm::dot(xk, lk)), py = glm::cross(lk, px);
+    const glm::vec2 widened = glm::max(t, glm::vec2(1e-4f));
+    for (int j = 0; j < 400; ++j) {
+      glm::vec3 d = lk;
+      if (kind == 0 || kind == 1) d = lk + uniform(-widened.x, widened.x) * px + uniform(-widened.y, widened.y) * py;
+      if (kind == 3) d = around(lk, cone);
+      const float ahead = glm::dot(d, l);
+      ASSERT_GT(ahead, 0.0f);
+      EXPECT_LE(std::abs(glm::dot(d, x)) / ahead, bounds.x * (1 + 1e-5f) + 1e-6f) << i << " kind " << kind;
+      EXPECT_LE(std::abs(glm::dot(d, y)) / ahead, bounds.y * (1 + 1e-5f) + 1e-6f) << i << " kind " << kind;
+    }
+    // Normals: at the boundary n·ℓ = A |n·x| + B |n·y| (tan θ = 1 / (A |cos φ| + B |sin φ|)), 1e-4 rad
+    // inside and outside of it, above and below; and random ones.
+    for (int j = 0; j < 200; ++j) {
+      glm::vec3 n;
+      if (j < 160) {
+        const float phi = uniform(0.0, 2 * kPi);
+        const float edge = std::atan(1.0f / (bounds.x * std::abs(std::cos(phi)) + bounds.y * std::abs(std::sin(phi))));
+        const float theta = (j % 4 < 2 ? edge : kPi - edge) + (j % 2 == 0 ? -1e-4f : 1e-4f);
+        n = std::cos(theta) * l + std::sin(theta) * (std::cos(phi) * x + std::sin(phi) * y);
+      } else {
+        n = around(l, kPi);
+      }
+      const int side = msm::msm_tangent_rect_side(n, l, x, y, bounds);
+      const float cosine = msm::msm_light_cosine(n, lk, xk, t, cone);
+      if (side > 0) {
+        EXPECT_NEAR(cosine, glm::dot(n, lk), 1e-6f) << i << " kind " << kind;
+      } else if (side < 0) {
+        EXPECT_LE(cosine, 1e-6f) << i << " kind " << kind;
+      }
+      decided += side != 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(decided, 400 * 200 / 4); // the test is about both verdicts
+  // Behind the frame's direction: no bounds, and no verdict.
+  const glm::vec2 none = msm::msm_light_tangent_bounds(l, x, y, glm::normalize(x + 0.1f * l), x, glm::vec2(0.3f), 0.0f);
+  EXPECT_LT(none.x, 0.0f);
+  EXPECT_EQ(msm::msm_tangent_rect_side(l, l, x, y, none), 0);
+  EXPECT_LT(msm::msm_light_tangent_bounds(l, x, y, l, x, glm::vec2(0.0f), 1.6f).x, 0.0f); // a disc past 90°
+}
+
 TEST(AreaLights, ConeCosineIsTheIntegralOverTheVisibleCone) {
   // ∫_cone max(n·ω, 0) dω / (π sin² α) by quadrature in double (θ, φ about the cone's axis).
   for (double alpha : {0.02, 0.3, 0.8, 1.3}) {

@@ -321,7 +321,8 @@ struct Renderer::Impl {
     std::size_t slots = frame_lights.size();
     for (const scene::DirectionalLight& l : frame_lights) slots += l.sub_lights.size() + (l.sub_lights.empty() ? 0 : 1);
     if (slots > kLightSlots)
-      throw RenderError(fmt::format("{} lights and sub-lights: the renderer holds {}", slots, kLightSlots));
+      throw RenderError(
+          fmt::format("{} lights, sub-lights and their summaries: the renderer holds {}", slots, kLightSlots));
     if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
       throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
                                     ctx.properties().limits.maxImageArrayLayers));

@@ -69,8 +69,9 @@ vec3 shadow_intensity_rgb(ShadowLookup s);
 #endif
 
 
-// Visibility of light l at the surface (0 where no part of the light is above the surface's
-// horizon, lit <= 0: its own shadow), per colour channel.
+// Visibility of light l at the surface, per colour channel: 0 where none of its light reaches the
+// surface (lit <= 0: its cosine factor, or with sub-lights their unshadowed irradiance's largest
+// channel; the surface's own shadow).
 vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixel) {
   current_layer = l;
   // Normal offset: more at grazing light, where depth varies fastest across a texel.
