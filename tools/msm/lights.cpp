@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <fmt/format.h>
@@ -25,6 +26,7 @@ struct LightsOptions {
   std::string probe;
   int size = 128;
   int count = 32;
+  int sub_lights = 0; // the finer cut whose lights each light's sub-lights are (0 or <= count: none)
   float rotation_deg = 0.0f;
   float intensity = 1.0f;
   bool json = false;
@@ -94,6 +96,8 @@ void run(const LightsOptions& o) {
   // Checked here, not by CLI11, so that a bad value is a failed command (exit 2) naming the range.
   if (o.count < 1 || o.count > 256)
     throw UsageError(fmt::format("--count {}: the median cut makes 1 to 256 lights", o.count));
+  if (o.sub_lights < 0 || o.sub_lights > 256)
+    throw UsageError(fmt::format("--sub-lights {}: expected 0 (none) to 256", o.sub_lights));
   if (o.size < 1 || o.size > probe::kMaxCubeSize)
     throw UsageError(
         fmt::format("--size {}: the cube map's faces are 1 to {} texels wide", o.size, probe::kMaxCubeSize));
@@ -109,6 +113,7 @@ void run(const LightsOptions& o) {
   }
   try {
     probe::check_cut(o.count, o.size, o.horizon_split); // --horizon-split: count >= 10, size even
+    if (probe::sub_lights_refine(o.count, o.sub_lights)) probe::check_cut(o.sub_lights, o.size, o.horizon_split);
   } catch (const probe::ProbeError& e) { throw UsageError(fmt::format("--horizon-split: {}", e.what())); }
   probe::CubeMap cube;
   try {
@@ -125,6 +130,18 @@ void run(const LightsOptions& o) {
   for (const probe::Region& r : regions)
     if (r.fixed_energy > 0) lit.push_back(r);
   const std::vector<MsmAreaLight> lights = probe::area_lights(tables, lit);
+  // Each light's sub-lights: the lights of the cut into --sub-lights regions inside its region, as
+  // a scene's "sub_lights" gives them to the renderer (the same cut, so the same lights in order).
+  std::vector<probe::ProbeLight> grouped;
+  if (probe::sub_lights_refine(o.count, o.sub_lights) && !lights.empty()) {
+    grouped = probe::lights_with_sub_lights(tables, o.count, o.sub_lights, o.horizon_split);
+    if (grouped.size() != lights.size())
+      throw std::logic_error(
+          fmt::format("msm lights: {} lights with sub-lights for {} lights", grouped.size(), lights.size()));
+    for (std::size_t k = 0; k < lights.size(); ++k)
+      if (grouped[k].light.direction != lights[k].direction)
+        throw std::logic_error(fmt::format("msm lights: light {} is not the light its sub-lights belong to", k));
+  }
   const glm::dvec3 total = probe::integrate(cube);
   nlohmann::ordered_json doc;
   doc["probe"] = o.probe;
@@ -133,6 +150,7 @@ void run(const LightsOptions& o) {
   doc["intensity"] = o.intensity;
   doc["horizon_split"] = o.horizon_split;
   doc["regions"] = regions.size();
+  doc["sub_lights"] = grouped.empty() ? 0 : o.sub_lights;
   doc["integral"] = {total.x, total.y, total.z};
   if (!o.json)
     fmt::print("probe {}: {}² texels per face, {} regions, {} lights{}; ∫L dω = ({:.4g}, {:.4g}, {:.4g})\n", o.probe,
@@ -175,6 +193,26 @@ void run(const LightsOptions& o) {
                      {"irradiance", vec(l.irradiance)},
                      {"facing_irradiance", vec(facing)},
                      {"region", region}});
+    if (!grouped.empty()) {
+      nlohmann::json subs = nlohmann::json::array();
+      for (const MsmAreaLight& sub : grouped[k].sub_lights)
+        subs.push_back({{"direction", vec(sub.direction)},
+                        {"x_axis", vec(sub.x_axis)},
+                        {"half_extent_deg",
+                         {glm::degrees(std::atan(sub.half_extent.x)), glm::degrees(std::atan(sub.half_extent.y))}},
+                        {"irradiance", vec(sub.irradiance)}});
+      table.back()["sub_lights"] = subs;
+    }
+  }
+  if (!o.json && !grouped.empty()) {
+    std::size_t fewest = grouped.front().sub_lights.size(), most = fewest, total_subs = 0;
+    for (const probe::ProbeLight& g : grouped) {
+      fewest = std::min(fewest, g.sub_lights.size());
+      most = std::max(most, g.sub_lights.size());
+      total_subs += g.sub_lights.size();
+    }
+    fmt::print("sub-lights: {} lights of the cut into {} regions, {} to {} per light (--json lists them)\n", total_subs,
+               o.sub_lights, fewest, most);
   }
   doc["lights"] = table;
   // Files first (each written whole under a temporary name, then renamed), then the JSON.
@@ -226,6 +264,9 @@ void add_lights(CLI::App& app) {
                   "Start the cut from the side faces halved at the horizon (10 regions: --count 10 to 256, even "
                   "--size), so that no light straddles the horizon");
     cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
+    cmd->add_option("--sub-lights", o->sub_lights,
+                    "Each light's sub-lights: the lights of the cut into this many regions inside its region, as a "
+                    "scene's \"sub_lights\" shades them (listed by --json; 0, or no more than --count: none)");
     cmd->callback([o] { run(*o); });
   }
   {
