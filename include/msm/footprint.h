@@ -33,8 +33,7 @@ MSM_FN MsmFootprint msm_surface_footprint(mat4 view_projection, vec2 viewport, v
   vec3 grad_x = (row_x * c.w - row_w * c.x) * (inv_w2 * 0.5f * viewport.x); // pixels per world unit
   vec3 grad_y = (row_y * c.w - row_w * c.y) * (inv_w2 * 0.5f * viewport.y);
   // A tangent frame of the plane (any: the result does not depend on it).
-  vec3 helper = abs(n.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f);
-  vec3 t = normalize(cross(n, helper));
+  vec3 t = msm_perpendicular(n);
   vec3 b = cross(n, t);
   float a00 = dot(grad_x, t), a01 = dot(grad_x, b), a10 = dot(grad_y, t), a11 = dot(grad_y, b);
   float det = a00 * a11 - a01 * a10;

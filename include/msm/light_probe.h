@@ -432,13 +432,15 @@ MSM_FN vec2 msm_light_tangent_bounds(vec3 l, vec3 x, vec3 y, vec3 light_l, vec3 
   vec2 t = vec2(0.0f);
   vec3 lx = light_x - light_l * dot(light_x, light_l);
   if (max(t_in.x, t_in.y) > 0.0f) {
-    if (length(lx) > 1e-6f) t = max(t_in, vec2(1e-4f));
+    if (length(lx) > 1e-6f) {
+      t = max(t_in, vec2(1e-4f));
+      lx = normalize(lx);
+    }
   } else if (cone_half_angle > 0.0f) {
     if (!(cone_half_angle < 0.5f * MSM_PI)) return vec2(-1.0f);
     t = vec2(tan(cone_half_angle));
-    lx = cross(light_l, abs(light_l.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f));
+    lx = msm_perpendicular(light_l);
   }
-  if (t.x > 0.0f) lx = normalize(lx);
   vec3 ly = cross(light_l, lx);
   vec2 bounds = vec2(0.0f);
   for (int i = 0; i < 4; ++i) {

@@ -116,6 +116,12 @@ MSM_FN float msm_fma(float a, float b, float c) {
 // undefined and GLM's returns it), so a degenerate texel shows as lit, never as garbage.
 MSM_FN float msm_saturate(float x) { return x > 0.0f ? min(x, 1.0f) : 0.0f; }
 
+// A unit vector orthogonal to the unit vector v: v crossed with the world axis x, or y where v is
+// within 26° of x (tangent frames whose orientation does not matter: footprint.h, light_probe.h).
+MSM_FN vec3 msm_perpendicular(vec3 v) {
+  return normalize(cross(v, abs(v.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f)));
+}
+
 MSM_END
 
 #endif // MSM_SHARED_H

@@ -577,8 +577,7 @@ SubLightsLinearPart sub_lights_linear_part(const DirectionalLight& light) {
   // The light frame's x axis as the shading takes it (msm_rect_light_cosine), else any.
   glm::vec3 x = light.x_axis.value_or(glm::vec3(0.0f));
   x -= l * glm::dot(x, l);
-  if (glm::length(x) <= 1e-6f) x = glm::cross(l, std::abs(l.x) < 0.9f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0));
-  part.x_axis = glm::normalize(x);
+  part.x_axis = glm::length(x) > 1e-6f ? glm::normalize(x) : msm::msm_perpendicular(l);
   part.y_axis = glm::cross(l, part.x_axis);
   part.bounds = glm::vec2(0.0f);
   for (const DirectionalLight& sub : light.sub_lights) {

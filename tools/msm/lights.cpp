@@ -8,7 +8,6 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
-#include <stdexcept>
 #include <string>
 
 #include <fmt/format.h>
@@ -120,28 +119,21 @@ void run(const LightsOptions& o) {
     cube = probe::load_probe(o.probe, o.size, o.rotation_deg, o.intensity);
   } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
   const probe::ProbeTables tables(cube);
-  std::vector<probe::Region> regions;
-  try {
-    regions = probe::median_cut(tables, o.count, o.horizon_split);
-  } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-  // The lights with their regions (area_lights skips regions without energy, Σ w Y = 0 in the
-  // tables: a black probe has none).
-  std::vector<probe::Region> lit;
-  for (const probe::Region& r : regions)
-    if (r.fixed_energy > 0) lit.push_back(r);
-  const std::vector<MsmAreaLight> lights = probe::area_lights(tables, lit);
-  // Each light's sub-lights: the lights of the cut into --sub-lights regions inside its region, as
-  // a scene's "sub_lights" gives them to the renderer (the same cut, so the same lights in order).
+  // The lights with their regions (cut_lights skips regions without energy, Σ w Y = 0 in the
+  // tables: a black probe has none), and each light's sub-lights: the lights of the cut into
+  // --sub-lights regions inside its region, as a scene's "sub_lights" gives them to the renderer.
+  probe::CutLights cut;
   std::vector<probe::ProbeLight> grouped;
-  if (probe::sub_lights_refine(o.count, o.sub_lights) && !lights.empty()) {
-    grouped = probe::lights_with_sub_lights(tables, o.count, o.sub_lights, o.horizon_split);
-    if (grouped.size() != lights.size())
-      throw std::logic_error(
-          fmt::format("msm lights: {} lights with sub-lights for {} lights", grouped.size(), lights.size()));
-    for (std::size_t k = 0; k < lights.size(); ++k)
-      if (grouped[k].light.direction != lights[k].direction)
-        throw std::logic_error(fmt::format("msm lights: light {} is not the light its sub-lights belong to", k));
-  }
+  try {
+    cut = probe::cut_lights(tables, o.count, o.horizon_split);
+    if (probe::sub_lights_refine(o.count, o.sub_lights))
+      grouped = probe::with_sub_lights(cut, probe::cut_lights(tables, o.sub_lights, o.horizon_split));
+  } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+  const std::vector<probe::Region>& regions = cut.regions;
+  const std::vector<MsmAreaLight>& lights = cut.lights;
+  std::vector<probe::Region> lit(lights.size());
+  for (std::size_t r = 0; r < regions.size(); ++r)
+    if (cut.light_of_region[r] >= 0) lit[std::size_t(cut.light_of_region[r])] = regions[r];
   const glm::dvec3 total = probe::integrate(cube);
   nlohmann::ordered_json doc;
   doc["probe"] = o.probe;
