@@ -207,10 +207,45 @@ MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float co
          abs(depth_per_texel.y) * (half_width.y + 0.5f);
 }
 
+// ---- The least depth bias for a planar receiver (the moment techniques) ----
+// msm_soft_depth_bias moves zf in front of the nearest texel of the receiver's own plane. A
+// moment technique needs less: the sharp lower bound of the shadow from 2n moments (Hamburger:
+// depths on the whole real line) is zero exactly while zf lies at or below the smallest node of
+// the n-point Gauss rule of the distribution's first 2n - 1 moments (the localizing matrix of
+// bias.h's receiver-plane bias is then positive semidefinite; the 2n-th moment is matched by mass
+// arbitrarily far behind zf). This is bias.h's argument for the filtered hard shadows, with the
+// filter region's exact distribution in place of a kernel's σ (JCGT §4.4 asks for an adaptive
+// bias, after Dou et al. 2014). Over a filter region of half-widths h the plane's depths are
+// zf + X, X = U(g.x h.x) + U(g.x / 2) + U(g.y h.y) + U(g.y / 2) (the region's offsets plus the
+// samples' offsets inside their texel; U(a) uniform on [-a, a]), symmetric about zf, so that node
+// is -x with
+//   two moments (Chebyshev, the 1-point rule: the mean):   x = 0,
+//   four moments (the 2-point rule ±sqrt(m2)):             x² = m2,
+//   six moments (the 3-point rule 0, ±sqrt(m4 / m2)):       x² = m4 / m2,
+// m_k the central moments of X: m2 = Σ a²/3, m4 = Σ a⁴/5 + 6 Σ_{i<j} a_i² a_j² / 9, i.e. from the
+// cumulants a²/3 and -2a⁴/15 of each uniform, which add: m4 = κ4 + 3 κ2² (κ4 < 0, so six
+// moments need at most bias.h's Gaussian limit √3 σ, and four exactly its σ). For one uniform that
+// is 0.577 (four) and 0.775 (six) of its half-range a; for a slope along both axes of a square
+// region of half-width 0.5 to 13 texels 0.29-0.39 (four) and 0.47-0.61 (six) of
+// msm_soft_depth_bias's worst case g.x (h.x + ½) + g.y (h.y + ½) (soft_test checks the bound at
+// this bias and below it). The constant bias still covers the moment bias and rounding.
+MSM_FN float msm_soft_plane_bias(vec2 half_width, vec2 depth_per_texel, int moments) {
+  vec4 a = abs(vec4(depth_per_texel.x * half_width.x, 0.5f * depth_per_texel.x, depth_per_texel.y * half_width.y,
+                    0.5f * depth_per_texel.y));
+  float range = a.x + a.y + a.z + a.w;
+  if (moments < 4 || !(range > 0.0f)) return 0.0f;
+  a /= range; // scale-free: the moments below stay near 1 whatever the slope
+  vec4 a2 = a * a;
+  float k2 = (a2.x + a2.y + a2.z + a2.w) / 3.0f;
+  if (moments < 6) return range * sqrt(k2);
+  float m4 = -2.0f / 15.0f * dot(a2, a2) + 3.0f * k2 * k2;
+  return range * sqrt(m4 / k2);
+}
+
 // ---- Shadow intensity from the filtered moments ----
 // q: the filter region's average Θ4* (Θ6*) moments (msm_sat_filter_average); zf_biased: the
-// fragment depth minus msm_soft_depth_bias. Hamburger lower bound (JCGT App. D.4), over-darkened by
-// 1 / (1 - ε_u) to match the umbra early-out.
+// fragment depth minus the constant bias and msm_soft_plane_bias. Hamburger lower bound (JCGT App.
+// D.4), over-darkened by 1 / (1 - ε_u) to match the umbra early-out.
 MSM_FN float msm_soft_shadow4(vec4 q, float zf_biased, float umbra_epsilon) {
   return msm_overdarken(msm_hamburger4_lower(msm_soft_moments4(q), zf_biased), 1.0f - umbra_epsilon);
 }

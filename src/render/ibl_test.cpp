@@ -3,9 +3,9 @@
 // (--probe-lights). The orderings of the paper that hold on the built-in probe scenes, asserted
 // with margins from the measurements of docs/results.md ("Image-based lighting against the ground
 // truth", scripts/ibl-compare.sh): on sky_probe, 32 soft-shadowed area lights are closer to the
-// full probe than 256 point lights with hard shadows (on city_probe they are not: not asserted
-// there); on both, MSSM6 is closer to the area lights than MSSM4 under large lights (16 lights,
-// cones of tens of degrees). The same for city_probe's objects under blender-data's interior.exr
+// full probe than 256 point lights with hard shadows (on city_probe with its plain cut they are
+// not: not asserted there; with the horizon split they are); on both, MSSM6 is closer to the area
+// lights than MSSM4 under large lights (16 lights, cones of tens of degrees). The same for city_probe's objects under blender-data's interior.exr
 // (both orderings) and courtyard.exr (MSSM6 against MSSM4 only; docs/results.md, "Image-based
 // lighting on three studio probes"). Tone-mapped images (the renderer's look), MAE of the
 // luminance, background masked.
@@ -62,9 +62,11 @@ double mae(const vk::Context& ctx, const scene::Scene& scene, const std::string&
 
 // The built-in scene `name` cut into `count` lights, under its own probe or under `probe` (a file
 // that replaces the scene's, as scripts/ibl-compare.sh's PROBE does).
-scene::Scene with_lights(const std::string& name, int count, const std::string& probe = "") {
+scene::Scene with_lights(const std::string& name, int count, const std::string& probe = "",
+                         bool horizon_split = false) {
   scene::Scene s = scene::builtin_scene(name);
   if (!probe.empty()) s.probe->file = probe;
+  s.probe->horizon_split = horizon_split;
   scene::set_probe_light_count(s, count);
   return s;
 }
@@ -77,7 +79,7 @@ const std::string kStudioLights = "/usr/share/blender/datafiles/studiolights/wor
 // 1e-6 (msm reference and msm compare, 160x90). The new probes' values are this test's own
 // measurements (256-sample truth): under interior.exr the first is 0.0008 here and 0.0004-0.0005
 // against 1024-sample truths of two seeds (scripts/ibl-compare.sh), a narrow ordering.
-// area_over_points 0: not asserted (on city_probe, under city.exr and courtyard.exr, the 256 point
+// area_over_points 0: not asserted (on city_probe's plain cut, under city.exr and courtyard.exr, the 256 point
 // lights are closer, docs/results.md; with the rectangles shaded as rectangles at the horizon they
 // still are). Re-measured here after that change (branch ibl-rect-horizon; before -> after, the
 // bounds kept): sky_probe 0.0042 -> 0.0042 and 0.0006 -> 0.0007, city_probe - and 0.0013 ->
@@ -86,36 +88,48 @@ const std::string kStudioLights = "/usr/share/blender/datafiles/studiolights/wor
 // before -> after, the bounds kept): sky_probe 0.0042 -> 0.0043 and 0.0007 -> 0.0007, city_probe -
 // and 0.0012 -> 0.0013, interior.exr 0.0006 -> 0.0005 and 0.0008 -> 0.0007, courtyard.exr - and
 // 0.0043 -> 0.0041.
+// And after the soft techniques took the least bias for the receiver's plane (msm_soft_plane_bias,
+// soft.h; before -> after, re-measured here, the values below): sky_probe 0.0043 -> 0.0048 and
+// 0.0007 -> 0.0003, city_probe - and 0.0013 -> 0.0010, interior.exr 0.0005 -> 0.0010 and 0.0006 ->
+// 0.0003, courtyard.exr - and 0.0042 -> 0.0011; city_probe with the horizon split (new) 0.0006 and
+// 0.0009. Every MAE fell; MSSM4's the most (its bound needs a bias of σ, MSSM6's sqrt(m4/m2)), so
+// the six-over-four margins narrowed: the ordering holds everywhere, by less.
 struct Expected {
   double area_over_points, six_over_four;
 };
 
 void check_orderings(const vk::Context& ctx, const std::string& name, const Expected& e,
-                     const std::string& probe_file = "") {
+                     const std::string& probe_file = "", bool horizon_split = false) {
   if (e.area_over_points > 0.0) {
     const Truth probe = truth(with_lights(name, 32, probe_file), false, 256);
-    const double area = mae(ctx, with_lights(name, 32, probe_file), "mssm6", probe);
-    const double points = mae(ctx, with_lights(name, 256, probe_file), "msm-hamburger-64", probe);
+    const double area = mae(ctx, with_lights(name, 32, probe_file, horizon_split), "mssm6", probe);
+    const double points = mae(ctx, with_lights(name, 256, probe_file, horizon_split), "msm-hamburger-64", probe);
     EXPECT_GT(points - area, 0.5 * e.area_over_points) << name << ": 32 area lights against 256 point lights";
   }
   if (e.six_over_four <= 0.0) return;
-  const scene::Scene sixteen = with_lights(name, 16, probe_file);
+  const scene::Scene sixteen = with_lights(name, 16, probe_file, horizon_split);
   const Truth lights = truth(sixteen, true, 64);
   const double six = mae(ctx, sixteen, "mssm6", lights), four = mae(ctx, sixteen, "mssm4", lights);
   EXPECT_GT(four - six, 0.5 * e.six_over_four) << name << ": MSSM6 against MSSM4 under 16 large lights";
 }
 
-TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0046, 0.0006}); }
-TEST_F(IblTest, CityProbeOrderings) { check_orderings(ctx(), "city_probe", {0.0, 0.0014}); }
+TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0048, 0.0003}); }
+TEST_F(IblTest, CityProbeOrderings) { check_orderings(ctx(), "city_probe", {0.0, 0.0010}); }
+// city_probe with the horizon split (docs/techniques.md): its 32 area lights beat the 256 point
+// lights since the soft techniques take the least bias for the receiver's plane (docs/results.md,
+// "The least bias for the receiver's plane"; before, they lost by 0.0008-0.0009).
+TEST_F(IblTest, CityProbeWithTheHorizonSplitOrderings) {
+  check_orderings(ctx(), "city_probe", {0.0006, 0.0009}, "", true);
+}
 // city_probe's objects under two more of blender-data's probes (docs/results.md, "Image-based
 // lighting on three studio probes"): interior.exr (a window-like light of 18% of the energy, 57°
 // high), where 32 area lights hold against 256 point lights; courtyard.exr (soft, no light above
 // 5% of the energy), where they do not (not asserted there).
 TEST_F(IblTest, InteriorProbeOrderings) {
-  check_orderings(ctx(), "city_probe", {0.0008, 0.0010}, kStudioLights + "interior.exr");
+  check_orderings(ctx(), "city_probe", {0.0010, 0.0003}, kStudioLights + "interior.exr");
 }
 TEST_F(IblTest, CourtyardProbeOrderings) {
-  check_orderings(ctx(), "city_probe", {0.0, 0.0046}, kStudioLights + "courtyard.exr");
+  check_orderings(ctx(), "city_probe", {0.0, 0.0011}, kStudioLights + "courtyard.exr");
 }
 
 // A wide PCSS kernel under many lights keeps the image's brightness. While the light count was a

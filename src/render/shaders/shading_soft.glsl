@@ -100,8 +100,9 @@ float shadow_intensity(ShadowLookup s) {
       t.s[4 * j + i] = table(f.x[i], f.y[j]);
       if (six) t1.s[4 * j + i] = table1(f.x[i], f.y[j]);
     }
-  // The receiver plane's slope in [-1,1] depth per texel.
-  float zb = zf - msm_soft_depth_bias(hp, 2.0f * s.depth_per_texel, frame.soft.z);
+  // The receiver plane's slope in [-1,1] depth per texel: the least bias that keeps its own plane
+  // out of the technique's bound (soft.h).
+  float zb = zf - frame.soft.z - msm_soft_plane_bias(hp, 2.0f * s.depth_per_texel, six ? 6 : (vssm ? 2 : 4));
   vec4 q = msm_sat_filter_average(t, f, scale);
   if (six) return msm_soft_shadow6(msm_sat_join6(q, msm_sat_filter_average(t1, f, scale)), zb, frame.soft.w);
   if (vssm) return msm_soft_vssm_shadow(vec2(q.x, q.y), zb, params.w, frame.soft.w);
