@@ -5,10 +5,10 @@
 // truth", scripts/ibl-compare.sh): on sky_probe, 32 soft-shadowed area lights are closer to the
 // full probe than 256 point lights with hard shadows (on city_probe with its plain cut they are
 // not: not asserted there; with the horizon split they are); on both, MSSM6 is closer to the area
-// lights than MSSM4 under large lights (16 lights, cones of tens of degrees). The same for city_probe's objects under blender-data's interior.exr
-// (both orderings) and courtyard.exr (MSSM6 against MSSM4 only; docs/results.md, "Image-based
-// lighting on three studio probes"). Tone-mapped images (the renderer's look), MAE of the
-// luminance, background masked.
+// lights than MSSM4 under large lights (16 lights, cones of tens of degrees). The same for
+// city_probe's objects under blender-data's interior.exr (both orderings) and courtyard.exr (MSSM6
+// against MSSM4 only; docs/results.md, "Image-based lighting on three studio probes"). Tone-mapped
+// images (the renderer's look), MAE of the luminance, background masked.
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
@@ -79,9 +79,9 @@ const std::string kStudioLights = "/usr/share/blender/datafiles/studiolights/wor
 // 1e-6 (msm reference and msm compare, 160x90). The new probes' values are this test's own
 // measurements (256-sample truth): under interior.exr the first is 0.0008 here and 0.0004-0.0005
 // against 1024-sample truths of two seeds (scripts/ibl-compare.sh), a narrow ordering.
-// area_over_points 0: not asserted (on city_probe's plain cut, under city.exr and courtyard.exr, the 256 point
-// lights are closer, docs/results.md; with the rectangles shaded as rectangles at the horizon they
-// still are). Re-measured here after that change (branch ibl-rect-horizon; before -> after, the
+// area_over_points 0: not asserted (on city_probe's plain cut, under city.exr and courtyard.exr,
+// the 256 point lights are closer, docs/results.md; with the rectangles shaded as rectangles at the
+// horizon they still are). Re-measured here after that change (branch ibl-rect-horizon; before -> after, the
 // bounds kept): sky_probe 0.0042 -> 0.0042 and 0.0006 -> 0.0007, city_probe - and 0.0013 ->
 // 0.0012, interior.exr 0.0010 -> 0.0006 and 0.0006 -> 0.0008, courtyard.exr - and 0.0042 -> 0.0043.
 // And after the lights' direction became the region's mean direction (msm_region_mean_direction;
