@@ -225,13 +225,17 @@ MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float co
 // m_k the central moments of X: m2 = Σ a²/3, m4 = Σ a⁴/5 + 6 Σ_{i<j} a_i² a_j² / 9, i.e. from the
 // cumulants a²/3 and -2a⁴/15 of each uniform, which add: m4 = κ4 + 3 κ2² (κ4 < 0, so six
 // moments need at most bias.h's Gaussian limit √3 σ, and four exactly its σ). For one uniform that
-// is 0.577 (four) and 0.775 (six) of its half-range a; for a slope along both axes of a square
-// region of half-width 0.5 to 13 texels 0.29-0.39 (four) and 0.47-0.61 (six) of
-// msm_soft_depth_bias's worst case g.x (h.x + ½) + g.y (h.y + ½) (soft_test checks the bound at
-// this bias and below it). The constant bias still covers the moment bias and rounding.
-MSM_FN float msm_soft_plane_bias(vec2 half_width, vec2 depth_per_texel, int moments) {
-  vec4 a = abs(vec4(depth_per_texel.x * half_width.x, 0.5f * depth_per_texel.x, depth_per_texel.y * half_width.y,
-                    0.5f * depth_per_texel.y));
+// is 0.577 (four) and 0.775 (six) of its half-range a; against msm_soft_depth_bias's worst case
+// g.x (h.x + ½) + g.y (h.y + ½), for half-widths of 0.5 to 13 texels, 0.29-0.39 (four) and
+// 0.47-0.61 (six) with equal slopes along both axes of a square region, 0.41-0.56 and 0.63-0.75
+// with the slope along one axis (soft_test checks the bound at this node and below it). The model
+// averages over where the fragment lies in its texel; msm_soft_plane_mean_shift adds the largest
+// shift of the region's mean that this hides. The constant bias still covers the moment bias and
+// rounding.
+// msm_soft_plane_spread_bias: that node, x.
+MSM_FN float msm_soft_plane_spread_bias(vec2 half_width, vec2 depth_per_texel, int moments) {
+  vec2 g = abs(depth_per_texel);
+  vec4 a = vec4(g.x * half_width.x, 0.5f * g.x, g.y * half_width.y, 0.5f * g.y);
   float range = a.x + a.y + a.z + a.w;
   if (moments < 4 || !(range > 0.0f)) return 0.0f;
   a /= range; // scale-free: the moments below stay near 1 whatever the slope
@@ -240,6 +244,18 @@ MSM_FN float msm_soft_plane_bias(vec2 half_width, vec2 depth_per_texel, int mome
   if (moments < 6) return range * sqrt(k2);
   float m4 = -2.0f / 15.0f * dot(a2, a2) + 3.0f * k2 * k2;
   return range * sqrt(m4 / k2);
+}
+// The texels' centres quantize the region's offsets, which moves its mean off zf by up to 1/(16 h)
+// texel per axis (the sawtooth floor(x) + ½ - x integrates to at most 1/8 over any window, here of
+// width 2h; 1/12 at h = 3/4).
+MSM_FN float msm_soft_plane_mean_shift(vec2 half_width, vec2 depth_per_texel) {
+  vec2 g = abs(depth_per_texel);
+  return g.x / (16.0f * max(half_width.x, 0.5f)) + g.y / (16.0f * max(half_width.y, 0.5f));
+}
+// The bias the shading takes (with the constant one): the node plus the mean's shift.
+MSM_FN float msm_soft_plane_bias(vec2 half_width, vec2 depth_per_texel, int moments) {
+  return msm_soft_plane_mean_shift(half_width, depth_per_texel) +
+         msm_soft_plane_spread_bias(half_width, depth_per_texel, moments);
 }
 
 // ---- Shadow intensity from the filtered moments ----
