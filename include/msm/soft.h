@@ -282,7 +282,7 @@ MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon) 
 //   SoftRegion region = msm_soft_region(uv * vec2(size), hp, size);
 //   SatFilter f = msm_sat_filter(region.lo, region.hi);
 //   SatSamples16 t; for j, i in 0..3: t.s[4 * j + i] = S(f.x[i], f.y[j]);
-//   float zb = zf - msm_soft_depth_bias(hp, receiver_gradient, constant_bias);
+//   float zb = zf - constant_bias - msm_soft_plane_bias(hp, receiver_gradient, 4); // 6: six moments
 //   return msm_soft_shadow4(msm_sat_filter_average(t, f, scale), zb, MSM_SOFT_UMBRA_EPSILON);
 
 MSM_END

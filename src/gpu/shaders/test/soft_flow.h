@@ -41,7 +41,7 @@ MSM_FN SoftFlow msm_test_soft_flow(vec4 region, vec4 fragment, ivec2 size, uint 
   SatSamples16 pt;
   for (int j = 0; j < 4; ++j)
     for (int i = 0; i < 4; ++i) pt.s[4 * j + i] = sat_fetch(pf.x[i], pf.y[j]);
-  float zb = zf - msm_soft_depth_bias(hp, vec2(fragment[3], 0.0f), 1.0e-4f);
+  float zb = zf - 1.0e-4f - msm_soft_plane_bias(hp, vec2(fragment[3], 0.0f), 4);
   float shadow = msm_soft_shadow4(msm_sat_filter_average(pt, pf, scale), zb, MSM_SOFT_UMBRA_EPSILON);
   return SoftFlow(rect_sum, filtered, vec4(shadow, blocker.depth, blocker.shadow, hp.x));
 }
