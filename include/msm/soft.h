@@ -201,7 +201,8 @@ MSM_FN bool msm_soft_in_umbra(BlockerResult blocker, float umbra_epsilon) {
 // JCGT's choice, proportional to the filter size and not adaptive, is a fixed g = the steepest
 // slope to tolerate (tan(angle of incidence) · w_t / w_d per texel; 80° needs 5.67 w_t / w_d);
 // passing the receiver plane's own gradient makes it adaptive (Dou et al. 2014). The blocker
-// search keeps the unbiased depth (blocker.h).
+// search keeps the unbiased depth (blocker.h). The moment techniques now take the smaller
+// msm_soft_plane_bias below; CSSM (cssm.h's series is not a bound) keeps this one.
 MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float constant_bias) {
   return constant_bias + abs(depth_per_texel.x) * (half_width.x + 0.5f) +
          abs(depth_per_texel.y) * (half_width.y + 0.5f);

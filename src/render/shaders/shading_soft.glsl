@@ -1,6 +1,6 @@
 // Soft shadows from integer summed-area tables (JCGT §4): blocker search with one query over a
 // grid-aligned region, average blocker depth, penumbra of the directional area light, umbra
-// early-out, nine-region filter (16 lookups per table), depth bias growing with the filter; the
+// early-out, nine-region filter (16 lookups per table), depth bias for the receiver's plane; the
 // per-pixel math is include/msm/soft.h (its recipe at the end), shared with the CPU. Three
 // techniques, one specialization each: mssm4 (Θ4*, one table), mssm6 (Θ6*, two tables, Kneiphof
 // §4.2) and vssm (two moments, naive variance soft shadows: the baseline), and the convolution soft
