@@ -343,14 +343,14 @@ TEST_F(SatBuilderTest, RejectsBadImages) {
 
 // The queries on the device: sat.h's 4-lookup rectangle sum (bitwise), the nine-region box filter
 // and soft.h's whole flow (search, Eq. (4), umbra early-out, penumbra, nine-region filter, depth
-// bias (msm_soft_plane_bias), Hamburger bound, over-darkening) against the same code (soft_flow.h) on the CPU, on a
-// scene of occluder rectangles at several depths over a receiver. Differences come from float
-// division (2.5 ulp on Vulkan), the device's contractions and sqrt; msm_fma is exact on both.
-// Measured (lavapipe, 20000 queries, 148 umbra early-outs): rect sums bitwise, filtered and blocker
-// depth bitwise too, shadow max 7.3e-7 (8.1e-7 with the worst-case depth bias before
-// msm_soft_plane_bias). Tolerances (for other devices): 1e-6 (filtered), 1e-3
-// (depth, shadow) with at most 0.2% of fragments beyond, for a branch taken differently at a
-// threshold (umbra, roots at zf).
+// bias (msm_soft_plane_bias), Hamburger bound, over-darkening) against the same code (soft_flow.h)
+// on the CPU, on a scene of occluder rectangles at several depths over a receiver. Differences
+// come from float division (2.5 ulp on Vulkan), the device's contractions and sqrt; msm_fma is
+// exact on both. Measured (lavapipe, 20000 queries, 148 umbra early-outs): rect sums bitwise,
+// filtered and blocker depth bitwise too, shadow max 7.3e-7 (8.1e-7 with the worst-case depth bias
+// before msm_soft_plane_bias). Tolerances (for other devices): 1e-6 (filtered), 1e-3 (depth,
+// shadow) with at most 0.2% of fragments beyond, for a branch taken differently at a threshold
+// (umbra, roots at zf).
 TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
   SatBuilder builder(ctx());
   std::mt19937_64 rng(33);
