@@ -552,32 +552,30 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
       if (i % 2) g.x = -g.x;
       vec2 h(0.5f + 12.5f * unit(rng), 0.5f + 12.5f * unit(rng));
       float zf = -0.3f + 0.6f * unit(rng);
-      double sum[6] = {0, 0, 0, 0, 0, 0};
+      // The raw moments (the renderer's path) and the moments of the offsets from zf in units of the
+      // bias (the node at -1: the exact bound is well conditioned in float there, unlike on the raw
+      // moments of a narrow range), from the same points.
+      const float bias = msm_soft_plane_spread_bias(h, g, moments);
+      double sum[6] = {0, 0, 0, 0, 0, 0}, unit_sum[6] = {0, 0, 0, 0, 0, 0};
       auto offset = [&](int k, double a) { return a * ((k + 0.5) / n * 2.0 - 1.0); };
       for (int a = 0; a < n; ++a)
         for (int b = 0; b < n; ++b)
           for (int c = 0; c < n; ++c)
             for (int d = 0; d < n; ++d) {
-              double z = zf + offset(a, g.x * h.x) + offset(b, 0.5 * g.x) + offset(c, g.y * h.y) + offset(d, 0.5 * g.y);
-              double p = 1.0;
-              for (double& s : sum) s += (p *= z);
+              const double x =
+                  offset(a, g.x * h.x) + offset(b, 0.5 * g.x) + offset(c, g.y * h.y) + offset(d, 0.5 * g.y);
+              double p = 1.0, u = 1.0;
+              for (int k = 0; k < 6; ++k) {
+                sum[k] += (p *= zf + x);
+                unit_sum[k] += (u *= x / bias);
+              }
             }
-      for (double& s : sum) s /= std::pow(double(n), 4);
+      for (int k = 0; k < 6; ++k) {
+        sum[k] /= std::pow(double(n), 4);
+        unit_sum[k] /= std::pow(double(n), 4);
+      }
       vec4 m4{float(sum[0]), float(sum[1]), float(sum[2]), float(sum[3])};
       Moments6 m6{vec3(float(sum[0]), float(sum[2]), float(sum[4])), vec3(float(sum[1]), float(sum[3]), float(sum[5]))};
-      // The exact bound on the plane's depths relative to zf in units of the bias (the node at -1):
-      // well conditioned in float, unlike the raw moments of a narrow range.
-      float bias = msm_soft_plane_spread_bias(h, g, moments);
-      double unit_sum[6] = {0, 0, 0, 0, 0, 0};
-      for (int a = 0; a < n; ++a)
-        for (int b = 0; b < n; ++b)
-          for (int c = 0; c < n; ++c)
-            for (int d = 0; d < n; ++d) {
-              double x =
-                  (offset(a, g.x * h.x) + offset(b, 0.5 * g.x) + offset(c, g.y * h.y) + offset(d, 0.5 * g.y)) / bias;
-              double p = 1.0;
-              for (double& s : unit_sum) s += (p *= x) / std::pow(double(n), 4);
-            }
       vec4 u4{float(unit_sum[0]), float(unit_sum[1]), float(unit_sum[2]), float(unit_sum[3])};
       Moments6 u6{vec3(float(unit_sum[0]), float(unit_sum[2]), float(unit_sum[4])),
                   vec3(float(unit_sum[1]), float(unit_sum[3]), float(unit_sum[5]))};

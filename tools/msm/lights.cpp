@@ -71,6 +71,11 @@ image::Image cross_picture(const probe::CubeMap& cube, const std::vector<probe::
   return out;
 }
 
+// A light's half extents in degrees (its tangents' angles) along its x and y axes.
+glm::vec2 half_extent_deg(const MsmAreaLight& l) {
+  return glm::degrees(glm::vec2(std::atan(l.half_extent.x), std::atan(l.half_extent.y)));
+}
+
 // Σ of the texels' solid angles (msm_cube_texel_weight) over a region.
 double solid_angle(const probe::Region& region, int size) {
   double sum = 0.0;
@@ -154,7 +159,7 @@ void run(const LightsOptions& o) {
   nlohmann::json list = nlohmann::json::array(), table = nlohmann::json::array();
   for (std::size_t k = 0; k < lights.size(); ++k) {
     const MsmAreaLight& l = lights[k];
-    const glm::vec2 half_deg(glm::degrees(std::atan(l.half_extent.x)), glm::degrees(std::atan(l.half_extent.y)));
+    const glm::vec2 half_deg = half_extent_deg(l);
     const double omega = solid_angle(lit[k], cube.size);
     if (!o.json)
       fmt::print("{:>3}  ({:>6.3f}, {:>6.3f}, {:>6.3f})  {:>6.2f} x {:>6.2f}  {:>7.4f}  {:>8.3f}  ({:>8.4g}, {:>8.4g}, "
@@ -190,8 +195,7 @@ void run(const LightsOptions& o) {
       for (const MsmAreaLight& sub : grouped[k].sub_lights)
         subs.push_back({{"direction", vec(sub.direction)},
                         {"x_axis", vec(sub.x_axis)},
-                        {"half_extent_deg",
-                         {glm::degrees(std::atan(sub.half_extent.x)), glm::degrees(std::atan(sub.half_extent.y))}},
+                        {"half_extent_deg", {half_extent_deg(sub).x, half_extent_deg(sub).y}},
                         {"irradiance", vec(sub.irradiance)}});
       table.back()["sub_lights"] = subs;
     }
