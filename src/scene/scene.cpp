@@ -411,6 +411,26 @@ class Parser {
     return t;
   }
 
+  Motion motion(const json& j, const std::string& ptr) const {
+    if (!j.is_object()) fail(ptr, "must be an object with \"translate\" and/or \"rotate\" (per frame)");
+    keys(j, ptr, {"translate", "rotate"});
+    Motion m;
+    if (const json* v = find(j, "translate")) {
+      m.translate = vec<3>(*v, ptr + "/translate");
+      if (glm::any(glm::greaterThan(glm::abs(m.translate), glm::vec3(kMaxMotionPerFrame))))
+        fail(ptr + "/translate", fmt::format("absurd motion (|component| > {:g} per frame)", kMaxMotionPerFrame));
+    }
+    if (const json* v = find(j, "rotate")) {
+      if (!v->is_object()) fail(ptr + "/rotate", "must be {\"axis\": [x,y,z], \"angle_deg\": a} (per frame)");
+      keys(*v, ptr + "/rotate", {"axis", "angle_deg"});
+      if (!find(*v, "axis") || !find(*v, "angle_deg"))
+        fail(ptr + "/rotate", "axis-angle needs \"axis\" and \"angle_deg\"");
+      m.axis = direction(*find(*v, "axis"), ptr + "/rotate/axis");
+      m.angle_deg = number_in(*find(*v, "angle_deg"), ptr + "/rotate/angle_deg", -360.0f, 360.0f, false, false);
+    }
+    return m;
+  }
+
   Mesh primitive(const json& j, const std::string& ptr, std::string& type) const {
     if (!j.is_object()) fail(ptr, "must be an object with a \"type\"");
     const json* tj = find(j, "type");
@@ -485,13 +505,14 @@ class Parser {
     if (j.is_object())
       if (const json* v = find(j, "name")) name = string(*v, ptr + "/name");
     try {
-      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material"});
+      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material", "motion"});
       const json* mesh = find(j, "mesh");
       const json* prim = find(j, "primitive");
       if (!mesh == !prim) fail(ptr, "needs exactly one of \"mesh\" (a file) and \"primitive\"");
       Object o;
       o.name = name;
       if (const json* v = find(j, "transform")) o.transform = transform(*v, ptr + "/transform");
+      if (const json* v = find(j, "motion")) o.motion = motion(*v, ptr + "/motion");
       const json* material_json = find(j, "material");
       if (material_json) {
         if (material_json->is_string()) {
@@ -630,6 +651,29 @@ Bounds Scene::bounds() const {
   Bounds b;
   for (const Object& o : objects) b.extend(o.bounds);
   return b;
+}
+
+bool Scene::animated() const {
+  return std::ranges::any_of(objects, [](const Object& o) { return o.motion.has_value(); });
+}
+
+Scene at_frame(const Scene& scene, int frame) {
+  if (frame < 0) throw SceneError(scene.source.string(), "", fmt::format("frame {}: must be >= 0", frame));
+  Scene out = scene;
+  for (Object& o : out.objects) {
+    if (!o.motion || frame == 0) continue;
+    // In double: frame × angle stays exact to far more frames than the CLI allows.
+    const double angle = glm::radians(double(frame) * double(o.motion->angle_deg));
+    const glm::mat3 turn(glm::rotate(glm::dmat4(1.0), angle, glm::dvec3(o.motion->axis)));
+    const glm::vec3 origin = o.transform.translate;
+    const glm::vec3 moved = origin + float(frame) * o.motion->translate;
+    for (glm::vec3& p : o.mesh.positions) p = moved + turn * (p - origin);
+    for (glm::vec3& n : o.mesh.normals) n = glm::normalize(turn * n);
+    o.transform.translate = moved;
+    o.transform.rotate = turn * o.transform.rotate;
+    o.bounds = o.mesh.bounds();
+  }
+  return out;
 }
 
 std::size_t Scene::triangle_count() const {

@@ -1169,3 +1169,57 @@ TEST(Lights, BadSecondExtentOrAxisNamesItsPointer) {
                         box + "]}",
                     {"/lights/1/angular_height_deg"});
 }
+
+// ---- Animated objects (issue 15's dynamic scenes) ----
+
+// A box 2 wide turning 30° a frame about +Y through its origin (1, 0, 0) and moving 0.5 a frame
+// along +Z: at frame 3 it has turned 90° (2 deep, 1 wide) about (1, 0, 1.5), by hand; the same
+// vertices as a box placed there by its transform, the normals too; the still object and frame 0
+// are the scene itself.
+TEST(Motion, AtFrameTurnsAboutTheOriginThenMoves) {
+  const std::string still = R"({"name": "still", "primitive": {"type": "sphere", "radius": 0.5}})";
+  const Scene s = load_scene_json(scene_with_object(R"({"name": "b", "primitive": {"type": "box", "size": [2, 1, 1]},
+          "transform": {"translate": [1, 0, 0]},
+          "motion": {"translate": [0, 0, 0.5], "rotate": {"axis": [0, 1, 0], "angle_deg": 30}}}, )" +
+                                                    still),
+                                  ".", "t.json");
+  ASSERT_TRUE(s.animated());
+  const Scene moved = at_frame(s, 3);
+  const Bounds b = moved.objects[0].bounds;
+  EXPECT_NEAR(b.min.x, 0.5f, 1e-5f);
+  EXPECT_NEAR(b.max.x, 1.5f, 1e-5f);
+  EXPECT_NEAR(b.min.z, 0.5f, 1e-5f);
+  EXPECT_NEAR(b.max.z, 2.5f, 1e-5f);
+  EXPECT_NEAR(b.min.y, -0.5f, 1e-5f);
+  const Scene placed = load_scene_json(scene_with_object(R"({"primitive": {"type": "box", "size": [2, 1, 1]},
+                            "transform": {"translate": [1, 0, 1.5], "rotate": [0, 90, 0]}})"),
+                                       ".", "t.json");
+  const Mesh &m = moved.objects[0].mesh, &p = placed.objects[0].mesh;
+  ASSERT_EQ(m.positions.size(), p.positions.size());
+  for (std::size_t v = 0; v < m.positions.size(); ++v) {
+    EXPECT_LT(glm::distance(m.positions[v], p.positions[v]), 1e-5f) << v;
+    EXPECT_GT(glm::dot(m.normals[v], p.normals[v]), 0.99999f) << v;
+  }
+  expect_consistent(m);
+  EXPECT_LT(glm::distance(moved.objects[0].transform.translate, glm::vec3(1, 0, 1.5f)), 1e-6f);
+  EXPECT_EQ(moved.objects[1].mesh.positions, s.objects[1].mesh.positions);
+  EXPECT_EQ(at_frame(s, 0).objects[0].mesh.positions, s.objects[0].mesh.positions);
+  EXPECT_FALSE(load_scene_json(scene_with_object(still), ".", "t.json").animated());
+  expect_error([&] { (void)at_frame(s, -1); }, {"frame -1", ">= 0"});
+}
+
+TEST(Motion, BadValuesNameTheirPointer) {
+  const auto with = [](const std::string& motion) {
+    return scene_with_object(R"({"name": "b", "primitive": {"type": "box"}, "motion": )" + motion + "}");
+  };
+  expect_json_error(with("1"), {"/objects/0/motion", "must be an object"});
+  expect_json_error(with(R"({"spin": 1})"), {"/objects/0/motion/spin", "unknown key"});
+  expect_json_error(with(R"({"translate": [0, 2000, 0]})"), {"/objects/0/motion/translate", "per frame"});
+  expect_json_error(with(R"({"translate": [0, 1]})"), {"/objects/0/motion/translate", "3 numbers"});
+  expect_json_error(with(R"({"rotate": [0, 10, 0]})"), {"/objects/0/motion/rotate", "axis"});
+  expect_json_error(with(R"({"rotate": {"axis": [0, 1, 0]}})"), {"/objects/0/motion/rotate", "angle_deg"});
+  expect_json_error(with(R"({"rotate": {"axis": [0, 0, 0], "angle_deg": 5}})"),
+                    {"/objects/0/motion/rotate/axis", "non-zero"});
+  expect_json_error(with(R"({"rotate": {"axis": [0, 1, 0], "angle_deg": 400}})"),
+                    {"/objects/0/motion/rotate/angle_deg", "[-360, 360]"});
+}

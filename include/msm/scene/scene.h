@@ -96,6 +96,13 @@
 //     "scale": s | [sx,sy,sz]              > 0 (no mirroring)
 //   },                                     world = translate * rotate * scale * local
 //   "material": <material> | "name"        default: the default material
+//   "motion": {                            an animated object (`msm render --frames`, `msm reference
+//                                          --frame`; at_frame): per frame, a turn about an axis
+//                                          through the object's origin (its "translate"), then a move
+//     "translate": [x,y,z],                scene units per frame (default [0,0,0]; |component| <= 1e3:
+//                                          kMaxMotionPerFrame)
+//     "rotate": {"axis": [x,y,z], "angle_deg": a}   degrees per frame, |a| <= 360 (default none)
+//   }
 // }
 //
 // Primitives (local frames; sizes > 0 and <= 1e6; segment counts capped, see kMax* below):
@@ -158,7 +165,10 @@ namespace msm::scene {
 inline constexpr int kMaxSegments = 4096; // any one segment/ring/step/bar count
 inline constexpr std::size_t kMaxPrimitiveTriangles = 4'000'000;
 inline constexpr float kMaxSize = 1e6f; // any primitive dimension / |translate|
-inline constexpr int kMaxLights = 256;  // render/frame.h MSM_MAX_LIGHTS: the layers of a shadow-map array
+// |component| of a motion's translation per frame: with `msm render`'s 10000 frames at most,
+// objects stay within kMaxSize × 10 of the scene.
+inline constexpr float kMaxMotionPerFrame = 1e3f;
+inline constexpr int kMaxLights = 256; // render/frame.h MSM_MAX_LIGHTS: the layers of a shadow-map array
 // Camera depth range: near in [kMinCameraNear, kMaxSize], far <= kMaxCameraFar and far / near <=
 // kMaxCameraDepthRatio (beyond, the float depth buffer cannot tell surfaces apart).
 inline constexpr float kMinCameraNear = 1e-6f;
@@ -268,14 +278,23 @@ struct Transform {
   glm::mat4 matrix() const; // translate * rotate * scale
 };
 
+// An object's motion over a frame sequence, per frame: a turn of angle_deg about `axis` through
+// the object's origin (its transform's translate), then a move by `translate` (at_frame).
+struct Motion {
+  glm::vec3 translate{0.0f};
+  glm::vec3 axis{0.0f, 1.0f, 0.0f}; // unit
+  float angle_deg = 0.0f;
+};
+
 struct Object {
   std::string name;
   std::filesystem::path mesh_file; // empty for primitives
   std::string primitive;           // primitive type, empty for meshes
   Transform transform;
-  std::uint32_t material = 0; // index into Scene::materials
-  Mesh mesh;                  // world space
-  Bounds bounds;              // world space
+  std::optional<Motion> motion; // the JSON's "motion": an animated object
+  std::uint32_t material = 0;   // index into Scene::materials
+  Mesh mesh;                    // world space
+  Bounds bounds;                // world space
 };
 
 struct Camera {
@@ -401,6 +420,8 @@ struct Scene {
   std::optional<ProbeLighting> probe; // the JSON's "probe"; its lights follow the directional ones
 
   const DirectionalLight& light() const { return lights.front(); }
+  // Some object has a "motion": its frames differ (at_frame).
+  bool animated() const;
 
   Bounds bounds() const;
   std::size_t triangle_count() const;
@@ -483,6 +504,13 @@ Scene load_scene(std::string_view name_or_path);
 // range or beyond kMaxLights with the other lights. sub_lights, where given, replaces the probe's
 // "sub_lights" (`msm render --sub-lights`; 0..256, at least 10 with the horizon split).
 void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_lights = std::nullopt);
+
+// The scene at frame `frame` (>= 0) of its animation: every object with a motion turned by frame ×
+// its angle about its axis through its origin, then moved by frame × its translation (vertices,
+// normals, bounds and transform); frame 0 is the scene itself. What the renderer draws
+// (Renderer::move_objects) and the ray tracer traces at that frame. The probe's lights are kept
+// (its per-frame rotation is the renderer's, `msm render --probe-rotation-speed`).
+Scene at_frame(const Scene& scene, int frame);
 
 // Mesh import through Assimp: node transforms applied (instances repeated), triangulated, texture
 // coordinates flipped to v down where the format has v up, KHR_texture_transform baked into them,
