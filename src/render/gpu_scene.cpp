@@ -26,26 +26,25 @@ vk::Image upload_r8(const vk::Context& ctx, int width, int height, std::span<con
   return image;
 }
 
-} // namespace
+// The vertices and indices of every object in scene order; a translucent object's triangles far
+// to near along the light's travel. first_index: each object's first index.
+struct Geometry {
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices, first_index;
+};
 
-GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
-  std::vector<Vertex> vertex_data;
-  std::vector<uint32_t> index_data;
-  std::map<std::filesystem::path, int> texture_index;
-  glm::vec3 travel = scene.light().travel();
-  std::vector<std::pair<float, Draw>> translucent_by_depth;
+Geometry geometry(const scene::Scene& scene) {
+  Geometry g;
+  const glm::vec3 travel = scene.light().travel();
   for (const scene::Object& object : scene.objects) {
     const scene::Mesh& mesh = object.mesh;
-    const scene::Material& material = scene.materials.at(object.material);
-    bool is_translucent = material.translucent();
-    uint32_t base = uint32_t(vertex_data.size());
+    const uint32_t base = uint32_t(g.vertices.size());
     for (std::size_t i = 0; i < mesh.positions.size(); ++i)
-      vertex_data.push_back({mesh.positions[i], mesh.normals[i], i < mesh.uvs.size() ? mesh.uvs[i] : glm::vec2(0.0f)});
-    Draw draw;
-    draw.first_index = uint32_t(index_data.size());
+      g.vertices.push_back({mesh.positions[i], mesh.normals[i], i < mesh.uvs.size() ? mesh.uvs[i] : glm::vec2(0.0f)});
+    g.first_index.push_back(uint32_t(g.indices.size()));
     std::vector<uint32_t> triangles(mesh.triangle_count());
     for (uint32_t t = 0; t < triangles.size(); ++t) triangles[t] = t;
-    if (is_translucent) { // far to near along the light
+    if (scene.materials.at(object.material).translucent()) {
       auto depth = [&](uint32_t t) {
         const uint32_t* i = &mesh.indices[3 * t];
         return glm::dot(mesh.positions[i[0]] + mesh.positions[i[1]] + mesh.positions[i[2]], travel);
@@ -53,8 +52,30 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
       std::stable_sort(triangles.begin(), triangles.end(), [&](uint32_t a, uint32_t b) { return depth(a) > depth(b); });
     }
     for (uint32_t t : triangles)
-      for (int k = 0; k < 3; ++k) index_data.push_back(base + mesh.indices[3 * t + uint32_t(k)]);
-    draw.index_count = uint32_t(mesh.indices.size());
+      for (int k = 0; k < 3; ++k) g.indices.push_back(base + mesh.indices[3 * t + uint32_t(k)]);
+  }
+  return g;
+}
+
+// The translucent draws far to near along the light (their centres'), as blended (JCGT §3).
+void sort_translucent(std::vector<Draw>& translucent, glm::vec3 travel) {
+  std::stable_sort(translucent.begin(), translucent.end(), [&](const Draw& a, const Draw& b) {
+    return glm::dot(a.center, travel) > glm::dot(b.center, travel);
+  });
+}
+
+} // namespace
+
+GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
+  const Geometry g = geometry(scene);
+  std::map<std::filesystem::path, int> texture_index;
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const scene::Object& object = scene.objects[o];
+    const scene::Material& material = scene.materials.at(object.material);
+    Draw draw;
+    draw.object = uint32_t(o);
+    draw.first_index = g.first_index[o];
+    draw.index_count = uint32_t(object.mesh.indices.size());
     draw.center = object.bounds.center();
     if (!material.albedo_texture.empty()) { // a file, or "<mesh file>#<index>" for embedded ones
       auto [it, inserted] = texture_index.try_emplace(material.albedo_texture, int(textures.size()));
@@ -78,23 +99,29 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
     draw.masked = material.masked();
     draw.push.transmission = glm::vec4(material.transmission_color, material.alpha_cutoff.value_or(0.0f));
     if (!draw.index_count) continue;
-    if (is_translucent)
-      translucent_by_depth.emplace_back(glm::dot(draw.center, travel), draw);
-    else
-      draws.push_back(draw);
+    (material.translucent() ? translucent : draws).push_back(draw);
   }
-  std::stable_sort(translucent_by_depth.begin(), translucent_by_depth.end(),
-                   [](const auto& a, const auto& b) { return a.first > b.first; });
-  for (const auto& [depth, draw] : translucent_by_depth) translucent.push_back(draw);
-  vertices = vk::create_buffer(ctx, vertex_data.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  vk::upload_buffer(ctx, vertices, std::as_bytes(std::span(vertex_data)));
-  indices = vk::create_buffer(ctx, index_data.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-  vk::upload_buffer(ctx, indices, std::as_bytes(std::span(index_data)));
+  sort_translucent(translucent, scene.light().travel());
+  vertices = vk::create_buffer(ctx, g.vertices.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vk::upload_buffer(ctx, vertices, std::as_bytes(std::span(g.vertices)));
+  indices = vk::create_buffer(ctx, g.indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  vk::upload_buffer(ctx, indices, std::as_bytes(std::span(g.indices)));
   const std::uint8_t white_texel[4] = {255, 255, 255, 255};
   white = upload_rgba8(ctx, 1, 1, white_texel);
   white_array = vk::create_image_view(ctx, white.handle(), white.format(), VK_IMAGE_ASPECT_COLOR_BIT,
                                       VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, 1, 0, 1);
   texture_sampler = vk::create_sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
+}
+
+void GpuScene::move_objects(const vk::Context& ctx, const scene::Scene& scene) {
+  const Geometry g = geometry(scene);
+  if (g.vertices.size() * sizeof(Vertex) != vertices.size() || g.indices.size() * sizeof(uint32_t) != indices.size())
+    throw RenderError("move_objects: the scene's objects differ from the renderer's (other meshes, not moved ones)");
+  vk::upload_buffer(ctx, vertices, std::as_bytes(std::span(g.vertices)));
+  vk::upload_buffer(ctx, indices, std::as_bytes(std::span(g.indices)));
+  for (std::vector<Draw>* list : {&draws, &translucent})
+    for (Draw& d : *list) d.center = scene.objects.at(d.object).bounds.center();
+  sort_translucent(translucent, scene.light().travel());
 }
 
 } // namespace msm::render

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "msm/render/frame.h"
+#include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
 #include "msm/vk/vk.h"
 
@@ -19,6 +20,7 @@ struct Vertex {
 static_assert(sizeof(Vertex) == 32, "the pipelines' vertex stride and attribute offsets assume this layout");
 
 struct Draw {
+  uint32_t object = 0; // into scene::Scene::objects
   uint32_t first_index = 0, index_count = 0;
   int texture = -1;         // into GpuScene::textures, -1: none (the white texture is bound)
   int opacity_texture = -1; // into GpuScene::opacity_textures, -1: none
@@ -42,6 +44,10 @@ struct GpuScene {
   vk::Sampler texture_sampler;             // linear, repeat
 
   GpuScene(const vk::Context& ctx, const scene::Scene& scene);
+  // The vertices of `scene`, whose objects are this scene's moved (scene::at_frame: the same meshes
+  // and materials), uploaded into the same buffers; the translucent triangles and draws sorted
+  // again along the light. RenderError where the vertex or index counts differ. Between frames.
+  void move_objects(const vk::Context& ctx, const scene::Scene& scene);
 };
 
 } // namespace msm::render

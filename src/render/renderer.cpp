@@ -620,6 +620,21 @@ void Renderer::set_camera(const scene::Camera& camera) {
   impl_->frames.clear(); // the fitted light frusta depend on the camera
 }
 
+void Renderer::move_objects(const scene::Scene& scene) {
+  Impl& m = *impl_;
+  if (scene.objects.size() != m.scene.objects.size())
+    throw RenderError(fmt::format("move_objects: {} objects, the renderer's scene has {}", scene.objects.size(),
+                                  m.scene.objects.size()));
+  m.gpu.move_objects(m.ctx, scene);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    scene::Object& mine = m.scene.objects[o];
+    mine.mesh = scene.objects[o].mesh;
+    mine.bounds = scene.objects[o].bounds;
+    mine.transform = scene.objects[o].transform;
+  }
+  m.frames.clear(); // the fitted light frusta depend on the vertices
+}
+
 std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {
   if (frames < 1) throw RenderError("time_frames: at least one frame");
   Impl& m = *impl_;

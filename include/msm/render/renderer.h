@@ -253,6 +253,13 @@ class Renderer {
   // Moves the camera of later frames (the shadow maps' "fit" framing follows it).
   void set_camera(const scene::Camera& camera);
 
+  // Draws later frames with the objects of `scene`: the renderer's scene with its objects moved
+  // (scene::at_frame; animated objects, `msm render --frames`). The vertex and index buffers are
+  // uploaded again (nothing is allocated), translucent objects sorted again along the light, the
+  // shadow maps' fitted frusta follow; camera and lights stay the renderer's. RenderError where
+  // the objects' meshes differ in size from the renderer's scene.
+  void move_objects(const scene::Scene& scene);
+
   // `frames` frames with the same settings, nothing read back: the per-pass times of each (for
   // msm bench). Precondition: frames >= 1.
   std::vector<std::vector<PassTime>> time_frames(const RenderSettings& settings, int frames);
