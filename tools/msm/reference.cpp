@@ -83,6 +83,8 @@ void add_reference(CLI::App& app) {
     std::optional<double> light_extent, light_width, light_height;
     std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
     std::optional<int> sub_lights; // and their sub-lights
+    int frame = 0;                 // of a dynamic scene (msm render --frames)
+    float probe_rotation_speed = 0.0f;
     bool json = false, progress = false, probe_lights = false;
   };
   auto opt = std::make_shared<Options>();
@@ -113,13 +115,19 @@ void add_reference(CLI::App& app) {
                   "default: the scene's); --probe-lights traces them");
   cmd->add_flag("--probe-lights", opt->probe_lights,
                 "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
+  cmd->add_option("--frame", opt->frame,
+                  "Trace frame K of a dynamic scene, as msm render --frames draws it: its animated objects moved K "
+                  "times (an object's \"motion\"), its probe turned K times --probe-rotation-speed")
+      ->check(CLI::Range(0, 9999));
+  cmd->add_option("--probe-rotation-speed", opt->probe_rotation_speed,
+                  "Degrees the scene's light probe turns about +Y per frame (with --frame)");
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
   cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
   cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
   cmd->add_flag("--progress", opt->progress,
                 "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth of the "
                 "rows once the run has taken 2 s)");
-  cmd->callback([opt] {
+  cmd->callback([opt, cmd] {
     const auto start = std::chrono::steady_clock::now();
     Settings settings;
     const auto effect = msm::reference::parse_effect(opt->effect);
@@ -154,7 +162,22 @@ void add_reference(CLI::App& app) {
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
     msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
-    if (opt->lights || opt->sub_lights) try {
+    if (opt->probe_rotation_speed != 0.0f) {
+      if (!scene.probe)
+        throw UsageError(
+            fmt::format("--probe-rotation-speed: scene '{}' has no light probe (its \"probe\" key)", scene.name));
+      if (cmd->count("--frame") == 0) throw UsageError("--probe-rotation-speed turns the probe per --frame: give one");
+      // The probe's lights are cut again at the turned probe (below), as msm render's device does.
+      scene.probe->rotation_deg += float(opt->frame) * opt->probe_rotation_speed;
+    }
+    if (opt->frame > 0) {
+      if (!scene.animated() && opt->probe_rotation_speed == 0.0f)
+        throw UsageError(fmt::format("--frame {}: scene '{}' is the same at every frame (no object has a "
+                                     "\"motion\", no --probe-rotation-speed)",
+                                     opt->frame, scene.name));
+      scene = msm::scene::at_frame(scene, opt->frame);
+    }
+    if (opt->lights || opt->sub_lights || opt->probe_rotation_speed != 0.0f) try {
         msm::scene::set_probe_light_count(scene, opt->lights.value_or(scene.probe ? scene.probe->lights : 1),
                                           opt->sub_lights);
       } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
@@ -226,6 +249,7 @@ void add_reference(CLI::App& app) {
     nlohmann::ordered_json j;
     j["scene"] = {{"name", scene.name}, {"source", scene.source.string()}, {"triangles", scene.triangle_count()}};
     j["effect"] = std::string(msm::reference::to_string(settings.effect));
+    j["frame"] = opt->frame;
     j["width"] = settings.width;
     j["height"] = settings.height;
     j["samples"] = result.samples;

@@ -1,5 +1,5 @@
 // `msm render`: one or more techniques on one scene; `msm scenes`: the built-in scenes.
-#include "probe_frames.h"
+#include "frames.h"
 #include "render_common.h"
 
 #include "msm/viewer/view_file.h"
@@ -33,7 +33,7 @@ void add_render(CLI::App& app) {
     std::string techniques = "msm-hamburger-64";
     std::string out = "msm-render";
     std::string view; // a view file (msm view)
-    ProbeFrames probe_frames;
+    Frames frames;
     std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
     std::optional<int> sub_lights; // and their sub-lights
   };
@@ -48,11 +48,12 @@ void add_render(CLI::App& app) {
                   "A view file of msm view (scene, camera, lights, every setting): renders exactly that view; only "
                   "-t, -o and --device go with it");
   add_frame_options(cmd, opt->frame);
-  cmd->add_option("--frames", opt->probe_frames.frames,
-                  "Frames to render of a scene with a light probe: each frame splits the (turned) probe into its "
-                  "area lights again on the device and reports the timings (probe_frames.h)")
+  cmd->add_option("--frames", opt->frames.frames,
+                  "Frames to render of a dynamic scene, with their timings: each frame splits the scene's (turned) "
+                  "light probe into its area lights again on the device, and moves its animated objects (an "
+                  "object's \"motion\"; frames.h)")
       ->check(CLI::Range(1, 10000));
-  cmd->add_option("--probe-rotation-speed", opt->probe_frames.rotation_speed_deg,
+  cmd->add_option("--probe-rotation-speed", opt->frames.rotation_speed_deg,
                   "Degrees the scene's light probe turns about +Y per frame (with --frames)");
   cmd->add_option("--lights", opt->lights,
                   "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
@@ -61,7 +62,7 @@ void add_render(CLI::App& app) {
                   "Image-based lighting: each area light's unshadowed light from the lights of a finer cut into this "
                   "many regions inside its own (0: none; default: the scene's \"sub_lights\")");
   cmd->callback([opt, cmd] {
-    const bool probe_frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
+    const bool frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
     std::optional<scene::Camera> view_camera;
     if (!opt->view.empty()) {
       for (const CLI::Option* o : cmd->get_options()) {
@@ -97,7 +98,7 @@ void add_render(CLI::App& app) {
     if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
       fmt::print(stderr, "msm render: {}\n", *w);
     check_limits(opt->frame, scene, names);
-    if (probe_frames) check_probe_frames(scene, opt->probe_frames);
+    if (frames) check_frames(scene, opt->frames);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
     fmt::print(stderr, "msm render: scene '{}', {} triangles, {}x{}, shadow map {}², on {}\n", scene.name,
                scene.triangle_count(), f.width, f.height, f.shadow_size, ctx->info().name);
@@ -105,8 +106,8 @@ void add_render(CLI::App& app) {
     // What the device cannot do is refused before the output directory exists.
     check_on_device(renderer, opt->frame, names);
     ensure_output_dir(opt->out);
-    if (probe_frames) {
-      render_probe_frames(*ctx, renderer, scene, opt->frame, names, opt->out, opt->probe_frames);
+    if (frames) {
+      render_frames(*ctx, renderer, scene, opt->frame, names, opt->out, opt->frames);
       return;
     }
     for (size_t i = 0; i < names.size(); ++i) {
