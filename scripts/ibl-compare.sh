@@ -12,9 +12,9 @@
 # direction per light each), a sixteenth for 256 lights: at 64 the probe's truth alone is off its
 # 1024-sample self by MAE 0.010 on sky_probe, as much as the whole "lights" error.
 # Environment (all optional):
-#   PROBE=FILE      light the scene with this equirectangular EXR instead of its own probe: the
-#                   scene's JSON (scenes/SCENE.json) with the probe's "file" replaced, written to
-#                   OUT/scene.json (lights, size, intensity and rotation kept)
+#   PROBE=FILE      light the scene with this probe (EXR or "sky") instead of its own lighting (--probe
+#                   of msm reference and msm render: the scene's probe settings kept, else 32 lights
+#                   at 128² per face), any scene (e.g. models)
 #   TECHNIQUES=...  the techniques below 256 lights (default mssm6,mssm4,pcss,vssm,cssm16,msm-hamburger-64;
 #                   256 lights: msm-hamburger-64 alone, the point-light limit)
 #   COUNTS="..."    light counts (default "16 32 64 256")
@@ -33,36 +33,31 @@ seed=${SEED:-1}
 sub=()
 [ -n "${SUB_LIGHTS:-}" ] && sub=(--sub-lights "$SUB_LIGHTS")
 mkdir -p "$out"
-if [ -n "${PROBE:-}" ]; then
-  json="$(dirname "$0")/../scenes/$scene.json"
-  [ -f "$json" ] || { echo "ibl-compare.sh: PROBE needs a built-in scene with a file scenes/$scene.json" >&2; exit 1; }
-  [ -f "$PROBE" ] || { echo "ibl-compare.sh: PROBE=$PROBE: no such file" >&2; exit 1; }
-  probe=$(realpath "$PROBE")
-  grep -q '"probe": {' "$json" || { echo "ibl-compare.sh: $json has no probe" >&2; exit 1; }
-  sed "/\"probe\": {/ s#\"file\": \"[^\"]*\"#\"file\": \"$probe\"#" "$json" >"$out/scene.json"
-  scene="$out/scene.json"
-fi
+probe=()
+[ -n "${PROBE:-}" ] && probe=(--probe "$PROBE")
 size=(--width "$width" --height "$height")
 mae() { "$msm" compare --json "$1" "$2" --mask "$out/truth/visibility.exr" --mask-channel background "${@:3}" |
   sed -n 's/.*"mae": \([0-9.e+-]*\).*/\1/p'; }
-"$msm" reference --scene "$scene" --effect environment "${size[@]}" --samples "$samples" --seed "$seed" \
-  --out "$out/truth" >/dev/null
+"$msm" reference --scene "$scene" "${probe[@]}" --effect environment "${size[@]}" --samples "$samples" \
+  --seed "$seed" --out "$out/truth" >/dev/null
 if [ "${NOISE:-0}" = 1 ]; then
-  "$msm" reference --scene "$scene" --effect environment "${size[@]}" --samples "$samples" --seed $((seed + 1)) \
-    --out "$out/truth-seed2" >/dev/null
+  "$msm" reference --scene "$scene" "${probe[@]}" --effect environment "${size[@]}" --samples "$samples" \
+    --seed $((seed + 1)) --out "$out/truth-seed2" >/dev/null
   printf 'truth noise (MAE between seeds %s and %s, %s samples): %.4f\n' "$seed" $((seed + 1)) "$samples" \
     "$(mae "$out/truth/radiance.png" "$out/truth-seed2/radiance.png")"
 fi
 printf '%-18s %6s %8s %8s %8s\n' technique lights total lights shadows
 for n in $counts; do
-  "$msm" reference --scene "$scene" --effect environment --probe-lights --lights "$n" "${sub[@]}" "${size[@]}" \
+  "$msm" reference --scene "$scene" "${probe[@]}" --effect environment --probe-lights --lights "$n" "${sub[@]}" \
+    "${size[@]}" \
     --seed "$seed" \
     --samples "$([ "$n" = 256 ] && echo $((samples / 16 > 4 ? samples / 16 : 4)) || echo $((samples / 4 > 4 ? samples / 4 : 4)))" \
     --out "$out/lights-$n" >/dev/null
   lights=$(mae "$out/truth/radiance.png" "$out/lights-$n/radiance.png")
   techniques=$techniques_all
   [ "$n" = 256 ] && techniques="msm-hamburger-64"
-  "$msm" render --scene "$scene" --lights "$n" "${sub[@]}" -t "$techniques" "${size[@]}" --shadow-size "$shadow" \
+  "$msm" render --scene "$scene" "${probe[@]}" --lights "$n" "${sub[@]}" -t "$techniques" "${size[@]}" \
+    --shadow-size "$shadow" \
     --device "${MSM_DEVICE:-cpu}" -o "$out/render-$n" >/dev/null 2>&1
   for t in ${techniques//,/ }; do
     error=()

@@ -801,6 +801,22 @@ void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_light
   scene.probe = p;
 }
 
+void set_probe(Scene& scene, const std::filesystem::path& file) {
+  ProbeLighting p = scene.probe.value_or(ProbeLighting{});
+  p.file = file;
+  p.first_light = 0;
+  std::error_code ec;
+  if (file != "sky" && !std::filesystem::is_regular_file(file, ec))
+    throw SceneError(file.string(), "", "no such light probe (an equirectangular EXR, a cube-map cross, or \"sky\")");
+  std::vector<DirectionalLight> lights;
+  try {
+    lights = probe_directional_lights(p);
+  } catch (const msm::probe::ProbeError& e) { throw SceneError("", "", e.what()); }
+  if (lights.empty()) throw SceneError(file.string(), "", "the probe has no light (every texel is black)");
+  scene.lights = std::move(lights);
+  scene.probe = p;
+}
+
 Scene load_scene(std::string_view name_or_path) {
   for (const BuiltinScene& b : kBuiltinScenes)
     if (b.name == name_or_path) return builtin_scene(name_or_path);

@@ -1223,3 +1223,39 @@ TEST(Motion, BadValuesNameTheirPointer) {
   expect_json_error(with(R"({"rotate": {"axis": [0, 1, 0], "angle_deg": 400}})"),
                     {"/objects/0/motion/rotate/angle_deg", "[-360, 360]"});
 }
+
+// ---- A probe instead of the scene's lighting (msm render --probe) ----
+
+// The directional light of `models` gives way to the sky's 32 area lights at ProbeLighting's face
+// size; sky_probe given its own probe gets the lights its JSON made; a scene with a probe keeps its
+// settings (sky_probe's 64² faces, a re-cut count); a missing file and a black probe are errors
+// naming the file.
+TEST(Probe, SetProbeReplacesTheScenesLighting) {
+  Scene models = builtin_scene("models");
+  ASSERT_FALSE(models.probe);
+  set_probe(models, "sky");
+  ASSERT_TRUE(models.probe);
+  EXPECT_EQ(models.probe->lights, 32);
+  EXPECT_EQ(models.probe->size, 128);
+  EXPECT_EQ(models.probe->first_light, 0u);
+  EXPECT_EQ(models.lights.size(), 32u);
+  Scene sky = builtin_scene("sky_probe");
+  Scene again = sky;
+  set_probe(again, "sky"); // what its JSON made
+  ASSERT_EQ(again.lights.size(), sky.lights.size());
+  for (std::size_t i = 0; i < sky.lights.size(); ++i) {
+    EXPECT_EQ(again.lights[i].towards_light, sky.lights[i].towards_light) << i;
+    EXPECT_EQ(again.lights[i].irradiance, sky.lights[i].irradiance) << i;
+  }
+  set_probe_light_count(sky, 12);
+  const std::string lamp = std::string(MSM_TEST_DATA_DIR) + "/probes/lamp.exr";
+  set_probe(sky, lamp);
+  EXPECT_EQ(sky.probe->file, lamp);
+  EXPECT_EQ(sky.probe->size, 64);
+  EXPECT_EQ(sky.probe->lights, 12);
+  EXPECT_EQ(sky.lights.size(), 12u);
+  expect_error([&] { set_probe(models, "/no/such/probe.exr"); }, {"/no/such/probe.exr", "no such light probe"});
+  expect_error([&] { set_probe(models, std::string(MSM_TEST_DATA_DIR) + "/probes/black.exr"); },
+               {"black.exr", "no light"});
+  EXPECT_EQ(models.lights.size(), 32u) << "a refused probe leaves the scene as it was";
+}

@@ -81,6 +81,7 @@ void add_reference(CLI::App& app) {
     std::uint64_t seed = 1;
     double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
     std::optional<double> light_extent, light_width, light_height;
+    std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
     std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
     std::optional<int> sub_lights; // and their sub-lights
     int frame = 0;                 // of a dynamic scene (msm render --frames)
@@ -107,6 +108,10 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--light-width", opt->light_width, "soft, rectangle: angular width in degrees (default: extent)");
   cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
   cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
+  cmd->add_option("--probe", opt->probe,
+                  "Image-based lighting: light the scene by this light probe instead of its own lights (an "
+                  "equirectangular EXR, a cube-map cross, or 'sky'; the scene's probe settings are kept, else 32 "
+                  "lights, 128² per face), as msm render --probe");
   cmd->add_option("--lights", opt->lights,
                   "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
                   "the scene's)");
@@ -162,6 +167,9 @@ void add_reference(CLI::App& app) {
     if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
       throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
     msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
+    if (!opt->probe.empty()) try {
+        msm::scene::set_probe(scene, opt->probe);
+      } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
     if (opt->probe_rotation_speed != 0.0f) {
       if (!scene.probe)
         throw UsageError(

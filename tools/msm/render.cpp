@@ -34,6 +34,7 @@ void add_render(CLI::App& app) {
     std::string out = "msm-render";
     std::string view; // a view file (msm view)
     Frames frames;
+    std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
     std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
     std::optional<int> sub_lights; // and their sub-lights
   };
@@ -55,6 +56,10 @@ void add_render(CLI::App& app) {
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--probe-rotation-speed", opt->frames.rotation_speed_deg,
                   "Degrees the scene's light probe turns about +Y per frame (with --frames)");
+  cmd->add_option("--probe", opt->probe,
+                  "Image-based lighting: light the scene by this light probe instead of its own lights (an "
+                  "equirectangular EXR, a cube-map cross, or 'sky'; the scene's probe settings are kept, else 32 "
+                  "lights, 128² per face)");
   cmd->add_option("--lights", opt->lights,
                   "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
                   "the scene's)");
@@ -90,6 +95,9 @@ void add_render(CLI::App& app) {
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;
+    if (!opt->probe.empty()) try {
+        scene::set_probe(scene, opt->probe);
+      } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     if (opt->lights || opt->sub_lights) try {
         scene::set_probe_light_count(scene, opt->lights.value_or(scene.probe ? scene.probe->lights : 1),
                                      opt->sub_lights);

@@ -505,6 +505,14 @@ Scene load_scene(std::string_view name_or_path);
 // "sub_lights" (`msm render --sub-lights`; 0..256, at least 10 with the horizon split).
 void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_lights = std::nullopt);
 
+// Lights the scene by the light probe `file` (an equirectangular EXR, a cube-map cross, or "sky")
+// instead of its own lighting (`msm render --probe`, `msm reference --probe`): its directional
+// lights and its probe's lights are replaced by the new probe's area lights. The scene's probe
+// settings (lights, size, intensity, rotation, horizon split, sub-lights) are kept where it has a
+// probe, else ProbeLighting's defaults (32 lights, 128² per face). SceneError naming the file for a
+// missing or unreadable probe, or one without light.
+void set_probe(Scene& scene, const std::filesystem::path& file);
+
 // The scene at frame `frame` (>= 0) of its animation: every object with a motion turned by frame ×
 // its angle about its axis through its origin, then moved by frame × its translation (vertices,
 // normals, bounds and transform); frame 0 is the scene itself. What the renderer draws
