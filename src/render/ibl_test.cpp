@@ -97,17 +97,29 @@ const std::string kStudioLights = "/usr/share/blender/datafiles/studiolights/wor
 // (0.0005 with the mean's shift) and 0.0009. Every MAE fell; MSSM4's the most (its bound needs a
 // bias of σ, MSSM6's sqrt(m4/m2)), so the six-over-four margins narrowed: the ordering holds
 // everywhere, by less.
+// pcss_over_points: the same with the 32 area lights rendered by PCSS, as the paper's Figure 2
+// renders them (Kneiphof §6: "the extracted area lights are rendered using PCSS"); measured here
+// (256-sample truth): sky_probe 0.01143 − 0.00643, city_probe split 0.00736 − 0.00599, under
+// interior.exr 0.00987 − 0.00779; with city.exr's plain cut and under courtyard.exr PCSS loses too
+// (docs/results.md), not asserted there.
 struct Expected {
-  double area_over_points, six_over_four;
+  double area_over_points, six_over_four, pcss_over_points = 0.0;
 };
 
 void check_orderings(const vk::Context& ctx, const std::string& name, const Expected& e,
                      const std::string& probe_file = "", bool horizon_split = false) {
-  if (e.area_over_points > 0.0) {
+  if (e.area_over_points > 0.0 || e.pcss_over_points > 0.0) {
     const Truth probe = truth(with_lights(name, 32, probe_file), false, 256);
-    const double area = mae(ctx, with_lights(name, 32, probe_file, horizon_split), "mssm6", probe);
+    const scene::Scene area_lights = with_lights(name, 32, probe_file, horizon_split);
     const double points = mae(ctx, with_lights(name, 256, probe_file, horizon_split), "msm-hamburger-64", probe);
-    EXPECT_GT(points - area, 0.5 * e.area_over_points) << name << ": 32 area lights against 256 point lights";
+    if (e.area_over_points > 0.0) {
+      EXPECT_GT(points - mae(ctx, area_lights, "mssm6", probe), 0.5 * e.area_over_points)
+          << name << ": 32 area lights against 256 point lights";
+    }
+    if (e.pcss_over_points > 0.0) {
+      EXPECT_GT(points - mae(ctx, area_lights, "pcss", probe), 0.5 * e.pcss_over_points)
+          << name << ": 32 area lights (PCSS) against 256 point lights";
+    }
   }
   if (e.six_over_four <= 0.0) return;
   const scene::Scene sixteen = with_lights(name, 16, probe_file, horizon_split);
@@ -116,21 +128,21 @@ void check_orderings(const vk::Context& ctx, const std::string& name, const Expe
   EXPECT_GT(four - six, 0.5 * e.six_over_four) << name << ": MSSM6 against MSSM4 under 16 large lights";
 }
 
-TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0048, 0.0003}); }
+TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0048, 0.0003, 0.0050}); }
 TEST_F(IblTest, CityProbeOrderings) { check_orderings(ctx(), "city_probe", {0.0, 0.0010}); }
 // city_probe with the horizon split (docs/techniques.md): its 32 area lights beat the 256 point
 // lights since the soft techniques take the least bias for the receiver's plane (docs/results.md,
 // "The least bias for the receiver's plane"; before, they lost by 0.0007 against ibl-compare's
 // 1024-sample truths).
 TEST_F(IblTest, CityProbeWithTheHorizonSplitOrderings) {
-  check_orderings(ctx(), "city_probe", {0.0006, 0.0009}, "", true);
+  check_orderings(ctx(), "city_probe", {0.0006, 0.0009, 0.0013}, "", true);
 }
 // city_probe's objects under two more of blender-data's probes (docs/results.md, "Image-based
 // lighting on three studio probes"): interior.exr (a window-like light of 18% of the energy, 57°
 // high), where 32 area lights hold against 256 point lights; courtyard.exr (soft, no light above
 // 5% of the energy), where they do not (not asserted there).
 TEST_F(IblTest, InteriorProbeOrderings) {
-  check_orderings(ctx(), "city_probe", {0.0010, 0.0003}, kStudioLights + "interior.exr");
+  check_orderings(ctx(), "city_probe", {0.0010, 0.0003, 0.0020}, kStudioLights + "interior.exr");
 }
 TEST_F(IblTest, CourtyardProbeOrderings) {
   check_orderings(ctx(), "city_probe", {0.0, 0.0011}, kStudioLights + "courtyard.exr");
@@ -143,13 +155,14 @@ TEST_F(IblTest, CourtyardProbeOrderings) {
 // not asserted) and under courtyard.exr they lose. MSSM6 beats MSSM4 at 16 lights under city.exr
 // and interior.exr; under the sky they tie (0.0094 against 0.0095: not asserted).
 // Margins: this test's own measurements (0.02269 − 0.00853; 0.01194 − 0.00957 and 0.00983 −
-// 0.00945; 0.00927 − 0.00876).
-TEST_F(IblTest, ModelsUnderTheSkyOrderings) { check_orderings(ctx(), "models", {0.0142, 0.0}, "sky"); }
+// 0.00945; 0.00927 − 0.00876). With PCSS the 32 lights win under all three, city.exr included
+// (0.00895 − 0.00719).
+TEST_F(IblTest, ModelsUnderTheSkyOrderings) { check_orderings(ctx(), "models", {0.0142, 0.0, 0.0150}, "sky"); }
 TEST_F(IblTest, ModelsUnderInteriorOrderings) {
-  check_orderings(ctx(), "models", {0.0024, 0.0004}, kStudioLights + "interior.exr");
+  check_orderings(ctx(), "models", {0.0024, 0.0004, 0.0032}, kStudioLights + "interior.exr");
 }
 TEST_F(IblTest, ModelsUnderCityOrderings) {
-  check_orderings(ctx(), "models", {0.0, 0.0005}, kStudioLights + "city.exr");
+  check_orderings(ctx(), "models", {0.0, 0.0005, 0.0017}, kStudioLights + "city.exr");
 }
 
 // A wide PCSS kernel under many lights keeps the image's brightness. While the light count was a
