@@ -211,8 +211,29 @@ CubeMap downsample_cube(const CubeMap& cube, int size) {
   return out;
 }
 
+bool is_cube_faces_path(const std::filesystem::path& file) { return file.string().find("{face}") != std::string::npos; }
+
+std::array<std::filesystem::path, 6> cube_face_files(const std::filesystem::path& pattern) {
+  static constexpr const char* kNames[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+  std::array<std::filesystem::path, 6> files;
+  for (int face = 0; face < 6; ++face) {
+    std::string name = pattern.string();
+    for (std::size_t at = name.find("{face}"); at != std::string::npos; at = name.find("{face}", at))
+      name.replace(at, 6, kNames[face]);
+    files[face] = name;
+  }
+  return files;
+}
+
 CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg) {
   check_size(size);
+  if (is_cube_faces_path(file)) {
+    if (rotation_deg != 0.0f)
+      throw ProbeError(fmt::format("{}: six cube faces cannot be rotated (rotation {}°)", file.string(), rotation_deg));
+    try {
+      return load_cube_faces(cube_face_files(file), size);
+    } catch (const ProbeError& e) { throw ProbeError(fmt::format("{}: {}", file.string(), e.what())); }
+  }
   Panorama picture = load_equirect(file);
   if (picture.width == 2 * picture.height)
     return cube_from_equirect(picture.width, picture.height, picture.rgb, size, rotation_deg);

@@ -788,6 +788,39 @@ TEST(CubeInputs, CrossRoundTripsAndIsContinuous) {
   std::filesystem::remove_all(dir);
 }
 
+// Six face files named by a "{face}" path (px nx py ny pz nz) give the cube back texel for texel, box
+// filtered to a smaller size as a cross is; the file named px holds the face around +X (its centre
+// texels' direction). A missing face names its file; turning them is refused.
+TEST(CubeInputs, SixFaceFilesMakeTheCube) {
+  const int m = 8;
+  const CubeMap cube = direction_cube(m);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "msm_probe_faces_test";
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path pattern = dir / "sky_{face}.exr";
+  ASSERT_TRUE(is_cube_faces_path(pattern));
+  EXPECT_FALSE(is_cube_faces_path(dir / "sky.exr"));
+  const std::array<std::filesystem::path, 6> files = cube_face_files(pattern);
+  EXPECT_EQ(files[0], dir / "sky_px.exr");
+  EXPECT_EQ(files[5], dir / "sky_nz.exr");
+  for (int face = 0; face < 6; ++face) {
+    msm::image::Image picture(m, m, std::vector<std::string>{"R", "G", "B"});
+    for (std::size_t k = 0; k < cube.faces[face].size(); ++k)
+      for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = cube.faces[face][k][c];
+    msm::image::write_exr(files[std::size_t(face)], picture);
+  }
+  const CubeMap loaded = load_probe_file(pattern, m);
+  EXPECT_TRUE(same_cube(loaded, cube));
+  EXPECT_TRUE(same_cube(load_probe_file(pattern, m / 2), downsample_cube(cube, m / 2)));
+  // direction_cube stores direction + 2 per texel.
+  const glm::vec3 centre =
+      glm::normalize(0.5f * (loaded.at(0, m / 2, m / 2) + loaded.at(0, m / 2 - 1, m / 2 - 1)) - glm::vec3(2.0f));
+  EXPECT_GT(centre.x, 0.99f) << "px is the +X face";
+  EXPECT_NE(message_of([&] { load_probe_file(pattern, m, 10.0f); }).find("cannot be rotated"), std::string::npos);
+  std::filesystem::remove(files[5]);
+  EXPECT_NE(message_of([&] { load_probe_file(pattern, m); }).find("sky_nz.exr"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
+
 // Six faces of one size make the cube; anything else is refused with a message naming the problem.
 TEST(CubeInputs, BadLayoutsAreRefusedClearly) {
   const CubeMap cube = direction_cube(4);

@@ -250,7 +250,7 @@ class Parser {
     const json* file = find(j, "file");
     if (!file) fail(ptr + "/file", "required key missing (an equirectangular EXR, or \"sky\")");
     const std::string name = string(*file, ptr + "/file");
-    p.file = name == "sky" ? fs::path("sky") : existing_file(name, ptr + "/file", "light probe");
+    p.file = name == "sky" ? fs::path("sky") : probe_file(name, ptr + "/file");
     if (const json* v = find(j, "lights")) p.lights = integer(*v, ptr + "/lights");
     if (p.lights < 1 || p.lights > 256) fail(ptr + "/lights", "must be in [1, 256]");
     if (s.lights.size() + std::size_t(p.lights) > std::size_t(kMaxLights))
@@ -330,6 +330,14 @@ class Parser {
     if (!fs::is_regular_file(p, ec))
       fail(ptr, fmt::format("{} file '{}' does not exist or is not a file", what, p.string()));
     return p;
+  }
+
+  // One EXR, or six face files named by a "{face}" path (msm::probe::cube_face_files), each there.
+  fs::path probe_file(const std::string& rel, const std::string& ptr) const {
+    if (!msm::probe::is_cube_faces_path(rel)) return existing_file(rel, ptr, "light probe");
+    for (const fs::path& face : msm::probe::cube_face_files(rel))
+      existing_file(face.string(), ptr, "light probe's cube face");
+    return (base_ / fs::path(rel)).lexically_normal();
   }
 
   Material material(const json& j, const std::string& ptr) const {
@@ -806,8 +814,14 @@ void set_probe(Scene& scene, const std::filesystem::path& file) {
   p.file = file;
   p.first_light = 0;
   std::error_code ec;
-  if (file != "sky" && !std::filesystem::is_regular_file(file, ec))
-    throw SceneError(file.string(), "", "no such light probe (an equirectangular EXR, a cube-map cross, or \"sky\")");
+  if (file != "sky")
+    for (const std::filesystem::path& f : msm::probe::is_cube_faces_path(file)
+                                              ? msm::probe::cube_face_files(file)
+                                              : std::array{file, file, file, file, file, file})
+      if (!std::filesystem::is_regular_file(f, ec))
+        throw SceneError(f.string(), "",
+                         "no such light probe (an equirectangular EXR, a cube-map cross, six faces named by a "
+                         "\"{face}\" path, or \"sky\")");
   std::vector<DirectionalLight> lights;
   try {
     lights = probe_directional_lights(p);

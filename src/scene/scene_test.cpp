@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "msm/image/io.h"
 #include "msm/light_probe.h"
 #include "msm/probe/probe.h"
 #include "msm/scene/scene.h"
@@ -1258,4 +1259,42 @@ TEST(Probe, SetProbeReplacesTheScenesLighting) {
   expect_error([&] { set_probe(models, std::string(MSM_TEST_DATA_DIR) + "/probes/black.exr"); },
                {"black.exr", "no light"});
   EXPECT_EQ(models.lights.size(), 32u) << "a refused probe leaves the scene as it was";
+}
+
+// Six face files named by a "{face}" path as a scene's probe: the lights of the cube they hold (the
+// sky written face by face) are the sky's own, from the JSON and through set_probe; a missing face
+// is an error naming it.
+TEST(Probe, SixFaceFilesAreAProbe) {
+  TempDir dir("msm_scene_test");
+  const msm::probe::CubeMap sky = msm::probe::load_probe("sky", 16);
+  const fs::path pattern = dir.path() / "sky_{face}.exr";
+  const std::array<fs::path, 6> files = msm::probe::cube_face_files(pattern);
+  for (int face = 0; face < 6; ++face) {
+    msm::image::Image picture(16, 16, std::vector<std::string>{"R", "G", "B"});
+    for (std::size_t k = 0; k < sky.faces[face].size(); ++k)
+      for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = sky.faces[face][k][c];
+    msm::image::write_exr(files[std::size_t(face)], picture);
+  }
+  const std::string box = R"({"primitive": {"type": "box"}})";
+  const auto with = [&](const std::string& file) {
+    return load_scene_json(scene_with_object(box, R"("probe": {"file": ")" + file + R"(", "size": 16, "lights": 8},)"),
+                           fs::current_path(), "t.json");
+  };
+  const Scene faces = with(pattern.string()), own = with("sky");
+  Scene set = own;
+  set_probe(set, pattern);
+  ASSERT_EQ(faces.lights.size(), own.lights.size());
+  ASSERT_EQ(set.lights.size(), 8u); // the scene's directional light replaced too
+  for (std::size_t i = 0; i < own.lights.size(); ++i) {
+    EXPECT_LT(glm::distance(faces.lights[i].towards_light, own.lights[i].towards_light), 1e-6f) << i;
+    EXPECT_LT(glm::distance(faces.lights[i].irradiance, own.lights[i].irradiance),
+              1e-6f * glm::length(own.lights[i].irradiance))
+        << i;
+  }
+  for (std::size_t i = 0; i < set.lights.size(); ++i)
+    EXPECT_EQ(set.lights[i].towards_light, faces.lights[faces.probe->first_light + i].towards_light) << i;
+  fs::remove(files[3]);
+  expect_json_error(scene_with_object(box, R"("probe": {"file": ")" + pattern.string() + R"("},)"),
+                    {"/probe/file", "sky_ny.exr", "does not exist"});
+  expect_error([&] { set_probe(set, pattern); }, {"sky_ny.exr", "no such light probe"});
 }

@@ -28,7 +28,11 @@ void check_frames(const scene::Scene& scene, const Frames& o) {
   if (scene.probe->size > probe::kMaxDeviceCubeSize)
     throw UsageError(fmt::format("the probe's size {} exceeds the device pipeline's {}", scene.probe->size,
                                  probe::kMaxDeviceCubeSize));
-  // A cube-map cross cannot be turned (load_probe_file): refused before the device is opened.
+  // A cube-map cross or six faces cannot be turned (load_probe_file): refused before the device is
+  // opened.
+  if (o.rotation_speed_deg != 0.0f && probe::is_cube_faces_path(scene.probe->file))
+    throw UsageError(fmt::format("--probe-rotation-speed {}: {} names six cube faces, which cannot be rotated",
+                                 o.rotation_speed_deg, scene.probe->file.string()));
   if (o.rotation_speed_deg != 0.0f && scene.probe->file != "sky") {
     probe::Panorama panorama;
     try {
@@ -49,6 +53,12 @@ class ProbeSequence {
       : p_(*scene.probe), device_(ctx, p_.size), timer_(ctx) {
     device_.set_horizon_split(p_.horizon_split); // the scene's probe checked its lights and size for it
     if (p_.file == "sky") return;
+    if (probe::is_cube_faces_path(p_.file)) { // six faces: box-filtered on the host, uploaded once, as a cross
+      try {
+        device_.set_cube(probe::load_probe(p_.file.string(), p_.size, 0.0f, p_.intensity));
+      } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+      return;
+    }
     probe::Panorama panorama;
     try {
       panorama = probe::load_equirect(p_.file);

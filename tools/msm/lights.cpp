@@ -4,6 +4,7 @@
 // picture of the cube map with the regions outlined. A black probe gives no lights (and a black
 // picture), exit status 0; a bad probe or count is a UsageError (exit status 2).
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -31,6 +32,7 @@ struct LightsOptions {
   bool json = false;
   bool horizon_split = false;
   std::string scene_lights, picture;
+  std::string faces; // a "{face}" path: the cube map written as six EXR faces
 };
 
 // The face across each edge of a face: [face][edge], edges u = −1, u = +1, v = −1, v = +1.
@@ -115,6 +117,9 @@ void run(const LightsOptions& o) {
     if (ext != ".png" && ext != ".exr")
       throw UsageError(fmt::format("--picture {}: expected a .png or .exr", o.picture));
   }
+  if (!o.faces.empty() && (!probe::is_cube_faces_path(o.faces) || std::filesystem::path(o.faces).extension() != ".exr"))
+    throw UsageError(
+        fmt::format("--faces {}: expected a path with \"{{face}}\" ending in .exr, e.g. probe_{{face}}.exr", o.faces));
   try {
     probe::check_cut(o.count, o.size, o.horizon_split); // --horizon-split: count >= 10, size even
     if (probe::sub_lights_refine(o.count, o.sub_lights)) probe::check_cut(o.sub_lights, o.size, o.horizon_split);
@@ -232,6 +237,19 @@ void run(const LightsOptions& o) {
     } catch (const image::ImageError& e) { throw UsageError(e.what()); }
     wrote(o.picture);
   }
+  if (!o.faces.empty()) {
+    make_parent(o.faces);
+    const std::array<std::filesystem::path, 6> files = probe::cube_face_files(o.faces);
+    for (int face = 0; face < 6; ++face) {
+      image::Image picture(cube.size, cube.size, std::vector<std::string>{"R", "G", "B"});
+      for (std::size_t k = 0; k < cube.faces[face].size(); ++k)
+        for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = cube.faces[face][k][c];
+      try {
+        image::write_exr(files[std::size_t(face)], picture);
+      } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+      wrote(files[std::size_t(face)].string());
+    }
+  }
   if (o.json) fmt::print("{}\n", doc.dump(2));
 }
 
@@ -240,7 +258,8 @@ void run(const LightsOptions& o) {
 void add_lights(CLI::App& app) {
   const std::string probe_help =
       "An equirectangular or cube-map cross (4:3, 3:4) EXR (e.g. /usr/share/blender/datafiles/studiolights/world/"
-      "studio.exr), or 'sky' for the procedural sky with a sun";
+      "studio.exr), six face EXRs named by a path with \"{face}\" (px nx py ny pz nz), or 'sky' for the procedural "
+      "sky with a sun";
   const std::string scene_lights_help = "Write the lights as a scene's \"lights\" list (JSON: direction, irradiance "
                                         "on a facing surface, angular diameter)";
   const std::string picture_help = "Write the cube map as a cross with the regions outlined (.png or .exr)";
@@ -256,6 +275,9 @@ void add_lights(CLI::App& app) {
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
     cmd->add_option("--intensity", o->intensity, "Radiance scale (default 1)");
     cmd->add_option("--picture", o->picture, picture_help);
+    cmd->add_option("--faces", o->faces,
+                    "Write the cube map the cut sees (--size, --rotation, --intensity applied) as six EXR faces named "
+                    "by a path with \"{face}\" (px nx py ny pz nz): a probe for scenes and --probe");
     cmd->add_flag("--horizon-split", o->horizon_split,
                   "Start the cut from the side faces halved at the horizon (10 regions: --count 10 to 256, even "
                   "--size), so that no light straddles the horizon");

@@ -89,7 +89,14 @@ CubeMap cube_from_faces(const std::array<int, 6>& sizes, const std::array<std::v
 CubeMap downsample_cube(const CubeMap& cube, int size);
 // A probe file as a cube map of size² faces: an equirectangular panorama (2:1, as
 // load_equirect_probe) or a cross EXR (4:3 or 3:4; the faces box-filtered to `size`, which must
-// divide their side; rotation_deg must be 0 for a cross). Six separate face files: load_cube_faces.
+// divide their side; rotation_deg must be 0 for a cross), or six face files named by a "{face}"
+// path (below).
+// A path holding "{face}" names six face files, one square EXR per face: "{face}" stands for px,
+// nx, py, ny, pz, nz (+X, −X, +Y, −Y, +Z, −Z, Vulkan's cube faces: msm_cube_direction), e.g.
+// "probe/{face}.exr"; load_probe_file reads them through load_cube_faces (they cannot be rotated,
+// as a cross cannot).
+bool is_cube_faces_path(const std::filesystem::path& file);
+std::array<std::filesystem::path, 6> cube_face_files(const std::filesystem::path& pattern);
 CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg = 0.0f);
 CubeMap load_cube_faces(const std::array<std::filesystem::path, 6>& files, int size);
 

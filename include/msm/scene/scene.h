@@ -22,8 +22,11 @@
 //   "probe": {                             image-based lighting (Kneiphof 2017): a light probe split
 //                                          by the median cut into area lights, added after "light" /
 //                                          "lights" (which become optional); msm::probe
-//     "file": "studio.exr" | "sky",        REQUIRED equirectangular EXR (relative to the scene file),
-//                                          or the procedural sky with a sun ("msm probe sky")
+//     "file": "studio.exr" | "sky",        REQUIRED equirectangular EXR or cube-map cross (relative to
+//                                          the scene file), six face EXRs named by a path with
+//                                          "{face}" (px nx py ny pz nz: msm::probe::cube_face_files;
+//                                          a cross and faces cannot be rotated), or the procedural
+//                                          sky with a sun ("msm probe sky")
 //     "lights": 32,                        area lights, 1..256 (all lights together <= kMaxLights)
 //     "intensity": 1,                      radiance scale, [0, 1e6]
 //     "rotation_deg": 0,                   about +Y, counter-clockwise seen from above
