@@ -12,7 +12,7 @@
 # direction per light each), a sixteenth for 256 lights: at 64 the probe's truth alone is off its
 # 1024-sample self by MAE 0.010 on sky_probe, as much as the whole "lights" error.
 # Environment (all optional):
-#   PROBE=FILE      light the scene with this probe (EXR or "sky") instead of its own lighting (--probe
+#   PROBE=FILE      light the scene with this probe (EXR, cross, "{face}" faces or "sky") instead of its own lighting (--probe
 #                   of msm reference and msm render: the scene's probe settings kept, else 32 lights
 #                   at 128² per face), any scene (e.g. models)
 #   TECHNIQUES=...  the techniques below 256 lights (default mssm6,mssm4,pcss,vssm,cssm16,msm-hamburger-64;

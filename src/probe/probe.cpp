@@ -225,6 +225,35 @@ std::array<std::filesystem::path, 6> cube_face_files(const std::filesystem::path
   return files;
 }
 
+std::vector<std::filesystem::path> probe_input_files(const std::filesystem::path& file) {
+  if (!is_cube_faces_path(file)) return {file};
+  const std::array<std::filesystem::path, 6> faces = cube_face_files(file);
+  return {faces.begin(), faces.end()};
+}
+
+void write_cube_faces(const std::filesystem::path& pattern, const CubeMap& cube) {
+  if (!is_cube_faces_path(pattern))
+    throw ProbeError(fmt::format("{}: six cube faces need a path with \"{{face}}\"", pattern.string()));
+  const std::array<std::filesystem::path, 6> files = cube_face_files(pattern);
+  std::array<std::filesystem::path, 6> temporary;
+  try {
+    for (int face = 0; face < 6; ++face) {
+      msm::image::Image picture(cube.size, cube.size, std::vector<std::string>{"R", "G", "B"});
+      for (std::size_t k = 0; k < cube.faces[face].size(); ++k)
+        for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = cube.faces[face][k][c];
+      temporary[face] = files[face];
+      temporary[face] += ".partial.exr";
+      msm::image::write_exr(temporary[face], picture);
+    }
+    for (int face = 0; face < 6; ++face) std::filesystem::rename(temporary[face], files[face]);
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    for (const std::filesystem::path& t : temporary)
+      if (!t.empty()) std::filesystem::remove(t, ec);
+    throw ProbeError(fmt::format("{}: writing the cube faces: {}", pattern.string(), e.what()));
+  }
+}
+
 CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg) {
   check_size(size);
   if (is_cube_faces_path(file)) {

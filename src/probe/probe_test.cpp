@@ -802,12 +802,11 @@ TEST(CubeInputs, SixFaceFilesMakeTheCube) {
   const std::array<std::filesystem::path, 6> files = cube_face_files(pattern);
   EXPECT_EQ(files[0], dir / "sky_px.exr");
   EXPECT_EQ(files[5], dir / "sky_nz.exr");
-  for (int face = 0; face < 6; ++face) {
-    msm::image::Image picture(m, m, std::vector<std::string>{"R", "G", "B"});
-    for (std::size_t k = 0; k < cube.faces[face].size(); ++k)
-      for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = cube.faces[face][k][c];
-    msm::image::write_exr(files[std::size_t(face)], picture);
-  }
+  write_cube_faces(pattern, cube);
+  for (const std::filesystem::path& f : files) EXPECT_FALSE(std::filesystem::exists(f.string() + ".partial.exr"));
+  EXPECT_EQ(probe_input_files(pattern), std::vector<std::filesystem::path>(files.begin(), files.end()));
+  EXPECT_EQ(probe_input_files(dir / "sky.exr"), std::vector<std::filesystem::path>{dir / "sky.exr"});
+  EXPECT_THROW(write_cube_faces(dir / "sky.exr", cube), ProbeError);
   const CubeMap loaded = load_probe_file(pattern, m);
   EXPECT_TRUE(same_cube(loaded, cube));
   EXPECT_TRUE(same_cube(load_probe_file(pattern, m / 2), downsample_cube(cube, m / 2)));

@@ -45,8 +45,9 @@ struct GpuScene {
 
   GpuScene(const vk::Context& ctx, const scene::Scene& scene);
   // The vertices of `scene`, whose objects are this scene's moved (scene::at_frame: the same meshes
-  // and materials), uploaded into the same buffers; the translucent triangles and draws sorted
-  // again along the light. RenderError where the vertex or index counts differ. Between frames.
+  // and materials; Renderer::move_objects checks them object by object), uploaded into the same
+  // buffers; the translucent triangles and draws sorted again along the light. RenderError where
+  // the total vertex or index counts differ. Between frames.
   void move_objects(const vk::Context& ctx, const scene::Scene& scene);
 };
 

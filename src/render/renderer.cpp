@@ -625,14 +625,20 @@ void Renderer::move_objects(const scene::Scene& scene) {
   if (scene.objects.size() != m.scene.objects.size())
     throw RenderError(fmt::format("move_objects: {} objects, the renderer's scene has {}", scene.objects.size(),
                                   m.scene.objects.size()));
-  m.gpu.move_objects(m.ctx, scene);
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const scene::Mesh &moved = scene.objects[o].mesh, &mine = m.scene.objects[o].mesh;
+    if (moved.positions.size() != mine.positions.size() || moved.indices.size() != mine.indices.size())
+      throw RenderError(fmt::format("move_objects: object {} ('{}') has another mesh than the renderer's scene", o,
+                                    scene.objects[o].name));
+  }
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {
     scene::Object& mine = m.scene.objects[o];
     mine.mesh = scene.objects[o].mesh;
     mine.bounds = scene.objects[o].bounds;
     mine.transform = scene.objects[o].transform;
   }
-  m.frames.clear(); // the fitted light frusta depend on the vertices
+  m.gpu.move_objects(m.ctx, m.scene); // sorted along the renderer's light, with its materials
+  m.frames.clear();                   // the fitted light frusta depend on the vertices
 }
 
 std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {

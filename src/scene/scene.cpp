@@ -4,6 +4,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <tuple>
 #include <utility>
 
 #include <fmt/format.h>
@@ -248,7 +249,9 @@ class Parser {
     keys(j, ptr, {"file", "lights", "intensity", "rotation_deg", "size", "horizon_split", "sub_lights"});
     ProbeLighting p;
     const json* file = find(j, "file");
-    if (!file) fail(ptr + "/file", "required key missing (an equirectangular EXR, or \"sky\")");
+    if (!file)
+      fail(ptr + "/file", "required key missing (an equirectangular EXR or cube-map cross, six faces named by a "
+                          "\"{face}\" path, or \"sky\")");
     const std::string name = string(*file, ptr + "/file");
     p.file = name == "sky" ? fs::path("sky") : probe_file(name, ptr + "/file");
     if (const json* v = find(j, "lights")) p.lights = integer(*v, ptr + "/lights");
@@ -332,11 +335,9 @@ class Parser {
     return p;
   }
 
-  // One EXR, or six face files named by a "{face}" path (msm::probe::cube_face_files), each there.
+  // One EXR, or six face files named by a "{face}" path (msm::probe::probe_input_files), each there.
   fs::path probe_file(const std::string& rel, const std::string& ptr) const {
-    if (!msm::probe::is_cube_faces_path(rel)) return existing_file(rel, ptr, "light probe");
-    for (const fs::path& face : msm::probe::cube_face_files(rel))
-      existing_file(face.string(), ptr, "light probe's cube face");
+    for (const fs::path& file : msm::probe::probe_input_files(rel)) existing_file(file.string(), ptr, "light probe");
     return (base_ / fs::path(rel)).lexically_normal();
   }
 
@@ -383,6 +384,14 @@ class Parser {
     return m;
   }
 
+  // {"axis": [x,y,z], "angle_deg": a}: the unit axis and the angle, in [lo, hi].
+  std::pair<glm::vec3, float> axis_angle(const json& j, const std::string& ptr, float lo, float hi) const {
+    keys(j, ptr, {"axis", "angle_deg"});
+    if (!find(j, "axis") || !find(j, "angle_deg")) fail(ptr, "axis-angle needs \"axis\" and \"angle_deg\"");
+    return {direction(*find(j, "axis"), ptr + "/axis"),
+            number_in(*find(j, "angle_deg"), ptr + "/angle_deg", lo, hi, false, false)};
+  }
+
   Transform transform(const json& j, const std::string& ptr) const {
     keys(j, ptr, {"translate", "rotate", "scale"});
     Transform t;
@@ -399,11 +408,8 @@ class Parser {
             glm::rotate(glm::mat4(1.0f), e.y, glm::vec3(0, 1, 0)) *
             glm::rotate(glm::mat4(1.0f), e.x, glm::vec3(1, 0, 0));
       } else if (v->is_object()) {
-        keys(*v, ptr + "/rotate", {"axis", "angle_deg"});
-        if (!find(*v, "axis") || !find(*v, "angle_deg"))
-          fail(ptr + "/rotate", "axis-angle needs \"axis\" and \"angle_deg\"");
-        const glm::vec3 axis = direction(*find(*v, "axis"), ptr + "/rotate/axis");
-        r = glm::rotate(glm::mat4(1.0f), glm::radians(number(*find(*v, "angle_deg"), ptr + "/rotate/angle_deg")), axis);
+        const auto [axis, angle_deg] = axis_angle(*v, ptr + "/rotate", -3e38f, 3e38f);
+        r = glm::rotate(glm::mat4(1.0f), glm::radians(angle_deg), axis);
       } else {
         fail(ptr + "/rotate", "must be Euler degrees [x,y,z] or {\"axis\": [x,y,z], \"angle_deg\": a}");
       }
@@ -430,12 +436,9 @@ class Parser {
     }
     if (const json* v = find(j, "rotate")) {
       if (!v->is_object()) fail(ptr + "/rotate", "must be {\"axis\": [x,y,z], \"angle_deg\": a} (per frame)");
-      keys(*v, ptr + "/rotate", {"axis", "angle_deg"});
-      if (!find(*v, "axis") || !find(*v, "angle_deg"))
-        fail(ptr + "/rotate", "axis-angle needs \"axis\" and \"angle_deg\"");
-      m.axis = direction(*find(*v, "axis"), ptr + "/rotate/axis");
-      m.angle_deg = number_in(*find(*v, "angle_deg"), ptr + "/rotate/angle_deg", -360.0f, 360.0f, false, false);
+      std::tie(m.axis, m.angle_deg) = axis_angle(*v, ptr + "/rotate", -360.0f, 360.0f);
     }
+    if (!find(j, "translate") && !find(j, "rotate")) fail(ptr, "needs \"translate\" and/or \"rotate\" (per frame)");
     return m;
   }
 
@@ -815,9 +818,7 @@ void set_probe(Scene& scene, const std::filesystem::path& file) {
   p.first_light = 0;
   std::error_code ec;
   if (file != "sky")
-    for (const std::filesystem::path& f : msm::probe::is_cube_faces_path(file)
-                                              ? msm::probe::cube_face_files(file)
-                                              : std::array{file, file, file, file, file, file})
+    for (const std::filesystem::path& f : msm::probe::probe_input_files(file))
       if (!std::filesystem::is_regular_file(f, ec))
         throw SceneError(f.string(), "",
                          "no such light probe (an equirectangular EXR, a cube-map cross, six faces named by a "
@@ -825,7 +826,13 @@ void set_probe(Scene& scene, const std::filesystem::path& file) {
   std::vector<DirectionalLight> lights;
   try {
     lights = probe_directional_lights(p);
-  } catch (const msm::probe::ProbeError& e) { throw SceneError("", "", e.what()); }
+  } catch (const msm::probe::ProbeError& e) {
+    // A cross or six faces cannot turn: say where the turn comes from.
+    throw SceneError("", "",
+                     p.rotation_deg == 0.0f
+                         ? std::string(e.what())
+                         : fmt::format("{} (the scene's probe has \"rotation_deg\": {:g})", e.what(), p.rotation_deg));
+  }
   if (lights.empty()) throw SceneError(file.string(), "", "the probe has no light (every texel is black)");
   scene.lights = std::move(lights);
   scene.probe = p;

@@ -12,7 +12,6 @@
 
 #include <gtest/gtest.h>
 
-#include "msm/image/io.h"
 #include "msm/light_probe.h"
 #include "msm/probe/probe.h"
 #include "msm/scene/scene.h"
@@ -1214,6 +1213,7 @@ TEST(Motion, BadValuesNameTheirPointer) {
     return scene_with_object(R"({"name": "b", "primitive": {"type": "box"}, "motion": )" + motion + "}");
   };
   expect_json_error(with("1"), {"/objects/0/motion", "must be an object"});
+  expect_json_error(with("{}"), {"/objects/0/motion", "\"translate\" and/or \"rotate\""});
   expect_json_error(with(R"({"spin": 1})"), {"/objects/0/motion/spin", "unknown key"});
   expect_json_error(with(R"({"translate": [0, 2000, 0]})"), {"/objects/0/motion/translate", "per frame"});
   expect_json_error(with(R"({"translate": [0, 1]})"), {"/objects/0/motion/translate", "3 numbers"});
@@ -1269,12 +1269,7 @@ TEST(Probe, SixFaceFilesAreAProbe) {
   const msm::probe::CubeMap sky = msm::probe::load_probe("sky", 16);
   const fs::path pattern = dir.path() / "sky_{face}.exr";
   const std::array<fs::path, 6> files = msm::probe::cube_face_files(pattern);
-  for (int face = 0; face < 6; ++face) {
-    msm::image::Image picture(16, 16, std::vector<std::string>{"R", "G", "B"});
-    for (std::size_t k = 0; k < sky.faces[face].size(); ++k)
-      for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = sky.faces[face][k][c];
-    msm::image::write_exr(files[std::size_t(face)], picture);
-  }
+  msm::probe::write_cube_faces(pattern, sky);
   const std::string box = R"({"primitive": {"type": "box"}})";
   const auto with = [&](const std::string& file) {
     return load_scene_json(scene_with_object(box, R"("probe": {"file": ")" + file + R"(", "size": 16, "lights": 8},)"),
@@ -1297,4 +1292,9 @@ TEST(Probe, SixFaceFilesAreAProbe) {
   expect_json_error(scene_with_object(box, R"("probe": {"file": ")" + pattern.string() + R"("},)"),
                     {"/probe/file", "sky_ny.exr", "does not exist"});
   expect_error([&] { set_probe(set, pattern); }, {"sky_ny.exr", "no such light probe"});
+  msm::probe::write_cube_faces(pattern, sky);
+  Scene turned = own;
+  turned.probe->rotation_deg = 10.0f;
+  expect_error([&] { set_probe(turned, pattern); },
+               {"cannot be rotated", "the scene's probe has \"rotation_deg\": 10"});
 }

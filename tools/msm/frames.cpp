@@ -76,8 +76,8 @@ class ProbeSequence {
     }
   }
 
-  // The frame's lights after the scene's directional ones (`fixed`), its entry of frames.json and
-  // its part of the line.
+  // The frame's lights: the probe's appended to `lights` (the scene's directional ones); fills the
+  // frame's entry of frames.json and its part of the line.
   std::vector<scene::DirectionalLight> run(int k, const Frames& o, std::vector<scene::DirectionalLight> lights,
                                            nlohmann::json& entry, std::string& line) {
     const float rotation = p_.rotation_deg + float(k) * o.rotation_speed_deg;

@@ -4,7 +4,6 @@
 // picture of the cube map with the regions outlined. A black probe gives no lights (and a black
 // picture), exit status 0; a bad probe or count is a UsageError (exit status 2).
 #include <algorithm>
-#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -239,16 +238,10 @@ void run(const LightsOptions& o) {
   }
   if (!o.faces.empty()) {
     make_parent(o.faces);
-    const std::array<std::filesystem::path, 6> files = probe::cube_face_files(o.faces);
-    for (int face = 0; face < 6; ++face) {
-      image::Image picture(cube.size, cube.size, std::vector<std::string>{"R", "G", "B"});
-      for (std::size_t k = 0; k < cube.faces[face].size(); ++k)
-        for (int c = 0; c < 3; ++c) picture.pixels()[3 * k + c] = cube.faces[face][k][c];
-      try {
-        image::write_exr(files[std::size_t(face)], picture);
-      } catch (const image::ImageError& e) { throw UsageError(e.what()); }
-      wrote(files[std::size_t(face)].string());
-    }
+    try {
+      probe::write_cube_faces(o.faces, cube);
+    } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+    for (const std::filesystem::path& face : probe::cube_face_files(o.faces)) wrote(face.string());
   }
   if (o.json) fmt::print("{}\n", doc.dump(2));
 }

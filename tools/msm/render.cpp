@@ -58,7 +58,8 @@ void add_render(CLI::App& app) {
                   "Degrees the scene's light probe turns about +Y per frame (with --frames)");
   cmd->add_option("--probe", opt->probe,
                   "Image-based lighting: light the scene by this light probe instead of its own lights (an "
-                  "equirectangular EXR, a cube-map cross, or 'sky'; the scene's probe settings are kept, else 32 "
+                  "equirectangular EXR, a cube-map cross, six faces named by a path with \"{face}\", or 'sky'; the "
+                  "scene's probe settings are kept, else 32 "
                   "lights, 128² per face)");
   cmd->add_option("--lights", opt->lights,
                   "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "

@@ -97,6 +97,11 @@ CubeMap downsample_cube(const CubeMap& cube, int size);
 // as a cross cannot).
 bool is_cube_faces_path(const std::filesystem::path& file);
 std::array<std::filesystem::path, 6> cube_face_files(const std::filesystem::path& pattern);
+// The files a probe path reads: its six faces for a "{face}" path, else the path itself.
+std::vector<std::filesystem::path> probe_input_files(const std::filesystem::path& file);
+// The cube map as six RGB EXR faces named by a "{face}" path (ProbeError otherwise): each written
+// under a temporary name first, all six renamed at the end, so that a failure leaves none.
+void write_cube_faces(const std::filesystem::path& pattern, const CubeMap& cube);
 CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg = 0.0f);
 CubeMap load_cube_faces(const std::array<std::filesystem::path, 6>& files, int size);
 

@@ -254,10 +254,12 @@ class Renderer {
   void set_camera(const scene::Camera& camera);
 
   // Draws later frames with the objects of `scene`: the renderer's scene with its objects moved
-  // (scene::at_frame; animated objects, `msm render --frames`). The vertex and index buffers are
-  // uploaded again (nothing is allocated), translucent objects sorted again along the light, the
-  // shadow maps' fitted frusta follow; camera and lights stay the renderer's. RenderError where
-  // the objects' meshes differ in size from the renderer's scene.
+  // (scene::at_frame; animated objects, `msm render --frames`). Only the objects' meshes, bounds
+  // and transforms are taken; the vertex and index buffers are uploaded again into the same
+  // buffers (through staging, one submission each), translucent objects sorted again along the
+  // renderer's first light, the shadow maps' fitted frusta follow; camera, lights and materials
+  // stay the renderer's. RenderError, the renderer unchanged, where an object's mesh differs in
+  // vertex or index count from the renderer's scene.
   void move_objects(const scene::Scene& scene);
 
   // `frames` frames with the same settings, nothing read back: the per-pass times of each (for

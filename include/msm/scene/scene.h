@@ -508,7 +508,8 @@ Scene load_scene(std::string_view name_or_path);
 // "sub_lights" (`msm render --sub-lights`; 0..256, at least 10 with the horizon split).
 void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_lights = std::nullopt);
 
-// Lights the scene by the light probe `file` (an equirectangular EXR, a cube-map cross, or "sky")
+// Lights the scene by the light probe `file` (an equirectangular EXR, a cube-map cross, six faces
+// named by a "{face}" path, or "sky")
 // instead of its own lighting (`msm render --probe`, `msm reference --probe`): its directional
 // lights and its probe's lights are replaced by the new probe's area lights. The scene's probe
 // settings (lights, size, intensity, rotation, horizon split, sub-lights) are kept where it has a
