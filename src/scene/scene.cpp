@@ -384,6 +384,14 @@ class Parser {
     return m;
   }
 
+  // [x,y,z] with every |component| <= limit.
+  glm::vec3 bounded(const json& v, const std::string& ptr, float limit, const char* what, const char* unit) const {
+    const glm::vec3 x = vec<3>(v, ptr);
+    if (glm::any(glm::greaterThan(glm::abs(x), glm::vec3(limit))))
+      fail(ptr, fmt::format("absurd {} (|component| > {:g}{})", what, limit, unit));
+    return x;
+  }
+
   // {"axis": [x,y,z], "angle_deg": a}: the unit axis and the angle, in [lo, hi].
   std::pair<glm::vec3, float> axis_angle(const json& j, const std::string& ptr, float lo, float hi) const {
     keys(j, ptr, {"axis", "angle_deg"});
@@ -395,11 +403,8 @@ class Parser {
   Transform transform(const json& j, const std::string& ptr) const {
     keys(j, ptr, {"translate", "rotate", "scale"});
     Transform t;
-    if (const json* v = find(j, "translate")) {
-      t.translate = vec<3>(*v, ptr + "/translate");
-      if (glm::any(glm::greaterThan(glm::abs(t.translate), glm::vec3(kMaxSize))))
-        fail(ptr + "/translate", fmt::format("absurd translation (|component| > {:g})", kMaxSize));
-    }
+    if (const json* v = find(j, "translate"))
+      t.translate = bounded(*v, ptr + "/translate", kMaxSize, "translation", "");
     if (const json* v = find(j, "rotate")) {
       glm::mat4 r(1.0f);
       if (v->is_array()) {
@@ -429,11 +434,8 @@ class Parser {
     if (!j.is_object()) fail(ptr, "must be an object with \"translate\" and/or \"rotate\" (per frame)");
     keys(j, ptr, {"translate", "rotate"});
     Motion m;
-    if (const json* v = find(j, "translate")) {
-      m.translate = vec<3>(*v, ptr + "/translate");
-      if (glm::any(glm::greaterThan(glm::abs(m.translate), glm::vec3(kMaxMotionPerFrame))))
-        fail(ptr + "/translate", fmt::format("absurd motion (|component| > {:g} per frame)", kMaxMotionPerFrame));
-    }
+    if (const json* v = find(j, "translate"))
+      m.translate = bounded(*v, ptr + "/translate", kMaxMotionPerFrame, "motion", " per frame");
     if (const json* v = find(j, "rotate")) {
       if (!v->is_object()) fail(ptr + "/rotate", "must be {\"axis\": [x,y,z], \"angle_deg\": a} (per frame)");
       std::tie(m.axis, m.angle_deg) = axis_angle(*v, ptr + "/rotate", -360.0f, 360.0f);
