@@ -62,6 +62,15 @@ void Viewer::set_light_direction(glm::vec3 towards) {
   view.settings.lights.front().towards_light = glm::normalize(towards);
 }
 
+void Viewer::show_object_frame(int frame) {
+  view.object_frame = std::clamp(frame, 0, kMaxObjectFrame);
+  if (!scene.animated()) return;
+  MSM_VK_CHECK(vkDeviceWaitIdle(ctx->device())); // the buffers are uploaded again
+  const scene::Scene moved = scene::at_frame(scene, view.object_frame);
+  left->move_objects(moved);
+  if (right) right->move_objects(moved);
+}
+
 void Viewer::set_technique(const std::string& name) {
   std::string canonical(canonical_technique_name(name));
   if (canonical == view.settings.technique) return;
@@ -89,7 +98,10 @@ void Viewer::set_scene(const std::string& name, bool keep_view) {
   if (!keep_view) {
     view.camera = scene.camera;
     view.settings.lights.clear();
+    view.object_frame = 0;
+    animate_objects = false;
   }
+  show_object_frame(view.object_frame);
   std::error_code ec;
   scene_time.reset();
   if (std::filesystem::is_regular_file(name, ec)) scene_time = std::filesystem::last_write_time(name, ec);
@@ -165,6 +177,10 @@ void Viewer::fly(float dt) {
     float elevation = std::clamp(std::asin(std::clamp(t.y, -1.0f, 1.0f)) - io.MouseDelta.y * 0.01f, 0.02f, 1.5707f);
     set_light_direction(
         {std::cos(elevation) * std::cos(azimuth), std::sin(elevation), std::cos(elevation) * std::sin(azimuth)});
+  }
+  if (animate_objects && scene.animated()) {
+    object_clock += double(object_rate) * double(dt);
+    if (int(object_clock) != view.object_frame) show_object_frame(int(object_clock));
   }
   if (animate_light) {
     glm::vec3 t = light_direction();
@@ -310,6 +326,16 @@ void Viewer::panel() {
     ImGui::Checkbox("animate light", &animate_light);
     ImGui::SameLine();
     ImGui::SliderFloat("deg/s", &light_speed_deg, -90.0f, 90.0f);
+    if (scene.animated()) { // the scene's objects with a "motion"
+      if (ImGui::Checkbox("animate objects", &animate_objects)) object_clock = view.object_frame;
+      ImGui::SameLine();
+      ImGui::SliderFloat("frames/s", &object_rate, 1.0f, 60.0f);
+      int frame = view.object_frame;
+      if (ImGui::InputInt("object frame", &frame)) {
+        show_object_frame(frame);
+        object_clock = view.object_frame;
+      }
+    }
     ImGui::SliderFloat("fly speed", &fly_speed, 0.05f, 50.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
     ImGui::TextDisabled("WASD/QE move, right drag looks, wheel: speed;");
     ImGui::TextDisabled("middle drag turns the light");
@@ -366,6 +392,7 @@ void Viewer::panel() {
         View loaded = load_view(view_path);
         if (loaded.camera) view.camera = loaded.camera;
         view.settings = loaded.settings;
+        show_object_frame(loaded.object_frame);
       } catch (const ViewError& e) { error = e.what(); }
     ImGui::SameLine();
     if (ImGui::Button("copy the command")) try {
@@ -425,6 +452,7 @@ void Viewer::step_script() {
             fmt::format("{}: {} shows scene '{}', the viewer '{}'", a.where, x[0], loaded.scene, view.scene));
       if (loaded.camera) view.camera = loaded.camera;
       view.settings = loaded.settings;
+      show_object_frame(loaded.object_frame);
       if (loaded.settings.width != int(swapchain->extent().width) ||
           loaded.settings.height != int(swapchain->extent().height)) {
         glfwSetWindowSize(window, loaded.settings.width, loaded.settings.height);
@@ -444,6 +472,11 @@ void Viewer::step_script() {
       resize_tries = 0;
     } else if (a.verb == "frames") {
       wait_frames = long(number(x[0]));
+    } else if (a.verb == "object-frame") {
+      show_object_frame(int(number(x[0])));
+      object_clock = view.object_frame;
+      note(fmt::format("object frame: {}{}", view.object_frame,
+                       scene.animated() ? "" : " (nothing moves in this scene)"));
     } else if (a.verb == "close") {
       glfwSetWindowShouldClose(window, GLFW_TRUE);
     } else if (a.verb == "scene") {

@@ -20,26 +20,13 @@ struct Verb {
   int min_args, max_args; // -1: rest of the line
 };
 
-constexpr Verb kVerbs[] = {{"technique", 1, 1},
-                           {"set", 2, -1},
-                           {"camera", 6, 6},
-                           {"light", 3, 3},
-                           {"split", 1, 1},
-                           {"divider", 1, 1},
-                           {"load-view", 1, 1},
-                           {"save-view", 1, 1},
-                           {"screenshot", 1, 1},
-                           {"panel-mask", 1, 1},
-                           {"resize", 2, 2},
-                           {"frames", 1, 1},
-                           {"close", 0, 0},
-                           {"quit", 0, 0},
-                           {"each-technique", 0, 0},
-                           {"ground-truth", 1, 1},
-                           {"wait-ground-truth", 0, 0},
-                           {"show-truth", 1, 1},
-                           {"scene", 1, 1},
-                           {"reload", 0, 0},
+constexpr Verb kVerbs[] = {{"technique", 1, 1},      {"set", 2, -1},         {"camera", 6, 6},
+                           {"light", 3, 3},          {"split", 1, 1},        {"divider", 1, 1},
+                           {"load-view", 1, 1},      {"save-view", 1, 1},    {"screenshot", 1, 1},
+                           {"panel-mask", 1, 1},     {"resize", 2, 2},       {"frames", 1, 1},
+                           {"object-frame", 1, 1},   {"close", 0, 0},        {"quit", 0, 0},
+                           {"each-technique", 0, 0}, {"ground-truth", 1, 1}, {"wait-ground-truth", 0, 0},
+                           {"show-truth", 1, 1},     {"scene", 1, 1},        {"reload", 0, 0},
                            {"show-map", 1, 1}};
 
 double parse_number(const std::string& where, const std::string& text) {
@@ -84,6 +71,11 @@ void check(const Action& a) {
     double v = parse_number(w, a.args[0]);
     if (v != std::floor(v) || v < 0 || v > 100000)
       throw ScriptError(fmt::format("{}: frames {}: expected an integer in [0, 100000]", w, a.args[0]));
+  } else if (a.verb == "object-frame") {
+    double v = parse_number(w, a.args[0]);
+    if (v != std::floor(v) || v < 0 || v > kMaxObjectFrame)
+      throw ScriptError(
+          fmt::format("{}: object-frame {}: expected an integer in [0, {}]", w, a.args[0], kMaxObjectFrame));
   }
 }
 

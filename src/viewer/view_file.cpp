@@ -242,6 +242,7 @@ json view_json(const View& v) {
                      {"far", v.camera->far}};
   out["settings"] = settings;
   if (!lights.empty()) out["lights"] = lights;
+  if (v.object_frame > 0) out["object_frame"] = v.object_frame;
   return out;
 }
 
@@ -252,7 +253,7 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
     j = json::parse(text, nullptr, true, true);
   } catch (const json::parse_error& e) { throw ViewError(fmt::format("{}: malformed JSON: {}", name, e.what())); }
   try {
-    check_keys(j, "", {"msm_view", "scene", "camera", "lights", "settings"});
+    check_keys(j, "", {"msm_view", "scene", "camera", "lights", "settings", "object_frame"});
     if (!j.contains("msm_view") || j["msm_view"] != 1) fail("/msm_view", "required, and only version 1 exists");
     View v;
     if (j.contains("scene")) {
@@ -312,6 +313,11 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
       }
       v.settings.lights = lights_read;
     }
+    if (j.contains("object_frame")) {
+      v.object_frame = integer("/object_frame", j["object_frame"]);
+      if (v.object_frame < 0 || v.object_frame > kMaxObjectFrame)
+        fail("/object_frame", fmt::format("expected 0 to {}", kMaxObjectFrame));
+    }
     if (j.contains("settings")) {
       const json& s = j["settings"];
       if (!s.is_object()) fail("/settings", "expected an object");
@@ -364,6 +370,7 @@ void save_view(const std::filesystem::path& file, const View& view) {
 
 scene::Scene load_view_scene(const View& view) {
   scene::Scene s = scene::load_scene(view.scene);
+  if (view.object_frame > 0) s = scene::at_frame(s, view.object_frame);
   if (view.camera) s.camera = *view.camera;
   return s;
 }

@@ -111,6 +111,26 @@ TEST(ViewFile, FrontBackDepthRoundTripsAndIsValidated) {
             std::string::npos);
 }
 
+// The animated objects' frame: round trip, absent at 0, its range; load_view_scene moves the
+// objects (the knot of city_probe turns 10° a frame).
+TEST(ViewFile, ObjectFrameRoundTripsAndIsValidated) {
+  View v;
+  v.scene = "city_probe";
+  EXPECT_FALSE(view_json(v).contains("object_frame"));
+  v.object_frame = 3;
+  const nlohmann::json j = view_json(v);
+  EXPECT_EQ(j["object_frame"], 3);
+  EXPECT_EQ(parse_view(j.dump(), "v.json").object_frame, 3);
+  const scene::Scene at3 = load_view_scene(v), at0 = scene::load_scene("city_probe");
+  EXPECT_EQ(at3.objects.back().mesh.positions, scene::at_frame(at0, 3).objects.back().mesh.positions);
+  EXPECT_NE(at3.objects.back().mesh.positions, at0.objects.back().mesh.positions);
+  auto bad = [](const std::string& text) { return error_of<ViewError>([&] { parse_view(text, "v.json"); }); };
+  EXPECT_NE(bad(R"({"msm_view": 1, "object_frame": -1})").find("v.json: /object_frame: expected 0 to 100000"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "object_frame": 2.5})").find("/object_frame: expected an integer"),
+            std::string::npos);
+}
+
 TEST(ViewFile, RelativeScenePathsFollowTheFile) {
   View v = parse_view(R"({"msm_view": 1, "scene": "my/scene.json"})", "/data/views/v.json");
   EXPECT_EQ(v.scene, "/data/views/my/scene.json");
@@ -180,6 +200,7 @@ TEST(Script, BadLinesAreNamed) {
   EXPECT_EQ(bad("camera 0 1 2 3 4 x\n"), "s.txt:1: 'x' is not a number");
   EXPECT_EQ(bad("resize 10 10\n"), "s.txt:1: resize 10 10: sizes are integers in [64, 8192]");
   EXPECT_EQ(bad("divider 1.5\n"), "s.txt:1: divider 1.5 is outside (0, 1)");
+  EXPECT_EQ(bad("object-frame -2\n"), "s.txt:1: object-frame -2: expected an integer in [0, 100000]");
   EXPECT_NE(error_of<ScriptError>([] { load_script("/nonexistent/s.txt"); }).find("cannot open the script"),
             std::string::npos);
 }

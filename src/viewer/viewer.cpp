@@ -85,7 +85,9 @@ Viewer::~Viewer() {
 }
 
 void Viewer::load() {
-  scene = load_view_scene(view);
+  View at_zero = view; // the scene as loaded: its objects move from frame 0 (show_object_frame)
+  at_zero.object_frame = 0;
+  scene = load_view_scene(at_zero);
   if (!view.camera) view.camera = scene.camera;
   std::error_code ec;
   if (std::filesystem::is_regular_file(view.scene, ec)) scene_time = std::filesystem::last_write_time(view.scene, ec);
@@ -137,6 +139,7 @@ void Viewer::open(const std::string& device) {
   acquired = {ctx->device(), s};
 
   left = std::make_unique<render::Renderer>(*ctx, scene);
+  show_object_frame(view.object_frame);
   init_imgui();
 }
 
@@ -241,7 +244,10 @@ void Viewer::frame() {
   if (show_truth && truth_image) {
     b.color = &truth_image;
   } else if (!split_technique.empty()) {
-    if (!right) right = std::make_unique<render::Renderer>(*ctx, scene);
+    if (!right) {
+      right = std::make_unique<render::Renderer>(*ctx, scene);
+      if (view.object_frame > 0 && scene.animated()) right->move_objects(scene::at_frame(scene, view.object_frame));
+    }
     b = render_side(*right, split_settings(), false);
   }
   push_times(a);
@@ -426,7 +432,7 @@ void Viewer::write_panel_mask(const std::string& path) {
 
 void Viewer::start_truth(int samples) {
   if (truth.running()) return;
-  scene::Scene s = scene;
+  scene::Scene s = scene::at_frame(scene, view.object_frame);
   s.camera = *view.camera;
   truth_camera = *view.camera;
   size_t n = std::min<size_t>(frame_ms.size(), 10);

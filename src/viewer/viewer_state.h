@@ -65,6 +65,8 @@ struct Viewer {
   void set_technique(const std::string& name);
   void set_split(const std::string& name); // empty: off
   void set_light_direction(glm::vec3 towards);
+  // The animated objects at this frame (scene::at_frame) in both renderers; view.object_frame.
+  void show_object_frame(int frame);
   void save_view_file(const std::string& path);
   // Another scene (its camera and lights), or the same file again (the view kept); SceneError
   // leaves everything as it was.
@@ -109,6 +111,10 @@ struct Viewer {
   float fly_speed = 2.0f; // scene units per second
   bool animate_light = false;
   float light_speed_deg = 20.0f;
+  // Object animation: the scene's "motion" frames advance at object_rate per second.
+  bool animate_objects = false;
+  float object_rate = 10.0f;
+  double object_clock = 0.0;
 
   ImVec2 panel_min{0, 0}, panel_max{0, 0};
   std::string status, error;

@@ -70,6 +70,7 @@ void add_render(CLI::App& app) {
   cmd->callback([opt, cmd] {
     const bool frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
     std::optional<scene::Camera> view_camera;
+    int view_object_frame = 0;
     if (!opt->view.empty()) {
       for (const CLI::Option* o : cmd->get_options()) {
         const std::vector<std::string>& long_names = o->get_lnames();
@@ -82,6 +83,7 @@ void add_render(CLI::App& app) {
         opt->frame.settings = view.settings;
         opt->frame.scene = view.scene;
         view_camera = view.camera;
+        view_object_frame = view.object_frame;
         if (cmd->count("--technique") == 0) opt->techniques = view.settings.technique;
       } catch (const viewer::ViewError& e) { throw UsageError(e.what()); }
     } else {
@@ -96,6 +98,7 @@ void add_render(CLI::App& app) {
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;
+    if (view_object_frame > 0) scene = scene::at_frame(scene, view_object_frame); // the view's animated objects
     if (!opt->probe.empty()) try {
         scene::set_probe(scene, opt->probe);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }

@@ -21,6 +21,7 @@
 //   show-map on|off           the left technique's first moment image in the bottom right corner
 //   resize W H                resize the window; the swapchain follows
 //   frames N                  let N frames pass
+//   object-frame N            the scene's animated objects at frame N (scene::at_frame), 0..100000
 //   close                     close the window as its close button does
 //   quit                      end the viewer (exit 0)
 // Errors: ScriptError "FILE:LINE: problem"; parsing checks names, keys and values before the

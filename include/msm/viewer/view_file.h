@@ -9,6 +9,8 @@
 //   "lights": [{"towards_light": [x,y,z], "irradiance": [r,g,b], "angular_extent_deg": 0}],  absent: the scene's
 //             (a rectangular light also "angular_height_deg": h, "x_axis": [x,y,z], as in a scene file)
 //   "settings": {"technique": "msm-hamburger-64", "width": 1280, ...}   the keys of setting_keys()
+//   "object_frame": 0                               the frame of the scene's animated objects
+//                                                   (scene::at_frame), 0..100000; written when > 0
 // }
 // Every key is optional but msm_view; unknown keys are errors naming the key (ViewError).
 #pragma once
@@ -36,7 +38,9 @@ struct View {
   std::string scene = "fence";         // as given (built-in name or path)
   std::optional<scene::Camera> camera; // empty: the scene's
   render::RenderSettings settings;     // its lights: "lights" (empty: the scene's)
+  int object_frame = 0;                // the animated objects at this frame (scene::at_frame)
 };
+inline constexpr int kMaxObjectFrame = 100000;
 
 // The keys of "settings", in the order view_json writes them.
 std::vector<std::string> setting_keys();
@@ -55,8 +59,8 @@ View load_view(const std::filesystem::path& file);
 // Written atomically (a temporary, then renamed); ViewError when it cannot be written.
 void save_view(const std::filesystem::path& file, const View& view);
 
-// Loads the view's scene (SceneError passes through) with the view's camera: with view.settings,
-// what `msm render --view` and the viewer render.
+// Loads the view's scene (SceneError passes through) with the view's camera and its objects at the
+// view's object_frame: with view.settings, what `msm render --view` and the viewer render.
 scene::Scene load_view_scene(const View& view);
 
 // The `msm render` line that renders a view file (the viewer's "copy the command").
