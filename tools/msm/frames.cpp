@@ -53,27 +53,23 @@ class ProbeSequence {
       : p_(*scene.probe), device_(ctx, p_.size), timer_(ctx) {
     device_.set_horizon_split(p_.horizon_split); // the scene's probe checked its lights and size for it
     if (p_.file == "sky") return;
-    if (probe::is_cube_faces_path(p_.file)) { // six faces: box-filtered on the host, uploaded once, as a cross
+    if (!probe::is_cube_faces_path(p_.file)) {
+      probe::Panorama panorama;
       try {
-        device_.set_cube(probe::load_probe(p_.file.string(), p_.size, 0.0f, p_.intensity));
+        panorama = probe::load_equirect(p_.file);
       } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-      return;
+      if (panorama.width == 2 * panorama.height) {
+        for (glm::vec3& t : panorama.rgb) t *= p_.intensity;
+        device_.set_panorama(panorama);
+        return;
+      }
     }
-    probe::Panorama panorama;
+    // A cube-map cross (the scene's loader took it as one, 4:3 or 3:4) or six face files: the faces
+    // box-filtered on the host (load_probe) and uploaded once; they do not turn (check_frames). The
+    // device's resampling is for panoramas: it read a cross as one (wrong lights) before.
     try {
-      panorama = probe::load_equirect(p_.file);
+      device_.set_cube(probe::load_probe(p_.file.string(), p_.size, 0.0f, p_.intensity));
     } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-    if (panorama.width == 2 * panorama.height) {
-      for (glm::vec3& t : panorama.rgb) t *= p_.intensity;
-      device_.set_panorama(panorama);
-    } else {
-      // A cube-map cross (the scene's loader took it as one, 4:3 or 3:4): its faces box-filtered
-      // on the host (load_probe) and uploaded once; it does not turn (check_frames). The
-      // device's resampling is for panoramas: it read a cross as one (wrong lights) before.
-      try {
-        device_.set_cube(probe::load_probe(p_.file.string(), p_.size, 0.0f, p_.intensity));
-      } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-    }
   }
 
   // The frame's lights: the probe's appended to `lights` (the scene's directional ones); fills the
