@@ -2,7 +2,7 @@
 // texel's moments to 32-bit unsigned integers, rectangle queries that are exact despite
 // wrap-around, and the nine-region query of a filter region with fractional borders (Figure 7b).
 // Shared by GLSL and C++ (see shared.h). No textures here: the caller fetches the table values
-// (the shaders of src/soft build the tables; a fetch at a coordinate < 0 must read as 0) and
+// (the shaders of src/gpu build the tables; a fetch at a coordinate < 0 must read as 0) and
 // passes them in.
 //
 // What a texel holds. Four moments in the 128-bit representation of JCGT §4.2 / App. D.4: the

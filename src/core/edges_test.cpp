@@ -1,4 +1,4 @@
-// The edges of the math (issue 19): the reconstructions where an independent check broke them,
+// The edges of the math: the reconstructions where an independent check broke them,
 // swept by class against the double-precision oracles. Classes of depth distributions:
 //  - near end: an occluder at the near end of the depth range (0 in [0,1], -1 in [-1,1]), alone
 //    or beside a receiver surface (the receiver on it);

@@ -350,7 +350,7 @@ TEST(Rectification, ResamplingLevelIsTheTexelsFootprintInTheShadowMap) {
   EXPECT_GT(above_zero, 64 * 16 / 4); // the test reaches the mips, not only the floor at 0
 }
 
-// ---- Transmittance layers (issue 14, branch scatter-delta) ----
+// ---- Transmittance layers ----
 
 TEST(Rectification, TransmittanceLayersCoverEveryViewRaysStep) {
   // The layers' range holds the step Δ = (r_max / width) / sin θ of every view ray of 64 views

@@ -1,4 +1,4 @@
-// The copy shaders of shaders/sat_copy.glsl (issue 18): what any shader moving a table of 16 B
+// The copy shaders of shaders/sat_copy.glsl: what any shader moving a table of 16 B
 // texels reaches on a device, timed beside the summed-area table schemes by msm_sat_timing and
 // checked (every texel copied) by msm_sat_builder_test. Not part of msm::gpu's interface: both
 // programs embed the shaders themselves.

@@ -13,13 +13,13 @@
 // read and one write, 32 B per texel, as a single fused pass would move. Fraction = bound / time.
 // Median of N runs, each its own submission, after one warm-up.
 //
-// The bound issue 18 asks for on a CPU device: a two-thread CPU copy of the same bytes (the moment
+// The copy bound on a CPU device: a two-thread CPU copy of the same bytes (the moment
 // image's 16 B per texel, two std::threads memcpy'ing one half each, best of 2N + 1 after a
 // warm-up that touches both buffers): its time is the 32 B bound (one read, one write per texel),
 // twice its time the 64 B bound. Every scheme's fraction of both bounds is printed beside the
 // fraction of the vkCmdCopyImage bound.
 //
-// The copy shaders (sat_copy.h, shaders/sat_copy.glsl; issue 18): shaders that only read and write
+// The copy shaders (sat_copy.h, shaders/sat_copy.glsl): shaders that only read and write
 // every texel once, on RGBA32_UINT storage images (imageLoad → imageStore), on storage buffers of
 // uvec4, and from the RGBA32F moment image (texelFetch → imageStore), one texel / four texels / a
 // row / a column per invocation. Each is one pass moving 32 B per texel: its fraction of the 32 B

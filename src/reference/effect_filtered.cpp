@@ -33,7 +33,7 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
   RunningStats stats;
   // The ray origins of a batch of samples first, then their rays: each sample's arithmetic is a
   // chain of dependent steps (two square roots), which the processor overlaps across the samples
-  // of a batch but not across a call into Embree (issue 18). The same random numbers in the same
+  // of a batch but not across a call into Embree. The same random numbers in the same
   // order: the same rays as one sample at a time.
   glm::dvec3 origins[kSampleBatch];
   for (int first = 0; first < set.count(); first += kSampleBatch) {

@@ -28,7 +28,7 @@ struct FrameConfig {
   int soft_kernel = 0; // soft techniques: the tables' largest kernel width W (n_t = W²)
   // The shading's lookup (MSM_LOOKUP_*, as resolved for the technique): a specialization constant of
   // the shading (kLookup), because lavapipe runs both sides of a branch on a uniform and recompiles
-  // a shader whose branches test uniforms (issue 18).
+  // a shader whose branches test uniforms.
   int lookup = MSM_LOOKUP_BILINEAR;
   // Deferred shading: a surfaces pass (depth, position, normal, albedo of the visible surface), then
   // one shadow evaluation per pixel in a full-screen shading pass (RenderSettings::deferred_shading).

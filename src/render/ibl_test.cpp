@@ -1,4 +1,4 @@
-// Image-based lighting in the renderer against the ray-traced ground truth (issue 15, Kneiphof
+// Image-based lighting in the renderer against the ray-traced ground truth (Kneiphof
 // 2017 §6): the full probe (msm::reference, effect environment) and its extracted area lights
 // (--probe-lights). The orderings of the paper that hold on the built-in probe scenes, asserted
 // with margins from the measurements of docs/results.md ("Image-based lighting against the ground
@@ -83,7 +83,7 @@ const std::string kStudioLights = "/usr/share/blender/datafiles/studiolights/wor
 // here, below).
 // area_over_points 0: not asserted (on city_probe's plain cut, under city.exr and courtyard.exr,
 // the 256 point lights are closer, docs/results.md; with the rectangles shaded as rectangles at the
-// horizon they still are). Re-measured here after that change (branch ibl-rect-horizon; before -> after, the
+// horizon they still are). Re-measured here after that change (before -> after, the
 // bounds kept): sky_probe 0.0042 -> 0.0042 and 0.0006 -> 0.0007, city_probe - and 0.0013 ->
 // 0.0012, interior.exr 0.0010 -> 0.0006 and 0.0006 -> 0.0008, courtyard.exr - and 0.0042 -> 0.0043.
 // And after the lights' direction became the region's mean direction (msm_region_mean_direction;
@@ -168,8 +168,8 @@ TEST_F(IblTest, ModelsUnderCityOrderings) {
 // A wide PCSS kernel under many lights keeps the image's brightness. While the light count was a
 // uniform loop bound, lavapipe recompiled the shading at every bind with the frame's values
 // inlined (docs/results.md, "CPU-side costs"), and with 64 lights and a 31-texel kernel the image
-// came out 0.128 darker on average than with 7 (city_probe, 160x90, 256²; branch ibl-probes found
-// it under courtyard.exr: 0.21). With the count a specialization constant: 0.0002. The cause in
+// came out 0.128 darker on average than with 7 (city_probe, 160x90, 256²; under courtyard.exr:
+// 0.21). With the count a specialization constant: 0.0002. The cause in
 // the driver was not isolated; this holds the result.
 TEST_F(IblTest, WidePcssKernelUnderManyLightsKeepsTheBrightness) {
   const scene::Scene scene = with_lights("city_probe", 64);

@@ -53,7 +53,7 @@ TEST(Limits, ShadowMemoryGrowsWithTexelsLightsAndColourChannels) {
   EXPECT_GT(double(render::estimated_bytes(s, 0, 1)), 2.0 * base); // three moment maps, one depth
 }
 
-// Prefiltered scattering: every light has its own rectified map and prefix sums (issue 14), shadow
+// Prefiltered scattering: every light has its own rectified map and prefix sums, shadow
 // size² texels of msm_technique_scatter_map_bytes each, the prefix sums once per transmittance
 // layer (default 1; parameter w); ray marching has neither (the techniques store no moment maps,
 // so the rest of the estimate is the same).

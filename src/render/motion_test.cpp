@@ -1,4 +1,4 @@
-// Animated objects in the renderer (issue 15's dynamic scenes): Renderer::move_objects draws a
+// Animated objects in the renderer (dynamic scenes): Renderer::move_objects draws a
 // frame of scene::at_frame exactly as a renderer made for that frame's scene, and as the scene
 // with the object placed there by hand (its transform written out); the translucent draws are
 // sorted again, and going back to frame 0 leaves nothing of the moved frame behind.

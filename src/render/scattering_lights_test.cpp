@@ -1,4 +1,4 @@
-// Single scattering from several lights (issue 14): on the gate lit from behind by two lights from
+// Single scattering from several lights: on the gate lit from behind by two lights from
 // either side (tests/data/gate_two_lights.json), every scattering technique
 //  - scatters the sum of what it scatters from each light alone (the scattering image's in-scattered
 //    radiance, pixel by pixel), and its visible fraction is the lights' visible fractions weighted by

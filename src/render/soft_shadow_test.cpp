@@ -83,7 +83,7 @@ std::map<std::string, image::Metrics> errors(const vk::Context& ctx, scene::Scen
 // Re-measured with the least bias for the receiver's plane (msm_soft_plane_bias; "The least bias
 // for the receiver's plane"): vssm 0.0034 -> 0.0019 (column), 0.0100 -> 0.0094 (fence), 0.0111 ->
 // 0.0055 (pillar_wall), mssm4 0.0078 -> 0.0050 and mssm6 0.0061 -> 0.0046 (pillar_wall); the rest
-// within 0.0002 of the same session's run before the change (which had itself drifted from this
+// within 0.0002 of a run just before the change (which had itself drifted from this
 // table's older values by up to +0.0003: column mssm4 0.0015, mssm6 0.0008, models mssm6 0.0041).
 const std::map<std::string, std::map<std::string, double>> kMeasuredSoftMae = {
     {"column", {{"mssm4", 0.0018}, {"mssm6", 0.0011}, {"vssm", 0.0019}, {"pcss", 0.0015}}},

@@ -561,7 +561,7 @@ TEST(Import, RealModel) {
   EXPECT_GE(double(consistent), 0.999 * double(m.triangle_count()));
 }
 
-// A truncated PLY (issue 19: the first 40000 bytes of assimp-testmodels' Wuson.ply) trips an
+// A truncated PLY (the first 40000 bytes of assimp-testmodels' Wuson.ply) trips an
 // assertion inside Assimp, which Debian's build turns into abort(): the import must fail with a
 // SceneError naming the file instead (import.cpp interposes Assimp's assertion handler). Cut at
 // 40000 bytes the header check (mesh_header.cpp) refuses it first; cut at 400000 its vertices are
@@ -638,7 +638,7 @@ TEST(Import, TriangleLimitCheckedFromTheFileBeforeImport) {
   ::unsetenv("MSM_MAX_TRIANGLES");
 }
 
-// The scene's running total is checked object by object while it loads (issue 19: 40 spheres of
+// The scene's running total is checked object by object while it loads (40 spheres of
 // 4M triangles ended in std::bad_alloc after 10 GB): loading stops at the object that crosses it.
 TEST(Errors, TriangleLimitStopsTheLoadAtTheObjectThatCrossesIt) {
   const std::string json = R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [
@@ -1170,7 +1170,7 @@ TEST(Lights, BadSecondExtentOrAxisNamesItsPointer) {
                     {"/lights/1/angular_height_deg"});
 }
 
-// ---- Animated objects (issue 15's dynamic scenes) ----
+// ---- Animated objects (dynamic scenes) ----
 
 // A box 2 wide turning 30° a frame about +Y through its origin (1, 0, 0) and moving 0.5 a frame
 // along +Z: at frame 3 it has turned 90° (2 deep, 1 wide) about (1, 0, 1.5), by hand; the same

@@ -1,4 +1,4 @@
-# msm evaluate (issue 16): the command and its CLI tests, kept apart from the other commands' file.
+# msm evaluate: the command and its CLI tests, kept apart from the other commands' file.
 # Every test goes through msm_cli_test (tests/cli/expect: exit status and output together).
 target_sources(msm PRIVATE ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp)
 target_link_libraries(msm PRIVATE msm::evaluate_mpi)

@@ -234,7 +234,7 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
                   const nlohmann::json& json) {
   try {
     // The EXRs (zlib: most of the output's work) are encoded on a second thread while this one
-    // encodes the PNG (issue 18: image output was 16% of a one-shot 1080p render). The files are
+    // encodes the PNG (image output was 16% of a one-shot 1080p render). The files are
     // added in the same order as before.
     const std::filesystem::path exr = dir / (stem + ".exr"), rgb = dir / (stem + "-rgb.exr"),
                                 scattering = dir / (stem + "-scattering.exr");

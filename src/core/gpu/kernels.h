@@ -108,7 +108,7 @@ const int MSM_K_CSM_BASIS = 54;         // a.x = z, u.x = texel -> a
 const int MSM_K_CSM_SHADOW = 55;        // a, b = texels 0, 1 (terms 1..4); u = (terms, bits of damping,
                                         // scale, zf); offset 0 -> a.x
 const int MSM_K_OVERDARKEN = 56;        // a.xy = (shadow, factor) -> a.x
-// techniques.h, soft.h, bias.h: whole reconstructions from stored texels (issue 19's edge classes)
+// techniques.h, soft.h, bias.h: whole reconstructions from stored texels (the edge classes)
 const int MSM_K_TECHNIQUE_SHADOW4 = 57; // a = stored texel, b.x = unit zf, u.x = technique id -> a.x
 const int MSM_K_SOFT4 = 58;    // a = Θ4* average, b.xy = (zf, depth bias), u.x = 1 for Eq. (19) -> a.xyz = (depth,
                                // blocker shadow, shadow)
@@ -120,7 +120,7 @@ const int MSM_K_SCATTERING4 = 61; // a = stored texel, b.xy = (zf, beta), u.x = 
 const int MSM_K_SCATTERING6 = 62; // a.xyz, b.xyz = stored Θ6* (odd, even), a.w = zf, b.w = beta, u.x = rep -> a.x
 // rectification.h: the mip level of the filtered resampling (§5.2)
 const int MSM_K_RESAMPLING_LOD = 63; // a = (r, φ, r step, φ step), b = (map_per_x, map_per_y) -> a.x
-// rectification.h: the transmittance layers (issue 14, branch scatter-delta)
+// rectification.h: the transmittance layers
 const int MSM_K_TRANSMITTANCE_LAYERS = 64; // a = (Δ_lo, Δ_hi, delta, K) -> a.xy = (k0 + t, Δ_(K/2) / Δ_lo)
 // rectification.h: the prefix sums' mip level of a pixel (App. D.5)
 const int MSM_K_PREFIX_SUM_LOD = 65; // a = (du/dx, du/dy, dv/dx, dv/dy), b = (width, height, full circle) -> a.x

@@ -1,4 +1,4 @@
-// Copy shaders of msm_sat_timing (issue 18, docs/results.md "Copy shaders and a buffer scheme
+// Copy shaders of msm_sat_timing (docs/results.md "Copy shaders and a buffer scheme
 // against the copy bound"): what any shader moving a table of 16 B texels can reach on a device,
 // measured beside the summed-area table schemes. Not used by the renderer. Each reads and writes
 // every texel of a width × height table once, with nothing else to do:
