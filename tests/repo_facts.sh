@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Facts about the tree that a grep can check: a README a newcomer reads in two minutes, and code and
+# docs that speak of what is rather than of how it came to be (no issue numbers, sessions or branch
+# names; "branch" as a conditional in code or a tree's branch is fine). Exit 1 naming each breach.
+set -uo pipefail
+root=${1:-$(dirname "$0")/..}
+cd "$root" || exit 2
+failed=0
+fail() { echo "repo facts: $*" >&2; failed=1; }
+
+words=$(wc -w < README.md)
+((words < 1000)) || fail "README.md has $words words (limit 999)"
+
+paths=(src include tools scenes README.md docs/architecture.md docs/techniques.md docs/usage.md docs/viewer.md)
+if hits=$(grep -rnIE 'issue #?[0-9]|\bsessions?\b|\bbranch(es)? [a-z0-9]+-[a-z0-9-]+' "${paths[@]}"); then
+  fail "history words (issue numbers, sessions, branch names) in code or docs:"
+  echo "$hits" >&2
+fi
+exit $failed
