@@ -16,6 +16,7 @@ packages=(
   glmark2-data  # real meshes for the import tests (the bunny, 9 MB)
   blender-data  # CC0 equirectangular HDR light probes (studiolights/world) for the light-probe tests
   libglfw3-dev libimgui-dev xvfb xauth  # msm view (GLFW, Dear ImGui) and its tests in a virtual X server
+  fonts-dejavu-core  # the font of msm view's panel (Greek letters of the parameter help)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
 )
 

@@ -15,6 +15,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace msm::viewer {
 namespace {
@@ -206,12 +207,27 @@ void Viewer::fly(float dt) {
 
 void Viewer::panel() {
   ImGuiIO& io = ImGui::GetIO();
+  PanelLayout layout = panel_layout(io.DisplaySize.x, io.DisplaySize.y);
+  // Collapsed when the window becomes small (and at the start in a small one), opened when it
+  // becomes large; the user's click holds in between.
+  if (layout.collapsed != small_window) {
+    small_window = layout.collapsed;
+    ImGui::SetNextWindowCollapsed(layout.collapsed);
+  }
+  if (collapse_panel) ImGui::SetNextWindowCollapsed(*std::exchange(collapse_panel, std::nullopt));
   ImGui::SetNextWindowPos(ImVec2(0, 0));
-  ImGui::SetNextWindowSize(ImVec2(std::min(kPanelWidth, io.DisplaySize.x), io.DisplaySize.y));
+  ImGui::SetNextWindowSize(ImVec2(layout.width, io.DisplaySize.y));
   ImGui::SetNextWindowBgAlpha(0.85f);
-  ImGui::Begin("msm view", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  // The title says where an error is when the panel is collapsed ("###": the same window).
+  std::string title = error.empty() ? "msm view###panel" : "msm view: error (open the panel)###panel";
+  bool open = ImGui::Begin(title.c_str(), nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize);
   panel_min = ImGui::GetWindowPos();
   panel_max = ImVec2(panel_min.x + ImGui::GetWindowSize().x, panel_min.y + ImGui::GetWindowSize().y);
+  if (!open) { // collapsed: the title bar only
+    ImGui::End();
+    return;
+  }
+  ImGui::PushItemWidth(kPanelWidgetShare * layout.width);
   render::RenderSettings& s = view.settings;
   ImGui::Text("%s, %d triangles, %dx%d", scene.name.c_str(), int(scene.triangle_count()), s.width, s.height);
   if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", error.c_str());
@@ -400,6 +416,7 @@ void Viewer::panel() {
       } catch (const ViewError& e) { error = e.what(); }
   }
   if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
+  ImGui::PopItemWidth();
   ImGui::End();
 }
 
@@ -465,6 +482,9 @@ void Viewer::step_script() {
       screenshot_path = x[0];
     } else if (a.verb == "panel-mask") {
       write_panel_mask(x[0]);
+    } else if (a.verb == "panel") {
+      collapse_panel = x[0] == "collapsed";
+      note(fmt::format("panel: {}", x[0]));
     } else if (a.verb == "resize") {
       int w = int(number(x[0])), h = int(number(x[1]));
       glfwSetWindowSize(window, w, h);

@@ -27,7 +27,7 @@ constexpr Verb kVerbs[] = {{"technique", 1, 1},      {"set", 2, -1},         {"c
                            {"object-frame", 1, 1},   {"close", 0, 0},        {"quit", 0, 0},
                            {"each-technique", 0, 0}, {"ground-truth", 1, 1}, {"wait-ground-truth", 0, 0},
                            {"show-truth", 1, 1},     {"scene", 1, 1},        {"reload", 0, 0},
-                           {"show-map", 1, 1}};
+                           {"show-map", 1, 1},       {"panel", 1, 1}};
 
 double parse_number(const std::string& where, const std::string& text) {
   double v = 0;
@@ -64,6 +64,9 @@ void check(const Action& a) {
     double v = parse_number(w, a.args[0]);
     if (v != std::floor(v) || v < 1 || v > 65536)
       throw ScriptError(fmt::format("{}: ground-truth {}: samples are an integer in [1, 65536]", w, a.args[0]));
+  } else if (a.verb == "panel") {
+    if (a.args[0] != "open" && a.args[0] != "collapsed")
+      throw ScriptError(fmt::format("{}: panel {}: open or collapsed", w, a.args[0]));
   } else if (a.verb == "show-truth" || a.verb == "show-map") {
     if (a.args[0] != "on" && a.args[0] != "off")
       throw ScriptError(fmt::format("{}: {} {}: on or off", w, a.verb, a.args[0]));

@@ -201,6 +201,7 @@ TEST(Script, BadLinesAreNamed) {
   EXPECT_EQ(bad("resize 10 10\n"), "s.txt:1: resize 10 10: sizes are integers in [64, 8192]");
   EXPECT_EQ(bad("divider 1.5\n"), "s.txt:1: divider 1.5 is outside (0, 1)");
   EXPECT_EQ(bad("object-frame -2\n"), "s.txt:1: object-frame -2: expected an integer in [0, 100000]");
+  EXPECT_EQ(bad("panel closed\n"), "s.txt:1: panel closed: open or collapsed");
   EXPECT_NE(error_of<ScriptError>([] { load_script("/nonexistent/s.txt"); }).find("cannot open the script"),
             std::string::npos);
 }

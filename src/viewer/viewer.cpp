@@ -1,6 +1,8 @@
 // The viewer's window, frame loop and script runner; the panel is panel.cpp.
 #include "viewer_state.h"
 
+#include "font.h"
+
 #include "msm/image/io.h"
 #include "msm/techniques.h"
 #include "msm/vk/commands.h"
@@ -154,6 +156,8 @@ void Viewer::init_imgui() {
   if (swapchain->srgb()) // the style's colours are sRGB values; the swapchain encodes what it gets
     for (ImVec4& c : ImGui::GetStyle().Colors)
       c = ImVec4(image::srgb_to_linear(c.x), image::srgb_to_linear(c.y), image::srgb_to_linear(c.z), c.w);
+  unscaled_style = ImGui::GetStyle();
+  load_font();
   ImGui_ImplGlfw_InitForVulkan(window, true);
   imgui_glfw = true;
 
@@ -181,6 +185,20 @@ void Viewer::init_imgui() {
   imgui_vulkan = true;
   vk::submit_and_wait(*ctx, [](VkCommandBuffer c) { ImGui_ImplVulkan_CreateFontsTexture(c); });
   ImGui_ImplVulkan_DestroyFontUploadObjects();
+}
+
+void Viewer::load_font() {
+  PanelFont font = load_panel_font(*ImGui::GetIO().Fonts, default_font_file(), kPanelFontPixels, font_ranges);
+  if (font.fallback) note(font.message);
+}
+
+void Viewer::scale_panel(int width, int height) {
+  PanelLayout layout = panel_layout(float(width), float(height));
+  if (layout.scale == panel_scale) return;
+  panel_scale = layout.scale;
+  ImGui::GetStyle() = unscaled_style;
+  ImGui::GetStyle().ScaleAllSizes(layout.scale);
+  ImGui::GetIO().FontGlobalScale = layout.scale;
 }
 
 // A frame of one renderer; an invalid setting (the panel allows combinations the renderer refuses)
@@ -228,6 +246,7 @@ void Viewer::frame() {
   view.settings.width = int(extent.width);
   view.settings.height = int(extent.height);
 
+  scale_panel(w, h);
   ImGui_ImplVulkan_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
@@ -427,7 +446,9 @@ void Viewer::write_panel_mask(const std::string& path) {
     files.add_exr(path, mask);
     files.commit();
   } catch (const image::ImageError& e) { throw ViewerError(fmt::format("{}: {}", script_where, e.what())); }
-  note(fmt::format("panel-mask: {} (panel {},{} to {},{})", path, x0, y0, x1, y1));
+  double share = double(std::max(0, x1 - x0)) * std::max(0, y1 - y0) / (double(w) * h);
+  note(fmt::format("panel-mask: {} (panel {},{} to {},{}, covering {:.0f}% of the window)", path, x0, y0, x1, y1,
+                   100 * share));
 }
 
 void Viewer::start_truth(int samples) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "ground_truth.h"
+#include "panel_layout.h"
 
 #include "msm/image/metrics.h"
 #include "msm/render/renderer.h"
@@ -30,8 +31,6 @@ class Swapchain;
 
 namespace msm::viewer {
 
-inline constexpr float kPanelWidth = 380.0f;
-
 struct Viewer {
   explicit Viewer(const ViewerOptions& options);
   ~Viewer();
@@ -44,6 +43,9 @@ struct Viewer {
 
   // viewer.cpp
   void init_imgui();
+  void load_font();
+  // The panel's scale for the window's size (panel_layout.h), before the frame's ImGui::NewFrame.
+  void scale_panel(int width, int height);
   void frame();
   void record(uint32_t index, const render::Renderer::DeviceFrame& a, const render::Renderer::DeviceFrame& b,
               bool capture);
@@ -117,6 +119,11 @@ struct Viewer {
   double object_clock = 0.0;
 
   ImVec2 panel_min{0, 0}, panel_max{0, 0};
+  ImVector<ImWchar> font_ranges;      // read by the font atlas when it is built
+  ImGuiStyle unscaled_style;          // ImGuiStyle::ScaleAllSizes compounds: always from this one
+  float panel_scale = 0.0f;           // 0: not yet scaled
+  std::optional<bool> small_window;   // the panel_layout's collapsed default last applied
+  std::optional<bool> collapse_panel; // the script's `panel open|collapsed`, for the next frame
   std::string status, error;
   std::string view_path = "msm-view.json";
   std::string screenshot_path; // non-empty: captured this frame

@@ -1,13 +1,14 @@
 // `msm demo` (what `make demo` runs), in three parts:
 //  1. filtered hard shadows: the default scene with PCF, VSM, EVSM4, MSM 64, MSM 128 and the
 //     non-linearly quantized MSM at 64 and 32 bits side by side, errors against PCF (same kernel);
-//  2. single scattering: the `trees` scene (JCGT Fig. 16) at a third of the width and height with ray
-//     marching (32, 128 samples), CSM-32 and four and six moments, errors in the visible fraction
-//     of each view ray against the ray-traced scattering;
+//  2. single scattering: the `trees` scene (JCGT Fig. 16) rendered at a third of the width and
+//     height (shown magnified to the full width) with ray marching (32, 128 samples), CSM-32 and
+//     four and six moments, errors in the visible fraction of each view ray against the ray-traced
+//     scattering;
 //  3. soft shadows: the `models` scene (JCGT Fig. 8) with moment soft shadows (four and six
 //     moments) and their baselines VSSM and PCSS, errors against the ray-traced area light;
-//  4. image-based lighting (Kneiphof): the `sky_probe` scene at a third of the width and height,
-//     its probe cut into 16, 32 and 64 area lights with mssm6, 32 with pcss and 256 point lights
+//  4. image-based lighting (Kneiphof): the `sky_probe` scene rendered at a third of the width and
+//     height (shown magnified to the full width), its probe cut into 16, 32 and 64 area lights with mssm6, 32 with pcss and 256 point lights
 //     with hard shadows, errors against the full probe's Monte Carlo ground truth.
 // Each part writes one labelled image with magnified insets where the techniques differ, and
 // prints a table of the errors and the GPU time per pass.
@@ -36,15 +37,33 @@
 namespace msm::tool {
 namespace {
 
+// The parts rendered at a third of the width and height (their ray-traced truths cost the most)
+// are drawn as wide as the first part's sheet: each texel shown as `factor`² pixels (nearest, so
+// the texels stay visible), which leaves room for the labels and captions the full width has.
+image::Image magnified(const image::Image& image, int factor) {
+  image::Image out(image.width() * factor, image.height() * factor, image.channel_names());
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x)
+      for (int c = 0; c < image.channels(); ++c) out.at(x, y, c) = image.at(x / factor, y / factor, c);
+  return out;
+}
+
+// The whole-number factor that brings a part rendered `part_width` wide to the sheet width of a
+// frame `frame_width` wide.
+int sheet_magnification(int frame_width, int part_width) {
+  return std::max(1, int(std::lround(double(frame_width) / part_width)));
+}
+
 // One comparison: every technique rendered (per technique PNG, EXR, JSON in `out`), a table of
 // the errors against `truth` (the ray-traced visibility and its background) or, without it,
 // against the first technique, and the GPU time per pass (median of 5 frames); the figure in
 // out/figure_name. `truth_rgb` is the first panel where given. `scattering`: the signal is the
 // visible fraction of the view rays (background included) against the truth's "visibility".
+// `magnification`: the figure's panels and insets shown that many times larger (magnified).
 void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, const FrameOptions& frame,
                         const std::vector<std::string>& techniques, const image::Image* truth,
                         const image::Image* truth_rgb, const std::string& out, const std::string& figure_name,
-                        bool scattering = false) {
+                        bool scattering = false, int magnification = 1) {
   const scene::Scene& scene = renderer.scene();
   bool tty = isatty(fileno(stderr));
   std::vector<render::RenderResult> results;
@@ -77,8 +96,10 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
   std::vector<image::Image> candidates = signals;
   if (truth) candidates.insert(candidates.begin(), reference);
   std::vector<image::Rect> insets = image::find_difference_regions(candidates, side, side, 3);
+  for (image::Rect& r : insets)
+    r = {r.x * magnification, r.y * magnification, r.width * magnification, r.height * magnification};
   std::vector<image::Panel> panels;
-  if (truth_rgb) panels.push_back({"ray traced", *truth_rgb, "reference"});
+  if (truth_rgb) panels.push_back({"ray traced", magnified(*truth_rgb, magnification), "reference"});
   std::vector<std::string> pass_names;
   // Every pass any technique ran, in the order of a frame.
   for (const char* name : {"shadow_depth", "moment_resolve", "translucent", "one_pass_filter", "sat", "blur", "mipmaps",
@@ -105,7 +126,7 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
     fmt::print("{} {:>10.3f}\n", line, results[i].total_ms);
     std::string caption =
         i == 0 && !truth ? std::string("reference") : fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking);
-    panels.push_back({std::string(t.name), results[i].color, caption});
+    panels.push_back({std::string(t.name), magnified(results[i].color, magnification), caption});
   }
   image::ComposeOptions options;
   options.insets = insets;
@@ -137,7 +158,7 @@ reference::Settings reference_settings(reference::Effect effect, const render::R
 // the reference's composite of surface and in-scattered radiance as the first panel (tone mapped
 // like the renderer; its background has no sky behind the haze, which the medium hides anyway).
 void scatter_part(render::Renderer& renderer, const vk::Context& ctx, const FrameOptions& frame,
-                  const scene::Scene& scene, const std::vector<std::string>& techniques, int samples,
+                  const scene::Scene& scene, const std::vector<std::string>& techniques, int samples, int magnification,
                   const std::string& out) {
   const render::RenderSettings& fs = frame.settings;
   fmt::print("\nmsm demo: single scattering, scene '{}' at {}x{}, medium σt {}, shadow map {}², ray traced with {} "
@@ -146,7 +167,7 @@ void scatter_part(render::Renderer& renderer, const vk::Context& ctx, const Fram
   reference::Result truth = reference::render(scene, reference_settings(reference::Effect::scattering, fs, samples));
   image::Image truth_rgb = image::tone_map(truth.radiance, {std::log2(fs.exposure), image::ToneCurve::aces});
   compare_techniques(renderer, ctx, frame, techniques, &truth.visibility, &truth_rgb, out, "scatter-comparison.png",
-                     true);
+                     true, magnification);
 }
 
 // One configuration of the image-based-lighting part: a technique and the probe's light count.
@@ -162,7 +183,7 @@ const std::vector<IblCase> kIblCases = {
 // The error is in the luminance of the tone-mapped images (the look, as scripts/ibl-compare.sh
 // measures it), background excluded; it adds the lights' extraction and the shadows.
 void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Scene& scene, int samples,
-              const std::string& out) {
+              int magnification, const std::string& out) {
   const render::RenderSettings& fs = frame.settings;
   fmt::print("\nmsm demo: image-based lighting, scene '{}' at {}x{}, probe {} cut into area lights, shadow map "
              "{}², ray traced from the whole probe with {} samples per pixel\n",
@@ -170,7 +191,7 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
   reference::Result truth = reference::render(scene, reference_settings(reference::Effect::environment, fs, samples));
   image::Image truth_rgb = reference_look(truth, fs.exposure);
   image::Image mask = truth.visibility.channel("background");
-  std::vector<image::Panel> panels = {{"ray traced, whole probe", truth_rgb, "reference"}};
+  std::vector<image::Panel> panels = {{"ray traced, whole probe", magnified(truth_rgb, magnification), "reference"}};
   fmt::print("\n{:<20} {:>6} {:>8} {:>7} {:>12}\n", "technique", "lights", "MAE", ">3%", "GPU ms");
   for (const IblCase& c : kIblCases) {
     scene::Scene lit = scene;
@@ -184,7 +205,8 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
     image::Metrics m = image::compute_metrics(r.color, truth_rgb, {.mask = &mask});
     fmt::print("{:<20} {:>6} {:>8.5f} {:>6.2f}% {:>12.3f}\n", c.technique, c.lights, m.mae, 100 * m.share_above_3pct,
                r.total_ms);
-    panels.push_back({fmt::format("{}, {} lights", c.technique, c.lights), r.color, fmt::format("MAE {:.4f}", m.mae)});
+    panels.push_back({fmt::format("{}, {} lights", c.technique, c.lights), magnified(r.color, magnification),
+                      fmt::format("MAE {:.4f}", m.mae)});
   }
   image::ComposeOptions options;
   options.columns = 3;
@@ -330,12 +352,12 @@ void add_demo(CLI::App& app) {
     hard.reset();
     if (scatter_scene)
       scatter_part(*scatter_renderer, *ctx, scatter, *scatter_scene, opt->scatter_techniques, opt->scatter_samples,
-                   opt->out);
+                   sheet_magnification(fs.width, scatter.settings.width), opt->out);
     else
       fmt::print("\nmsm demo: scattering part skipped (no --scatter-techniques)\n");
     scatter_renderer.reset();
     if (ibl_scene)
-      ibl_part(*ctx, ibl, *ibl_scene, opt->ibl_samples, opt->out);
+      ibl_part(*ctx, ibl, *ibl_scene, opt->ibl_samples, sheet_magnification(fs.width, ibl.settings.width), opt->out);
     else
       fmt::print("\nmsm demo: image-based-lighting part skipped (--ibl-scene \"\")\n");
     if (!soft_scene) {
