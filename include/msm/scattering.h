@@ -22,16 +22,48 @@
 
 MSM_BEGIN
 
-// Henyey–Greenstein phase function, (1 − g²) / (4π (1 + g² − 2 g cos θ)^(3/2)).
-// Precondition: −1 < g < 1 (the scene loader refuses others), cos θ in [−1, 1].
-MSM_FN float msm_phase_henyey_greenstein(float cos_theta, float g) {
-  const float denominator = max(1.0f + g * g - 2.0f * g * cos_theta, 1e-12f);
-  return (1.0f - g * g) / (4.0f * MSM_PI * denominator * sqrt(denominator));
+// Henyey–Greenstein phase function, (1 − g²) / (4π (1 + g² − 2 g cos θ)^(3/2)), of the scattering
+// angle given by its versines 1 − cos θ and 1 + cos θ. As |g| → 1 the function peaks at cos θ =
+// sign(g), where 1 + g² − 2 g cos θ falls to (1 − |g|)², 1e-8 at |g| = 0.9999: as a difference of
+// terms near 1, which float rounds by 6e-8, that is lost. Written as (1 − |g|)² + 2 |g| (1 ∓ cos θ)
+// and (1 − g)(1 + g) nothing cancels (1 − |g| is exact for |g| >= ½), given versines without
+// cancellation (msm_versines_between). Precondition: −1 < g < 1 (the scene loader refuses others),
+// versines in [0, 2].
+MSM_FN float msm_phase_henyey_greenstein_versines(float one_minus_cos, float one_plus_cos, float g) {
+  const float a = abs(g);
+  const float one_minus_a = 1.0f - a;
+  const float versine = max(g >= 0.0f ? one_minus_cos : one_plus_cos, 0.0f);
+  const float denominator = one_minus_a * one_minus_a + 2.0f * a * versine;
+  return (1.0f - g) * (1.0f + g) / (4.0f * MSM_PI * denominator * sqrt(denominator));
 }
 
-// f(ω_l, ω_p) of the radiance above: ρ σt p(cos θ); cos_theta = dot(towards_light, view direction).
-MSM_FN float msm_scattering_phase_term(float extinction, float albedo, float g, float cos_theta) {
-  return albedo * extinction * msm_phase_henyey_greenstein(cos_theta, g);
+// The versines (1 − cos θ, 1 + cos θ) of the angle θ between unit vectors u and v, as ½|u − v|²
+// and ½|u + v|²: accurate to a few ulp where 1 ∓ dot(u, v) loses every digit (θ below 3e-4 rad,
+// where float's cos θ is 1). Vectors of length 1 + ε add (ε_u − ε_v)² / 2 to them (float's
+// normalize: ε ~ 1e-7, so ~1e-14).
+MSM_FN vec2 msm_versines_between(vec3 u, vec3 v) {
+  const vec3 difference = u - v, sum = u + v;
+  return vec2(0.5f * dot(difference, difference), 0.5f * dot(sum, sum));
+}
+
+// Henyey–Greenstein of cos θ: exact to a few ulp for the float cos θ given (1 ∓ cos θ is exact
+// where it is small), but float's cos θ itself cannot tell angles below 3e-4 rad from 0; where
+// the directions are at hand, msm_phase_henyey_greenstein_between.
+MSM_FN float msm_phase_henyey_greenstein(float cos_theta, float g) {
+  return msm_phase_henyey_greenstein_versines(1.0f - cos_theta, 1.0f + cos_theta, g);
+}
+
+// Henyey–Greenstein of the angle between unit vectors: the light's towards_light and the view
+// direction (from the camera outwards), cos θ = dot(towards_light, view_dir).
+MSM_FN float msm_phase_henyey_greenstein_between(vec3 towards_light, vec3 view_dir, float g) {
+  const vec2 versines = msm_versines_between(towards_light, view_dir);
+  return msm_phase_henyey_greenstein_versines(versines.x, versines.y, g);
+}
+
+// f(ω_l, ω_p) of the radiance above: ρ σt p(cos θ), cos θ = dot(towards_light, view_dir) of unit
+// vectors (view_dir from the camera outwards).
+MSM_FN float msm_scattering_phase_term(float extinction, float albedo, float g, vec3 towards_light, vec3 view_dir) {
+  return albedo * extinction * msm_phase_henyey_greenstein_between(towards_light, view_dir, g);
 }
 
 // (1 − exp(−x)) / x for x >= 0 without the cancellation of 1 − exp(−x) at small x (GLSL has no

@@ -240,8 +240,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     std::vector<float> phase(light_towards.size());
     std::vector<ScatteringLight> lights(light_towards.size());
     for (std::size_t l = 0; l < lights.size(); ++l) {
-      phase[l] =
-          msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, float(glm::dot(light_towards[l], dir)));
+      phase[l] = msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, glm::vec3(light_towards[l]),
+                                           glm::vec3(dir));
       lights[l] = {light_towards[l], double(msm_scattering_light_weight(glm::vec3(light_irradiance[l]), phase[l]))};
     }
     const ScatteringSample e = scattering_along_ray(ctx, m, camera, dir, s, lights, rng);

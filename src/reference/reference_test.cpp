@@ -944,8 +944,7 @@ TEST(reference_scattering, TwoLightsScatterTheSumOfEach) {
       double weighted = 0.0, weight = 0.0;
       for (int l = 0; l < 2; ++l) {
         const msm::scene::DirectionalLight& light = both.lights[std::size_t(l)];
-        const float phase =
-            msm::msm_scattering_phase_term(0.3f, 0.8f, 0.4f, float(glm::dot(glm::dvec3(light.towards_light), d)));
+        const float phase = msm::msm_scattering_phase_term(0.3f, 0.8f, 0.4f, light.towards_light, glm::vec3(d));
         const double w = msm::msm_scattering_light_weight(light.irradiance, phase);
         weighted += w * channel(alone[l].visibility, "visibility", x, y);
         weight += w;

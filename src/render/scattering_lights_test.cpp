@@ -106,7 +106,7 @@ TEST_F(ScatteringLightsTest, ScatteringIsTheSumOverTheLights) {
         for (int l = 0; l < 2; ++l) {
           const scene::DirectionalLight& light = scene.lights[size_t(l)];
           const float phase = msm_scattering_phase_term(medium.extinction, medium.scattering_albedo, medium.g,
-                                                        float(glm::dot(glm::dvec3(light.towards_light), d)));
+                                                        light.towards_light, glm::vec3(d));
           const double w = msm_scattering_light_weight(light.irradiance, phase);
           v[l] = alone[l].scattering.at(x, y, 3);
           weighted += w * v[l];

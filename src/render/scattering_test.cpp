@@ -99,8 +99,8 @@ TEST_F(ScatteringTest, UnshadowedMediumMatchesTheClosedForm) {
         if (!hit) continue;
         glm::dvec3 ray = *hit - glm::dvec3(scene.camera.position);
         double s = glm::length(ray);
-        float cos_theta = float(glm::dot(glm::dvec3(scene.light().towards_light), ray / s));
-        double phase = msm_scattering_phase_term(medium.extinction, medium.scattering_albedo, medium.g, cos_theta);
+        double phase = msm_scattering_phase_term(medium.extinction, medium.scattering_albedo, medium.g,
+                                                 scene.light().towards_light, glm::vec3(ray / s));
         double integral = -std::expm1(-double(medium.extinction) * s) / double(medium.extinction);
         for (int c = 0; c < 3; ++c) {
           double expected = phase * double(scene.light().irradiance[c]) * integral;

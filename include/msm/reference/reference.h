@@ -92,7 +92,7 @@
 //               per light from each, whose plain mean estimates V_l. The radiance is
 //               msm/scattering.h's sum over the lights: exp(-st s) L_s + sum_l f_l E_l V_l
 //               integral_0^s exp(-st t) dt, with f_l = msm_scattering_phase_term(st, albedo, g,
-//               dot(L_l, d)) and L_s the surface's radiance lit by every light with its exact
+//               L_l, d) and L_s the surface's radiance lit by every light with its exact
 //               (hard) shadow, 0 on background; "visibility" is V = sum_l w_l V_l / sum_l w_l
 //               (w_l = msm_scattering_light_weight: the luminance of f_l E_l; one light: V_1),
 //               its std_error that of the samples sum_l w_l V_l(t) / sum_l w_l. A camera inside an

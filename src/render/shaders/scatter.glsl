@@ -146,8 +146,8 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
 // Light l's in-scattering along the view ray, added to sum.
 ScatteringSum add_light(ScatteringSum sum, int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
   float extinction = scatter.medium.x;
-  float phase = msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z,
-                                          dot(lights[l].towards_light.xyz, direction));
+  float phase =
+      msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z, lights[l].towards_light.xyz, direction);
   return msm_scattering_add_light(sum, lights[l].irradiance.rgb, extinction, phase, s,
                                   visible_fraction(l, pixel, camera, direction, s));
 }
