@@ -3,9 +3,13 @@
 // combined by the balance heuristic; the extracted area lights (--probe-lights) and the scene's
 // other directional lights are uniform cones (discs) or rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
+#include <vector>
 
 #include "internal.h"
 #include "msm/light_probe.h"
@@ -53,9 +57,12 @@ ConeLight cone_light(const scene::Scene& scene, const scene::DirectionalLight& l
   return c;
 }
 
-double face_coordinate(int i, int m, double offset) { return (2.0 * (i + offset)) / m - 1.0; }
+std::atomic<ProbeDistribution> distribution_in_use{ProbeDistribution::compensated};
 
 } // namespace
+
+void set_probe_distribution(ProbeDistribution distribution) { distribution_in_use = distribution; }
+ProbeDistribution probe_distribution() { return distribution_in_use; }
 
 EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_lights) {
   if (!scene.probe)
@@ -79,23 +86,38 @@ EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_l
     cube = msm::probe::load_probe(p.file.string(), p.size, p.rotation_deg, p.intensity);
   } catch (const msm::probe::ProbeError& e) { throw std::invalid_argument(e.what()); }
   size = cube.size;
+  distribution = probe_distribution();
   const int m = size;
-  radiance.reserve(std::size_t(6) * m * m);
-  cdf.reserve(radiance.capacity());
-  double total = 0.0;
+  const std::size_t texels = std::size_t(6) * m * m;
+  radiance.reserve(texels);
+  std::vector<double> luminance, weight;
+  luminance.reserve(texels);
+  weight.reserve(texels);
+  double energy = 0.0, solid_angle = 0.0;
   for (int face = 0; face < 6; ++face)
     for (int j = 0; j < m; ++j)
       for (int i = 0; i < m; ++i) {
         const glm::vec3 L = cube.at(face, i, j);
         radiance.push_back(L);
-        total += double(msm_luminance(L)) *
-                 msm_cube_texel_weight(float(face_coordinate(i, m, 0.5)), float(face_coordinate(j, m, 0.5)), float(m));
-        cdf.push_back(total);
+        luminance.push_back(double(msm_luminance(L)));
+        weight.push_back(double(msm_cube_texel_weight(msm_cube_face_coordinate(i, 0.5f, float(m)),
+                                                      msm_cube_face_coordinate(j, 0.5f, float(m)), float(m))));
+        energy += luminance.back() * weight.back();
+        solid_angle += weight.back();
       }
+  // Compensated: the radiance above the probe's mean is what the cosine samples, whose density is
+  // smooth, draw poorly; the rest they draw well, and the balance heuristic gives them all of it.
+  const double floor = distribution == ProbeDistribution::compensated ? energy / solid_angle : 0.0;
+  cdf.reserve(texels);
+  double total = 0.0;
+  for (std::size_t t = 0; t < texels; ++t) {
+    total += std::max(luminance[t] - floor, 0.0) * weight[t];
+    cdf.push_back(total);
+  }
   if (total > 0.0)
     for (double& c : cdf) c /= total;
   else
-    cdf.clear(); // a black probe: only the cosine samples (which find no light)
+    cdf.clear(); // a uniform or black probe: only the cosine samples
 }
 
 EnvironmentSample environment_irradiance(const EffectContext& ctx, const EnvironmentLighting& lighting,
@@ -103,76 +125,98 @@ EnvironmentSample environment_irradiance(const EffectContext& ctx, const Environ
   const int count = ctx.settings.samples;
   const SampleSet set(ctx.settings.sampler, count);
   const glm::dvec3 facing = glm::dot(hit.normal, view) > 0.0 ? -hit.normal : hit.normal;
-  EnvironmentSample out;
-  // V(ω): directions below the geometric horizon cross the surface itself.
-  const auto visible = [&](const glm::dvec3& d) {
-    if (glm::dot(facing, d) <= 0.0) return false;
-    ++out.rays;
-    return !ctx.tracer.occluded(offset_origin(hit.p, hit.normal, hit.scale, d), d);
-  };
   const int m = lighting.size;
-  const bool probe = !lighting.cdf.empty();
-  const auto probability = [&](std::size_t t) { return lighting.cdf[t] - (t ? lighting.cdf[t - 1] : 0.0); };
+  const bool probe = !lighting.radiance.empty(), probe_sampled = !lighting.cdf.empty();
+  const auto probability = [&](std::size_t t) {
+    return probe_sampled ? lighting.cdf[t] - (t ? lighting.cdf[t - 1] : 0.0) : 0.0;
+  };
   // Solid-angle density of the probe sampler at a point (u, v) of texel t: the texel's
   // probability over its area 4 / m² on the face plane, times the plane's dA / dω.
-  const auto probe_pdf = [&](std::size_t t, double u, double v) {
-    return probability(t) / double(msm_cube_texel_weight(float(u), float(v), float(m)));
+  const auto probe_pdf = [&](std::size_t t, float u, float v) {
+    return probability(t) / double(msm_cube_texel_weight(u, v, float(m)));
   };
   glm::dvec3 tx, ty;
   basis(n, tx, ty);
+  // The rays of a batch of samples, traced together (Tracer::occluded's packets): f / pdf of each
+  // direction and the sample it belongs to. V(ω) = 0 below the geometric horizon (the ray crosses
+  // the surface itself): those directions count in the unoccluded sum only, untraced.
+  const std::size_t per_sample = 2 + lighting.cones.size();
+  std::vector<glm::dvec3> origins(kSampleBatch * per_sample), dirs(origins.size()), values(origins.size());
+  std::vector<int> owners(origins.size());
+  const auto blocked = std::make_unique<bool[]>(origins.size());
+  std::array<glm::dvec3, kSampleBatch> value, value0;
+  EnvironmentSample out;
   RunningStats stats;
   glm::dvec3 sum(0.0), sum0(0.0);
-  for (int i = 0; i < count; ++i) {
-    glm::dvec3 value(0.0), value0(0.0);
-    const auto add = [&](const glm::dvec3& f, const glm::dvec3& d) {
-      value0 += f;
-      if (visible(d)) value += f;
+  for (int first = 0; first < count; first += kSampleBatch) {
+    const int batch = std::min(kSampleBatch, count - first);
+    int rays = 0;
+    const auto add = [&](int sample, const glm::dvec3& f, const glm::dvec3& d) {
+      value0[sample] += f;
+      if (glm::dot(facing, d) <= 0.0) return;
+      origins[rays] = offset_origin(hit.p, hit.normal, hit.scale, d);
+      dirs[rays] = d;
+      values[rays] = f;
+      owners[rays++] = sample;
     };
-    if (probe) {
-      // Probe sample: the texel by the first coordinate, the point inside it by what is left of it and the second.
-      const glm::dvec2 a = set.point(i, rng);
-      const std::size_t t =
-          std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), a.x) - lighting.cdf.begin(),
-                                lighting.cdf.size() - 1);
-      const double p = probability(t);
-      const double s = p > 0.0 ? std::clamp((a.x - (lighting.cdf[t] - p)) / p, 0.0, 1.0) : 0.5;
-      const int face = int(t / (std::size_t(m) * m)), j = int(t / m % m), k = int(t % m);
-      const double u = face_coordinate(k, m, s), v = face_coordinate(j, m, a.y);
-      const glm::dvec3 d = glm::normalize(glm::dvec3(msm_cube_direction(face, float(u), float(v))));
-      const double c = glm::dot(n, d);
-      if (c > 0.0) add(glm::dvec3(lighting.radiance[t]) * (c / (probe_pdf(t, u, v) + c / kPi)), d);
-      // Cosine sample.
-      const glm::dvec2 b = concentric_disc(set.point(i, rng));
-      const double z = std::sqrt(std::max(0.0, 1.0 - b.x * b.x - b.y * b.y));
-      const glm::dvec3 e = glm::normalize(b.x * tx + b.y * ty + z * n);
-      const double ce = glm::dot(n, e);
-      if (ce > 0.0) {
-        const MsmCubeCoord q = msm_cube_coord(glm::vec3(e));
-        const int qi = std::clamp(int((q.uv.x + 1.0f) * 0.5f * m), 0, m - 1);
-        const int qj = std::clamp(int((q.uv.y + 1.0f) * 0.5f * m), 0, m - 1);
-        const std::size_t te = (std::size_t(q.face) * m + qj) * m + qi;
-        add(glm::dvec3(lighting.radiance[te]) * (ce / (probe_pdf(te, q.uv.x, q.uv.y) + ce / kPi)), e);
-      }
-    }
-    for (const ConeLight& l : lighting.cones) {
-      const glm::dvec2 a = set.point(i, rng);
-      if (l.rectangle) {
-        const glm::dvec3 p = l.axis + (2.0 * a.x - 1.0) * l.half_x * l.x + (2.0 * a.y - 1.0) * l.half_y * l.y;
-        const double r = glm::length(p);
-        const glm::dvec3 d = p / r;
+    for (int b = 0; b < batch; ++b) {
+      const int i = first + b;
+      value[b] = value0[b] = glm::dvec3(0.0);
+      if (probe_sampled) {
+        // Probe sample: the texel by the first coordinate, the point inside it by what is left of it and the second.
+        const glm::dvec2 a = set.point(i, rng);
+        const std::size_t t = std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), a.x) -
+                                                        lighting.cdf.begin(),
+                                                    lighting.cdf.size() - 1);
+        const double p = probability(t);
+        const double s = p > 0.0 ? std::clamp((a.x - (lighting.cdf[t] - p)) / p, 0.0, 1.0) : 0.5;
+        const int face = int(t / (std::size_t(m) * m)), j = int(t / m % m), k = int(t % m);
+        const float u = msm_cube_face_coordinate(k, float(s), float(m)),
+                    v = msm_cube_face_coordinate(j, float(a.y), float(m));
+        const glm::dvec3 d = glm::normalize(glm::dvec3(msm_cube_direction(face, u, v)));
         const double c = glm::dot(n, d);
-        if (c > 0.0) add(l.estimate * (c / (r * r * r)), d); // cos θ = 1 / r
-        continue;
+        if (c > 0.0) add(b, glm::dvec3(lighting.radiance[t]) * (c / (probe_pdf(t, u, v) + c / kPi)), d);
       }
-      const double cos_t = 1.0 - a.x * (1.0 - l.cos_alpha), sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
-      const double phi = 2.0 * kPi * a.y;
-      const glm::dvec3 d = glm::normalize(cos_t * l.axis + sin_t * (std::cos(phi) * l.x + std::sin(phi) * l.y));
-      const double c = glm::dot(n, d);
-      if (c > 0.0) add(l.estimate * c, d);
+      if (probe) {
+        // Cosine sample.
+        const glm::dvec2 q2 = concentric_disc(set.point(i, rng));
+        const double z = std::sqrt(std::max(0.0, 1.0 - q2.x * q2.x - q2.y * q2.y));
+        const glm::dvec3 e = glm::normalize(q2.x * tx + q2.y * ty + z * n);
+        const double ce = glm::dot(n, e);
+        if (ce > 0.0) {
+          const MsmCubeCoord q = msm_cube_coord(glm::vec3(e));
+          const int qi = std::clamp(int((q.uv.x + 1.0f) * 0.5f * m), 0, m - 1);
+          const int qj = std::clamp(int((q.uv.y + 1.0f) * 0.5f * m), 0, m - 1);
+          const std::size_t te = (std::size_t(q.face) * m + qj) * m + qi;
+          add(b, glm::dvec3(lighting.radiance[te]) * (ce / (probe_pdf(te, q.uv.x, q.uv.y) + ce / kPi)), e);
+        }
+      }
+      for (const ConeLight& l : lighting.cones) {
+        const glm::dvec2 a = set.point(i, rng);
+        if (l.rectangle) {
+          const glm::dvec3 p = l.axis + (2.0 * a.x - 1.0) * l.half_x * l.x + (2.0 * a.y - 1.0) * l.half_y * l.y;
+          const double r = glm::length(p);
+          const glm::dvec3 d = p / r;
+          const double c = glm::dot(n, d);
+          if (c > 0.0) add(b, l.estimate * (c / (r * r * r)), d); // cos θ = 1 / r
+          continue;
+        }
+        const double cos_t = 1.0 - a.x * (1.0 - l.cos_alpha), sin_t = std::sqrt(std::max(0.0, 1.0 - cos_t * cos_t));
+        const double phi = 2.0 * kPi * a.y;
+        const glm::dvec3 d = glm::normalize(cos_t * l.axis + sin_t * (std::cos(phi) * l.x + std::sin(phi) * l.y));
+        const double c = glm::dot(n, d);
+        if (c > 0.0) add(b, l.estimate * c, d);
+      }
     }
-    sum += value;
-    sum0 += value0;
-    stats.add(double(msm_luminance(glm::vec3(value))));
+    ctx.tracer.occluded(origins.data(), dirs.data(), rays, blocked.get());
+    out.rays += std::uint64_t(rays);
+    for (int r = 0; r < rays; ++r)
+      if (!blocked[r]) value[owners[r]] += values[r];
+    for (int b = 0; b < batch; ++b) {
+      sum += value[b];
+      sum0 += value0[b];
+      stats.add(double(msm_luminance(glm::vec3(value[b]))));
+    }
   }
   out.irradiance = sum / double(count);
   out.unoccluded = sum0 / double(count);

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "internal.h"
 #include "msm/light_probe.h"
 #include "msm/probe/probe.h"
 #include "msm/reference/reference.h"
@@ -195,6 +196,128 @@ TEST(Environment, BoxShadowTakesTheSunsShareAway) {
   EXPECT_GT(drop, lum(sun_share) - tolerance);
   EXPECT_LT(drop, lum(sun_share) + sky_hidden + tolerance);
   EXPECT_GT(lum(sun_share), 0.5 * lum(open)); // the test means something: the sun is most of the light
+}
+
+// ∫ L max(n·ω, 0) dω of the piecewise constant probe exactly as the estimator integrates it
+// (each texel's radiance over the texel), by the midpoint rule over k x k parts of each texel
+// (msm_cube_texel_weight at the finer size): within 1e-6 relative of the exact integral here, where
+// the midpoint rule over whole texels (quadrature above) is off by the cosine's curvature.
+glm::dvec3 piecewise_constant_irradiance(const msm::probe::CubeMap& cube, const glm::dvec3& n, int k) {
+  glm::dvec3 sum(0.0);
+  const int m = cube.size, fine = m * k;
+  for (int face = 0; face < 6; ++face)
+    for (int j = 0; j < fine; ++j)
+      for (int i = 0; i < fine; ++i) {
+        const float u = msm::msm_cube_face_coordinate(i, 0.5f, float(fine)),
+                    v = msm::msm_cube_face_coordinate(j, 0.5f, float(fine));
+        const glm::dvec3 d = glm::normalize(glm::dvec3(msm::msm_cube_direction(face, u, v)));
+        sum += double(msm::msm_cube_texel_weight(u, v, float(fine))) * std::max(glm::dot(n, d), 0.0) *
+               glm::dvec3(cube.at(face, i / k, j / k));
+      }
+  return sum;
+}
+
+// Pixels of one render as independent runs: each pixel draws from its own generator.
+struct PixelStatistics {
+  double mean = 0.0, std_error = 0.0; // of the pixels' irradiance luminance, from their spread
+  double mean_relative_error = 0.0;   // each pixel's own std_error over its luminance, averaged
+};
+PixelStatistics pixel_statistics(const Result& r) {
+  const auto& p = r.irradiance.pixels();
+  const std::size_t n = r.irradiance.pixel_count();
+  double sum = 0.0, squares = 0.0, relative = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double y = lum(glm::dvec3(p[4 * k], p[4 * k + 1], p[4 * k + 2]));
+    sum += y;
+    squares += y * y;
+    relative += p[4 * k + 3] / y;
+  }
+  PixelStatistics s;
+  s.mean = sum / double(n);
+  s.std_error = std::sqrt(std::max(0.0, (squares - sum * s.mean) / double(n - 1)) / double(n));
+  s.mean_relative_error = relative / double(n);
+  return s;
+}
+
+// The estimator is unbiased: on the unoccluded plane under the procedural sky (every pixel the
+// same irradiance), the mean of 1296 independent pixels of 256 samples each is the probe's exact
+// irradiance within 4 standard errors of that mean (measured from the pixels' spread), for both
+// probe distributions; the standard error is below 0.1% of it, so this is a sharp check.
+TEST(Environment, EstimatorIsUnbiasedOnTheUnoccludedPlane) {
+  const Scene scene = sky_scene(kTopCamera, kPlane);
+  const msm::probe::CubeMap cube = msm::probe::load_probe("sky", kProbeSize);
+  const double expected = lum(piecewise_constant_irradiance(cube, {0.0, 1.0, 0.0}, 16));
+  Settings s = environment_settings(256);
+  s.width = 48;
+  s.height = 27;
+  for (auto distribution : {detail::ProbeDistribution::compensated, detail::ProbeDistribution::luminance}) {
+    detail::set_probe_distribution(distribution);
+    const PixelStatistics m = pixel_statistics(render(scene, s));
+    const char* name = distribution == detail::ProbeDistribution::compensated ? "compensated" : "luminance";
+    std::printf("[unbiased] %s: mean %.6f, exact %.6f, standard error %.6f (%.2f of them off)\n", name, m.mean,
+                expected, m.std_error, (m.mean - expected) / m.std_error);
+    EXPECT_LT(std::abs(m.mean - expected), 4.0 * m.std_error) << name;
+    EXPECT_LT(m.std_error, 1e-3 * expected) << name;
+  }
+  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
+}
+
+// With occlusion (the box's shadow and contact shadows on the plane, under the sky and its sun):
+// the two probe distributions estimate the same irradiance. Independent samples (whose std_error
+// is the standard error, where the stratified sampler's is an upper bound); per pixel z = (E_c −
+// E_l) / sqrt(se_c² + se_l²) from two independent renders: the mean of z within 4 / sqrt(pixels)
+// of 0 (a bias of a tenth of a standard error in every pixel shows), and the mean of z² below 1.3
+// (1 without a bias, give or take 0.04 over 1296 pixels; a bias of 0.6 standard errors in every
+// pixel, or of 1.2 in a quarter of them, adds 0.36).
+TEST(Environment, ProbeDistributionsAgreeUnderOcclusion) {
+  const std::string box =
+      R"({"primitive": {"type": "box", "size": [1, 1, 1]}, "transform": {"translate": [0, 0.5, 0]}})";
+  const std::string camera = R"({"position": [2, 3, 3], "target": [0, 0.3, 0], "fov_y_deg": 50})";
+  const Scene scene = sky_scene(camera, kPlane + ", " + box);
+  Settings s = environment_settings(256);
+  s.width = 48;
+  s.height = 27;
+  s.sampler = Sampler::independent;
+  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
+  const Result c = render(scene, s);
+  detail::set_probe_distribution(detail::ProbeDistribution::luminance);
+  s.seed = 2;
+  const Result l = render(scene, s);
+  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
+  const auto& pc = c.irradiance.pixels();
+  const auto& pl = l.irradiance.pixels();
+  double z_sum = 0.0, z2_sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < c.irradiance.pixel_count(); ++k) {
+    const double se = std::hypot(pc[4 * k + 3], pl[4 * k + 3]);
+    if (!(se > 0.0)) continue;
+    const double z = (lum(glm::dvec3(pc[4 * k], pc[4 * k + 1], pc[4 * k + 2])) -
+                      lum(glm::dvec3(pl[4 * k], pl[4 * k + 1], pl[4 * k + 2]))) /
+                     se;
+    z_sum += z;
+    z2_sum += z * z;
+    ++n;
+  }
+  ASSERT_GT(n, 1000u);
+  const double z_mean = z_sum / double(n), z2_mean = z2_sum / double(n);
+  std::printf("[agree] %zu pixels: mean z %.4f, mean z^2 %.4f\n", n, z_mean, z2_mean);
+  EXPECT_LT(std::abs(z_mean), 4.0 / std::sqrt(double(n)));
+  EXPECT_LT(z2_mean, 1.3);
+}
+
+// The default estimator's noise on the sky with its sun: the pixels' own relative standard error at
+// 64 samples, averaged over the unoccluded plane. Measured: 0.0038 with the compensated
+// distribution (the default), 0.0905 with the luminance one (its sun texel drawn by a fifth of the
+// probe samples, where the compensated distribution gives it two thirds and the rest of the sky to
+// the cosine samples). Asserted: below 0.01.
+TEST(Environment, DefaultEstimatorIsQuietUnderTheSun) {
+  const Scene scene = sky_scene(kTopCamera, kPlane);
+  Settings s = environment_settings(64);
+  s.width = 48;
+  s.height = 27;
+  const double noise = pixel_statistics(render(scene, s)).mean_relative_error;
+  std::printf("[noise] default estimator: mean relative standard error %.4f\n", noise);
+  EXPECT_LT(noise, 0.01);
 }
 
 TEST(Environment, SceneWithoutProbeIsRefused) {

@@ -282,12 +282,22 @@ struct ConeLight {
   // rectangle: that irradiance x area / F (msm_rect_light_facing_integral), times cos³ θ per sample.
   glm::dvec3 estimate{0.0};
 };
+// The distribution of the environment effect's probe samples over the texels (reference.h,
+// "environment"): `compensated` (the default) in proportion to max(Y − Ȳ, 0) x solid angle, Ȳ the
+// probe's mean luminance (Karlík et al., "MIS Compensation", 2019; pbrt-v4's image infinite light),
+// `luminance` in proportion to Y x solid angle. Process-wide: a measurement
+// (bench/environment_noise.cpp) compares the two in one binary.
+enum class ProbeDistribution { compensated, luminance };
+void set_probe_distribution(ProbeDistribution distribution);
+ProbeDistribution probe_distribution();
+
 struct EnvironmentLighting {
   EnvironmentLighting(const scene::Scene& scene, bool probe_lights);
   int size = 0;                    // of the probe's faces; 0 with probe_lights (no probe sampled)
   std::vector<glm::vec3> radiance; // 6 size² texels, face-major, rows along +v
-  std::vector<double> cdf;         // of luminance x texel weight, normalized, cdf.back() = 1
-  std::vector<ConeLight> cones;    // lights sampled as uniform cones or rectangles
+  ProbeDistribution distribution = ProbeDistribution::compensated;
+  std::vector<double> cdf;      // of the distribution, normalized, cdf.back() = 1; empty: no probe samples
+  std::vector<ConeLight> cones; // lights sampled as uniform cones or rectangles
 };
 struct EnvironmentSample {
   glm::dvec3 irradiance{0.0}, unoccluded{0.0};
