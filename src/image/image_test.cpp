@@ -621,6 +621,21 @@ TEST(Metrics, MaskNonFiniteChannelsAndLuminance) {
   EXPECT_EQ(n.non_finite, 2u);
   EXPECT_EQ(n.pixels, 126u);
   EXPECT_EQ(n.mae, 8.0 / 126.0);
+  EXPECT_EQ(n.non_finite_in_test, 2u); // the reference is finite there
+
+  // Non-finite in the reference (or both) is not the test's failure; masked pixels are not counted.
+  Image nan_ref = ref;
+  nan_ref.at(0, 0) = std::nanf("");
+  nan_ref.at(2, 0) = -INFINITY;
+  Image nan_mask(16, 8, 1, 0.0f);
+  nan_mask.at(1, 0) = 1.0f;
+  const Metrics r = compute_metrics(nan_test, nan_ref, {.mask = &nan_mask});
+  EXPECT_EQ(r.masked, 1u);
+  EXPECT_EQ(r.non_finite, 2u);
+  EXPECT_EQ(r.non_finite_in_test, 0u);
+  const Metrics all_nan = compute_metrics(Image(16, 8, 1, std::nanf("")), ref);
+  EXPECT_EQ(all_nan.pixels, 0u);
+  EXPECT_EQ(all_nan.non_finite_in_test, 128u);
 
   // RGB: compared as Rec. 709 luminance; a named channel on request.
   Image rgb_ref(2, 1, 3, 0.0f), rgb_test(2, 1, 3, 0.0f);

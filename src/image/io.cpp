@@ -579,6 +579,14 @@ Image read_exr(const fs::path& path) {
 
 Image read_image(const fs::path& path) { return decode_image(read_file(path), path); }
 
+std::string_view to_string(FileFormat format) { return format == FileFormat::png ? "PNG" : "EXR"; }
+
+ImageFile read_image_file(const fs::path& path) {
+  const std::vector<std::uint8_t> bytes = read_file(path);
+  const FileFormat format = is_png(bytes) ? FileFormat::png : FileFormat::exr;
+  return {decode_image(bytes, path), format};
+}
+
 Image decode_image(std::span<const std::uint8_t> bytes, const fs::path& name) {
   if (is_png(bytes)) return decode_png(name, bytes);
   if (is_exr(bytes)) return decode_exr(name, bytes);

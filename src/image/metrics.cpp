@@ -38,7 +38,10 @@ void check_same_size(const Image& a, const Image& b, const char* what) {
                                      b.width(), b.height()));
 }
 
-// Visits every pixel: f(index, masked, brightness difference b or NaN if non-finite).
+// What a pixel is to the metrics.
+enum class Pixel { counted, masked, non_finite, non_finite_in_test };
+
+// Visits every pixel: f(index, kind, brightness difference b; NaN unless counted).
 template <class F>
 void for_each_difference(const Image& test, const Image& reference, const MetricOptions& options, F&& f) {
   check_same_size(test, reference, "test");
@@ -51,8 +54,13 @@ void for_each_difference(const Image& test, const Image& reference, const Metric
   auto rp = r.pixels();
   for (std::size_t i = 0; i < tp.size(); ++i) {
     const bool masked = options.mask && options.mask->pixels()[i * mask_stride] > 0.5f;
-    const double d = double(tp[i]) - double(rp[i]);
-    f(i, masked, std::isfinite(tp[i]) && std::isfinite(rp[i]) ? sign * d : std::nan(""));
+    const bool test_finite = std::isfinite(tp[i]), reference_finite = std::isfinite(rp[i]);
+    if (masked)
+      f(i, Pixel::masked, std::nan(""));
+    else if (test_finite && reference_finite)
+      f(i, Pixel::counted, sign * (double(tp[i]) - double(rp[i])));
+    else
+      f(i, reference_finite ? Pixel::non_finite_in_test : Pixel::non_finite, std::nan(""));
   }
 }
 
@@ -65,13 +73,14 @@ Metrics compute_metrics(const Image& test, const Image& reference, const MetricO
   double sum_abs = 0, sum_sq = 0, sum_leak = 0, sum_dark = 0, sum_signed = 0;
   std::size_t above1 = 0, above3 = 0, above10 = 0;
   const std::size_t width = std::size_t(reference.width());
-  for_each_difference(test, reference, options, [&](std::size_t i, bool masked, double b) {
-    if (masked) {
+  for_each_difference(test, reference, options, [&](std::size_t i, Pixel kind, double b) {
+    if (kind == Pixel::masked) {
       ++m.masked;
       return;
     }
-    if (std::isnan(b)) {
+    if (kind != Pixel::counted) {
       ++m.non_finite;
+      m.non_finite_in_test += kind == Pixel::non_finite_in_test;
       return;
     }
     const double a = std::abs(b);
@@ -111,6 +120,7 @@ std::string format_metrics(const Metrics& m) {
   s += fmt::format("{:<20} {}\n", "pixels", m.pixels);
   s += fmt::format("{:<20} {}\n", "masked", m.masked);
   s += fmt::format("{:<20} {}\n", "non_finite", m.non_finite);
+  s += fmt::format("{:<20} {}\n", "non_finite_in_test", m.non_finite_in_test);
   s += fmt::format("{:<20} {:.6g}\n", "mae", m.mae);
   s += fmt::format("{:<20} {:.6g}\n", "rmse", m.rmse);
   s += fmt::format("{:<20} {:.6g} at ({}, {})\n", "max_error", m.max_error, m.max_error_x, m.max_error_y);
@@ -130,6 +140,7 @@ std::string metrics_json(const Metrics& m, int indent) {
   j["pixels"] = m.pixels;
   j["masked"] = m.masked;
   j["non_finite"] = m.non_finite;
+  j["non_finite_in_test"] = m.non_finite_in_test;
   j["mae"] = m.mae;
   j["rmse"] = m.rmse;
   j["max_error"] = m.max_error;
@@ -153,9 +164,9 @@ Image error_image(const Image& test, const Image& reference, double range, const
     px[3 * i + 1] = srgb_to_linear(g);
     px[3 * i + 2] = srgb_to_linear(b);
   };
-  for_each_difference(test, reference, options, [&](std::size_t i, bool masked, double b) {
-    if (masked) return set(i, 0.5f, 0.5f, 0.5f);
-    if (std::isnan(b)) return set(i, 0.0f, 1.0f, 0.0f);
+  for_each_difference(test, reference, options, [&](std::size_t i, Pixel kind, double b) {
+    if (kind == Pixel::masked) return set(i, 0.5f, 0.5f, 0.5f);
+    if (kind != Pixel::counted) return set(i, 0.0f, 1.0f, 0.0f);
     const float t = float(std::clamp(b / range, -1.0, 1.0));
     if (t >= 0)
       set(i, 1.0f, 1.0f - t, 1.0f - t);

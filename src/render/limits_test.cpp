@@ -111,13 +111,25 @@ TEST(Limits, TheEnvironmentOverridesEachLimit) {
   EXPECT_EQ(limits::max_bytes(), 1u << 20);
   EXPECT_NE(limit_message([] { limits::check_triangles(1001); }), "");
   EXPECT_EQ(limit_message([] { limits::check_triangles(1000); }), "");
-  // Not a positive integer: the default, not a limit of zero.
-  ::setenv("MSM_MAX_TRIANGLES", "lots", 1);
-  ::setenv("MSM_MAX_MEMORY_MB", "0", 1);
-  EXPECT_EQ(limits::max_triangles(), limits::kMaxTriangles);
-  EXPECT_EQ(limits::max_bytes(), limits::kMaxBytes);
+  // Not a positive whole number: refused, naming the variable (not the default in silence, not a
+  // limit of zero, and "-5" not 2^64 - 5), as is a value whose bytes overflow.
+  for (const char* bad : {"lots", "0", "-5", " 7", "7 ", "+7", "1e3", "18446744073709551616"}) {
+    ::setenv("MSM_MAX_TRIANGLES", bad, 1);
+    EXPECT_EQ(limit_message([] { limits::max_triangles(); }).find("MSM_MAX_TRIANGLES=" + std::string(bad) + ": "), 0u)
+        << bad;
+    EXPECT_NE(limit_message([] { limits::check_environment(); }), "") << bad;
+  }
   ::unsetenv("MSM_MAX_TRIANGLES");
+  ::setenv("MSM_MAX_MEMORY_MB", "17592186044416", 1); // 2^44 MiB = 2^64 bytes
+  EXPECT_NE(limit_message([] { limits::max_bytes(); }).find("expected a whole number from 1 to 17592186044415"),
+            std::string::npos);
+  ::setenv("MSM_MAX_MEMORY_MB", "17592186044415", 1);
+  EXPECT_EQ(limits::max_bytes(), 17592186044415ull << 20);
   ::unsetenv("MSM_MAX_MEMORY_MB");
+  ::setenv("MSM_IMPORT_TIMEOUT_S", "-5", 1);
+  EXPECT_NE(limit_message([] { limits::check_environment(); }).find("MSM_IMPORT_TIMEOUT_S=-5"), std::string::npos);
+  ::unsetenv("MSM_IMPORT_TIMEOUT_S");
+  EXPECT_EQ(limit_message([] { limits::check_environment(); }), "");
 }
 
 // Progress lines for a log: nothing from a short run; from a long one a line per tenth once it has

@@ -3,9 +3,11 @@
 // Debian packages (assimp-testmodels, glmark2-data), found through CMake-configured paths.
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "msm/scene/scene.h"
@@ -16,6 +18,7 @@ namespace fs = std::filesystem;
 using namespace msm::scene;
 using msm::scene::testing::GltfMaterial;
 using msm::scene::testing::GltfModel;
+using msm::scene::testing::GltfPrimitive;
 using msm::scene::testing::GltfTexture;
 using msm::scene::testing::quad;
 using msm::scene::testing::write_gltf;
@@ -227,6 +230,81 @@ TEST(GltfImport, EmbeddedAndExternalTextures) {
     load(dir, scene_json("files.gltf"));
     ADD_FAILURE() << "no error for a missing texture";
   } catch (const SceneError& e) { EXPECT_NE(std::string(e.what()).find("files_0.png"), std::string::npos); }
+}
+
+// A texture that cannot be decoded names its file (or the model and the embedded texture) and
+// what it is: empty, or a format msm does not read (KTX2 from KHR_texture_basisu), not only stb's
+// "unknown image type".
+TEST(GltfImport, UndecodableTexturesAreNamed) {
+  TempDir dir("msm_gltf_test");
+  GltfModel model;
+  model.textures = {corners_texture()};
+  model.materials = {{.name = "t", .texture = 0}};
+  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
+  write_gltf(dir.path() / "files.gltf", model, true);
+  const std::string ktx2_magic = "\xABKTX 20\xBB\r\n\x1A\n" + std::string(20, '\0');
+  const auto texture_error = [&](const std::string& bytes) -> std::string {
+    std::ofstream(dir.path() / "files_0.png", std::ios::binary | std::ios::trunc) << bytes;
+    const Scene s = load(dir, scene_json("files.gltf"));
+    try {
+      albedo_image(s.materials.at(s.objects[0].material));
+    } catch (const SceneError& e) { return e.what(); }
+    return "no error";
+  };
+  std::string what = texture_error("");
+  EXPECT_NE(what.find("files_0.png: cannot decode the texture: the image is empty (0 bytes)"), std::string::npos)
+      << what;
+  what = texture_error(ktx2_magic);
+  EXPECT_NE(what.find("files_0.png: cannot decode the texture: a KTX2 image, which msm does not read (PNG, JPEG"),
+            std::string::npos)
+      << what;
+  what = texture_error("not an image at all");
+  EXPECT_NE(what.find("files_0.png: cannot decode the texture: not an image msm reads (PNG, JPEG"), std::string::npos)
+      << what;
+
+  // Embedded (a data URI whose bytes are KTX2): the model, the texture's index and the format.
+  write_gltf(dir.path() / "data.gltf", model);
+  std::ifstream in(dir.path() / "data.gltf");
+  std::string gltf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = gltf.find("data:image/png;base64,");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t end = gltf.find('"', at);
+  gltf.replace(at, end - at, "data:image/png;base64,q0tUWCAyMLsNChoKAAAAAAAAAAAAAAAAAAAAAAAAAAA=");
+  std::ofstream(dir.path() / "ktx2.gltf", std::ios::binary) << gltf;
+  try {
+    load(dir, scene_json("ktx2.gltf"));
+    ADD_FAILURE() << "no error for an embedded KTX2 texture";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("ktx2.gltf"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot decode embedded texture 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a KTX2 image, which msm does not read"), std::string::npos) << e.what();
+  }
+}
+
+// A model of points or lines only says so (Assimp alone ends in "No meshes remaining"); lines
+// beside triangles are skipped.
+TEST(GltfImport, PointsAndLinesAreNotTriangles) {
+  TempDir dir("msm_gltf_test");
+  for (int mode : {0, 1}) {
+    GltfModel model;
+    GltfPrimitive p;
+    p.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    p.indices = {0, 1, 1, 2, 2, 3};
+    p.mode = mode;
+    model.primitives.push_back(p);
+    const fs::path file = dir.path() / fmt::format("mode{}.gltf", mode);
+    write_gltf(file, model);
+    try {
+      import_mesh(file);
+      ADD_FAILURE() << "no error for mode " << mode;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("contains no triangles, only points or lines"), std::string::npos)
+          << e.what();
+    }
+    model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}));
+    write_gltf(file, model);
+    EXPECT_EQ(import_mesh(file).indices.size(), 6u) << mode;
+  }
 }
 
 // The JSON schema has alpha testing too.

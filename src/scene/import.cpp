@@ -1,14 +1,18 @@
 // Mesh import through Assimp, and minimal texture loading through stb_image.
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <new>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
 #include <assimp/GltfMaterial.h>
 #include <assimp/Importer.hpp>
@@ -39,21 +43,56 @@ void check_regular_file(const std::filesystem::path& file, const char* what) {
 
 namespace {
 
-// Texels of a texture embedded in the file: compressed (PNG, JPEG: mHeight 0, mWidth bytes) or
-// raw BGRA8.
-Image decode_embedded(const aiTexture& t, const std::filesystem::path& file) {
+// Why stb could not decode a texture's bytes, naming the format where it is a known one stb lacks
+// (glTF's KHR_texture_basisu brings KTX2, KHR_texture_webp WebP).
+std::string undecodable_texture(std::span<const unsigned char> bytes) {
+  const auto starts = [&](std::string_view magic, std::size_t at = 0) {
+    return bytes.size() >= at + magic.size() &&
+           std::equal(magic.begin(), magic.end(), bytes.begin() + std::ptrdiff_t(at),
+                      [](char a, unsigned char b) { return static_cast<unsigned char>(a) == b; });
+  };
+  constexpr std::string_view readable = "PNG, JPEG, TGA, BMP, GIF, HDR, PSD or PNM";
+  std::string_view format;
+  if (bytes.empty()) return "the image is empty (0 bytes)";
+  if (starts("\xABKTX 20\xBB\r\n\x1A\n"))
+    format = "KTX2";
+  else if (starts("\xABKTX 11\xBB\r\n\x1A\n"))
+    format = "KTX";
+  else if (starts("DDS "))
+    format = "DDS";
+  else if (starts("RIFF") && starts("WEBP", 8))
+    format = "WebP";
+  else if (starts("\x89PNG"))
+    return fmt::format("a PNG that cannot be decoded: {}", stbi_failure_reason());
+  if (!format.empty()) return fmt::format("a {} image, which msm does not read ({} are read)", format, readable);
+  return fmt::format("not an image msm reads ({}): {}", readable, stbi_failure_reason());
+}
+
+Image decoded_rgba(stbi_uc* data, int w, int h) {
+  Image img;
+  img.width = w;
+  img.height = h;
+  img.rgba.assign(data, data + std::size_t(w) * h * 4);
+  stbi_image_free(data);
+  return img;
+}
+
+// Texels of a texture embedded in the file (its index in the file): compressed (PNG, JPEG:
+// mHeight 0, mWidth bytes) or raw BGRA8.
+Image decode_embedded(const aiTexture& t, int index, const std::filesystem::path& file) {
   Image img;
   if (t.mHeight == 0) {
+    const std::span<const unsigned char> bytes(reinterpret_cast<const unsigned char*>(t.pcData), t.mWidth);
     int w = 0, h = 0, channels = 0;
-    stbi_uc* data =
-        stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(t.pcData), int(t.mWidth), &w, &h, &channels, 4);
-    if (!data)
-      throw SceneError(file.string(), "", fmt::format("cannot decode an embedded texture: {}", stbi_failure_reason()));
-    img.width = w;
-    img.height = h;
-    img.rgba.assign(data, data + std::size_t(w) * h * 4);
-    stbi_image_free(data);
-    return img;
+    stbi_uc* data = stbi_load_from_memory(bytes.data(), int(bytes.size()), &w, &h, &channels, 4);
+    if (!data) {
+      const std::string name = t.mFilename.length > 0 ? fmt::format(" '{}'", t.mFilename.C_Str()) : "";
+      const std::string hint = t.achFormatHint[0] ? fmt::format(", format hint '{:.4}'", t.achFormatHint) : "";
+      throw SceneError(
+          file.string(), "",
+          fmt::format("cannot decode embedded texture {}{}{}: {}", index, name, hint, undecodable_texture(bytes)));
+    }
+    return decoded_rgba(data, w, h);
   }
   img.width = int(t.mWidth);
   img.height = int(t.mHeight);
@@ -83,7 +122,7 @@ std::optional<TextureRef> texture_of(const aiScene& s, const aiMaterial& m, aiTe
   const auto [embedded, index] = s.GetEmbeddedTextureAndIndex(name.C_Str());
   if (embedded) {
     auto& pixels = decoded[index];
-    if (!pixels) pixels = std::make_shared<const Image>(decode_embedded(*embedded, file));
+    if (!pixels) pixels = std::make_shared<const Image>(decode_embedded(*embedded, index, file));
     return TextureRef{std::filesystem::path(file.string() + "#" + std::to_string(index)), pixels};
   }
   const std::filesystem::path path = (file.parent_path() / std::filesystem::path(name.C_Str())).lexically_normal();
@@ -204,8 +243,8 @@ namespace msm::scene {
 // (import_child.cpp), after the parent's checks of the file and its header.
 std::vector<ModelPart> detail::import_model_in_process(const std::filesystem::path& file) {
   Assimp::Importer importer;
-  // Points and lines are removed; only triangles are kept.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  // Points and lines are skipped below, not removed by Assimp (AI_CONFIG_PP_SBP_REMOVE): a file of
+  // nothing else would end in Assimp's "No meshes remaining" instead of saying what it holds.
   // FlipUVs: Assimp hands out v up (OpenGL), msm and Vulkan sample with v down (row 0 on top).
   const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
                          aiProcess_GenSmoothNormals | aiProcess_SortByPType | aiProcess_ValidateDataStructure |
@@ -231,8 +270,10 @@ std::vector<ModelPart> detail::import_model_in_process(const std::filesystem::pa
   std::map<unsigned, std::size_t> part_of_material;
   std::vector<ModelPart> parts;
   std::map<int, std::shared_ptr<const Image>> decoded;
+  bool points_or_lines = false;
   for (unsigned mi = 0; mi < s->mNumMeshes; ++mi) {
     const aiMesh* am = s->mMeshes[mi];
+    points_or_lines |= (am->mPrimitiveTypes & (aiPrimitiveType_POINT | aiPrimitiveType_LINE)) != 0;
     if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || !am->mVertices) continue;
     auto [it, inserted] = part_of_material.try_emplace(am->mMaterialIndex, parts.size());
     if (inserted) {
@@ -288,7 +329,10 @@ std::vector<ModelPart> detail::import_model_in_process(const std::filesystem::pa
     }
     kept.push_back(std::move(part));
   }
-  if (parts.empty()) throw SceneError(file.string(), "", "the mesh file contains no triangles");
+  if (parts.empty())
+    throw SceneError(file.string(), "",
+                     points_or_lines ? "the mesh file contains no triangles, only points or lines (msm draws triangles)"
+                                     : "the mesh file contains no triangles");
   if (kept.empty()) throw SceneError(file.string(), "", "the mesh has no triangles with a non-zero area");
   return kept;
 }
@@ -312,15 +356,14 @@ Mesh import_mesh(const std::filesystem::path& file) {
 
 Image load_texture(const std::filesystem::path& file) {
   check_regular_file(file, "texture");
+  std::ifstream in(file, std::ios::binary);
+  const std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.eof() && in.fail()) throw SceneError(file.string(), "", "cannot read the texture file");
   int w = 0, h = 0, channels = 0;
-  stbi_uc* data = stbi_load(file.string().c_str(), &w, &h, &channels, 4);
-  if (!data) throw SceneError(file.string(), "", fmt::format("cannot decode the image: {}", stbi_failure_reason()));
-  Image img;
-  img.width = w;
-  img.height = h;
-  img.rgba.assign(data, data + std::size_t(w) * h * 4);
-  stbi_image_free(data);
-  return img;
+  stbi_uc* data = stbi_load_from_memory(bytes.data(), int(bytes.size()), &w, &h, &channels, 4);
+  if (!data)
+    throw SceneError(file.string(), "", fmt::format("cannot decode the texture: {}", undecodable_texture(bytes)));
+  return decoded_rgba(data, w, h);
 }
 
 } // namespace msm::scene

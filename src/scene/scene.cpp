@@ -29,6 +29,9 @@ constexpr BuiltinScene kBuiltinScenes[] = {
 #include "builtin_scenes.inc"
 };
 
+// Scene, object and material names: labels in messages, outputs and the viewer, refused beyond this.
+constexpr std::size_t kMaxNameBytes = 256;
+
 std::string compose(const std::string& file, const std::string& where, const std::string& problem) {
   std::string s;
   if (!file.empty()) s += file + ": ";
@@ -71,6 +74,8 @@ class Parser {
   Parser(std::string file, fs::path base) : file_(file.empty() ? "<json>" : std::move(file)), base_(std::move(base)) {}
 
   Scene parse(std::string_view text) {
+    if (const std::string encoding = wide_encoding(text); !encoding.empty())
+      fail("", fmt::format("the scene is {}, not UTF-8: save it as UTF-8", encoding));
     json root;
     try {
       root = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
@@ -85,7 +90,7 @@ class Parser {
       fail("/msm_scene", "unsupported format version (only 1 exists)");
     Scene s;
     s.source = file_;
-    if (const json* v = find(root, "name")) s.name = string(*v, "/name");
+    if (const json* v = find(root, "name")) s.name = name(*v, "/name");
     if (const json* v = find(root, "camera")) s.camera = camera(*v, "/camera");
     const json* light_json = find(root, "light");
     const json* lights_json = find(root, "lights");
@@ -115,6 +120,7 @@ class Parser {
       if (!mats->is_object()) fail("/materials", "must be an object mapping names to materials");
       for (const auto& [name, m] : mats->items()) {
         const std::string ptr = "/materials/" + escape(name);
+        check_name_length(name, ptr);
         named_[name] = static_cast<std::uint32_t>(s.materials.size());
         s.materials.push_back(material(m, ptr));
         s.materials.back().name = name;
@@ -132,10 +138,47 @@ class Parser {
     throw SceneError(file_, where, problem);
   }
 
-  static std::string escape(const std::string& key) { // JSON pointer escaping
+  // JSON pointer escaping, of a key shortened for messages.
+  static std::string escape(const std::string& key) {
     std::string r;
-    for (char c : key) r += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+    for (char c : shortened(key)) r += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
     return r;
+  }
+
+  // A name as messages show it: at most 48 bytes of it (whole UTF-8 characters) and its length.
+  static std::string shortened(const std::string& text) {
+    if (text.size() <= 64) return text;
+    std::size_t end = 48;
+    while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end; // not mid-character
+    return fmt::format("{}... ({} bytes)", text.substr(0, end), text.size());
+  }
+
+  // Scene, object and material names are labels (messages, JSON outputs, the viewer's panel): a
+  // name longer than kMaxNameBytes is refused, not echoed whole into every message and output.
+  void check_name_length(const std::string& text, const std::string& ptr) const {
+    if (text.size() > kMaxNameBytes)
+      fail(ptr, fmt::format("a name of {} bytes ('{}'): names are at most {} bytes", text.size(), shortened(text),
+                            kMaxNameBytes));
+  }
+
+  std::string name(const json& v, const std::string& ptr) const {
+    std::string text = string(v, ptr);
+    check_name_length(text, ptr);
+    return text;
+  }
+
+  // A scene saved as UTF-16 or UTF-32 (with or without a byte-order mark): nlohmann::json reads
+  // UTF-8 only, and would report "invalid literal" at the first byte. Empty: not one of those.
+  static std::string wide_encoding(std::string_view text) {
+    const auto byte = [&](std::size_t i) { return i < text.size() ? static_cast<unsigned char>(text[i]) : 0x100u; };
+    if (byte(0) == 0x00 && byte(1) == 0x00 && byte(2) == 0xFE && byte(3) == 0xFF) return "UTF-32 (big-endian)";
+    if (byte(0) == 0xFF && byte(1) == 0xFE && byte(2) == 0x00 && byte(3) == 0x00) return "UTF-32 (little-endian)";
+    if (byte(0) == 0xFE && byte(1) == 0xFF) return "UTF-16 (big-endian, byte-order mark FE FF)";
+    if (byte(0) == 0xFF && byte(1) == 0xFE) return "UTF-16 (little-endian, byte-order mark FF FE)";
+    // Without a mark: JSON starts with ASCII, so a NUL beside the first character gives it away.
+    if (byte(0) == 0x00 && byte(1) != 0x00 && byte(1) < 0x80) return "UTF-16 (big-endian, no byte-order mark)";
+    if (byte(0) != 0x00 && byte(0) < 0x80 && byte(1) == 0x00) return "UTF-16 (little-endian, no byte-order mark)";
+    return {};
   }
 
   static const json* find(const json& obj, const char* key) {
@@ -516,7 +559,7 @@ class Parser {
   void object(const json& j, const std::string& ptr, std::size_t index, Scene& s) const {
     std::string name = fmt::format("object{}", index);
     if (j.is_object())
-      if (const json* v = find(j, "name")) name = string(*v, ptr + "/name");
+      if (const json* v = find(j, "name")) name = this->name(*v, ptr + "/name");
     try {
       keys(j, ptr, {"name", "mesh", "primitive", "transform", "material", "motion"});
       const json* mesh = find(j, "mesh");

@@ -804,6 +804,54 @@ TEST(Errors, Files) {
   expect_error([&] { load_scene("nosuch"); }, {"nosuch", "neither a built-in scene"});
 }
 
+// A scene saved as UTF-16 (Windows editors' "Unicode"), with or without a byte-order mark, or as
+// UTF-32: named as such, not "invalid literal" at a byte the terminal cannot show.
+TEST(Errors, WideEncodingsAreNamed) {
+  const std::string json = scene_with_object(R"({"primitive": {"type": "box"}})");
+  const auto utf16 = [&](bool big_endian, bool mark) {
+    std::string out = mark ? (big_endian ? std::string("\xFE\xFF") : std::string("\xFF\xFE")) : std::string();
+    for (char c : json) out += big_endian ? std::string{'\0', c} : std::string{c, '\0'};
+    return out;
+  };
+  expect_json_error(utf16(false, true),
+                    {"test.json", "UTF-16 (little-endian, byte-order mark FF FE)", "save it as UTF-8"});
+  expect_json_error(utf16(true, true), {"UTF-16 (big-endian, byte-order mark FE FF)"});
+  expect_json_error(utf16(false, false), {"UTF-16 (little-endian, no byte-order mark)"});
+  expect_json_error(utf16(true, false), {"UTF-16 (big-endian, no byte-order mark)"});
+  expect_json_error(std::string("\xFF\xFE\0\0", 4) + "{", {"UTF-32 (little-endian)"});
+  // UTF-8 with its mark still reads.
+  EXPECT_EQ(load_scene_json("\xEF\xBB\xBF" + json, fs::current_path(), "test.json").objects.size(), 1u);
+}
+
+// Names are labels: one of 5 MB is refused at load, and the message shows 48 bytes of it, not
+// the whole (nor do JSON pointers through a long key).
+TEST(Errors, AbsurdNamesAreRefusedAndShortened) {
+  const std::string huge(5u << 20, 'n');
+  const auto check = [&](const std::string& json, std::initializer_list<std::string> fragments) {
+    try {
+      load_scene_json(json, fs::current_path(), "test.json");
+      ADD_FAILURE() << "no SceneError";
+    } catch (const SceneError& e) {
+      const std::string what = e.what();
+      EXPECT_LT(what.size(), 400u);
+      for (const std::string& f : fragments) EXPECT_NE(what.find(f), std::string::npos) << f << " not in: " << what;
+    }
+  };
+  check(scene_with_object(R"({"name": ")" + huge + R"(", "primitive": {"type": "box"}})"),
+        {"/objects/0/name", "a name of 5242880 bytes ('nnnnnnnn", "... (5242880 bytes)", "at most 256 bytes"});
+  check(scene_with_object(R"({"primitive": {"type": "box"}})", R"("name": ")" + huge + R"(",)"), {"/name"});
+  check(scene_with_object(R"({"primitive": {"type": "box"}})", R"("materials": {")" + huge + R"(": {}},)"),
+        {"/materials/nnnn", "at most 256 bytes"});
+  check(scene_with_object(R"({"primitive": {"type": "box"}, ")" + huge + R"(": 1})"),
+        {"/objects/0/nnnn", "unknown key"});
+  const std::string longest(256, 'x');
+  EXPECT_EQ(load_scene_json(scene_with_object(R"({"name": ")" + longest + R"(", "primitive": {"type": "box"}})"),
+                            fs::current_path(), "test.json")
+                .objects.front()
+                .name,
+            longest);
+}
+
 TEST(Errors, Structure) {
   expect_json_error("[1, 2]", {"test.json", "must be a JSON object"});
   expect_json_error(R"({"light": {"towards_light": [0,1,0]}, "objects": []})", {"/msm_scene", "required"});

@@ -109,6 +109,7 @@ void write_gltf(const std::filesystem::path& file, const GltfModel& model, bool 
                  {"indices", accessor(buffer.add(p.indices.data(), p.indices.size() * 4, 34963), 5125, p.indices.size(),
                                       "SCALAR")}};
     if (p.material >= 0) prim["material"] = p.material;
+    if (p.mode != 4) prim["mode"] = p.mode;
     primitives.push_back(prim);
   }
   json images = json::array(), textures = json::array();

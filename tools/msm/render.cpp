@@ -117,11 +117,18 @@ void add_render(CLI::App& app) {
     render::Renderer renderer(*ctx, scene);
     // What the device cannot do is refused before the output directory exists.
     check_on_device(renderer, opt->frame, names);
-    ensure_output_dir(opt->out);
     if (frames) {
+      ensure_output_dir(opt->out);
       render_frames(*ctx, renderer, scene, opt->frame, names, opt->out, opt->frames);
       return;
     }
+    // The directory is made once the first technique has rendered (a render the device cannot
+    // hold leaves none), and every technique's files are renamed into it together at the end: an
+    // interrupted or failed run leaves the directory as the last complete run left it, never one
+    // run's files of some techniques beside another's (the temporaries of an interrupted run are
+    // hidden files, ".<name>.tmp.<pid>.<n>").
+    check_output_dir(opt->out);
+    image::FileSet files;
     for (size_t i = 0; i < names.size(); ++i) {
       render::RenderSettings s = settings_for(opt->frame, names[i]);
       render::RenderResult result;
@@ -132,13 +139,17 @@ void add_render(CLI::App& app) {
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
-      write_render(opt->out, names[i], result, render_json(s, scene, *ctx, result));
+      if (i == 0) ensure_output_dir(opt->out);
+      write_render(files, opt->out, names[i], result, render_json(s, scene, *ctx, result));
       double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU {:8.0f} ms wall -> {}/{}.png{}{}\n", i + 1, names.size(),
                  names[i], result.total_ms, wall_ms, opt->out, names[i],
                  result.shadow_rgb.empty() ? "" : fmt::format(", {}-rgb.exr (visibility per colour channel)", names[i]),
                  result.scattering.empty() ? "" : fmt::format(", {}-scattering.exr", names[i]));
     }
+    try {
+      files.commit();
+    } catch (const image::ImageError& e) { throw UsageError(e.what()); }
   });
 }
 

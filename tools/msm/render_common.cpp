@@ -186,6 +186,20 @@ void ensure_output_dir(const std::filesystem::path& dir) {
     throw UsageError(fmt::format("{}: the output directory is not writable", dir.string()));
 }
 
+void check_output_dir(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::path existing = dir.empty() ? "." : dir;
+  while (!std::filesystem::exists(existing, ec) && existing.has_relative_path())
+    existing = existing.has_parent_path() && existing.parent_path() != existing ? existing.parent_path() : ".";
+  if (!std::filesystem::is_directory(existing, ec))
+    throw UsageError(
+        fmt::format("{}: cannot create the output directory: {} is not a directory", dir.string(), existing.string()));
+  if (access(existing.c_str(), W_OK) != 0)
+    throw UsageError(existing == dir ? fmt::format("{}: the output directory is not writable", dir.string())
+                                     : fmt::format("{}: cannot create the output directory: {} is not writable",
+                                                   dir.string(), existing.string()));
+}
+
 nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, const vk::Context& ctx,
                            const render::RenderResult& result) {
   const Technique& t = render::find_rendered_technique(s.technique);
@@ -232,6 +246,15 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json) {
+  image::FileSet files;
+  write_render(files, dir, stem, result, json);
+  try {
+    files.commit();
+  } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+}
+
+void write_render(image::FileSet& files, const std::filesystem::path& dir, const std::string& stem,
+                  const render::RenderResult& result, const nlohmann::json& json) {
   try {
     // The EXRs (zlib: most of the output's work) are encoded on a second thread while this one
     // encodes the PNG (image output was 16% of a one-shot 1080p render). The files are
@@ -253,7 +276,6 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
             ? image::encode_png(png_path, result.color)
             : image::encode_png8(png_path, result.color.width(), result.color.height(), 3, result.color_srgb8);
     const std::array<std::vector<std::uint8_t>, 3> exr_bytes = exrs.get(); // rethrows its ImageError
-    image::FileSet files;
     files.add(png_path, png);
     files.add(exr, exr_bytes[0]);
     if (!result.shadow_rgb.empty())
@@ -266,7 +288,6 @@ void write_render(const std::filesystem::path& dir, const std::string& stem, con
       files.remove(scattering);
     std::string text = json.dump(2) + "\n";
     files.add(dir / (stem + ".json"), std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-    files.commit();
   } catch (const image::ImageError& e) { throw UsageError(e.what()); }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "commands.h"
+#include "msm/image/io.h"
 #include "msm/render/renderer.h"
 #include "msm/vk/context.h"
 
@@ -62,6 +63,10 @@ scene::Scene load_scene_or_fail(const std::string& name_or_path);
 
 // Creates the directory (UsageError if impossible or not writable).
 void ensure_output_dir(const std::filesystem::path& dir);
+// What ensure_output_dir would refuse, creating nothing: the directory, or where it does not exist
+// yet its nearest existing parent, must be a writable directory. For commands that create the
+// directory only once they have something to put in it.
+void check_output_dir(const std::filesystem::path& dir);
 
 // Every setting of a render (technique parameters included) and its pass times.
 nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, const vk::Context& ctx,
@@ -71,5 +76,8 @@ nlohmann::json render_json(const render::RenderSettings& settings, const scene::
 // shadows only), <dir>/<stem>.json: all or none (image::FileSet: temporaries, then renamed together).
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,
                   const nlohmann::json& json);
+// The same files added to a set the caller commits (with other renders': all of them or none).
+void write_render(image::FileSet& files, const std::filesystem::path& dir, const std::string& stem,
+                  const render::RenderResult& result, const nlohmann::json& json);
 
 } // namespace msm::tool

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace msm::image {
@@ -35,6 +36,17 @@ Image read_exr(const std::filesystem::path& path);
 
 // By content (PNG or EXR signature), whatever the extension.
 Image read_image(const std::filesystem::path& path);
+// The encoding of an image file's values: sRGB-encoded integers (PNG, a picture for display) or
+// linear floats (EXR). read_png decodes a PNG to linear values, but whatever tone curve and clamp
+// made the picture stay in them.
+enum class FileFormat { png, exr };
+std::string_view to_string(FileFormat format);
+struct ImageFile {
+  Image image;
+  FileFormat format;
+};
+// read_image and the format it found.
+ImageFile read_image_file(const std::filesystem::path& path);
 // The same for a file already in memory (name: for the messages only).
 Image decode_image(std::span<const std::uint8_t> bytes, const std::filesystem::path& name);
 // By extension: ".png" or ".exr" (case-insensitive); anything else throws ImageError.

@@ -22,8 +22,10 @@
 //
 // Counted pixels: not masked, and both values finite. A mask (same size, its first channel) marks
 // pixels to IGNORE where its value is > 0.5 (e.g. background). Pixels with a NaN or infinite
-// value in either image are counted in non_finite and left out of everything else. With N = 0
-// every statistic is 0.
+// value in either image are counted in non_finite and left out of everything else; of those,
+// non_finite_in_test counts the ones where only the test is non-finite (the reference is finite):
+// values the test failed to produce, which no statistic over the counted pixels shows (an all-NaN
+// test has N = 0). With N = 0 every statistic is 0.
 #pragma once
 
 #include "msm/image/image.h"
@@ -46,9 +48,10 @@ struct MetricOptions {
 
 struct Metrics {
   int width = 0, height = 0;
-  std::size_t pixels = 0;     // counted pixels N
-  std::size_t masked = 0;     // ignored by the mask
-  std::size_t non_finite = 0; // NaN/inf in test or reference (not masked)
+  std::size_t pixels = 0;             // counted pixels N
+  std::size_t masked = 0;             // ignored by the mask
+  std::size_t non_finite = 0;         // NaN/inf in test or reference (not masked)
+  std::size_t non_finite_in_test = 0; // of non_finite: NaN/inf in the test, the reference finite
   double mae = 0, rmse = 0, max_error = 0;
   int max_error_x = -1, max_error_y = -1;
   double share_above_1pct = 0, share_above_3pct = 0, share_above_10pct = 0;

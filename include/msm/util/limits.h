@@ -53,17 +53,38 @@ class LimitError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// The limit, or the environment's override (a positive integer; anything else is ignored).
+// The limit, or the environment's override: a positive whole number (of `unit`s), digits only.
+// Anything else (empty counts as unset) is a LimitError naming the variable and the value, not a
+// silent fallback: "-5" would otherwise wrap to 2^64 - 5, and "0" or "abc" quietly mean the default.
 inline std::uint64_t from_environment(const char* variable, std::uint64_t fallback, std::uint64_t unit = 1) {
   const char* text = std::getenv(variable);
   if (!text || !*text) return fallback;
-  char* end = nullptr;
-  const unsigned long long v = std::strtoull(text, &end, 10);
-  if (*end != '\0' || v == 0) return fallback;
-  return std::uint64_t(v) * unit;
+  std::uint64_t v = 0;
+  bool valid = true;
+  for (const char* c = text; *c && valid; ++c) {
+    const unsigned digit = unsigned(*c) - unsigned('0');
+    valid = digit <= 9 && v <= (UINT64_MAX - digit) / 10;
+    v = valid ? v * 10 + digit : v;
+  }
+  if (!valid || v == 0 || v > UINT64_MAX / unit) {
+    std::string shown(text);
+    if (shown.size() > 40) shown = shown.substr(0, 40) + "...";
+    throw LimitError(fmt::format("{}={}: expected a whole number from 1 to {} (unset it for the default)", variable,
+                                 shown, UINT64_MAX / unit));
+  }
+  return v * unit;
 }
 inline std::uint64_t max_triangles() { return from_environment("MSM_MAX_TRIANGLES", kMaxTriangles); }
 inline std::uint64_t max_bytes() { return from_environment("MSM_MAX_MEMORY_MB", kMaxBytes, 1ull << 20); }
+
+// The environment's overrides of limits (the import timeout's default is the scene library's;
+// any positive value stands in for it here): LimitError for the first malformed one, so that a
+// command refuses a mistyped override before any work rather than when (or if) it reads it.
+inline void check_environment() {
+  from_environment("MSM_MAX_TRIANGLES", kMaxTriangles);
+  from_environment("MSM_MAX_MEMORY_MB", kMaxBytes, 1ull << 20);
+  from_environment("MSM_IMPORT_TIMEOUT_S", 1);
+}
 
 // The bytes of a light's shadow maps: `layers` (one per light) of size² texels, each with the
 // MSAA depth samples and `sets` moment images (one per colour channel) of moment_bytes per texel,

@@ -36,6 +36,7 @@ struct GltfPrimitive {
   std::vector<glm::vec2> uvs; // glTF convention: (0, 0) the top-left of the picture
   std::vector<std::uint32_t> indices;
   int material = -1;
+  int mode = 4; // glTF's primitive mode: 0 points, 1 lines, 4 triangles
 };
 
 // One mesh of all primitives, on one node.
