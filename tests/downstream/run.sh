@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the build tree into a temporary prefix and builds and runs tests/downstream against it
 # twice: with the header-only math alone, every other package msm uses hidden from CMake, and with
-# every component.
+# every component (the renderer's and the viewer's where the build has them: with_renderer, ON by
+# default, the build's MSM_BUILD_VULKAN).
 set -euo pipefail
-build_dir=$1; source_dir=$2
+build_dir=$1; source_dir=$2; with_renderer=${3:-ON}
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
 
@@ -21,4 +22,4 @@ consumer() { # name, cmake arguments...
 }
 consumer math -DMSM_DOWNSTREAM_FULL=OFF "${math_only[@]}"
 test -s "$work/math/shader.spv"
-consumer full -DMSM_DOWNSTREAM_FULL=ON
+consumer full -DMSM_DOWNSTREAM_FULL=ON -DMSM_DOWNSTREAM_RENDER="$with_renderer"
