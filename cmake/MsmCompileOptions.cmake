@@ -23,7 +23,7 @@ if(MSM_BUILD_FUZZERS)
   # Coverage feedback from all of msm's code; the fuzz targets link libFuzzer itself.
   target_compile_options(msm_compile_options INTERFACE -fsanitize=fuzzer-no-link)
 endif()
-install(TARGETS msm_compile_options EXPORT msmTargets)
+msm_install_library(msm_compile_options COMPONENT math) # the installed static libraries link it
 
 # Test support (tests/support: the Vulkan test fixture, the glTF writer) and the one place of test
 # data: tests/data, and the real models no one here wrote, from Debian packages that

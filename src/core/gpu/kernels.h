@@ -126,7 +126,9 @@ const int MSM_K_TRANSMITTANCE_LAYERS = 64; // a = (Δ_lo, Δ_hi, delta, K) -> a.
 const int MSM_K_PREFIX_SUM_LOD = 65; // a = (du/dx, du/dy, dv/dx, dv/dy), b = (width, height, full circle) -> a.x
 // scattering.h: the proportional β from the shadow's bounds and the view and light directions
 const int MSM_K_SCATTERING_BETA = 66; // a = (lower, upper, view.xy), b = (view.z, towards_light) -> a.x
-const int MSM_K_COUNT = 67;
+// scattering.h: the Henyey–Greenstein phase function of a light and a view direction
+const int MSM_K_SCATTERING_PHASE = 67; // a = (towards_light, g), b.xyz = view direction -> a.x
+const int MSM_K_COUNT = 68;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
 MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
@@ -247,6 +249,9 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
   case MSM_K_SCATTERING_BETA:
     r.a[0] = msm_scattering_beta_proportional(
         vec2(x.a[0], x.a[1]), msm_scattering_beta_adaptive(vec3(x.b[1], x.b[2], x.b[3]), vec3(x.a[2], x.a[3], x.b[0])));
+    break;
+  case MSM_K_SCATTERING_PHASE:
+    r.a[0] = msm_phase_henyey_greenstein_between(vec3(x.a[0], x.a[1], x.a[2]), vec3(x.b[0], x.b[1], x.b[2]), x.a[3]);
     break;
   case MSM_K_PREFIX_SUM_LOD:
     r.a[0] = msm_prefix_sum_lod(vec2(x.a[0], x.a[1]), vec2(x.a[2], x.a[3]), vec2(x.b[0], x.b[1]), x.b[2] != 0.0f);
