@@ -1,7 +1,8 @@
 // environment: image-based lighting with exact visibility (reference.h, "environment"). The full
-// probe is sampled in proportion to luminance x solid angle and the cosine-weighted hemisphere,
-// combined by the balance heuristic; the extracted area lights (--probe-lights) and the scene's
-// other directional lights are uniform cones (discs) or rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
+// probe is sampled in proportion to its luminance above its mean x solid angle and the
+// cosine-weighted hemisphere, combined by the balance heuristic; the extracted area lights
+// (--probe-lights) and the scene's other directional lights are uniform cones (discs) or
+// rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -114,10 +115,25 @@ EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_l
     total += std::max(luminance[t] - floor, 0.0) * weight[t];
     cdf.push_back(total);
   }
-  if (total > 0.0)
-    for (double& c : cdf) c /= total;
-  else
+  if (!(total > 0.0)) {
     cdf.clear(); // a uniform or black probe: only the cosine samples
+    return;
+  }
+  for (double& c : cdf) c /= total;
+  guide.resize(texels);
+  for (std::size_t k = 0, t = 0; k < texels; ++k) {
+    const double x = double(k) / double(texels);
+    while (t + 1 < texels && !(cdf[t] > x)) ++t;
+    guide[k] = std::uint32_t(t);
+  }
+}
+
+std::size_t EnvironmentLighting::texel_of(double x) const {
+  // k = floor(x n) but for the product's rounding: the interval one guide entry wider each side.
+  const std::size_t n = guide.size(), k = std::min(std::size_t(x * double(n)), n - 1);
+  const auto first = cdf.begin() + guide[k > 0 ? k - 1 : 0];
+  const auto last = k + 2 < n ? cdf.begin() + guide[k + 2] + 1 : cdf.end();
+  return std::min<std::size_t>(std::upper_bound(first, last, x) - cdf.begin(), n - 1);
 }
 
 EnvironmentSample environment_irradiance(const EffectContext& ctx, const EnvironmentLighting& lighting,
@@ -165,9 +181,7 @@ EnvironmentSample environment_irradiance(const EffectContext& ctx, const Environ
       if (probe_sampled) {
         // Probe sample: the texel by the first coordinate, the point inside it by what is left of it and the second.
         const glm::dvec2 a = set.point(i, rng);
-        const std::size_t t = std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), a.x) -
-                                                        lighting.cdf.begin(),
-                                                    lighting.cdf.size() - 1);
+        const std::size_t t = lighting.texel_of(a.x);
         const double p = probability(t);
         const double s = p > 0.0 ? std::clamp((a.x - (lighting.cdf[t] - p)) / p, 0.0, 1.0) : 0.5;
         const int face = int(t / (std::size_t(m) * m)), j = int(t / m % m), k = int(t % m);

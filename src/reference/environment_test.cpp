@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -303,6 +304,34 @@ TEST(Environment, ProbeDistributionsAgreeUnderOcclusion) {
   std::printf("[agree] %zu pixels: mean z %.4f, mean z^2 %.4f\n", n, z_mean, z2_mean);
   EXPECT_LT(std::abs(z_mean), 4.0 / std::sqrt(double(n)));
   EXPECT_LT(z2_mean, 1.3);
+}
+
+// The guide table finds the texel the whole CDF's binary search finds: for every texel's CDF value,
+// the doubles either side of it, every guide entry's k / n and its neighbours, and a million
+// uniform points, under both distributions (the compensated one's flat runs of texels never drawn).
+TEST(Environment, GuideTableFindsTheBinarySearchesTexel) {
+  const Scene scene = sky_scene(kTopCamera, kPlane);
+  for (auto distribution : {detail::ProbeDistribution::compensated, detail::ProbeDistribution::luminance}) {
+    detail::set_probe_distribution(distribution);
+    const detail::EnvironmentLighting lighting(scene, false);
+    ASSERT_EQ(lighting.cdf.size(), std::size_t(6 * kProbeSize * kProbeSize));
+    const auto searched = [&](double x) {
+      return std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), x) - lighting.cdf.begin(),
+                                   lighting.cdf.size() - 1);
+    };
+    std::vector<double> xs;
+    const double n = double(lighting.guide.size());
+    for (std::size_t k = 0; k < lighting.cdf.size(); ++k)
+      for (double x : {lighting.cdf[k], double(k) / n})
+        xs.insert(xs.end(), {x, std::nextafter(x, 0.0), std::nextafter(x, 1.0)});
+    msm::util::SplitMix64 rng(7);
+    for (int i = 0; i < 1000000; ++i) xs.push_back(rng.uniform());
+    std::size_t wrong = 0;
+    for (double x : xs)
+      if (x >= 0.0 && x < 1.0 && lighting.texel_of(x) != searched(x)) ++wrong;
+    EXPECT_EQ(wrong, 0u);
+  }
+  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
 }
 
 // The default estimator's noise on the sky with its sun: the pixels' own relative standard error at

@@ -296,8 +296,12 @@ struct EnvironmentLighting {
   int size = 0;                    // of the probe's faces; 0 with probe_lights (no probe sampled)
   std::vector<glm::vec3> radiance; // 6 size² texels, face-major, rows along +v
   ProbeDistribution distribution = ProbeDistribution::compensated;
-  std::vector<double> cdf;      // of the distribution, normalized, cdf.back() = 1; empty: no probe samples
-  std::vector<ConeLight> cones; // lights sampled as uniform cones or rectangles
+  std::vector<double> cdf; // of the distribution, normalized, cdf.back() = 1; empty: no probe samples
+  // guide[k] = the first texel t with cdf[t] > k / guide.size(): the texel of x in [k, k + 1) /
+  // guide.size() lies in [guide[k], guide[k + 1]] (a guide table, Chen and Asau 1974).
+  std::vector<std::uint32_t> guide;
+  std::size_t texel_of(double x) const; // the first t with cdf[t] > x (the last where none is)
+  std::vector<ConeLight> cones;         // lights sampled as uniform cones or rectangles
 };
 struct EnvironmentSample {
   glm::dvec3 irradiance{0.0}, unoccluded{0.0};
