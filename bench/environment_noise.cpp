@@ -1,13 +1,13 @@
-// The environment effect's cost of a given noise, for its two probe distributions
-// (ProbeDistribution, src/reference/internal.h) in this one binary: per scene, a converged
-// reference (the compensated distribution at --reference samples per pixel, its own seed), then
-// each distribution at 16, 32, ..., 1024 samples per pixel against it. The relative RMSE of an
+// The environment effect's cost of a given noise, for its two ways of sampling the probe
+// (ProbeSampling, src/reference/internal.h) in this one binary: per scene, a converged
+// reference (the compensated sampling at --reference samples per pixel, its own seed), then
+// each sampling at 16, 36, 64, ..., 1024 (squares: a whole jittered grid) samples per pixel against it. The relative RMSE of an
 // image is the RMSE of its irradiance's luminance over the lit pixels divided by the reference's
 // mean luminance; the reference's own noise counts against both. Printed per scene and
-// distribution: the relative RMSE at each count, the samples needed for the target (log-log
+// sampling: the relative RMSE at each count, the samples needed for the target (log-log
 // interpolation between the counts that bracket it; beyond them, 1/sqrt(N) from the last), the
 // time per sample (render time over pixel-samples, all counts together; the runs of the two
-// distributions alternate so that a busy machine slows both alike) and their product, the
+// samplings alternate so that a busy machine slows both alike) and their product, the
 // equal-noise time.
 //
 // msm_bench_environment_noise [--size W H] [--reference N] [--target RMSE] [--threads T] [scene...]
@@ -28,7 +28,7 @@
 namespace {
 
 using namespace msm::reference;
-using detail::ProbeDistribution;
+using detail::ProbeSampling;
 
 struct Options {
   int width = 96, height = 54, reference_samples = 4096, threads = 0;
@@ -69,7 +69,7 @@ double samples_needed(const std::vector<int>& counts, const std::vector<double>&
   return counts[last] * std::pow(errors[last] / target, 2.0);
 }
 
-const char* name_of(ProbeDistribution d) { return d == ProbeDistribution::compensated ? "compensated" : "luminance"; }
+const char* name_of(ProbeSampling d) { return d == ProbeSampling::compensated ? "compensated" : "luminance"; }
 
 void measure(const std::string& file, const Options& o) {
   const msm::scene::Scene scene = msm::scene::load_scene(file);
@@ -80,15 +80,15 @@ void measure(const std::string& file, const Options& o) {
   s.threads = o.threads;
   s.samples = o.reference_samples;
   s.seed = 1000003;
-  detail::set_probe_distribution(ProbeDistribution::compensated);
+  detail::set_probe_sampling(ProbeSampling::compensated);
   const std::vector<double> reference = luminance_of(render(scene, s));
-  const std::vector<int> counts = {16, 32, 64, 128, 256, 512, 1024};
-  const ProbeDistribution distributions[] = {ProbeDistribution::luminance, ProbeDistribution::compensated};
+  const std::vector<int> counts = {16, 36, 64, 144, 256, 576, 1024}; // squares: fully stratified
+  const ProbeSampling samplings[] = {ProbeSampling::luminance, ProbeSampling::compensated};
   std::vector<double> errors[2], seconds(2, 0.0), pixel_samples(2, 0.0);
   s.seed = 1;
   for (int count : counts)
     for (int d = 0; d < 2; ++d) {
-      detail::set_probe_distribution(distributions[d]);
+      detail::set_probe_sampling(samplings[d]);
       s.samples = count;
       const Result r = render(scene, s);
       errors[d].push_back(relative_rmse(luminance_of(r), reference));
@@ -99,15 +99,15 @@ void measure(const std::string& file, const Options& o) {
               o.reference_samples);
   double cost[2];
   for (int d = 0; d < 2; ++d) {
-    std::printf("  %-11s relative RMSE", name_of(distributions[d]));
+    std::printf("  %-11s relative RMSE", name_of(samplings[d]));
     for (std::size_t k = 0; k < counts.size(); ++k) std::printf(" %d: %.4f", counts[k], errors[d][k]);
     const double needed = samples_needed(counts, errors[d], o.target);
     const double per_sample = seconds[d] / pixel_samples[d];
     cost[d] = needed * per_sample;
-    std::printf("\n  %-11s %.0f samples for %.2g, %.1f ns per sample, %.1f us per pixel\n", name_of(distributions[d]),
+    std::printf("\n  %-11s %.0f samples for %.2g, %.1f ns per sample, %.1f us per pixel\n", name_of(samplings[d]),
                 needed, o.target, per_sample * 1e9, cost[d] * 1e6);
   }
-  std::printf("  equal-noise time: %.2fx less with the compensated distribution\n", cost[0] / cost[1]);
+  std::printf("  equal-noise time: %.2fx less with the compensated sampling\n", cost[0] / cost[1]);
   std::fflush(stdout);
 }
 

@@ -1,7 +1,8 @@
 // environment: image-based lighting with exact visibility (reference.h, "environment"). The full
-// probe is sampled in proportion to luminance x solid angle and the cosine-weighted hemisphere,
-// combined by the balance heuristic; the extracted area lights (--probe-lights) and the scene's
-// other directional lights are uniform cones (discs) or rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
+// probe is sampled in proportion to its luminance above its mean x solid angle and the
+// cosine-weighted hemisphere, combined by the balance heuristic; the extracted area lights
+// (--probe-lights) and the scene's other directional lights are uniform cones (discs) or
+// rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -57,12 +58,12 @@ ConeLight cone_light(const scene::Scene& scene, const scene::DirectionalLight& l
   return c;
 }
 
-std::atomic<ProbeDistribution> distribution_in_use{ProbeDistribution::compensated};
+std::atomic<ProbeSampling> sampling_in_use{ProbeSampling::compensated};
 
 } // namespace
 
-void set_probe_distribution(ProbeDistribution distribution) { distribution_in_use = distribution; }
-ProbeDistribution probe_distribution() { return distribution_in_use; }
+void set_probe_sampling(ProbeSampling sampling) { sampling_in_use = sampling; }
+ProbeSampling probe_sampling() { return sampling_in_use; }
 
 EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_lights) {
   if (!scene.probe)
@@ -86,7 +87,7 @@ EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_l
     cube = msm::probe::load_probe(p.file.string(), p.size, p.rotation_deg, p.intensity);
   } catch (const msm::probe::ProbeError& e) { throw std::invalid_argument(e.what()); }
   size = cube.size;
-  distribution = probe_distribution();
+  sampling = probe_sampling();
   const int m = size;
   const std::size_t texels = std::size_t(6) * m * m;
   radiance.reserve(texels);
@@ -107,17 +108,32 @@ EnvironmentLighting::EnvironmentLighting(const scene::Scene& scene, bool probe_l
       }
   // Compensated: the radiance above the probe's mean is what the cosine samples, whose density is
   // smooth, draw poorly; the rest they draw well, and the balance heuristic gives them all of it.
-  const double floor = distribution == ProbeDistribution::compensated ? energy / solid_angle : 0.0;
+  const double floor = sampling == ProbeSampling::compensated ? energy / solid_angle : 0.0;
   cdf.reserve(texels);
   double total = 0.0;
   for (std::size_t t = 0; t < texels; ++t) {
     total += std::max(luminance[t] - floor, 0.0) * weight[t];
     cdf.push_back(total);
   }
-  if (total > 0.0)
-    for (double& c : cdf) c /= total;
-  else
+  if (!(total > 0.0)) {
     cdf.clear(); // a uniform or black probe: only the cosine samples
+    return;
+  }
+  for (double& c : cdf) c /= total;
+  guide.resize(texels);
+  for (std::size_t k = 0, t = 0; k < texels; ++k) {
+    const double x = double(k) / double(texels);
+    while (t + 1 < texels && !(cdf[t] > x)) ++t;
+    guide[k] = std::uint32_t(t);
+  }
+}
+
+std::size_t EnvironmentLighting::texel_of(double x) const {
+  // k = floor(x n) but for the product's rounding: the interval one guide entry wider each side.
+  const std::size_t n = guide.size(), k = std::min(std::size_t(x * double(n)), n - 1);
+  const auto first = cdf.begin() + guide[k > 0 ? k - 1 : 0];
+  const auto last = k + 2 < n ? cdf.begin() + guide[k + 2] + 1 : cdf.end();
+  return std::min<std::size_t>(std::upper_bound(first, last, x) - cdf.begin(), n - 1);
 }
 
 EnvironmentSample environment_irradiance(const EffectContext& ctx, const EnvironmentLighting& lighting,
@@ -127,6 +143,9 @@ EnvironmentSample environment_irradiance(const EffectContext& ctx, const Environ
   const glm::dvec3 facing = glm::dot(hit.normal, view) > 0.0 ? -hit.normal : hit.normal;
   const int m = lighting.size;
   const bool probe = !lighting.radiance.empty(), probe_sampled = !lighting.cdf.empty();
+  // The plain importance sampling as it is measured against: also without the guide table and
+  // with one ray at a time (the same texels and rays; ProbeSampling).
+  const bool plain = lighting.sampling == ProbeSampling::luminance;
   const auto probability = [&](std::size_t t) {
     return probe_sampled ? lighting.cdf[t] - (t ? lighting.cdf[t - 1] : 0.0) : 0.0;
   };
@@ -164,10 +183,12 @@ EnvironmentSample environment_irradiance(const EffectContext& ctx, const Environ
       value[b] = value0[b] = glm::dvec3(0.0);
       if (probe_sampled) {
         // Probe sample: the texel by the first coordinate, the point inside it by what is left of it and the second.
-        const glm::dvec2 a = set.point(i, rng);
-        const std::size_t t = std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), a.x) -
-                                                        lighting.cdf.begin(),
-                                                    lighting.cdf.size() - 1);
+        const glm::dvec2 a = plain ? set.point(i, rng) : set.point_along_first(i, rng);
+        const std::size_t t =
+            plain ? std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), a.x) -
+                                              lighting.cdf.begin(),
+                                          lighting.cdf.size() - 1)
+                  : lighting.texel_of(a.x);
         const double p = probability(t);
         const double s = p > 0.0 ? std::clamp((a.x - (lighting.cdf[t] - p)) / p, 0.0, 1.0) : 0.5;
         const int face = int(t / (std::size_t(m) * m)), j = int(t / m % m), k = int(t % m);
@@ -208,7 +229,10 @@ EnvironmentSample environment_irradiance(const EffectContext& ctx, const Environ
         if (c > 0.0) add(b, l.estimate * c, d);
       }
     }
-    ctx.tracer.occluded(origins.data(), dirs.data(), rays, blocked.get());
+    if (plain)
+      for (int r = 0; r < rays; ++r) blocked[r] = ctx.tracer.occluded(origins[r], dirs[r]);
+    else
+      ctx.tracer.occluded(origins.data(), dirs.data(), rays, blocked.get());
     out.rays += std::uint64_t(rays);
     for (int r = 0; r < rays; ++r)
       if (!blocked[r]) value[owners[r]] += values[r];

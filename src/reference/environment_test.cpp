@@ -10,6 +10,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -242,7 +243,7 @@ PixelStatistics pixel_statistics(const Result& r) {
 // The estimator is unbiased: on the unoccluded plane under the procedural sky (every pixel the
 // same irradiance), the mean of 1296 independent pixels of 256 samples each is the probe's exact
 // irradiance within 4 standard errors of that mean (measured from the pixels' spread), for both
-// probe distributions; the standard error is below 0.1% of it, so this is a sharp check.
+// ways of sampling the probe; the standard error is below 0.1% of it, so this is a sharp check.
 TEST(Environment, EstimatorIsUnbiasedOnTheUnoccludedPlane) {
   const Scene scene = sky_scene(kTopCamera, kPlane);
   const msm::probe::CubeMap cube = msm::probe::load_probe("sky", kProbeSize);
@@ -250,26 +251,27 @@ TEST(Environment, EstimatorIsUnbiasedOnTheUnoccludedPlane) {
   Settings s = environment_settings(256);
   s.width = 48;
   s.height = 27;
-  for (auto distribution : {detail::ProbeDistribution::compensated, detail::ProbeDistribution::luminance}) {
-    detail::set_probe_distribution(distribution);
+  for (auto sampling : {detail::ProbeSampling::compensated, detail::ProbeSampling::luminance}) {
+    detail::set_probe_sampling(sampling);
     const PixelStatistics m = pixel_statistics(render(scene, s));
-    const char* name = distribution == detail::ProbeDistribution::compensated ? "compensated" : "luminance";
+    const char* name = sampling == detail::ProbeSampling::compensated ? "compensated" : "luminance";
     std::printf("[unbiased] %s: mean %.6f, exact %.6f, standard error %.6f (%.2f of them off)\n", name, m.mean,
                 expected, m.std_error, (m.mean - expected) / m.std_error);
     EXPECT_LT(std::abs(m.mean - expected), 4.0 * m.std_error) << name;
     EXPECT_LT(m.std_error, 1e-3 * expected) << name;
   }
-  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
+  detail::set_probe_sampling(detail::ProbeSampling::compensated);
 }
 
 // With occlusion (the box's shadow and contact shadows on the plane, under the sky and its sun):
-// the two probe distributions estimate the same irradiance. Independent samples (whose std_error
-// is the standard error, where the stratified sampler's is an upper bound); per pixel z = (E_c −
-// E_l) / sqrt(se_c² + se_l²) from two independent renders: the mean of z within 4 / sqrt(pixels)
-// of 0 (a bias of a tenth of a standard error in every pixel shows), and the mean of z² below 1.3
-// (1 without a bias, give or take 0.04 over 1296 pixels; a bias of 0.6 standard errors in every
-// pixel, or of 1.2 in a quarter of them, adds 0.36).
-TEST(Environment, ProbeDistributionsAgreeUnderOcclusion) {
+// the compensated sampling (with each sampler) estimates the irradiance that plain importance
+// sampling of the probe does. The latter with independent samples, whose std_error is the standard
+// error (the stratified sampler's is an upper bound); per pixel z = (E_c − E_l) / sqrt(se_c² +
+// se_l²) from two independent renders: the mean of z within 4 / sqrt(pixels) of 0 (a bias of a
+// tenth of a standard error in every pixel shows), and the mean of z² below 1.3 (1 or less without
+// a bias, give or take 0.04 over 1296 pixels; a bias of 0.6 standard errors in every pixel, or of
+// 1.2 in a quarter of them, adds 0.36).
+TEST(Environment, ProbeSamplingsAgreeUnderOcclusion) {
   const std::string box =
       R"({"primitive": {"type": "box", "size": [1, 1, 1]}, "transform": {"translate": [0, 0.5, 0]}})";
   const std::string camera = R"({"position": [2, 3, 3], "target": [0, 0.3, 0], "fov_y_deg": 50})";
@@ -278,38 +280,70 @@ TEST(Environment, ProbeDistributionsAgreeUnderOcclusion) {
   s.width = 48;
   s.height = 27;
   s.sampler = Sampler::independent;
-  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
-  const Result c = render(scene, s);
-  detail::set_probe_distribution(detail::ProbeDistribution::luminance);
   s.seed = 2;
+  detail::set_probe_sampling(detail::ProbeSampling::luminance);
   const Result l = render(scene, s);
-  detail::set_probe_distribution(detail::ProbeDistribution::compensated);
-  const auto& pc = c.irradiance.pixels();
-  const auto& pl = l.irradiance.pixels();
-  double z_sum = 0.0, z2_sum = 0.0;
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < c.irradiance.pixel_count(); ++k) {
-    const double se = std::hypot(pc[4 * k + 3], pl[4 * k + 3]);
-    if (!(se > 0.0)) continue;
-    const double z = (lum(glm::dvec3(pc[4 * k], pc[4 * k + 1], pc[4 * k + 2])) -
-                      lum(glm::dvec3(pl[4 * k], pl[4 * k + 1], pl[4 * k + 2]))) /
-                     se;
-    z_sum += z;
-    z2_sum += z * z;
-    ++n;
+  detail::set_probe_sampling(detail::ProbeSampling::compensated);
+  for (const Sampler sampler : {Sampler::independent, Sampler::stratified}) {
+    s.sampler = sampler;
+    s.seed = 1;
+    const Result c = render(scene, s);
+    const auto& pc = c.irradiance.pixels();
+    const auto& pl = l.irradiance.pixels();
+    double z_sum = 0.0, z2_sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < c.irradiance.pixel_count(); ++k) {
+      const double se = std::hypot(pc[4 * k + 3], pl[4 * k + 3]);
+      if (!(se > 0.0)) continue;
+      const double z = (lum(glm::dvec3(pc[4 * k], pc[4 * k + 1], pc[4 * k + 2])) -
+                        lum(glm::dvec3(pl[4 * k], pl[4 * k + 1], pl[4 * k + 2]))) /
+                       se;
+      z_sum += z;
+      z2_sum += z * z;
+      ++n;
+    }
+    ASSERT_GT(n, 1000u);
+    const double z_mean = z_sum / double(n), z2_mean = z2_sum / double(n);
+    std::printf("[agree] %s, %zu pixels: mean z %.4f, mean z^2 %.4f\n", std::string(to_string(sampler)).c_str(), n,
+                z_mean, z2_mean);
+    EXPECT_LT(std::abs(z_mean), 4.0 / std::sqrt(double(n))) << to_string(sampler);
+    EXPECT_LT(z2_mean, 1.3) << to_string(sampler);
   }
-  ASSERT_GT(n, 1000u);
-  const double z_mean = z_sum / double(n), z2_mean = z2_sum / double(n);
-  std::printf("[agree] %zu pixels: mean z %.4f, mean z^2 %.4f\n", n, z_mean, z2_mean);
-  EXPECT_LT(std::abs(z_mean), 4.0 / std::sqrt(double(n)));
-  EXPECT_LT(z2_mean, 1.3);
+}
+
+// The guide table finds the texel the whole CDF's binary search finds: for every texel's CDF value,
+// the doubles either side of it, every guide entry's k / n and its neighbours, and a million
+// uniform points, under both samplings (the compensated one's flat runs of texels never drawn).
+TEST(Environment, GuideTableFindsTheBinarySearchesTexel) {
+  const Scene scene = sky_scene(kTopCamera, kPlane);
+  for (auto sampling : {detail::ProbeSampling::compensated, detail::ProbeSampling::luminance}) {
+    detail::set_probe_sampling(sampling);
+    const detail::EnvironmentLighting lighting(scene, false);
+    ASSERT_EQ(lighting.cdf.size(), std::size_t(6 * kProbeSize * kProbeSize));
+    const auto searched = [&](double x) {
+      return std::min<std::size_t>(std::upper_bound(lighting.cdf.begin(), lighting.cdf.end(), x) - lighting.cdf.begin(),
+                                   lighting.cdf.size() - 1);
+    };
+    std::vector<double> xs;
+    const double n = double(lighting.guide.size());
+    for (std::size_t k = 0; k < lighting.cdf.size(); ++k)
+      for (double x : {lighting.cdf[k], double(k) / n})
+        xs.insert(xs.end(), {x, std::nextafter(x, 0.0), std::nextafter(x, 1.0)});
+    msm::util::SplitMix64 rng(7);
+    for (int i = 0; i < 1000000; ++i) xs.push_back(rng.uniform());
+    std::size_t wrong = 0;
+    for (double x : xs)
+      if (x >= 0.0 && x < 1.0 && lighting.texel_of(x) != searched(x)) ++wrong;
+    EXPECT_EQ(wrong, 0u);
+  }
+  detail::set_probe_sampling(detail::ProbeSampling::compensated);
 }
 
 // The default estimator's noise on the sky with its sun: the pixels' own relative standard error at
-// 64 samples, averaged over the unoccluded plane. Measured: 0.0038 with the compensated
-// distribution (the default), 0.0905 with the luminance one (its sun texel drawn by a fifth of the
-// probe samples, where the compensated distribution gives it two thirds and the rest of the sky to
-// the cosine samples). Asserted: below 0.01.
+// 64 samples, averaged over the unoccluded plane. Measured: 0.0037 with the compensated sampling
+// (the default: nearly every probe sample on the sun, the sky the cosine samples'), 0.0905 with
+// the luminance one (the sun drawn by some of the probe samples, with the variance of how many).
+// Asserted: below 0.01.
 TEST(Environment, DefaultEstimatorIsQuietUnderTheSun) {
   const Scene scene = sky_scene(kTopCamera, kPlane);
   Settings s = environment_settings(64);

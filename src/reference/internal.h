@@ -48,6 +48,14 @@ class SampleSet {
     }
     return {a, b};
   }
+  // The i-th of N points with the first coordinate stratified over all N (jittered in [i, i + 1) /
+  // N) and the second independent: for a first coordinate that matters most (the environment's
+  // texel choice), N strata where point() has m. The independent sampler: independent points.
+  glm::dvec2 point_along_first(int i, Rng& rng) const {
+    const double a = rng.uniform(), b = rng.uniform();
+    constexpr double below_one = 1.0 - 0x1.0p-53;
+    return sampler_ == Sampler::stratified ? glm::dvec2(std::min((i + a) / count_, below_one), b) : glm::dvec2(a, b);
+  }
 
  private:
   Sampler sampler_;
@@ -282,22 +290,28 @@ struct ConeLight {
   // rectangle: that irradiance x area / F (msm_rect_light_facing_integral), times cos³ θ per sample.
   glm::dvec3 estimate{0.0};
 };
-// The distribution of the environment effect's probe samples over the texels (reference.h,
-// "environment"): `compensated` (the default) in proportion to max(Y − Ȳ, 0) x solid angle, Ȳ the
-// probe's mean luminance (Karlík et al., "MIS Compensation", 2019; pbrt-v4's image infinite light),
-// `luminance` in proportion to Y x solid angle. Process-wide: a measurement
-// (bench/environment_noise.cpp) compares the two in one binary.
-enum class ProbeDistribution { compensated, luminance };
-void set_probe_distribution(ProbeDistribution distribution);
-ProbeDistribution probe_distribution();
+// How the environment effect draws its probe samples (reference.h, "environment"). `compensated`
+// (the default): texels in proportion to max(Y − Ȳ, 0) x solid angle, Ȳ the probe's mean luminance
+// (Karlík et al., "MIS Compensation", 2019; pbrt-v4's image infinite light), the texel choice
+// stratified over all N samples (SampleSet::point_along_first). `luminance`: texels in proportion
+// to Y x solid angle, the choice stratified by the jittered grid's columns (SampleSet::point): the
+// plain importance sampling that the compensated one is measured against. Process-wide: a
+// measurement (bench/environment_noise.cpp) compares the two in one binary.
+enum class ProbeSampling { compensated, luminance };
+void set_probe_sampling(ProbeSampling sampling);
+ProbeSampling probe_sampling();
 
 struct EnvironmentLighting {
   EnvironmentLighting(const scene::Scene& scene, bool probe_lights);
   int size = 0;                    // of the probe's faces; 0 with probe_lights (no probe sampled)
   std::vector<glm::vec3> radiance; // 6 size² texels, face-major, rows along +v
-  ProbeDistribution distribution = ProbeDistribution::compensated;
-  std::vector<double> cdf;      // of the distribution, normalized, cdf.back() = 1; empty: no probe samples
-  std::vector<ConeLight> cones; // lights sampled as uniform cones or rectangles
+  ProbeSampling sampling = ProbeSampling::compensated;
+  std::vector<double> cdf; // of the sampling's distribution, normalized, cdf.back() = 1; empty: no probe samples
+  // guide[k] = the first texel t with cdf[t] > k / guide.size(): the texel of x in [k, k + 1) /
+  // guide.size() lies in [guide[k], guide[k + 1]] (a guide table, Chen and Asau 1974).
+  std::vector<std::uint32_t> guide;
+  std::size_t texel_of(double x) const; // the first t with cdf[t] > x (the last where none is)
+  std::vector<ConeLight> cones;         // lights sampled as uniform cones or rectangles
 };
 struct EnvironmentSample {
   glm::dvec3 irradiance{0.0}, unoccluded{0.0};

@@ -107,10 +107,10 @@
 //               same file, size, rotation and intensity; piecewise constant over the texels of the
 //               cube's faces) plus the scene's directional lights that are not the probe's, as
 //               uniform cones or rectangles (below). Each of the `samples` samples draws one direction from the
-//               probe (a texel chosen in proportion to luminance x solid angle, msm_cube_texel_weight,
-//               then a uniform point of it on the face plane: density p_texel / msm_cube_texel_weight
-//               at that point) and one from the cosine-weighted hemisphere around n_s (Shirley-Chiu
-//               disc), combined by the balance heuristic: each adds f / (p_probe + p_cosine).
+//               probe (a texel chosen in proportion to max(Y − Ȳ, 0) msm_cube_texel_weight, Y its luminance, Ȳ
+//               the probe's mean, the choice stratified over all N samples; a uniform point of it on the face
+//               plane: density p_texel / msm_cube_texel_weight there) and one from the cosine-weighted hemisphere
+//               (Shirley-Chiu disc), balance heuristic: each adds f / (p_probe + p_cosine); p_probe = 0 below Ȳ.
 //               --probe-lights (Settings::probe_lights): every light of the scene, the probe's
 //               extracted area lights included, is a light of uniform radiance whose irradiance on
 //               a facing surface is the light's `irradiance` (scene.cpp: Eq. 18 for the rectangle,
