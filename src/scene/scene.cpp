@@ -635,6 +635,16 @@ DirectionalLight light_of_area_light(const msm::MsmAreaLight& area) {
   return l;
 }
 
+DirectionalLight overridden_light(DirectionalLight light, std::optional<float> extent_deg,
+                                  std::optional<float> height_deg) {
+  if (extent_deg) {
+    light.angular_extent_deg = *extent_deg;
+    light.angular_height_deg.reset();
+  }
+  if (height_deg) light.angular_height_deg = *height_deg;
+  return light;
+}
+
 glm::vec2 DirectionalLight::tan_half_extents() const {
   const auto half_tan = [](float deg) { return std::tan(glm::radians(deg) * 0.5f); };
   return {half_tan(angular_extent_deg), half_tan(angular_height_deg.value_or(angular_extent_deg))};

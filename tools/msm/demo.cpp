@@ -347,7 +347,9 @@ void add_demo(CLI::App& app) {
                "samples per pixel\n",
                soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, opt->soft_samples);
     reference::Settings rs = reference_settings(reference::Effect::soft, fs, opt->soft_samples);
-    rs.light_extent_deg = extent;
+    // The light the renderer draws: the scene's, or the command line's overrides of it.
+    if (fs.light_extent_deg) rs.light_extent_deg = *fs.light_extent_deg;
+    if (fs.light_height_deg) rs.light_height_deg = *fs.light_height_deg;
     rs.progress = [lines = std::make_shared<util::ProgressLines>("msm demo: ray tracing ", " rows")](
                       const reference::Progress& p) {
       if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);

@@ -341,6 +341,14 @@ struct DirectionalLight {
   glm::vec2 rectangle_extents() const { return rectangular() ? tan_half_extents() : glm::vec2(0.0f); }
 };
 
+// The light that the renderer, the ray tracer and the viewer draw for `light` under a command
+// line's (or a viewer's) overrides, the one rule for all three: an extent alone replaces the light
+// by a disc of that angular diameter; a height makes it a rectangle of that height, its width the
+// extent (given, else its own). Neither: the light exactly as the scene declares it, a rectangle
+// where it has angular_height_deg.
+DirectionalLight overridden_light(DirectionalLight light, std::optional<float> extent_deg,
+                                  std::optional<float> height_deg);
+
 // A homogeneous medium (JCGT 2017 §5.1.1): extinction σt, scattering albedo ρ and a Henyey–
 // Greenstein phase function of asymmetry g (g = 0: isotropic). Lit by the scene's light(s) with
 // their irradiance E_l.
