@@ -154,12 +154,13 @@ void render_frames(const vk::Context& ctx, render::Renderer& renderer, const sce
     entry["render_ms"] = nlohmann::json::object();
     for (const std::string& name : techniques) {
       render::RenderSettings s = settings_for(frame, name);
+      s.frame = frame.noise_frame.value_or(k); // a blue-noise layer of its own each frame
       s.lights = lights;
       render::RenderResult result;
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
-      write_render(out, fmt::format("{}-frame{:03}", name, k), result, render_json(s, scene, ctx, result));
+      write_render(out, fmt::format("{}-frame{:03}", name, k), result, render_json(s, scene, k, ctx, result));
       entry["render_ms"][name] = result.total_ms;
       line += fmt::format("  {} {:.2f} ms", name, result.total_ms);
     }
