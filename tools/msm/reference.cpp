@@ -225,9 +225,11 @@ void add_reference(CLI::App& app) {
       throw UsageError(fmt::format("{}: --effect environment needs a scene with a \"probe\" (file, lights, intensity, "
                                    "rotation_deg, size; scenes/README.md)",
                                    scene.source.string()));
+    // The filtered effect traces the renderer's shadow map: the warnings of its framing.
+    std::vector<std::string> warnings;
     if (settings.effect == msm::reference::Effect::filtered)
-      if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
-        fmt::print(stderr, "msm reference: {}\n", *w);
+      warnings = msm::scene::shadow_framing_warnings(scene, settings.width, settings.height, settings.shadow_size);
+    for (const std::string& w : warnings) fmt::print(stderr, "msm reference: {}\n", w);
     // The same limits as msm render's, before the output directory or anything large exists.
     try {
       msm::reference::check_limits(settings, scene.triangle_count());
@@ -295,6 +297,7 @@ void add_reference(CLI::App& app) {
         {"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
     j["light"] = light_json(scene.light(), settings, result);
     j["max_crossings"] = settings.max_crossings;
+    j["warnings"] = warnings;
     j["threads"] = result.threads;
     j["rays"] = result.rays;
     j["background_pixels"] = result.background_pixels;

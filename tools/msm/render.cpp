@@ -113,8 +113,8 @@ void add_render(CLI::App& app) {
                                      opt->sub_lights);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     const render::RenderSettings& f = opt->frame.settings;
-    if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
-      fmt::print(stderr, "msm render: {}\n", *w);
+    const std::vector<std::string> warnings = scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size);
+    for (const std::string& w : warnings) fmt::print(stderr, "msm render: {}\n", w);
     check_limits(opt->frame, scene, names);
     if (frames) check_frames(scene, opt->frames);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
@@ -138,7 +138,7 @@ void add_render(CLI::App& app) {
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
-      write_render(opt->out, names[i], result, render_json(s, scene, frame, *ctx, result));
+      write_render(opt->out, names[i], result, render_json(s, scene, frame, warnings, *ctx, result));
       double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU {:8.0f} ms wall -> {}/{}.png{}{}\n", i + 1, names.size(),
                  names[i], result.total_ms, wall_ms, opt->out, names[i],

@@ -203,7 +203,8 @@ void ensure_output_dir(const std::filesystem::path& dir) {
 }
 
 nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, int frame,
-                           const vk::Context& ctx, const render::RenderResult& result) {
+                           const std::vector<std::string>& warnings, const vk::Context& ctx,
+                           const render::RenderResult& result) {
   const Technique& t = render::find_rendered_technique(s.technique);
   glm::vec4 p = s.params ? *s.params : t.default_params();
   nlohmann::json passes = nlohmann::json::object();
@@ -244,7 +245,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"coloured_translucency", s.coloured_translucency},
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
-          {"gpu_ms_total", result.total_ms}};
+          {"gpu_ms_total", result.total_ms},
+          {"warnings", warnings}};
 }
 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,

@@ -73,10 +73,11 @@ scene::Scene load_scene_or_fail(const std::string& name_or_path);
 // Creates the directory (UsageError if impossible or not writable).
 void ensure_output_dir(const std::filesystem::path& dir);
 
-// Every setting of a render (technique parameters included), the scene's frame (--frame), and its
-// pass times.
+// Every setting of a render (technique parameters included), the scene's frame (--frame) and the
+// warnings printed for it (scene::shadow_framing_warnings), and its pass times.
 nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, int frame,
-                           const vk::Context& ctx, const render::RenderResult& result);
+                           const std::vector<std::string>& warnings, const vk::Context& ctx,
+                           const render::RenderResult& result);
 
 // <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>-rgb.exr (coloured
 // shadows only), <dir>/<stem>.json: all or none (image::FileSet: temporaries, then renamed together).
