@@ -18,6 +18,12 @@
 namespace msm::scene {
 namespace {
 
+// The largest irradiance of a light (each RGB component): the shading sums the irradiance of every
+// light of a frame and as many luminance weights in single precision (shading.glsl), which stay
+// finite for kMaxLights lights of at most FLT_MAX / kMaxLights ≈ 1.3e36 each (above, the weights'
+// sum overflowed to inf and the shadow buffer's visibility became inf / inf = NaN).
+constexpr float kMaxIrradiance = 1e36f;
+
 using nlohmann::json;
 namespace fs = std::filesystem;
 
@@ -229,6 +235,10 @@ class Parser {
     if (const json* v = find(j, "irradiance")) {
       l.irradiance = vec<3>(*v, ptr + "/irradiance");
       if (glm::any(glm::lessThan(l.irradiance, glm::vec3(0.0f)))) fail(ptr + "/irradiance", "must be >= 0");
+      if (glm::any(glm::greaterThan(l.irradiance, glm::vec3(kMaxIrradiance))))
+        fail(ptr + "/irradiance",
+             fmt::format("must be at most {:g} (the shading sums up to {} lights in single precision)", kMaxIrradiance,
+                         kMaxLights));
     }
     if (const json* v = find(j, "angular_extent_deg"))
       l.angular_extent_deg = number_in(*v, ptr + "/angular_extent_deg", 0.0f, 90.0f, false, true);
