@@ -33,13 +33,21 @@ MSM_FN float msm_luminance(vec3 rgb) {
   return y;
 }
 
+// The curve below reaches 1 at x = (0.56 + sqrt(0.56² + 4 · 0.08 · 0.14)) / 0.16 ≈ 7.24 and exceeds it
+// above, where the clamp makes it 1: x is capped at this value first, which changes no result and
+// keeps x² finite (in single precision x² overflowed above ~1.16e19: inf / inf, NaN, a black pixel
+// where the surface is brightest).
+const float MSM_ACES_SATURATION = 16.0f;
+
 // Narkowicz 2015 fit of the ACES filmic curve, x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14),
-// clamped to [0, 1]; applied after the exposure. Precondition: x >= 0 and finite (callers map NaN,
-// negative and infinite values first where they can occur).
+// clamped to [0, 1]; applied after the exposure. Precondition: x >= 0 and not NaN (callers map
+// NaN and negative values first where they can occur); +inf gives 1.
 MSM_FN float msm_aces(float x) {
+  x = min(x, MSM_ACES_SATURATION);
   return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
 }
 MSM_FN vec3 msm_aces(vec3 x) {
+  x = min(x, vec3(MSM_ACES_SATURATION));
   return clamp(x * (2.51f * x + 0.03f) / (x * (2.43f * x + 0.59f) + 0.14f), vec3(0.0f), vec3(1.0f));
 }
 

@@ -27,7 +27,7 @@ double facing_integral(bool disc, double half_x, double half_y) {
 
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng) {
   const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
-  const bool disc = ctx.settings.light_shape == LightShape::disc;
+  const bool disc = ctx.light_shape == LightShape::disc;
   // The origin is on the side of the surface facing the light's centre (as in `hard`); sampled
   // directions below that side's horizon cross the surface itself and are blocked.
   const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, ctx.towards_light);

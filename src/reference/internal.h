@@ -207,8 +207,9 @@ struct EffectContext {
   // filtered
   FilterKernel kernel;
   glm::dvec3 texel_x{0.0}, texel_y{0.0}; // world vector of one texel along light-space x / y
-  // soft: half-sizes of the light in the plane at unit distance along towards_light (tangents
-  // of the half-angles); the disc uses half_x as its radius.
+  // soft: the light's shape (traced_light) and half-sizes in the plane at unit distance along
+  // towards_light (tangents of the half-angles); the disc uses half_x as its radius.
+  LightShape light_shape = LightShape::disc;
   double half_x = 0.0, half_y = 0.0;
   glm::dvec3 light_x{0.0}, light_y{0.0}; // unit, orthogonal to towards_light
 };

@@ -90,6 +90,27 @@ void validate(const Settings& s) {
   check_angle("light extent", s.light_extent_deg);
   check_angle("light width", s.light_width_deg);
   check_angle("light height", s.light_height_deg);
+  if (s.light_shape == LightShape::disc && (s.light_width_deg || s.light_height_deg))
+    throw std::invalid_argument("a light width or height applies to a rectangular light only, not a disc");
+}
+
+TracedLight traced_light(const scene::DirectionalLight& light, const Settings& s) {
+  const auto as_float = [](const std::optional<double>& deg) -> std::optional<float> {
+    if (deg) return float(*deg);
+    return std::nullopt;
+  };
+  const scene::DirectionalLight drawn =
+      scene::overridden_light(light, as_float(s.light_extent_deg), as_float(s.light_height_deg));
+  TracedLight t;
+  t.extent_deg = drawn.angular_extent_deg;
+  t.shape = s.light_shape.value_or(drawn.rectangular() || s.light_width_deg ? LightShape::rectangle : LightShape::disc);
+  if (t.shape == LightShape::disc) {
+    t.width_deg = t.height_deg = t.extent_deg;
+  } else {
+    t.width_deg = s.light_width_deg.value_or(t.extent_deg);
+    t.height_deg = drawn.angular_height_deg.value_or(t.extent_deg);
+  }
+  return t;
 }
 
 std::uint64_t estimated_bytes(const Settings& s, std::uint64_t triangles) {
@@ -168,21 +189,15 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   ctx.light_x = glm::normalize(ctx.frame.x_axis - glm::dot(ctx.frame.x_axis, ctx.towards_light) * ctx.towards_light);
   ctx.light_y = glm::cross(ctx.towards_light, ctx.light_x);
   if (glm::dot(ctx.light_y, ctx.frame.y_axis) < 0.0) ctx.light_y = -ctx.light_y;
-  const double extent = settings.light_extent_deg.value_or(scene.light().angular_extent_deg);
-  if (!(std::isfinite(extent) && extent >= 0.0 && extent < 90.0))
-    throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", extent));
-  result.light_extent_deg = extent;
-  if (settings.light_shape == LightShape::disc) {
-    result.light_width_deg = result.light_height_deg = extent;
-  } else {
-    // A rectangular scene light (angular_height_deg) gives its own height unless --light-extent
-    // replaces the light.
-    const std::optional<float> scene_height =
-        settings.light_extent_deg ? std::nullopt : scene.light().angular_height_deg;
-    result.light_width_deg = settings.light_width_deg.value_or(extent);
-    result.light_height_deg = settings.light_height_deg.value_or(scene_height ? double(*scene_height) : extent);
-  }
+  const TracedLight light = traced_light(scene.light(), settings);
+  if (!(std::isfinite(light.extent_deg) && light.extent_deg >= 0.0 && light.extent_deg < 90.0))
+    throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", light.extent_deg));
+  result.light_shape = light.shape;
+  result.light_extent_deg = light.extent_deg;
+  result.light_width_deg = light.width_deg;
+  result.light_height_deg = light.height_deg;
   const auto half_tan = [](double deg) { return std::tan(deg * std::numbers::pi / 360.0); };
+  ctx.light_shape = light.shape;
   ctx.half_x = half_tan(result.light_width_deg);
   ctx.half_y = half_tan(result.light_height_deg);
   const EffectFunction effect = effect_function(settings.effect);

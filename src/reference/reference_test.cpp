@@ -567,6 +567,51 @@ TEST(reference_soft, RectangleLightOverHalfPlaneIsALinearRamp) {
   EXPECT_GT(ramp, 100);
 }
 
+// A scene light declared as a rectangle (angular_height_deg) is traced as that rectangle without any
+// override: the same image, sample for sample, as the explicit --light-shape rectangle with its
+// extents; --light-shape disc and --light-extent alone (which makes it a disc, as in the renderer:
+// scene::overridden_light) trace the disc; --light-height keeps the scene's width.
+TEST(reference_soft, SceneRectangleLightIsTracedAsDeclared) {
+  const CameraSpec camera{{0.0, 0.06, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
+  const std::string light =
+      R"("light": {"towards_light": [0, 1, 0], "angular_extent_deg": 8, "angular_height_deg": 20})";
+  const Scene scene = make_scene(camera, light, ground_and_half_plane(1.0));
+  Settings s;
+  s.effect = Effect::soft;
+  s.width = 48;
+  s.height = 8;
+  s.samples = 64;
+  const Result declared = render(scene, s);
+  EXPECT_EQ(declared.light_shape, LightShape::rectangle);
+  EXPECT_DOUBLE_EQ(declared.light_width_deg, 8.0);
+  EXPECT_DOUBLE_EQ(declared.light_height_deg, 20.0);
+  Settings explicit_rectangle = s;
+  explicit_rectangle.light_shape = LightShape::rectangle;
+  explicit_rectangle.light_width_deg = 8.0;
+  explicit_rectangle.light_height_deg = 20.0;
+  EXPECT_EQ(declared.visibility, render(scene, explicit_rectangle).visibility);
+  Settings disc = s;
+  disc.light_shape = LightShape::disc;
+  const Result as_disc = render(scene, disc);
+  EXPECT_EQ(as_disc.light_shape, LightShape::disc);
+  EXPECT_DOUBLE_EQ(as_disc.light_height_deg, 8.0);
+  EXPECT_NE(as_disc.visibility, declared.visibility);
+  Settings extent = s;
+  extent.light_extent_deg = 8.0;
+  const Result extent_disc = render(scene, extent);
+  EXPECT_EQ(extent_disc.light_shape, LightShape::disc);
+  EXPECT_EQ(extent_disc.visibility, as_disc.visibility);
+  Settings height = s;
+  height.light_height_deg = 4.0;
+  const TracedLight lower = traced_light(scene.light(), height);
+  EXPECT_EQ(lower.shape, LightShape::rectangle);
+  EXPECT_DOUBLE_EQ(lower.width_deg, 8.0);
+  EXPECT_DOUBLE_EQ(lower.height_deg, 4.0);
+  // A width or height with a disc is refused.
+  disc.light_height_deg = 4.0;
+  EXPECT_THROW(validate(disc), std::invalid_argument);
+}
+
 TEST(reference_soft, ZeroExtentIsTheHardShadow) {
   const DiscScene ds(0.0);
   Settings s;

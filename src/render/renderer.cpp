@@ -249,15 +249,9 @@ struct Renderer::Impl {
     u.towards_light = glm::vec4(light.towards_light, s.normal_offset * float(texel.x));
     u.irradiance = glm::vec4(light.irradiance, 0.0f);
     if (msm_technique_is_area_light(technique.id)) {
-      // The light's two half extents along the frame's axes (a disc: its radius both; --light-extent
-      // alone makes every light that disc, with light_height_deg a rectangle), the search region
-      // and filter per axis from them.
-      scene::DirectionalLight drawn = light;
-      if (s.light_extent_deg) {
-        drawn.angular_extent_deg = *s.light_extent_deg;
-        drawn.angular_height_deg.reset();
-      }
-      if (s.light_height_deg) drawn.angular_height_deg = *s.light_height_deg;
+      // The light's two half extents along the frame's axes (a disc: its radius both), the search
+      // region and filter per axis from them.
+      const scene::DirectionalLight drawn = scene::overridden_light(light, s.light_extent_deg, s.light_height_deg);
       // soft.h: texels of reach per unit of [-1,1] depth.
       vec2 spread = msm_soft_spread(drawn.tan_half_extents(), float(0.5 * f.depth_extent), vec2(texel));
       // The shading integrates the cosine over the disc (msm_cone_cosine), or over the rectangle

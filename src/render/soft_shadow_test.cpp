@@ -32,9 +32,10 @@ class SoftShadowTest : public vk::test::VulkanTest {};
 
 const std::vector<std::string> kSoftTechniques = {"mssm4", "mssm6", "vssm", "pcss"};
 
-// The ray-traced soft shadow of the scene's light (its own extent where extent_deg is empty).
+// The ray-traced soft shadow of the scene's light (its own extent where extent_deg is empty, its
+// own shape where shape is).
 reference::Result area_light_truth(const scene::Scene& scene, int width, int height, std::optional<double> extent_deg,
-                                   int samples = 64, reference::LightShape shape = reference::LightShape::disc) {
+                                   int samples = 64, std::optional<reference::LightShape> shape = std::nullopt) {
   reference::Settings rs;
   rs.effect = reference::Effect::soft;
   rs.light_shape = shape;

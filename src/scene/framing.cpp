@@ -1,5 +1,5 @@
-// The shadow map's framing ("fit": what the camera sees) and the check that its texels are not
-// too coarse for the image (shadow_framing_warning).
+// The shadow map's framing ("fit": what the camera sees) and the checks that its texels are not
+// too coarse for the image and that an explicit one holds what matters (shadow_framing_warnings).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -212,26 +212,127 @@ TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, i
   return c;
 }
 
-std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size) {
+namespace {
+
+// Sutherland–Hodgman: the part of the convex polygon where inside(p) >= 0 (a linear function).
+template <class Inside>
+void clip_polygon(std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch, Inside inside) {
+  scratch.clear();
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const glm::dvec4 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+    const double da = inside(a), db = inside(b);
+    if (da >= 0.0) scratch.push_back(a);
+    if ((da >= 0.0) != (db >= 0.0)) scratch.push_back(a + (da / (da - db)) * (b - a));
+  }
+  poly.swap(scratch);
+}
+
+// Whether the triangle's part selected by `clip` (world points, w = 1) meets the light's map box:
+// clip-space x and y in [-1, 1] and depth at most 1 (orthographic: w stays 1).
+template <class Clip>
+bool meets_map(const glm::dmat4& light_vp, std::array<glm::dvec4, 3> triangle, Clip clip, std::vector<glm::dvec4>& poly,
+               std::vector<glm::dvec4>& scratch) {
+  poly.assign(triangle.begin(), triangle.end());
+  clip(poly, scratch);
+  for (glm::dvec4& p : poly) p = light_vp * p;
+  for (int plane = 0; plane < 5 && !poly.empty(); ++plane)
+    clip_polygon(poly, scratch, [plane](const glm::dvec4& p) {
+      switch (plane) {
+      case 0: return p.w + p.x;
+      case 1: return p.w - p.x;
+      case 2: return p.w + p.y;
+      case 3: return p.w - p.y;
+      default: return p.w - p.z;
+      }
+    });
+  return !poly.empty();
+}
+
+} // namespace
+
+std::vector<FramingMiss> shadow_framing_misses(const Scene& scene, int width, int height) {
+  std::vector<FramingMiss> misses;
+  if (scene.shadow.mode != ShadowFraming::Mode::given || width <= 0 || height <= 0) return misses;
+  const glm::dmat4 camera_vp =
+      glm::dmat4(scene.camera.projection(float(width) / float(height))) * glm::dmat4(scene.camera.view());
+  const glm::dmat4 camera_inverse = glm::inverse(camera_vp);
+  // The part of a triangle inside the camera's view frustum, back in world space (w = 1).
+  const auto visible_part = [&](std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch) {
+    for (glm::dvec4& p : poly) p = camera_vp * p;
+    for (int plane = 0; plane < 6 && !poly.empty(); ++plane)
+      clip_polygon(poly, scratch, [plane](const glm::dvec4& p) {
+        switch (plane) {
+        case 0: return p.w + p.x;
+        case 1: return p.w - p.x;
+        case 2: return p.w + p.y;
+        case 3: return p.w - p.y;
+        case 4: return p.z;
+        default: return p.w - p.z;
+        }
+      });
+    for (glm::dvec4& p : poly) {
+      p = camera_inverse * p;
+      p /= p.w;
+    }
+  };
+  const auto whole = [](std::vector<glm::dvec4>&, std::vector<glm::dvec4>&) {};
+  std::vector<glm::dvec4> poly, scratch;
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const glm::dmat4 light_vp(scene.light_view_projection(l));
+    bool receiver = false, caster = false;
+    for (const Object& o : scene.objects) {
+      const Mesh& m = o.mesh;
+      for (std::size_t t = 0; t < m.triangle_count() && !(receiver && caster); ++t) {
+        std::array<glm::dvec4, 3> triangle;
+        for (int k = 0; k < 3; ++k)
+          triangle[std::size_t(k)] = glm::dvec4(glm::dvec3(m.positions[m.indices[3 * t + std::size_t(k)]]), 1.0);
+        if (!caster) caster = meets_map(light_vp, triangle, whole, poly, scratch);
+        if (!receiver) receiver = meets_map(light_vp, triangle, visible_part, poly, scratch);
+      }
+    }
+    if (!receiver || !caster) misses.push_back({l, !receiver, !caster});
+  }
+  return misses;
+}
+
+std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, int height, int shadow_size) {
+  std::vector<std::string> out;
   const TexelCoverage c = shadow_texel_coverage(scene, width, height, shadow_size);
-  std::string text;
   if (c.pixels_per_texel > kMaxPixelsPerTexel) {
     const int needed = int(std::min<double>(65536.0, std::ceil(shadow_size * c.pixels_per_texel / kMaxPixelsPerTexel)));
-    text = fmt::format(
+    out.push_back(fmt::format(
         "warning: one shadow-map texel ({:.3g} scene units) spans {:.1f} screen pixels (more than {:g}) at the nearest "
         "visible surface, {:.3g} units from the camera: shadows there are blocky or lost. Cures: a larger map "
         "(--shadow-size {} or more), an explicit framing of what matters (\"shadow_map\": {{\"framing\": "
         "\"explicit\", ...}}), a camera that sees less of a large scene; cascaded shadow maps would fix it but are "
         "not implemented.",
-        c.texel_size, c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, needed);
+        c.texel_size, c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, needed));
   }
-  if (c.aspect_beyond_fit) {
-    if (!text.empty()) text += "\n";
-    text += fmt::format("warning: the image ({}x{}) is wider than the {:g}:1 the shadow map's fit covers: surfaces at "
-                        "its left and right edges may lie outside the map (unshadowed). Cure: an explicit framing.",
-                        width, height, kFitMaxAspect);
+  if (c.aspect_beyond_fit)
+    out.push_back(fmt::format("warning: the image ({}x{}) is wider than the {:g}:1 the shadow map's fit covers: "
+                              "surfaces at its left and right edges may lie outside the map (unshadowed). Cure: an "
+                              "explicit framing.",
+                              width, height, kFitMaxAspect));
+  for (const FramingMiss& miss : shadow_framing_misses(scene, width, height)) {
+    const ShadowFraming& f = scene.shadow;
+    const std::string what = miss.receivers && miss.casters ? "none of the visible surfaces and no shadow caster"
+                             : miss.receivers               ? "none of the visible surfaces"
+                                                            : "no shadow caster";
+    out.push_back(fmt::format(
+        "warning: the explicit shadow-map framing (center [{:g}, {:g}, {:g}], extent [{:g}, {:g}], depth_range [{:g}, "
+        "{:g}]) holds {} for light {}: it casts no shadow the camera can see. Cure: a framing around what the camera "
+        "sees (\"shadow_map\": {{\"framing\": \"fit\"}}, the default).",
+        f.center.x, f.center.y, f.center.z, f.extent.x, f.extent.y, f.depth_range.x, f.depth_range.y, what,
+        miss.light));
   }
-  if (text.empty()) return std::nullopt;
+  return out;
+}
+
+std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size) {
+  const std::vector<std::string> warnings = shadow_framing_warnings(scene, width, height, shadow_size);
+  if (warnings.empty()) return std::nullopt;
+  std::string text = warnings.front();
+  for (std::size_t i = 1; i < warnings.size(); ++i) text += "\n" + warnings[i];
   return text;
 }
 

@@ -134,6 +134,55 @@ TEST(Framing, CoarseTexelWarning) {
   EXPECT_NE(wide->find("wider"), std::string::npos);
 }
 
+// An explicit framing (light straight down, the map centred on `center`, extent 2 x 2, depth range
+// [-near, far] from the centre along the light) over ground_scene's 20 m ground and 1 m box.
+Scene explicit_framing(const std::string& center, const std::string& depth_range = "[-10, 10]") {
+  std::string json = ground_scene(20.0f, false);
+  const std::string light = R"("light": {"towards_light": [0.3, 1, 0.5]})";
+  json.replace(json.find(light), light.size(), R"("light": {"towards_light": [0, 1, 0]})");
+  const std::string fit = R"("shadow_map": {"framing": "fit"})";
+  json.replace(json.find(fit), fit.size(),
+               R"("shadow_map": {"framing": "explicit", "center": )" + center +
+                   R"(, "extent": [2, 2], "depth_range": )" + depth_range + "}");
+  return load(json);
+}
+
+// Explicit framing that holds none of the visible receivers, or no caster: warned (naming the
+// framing and what it misses); a framing around the box, and the fitted ones, not.
+TEST(Framing, ExplicitFramingThatMissesTheSceneWarns) {
+  // Around the box: receivers and casters.
+  const Scene around = explicit_framing("[0, 0.5, 0]");
+  EXPECT_TRUE(shadow_framing_misses(around, 1280, 720).empty());
+  EXPECT_FALSE(shadow_framing_warning(around, 1280, 720, 1024).has_value());
+  // 100 m beside the scene: nothing at all in the map.
+  const Scene beside = explicit_framing("[100, 0, 100]");
+  const std::vector<FramingMiss> misses = shadow_framing_misses(beside, 1280, 720);
+  ASSERT_EQ(misses.size(), 1u);
+  EXPECT_TRUE(misses[0].receivers);
+  EXPECT_TRUE(misses[0].casters);
+  const std::vector<std::string> warnings = shadow_framing_warnings(beside, 1280, 720, 1024);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("explicit shadow-map framing (center [100, 0, 100]"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("none of the visible surfaces and no shadow caster"), std::string::npos) << warnings[0];
+  // On the ground 9 m away, behind the camera (it looks down at the box from z = 3): casters (the
+  // ground), no visible receiver.
+  const Scene behind = explicit_framing("[0, 0, 9]");
+  const std::vector<FramingMiss> behind_misses = shadow_framing_misses(behind, 1280, 720);
+  ASSERT_EQ(behind_misses.size(), 1u);
+  EXPECT_TRUE(behind_misses[0].receivers);
+  EXPECT_FALSE(behind_misses[0].casters);
+  // Over the box but with a depth range ending above everything (10 m up, 1 m deep): the receivers
+  // lie beyond depth 1, the map holds no caster either.
+  const Scene above = explicit_framing("[0, 10, 0]", "[-0.5, 0.5]");
+  const std::vector<FramingMiss> above_misses = shadow_framing_misses(above, 1280, 720);
+  ASSERT_EQ(above_misses.size(), 1u);
+  EXPECT_TRUE(above_misses[0].receivers);
+  EXPECT_TRUE(above_misses[0].casters);
+  // The fitted framings are not checked (they hold the scene by construction).
+  for (const std::string& name : builtin_scene_names())
+    EXPECT_TRUE(shadow_framing_misses(builtin_scene(name), 1280, 720).empty()) << name;
+}
+
 TEST(Framing, AbsurdCameraDepthRangeRefused) {
   auto with_camera = [](const std::string& camera) {
     return R"({"msm_scene": 1, "camera": )" + camera +

@@ -18,6 +18,12 @@
 namespace msm::scene {
 namespace {
 
+// The largest irradiance of a light (each RGB component): the shading sums the irradiance of every
+// light of a frame and as many luminance weights in single precision (shading.glsl), which stay
+// finite for kMaxLights lights of at most FLT_MAX / kMaxLights ≈ 1.3e36 each (above, the weights'
+// sum overflowed to inf and the shadow buffer's visibility became inf / inf = NaN).
+constexpr float kMaxIrradiance = 1e36f;
+
 using nlohmann::json;
 namespace fs = std::filesystem;
 
@@ -272,6 +278,10 @@ class Parser {
     if (const json* v = find(j, "irradiance")) {
       l.irradiance = vec<3>(*v, ptr + "/irradiance");
       if (glm::any(glm::lessThan(l.irradiance, glm::vec3(0.0f)))) fail(ptr + "/irradiance", "must be >= 0");
+      if (glm::any(glm::greaterThan(l.irradiance, glm::vec3(kMaxIrradiance))))
+        fail(ptr + "/irradiance",
+             fmt::format("must be at most {:g} (the shading sums up to {} lights in single precision)", kMaxIrradiance,
+                         kMaxLights));
     }
     if (const json* v = find(j, "angular_extent_deg"))
       l.angular_extent_deg = number_in(*v, ptr + "/angular_extent_deg", 0.0f, 90.0f, false, true);
@@ -676,6 +686,16 @@ DirectionalLight light_of_area_light(const msm::MsmAreaLight& area) {
   // Eq. 18 for the rectangle that is drawn (the extents kept below 90°): M_e F / Ω.
   l.irradiance = area.irradiance * msm::msm_rect_light_facing_fraction(l.tan_half_extents());
   return l;
+}
+
+DirectionalLight overridden_light(DirectionalLight light, std::optional<float> extent_deg,
+                                  std::optional<float> height_deg) {
+  if (extent_deg) {
+    light.angular_extent_deg = *extent_deg;
+    light.angular_height_deg.reset();
+  }
+  if (height_deg) light.angular_height_deg = *height_deg;
+  return light;
 }
 
 glm::vec2 DirectionalLight::tan_half_extents() const {

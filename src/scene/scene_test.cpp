@@ -1157,6 +1157,48 @@ TEST(Probe, BadValuesNameTheirPointer) {
 
 // ---- Rectangular lights (Kneiphof §4.1.2) ----
 
+// overridden_light, the one rule of the renderer, the ray tracer and the viewer: no override is the
+// light as declared; an extent alone a disc of that diameter; a height a rectangle of that height,
+// its width the extent given or the light's own.
+TEST(Lights, OverriddenLightIsTheDeclaredOneUnlessOverridden) {
+  DirectionalLight rect;
+  rect.angular_extent_deg = 20.0f;
+  rect.angular_height_deg = 2.0f;
+  const DirectionalLight same = overridden_light(rect, std::nullopt, std::nullopt);
+  EXPECT_TRUE(same.rectangular());
+  EXPECT_EQ(same.angular_extent_deg, 20.0f);
+  EXPECT_EQ(same.angular_height_deg, 2.0f);
+  const DirectionalLight disc = overridden_light(rect, 8.0f, std::nullopt);
+  EXPECT_FALSE(disc.rectangular());
+  EXPECT_EQ(disc.angular_extent_deg, 8.0f);
+  const DirectionalLight lower = overridden_light(rect, std::nullopt, 4.0f);
+  EXPECT_EQ(lower.angular_extent_deg, 20.0f);
+  EXPECT_EQ(lower.angular_height_deg, 4.0f);
+  DirectionalLight round;
+  round.angular_extent_deg = 10.0f;
+  EXPECT_FALSE(overridden_light(round, std::nullopt, std::nullopt).rectangular());
+  const DirectionalLight made = overridden_light(round, 6.0f, 3.0f);
+  EXPECT_EQ(made.angular_extent_deg, 6.0f);
+  EXPECT_EQ(made.angular_height_deg, 3.0f);
+}
+
+// Irradiance above 1e36 (the shading's sums over kMaxLights lights stay finite in single precision)
+// is refused with its JSON pointer; 1e36 itself is taken.
+TEST(Lights, IrradianceAboveTheFloatLimitRefused) {
+  const auto scene_of = [](const std::string& irradiance) {
+    return R"({"msm_scene": 1, "lights": [{"towards_light": [0, 1, 0]}, {"towards_light": [0, 1, 0], "irradiance": )" +
+           irradiance + R"(}], "objects": [{"primitive": {"type": "box"}}]})";
+  };
+  EXPECT_EQ(load_scene_json(scene_of("[1e36, 1e36, 1e36]"), fs::current_path(), "t").lights[1].irradiance.y, 1e36f);
+  try {
+    load_scene_json(scene_of("[1, 2e36, 1]"), fs::current_path(), "t");
+    ADD_FAILURE() << "accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("/lights/1/irradiance"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at most 1e+36"), std::string::npos) << e.what();
+  }
+}
+
 // A light with one extent is the disc it always was; a second extent makes it a rectangle along
 // its x_axis, whose shadow-map frame takes that axis (the probe's lights take their face's u axis).
 TEST(Lights, RectangularLightsCarryTwoExtentsAndTheirFrame) {

@@ -31,13 +31,10 @@ void GroundTruth::start(scene::Scene scene, const render::RenderSettings& s, int
   rs.filter_sigma = s.filter_sigma;
   if (msm_technique_is_area_light(t.id)) {
     rs.effect = reference::Effect::soft;
+    // The renderer's overrides: the ray tracer draws the light they make as the renderer does
+    // (scene::overridden_light).
     if (s.light_extent_deg) rs.light_extent_deg = *s.light_extent_deg;
-    // A rectangle where the renderer draws one (RenderSettings::light_height_deg, or the scene
-    // light's own height unless light_extent_deg alone makes it a disc).
-    if (s.light_height_deg || (!s.light_extent_deg && scene.light().rectangular())) {
-      rs.light_shape = reference::LightShape::rectangle;
-      if (s.light_height_deg) rs.light_height_deg = *s.light_height_deg;
-    }
+    if (s.light_height_deg) rs.light_height_deg = *s.light_height_deg;
   } else {
     rs.effect = reference::Effect::filtered;
   }

@@ -297,9 +297,11 @@ void Viewer::panel() {
       ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.id == MSM_TECH_PCSS ? render::kMaxPcssKernel : 255);
       // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
       // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
-      float extent = s.light_extent_deg.value_or(scene.light().angular_extent_deg);
-      bool rectangle = s.light_height_deg || (!s.light_extent_deg && scene.light().rectangular());
-      float height = s.light_height_deg.value_or(scene.light().angular_height_deg.value_or(extent));
+      const scene::DirectionalLight drawn =
+          scene::overridden_light(scene.light(), s.light_extent_deg, s.light_height_deg);
+      float extent = drawn.angular_extent_deg;
+      bool rectangle = drawn.rectangular();
+      float height = drawn.angular_height_deg.value_or(extent);
       if (ImGui::Checkbox("rectangular light", &rectangle)) {
         s.light_extent_deg = extent;
         if (rectangle)

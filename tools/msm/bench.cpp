@@ -428,7 +428,7 @@ void add_bench(CLI::App& app) {
         }
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
     }
-    scene::Scene scene = load_scene_or_fail(opt->frame.scene);
+    scene::Scene scene = scene_at_frame(opt->frame, load_scene_or_fail(opt->frame.scene));
     if (opt->scattering && !scene.medium)
       throw UsageError(
           fmt::format("--scattering: scene '{}' has no medium (tower, trees, gate and room have one)", scene.name));

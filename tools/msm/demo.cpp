@@ -83,7 +83,9 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
     }
     results.back().total_ms = 0;
     for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
-    write_render(out, s.technique, results.back(), render_json(s, scene, ctx, results.back()));
+    write_render(out, s.technique, results.back(),
+                 render_json(s, scene, 0, scene::shadow_framing_warnings(scene, s.width, s.height, s.shadow_size), ctx,
+                             results.back()));
     signals.push_back(scattering ? results.back().scattering.channel("visible_fraction")
                                  : results.back().shadow.channel("visibility"));
   }
@@ -200,7 +202,8 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
     render::RenderSettings s = settings_for(frame, c.technique);
     render::RenderResult r = renderer.render(s);
     const std::string name = fmt::format("ibl-{}-{}", c.technique, c.lights);
-    write_render(out, name, r, render_json(s, lit, ctx, r));
+    write_render(out, name, r,
+                 render_json(s, lit, 0, scene::shadow_framing_warnings(lit, s.width, s.height, s.shadow_size), ctx, r));
     // Both images are R, G, B: the metrics compare their luminance (msm/image/metrics.h).
     image::Metrics m = image::compute_metrics(r.color, truth_rgb, {.mask = &mask});
     fmt::print("{:<20} {:>6} {:>8.5f} {:>6.2f}% {:>12.3f}\n", c.technique, c.lights, m.mae, 100 * m.share_above_3pct,
@@ -274,6 +277,8 @@ void add_demo(CLI::App& app) {
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] {
     finish_frame_options(opt->frame);
+    if (opt->frame.animation_frame != 0)
+      throw UsageError("msm demo draws its scenes as they are (frame 0); --frame is msm render's");
     // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
     for (auto* list : {&opt->techniques, &opt->soft_techniques, &opt->scatter_techniques}) {
       std::erase(*list, std::string());
@@ -369,7 +374,9 @@ void add_demo(CLI::App& app) {
                "samples per pixel\n",
                soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, opt->soft_samples);
     reference::Settings rs = reference_settings(reference::Effect::soft, fs, opt->soft_samples);
-    rs.light_extent_deg = extent;
+    // The light the renderer draws: the scene's, or the command line's overrides of it.
+    if (fs.light_extent_deg) rs.light_extent_deg = *fs.light_extent_deg;
+    if (fs.light_height_deg) rs.light_height_deg = *fs.light_height_deg;
     rs.progress = [lines = std::make_shared<util::ProgressLines>("msm demo: ray tracing ", " rows")](
                       const reference::Progress& p) {
       if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);

@@ -134,6 +134,8 @@ void render_frames(const vk::Context& ctx, render::Renderer& renderer, const sce
                                                           scene.lights.begin() + std::ptrdiff_t(fixed));
   const std::size_t moving =
       std::ranges::count_if(scene.objects, [](const scene::Object& object) { return object.motion.has_value(); });
+  const render::RenderSettings& f = frame.settings;
+  const std::vector<std::string> warnings = scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size);
   nlohmann::json list = nlohmann::json::array();
   for (int k = 0; k < o.frames; ++k) {
     nlohmann::json entry = {{"frame", k}};
@@ -154,12 +156,13 @@ void render_frames(const vk::Context& ctx, render::Renderer& renderer, const sce
     entry["render_ms"] = nlohmann::json::object();
     for (const std::string& name : techniques) {
       render::RenderSettings s = settings_for(frame, name);
+      s.frame = frame.noise_frame.value_or(k); // a blue-noise layer of its own each frame
       s.lights = lights;
       render::RenderResult result;
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
-      write_render(out, fmt::format("{}-frame{:03}", name, k), result, render_json(s, scene, ctx, result));
+      write_render(out, fmt::format("{}-frame{:03}", name, k), result, render_json(s, scene, k, warnings, ctx, result));
       entry["render_ms"][name] = result.total_ms;
       line += fmt::format("  {} {:.2f} ms", name, result.total_ms);
     }

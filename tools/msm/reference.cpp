@@ -70,12 +70,32 @@ class ProgressBar {
   }
 };
 
+// The light as traced, the scene's as declared and the command line's overrides of it (each given
+// one; none: the scene's light exactly).
+nlohmann::ordered_json light_json(const msm::scene::DirectionalLight& declared, const Settings& settings,
+                                  const msm::reference::Result& result) {
+  nlohmann::ordered_json overrides = nlohmann::ordered_json::object();
+  if (settings.light_shape) overrides["shape"] = std::string(msm::reference::to_string(*settings.light_shape));
+  if (settings.light_extent_deg) overrides["extent_deg"] = *settings.light_extent_deg;
+  if (settings.light_width_deg) overrides["width_deg"] = *settings.light_width_deg;
+  if (settings.light_height_deg) overrides["height_deg"] = *settings.light_height_deg;
+  nlohmann::ordered_json scene_light = {{"shape", declared.rectangular() ? "rectangle" : "disc"},
+                                        {"extent_deg", declared.angular_extent_deg}};
+  if (declared.angular_height_deg) scene_light["height_deg"] = *declared.angular_height_deg;
+  return {{"shape", std::string(msm::reference::to_string(result.light_shape))},
+          {"extent_deg", result.light_extent_deg},
+          {"width_deg", result.light_width_deg},
+          {"height_deg", result.light_height_deg},
+          {"scene", scene_light},
+          {"overrides", overrides}};
+}
+
 } // namespace
 
 void add_reference(CLI::App& app) {
   struct Options {
     std::string scene{msm::scene::default_scene_name()};
-    std::string effect, out = "out/reference", light_shape = "disc", sampler = "stratified";
+    std::string effect, out = "out/reference", light_shape, sampler = "stratified";
     int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = MSM_FILTER_DEFAULT_TAPS,
         max_crossings = 64, threads = 0;
     std::uint64_t seed = 1;
@@ -103,10 +123,15 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--filter-size", opt->filter_size, "filtered: Gaussian taps per axis, odd")->capture_default_str();
   cmd->add_option("--filter-sigma", opt->filter_sigma, "filtered: Gaussian sigma in texels")->capture_default_str();
   cmd->add_option("--light-extent", opt->light_extent,
-                  "soft: angular diameter of the light in degrees (default: the scene's)");
-  cmd->add_option("--light-shape", opt->light_shape, "soft: disc (default) | rectangle");
-  cmd->add_option("--light-width", opt->light_width, "soft, rectangle: angular width in degrees (default: extent)");
-  cmd->add_option("--light-height", opt->light_height, "soft, rectangle: angular height in degrees (default: extent)");
+                  "soft: override the light by a disc of this angular diameter in degrees, as msm render "
+                  "--light-extent (default: the scene's light as it declares it)");
+  cmd->add_option("--light-shape", opt->light_shape,
+                  "soft: override the light's shape: disc | rectangle (default: the scene light's own)");
+  cmd->add_option("--light-width", opt->light_width,
+                  "soft: a rectangle of this angular width in degrees (default: the light's extent)");
+  cmd->add_option("--light-height", opt->light_height,
+                  "soft: a rectangle of this angular height in degrees, as msm render --light-height (default: the "
+                  "light's own, else its extent)");
   cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
   cmd->add_option("--probe", opt->probe,
                   "Image-based lighting: light the scene by this light probe instead of its own lights (an "
@@ -144,9 +169,11 @@ void add_reference(CLI::App& app) {
       throw UsageError("--probe-lights applies to --effect environment only");
     settings.probe_lights = opt->probe_lights;
     settings.effect = *effect;
-    const auto shape = msm::reference::parse_light_shape(opt->light_shape);
-    if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
-    settings.light_shape = *shape;
+    if (cmd->count("--light-shape") > 0) {
+      const auto shape = msm::reference::parse_light_shape(opt->light_shape);
+      if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
+      settings.light_shape = *shape;
+    }
     const auto sampler = msm::reference::parse_sampler(opt->sampler);
     if (!sampler) throw UsageError(fmt::format("--sampler {}: expected stratified or independent", opt->sampler));
     settings.sampler = *sampler;
@@ -162,11 +189,11 @@ void add_reference(CLI::App& app) {
     settings.light_height_deg = opt->light_height;
     settings.max_crossings = opt->max_crossings;
     settings.threads = opt->threads;
+    if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
+      throw UsageError("--light-width / --light-height make a rectangle: they cannot go with --light-shape disc");
     try {
       msm::reference::validate(settings);
     } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
-    if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
-      throw UsageError("--light-width / --light-height apply to --light-shape rectangle only");
     msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
     if (!opt->probe.empty()) try {
         msm::scene::set_probe(scene, opt->probe);
@@ -198,9 +225,11 @@ void add_reference(CLI::App& app) {
       throw UsageError(fmt::format("{}: --effect environment needs a scene with a \"probe\" (file, lights, intensity, "
                                    "rotation_deg, size; scenes/README.md)",
                                    scene.source.string()));
+    // The filtered effect traces the renderer's shadow map: the warnings of its framing.
+    std::vector<std::string> warnings;
     if (settings.effect == msm::reference::Effect::filtered)
-      if (auto w = msm::scene::shadow_framing_warning(scene, settings.width, settings.height, settings.shadow_size))
-        fmt::print(stderr, "msm reference: {}\n", *w);
+      warnings = msm::scene::shadow_framing_warnings(scene, settings.width, settings.height, settings.shadow_size);
+    for (const std::string& w : warnings) fmt::print(stderr, "msm reference: {}\n", w);
     // The same limits as msm render's, before the output directory or anything large exists.
     try {
       msm::reference::check_limits(settings, scene.triangle_count());
@@ -266,11 +295,9 @@ void add_reference(CLI::App& app) {
     j["seed"] = settings.seed;
     j["filter"] = {
         {"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
-    j["light"] = {{"shape", std::string(msm::reference::to_string(settings.light_shape))},
-                  {"extent_deg", result.light_extent_deg},
-                  {"width_deg", result.light_width_deg},
-                  {"height_deg", result.light_height_deg}};
+    j["light"] = light_json(scene.light(), settings, result);
     j["max_crossings"] = settings.max_crossings;
+    j["warnings"] = warnings;
     j["threads"] = result.threads;
     j["rays"] = result.rays;
     j["background_pixels"] = result.background_pixels;

@@ -99,6 +99,12 @@ void add_render(CLI::App& app) {
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;
     if (view_object_frame > 0) scene = scene::at_frame(scene, view_object_frame); // the view's animated objects
+    if (frames && opt->frame.animation_frame > 0)
+      throw UsageError(fmt::format("--frame {} renders one frame of the scene, --frames a sequence from frame 0: give "
+                                   "one of them",
+                                   opt->frame.animation_frame));
+    scene = scene_at_frame(opt->frame, std::move(scene));
+    const int frame = view_object_frame > 0 ? view_object_frame : opt->frame.animation_frame;
     if (!opt->probe.empty()) try {
         scene::set_probe(scene, opt->probe);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
@@ -107,8 +113,8 @@ void add_render(CLI::App& app) {
                                      opt->sub_lights);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     const render::RenderSettings& f = opt->frame.settings;
-    if (auto w = scene::shadow_framing_warning(scene, f.width, f.height, f.shadow_size))
-      fmt::print(stderr, "msm render: {}\n", *w);
+    const std::vector<std::string> warnings = scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size);
+    for (const std::string& w : warnings) fmt::print(stderr, "msm render: {}\n", w);
     check_limits(opt->frame, scene, names);
     if (frames) check_frames(scene, opt->frames);
     std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
@@ -140,7 +146,7 @@ void add_render(CLI::App& app) {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
       if (i == 0) ensure_output_dir(opt->out);
-      write_render(files, opt->out, names[i], result, render_json(s, scene, *ctx, result));
+      write_render(files, opt->out, names[i], result, render_json(s, scene, frame, warnings, *ctx, result));
       double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       fmt::print(stderr, "[{}/{}] {:<26} {:8.2f} ms GPU {:8.0f} ms wall -> {}/{}.png{}{}\n", i + 1, names.size(),
                  names[i], result.total_ms, wall_ms, opt->out, names[i],

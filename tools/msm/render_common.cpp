@@ -76,12 +76,19 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
                 "(Kneiphof §4.2.3; for closed occluders)");
   cmd->add_option("--soft-kernel", s.soft_kernel,
                   "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15");
-  cmd->add_option("--frame", s.frame, "Frame number (blue-noise layer and offset)")->capture_default_str();
+  cmd->add_option("--frame", o.animation_frame,
+                  "Frame K of a dynamic scene: its animated objects moved K times (an object's \"motion\"), as msm "
+                  "reference --frame K traces it (default 0)")
+      ->check(CLI::Range(0, 9999));
+  cmd->add_option("--noise-frame", o.noise_frame,
+                  "Blue-noise layer and offset of the dithered lookups (default: the --frame)")
+      ->check(CLI::Range(0, 1 << 30));
   cmd->add_option("--device", o.device,
                   "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
 }
 
 void finish_frame_options(FrameOptions& o) {
+  o.settings.frame = o.noise_frame.value_or(o.animation_frame);
   if (!o.params.empty()) {
     if (o.params.size() != 4) throw UsageError("--param takes four comma-separated values");
     o.settings.params = glm::vec4(o.params[0], o.params[1], o.params[2], o.params[3]);
@@ -116,6 +123,15 @@ void finish_frame_options(FrameOptions& o) {
     o.settings.prefix_sums = render::RenderSettings::PrefixSums::appendix_c;
   else
     throw UsageError(fmt::format("--prefix-sums {}: use rows or appendix-c", o.prefix_sums));
+}
+
+scene::Scene scene_at_frame(const FrameOptions& o, scene::Scene scene) {
+  if (o.animation_frame == 0) return scene;
+  if (!scene.animated())
+    throw UsageError(fmt::format("--frame {}: scene '{}' is the same at every frame (no object has a \"motion\"); "
+                                 "the blue-noise layer is --noise-frame",
+                                 o.animation_frame, scene.name));
+  return scene::at_frame(scene, o.animation_frame);
 }
 
 render::RenderSettings settings_for(const FrameOptions& options, const std::string& technique) {
@@ -200,7 +216,8 @@ void check_output_dir(const std::filesystem::path& dir) {
                                                    dir.string(), existing.string()));
 }
 
-nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, const vk::Context& ctx,
+nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, int frame,
+                           const std::vector<std::string>& warnings, const vk::Context& ctx,
                            const render::RenderResult& result) {
   const Technique& t = render::find_rendered_technique(s.technique);
   glm::vec4 p = s.params ? *s.params : t.default_params();
@@ -231,7 +248,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                      : msm_technique_is_nonlinear(t.id)                    ? "dither (auto)"
                                                                            : "bilinear (auto)"},
           {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
-          {"frame", s.frame},
+          {"frame", frame},
+          {"noise_frame", s.frame},
           {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light().angular_extent_deg},
           {"light_height_deg", s.light_height_deg ? nlohmann::json(*s.light_height_deg) : nlohmann::json()},
           {"front_back_depth", s.front_back_depth},
@@ -241,7 +259,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"coloured_translucency", s.coloured_translucency},
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
-          {"gpu_ms_total", result.total_ms}};
+          {"gpu_ms_total", result.total_ms},
+          {"warnings", warnings}};
 }
 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,

@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,11 @@ struct FrameOptions {
   std::string filter_mode = "auto"; // auto, one-pass, three-pass
   std::string shading = "auto";     // auto, forward, deferred
   std::string prefix_sums = "rows"; // rows, appendix-c
+  // --frame: the frame of a dynamic scene (scene::at_frame: its animated objects moved), as msm
+  // reference --frame traces it. --noise-frame: the blue-noise layer and offset
+  // (RenderSettings::frame); unset, the animation frame's, so that a sequence varies.
+  int animation_frame = 0;
+  std::optional<int> noise_frame;
 };
 
 // --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --param,
@@ -33,6 +39,10 @@ struct FrameOptions {
 void add_frame_options(CLI::App* cmd, FrameOptions& options);
 // Applies the parsed options to options.settings; UsageError for bad values.
 void finish_frame_options(FrameOptions& options);
+
+// The scene at --frame (scene::at_frame; the scene itself at frame 0); UsageError where the frame
+// is not 0 and every frame of the scene is the same.
+scene::Scene scene_at_frame(const FrameOptions& options, scene::Scene scene);
 
 // The frame settings for one technique: --filter-mode one-pass applies to the techniques with one
 // moment image (the depth-based ones and 6MSM keep their own pipeline).
@@ -68,8 +78,10 @@ void ensure_output_dir(const std::filesystem::path& dir);
 // directory only once they have something to put in it.
 void check_output_dir(const std::filesystem::path& dir);
 
-// Every setting of a render (technique parameters included) and its pass times.
-nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, const vk::Context& ctx,
+// Every setting of a render (technique parameters included), the scene's frame (--frame) and the
+// warnings printed for it (scene::shadow_framing_warnings), and its pass times.
+nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, int frame,
+                           const std::vector<std::string>& warnings, const vk::Context& ctx,
                            const render::RenderResult& result);
 
 // <dir>/<stem>.png (sRGB colour), <dir>/<stem>.exr (shadow buffer), <dir>/<stem>-rgb.exr (coloured

@@ -48,11 +48,11 @@
 //   soft        Visibility averaged over a directional area light: the fraction of the light
 //               that p sees. The light is a planar emitter at infinity: its directions are
 //               normalize(L + a * x_axis + b * y_axis) with (a, b) uniform over a disc of radius
-//               tan(extent / 2) (extent = angular DIAMETER; default the scene's
-//               angular_extent_deg) or over the rectangle [-tan(w/2), tan(w/2)] x
-//               [-tan(h/2), tan(h/2)] (angular width w along light-space x, height h along y;
-//               defaults: the scene light's angular_extent_deg and, for a rectangular light,
-//               angular_height_deg; the axes are its shadow-map frame's, Scene::light_frame).
+//               tan(extent / 2) (extent = angular DIAMETER) or over the rectangle
+//               [-tan(w/2), tan(w/2)] x [-tan(h/2), tan(h/2)] (angular width w along light-space
+//               x, height h along y; the axes are its shadow-map frame's, Scene::light_frame):
+//               the scene light's own shape and extents (angular_extent_deg, angular_height_deg)
+//               unless Settings overrides them (traced_light).
 //               This is the light model of shadow-map soft shadows (penumbra width in light
 //               space = 2 tan(extent/2) x distance to the blocker); it differs from a disc that
 //               is uniform in solid angle by a density of cos^3 of the angle off L (relative
@@ -222,11 +222,15 @@ struct Settings {
   int shadow_size = 1024;                         // 1..kMaxShadowSize
   int filter_size = MSM_FILTER_DEFAULT_TAPS;      // odd, 1..MSM_FILTER_MAX_TAPS (msm/filter.h)
   double filter_sigma = MSM_FILTER_DEFAULT_SIGMA; // texels
-  // soft: light extent in degrees, in [0, 90). Unset: the scene's angular_extent_deg (the disc's
-  // diameter, and the rectangle's width and height unless given).
+  // soft: overrides of the scene's light, each in [0, 90) degrees; none set: the light exactly as
+  // the scene declares it (a disc, or a rectangle where it has angular_height_deg). The light is
+  // scene::overridden_light(light, light_extent_deg, light_height_deg), as the renderer draws it;
+  // then light_shape, where set, makes it that shape, and light_width_deg (a rectangle's only)
+  // replaces its width. A rectangle's height without an override or a height of its own: its
+  // extent.
   std::optional<double> light_extent_deg;
-  LightShape light_shape = LightShape::disc;
-  std::optional<double> light_width_deg, light_height_deg; // rectangle only
+  std::optional<LightShape> light_shape;
+  std::optional<double> light_width_deg, light_height_deg; // a rectangle's
   // translucent
   int max_crossings = 64; // 1..kMaxCrossings
   // environment: lit by the scene's extracted area lights (every light a uniform cone) instead of
@@ -239,8 +243,17 @@ struct Settings {
   std::function<void(const Progress&)> progress;
 };
 
-// Throws std::invalid_argument naming the setting and its allowed range.
+// Throws std::invalid_argument naming the setting and its allowed range (or a width or height
+// given to a disc).
 void validate(const Settings& settings);
+
+// The soft light that render() traces for `light` under the settings' overrides (Settings):
+// its shape and angular extents in degrees (a disc's width and height its diameter).
+struct TracedLight {
+  LightShape shape = LightShape::disc;
+  double extent_deg = 0.0, width_deg = 0.0, height_deg = 0.0;
+};
+TracedLight traced_light(const scene::DirectionalLight& light, const Settings& settings);
 // What render() would allocate for a scene of `triangles` triangles: the tracer's BVH and the
 // per-pixel images (the model and its constants: msm/util/limits.h).
 std::uint64_t estimated_bytes(const Settings& settings, std::uint64_t triangles);
@@ -256,7 +269,8 @@ struct Result {
   image::Image irradiance;     // environment: R, G, B irradiance E, "std_error" of its luminance; else empty
   image::Image surface;        // n_dot_l, object (see above)
   int samples = 1;             // per covered pixel (1 for hard and translucent)
-  double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0; // as used (soft)
+  LightShape light_shape = LightShape::disc;                                    // as traced (soft)
+  double light_extent_deg = 0.0, light_width_deg = 0.0, light_height_deg = 0.0; // as traced (soft)
   double build_seconds = 0.0;                                                   // Embree scene
   double render_seconds = 0.0;                                                  // tracing
   std::uint64_t rays = 0;                                                       // primary + shadow rays traced

@@ -341,6 +341,14 @@ struct DirectionalLight {
   glm::vec2 rectangle_extents() const { return rectangular() ? tan_half_extents() : glm::vec2(0.0f); }
 };
 
+// The light that the renderer, the ray tracer and the viewer draw for `light` under a command
+// line's (or a viewer's) overrides, the one rule for all three: an extent alone replaces the light
+// by a disc of that angular diameter; a height makes it a rectangle of that height, its width the
+// extent (given, else its own). Neither: the light exactly as the scene declares it, a rectangle
+// where it has angular_height_deg.
+DirectionalLight overridden_light(DirectionalLight light, std::optional<float> extent_deg,
+                                  std::optional<float> height_deg);
+
 // A homogeneous medium (JCGT 2017 §5.1.1): extinction σt, scattering albedo ρ and a Henyey–
 // Greenstein phase function of asymmetry g (g = 0: isotropic). Lit by the scene's light(s) with
 // their irradiance E_l.
@@ -483,9 +491,24 @@ TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, i
 // Above this many screen pixels per shadow-map texel the tools warn.
 inline constexpr double kMaxPixelsPerTexel = 8.0;
 
-// The warning the tools print (one call), or none: when a texel spans more than kMaxPixelsPerTexel
-// pixels (naming the cures: a larger map, explicit framing; cascades do not exist yet) or the image
-// is wider than the fit covers.
+// Where a light's shadow map holds nothing that matters, for an image of width x height: the map's
+// box (x, y in [-1, 1], depth at most 1: what the shading looks up; nearer casters are clamped to
+// depth 0 and still cast) meets none of the surfaces inside the camera's view frustum (visible
+// receivers: none can be shadowed), or none of the scene's triangles at all (casters: no shadow).
+// Checked for explicit framing only: the fitted ones contain the scene by construction.
+struct FramingMiss {
+  std::size_t light = 0;
+  bool receivers = false; // the map holds no visible receiver
+  bool casters = false;   // the map holds no caster
+};
+std::vector<FramingMiss> shadow_framing_misses(const Scene& scene, int width, int height);
+
+// The warnings the tools print and write into their JSON "warnings", one string each (none: empty):
+// when a texel spans more than kMaxPixelsPerTexel pixels (naming the cures: a larger map, explicit
+// framing; cascades do not exist yet), when the image is wider than the fit covers, and for each
+// light whose framing misses the visible receivers or the casters (shadow_framing_misses).
+std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, int height, int shadow_size);
+// The same joined by newlines, or none.
 std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size);
 
 // Loading. Relative mesh/texture paths resolve against base_dir (the file's directory).
