@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -678,4 +679,142 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
   std::printf("[soft, plane bias] a plane's table, the fragment anywhere in its texel: shadow max %.2e (four), %.2e "
               "(six); without the mean's shift %.2e, %.2e\n",
               worst[0], worst[1], worst_without_shift[0], worst_without_shift[1]);
+}
+
+namespace {
+
+// The smallest node of the n-point Gauss rule (n = 2, 3) of the moments mu[0..2n-1] of a
+// distribution inside [lo, hi]: the least root of the monic orthogonal polynomial of degree n,
+// whose coefficients solve Σ_j c_j mu_{k+j} = -mu_{k+n} (k < n), found by a scan and bisection.
+double smallest_gauss_node(const std::array<double, 6>& mu, int n, double lo, double hi) {
+  double m[3][4] = {};
+  for (int k = 0; k < n; ++k) {
+    for (int j = 0; j < n; ++j) m[k][j] = mu[size_t(k + j)];
+    m[k][3] = -mu[size_t(k + n)];
+  }
+  for (int p = 0; p < n; ++p) { // Gauss-Jordan with partial pivoting
+    int pivot = p;
+    for (int r = p + 1; r < n; ++r)
+      if (std::abs(m[r][p]) > std::abs(m[pivot][p])) pivot = r;
+    for (int j = 0; j < 4; ++j) std::swap(m[p][j], m[pivot][j]);
+    for (int r = 0; r < n; ++r)
+      if (r != p) {
+        const double f = m[r][p] / m[p][p];
+        for (int j = 0; j < 4; ++j) m[r][j] -= f * m[p][j];
+      }
+  }
+  auto poly = [&](double x) {
+    double v = 1.0;
+    for (int k = n - 1; k >= 0; --k) v = v * x + m[k][3] / m[k][k];
+    return v;
+  };
+  const int steps = 20000;
+  for (int i = 1; i <= steps; ++i) {
+    double a = lo + (hi - lo) * (i - 1) / steps, b = lo + (hi - lo) * i / steps;
+    if ((poly(a) <= 0.0) == (poly(b) <= 0.0)) continue;
+    for (int k = 0; k < 80; ++k) {
+      const double c = 0.5 * (a + b);
+      ((poly(a) <= 0.0) == (poly(c) <= 0.0) ? a : b) = c;
+    }
+    return 0.5 * (a + b);
+  }
+  return lo;
+}
+
+} // namespace
+
+// msm_soft_plane_bias against the least bias of a table's region in exact arithmetic: the plane's
+// depths at each texel's four MSAA samples, weighted by the box's coverage of the texel (what the
+// nine-region query averages), their moments about zf in double, the bias at which zf reaches the
+// smallest Gauss node (2 points for four moments, 3 for six: bias.h's argument, exact for this
+// distribution). 300 cases per band of half-widths (both axes in the band; slopes up to the
+// shading's clamp, 0.04 per texel, along one or both axes; the fragment anywhere in its texel).
+// Measured (seed 35), the shading's bias over the least: 0.5-2 texels four 0.73-2.45, six
+// 0.67-2.11; 2-4 0.95-1.07, 0.89-1.07; 4-8 0.98-1.02, 0.97-1.03; 8-13 0.995-1.006, 0.990-1.007.
+// Bounds: the low ends 0.6, 0.85, 0.95, 0.98, the high ends 2.5, 1.15, 1.05, 1.02. Where it falls
+// short (below 2 texels) the renderer's path on a real table with the 1e-3 constant bias reads its
+// own plane nearly lit: shadow max 1.01e-3 (four), 1.4e-6 (six); bound 1.5e-3 (below half an 8-bit
+// step; the bias is not the least there, so the constant bias decides).
+TEST(SoftShadows, PlaneBiasAgainstTheTablesExactLeastBias) {
+  struct Band {
+    float lo, hi;
+    double ratio_min, ratio_max;
+  };
+  const Band bands[] = {
+      {0.5f, 2.0f, 0.6, 2.5}, {2.0f, 4.0f, 0.85, 1.15}, {4.0f, 8.0f, 0.95, 1.05}, {8.0f, 13.0f, 0.98, 1.02}};
+  const vec2 samples[4] = {vec2(0.375f, 0.125f), vec2(0.875f, 0.375f), vec2(0.125f, 0.625f), vec2(0.625f, 0.875f)};
+  const int size = 40;
+  const uint scale = msm_sat_scale(kTexels);
+  std::mt19937_64 rng(35);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (const Band& band : bands) {
+    double ratio_min[2] = {1e9, 1e9}, ratio_max[2] = {0.0, 0.0};
+    float shadow_max[2] = {0.0f, 0.0f};
+    for (int i = 0; i < 300; ++i) {
+      vec2 g(0.04f * unit(rng), i % 3 == 0 ? 0.0f : 0.04f * unit(rng));
+      if (i % 2) g.x = -g.x;
+      vec2 h(band.lo + (band.hi - band.lo) * unit(rng), band.lo + (band.hi - band.lo) * unit(rng));
+      vec2 center(20.0f + unit(rng), 20.0f + unit(rng));
+      SoftRegion r = msm_soft_region(center, h, ivec2(size));
+      const double range = std::abs(g.x) * (h.x + 1.0f) + std::abs(g.y) * (h.y + 1.0f); // offsets within ±range
+      std::array<double, 6> mu{};
+      for (int y = int(std::floor(r.lo.y)); y < int(std::ceil(r.hi.y)); ++y)
+        for (int x = int(std::floor(r.lo.x)); x < int(std::ceil(r.hi.x)); ++x) {
+          const double w = double(msm_soft_texel_overlap(x, r.lo.x, r.hi.x)) *
+                           double(msm_soft_texel_overlap(y, r.lo.y, r.hi.y)) /
+                           (double(r.hi.x - r.lo.x) * double(r.hi.y - r.lo.y));
+          for (vec2 o : samples) {
+            const double offset = (double(g.x) * (x + o.x - center.x) + double(g.y) * (y + o.y - center.y)) / range;
+            double p = 0.25 * w;
+            for (double& m : mu) {
+              m += p;
+              p *= offset;
+            }
+          }
+        }
+      for (int k = 0; k < 2; ++k) {
+        const int moments = k == 0 ? 4 : 6;
+        const double least = -smallest_gauss_node(mu, moments / 2, -1.0, 1.0) * range;
+        const double ratio = double(msm_soft_plane_bias(h, g, moments)) / least;
+        ratio_min[k] = std::min(ratio_min[k], ratio);
+        ratio_max[k] = std::max(ratio_max[k], ratio);
+      }
+      if (band.lo >= 2.0f) continue;
+      // The renderer's path where the bias may fall short: the plane's table, the 1e-3 constant bias.
+      auto plane = [&](vec2 p) { return 0.1f + g.x * (p.x - center.x) + g.y * (p.y - center.y); };
+      std::vector<vec4> m4(size * size), m6a(size * size), m6b(size * size);
+      for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+          vec4 b4(0.0f);
+          Moments6 b6{vec3(0.0f), vec3(0.0f)};
+          for (vec2 o : samples) {
+            float z = plane(vec2(float(x), float(y)) + o);
+            b4 += 0.25f * msm_moments4(z);
+            b6 = msm_moments6_scale_add(b6, msm_moments6(z), 0.25f);
+          }
+          m4[size_t(y * size + x)] = msm_theta4_star(b4);
+          SatTexels6 s6 = msm_sat_split6(msm_theta6_star(b6));
+          m6a[size_t(y * size + x)] = s6.a;
+          m6b[size_t(y * size + x)] = s6.b;
+        }
+      Table t4 = test::build(m4, size, size, scale), t6a = test::build(m6a, size, size, scale),
+            t6b = test::build(m6b, size, size, scale);
+      SatFilter f = msm_sat_filter(r.lo, r.hi);
+      const float zf = plane(center);
+      shadow_max[0] = std::max(shadow_max[0],
+                               msm_soft_shadow4(t4.filter_average(f, scale), zf - 1e-3f - msm_soft_plane_bias(h, g, 4),
+                                                MSM_SOFT_UMBRA_EPSILON, scale));
+      shadow_max[1] = std::max(
+          shadow_max[1], msm_soft_shadow6(msm_sat_join6(t6a.filter_average(f, scale), t6b.filter_average(f, scale)),
+                                          zf - 1e-3f - msm_soft_plane_bias(h, g, 6), MSM_SOFT_UMBRA_EPSILON, scale));
+    }
+    std::printf("[soft, plane bias against the table's least] h in [%.1f, %.1f]: four %.3f-%.3f, six %.3f-%.3f; "
+                "renderer's shadow max %.2e, %.2e\n",
+                band.lo, band.hi, ratio_min[0], ratio_max[0], ratio_min[1], ratio_max[1], shadow_max[0], shadow_max[1]);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_GE(ratio_min[k], band.ratio_min) << (k ? "six" : "four") << ", h in " << band.lo << ".." << band.hi;
+      EXPECT_LE(ratio_max[k], band.ratio_max) << (k ? "six" : "four") << ", h in " << band.lo << ".." << band.hi;
+      EXPECT_LT(shadow_max[k], 1.5e-3f) << (k ? "six" : "four") << ", h in " << band.lo << ".." << band.hi;
+    }
+  }
 }
