@@ -39,6 +39,13 @@ bool supports_translucency(const Technique& t) {
          t.formats[1] == TexelFormat::none;
 }
 
+int max_soft_kernel(int technique_id) {
+  if (technique_id == MSM_TECH_PCSS) return kMaxPcssKernel;
+  if (technique_id == MSM_TECH_MSSM4) return MSM_SOFT_MAX_KERNEL_WIDTH4;
+  if (technique_id == MSM_TECH_MSSM6) return MSM_SOFT_MAX_KERNEL_WIDTH6;
+  return 255;
+}
+
 int RenderSettings::resolved_soft_kernel() const {
   if (soft_kernel != 0) return soft_kernel;
   return find_rendered_technique(technique).id == MSM_TECH_PCSS ? kDefaultPcssKernel : kDefaultSatKernel;
@@ -100,11 +107,8 @@ void RenderSettings::validate() const {
                                   technique));
   if (soft_kernel != 0) {
     // Moment tables: the bias that covers their rounding (log2((2^32 - 1) / W²) bits) keeps a
-    // plane of one depth reconstructible up to these widths only (soft.h).
-    int widest = t.id == MSM_TECH_PCSS    ? kMaxPcssKernel
-                 : t.id == MSM_TECH_MSSM4 ? MSM_SOFT_MAX_KERNEL_WIDTH4
-                 : t.id == MSM_TECH_MSSM6 ? MSM_SOFT_MAX_KERNEL_WIDTH6
-                                          : 255;
+    // plane of one depth reconstructible up to max_soft_kernel only (soft.h).
+    int widest = max_soft_kernel(t.id);
     if (soft_kernel < 3 || soft_kernel > widest) {
       bool precision = soft_kernel > widest && (t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6);
       std::string why =
