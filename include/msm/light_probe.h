@@ -353,12 +353,17 @@ MSM_FN vec2 msm_rect_corner(int i, vec2 t) {
   return vec2(k == 1 || k == 2 ? t.x : -t.x, k >= 2 ? t.y : -t.y);
 }
 
-// Lambert's term of the arc from p to q (not unit) for msm_rect_light_cosine: Θ n·normalize(p × q),
-// with Θ / |p × q| -> 1 / (|p| |q|) as the arc degenerates.
-MSM_FN float msm_lambert_edge(vec3 n, vec3 p, vec3 q) {
-  vec3 c = cross(p, q);
-  float s = length(c), d = dot(p, q);
-  float theta_per_s = s > 1e-12f ? atan(s, d) / s : 1.0f / (length(p) * length(q));
+// Lambert's term of the arc between the directions P = (p, 1) and Q = (q, 1) for
+// msm_rect_light_cosine, in the light's frame (x, y, ℓ): Θ n·normalize(P × Q), n = (n·x, n·y, n·ℓ),
+// with Θ / |P × Q| -> 1 / (|P| |Q|) as the arc degenerates. The cross product is written out,
+// P × Q = (p.y - q.y, q.x - p.x, p.x q.y - p.y q.x) = (-d.y, d.x, p.x d.y - p.y d.x) with d = q - p:
+// formed from 3D vectors ℓ + a x + b y, a wide rectangle's nearly parallel long vectors (|a| ~
+// 100) would cancel in every component (products of ~a² down to ~a), and the factor exceeded 1.
+MSM_FN float msm_lambert_edge(vec3 n, vec2 p, vec2 q) {
+  vec2 d = q - p;
+  vec3 c = vec3(-d.y, d.x, p.x * d.y - p.y * d.x);
+  float s = length(c), cos_term = dot(p, q) + 1.0f;
+  float theta_per_s = s > 1e-12f ? atan(s, cos_term) / s : 1.0f / (sqrt(1.0f + dot(p, p)) * sqrt(1.0f + dot(q, q)));
   return theta_per_s * dot(n, c);
 }
 
@@ -388,6 +393,7 @@ MSM_FN float msm_rect_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t_in) {
   vec3 y = cross(l, x);
   // The height of the point (a, b) of the rectangle's plane over the horizon: h = n·ℓ + a n·x + b n·y.
   float n_x = dot(n, x), n_y = dot(n, y);
+  vec3 n_frame = vec3(n_x, n_y, n_dot_l);
   float reach = t.x * abs(n_x) + t.y * abs(n_y);
   if (n_dot_l >= reach) return n_dot_l; // every corner above the horizon
   if (n_dot_l <= -reach) return 0.0f;   // every corner below
@@ -405,9 +411,9 @@ MSM_FN float msm_rect_light_cosine(vec3 n, vec3 l, vec3 x_axis, vec2 t_in) {
     if (p_above && !q_above) leaves = crossing;
     if (!p_above && q_above) comes_back = crossing;
     vec2 a = p_above ? p : crossing, b = q_above ? q : crossing;
-    if (p_above || q_above) sum += msm_lambert_edge(n, l + a.x * x + a.y * y, l + b.x * x + b.y * y);
+    if (p_above || q_above) sum += msm_lambert_edge(n_frame, a, b);
   }
-  sum += msm_lambert_edge(n, l + leaves.x * x + leaves.y * y, l + comes_back.x * x + comes_back.y * y);
+  sum += msm_lambert_edge(n_frame, leaves, comes_back);
   return clamp(0.5f * sum / facing, 0.0f, max(n_dot_l + reach, 0.0f));
 }
 

@@ -35,6 +35,18 @@
 // (n_t = W², e.g. W = 27: JCGT's 27² search region): every query then touches <= W × W texels.
 // They are also at least 0.5 texel: a one-texel box with fractional borders is bilinear
 // interpolation of the moment map, the hard-shadow limit at contact points.
+//
+// ---- The widest kernel per technique ----
+// W bounds not only the queries but the precision: the tables keep log2((2^32 - 1) / W²) bits per
+// moment (sat.h; 22.5 at W = 27, 18.0 at 127, 16.7 at 200, 16.0 at 255), and the moment bias has
+// to cover that rounding (msm_soft_alpha4/6 below). Where the bias needed grows past what keeps
+// a region of one depth (a plane parallel to the map: the Hankel matrices' worst case) intact —
+// a receiver on it lit, blockers on it at its depth within 0.02, a receiver 0.05 behind it in
+// umbra, one 0.05 in front lit (soft_test, TableBiasHoldsForSingleDepths) — the technique
+// refuses the kernel (RenderSettings::validate): four moments hold up to W = 144, six up to 120
+// (measured for every W); the limits keep a margin. With the fixed α of 27² kernels, six moments
+// failed from W = 94 (flat planes read shadowed, umbrae lit: rings, black planes) and four from
+// W = 37 (umbrae read lit at some depths).
 #ifndef MSM_SOFT_H
 #define MSM_SOFT_H
 #include "msm/baselines.h"
@@ -49,6 +61,10 @@
 #include "msm/shared.h"
 
 MSM_BEGIN
+
+// The widest kernel of the moment soft shadows (see "The widest kernel per technique" above).
+const int MSM_SOFT_MAX_KERNEL_WIDTH4 = 127; // mssm4
+const int MSM_SOFT_MAX_KERNEL_WIDTH6 = 111; // mssm6
 
 // JCGT §4.5: a blocker search whose shadow intensity exceeds 1 - ε_u means the whole search
 // region occludes the fragment (umbra): it returns full shadow without filtering. To match, the
@@ -109,44 +125,62 @@ MSM_FN SatRect msm_soft_search_rect(vec2 center, vec2 half_width, ivec2 size) {
 // Averages from sat.h are Θ4* (Θ6*) moments in [0,1]; Θ is affine, so the inverse of the average
 // is the average of the moments. Biasing (bias.h): four moments with MSM_REP_SAT_INT32 (JCGT §4.2:
 // α = 6e-7 at ~22.4 bits, towards the b* measured after Θ4*, (0, 0.628, 0, 0.628), as the
-// tables round Θ4* moments: JCGT §2.5, App. D.4). Six moments: no paper gives α for integer tables. Scaling the 16-bit
-// values by the precision gained predicts it: 4 moments 6e-5 · 2^-(22.4-16) = 7.1e-7 (JCGT's 6e-7),
-// 6 moments 8e-5 · 2^-6.4 = 9.5e-7, below float's 5e-6, whose own rounding then dominates: the
-// float bias MSM_REP6_FLOAT (soft_test checks it on single depths and flat receivers).
-MSM_FN vec4 msm_soft_moments4(vec4 q) {
-  return msm_apply_bias(msm_theta4_star_inverse(q), msm_moment_bias(MSM_REP_SAT_INT32));
+// tables round Θ4* moments: JCGT §2.5, App. D.4). Six moments: no paper gives α for integer
+// tables. The tables round each Θ6* moment to a step of 1 / s (s = msm_sat_scale(W²)), as 16-bit
+// storage rounds it to 1 / 65535, so α scales with the step: α = α_16 · 65535 / s (α_16 = 8e-5,
+// MSM_ALPHA6_16BIT), or float's own 5e-6 (MSM_ALPHA6_FLOAT) where that is larger: the table's
+// step is finer than float's rounding up to W = 64 (27²: 8.9e-7 < 5e-6; 4 moments, the same rule
+// predicts 6e-5 · 2^-6.4 = 7.1e-7, JCGT's 6e-7). Above W = 64 the float α alone is below the
+// quantization of a region of one depth, whose Hankel matrix is then not positive definite (a flat
+// receiver at some depths reads up to 0.85 shadow at W = 255). Four moments likewise: JCGT's α at
+// 28² (s = msm_sat_scale(784)) scaled by the step, α = 6e-7 · s_784 / s, the same up to W = 28.
+// Both hold up to the widths above (MSM_SOFT_MAX_KERNEL_WIDTH4/6).
+// scale: the table's msm_sat_scale.
+MSM_FN float msm_soft_alpha6(uint scale) {
+  return max(MSM_ALPHA6_FLOAT, MSM_ALPHA6_16BIT * (65535.0f / float(max(scale, 1u))));
 }
-MSM_FN Moments6 msm_soft_moments6(Moments6 q) {
-  return msm_apply_bias6(msm_theta6_star_inverse(q), msm_moment_bias6(MSM_REP6_FLOAT));
+MSM_FN float msm_soft_alpha4(uint scale) {
+  return MSM_ALPHA_SAT_INT32 * max(float(msm_sat_scale(28 * 28)) / float(max(scale, 1u)), 1.0f);
+}
+MSM_FN vec4 msm_soft_moments4(vec4 q, uint scale) {
+  MomentBias4 bias = msm_moment_bias(MSM_REP_SAT_INT32);
+  bias.alpha = msm_soft_alpha4(scale);
+  return msm_apply_bias(msm_theta4_star_inverse(q), bias);
+}
+MSM_FN Moments6 msm_soft_moments6(Moments6 q, uint scale) {
+  MomentBias6 bias = msm_moment_bias6(MSM_REP6_FLOAT);
+  bias.alpha = msm_soft_alpha6(scale);
+  return msm_apply_bias6(msm_theta6_star_inverse(q), bias);
 }
 
 // ---- Average blocker depth (blocker.h: JCGT Eq. (4), Kneiphof Eq. (19)) ----
-// q: the search region's average Θ4* / Θ6* moments; zf: the UNBIASED fragment depth ([-1,1]).
-MSM_FN BlockerResult msm_soft_blocker4(vec4 q, float zf) {
-  return msm_blocker4(msm_soft_moments4(q), zf, MSM_BLOCKER_EPSILON);
+// q: the search region's average Θ4* / Θ6* moments; zf: the UNBIASED fragment depth ([-1,1]);
+// scale (six moments): the tables' msm_sat_scale.
+MSM_FN BlockerResult msm_soft_blocker4(vec4 q, float zf, uint scale) {
+  return msm_blocker4(msm_soft_moments4(q, scale), zf, MSM_BLOCKER_EPSILON);
 }
-MSM_FN BlockerResult msm_soft_blocker6(Moments6 q, float zf) {
-  return msm_blocker6(msm_soft_moments6(q), zf, MSM_BLOCKER_EPSILON);
+MSM_FN BlockerResult msm_soft_blocker6(Moments6 q, float zf, uint scale) {
+  return msm_blocker6(msm_soft_moments6(q, scale), zf, MSM_BLOCKER_EPSILON);
 }
 // Kneiphof Eq. (19) with the mass at zf clamped to [delta1, delta2] (0 < delta1 <= delta2):
 // between Eq. (4) with ε = delta1 and Eq. (4) with ε = delta2 on the same reconstruction, so never
 // farther from the receiver than Eq. (4) with ε = delta1 (harder shadows when in doubt).
-MSM_FN BlockerResult msm_soft_blocker6_upper(Moments6 q, float zf, float delta1, float delta2) {
-  return msm_blocker6_upper(msm_soft_moments6(q), zf, delta1, delta2);
+MSM_FN BlockerResult msm_soft_blocker6_upper(Moments6 q, float zf, float delta1, float delta2, uint scale) {
+  return msm_blocker6_upper(msm_soft_moments6(q, scale), zf, delta1, delta2);
 }
-MSM_FN BlockerResult msm_soft_blocker4_upper(vec4 q, float zf, float delta1, float delta2) {
-  return msm_blocker4_upper(msm_soft_moments4(q), zf, delta1, delta2);
+MSM_FN BlockerResult msm_soft_blocker4_upper(vec4 q, float zf, float delta1, float delta2, uint scale) {
+  return msm_blocker4_upper(msm_soft_moments4(q, scale), zf, delta1, delta2);
 }
 
 // The estimator chosen by the technique's parameters (techniques.h: x = δ1, y = δ2, z = 1 for
 // Kneiphof Eq. (19), 0 for JCGT Eq. (4) with ε = δ1).
-MSM_FN BlockerResult msm_soft_blocker4_select(vec4 q, float zf, vec4 params) {
-  return params.z > 0.5f ? msm_soft_blocker4_upper(q, zf, params.x, params.y)
-                         : msm_blocker4(msm_soft_moments4(q), zf, params.x);
+MSM_FN BlockerResult msm_soft_blocker4_select(vec4 q, float zf, vec4 params, uint scale) {
+  return params.z > 0.5f ? msm_soft_blocker4_upper(q, zf, params.x, params.y, scale)
+                         : msm_blocker4(msm_soft_moments4(q, scale), zf, params.x);
 }
-MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params) {
-  return params.z > 0.5f ? msm_soft_blocker6_upper(q, zf, params.x, params.y)
-                         : msm_blocker6(msm_soft_moments6(q), zf, params.x);
+MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params, uint scale) {
+  return params.z > 0.5f ? msm_soft_blocker6_upper(q, zf, params.x, params.y, scale)
+                         : msm_blocker6(msm_soft_moments6(q, scale), zf, params.x);
 }
 
 // ---- Naive variance soft shadow mapping (Yang et al. 2010, the baseline of JCGT §4) ----
@@ -208,7 +242,7 @@ MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float co
          abs(depth_per_texel.y) * (half_width.y + 0.5f);
 }
 
-// ---- The least depth bias for a planar receiver (the moment techniques) ----
+// ---- The least depth bias for a planar receiver, as modelled (the moment techniques) ----
 // msm_soft_depth_bias moves zf in front of the nearest texel of the receiver's own plane. A
 // moment technique needs less: the sharp lower bound of the shadow from 2n moments (Hamburger:
 // depths on the whole real line) is zero exactly while zf lies at or below the smallest node of
@@ -233,6 +267,15 @@ MSM_FN float msm_soft_depth_bias(vec2 half_width, vec2 depth_per_texel, float co
 // averages over where the fragment lies in its texel; msm_soft_plane_mean_shift adds the largest
 // shift of the region's mean that this hides. The constant bias still covers the moment bias and
 // rounding.
+// It is the least bias of that model, not of a table's region: there the offsets are quantized to
+// the texels' samples and a box with fractional borders weights its border texels unevenly (skew),
+// which the model omits. Against the least bias of the region's exact distribution (its texels'
+// four samples, weighted by coverage; the same Gauss node in double) msm_soft_plane_bias is within
+// 1% for half-widths of 8 texels and more, within 5% from 4, 0.89-1.10 of it from 2, but for
+// regions of 0.5-2 texels anywhere from 0.66 to 2.4 of it: too small by up to a third. The constant
+// bias (1e-3 in the renderer) and the moment bias cover most of that gap: the shading's shadow of
+// its own plane reaches 1.0e-3 (four moments; six 1.4e-6) there, up to the slope clamp, and 0 from
+// 2 texels on (soft_test, PlaneBiasAgainstTheTablesExactLeastBias).
 // msm_soft_plane_spread_bias: that node, x.
 MSM_FN float msm_soft_plane_spread_bias(vec2 half_width, vec2 depth_per_texel, int moments) {
   vec2 g = abs(depth_per_texel);
@@ -263,11 +306,11 @@ MSM_FN float msm_soft_plane_bias(vec2 half_width, vec2 depth_per_texel, int mome
 // q: the filter region's average Θ4* (Θ6*) moments (msm_sat_filter_average); zf_biased: the
 // fragment depth minus the constant bias and msm_soft_plane_bias. Hamburger lower bound (JCGT App.
 // D.4), over-darkened by 1 / (1 - ε_u) to match the umbra early-out.
-MSM_FN float msm_soft_shadow4(vec4 q, float zf_biased, float umbra_epsilon) {
-  return msm_overdarken(msm_hamburger4_lower(msm_soft_moments4(q), zf_biased), 1.0f - umbra_epsilon);
+MSM_FN float msm_soft_shadow4(vec4 q, float zf_biased, float umbra_epsilon, uint scale) {
+  return msm_overdarken(msm_hamburger4_lower(msm_soft_moments4(q, scale), zf_biased), 1.0f - umbra_epsilon);
 }
-MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon) {
-  return msm_overdarken(msm_hamburger6_lower(msm_soft_moments6(q), zf_biased), 1.0f - umbra_epsilon);
+MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon, uint scale) {
+  return msm_overdarken(msm_hamburger6_lower(msm_soft_moments6(q, scale), zf_biased), 1.0f - umbra_epsilon);
 }
 
 // The whole per-pixel flow, with S(x, y) a fetch from the table (0 where x or y is -1), size the
@@ -285,6 +328,7 @@ MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon) 
 //   SatSamples16 t; for j, i in 0..3: t.s[4 * j + i] = S(f.x[i], f.y[j]);
 //   float zb = zf - constant_bias - msm_soft_plane_bias(hp, receiver_gradient, 4); // 6: six moments
 //   return msm_soft_shadow4(msm_sat_filter_average(t, f, scale), zb, MSM_SOFT_UMBRA_EPSILON);
+// (six moments: msm_soft_blocker6(..., zf, scale) and msm_soft_shadow6(..., MSM_SOFT_UMBRA_EPSILON, scale)).
 
 MSM_END
 

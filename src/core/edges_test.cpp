@@ -105,7 +105,7 @@ struct Path4 {
 
 vec4 sat_texel(vec4 b) { // one texel of a 27² table: quantized to 22.5 bits, queried alone
   uint scale = msm_sat_scale(27 * 27);
-  return msm_soft_moments4(msm_sat_rect_average(msm_sat_quantize(msm_theta4_star(b), scale), 1, scale));
+  return msm_soft_moments4(msm_sat_rect_average(msm_sat_quantize(msm_theta4_star(b), scale), 1, scale), scale);
 }
 
 std::vector<Path4> paths4() {
@@ -156,7 +156,7 @@ std::vector<Path6> paths6() {
        [](const Case& c) {
          uint scale = msm_sat_scale(27 * 27);
          return msm_soft_moments6(
-             msm_sat_rect_average6(msm_sat_quantize6(msm_theta6_star(moments6f(c.d)), scale), 1, scale));
+             msm_sat_rect_average6(msm_sat_quantize6(msm_theta6_star(moments6f(c.d)), scale), 1, scale), scale);
        }},
   };
 }
@@ -421,8 +421,8 @@ TEST(Edges, NanTexelReadsLitInEveryRepresentation) {
   vec4 q = msm_sat_rect_average(msm_sat_quantize(nan4, scale), 1, scale);
   for (int j = 0; j <= 100; ++j) {
     float zf = -1.0f + 2.0f * float(j) / 100.0f;
-    EXPECT_EQ(msm_soft_shadow4(q, zf, MSM_SOFT_UMBRA_EPSILON), 0.0f);
-    BlockerResult r = msm_soft_blocker4(q, zf);
+    EXPECT_EQ(msm_soft_shadow4(q, zf, MSM_SOFT_UMBRA_EPSILON, scale), 0.0f);
+    BlockerResult r = msm_soft_blocker4(q, zf, scale);
     EXPECT_EQ(r.shadow, 0.0f);
     EXPECT_TRUE(r.depth >= -1.0f && r.depth <= 1.0f);
   }
@@ -490,8 +490,9 @@ TEST(Edges, BlockerDepthStaysInTheDepthRange) {
     vec4 q4 = msm_sat_rect_average(msm_sat_quantize(msm_theta4_star(test::moments4f(c.d)), scale), 1, scale);
     Moments6 q6 = msm_sat_rect_average6(msm_sat_quantize6(msm_theta6_star(moments6f(c.d)), scale), 1, scale);
     float zf = c.signed_zf();
-    for (BlockerResult r : {msm_soft_blocker4_select(q4, zf, eq4), msm_soft_blocker4_select(q4, zf, eq19),
-                            msm_soft_blocker6_select(q6, zf, eq4), msm_soft_blocker6_select(q6, zf, eq19)})
+    for (BlockerResult r :
+         {msm_soft_blocker4_select(q4, zf, eq4, scale), msm_soft_blocker4_select(q4, zf, eq19, scale),
+          msm_soft_blocker6_select(q6, zf, eq4, scale), msm_soft_blocker6_select(q6, zf, eq19, scale)})
       ASSERT_TRUE(r.depth >= -1.0f && r.depth <= zf + 1e-6f && r.shadow >= 0.0f && r.shadow <= 1.0f)
           << c.kind << " case " << i << " zf " << zf << ": depth " << r.depth;
   }

@@ -820,6 +820,7 @@ std::vector<KernelIO> make_inputs(int id, int count) {
         x.b = vec4(q.even, bias);
       }
       x.u[0] = uint32_t(g.integer(0, 1));
+      x.u[1] = scale;
       break;
     }
     case MSM_K_SCATTERING4: {

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -202,7 +203,7 @@ TEST(SoftShadows, FourMomentBlockerDepthMatchesTheExactMean) {
     std::vector<float> d = texels({z1, zf}, {n1, kTexels - n1});
     Region reg = region_of(rng, d);
     Truth t = truth(d, zf, eps);
-    BlockerResult r = msm_soft_blocker4(reg.moments4(), zf);
+    BlockerResult r = msm_soft_blocker4(reg.moments4(), zf, reg.scale);
     double distance = zf - t.eq4;
     one_eq4.add((r.depth - t.eq4) / distance);
     one_mean.add((r.depth - t.mean) / (zf - t.mean));
@@ -218,7 +219,7 @@ TEST(SoftShadows, FourMomentBlockerDepthMatchesTheExactMean) {
     std::vector<float> d3 = texels({z1, z2, zf}, {n1, n2, kTexels - n1 - n2});
     Region reg3 = region_of(rng, d3);
     Truth t3 = truth(d3, zf, eps);
-    BlockerResult r3 = msm_soft_blocker4(reg3.moments4(), zf);
+    BlockerResult r3 = msm_soft_blocker4(reg3.moments4(), zf, reg3.scale);
     two_eq4.add((r3.depth - t3.eq4) / (zf - t3.eq4));
     two_shadow.add(r3.shadow - t3.coverage);
   }
@@ -271,7 +272,7 @@ TEST(SoftShadows, SixMomentBlockerDepthMatchesTheExactMean) {
     std::vector<float> d = texels(z, n);
     Region reg = region_of(rng, d);
     Truth t = truth(d, zf, eps);
-    BlockerResult r = msm_soft_blocker6(reg.moments6(), zf);
+    BlockerResult r = msm_soft_blocker6(reg.moments6(), zf, reg.scale);
     int k = occluders - 1;
     depth[k].add((r.depth - t.eq4) / (zf - t.eq4));
     shadow[k].add(r.shadow - t.coverage);
@@ -289,69 +290,88 @@ TEST(SoftShadows, SixMomentBlockerDepthMatchesTheExactMean) {
   }
 }
 
-// The biases of msm_soft_moments4/6 (α = 6e-7 for four moments, JCGT §4.2; the float α = 5e-6
-// for six, argued in soft.h) keep the worst case of the Hankel matrices, a region of one single
-// depth, reconstructible after the table's quantization: for 2001 depths in [-1,1] (a 27 × 27
-// region of one depth, averaged through the integer sums), a flat receiver at that depth is lit
-// (with the constant depth bias 1e-4: without it, four moments reach 0.071 at a few depths, where
-// rounding leaves the reconstructed depth a hair in front of zf) and its blockers are at zf, a
-// receiver 0.05 behind is fully shadowed (umbra) by blockers at that depth, one 0.05 in front is
-// lit; no NaN. Measured: 4 moments: flat shadow max 5.5e-7, |blocker depth - zf| max 1.1e-3;
-// behind |shadow - 1| max 0, |depth - z| 5.0e-5; in front max 5.9e-7. 6 moments: 3.6e-6, 5.5e-3;
-// 0, 5.0e-5; 3.6e-6. Tolerances 1e-3, 0.02, 2e-3, 2e-3, 2e-3.
+// The biases of msm_soft_moments4/6 (msm_soft_alpha4/6: JCGT's 6e-7 at 28² for four moments, the
+// float 5e-6 for six, each grown with the table's rounding step for wider kernels; soft.h) keep
+// the worst case of the Hankel matrices, a region of one single depth, reconstructible after the
+// table's quantization, for every kernel width the settings accept (3..MSM_SOFT_MAX_KERNEL_WIDTH4
+// / 6): for 4001 depths in [-1,1] (a W × W region of one depth, averaged through the integer
+// sums), a flat receiver at that depth is lit (with the constant depth bias 1e-4: without it,
+// four moments reach 0.071 at a few depths at W = 27, where rounding leaves the reconstructed
+// depth a hair in front of zf) and its blockers are at zf, a receiver 0.05 behind is fully
+// shadowed (umbra) by blockers at that depth, one 0.05 in front is lit; no NaN. Measured (the
+// output): at W = 27 four moments: flat shadow max 5.2e-7, |blocker depth - zf| 1.1e-3; behind
+// |shadow - 1| 0, |depth - z| 5.0e-5; in front 5.6e-7; six: 3.6e-6, 5.5e-3; 0, 5.0e-5; 3.6e-6; the
+// blocker depth of the flat receiver grows with α (four: 0.016 at W = 127; six: 0.017 at 111).
+// Tolerances 1e-3, 0.02, 2e-3, 2e-3, 2e-3. With α fixed at its 27² value, four moments fail from
+// W = 37 (a receiver behind a plane reads lit) and six from W = 94 (a flat receiver reads 3.2e-3
+// shadow at W = 94, 0.3 at 127, 0.85 at 255 among 20001 depths).
+struct SingleDepthStats {
+  Stats flat, flat_depth, behind, behind_depth, front;
+  int not_umbra = 0, nan = 0;
+  void print(int width, int moments, float alpha) {
+    std::printf("[soft, single depths, W = %d, %d moments, α = %.2e] flat receiver shadow max %.2e, |blocker depth "
+                "- zf| max %.2e; 0.05 behind |shadow - 1| max %.2e, |depth - z| max %.2e, not umbra %d; in front "
+                "shadow max %.2e; NaN %d\n",
+                width, moments, alpha, flat.max(), flat_depth.max(), behind.max(), behind_depth.max(), not_umbra,
+                front.max(), nan);
+  }
+  void expect_within_tolerances(int width, int moments) {
+    EXPECT_EQ(nan, 0) << "W " << width << ", " << moments << " moments";
+    EXPECT_EQ(not_umbra, 0) << "W " << width << ", " << moments << " moments";
+    EXPECT_LT(flat.max(), 1e-3) << "W " << width << ", " << moments << " moments";
+    EXPECT_LT(flat_depth.max(), 0.02) << "W " << width << ", " << moments << " moments";
+    EXPECT_LT(behind.max(), 2e-3) << "W " << width << ", " << moments << " moments";
+    EXPECT_LT(behind_depth.max(), 2e-3) << "W " << width << ", " << moments << " moments";
+    EXPECT_LT(front.max(), 2e-3) << "W " << width << ", " << moments << " moments";
+  }
+};
+
+// One W × W region of one depth z through the tables: the receiver at z, 0.05 behind, 0.05 in front.
+template <class Q, class Blocker, class Shadow>
+void add_single_depth(SingleDepthStats& s, float z, Q q, Blocker blocker, Shadow shadow) {
+  // The flat receiver is tested with the constant depth bias 1e-4 (no slope): at zf itself the
+  // quantization may leave the reconstructed depth a hair in front of zf.
+  float flat = shadow(q, z - msm_soft_depth_bias(vec2(0.5f), vec2(0.0f), 1e-4f));
+  BlockerResult b = blocker(q, z);
+  s.flat.add(flat);
+  s.flat_depth.add(b.depth - z);
+  s.nan += std::isfinite(flat + b.depth) ? 0 : 1;
+  if (z <= 0.95f) {
+    BlockerResult c = blocker(q, z + 0.05f);
+    s.behind.add(shadow(q, z + 0.05f) - 1.0f);
+    s.behind_depth.add(c.depth - z);
+    s.not_umbra += msm_soft_in_umbra(c, MSM_SOFT_UMBRA_EPSILON) ? 0 : 1;
+  }
+  if (z >= -0.95f) s.front.add(shadow(q, z - 0.05f));
+}
+
 TEST(SoftShadows, TableBiasHoldsForSingleDepths) {
-  const uint scale = msm_sat_scale(kTexels);
-  Stats flat4, flat_depth4, behind4, behind_depth4, front4, flat6, flat_depth6, behind6, behind_depth6, front6,
-      unbiased4;
-  int nan = 0;
-  for (int i = 0; i <= 2000; ++i) {
-    float z = -1.0f + 2.0f * float(i) / 2000.0f;
-    uvec4 q4 = msm_sat_quantize(msm_theta4_star(msm_moments4(z)), scale);
-    vec4 m4 = msm_sat_rect_average(q4 * uint(kTexels), kTexels, scale);
-    SatValues6 q6 = msm_sat_quantize6(msm_theta6_star(msm_moments6(z)), scale);
-    Moments6 m6 = msm_sat_rect_average6(SatValues6(q6.a * uint(kTexels), q6.b * uint(kTexels)), kTexels, scale);
-    BlockerResult b4 = msm_soft_blocker4(m4, z), b6 = msm_soft_blocker6(m6, z);
-    // The flat receiver is tested with the constant depth bias 1e-4 (no slope): at zf itself the
-    // quantization may leave the reconstructed depth a hair in front of zf.
-    float zb = z - msm_soft_depth_bias(vec2(0.5f), vec2(0.0f), 1e-4f);
-    float s4 = msm_soft_shadow4(m4, zb, MSM_SOFT_UMBRA_EPSILON), s6 = msm_soft_shadow6(m6, zb, MSM_SOFT_UMBRA_EPSILON);
-    unbiased4.add(msm_soft_shadow4(m4, z, MSM_SOFT_UMBRA_EPSILON));
-    flat4.add(s4);
-    flat_depth4.add(b4.depth - z);
-    flat6.add(s6);
-    flat_depth6.add(b6.depth - z);
-    nan += std::isfinite(s4 + s6 + b4.depth + b6.depth) ? 0 : 1;
-    if (z <= 0.95f) {
-      float zf = z + 0.05f;
-      BlockerResult c4 = msm_soft_blocker4(m4, zf), c6 = msm_soft_blocker6(m6, zf);
-      behind4.add(msm_soft_shadow4(m4, zf, MSM_SOFT_UMBRA_EPSILON) - 1.0f);
-      behind6.add(msm_soft_shadow6(m6, zf, MSM_SOFT_UMBRA_EPSILON) - 1.0f);
-      behind_depth4.add(c4.depth - z);
-      behind_depth6.add(c6.depth - z);
-      EXPECT_TRUE(msm_soft_in_umbra(c4, MSM_SOFT_UMBRA_EPSILON)) << "z " << z;
-      EXPECT_TRUE(msm_soft_in_umbra(c6, MSM_SOFT_UMBRA_EPSILON)) << "z " << z;
+  for (int width : {3, 15, 27, 37, 63, 94, 101, 111, 127}) {
+    const int texels = width * width;
+    const uint scale = msm_sat_scale(texels);
+    SingleDepthStats four, six;
+    for (int i = 0; i <= 4000; ++i) {
+      float z = -1.0f + 2.0f * float(i) / 4000.0f;
+      uvec4 q4 = msm_sat_quantize(msm_theta4_star(msm_moments4(z)), scale);
+      SatValues6 q6 = msm_sat_quantize6(msm_theta6_star(msm_moments6(z)), scale);
+      add_single_depth(
+          four, z, msm_sat_rect_average(q4 * uint(texels), texels, scale),
+          [&](vec4 q, float zf) { return msm_soft_blocker4(q, zf, scale); },
+          [&](vec4 q, float zb) { return msm_soft_shadow4(q, zb, MSM_SOFT_UMBRA_EPSILON, scale); });
+      add_single_depth(
+          six, z, msm_sat_rect_average6(SatValues6(q6.a * uint(texels), q6.b * uint(texels)), texels, scale),
+          [&](Moments6 q, float zf) { return msm_soft_blocker6(q, zf, scale); },
+          [&](Moments6 q, float zb) { return msm_soft_shadow6(q, zb, MSM_SOFT_UMBRA_EPSILON, scale); });
     }
-    if (z >= -0.95f) {
-      front4.add(msm_soft_shadow4(m4, z - 0.05f, MSM_SOFT_UMBRA_EPSILON));
-      front6.add(msm_soft_shadow6(m6, z - 0.05f, MSM_SOFT_UMBRA_EPSILON));
+    if (width <= MSM_SOFT_MAX_KERNEL_WIDTH4) {
+      four.print(width, 4, msm_soft_alpha4(scale));
+      four.expect_within_tolerances(width, 4);
+    }
+    if (width <= MSM_SOFT_MAX_KERNEL_WIDTH6) {
+      six.print(width, 6, msm_soft_alpha6(scale));
+      six.expect_within_tolerances(width, 6);
     }
   }
-  std::printf("[soft, single depths] 4 moments: flat receiver shadow max %.2e (without the constant bias %.2e), "
-              "|depth - zf| max %.2e; 0.05 behind |shadow - 1| max %.2e, |depth - z| max %.2e; in front shadow max "
-              "%.2e. 6 moments: %.2e, %.2e; %.2e, %.2e; %.2e; NaN %d\n",
-              flat4.max(), unbiased4.max(), flat_depth4.max(), behind4.max(), behind_depth4.max(), front4.max(),
-              flat6.max(), flat_depth6.max(), behind6.max(), behind_depth6.max(), front6.max(), nan);
-  EXPECT_EQ(nan, 0);
-  EXPECT_LT(flat4.max(), 1e-3);
-  EXPECT_LT(flat6.max(), 1e-3);
-  EXPECT_LT(flat_depth4.max(), 0.02);
-  EXPECT_LT(flat_depth6.max(), 0.02);
-  EXPECT_LT(behind4.max(), 2e-3);
-  EXPECT_LT(behind6.max(), 2e-3);
-  EXPECT_LT(behind_depth4.max(), 2e-3);
-  EXPECT_LT(behind_depth6.max(), 2e-3);
-  EXPECT_LT(front4.max(), 2e-3);
-  EXPECT_LT(front6.max(), 2e-3);
 }
 
 // Kneiphof Eq. (19), six moments: counting the mass the moments allow at zf, clamped to
@@ -410,10 +430,11 @@ TEST(SoftShadows, SixMomentUpperBoundBlockerDepth) {
     Truth t = truth(d, zf, d1);
     if (t.coverage < 0.02) continue; // nearly unoccluded: no blockers to average
     Moments6 q = reg.moments6();
-    Moments6 b = msm_soft_moments6(q);
+    Moments6 b = msm_soft_moments6(q, reg.scale);
     BlockerResult eq4 = msm_blocker6(b, zf, d1);
     BlockerResult lo = msm_blocker6(b, zf, d1), hi01 = msm_blocker6(b, zf, 0.1f), hi1 = msm_blocker6(b, zf, 1.0f);
-    BlockerResult u01 = msm_soft_blocker6_upper(q, zf, d1, 0.1f), u1 = msm_soft_blocker6_upper(q, zf, d1, 1.0f);
+    BlockerResult u01 = msm_soft_blocker6_upper(q, zf, d1, 0.1f, reg.scale),
+                  u1 = msm_soft_blocker6_upper(q, zf, d1, 1.0f, reg.scale);
     for (auto [u, hi] : {std::pair(u01, hi01), std::pair(u1, hi1)}) {
       bool ok = u.depth >= lo.depth - 1e-4f && u.depth <= hi.depth + 1e-4f && u.depth <= zf + 1e-4f;
       bracket_violations += ok ? 0 : 1;
@@ -452,11 +473,11 @@ TEST(SoftShadows, UmbraEarlyOutAndOverdarkening) {
   for (int lit : {0, 3, 11, 36}) { // of 729 texels: 0%, 0.4%, 1.5%, 4.9%
     std::vector<float> d = texels({z1, 0.6f}, {kTexels - lit, lit});
     Region reg = region_of(rng, d);
-    BlockerResult b = msm_soft_blocker4(reg.moments4(), zf);
+    BlockerResult b = msm_soft_blocker4(reg.moments4(), zf, reg.scale);
     float coverage = float(kTexels - lit) / float(kTexels);
     bool umbra = msm_soft_in_umbra(b, MSM_SOFT_UMBRA_EPSILON);
     EXPECT_EQ(umbra, lit <= 3) << "lit " << lit;
-    float filtered = msm_soft_shadow4(reg.moments4(), zf, MSM_SOFT_UMBRA_EPSILON);
+    float filtered = msm_soft_shadow4(reg.moments4(), zf, MSM_SOFT_UMBRA_EPSILON, reg.scale);
     EXPECT_NEAR(filtered, std::min(coverage / 0.99f, 1.0f), 2e-3f) << "lit " << lit;
     if (coverage >= 0.99f) { EXPECT_GE(filtered, 0.999f) << "lit " << lit; }
     float result = umbra ? 1.0f : filtered;
@@ -466,8 +487,8 @@ TEST(SoftShadows, UmbraEarlyOutAndOverdarkening) {
   }
   EXPECT_TRUE(msm_soft_in_umbra(BlockerResult(0.0f, 0.995f), 0.01f));
   EXPECT_FALSE(msm_soft_in_umbra(BlockerResult(0.0f, 0.985f), 0.01f));
-  EXPECT_FLOAT_EQ(msm_soft_shadow4(msm_theta4_star(msm_moments4(-0.5f)), 0.5f, 0.01f), 1.0f);
-  EXPECT_NEAR(msm_soft_shadow6(msm_theta6_star(msm_moments6(-0.5f)), 0.5f, 0.01f), 1.0f, 1e-3f);
+  EXPECT_FLOAT_EQ(msm_soft_shadow4(msm_theta4_star(msm_moments4(-0.5f)), 0.5f, 0.01f, msm_sat_scale(kTexels)), 1.0f);
+  EXPECT_NEAR(msm_soft_shadow6(msm_theta6_star(msm_moments6(-0.5f)), 0.5f, 0.01f, msm_sat_scale(kTexels)), 1.0f, 1e-3f);
 }
 
 // JCGT §4.4, Fig. 11: a sloped receiver (the receiver's own surface in the whole filter region,
@@ -500,8 +521,8 @@ TEST(SoftShadows, DepthBiasGrowingWithTheFilterRemovesSelfShadowing) {
     vec2 h = vec2(4.0f + 9.0f * unit(rng));
     SoftRegion r = msm_soft_region(center, h, ivec2(size));
     vec4 q = t.filter_average(msm_sat_filter(r.lo, r.hi), scale);
-    float unbiased = msm_soft_shadow4(q, zf, MSM_SOFT_UMBRA_EPSILON);
-    float biased = msm_soft_shadow4(q, zf - msm_soft_depth_bias(h, g, 1e-4f), MSM_SOFT_UMBRA_EPSILON);
+    float unbiased = msm_soft_shadow4(q, zf, MSM_SOFT_UMBRA_EPSILON, scale);
+    float biased = msm_soft_shadow4(q, zf - msm_soft_depth_bias(h, g, 1e-4f), MSM_SOFT_UMBRA_EPSILON, scale);
     unbiased_all.add(unbiased);
     biased_max = std::max(biased_max, biased);
     EXPECT_LT(biased, 0.01f) << "case " << i;
@@ -581,8 +602,8 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
                   vec3(float(unit_sum[1]), float(unit_sum[3]), float(unit_sum[5]))};
       auto exact = [&](float c) { return moments == 4 ? msm_hamburger4_lower(u4, c) : msm_hamburger6_lower(u6, c); };
       auto rendered = [&](float zb) {
-        return moments == 4 ? msm_soft_shadow4(msm_theta4_star(m4), zb, MSM_SOFT_UMBRA_EPSILON)
-                            : msm_soft_shadow6(msm_theta6_star(m6), zb, MSM_SOFT_UMBRA_EPSILON);
+        return moments == 4 ? msm_soft_shadow4(msm_theta4_star(m4), zb, MSM_SOFT_UMBRA_EPSILON, msm_sat_scale(kTexels))
+                            : msm_soft_shadow6(msm_theta6_star(m6), zb, MSM_SOFT_UMBRA_EPSILON, msm_sat_scale(kTexels));
       };
       float at = rendered(zf - 1e-4f - bias);
       at_max = std::max(at_max, at);
@@ -645,8 +666,8 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
     for (int k = 0; k < 2; ++k) {
       int moments = k == 0 ? 4 : 6;
       auto shadow = [&](float zb) {
-        return k == 0 ? msm_soft_shadow4(q4, zb, MSM_SOFT_UMBRA_EPSILON)
-                      : msm_soft_shadow6(q6, zb, MSM_SOFT_UMBRA_EPSILON);
+        return k == 0 ? msm_soft_shadow4(q4, zb, MSM_SOFT_UMBRA_EPSILON, scale)
+                      : msm_soft_shadow6(q6, zb, MSM_SOFT_UMBRA_EPSILON, scale);
       };
       float at = shadow(zf - 1e-3f - msm_soft_plane_bias(h, g, moments));
       worst[k] = std::max(worst[k], at);
@@ -658,4 +679,142 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
   std::printf("[soft, plane bias] a plane's table, the fragment anywhere in its texel: shadow max %.2e (four), %.2e "
               "(six); without the mean's shift %.2e, %.2e\n",
               worst[0], worst[1], worst_without_shift[0], worst_without_shift[1]);
+}
+
+namespace {
+
+// The smallest node of the n-point Gauss rule (n = 2, 3) of the moments mu[0..2n-1] of a
+// distribution inside [lo, hi]: the least root of the monic orthogonal polynomial of degree n,
+// whose coefficients solve Σ_j c_j mu_{k+j} = -mu_{k+n} (k < n), found by a scan and bisection.
+double smallest_gauss_node(const std::array<double, 6>& mu, int n, double lo, double hi) {
+  double m[3][4] = {};
+  for (int k = 0; k < n; ++k) {
+    for (int j = 0; j < n; ++j) m[k][j] = mu[size_t(k + j)];
+    m[k][3] = -mu[size_t(k + n)];
+  }
+  for (int p = 0; p < n; ++p) { // Gauss-Jordan with partial pivoting
+    int pivot = p;
+    for (int r = p + 1; r < n; ++r)
+      if (std::abs(m[r][p]) > std::abs(m[pivot][p])) pivot = r;
+    for (int j = 0; j < 4; ++j) std::swap(m[p][j], m[pivot][j]);
+    for (int r = 0; r < n; ++r)
+      if (r != p) {
+        const double f = m[r][p] / m[p][p];
+        for (int j = 0; j < 4; ++j) m[r][j] -= f * m[p][j];
+      }
+  }
+  auto poly = [&](double x) {
+    double v = 1.0;
+    for (int k = n - 1; k >= 0; --k) v = v * x + m[k][3] / m[k][k];
+    return v;
+  };
+  const int steps = 20000;
+  for (int i = 1; i <= steps; ++i) {
+    double a = lo + (hi - lo) * (i - 1) / steps, b = lo + (hi - lo) * i / steps;
+    if ((poly(a) <= 0.0) == (poly(b) <= 0.0)) continue;
+    for (int k = 0; k < 80; ++k) {
+      const double c = 0.5 * (a + b);
+      ((poly(a) <= 0.0) == (poly(c) <= 0.0) ? a : b) = c;
+    }
+    return 0.5 * (a + b);
+  }
+  return lo;
+}
+
+} // namespace
+
+// msm_soft_plane_bias against the least bias of a table's region in exact arithmetic: the plane's
+// depths at each texel's four MSAA samples, weighted by the box's coverage of the texel (what the
+// nine-region query averages), their moments about zf in double, the bias at which zf reaches the
+// smallest Gauss node (2 points for four moments, 3 for six: bias.h's argument, exact for this
+// distribution). 300 cases per band of half-widths (both axes in the band; slopes up to the
+// shading's clamp, 0.04 per texel, along one or both axes; the fragment anywhere in its texel).
+// Measured (seed 35), the shading's bias over the least: 0.5-2 texels four 0.73-2.45, six
+// 0.67-2.11; 2-4 0.95-1.07, 0.89-1.07; 4-8 0.98-1.02, 0.97-1.03; 8-13 0.995-1.006, 0.990-1.007.
+// Bounds: the low ends 0.6, 0.85, 0.95, 0.98, the high ends 2.5, 1.15, 1.05, 1.02. Where it falls
+// short (below 2 texels) the renderer's path on a real table with the 1e-3 constant bias reads its
+// own plane nearly lit: shadow max 1.01e-3 (four), 1.4e-6 (six); bound 1.5e-3 (below half an 8-bit
+// step; the bias is not the least there, so the constant bias decides).
+TEST(SoftShadows, PlaneBiasAgainstTheTablesExactLeastBias) {
+  struct Band {
+    float lo, hi;
+    double ratio_min, ratio_max;
+  };
+  const Band bands[] = {
+      {0.5f, 2.0f, 0.6, 2.5}, {2.0f, 4.0f, 0.85, 1.15}, {4.0f, 8.0f, 0.95, 1.05}, {8.0f, 13.0f, 0.98, 1.02}};
+  const vec2 samples[4] = {vec2(0.375f, 0.125f), vec2(0.875f, 0.375f), vec2(0.125f, 0.625f), vec2(0.625f, 0.875f)};
+  const int size = 40;
+  const uint scale = msm_sat_scale(kTexels);
+  std::mt19937_64 rng(35);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (const Band& band : bands) {
+    double ratio_min[2] = {1e9, 1e9}, ratio_max[2] = {0.0, 0.0};
+    float shadow_max[2] = {0.0f, 0.0f};
+    for (int i = 0; i < 300; ++i) {
+      vec2 g(0.04f * unit(rng), i % 3 == 0 ? 0.0f : 0.04f * unit(rng));
+      if (i % 2) g.x = -g.x;
+      vec2 h(band.lo + (band.hi - band.lo) * unit(rng), band.lo + (band.hi - band.lo) * unit(rng));
+      vec2 center(20.0f + unit(rng), 20.0f + unit(rng));
+      SoftRegion r = msm_soft_region(center, h, ivec2(size));
+      const double range = std::abs(g.x) * (h.x + 1.0f) + std::abs(g.y) * (h.y + 1.0f); // offsets within ±range
+      std::array<double, 6> mu{};
+      for (int y = int(std::floor(r.lo.y)); y < int(std::ceil(r.hi.y)); ++y)
+        for (int x = int(std::floor(r.lo.x)); x < int(std::ceil(r.hi.x)); ++x) {
+          const double w = double(msm_soft_texel_overlap(x, r.lo.x, r.hi.x)) *
+                           double(msm_soft_texel_overlap(y, r.lo.y, r.hi.y)) /
+                           (double(r.hi.x - r.lo.x) * double(r.hi.y - r.lo.y));
+          for (vec2 o : samples) {
+            const double offset = (double(g.x) * (x + o.x - center.x) + double(g.y) * (y + o.y - center.y)) / range;
+            double p = 0.25 * w;
+            for (double& m : mu) {
+              m += p;
+              p *= offset;
+            }
+          }
+        }
+      for (int k = 0; k < 2; ++k) {
+        const int moments = k == 0 ? 4 : 6;
+        const double least = -smallest_gauss_node(mu, moments / 2, -1.0, 1.0) * range;
+        const double ratio = double(msm_soft_plane_bias(h, g, moments)) / least;
+        ratio_min[k] = std::min(ratio_min[k], ratio);
+        ratio_max[k] = std::max(ratio_max[k], ratio);
+      }
+      if (band.lo >= 2.0f) continue;
+      // The renderer's path where the bias may fall short: the plane's table, the 1e-3 constant bias.
+      auto plane = [&](vec2 p) { return 0.1f + g.x * (p.x - center.x) + g.y * (p.y - center.y); };
+      std::vector<vec4> m4(size * size), m6a(size * size), m6b(size * size);
+      for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+          vec4 b4(0.0f);
+          Moments6 b6{vec3(0.0f), vec3(0.0f)};
+          for (vec2 o : samples) {
+            float z = plane(vec2(float(x), float(y)) + o);
+            b4 += 0.25f * msm_moments4(z);
+            b6 = msm_moments6_scale_add(b6, msm_moments6(z), 0.25f);
+          }
+          m4[size_t(y * size + x)] = msm_theta4_star(b4);
+          SatTexels6 s6 = msm_sat_split6(msm_theta6_star(b6));
+          m6a[size_t(y * size + x)] = s6.a;
+          m6b[size_t(y * size + x)] = s6.b;
+        }
+      Table t4 = test::build(m4, size, size, scale), t6a = test::build(m6a, size, size, scale),
+            t6b = test::build(m6b, size, size, scale);
+      SatFilter f = msm_sat_filter(r.lo, r.hi);
+      const float zf = plane(center);
+      shadow_max[0] = std::max(shadow_max[0],
+                               msm_soft_shadow4(t4.filter_average(f, scale), zf - 1e-3f - msm_soft_plane_bias(h, g, 4),
+                                                MSM_SOFT_UMBRA_EPSILON, scale));
+      shadow_max[1] = std::max(
+          shadow_max[1], msm_soft_shadow6(msm_sat_join6(t6a.filter_average(f, scale), t6b.filter_average(f, scale)),
+                                          zf - 1e-3f - msm_soft_plane_bias(h, g, 6), MSM_SOFT_UMBRA_EPSILON, scale));
+    }
+    std::printf("[soft, plane bias against the table's least] h in [%.1f, %.1f]: four %.3f-%.3f, six %.3f-%.3f; "
+                "renderer's shadow max %.2e, %.2e\n",
+                band.lo, band.hi, ratio_min[0], ratio_max[0], ratio_min[1], ratio_max[1], shadow_max[0], shadow_max[1]);
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_GE(ratio_min[k], band.ratio_min) << (k ? "six" : "four") << ", h in " << band.lo << ".." << band.hi;
+      EXPECT_LE(ratio_max[k], band.ratio_max) << (k ? "six" : "four") << ", h in " << band.lo << ".." << band.hi;
+      EXPECT_LT(shadow_max[k], 1.5e-3f) << (k ? "six" : "four") << ", h in " << band.lo << ".." << band.hi;
+    }
+  }
 }

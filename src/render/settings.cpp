@@ -44,6 +44,13 @@ bool supports_translucency(const Technique& t) {
          t.formats[1] == TexelFormat::none;
 }
 
+int max_soft_kernel(int technique_id) {
+  if (technique_id == MSM_TECH_PCSS) return kMaxPcssKernel;
+  if (technique_id == MSM_TECH_MSSM4) return MSM_SOFT_MAX_KERNEL_WIDTH4;
+  if (technique_id == MSM_TECH_MSSM6) return MSM_SOFT_MAX_KERNEL_WIDTH6;
+  return 255;
+}
+
 int RenderSettings::resolved_soft_kernel() const {
   if (soft_kernel != 0) return soft_kernel;
   return find_rendered_technique(technique).id == MSM_TECH_PCSS ? kDefaultPcssKernel : kDefaultSatKernel;
@@ -104,10 +111,20 @@ void RenderSettings::validate() const {
                                   "vssm, cssm8, cssm16), not to {}",
                                   technique));
   if (soft_kernel != 0) {
-    if (t.id == MSM_TECH_PCSS)
-      range("soft kernel", soft_kernel, 3, kMaxPcssKernel);
-    else
-      range("soft kernel", soft_kernel, 3, 255);
+    // Moment tables: the bias that covers their rounding (log2((2^32 - 1) / W²) bits) keeps a
+    // plane of one depth reconstructible up to max_soft_kernel only (soft.h).
+    int widest = max_soft_kernel(t.id);
+    if (soft_kernel < 3 || soft_kernel > widest) {
+      bool precision = soft_kernel > widest && (t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6);
+      std::string why =
+          precision ? fmt::format(" for {}: its 32-bit summed-area tables keep log2((2^32 - 1) / W²) = {:.1f} bits per "
+                                  "moment at W = {}, a rounding coarser than its moment bias covers (a plane of one "
+                                  "depth is not reconstructed above W = {})",
+                                  technique, std::log2(4294967295.0 / (double(soft_kernel) * double(soft_kernel))),
+                                  soft_kernel, widest)
+                    : std::string();
+      throw RenderError(fmt::format("soft kernel = {} is outside [3, {}]{}", soft_kernel, widest, why));
+    }
   }
   if (uses_one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));

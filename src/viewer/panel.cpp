@@ -294,7 +294,7 @@ void Viewer::panel() {
     std::string lookup = setting_json(s, "lookup").get<std::string>();
     if (choose("lookup", lookup, {"auto", "bilinear", "nearest", "dither"})) set(s, "lookup", lookup);
     if (msm_technique_is_soft(t.id) || msm_technique_is_area_light(t.id)) {
-      ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.id == MSM_TECH_PCSS ? render::kMaxPcssKernel : 255);
+      ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, render::max_soft_kernel(t.id));
       // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
       // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
       const scene::DirectionalLight drawn =

@@ -75,7 +75,8 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
                 "Moment soft shadows: the map stores the mean of the nearest front- and back-face depth "
                 "(Kneiphof §4.2.3; for closed occluders)");
   cmd->add_option("--soft-kernel", s.soft_kernel,
-                  "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15");
+                  "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15; at most "
+                  "127 for mssm4 and 111 for mssm6 (the tables' precision), 63 for pcss, 255 otherwise");
   cmd->add_option("--frame", o.animation_frame,
                   "Frame K of a dynamic scene: its animated objects moved K times (an object's \"motion\"), as msm "
                   "reference --frame K traces it (default 0)")

@@ -69,6 +69,9 @@ inline constexpr int kMaxOnePassTaps = 17;    // radius 8 in one_pass_filter.gls
 inline constexpr int kDefaultSatKernel = 27;  // JCGT §4.5: a 27² search region
 inline constexpr int kDefaultPcssKernel = 15; // the PCSS baseline's 15² search
 inline constexpr int kMaxPcssKernel = 63;     // 63² taps per pixel and loop
+// The widest soft kernel W a technique takes: kMaxPcssKernel for PCSS; for the moment tables 255,
+// less where the moment bias no longer covers the tables' rounding (mssm4 127, mssm6 111: soft.h).
+int max_soft_kernel(int technique_id);
 
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
@@ -127,7 +130,7 @@ struct RenderSettings {
   // (default: the scene's angular_extent_deg) and the largest kernel width W in texels of the
   // blocker search and the filter (summed-area tables: n_t = W²). 0 = the technique's default:
   // 27 for the tables (JCGT's 27² search region), 15 for PCSS (its 15² search: 225 taps, and up to
-  // 256 more for the filter). Tables take 3..255, PCSS 3..kMaxPcssKernel.
+  // 256 more for the filter). 3..max_soft_kernel(technique).
   std::optional<float> light_extent_deg;
   // A rectangular light's angular height in degrees (Kneiphof §4.1.2; the width is
   // light_extent_deg or each light's own angular_extent_deg): set, every light is a rectangle of

@@ -110,10 +110,10 @@ const int MSM_K_CSM_SHADOW = 55;        // a, b = texels 0, 1 (terms 1..4); u = 
 const int MSM_K_OVERDARKEN = 56;        // a.xy = (shadow, factor) -> a.x
 // techniques.h, soft.h, bias.h: whole reconstructions from stored texels (the edge classes)
 const int MSM_K_TECHNIQUE_SHADOW4 = 57; // a = stored texel, b.x = unit zf, u.x = technique id -> a.x
-const int MSM_K_SOFT4 = 58;    // a = Θ4* average, b.xy = (zf, depth bias), u.x = 1 for Eq. (19) -> a.xyz = (depth,
-                               // blocker shadow, shadow)
-const int MSM_K_SOFT6 = 59;    // a.xyz, b.xyz = Θ6* average (odd, even), a.w = zf, b.w = depth bias, u.x as above
-                               // -> a.xyz
+const int MSM_K_SOFT4 = 58;    // a = Θ4* average, b.xy = (zf, depth bias), u.x = 1 for Eq. (19), u.y = the table's
+                               // scale -> a.xyz = (depth, blocker shadow, shadow)
+const int MSM_K_SOFT6 = 59;    // a.xyz, b.xyz = Θ6* average (odd, even), a.w = zf, b.w = depth bias, u.x as above,
+                               // u.y = the tables' scale -> a.xyz
 const int MSM_K_RAISE_D2 = 60; // a = b4, b.x = min D2 -> a
 // scattering.h: the visible fraction of a view ray from a prefix-summed rectified texel
 const int MSM_K_SCATTERING4 = 61; // a = stored texel, b.xy = (zf, beta), u.x = representation -> a.x
@@ -229,14 +229,14 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
   }
   case MSM_K_SOFT4: {
     vec4 params = msm_technique_default_params(x.u[0] == 1u ? MSM_TECH_MSSM6 : MSM_TECH_MSSM4);
-    BlockerResult o = msm_soft_blocker4_select(x.a, x.b[0], params);
-    r.a = vec4(o.depth, o.shadow, msm_soft_shadow4(x.a, x.b[0] - x.b[1], MSM_SOFT_UMBRA_EPSILON), 0.0f);
+    BlockerResult o = msm_soft_blocker4_select(x.a, x.b[0], params, x.u[1]);
+    r.a = vec4(o.depth, o.shadow, msm_soft_shadow4(x.a, x.b[0] - x.b[1], MSM_SOFT_UMBRA_EPSILON, x.u[1]), 0.0f);
     break;
   }
   case MSM_K_SOFT6: {
     vec4 params = msm_technique_default_params(x.u[0] == 1u ? MSM_TECH_MSSM6 : MSM_TECH_MSSM4);
-    BlockerResult o = msm_soft_blocker6_select(b6, x.a[3], params);
-    r.a = vec4(o.depth, o.shadow, msm_soft_shadow6(b6, x.a[3] - x.b[3], MSM_SOFT_UMBRA_EPSILON), 0.0f);
+    BlockerResult o = msm_soft_blocker6_select(b6, x.a[3], params, x.u[1]);
+    r.a = vec4(o.depth, o.shadow, msm_soft_shadow6(b6, x.a[3] - x.b[3], MSM_SOFT_UMBRA_EPSILON, x.u[1]), 0.0f);
     break;
   }
   case MSM_K_RAISE_D2: r.a = msm_raise_d2(x.a, x.b[0]); break;

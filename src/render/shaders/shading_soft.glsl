@@ -82,12 +82,13 @@ float shadow_intensity(ShadowLookup s) {
   int texels = msm_sat_rect_texels(r);
   BlockerResult blocker;
   if (six) {
-    blocker = msm_soft_blocker6_select(msm_sat_rect_average6(rect_sum6(r), texels, scale), zf, params);
+    blocker = msm_soft_blocker6_select(msm_sat_rect_average6(rect_sum6(r), texels, scale), zf, params, scale);
   } else {
     vec4 q = msm_sat_rect_average(msm_sat_rect_sum(table(r.hi.x, r.hi.y), table(r.lo.x - 1, r.hi.y),
                                                    table(r.hi.x, r.lo.y - 1), table(r.lo.x - 1, r.lo.y - 1)),
                                   texels, scale);
-    blocker = vssm ? msm_soft_vssm_blocker(vec2(q.x, q.y), s.z, params.w) : msm_soft_blocker4_select(q, zf, params);
+    blocker =
+        vssm ? msm_soft_vssm_blocker(vec2(q.x, q.y), s.z, params.w) : msm_soft_blocker4_select(q, zf, params, scale);
   }
   if (msm_soft_in_umbra(blocker, frame.soft.w)) return 1.0f;
 
@@ -104,7 +105,7 @@ float shadow_intensity(ShadowLookup s) {
   // out of the technique's bound (soft.h).
   float zb = zf - frame.soft.z - msm_soft_plane_bias(hp, 2.0f * s.depth_per_texel, six ? 6 : (vssm ? 2 : 4));
   vec4 q = msm_sat_filter_average(t, f, scale);
-  if (six) return msm_soft_shadow6(msm_sat_join6(q, msm_sat_filter_average(t1, f, scale)), zb, frame.soft.w);
+  if (six) return msm_soft_shadow6(msm_sat_join6(q, msm_sat_filter_average(t1, f, scale)), zb, frame.soft.w, scale);
   if (vssm) return msm_soft_vssm_shadow(vec2(q.x, q.y), zb, params.w, frame.soft.w);
-  return msm_soft_shadow4(q, zb, frame.soft.w);
+  return msm_soft_shadow4(q, zb, frame.soft.w, scale);
 }

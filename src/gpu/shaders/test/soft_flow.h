@@ -32,7 +32,7 @@ MSM_FN SoftFlow msm_test_soft_flow(vec4 region, vec4 fragment, ivec2 size, uint 
   SatRect sr = msm_soft_search_rect(center, hs, size);
   uvec4 sum = msm_sat_rect_sum(sat_fetch(sr.hi.x, sr.hi.y), sat_fetch(sr.lo.x - 1, sr.hi.y),
                                sat_fetch(sr.hi.x, sr.lo.y - 1), sat_fetch(sr.lo.x - 1, sr.lo.y - 1));
-  BlockerResult blocker = msm_soft_blocker4(msm_sat_rect_average(sum, msm_sat_rect_texels(sr), scale), zf);
+  BlockerResult blocker = msm_soft_blocker4(msm_sat_rect_average(sum, msm_sat_rect_texels(sr), scale), zf, scale);
   if (msm_soft_in_umbra(blocker, MSM_SOFT_UMBRA_EPSILON))
     return SoftFlow(rect_sum, filtered, vec4(1.0f, blocker.depth, blocker.shadow, 0.0f));
   vec2 hp = msm_soft_penumbra_half_width(spread, zf, blocker.depth, width);
@@ -42,7 +42,7 @@ MSM_FN SoftFlow msm_test_soft_flow(vec4 region, vec4 fragment, ivec2 size, uint 
   for (int j = 0; j < 4; ++j)
     for (int i = 0; i < 4; ++i) pt.s[4 * j + i] = sat_fetch(pf.x[i], pf.y[j]);
   float zb = zf - 1.0e-4f - msm_soft_plane_bias(hp, vec2(fragment[3], 0.0f), 4);
-  float shadow = msm_soft_shadow4(msm_sat_filter_average(pt, pf, scale), zb, MSM_SOFT_UMBRA_EPSILON);
+  float shadow = msm_soft_shadow4(msm_sat_filter_average(pt, pf, scale), zb, MSM_SOFT_UMBRA_EPSILON, scale);
   return SoftFlow(rect_sum, filtered, vec4(shadow, blocker.depth, blocker.shadow, hp.x));
 }
 
