@@ -1,6 +1,6 @@
 // The ray tracer's radiance in the renderer's look (ACES after the exposure; where no surface is, the
-// renderer's sky, or the probe of a probe-lit scene as traced), so that a reference compares with `msm render`'s colour image: `msm reference`'s
-// radiance.png and `msm demo`'s ground-truth panels.
+// renderer's sky, or the probe of a probe-lit scene as traced), so that a reference compares with
+// `msm render`'s colour image: `msm reference`'s radiance.png and `msm demo`'s ground-truth panels.
 #pragma once
 
 #include "msm/image/image.h"
