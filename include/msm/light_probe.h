@@ -50,6 +50,15 @@ MSM_FN MsmCubeCoord msm_cube_coord(vec3 d) {
   return d.z >= 0.0f ? MsmCubeCoord(4, vec2(d.x, -d.y) / a.z) : MsmCubeCoord(5, vec2(-d.x, -d.y) / a.z);
 }
 
+// The texel (column, row, face) of an m x m face cube map that direction d falls in: what the
+// renderer and the ray tracer show as the background of a probe-lit scene (nearest texel, so that
+// both show the same value). Precondition: d != 0, m >= 1.
+MSM_FN ivec3 msm_cube_texel(vec3 d, int m) {
+  MsmCubeCoord c = msm_cube_coord(d);
+  ivec2 t = clamp(ivec2(floor((c.uv + 1.0f) * (0.5f * float(m)))), ivec2(0), ivec2(m - 1));
+  return ivec3(t.x, t.y, c.face);
+}
+
 // The solid angle a texel at (u, v) of an m x m face subtends, to first order: the density
 // (1 + u² + v²)^(−3/2) (Kneiphof Eq. 8 with the sign of the exponent the extracted text lost; see
 // ERRATA.md) times the texel's area 4 / m² on the face. Summed over the six faces: 4π.

@@ -16,6 +16,8 @@
 #include <tbb/task_arena.h>
 
 #include "internal.h"
+#include "msm/light_probe.h"
+#include "msm/probe/probe.h"
 #include "msm/scattering.h"
 #include "msm/shading.h"
 #include "msm/util/limits.h"
@@ -224,6 +226,18 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   };
   const glm::dvec3 irradiance(scene.light().irradiance);
   const glm::dvec3 camera(scene.camera.position);
+  // A probe-lit scene's background: its probe as the renderer loads it (GpuScene), by texel.
+  msm::probe::CubeMap probe;
+  if (scene.probe) try {
+      probe = msm::probe::load_probe(scene.probe->file.string(), scene.probe->size, scene.probe->rotation_deg,
+                                     scene.probe->intensity);
+    } catch (const msm::probe::ProbeError& e) { throw std::invalid_argument(e.what()); }
+  result.probe_background = bool(scene.probe);
+  const auto background = [&](const glm::dvec3& dir) {
+    if (!probe.size) return glm::vec3(0.0f);
+    const glm::ivec3 t = msm_cube_texel(glm::vec3(dir), probe.size);
+    return probe.at(t.z, t.x, t.y);
+  };
   // scattering: every light of the scene (the first is ctx's), its direction and irradiance.
   std::vector<glm::dvec3> light_towards, light_irradiance;
   if (scattering)
@@ -308,8 +322,11 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
           v[0] = 1.0f;
           v[1] = 1.0f;
           ++row_background[y];
-          if (scattering) add_scattering(x, y, dir, far, glm::vec3(0.0f), row_rays);
-          continue; // radiance 0, sample_count and std_error 0 (scattering: the ray's)
+          const glm::vec3 sky = background(dir);
+          float* c = rad + (std::size_t(y) * W + x) * 3;
+          c[0] = sky.r, c[1] = sky.g, c[2] = sky.b;
+          if (scattering) add_scattering(x, y, dir, far, sky, row_rays);
+          continue; // sample_count and std_error 0 (scattering: the ray's)
         }
         Rng rng = pixel_rng(settings.seed, x, y, settings.effect);
         // Shading: interpolated normal turned towards the viewer.

@@ -111,7 +111,7 @@ struct FrameResources {
   const vk::Sampler& point_sampler;
   const vk::Sampler& linear_sampler;
   glm::vec3 camera_position{0.0f};
-  ScatteringPush scattering{};                 // the scattering pass's (scattering techniques)
+  ScatteringPush scattering{};                 // the camera rays of the scattering pass and the background
   const vk::Buffer* rectification = nullptr;   // RectificationUniforms per light (render/rectification_uniforms.h)
   const vk::Sampler* repeat_sampler = nullptr; // linear, repeat: the prefix sums (v wraps on the circle)
 };

@@ -1,5 +1,7 @@
 #include "gpu_scene.h"
 
+#include "msm/probe/probe.h"
+
 #include <algorithm>
 #include <map>
 
@@ -64,6 +66,26 @@ void sort_translucent(std::vector<Draw>& translucent, glm::vec3 travel) {
   });
 }
 
+// The probe's cube map as a six-layer image (layer = face), the background of a probe-lit scene.
+vk::Image upload_probe(const vk::Context& ctx, const scene::ProbeLighting& p) {
+  probe::CubeMap cube;
+  try {
+    cube = probe::load_probe(p.file.string(), p.size, p.rotation_deg, p.intensity);
+  } catch (const probe::ProbeError& e) { throw RenderError(e.what()); }
+  std::vector<glm::vec4> texels;
+  texels.reserve(std::size_t(6) * std::size_t(cube.size) * std::size_t(cube.size));
+  for (const std::vector<glm::vec3>& face : cube.faces)
+    for (const glm::vec3& L : face) texels.emplace_back(L, 1.0f);
+  vk::Image image = vk::create_image(ctx, {.width = uint32_t(cube.size),
+                                           .height = uint32_t(cube.size),
+                                           .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                           .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                                           .layers = 6});
+  vk::upload_image(ctx, image, std::as_bytes(std::span(texels)), VK_IMAGE_LAYOUT_UNDEFINED,
+                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+  return image;
+}
+
 } // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
@@ -111,6 +133,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
   white_array = vk::create_image_view(ctx, white.handle(), white.format(), VK_IMAGE_ASPECT_COLOR_BIT,
                                       VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, 1, 0, 1);
   texture_sampler = vk::create_sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
+  if (scene.probe) probe = upload_probe(ctx, *scene.probe);
 }
 
 void GpuScene::move_objects(const vk::Context& ctx, const scene::Scene& scene) {

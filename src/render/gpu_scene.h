@@ -42,6 +42,10 @@ struct GpuScene {
   vk::Image white;                         // 1x1, for draws without a texture
   vk::ImageView white_array;               // the same as a one-layer array (unused array bindings)
   vk::Sampler texture_sampler;             // linear, repeat
+  // A probe-lit scene's probe (msm::probe::load_probe of its "probe", as the ray tracer loads it):
+  // six layers of RGBA32F radiance, the cube's faces, read by texel as the background (empty
+  // without a probe: the sky colour is the background).
+  vk::Image probe;
 
   GpuScene(const vk::Context& ctx, const scene::Scene& scene);
   // The vertices of `scene`, whose objects are this scene's moved (scene::at_frame: the same meshes

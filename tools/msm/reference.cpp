@@ -275,7 +275,7 @@ void add_reference(CLI::App& app) {
         files.remove(out / "scattering.exr");
       if (!result.irradiance.empty()) {
         files.add_exr(out / "irradiance.exr", result.irradiance);
-        // environment: the renderer's look (ACES at exposure 1, its sky where no surface is), to
+        // environment: the renderer's look (ACES at exposure 1, the probe where no surface is), to
         // compare with msm render's PNG (msm compare radiance.png TECHNIQUE.png).
         files.add_png(out / "radiance.png", reference_look(result, 1.0f));
       } else {

@@ -150,7 +150,9 @@
 //                pixels too), with "sample_count" and "std_error".
 //   scattering   scattering only: "R", "G", "B" the in-scattered radiance sum_l f_l E_l V_l
 //                integral_0^s exp(-st t) dt alone, "length" the ray's length s.
-//   radiance     "R", "G", "B" (linear): msm/shading.h's radiance at the visible surface, 0 on background;
+//   radiance     "R", "G", "B" (linear): msm/shading.h's radiance at the visible surface; on background
+//                the radiance of a probe-lit scene's probe in the ray's direction (its texel
+//                msm_cube_texel of msm::probe::load_probe's cube, as the renderer shows it), else 0;
 //                scattering: that radiance attenuated plus the in-scattered (msm_scattered_radiance);
 //                for translucent with the visibility of each channel (T_r, T_g, T_b) in its
 //                channel. Result::mean_visibility averages "visibility".
@@ -275,9 +277,10 @@ struct Result {
   double render_seconds = 0.0;                                                  // tracing
   std::uint64_t rays = 0;                                                       // primary + shadow rays traced
   std::size_t background_pixels = 0;
-  double mean_visibility = 0.0; // over the covered (non-background) pixels; 1 if none; scattering: the
-                                // mean visible fraction over every pixel
-  unsigned threads = 0;         // TBB concurrency used
+  bool probe_background = false; // the background's radiance is the scene's probe (see radiance)
+  double mean_visibility = 0.0;  // over the covered (non-background) pixels; 1 if none; scattering: the
+                                 // mean visible fraction over every pixel
+  unsigned threads = 0;          // TBB concurrency used
 };
 
 // Throws std::invalid_argument for bad settings, a scene with non-finite vertices or, for

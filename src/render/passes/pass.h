@@ -178,8 +178,9 @@ class ShadingPass : public Pass {
   void execute(const PassContext& c) const override;
 
  private:
-  // opaque (forward, or the full-screen deferred one); translucent over it (forward)
-  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr;
+  // opaque (forward, or the full-screen deferred one); translucent over it (forward); a probe-lit
+  // scene's background
+  const vk::Program *program_ = nullptr, *translucent_program_ = nullptr, *background_program_ = nullptr;
   FrameConfig config_;
 };
 

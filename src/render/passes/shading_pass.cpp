@@ -84,6 +84,26 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
 
 const VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 
+// A probe-lit scene's background (background.frag): a full-screen triangle at the far plane where
+// no surface is, into the colour attachment only (the shadow buffer keeps visibility 1, coverage 0).
+vk::GraphicsDesc background_desc(const FrameConfig& config) {
+  bool linear = msm_technique_is_scattering(config.technique->id);
+  return {.name = "background (probe)",
+          .vertex_shader = "background.vert",
+          .fragment_shader = "background.frag",
+          .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image},
+          .push_constant_size = sizeof(ScatteringPush),
+          .color_formats = {linear ? VK_FORMAT_R16G16B16A16_SFLOAT : VK_FORMAT_R8G8B8A8_SRGB,
+                            VK_FORMAT_R32G32B32A32_SFLOAT},
+          .depth_format = VK_FORMAT_D32_SFLOAT,
+          .depth_compare = VK_COMPARE_OP_LESS_OR_EQUAL,
+          .depth_write = false,
+          .color_write_masks = {VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
+                                    VK_COLOR_COMPONENT_A_BIT,
+                                0},
+          .constants = {{5, linear ? 1u : 0u}}};
+}
+
 // The shading's bindings 0-10 but the per-draw textures (1 and 5): the uniforms, the shadow maps of
 // the technique (a white image of the declared kind in the bindings it does not read: every
 // declared binding needs a valid descriptor), the blue noise and the lights.
@@ -174,6 +194,7 @@ void SurfacesPass::execute(const PassContext& c) const {
 void ShadingPass::prepare(const PassResources& r) {
   program_ = &r.programs.graphics(shading_desc(config_, config_.deferred ? Stage::deferred : Stage::opaque));
   translucent_program_ = &r.programs.graphics(shading_desc(config_, Stage::translucent));
+  background_program_ = &r.programs.graphics(background_desc(config_));
 }
 
 void ShadingPass::reflect(PassBuilder& b) const {
@@ -227,6 +248,14 @@ void ShadingPass::execute(const PassContext& c) const {
     vkCmdDraw(c.cmd, 3, 1, 0, 0);
   } else {
     draw_scene(c, *program_, descriptors, opaque_draws(scene));
+  }
+  if (scene.probe) {
+    vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
+    vk::bind_program(
+        c.cmd, *background_program_,
+        {vk::Descriptor(c.frame.uniforms), vk::Descriptor(scene.probe.view(), kReadOnly, c.frame.point_sampler)},
+        std::as_bytes(std::span(&c.frame.scattering, 1)));
+    vkCmdDraw(c.cmd, 3, 1, 0, 0);
   }
   // Translucent surfaces over the opaque image, far to near from the camera (per object).
   std::vector<const Draw*> order;
