@@ -22,6 +22,8 @@
 #include <nlohmann/json.hpp>
 
 #include "msm/scene/scene.h"
+#include "msm/util/clock.h"
+#include "msm/util/output_dir.h"
 
 namespace msm::evaluate {
 
@@ -56,7 +58,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+using util::seconds_since;
 
 std::unique_ptr<Communicator> make_single();
 
@@ -320,18 +322,8 @@ RunResult run_evaluation(const RunSettings& settings, Communicator& comm,
 
   // The output directory, before any long work.
   on_rank0(comm, [&] {
-    std::error_code ec;
-    fs::create_directories(settings.out, ec);
-    if (ec || !fs::is_directory(settings.out))
-      throw std::invalid_argument(
-          fmt::format("--out {}: cannot create the directory{}", settings.out.string(), ec ? ": " + ec.message() : ""));
-    const fs::path probe = settings.out / fmt::format(".msm-evaluate-probe.{}", ::getpid());
-    std::ofstream out(probe);
-    const bool writable = out && (out << "probe") && out.flush();
-    out.close();
-    fs::remove(probe, ec);
-    if (!writable)
-      throw std::invalid_argument(fmt::format("--out {}: the directory is not writable", settings.out.string()));
+    if (const auto problem = util::prepare_output_dir(settings.out, "msm-evaluate-probe"))
+      throw std::invalid_argument(fmt::format("--out {}: {}", settings.out.string(), *problem));
     return std::vector<char>{};
   });
 
