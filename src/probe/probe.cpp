@@ -254,6 +254,13 @@ void write_cube_faces(const std::filesystem::path& pattern, const CubeMap& cube)
   }
 }
 
+PictureLayout picture_layout(int width, int height) {
+  if (width <= 0 || height <= 0) return PictureLayout::neither;
+  if (width == 2 * height) return PictureLayout::panorama;
+  if (4 * height == 3 * width || 4 * width == 3 * height) return PictureLayout::cross;
+  return PictureLayout::neither;
+}
+
 CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg) {
   check_size(size);
   if (is_cube_faces_path(file)) {
@@ -264,9 +271,10 @@ CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotat
     } catch (const ProbeError& e) { throw ProbeError(fmt::format("{}: {}", file.string(), e.what())); }
   }
   Panorama picture = load_equirect(file);
-  if (picture.width == 2 * picture.height)
+  const PictureLayout layout = picture_layout(picture.width, picture.height);
+  if (layout == PictureLayout::panorama)
     return cube_from_equirect(picture.width, picture.height, picture.rgb, size, rotation_deg);
-  if (4 * picture.height != 3 * picture.width && 4 * picture.width != 3 * picture.height)
+  if (layout == PictureLayout::neither)
     throw ProbeError(fmt::format("{}: {}x{} is neither an equirectangular panorama (width = 2 height) nor a cube-map "
                                  "cross (4:3 or 3:4)",
                                  file.string(), picture.width, picture.height));

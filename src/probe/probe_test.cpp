@@ -821,6 +821,17 @@ TEST(CubeInputs, SixFaceFilesMakeTheCube) {
 }
 
 // Six faces of one size make the cube; anything else is refused with a message naming the problem.
+// The layout of a probe picture by its shape: what load_probe_file and the frame sequences read.
+TEST(CubeInputs, PictureLayoutIsToldByShape) {
+  EXPECT_EQ(picture_layout(64, 32), PictureLayout::panorama);
+  EXPECT_EQ(picture_layout(2, 1), PictureLayout::panorama);
+  EXPECT_EQ(picture_layout(16, 12), PictureLayout::cross); // horizontal, 4s x 3s
+  EXPECT_EQ(picture_layout(12, 16), PictureLayout::cross); // vertical, 3s x 4s
+  EXPECT_EQ(picture_layout(30, 20), PictureLayout::neither);
+  EXPECT_EQ(picture_layout(32, 32), PictureLayout::neither); // a single face
+  EXPECT_EQ(picture_layout(0, 0), PictureLayout::neither);
+}
+
 TEST(CubeInputs, BadLayoutsAreRefusedClearly) {
   const CubeMap cube = direction_cube(4);
   std::array<int, 6> sizes{4, 4, 4, 4, 4, 4};

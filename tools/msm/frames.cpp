@@ -38,7 +38,7 @@ void check_frames(const scene::Scene& scene, const Frames& o) {
     try {
       panorama = probe::load_equirect(scene.probe->file);
     } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-    if (panorama.width != 2 * panorama.height)
+    if (probe::picture_layout(panorama.width, panorama.height) != probe::PictureLayout::panorama)
       throw UsageError(fmt::format("--probe-rotation-speed {}: {} is a cube-map cross, which cannot be rotated",
                                    o.rotation_speed_deg, scene.probe->file.string()));
   }
@@ -58,7 +58,7 @@ class ProbeSequence {
       try {
         panorama = probe::load_equirect(p_.file);
       } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-      if (panorama.width == 2 * panorama.height) {
+      if (probe::picture_layout(panorama.width, panorama.height) == probe::PictureLayout::panorama) {
         for (glm::vec3& t : panorama.rgb) t *= p_.intensity;
         device_.set_panorama(panorama);
         return;

@@ -65,6 +65,11 @@ struct Panorama {
 // An equirectangular EXR as it is (the checks and clamping of load_equirect_probe, no resampling):
 // what the device pipeline (DeviceProbe) resamples itself.
 Panorama load_equirect(const std::filesystem::path& file);
+// How a probe picture is laid out, told by its shape alone: a panorama is 2:1 (width = 2 height), a
+// cube-map cross 4:3 or 3:4 (cube_from_cross); any other shape, or an empty one, is neither. The one rule that
+// load_probe_file and the frame sequences' device probe read: only a panorama can be rotated.
+enum class PictureLayout { panorama, cross, neither };
+PictureLayout picture_layout(int width, int height);
 
 // An equirectangular EXR (any compression OpenEXR reads: ZIP, PIZ, DWAB, ...) as a cube map;
 // throws ProbeError naming the file (missing, not an EXR, no R, G and B channels, a non-finite
