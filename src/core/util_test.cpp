@@ -72,6 +72,7 @@ TEST(Clock, SecondsSinceCountsForward) {
   EXPECT_GE(first, 0.0);
   EXPECT_GE(util::seconds_since(start), first);
   EXPECT_NEAR(util::seconds_since(start - std::chrono::seconds(3)), 3.0, 1.0);
+  EXPECT_NEAR(util::ms_since(start - std::chrono::seconds(3)), 3000.0, 1000.0);
 }
 
 } // namespace
