@@ -713,17 +713,10 @@ namespace {
 // A cube whose texels are their own unit directions (as colours) plus a texel-unique offset, so
 // that a misplaced or mirrored texel cannot go unnoticed.
 CubeMap direction_cube(int m) {
-  CubeMap cube;
-  cube.size = m;
-  for (int face = 0; face < 6; ++face) {
-    cube.faces[face].resize(std::size_t(m) * m);
-    for (int j = 0; j < m; ++j)
-      for (int i = 0; i < m; ++i) {
-        const float u = (2.0f * float(i) + 1.0f) / float(m) - 1.0f, v = (2.0f * float(j) + 1.0f) / float(m) - 1.0f;
-        cube.at(face, i, j) = glm::normalize(msm::msm_cube_direction(face, u, v)) + glm::vec3(2.0f);
-      }
-  }
-  return cube;
+  return make_cube(m, [m](int face, int i, int j) {
+    const float u = (2.0f * float(i) + 1.0f) / float(m) - 1.0f, v = (2.0f * float(j) + 1.0f) / float(m) - 1.0f;
+    return glm::normalize(msm::msm_cube_direction(face, u, v)) + glm::vec3(2.0f);
+  });
 }
 
 bool same_cube(const CubeMap& a, const CubeMap& b) { return a.size == b.size && a.faces == b.faces; }

@@ -30,6 +30,20 @@ struct CubeMap {
   const glm::vec3& at(int face, int i, int j) const { return faces[face][std::size_t(j) * size + i]; }
 };
 
+// A cube map of size² faces whose texel (face, i, j) is texel(face, i, j), filled face by face and
+// row by row.
+template <typename Texel>
+CubeMap make_cube(int size, Texel&& texel) {
+  CubeMap cube;
+  cube.size = size;
+  for (int face = 0; face < 6; ++face) {
+    cube.faces[face].resize(std::size_t(size) * size);
+    for (int j = 0; j < size; ++j)
+      for (int i = 0; i < size; ++i) cube.at(face, i, j) = texel(face, i, j);
+  }
+  return cube;
+}
+
 // Largest face size accepted (a 6 x 4096² RGB float cube map is 1.2 GB).
 inline constexpr int kMaxCubeSize = 4096;
 // Largest radiance a probe texel may hold, after its intensity (load_equirect, load_probe: a
