@@ -45,11 +45,6 @@ struct Hamburger4Roots {
   float z3;
 };
 
-const float MSM_MIN_PIVOT1 = 1.0e-10f;
-const float MSM_MIN_PIVOT2 = 1.0e-12f;
-// 2^-24: the unit roundoff of float, the relative rounding of every stored moment.
-const float MSM_FLOAT_ROUNDING = 5.96046448e-8f;
-
 // B = [[1,b1,b2],[b1,b2,b3],[b2,b3,b4]] = L D Lᵀ with L = [[1,0,0],[b1,1,0],[b2,L21,1]] and
 // D = diag(1, D1, D2). D1 is the variance; D2 = det B / D1 is ξ4 of the non-linear
 // representation (HPG Eq. (3)). The differences cancel to ~α for biased moments, so each is formed
@@ -61,6 +56,12 @@ struct HankelLdl3 {
   float L21D1;
   float D2;
 };
+
+// Floors of the pivots D1 and D2 (see the top of this file).
+const float MSM_MIN_PIVOT1 = 1.0e-10f;
+const float MSM_MIN_PIVOT2 = 1.0e-12f;
+// 2^-24: the unit roundoff of float, the relative rounding of every stored moment.
+const float MSM_FLOAT_ROUNDING = 5.96046448e-8f;
 
 MSM_FN HankelLdl3 msm_hankel3_ldl(vec4 b) {
   float b1 = b[0], b2 = b[1], b3 = b[2], b4 = b[3];

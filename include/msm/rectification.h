@@ -56,19 +56,6 @@
 
 MSM_BEGIN
 
-// Relative padding of r_max and absolute padding of φ (radians): the bounds come from float corner
-// coordinates; the padding keeps pixels computed with other roundings inside the map.
-const float MSM_RECT_R_PAD = 1.0e-4f;
-const float MSM_RECT_PHI_PAD = 1.0e-3f;
-// The epipole counts as in view when the light's axis is within this angle (radians, as the sine
-// of the angle to a side plane) of the frustum: near the epipole the corners' azimuths are
-// ill-conditioned, and the full circle is always a cover.
-const float MSM_RECT_EPIPOLE_TOLERANCE = 1.0e-3f;
-// §5.1.1: the θ interval is stretched by 10% (5% on each side).
-const float MSM_RECT_THETA_GUARD = 0.1f;
-// Floor of sin θ in Δ(v): slices whose mean inclination is within 1e-3 of the light's axis.
-const float MSM_RECT_MIN_SIN = 1.0e-3f;
-
 struct RectificationFrame {
   vec3 origin; // the camera position (world)
   vec3 x_axis; // unit, across the light
@@ -126,6 +113,17 @@ MSM_FN vec3 msm_rectified_side(RectifiedBounds b, int i) {
 
 // The inclination of a direction (unnormalized) in rectification space.
 MSM_FN float msm_inclination(vec3 d) { return msm_atan2_safe(length(vec2(d.x, d.y)), d.z); }
+
+// Relative padding of r_max and absolute padding of φ (radians): the bounds come from float corner
+// coordinates; the padding keeps pixels computed with other roundings inside the map.
+const float MSM_RECT_R_PAD = 1.0e-4f;
+const float MSM_RECT_PHI_PAD = 1.0e-3f;
+// The epipole counts as in view when the light's axis is within this angle (radians, as the sine
+// of the angle to a side plane) of the frustum: near the epipole the corners' azimuths are
+// ill-conditioned, and the full circle is always a cover.
+const float MSM_RECT_EPIPOLE_TOLERANCE = 1.0e-3f;
+// §5.1.1: the θ interval is stretched by 10% (5% on each side).
+const float MSM_RECT_THETA_GUARD = 0.1f;
 
 // Appendix A. far_corners_world: the four corners of the far plane (or of any plane cutting the
 // frustum where the scene ends), in world space, IN ORDER AROUND THE QUAD (columns of the
@@ -245,6 +243,9 @@ MSM_FN vec2 msm_slice_inclination_range(RectifiedBounds b, float phi) {
   }
   return lo <= hi ? vec2(lo, hi) : vec2(b.view_theta_min, b.view_theta_max);
 }
+
+// Floor of sin θ in Δ(v): slices whose mean inclination is within 1e-3 of the light's axis.
+const float MSM_RECT_MIN_SIN = 1.0e-3f;
 
 // Δ(v) of §5.1.1: the world distance along the view rays of row v (texture coordinate, e.g.
 // (j + 0.5) / height) between successive texels of a row `width` texels wide, taken at the mean of

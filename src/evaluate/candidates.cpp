@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "msm/evaluate/functions.h"
+#include "msm/util/text.h"
 
 namespace msm::evaluate {
 namespace {
@@ -36,17 +37,6 @@ const std::vector<Alias>& function_aliases() {
 
 constexpr Technique kClosedForms[] = {Technique::pcf,   Technique::vsm,        Technique::esm,        Technique::evsm2,
                                       Technique::evsm4, Technique::hamburger4, Technique::hausdorff4, Technique::tmsm};
-
-std::vector<std::string_view> split(std::string_view text, char separator) {
-  std::vector<std::string_view> parts;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t end = text.find(separator, start);
-    parts.push_back(text.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start));
-    if (end == std::string_view::npos) return parts;
-    start = end + 1;
-  }
-}
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -80,7 +70,7 @@ Candidate lp_candidate(std::vector<int> functions) {
 
 Candidate explicit_candidate(std::string_view item) {
   std::vector<int> functions;
-  for (std::string_view name : split(item, '+')) {
+  for (std::string_view name : util::split(item, '+')) {
     name = trim(name);
     const std::optional<int> index = find_function(name);
     if (!index) {
@@ -176,7 +166,7 @@ std::vector<Candidate> parse_candidates(std::string_view spec) {
   };
 
   if (trim(spec).empty()) throw CandidateError("the candidate list is empty");
-  for (std::string_view item : split(spec, ',')) {
+  for (std::string_view item : util::split(spec, ',')) {
     item = trim(item);
     if (item.empty()) throw CandidateError(fmt::format("candidate list '{}': an empty item", spec));
     if (item == "named") {
@@ -188,7 +178,7 @@ std::vector<Candidate> parse_candidates(std::string_view spec) {
       for (std::uint64_t rank = 0; rank < count; ++rank)
         list.push_back(lp_candidate(unrank_combination(kFunctionCount, k, rank)));
     } else if (item.starts_with("sample:")) {
-      const std::vector<std::string_view> parts = split(item, ':');
+      const std::vector<std::string_view> parts = util::split(item, ':');
       if (parts.size() != 3 && parts.size() != 4)
         throw CandidateError(fmt::format("candidate '{}': expected sample:K:N or sample:K:N:SEED", item));
       const int k = parse_k(parts[1], item);

@@ -22,6 +22,8 @@
 #include <nlohmann/json.hpp>
 
 #include "msm/scene/scene.h"
+#include "msm/util/clock.h"
+#include "msm/util/output_dir.h"
 
 namespace msm::evaluate {
 
@@ -56,7 +58,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using nlohmann::json;
 
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+using util::seconds_since;
 
 std::unique_ptr<Communicator> make_single();
 
@@ -297,11 +299,8 @@ int default_threads(const Communicator& comm) {
   return std::max(1, int(cores) / std::max(1, comm.local_size()));
 }
 
-} // namespace
-
-RunResult run_evaluation(const RunSettings& settings, Communicator& comm,
-                         const std::function<void(const Progress&)>& progress) {
-  const auto start = Clock::now();
+// The settings and the candidate list checked, and the output directory made, before any long work.
+RunResult start_run(const RunSettings& settings, Communicator& comm) {
   validate(settings.stack);
   if (settings.scenes.empty()) throw std::invalid_argument("no scene to evaluate");
   if (settings.threads < 0 || settings.threads > 1024)
@@ -318,184 +317,213 @@ RunResult run_evaluation(const RunSettings& settings, Communicator& comm,
     if (c.technique == Technique::lp && c.listed) prepare_basis(c, settings.stack.grid); // throws SingularBasis
   run.scene_names = settings.scenes;
 
-  // The output directory, before any long work.
   on_rank0(comm, [&] {
-    std::error_code ec;
-    fs::create_directories(settings.out, ec);
-    if (ec || !fs::is_directory(settings.out))
-      throw std::invalid_argument(
-          fmt::format("--out {}: cannot create the directory{}", settings.out.string(), ec ? ": " + ec.message() : ""));
-    const fs::path probe = settings.out / fmt::format(".msm-evaluate-probe.{}", ::getpid());
-    std::ofstream out(probe);
-    const bool writable = out && (out << "probe") && out.flush();
-    out.close();
-    fs::remove(probe, ec);
-    if (!writable)
-      throw std::invalid_argument(fmt::format("--out {}: the directory is not writable", settings.out.string()));
+    if (const auto problem = util::prepare_output_dir(settings.out, "msm-evaluate-probe"))
+      throw std::invalid_argument(fmt::format("--out {}: {}", settings.out.string(), *problem));
     return std::vector<char>{};
   });
+  return run;
+}
 
-  // Stacks: traced on rank 0, the same bits everywhere.
+// A scene's stack, refused when it holds nothing to evaluate.
+Stack traced_stack(const std::string& name, const StackSettings& settings) {
+  scene::Scene scene;
+  try {
+    scene = scene::load_scene(name);
+  } catch (const scene::SceneError& e) { throw std::invalid_argument(e.what()); }
+  Stack stack = build_stack(name, scene, settings);
+  if (stack.stats.fragments == 0)
+    throw std::invalid_argument(fmt::format("scene {}: the stack is empty: no surface within the light frustum", name));
+  if (stack.stats.counted == 0)
+    throw std::invalid_argument(fmt::format("scene {}: the stack has {} fragments but none receives light "
+                                            "(every surface faces away from it): nothing to evaluate",
+                                            name, stack.stats.fragments));
+  return stack;
+}
+
+// The stacks: traced on rank 0, the same bits everywhere; their statistics recorded in `run`.
+std::vector<Stack> shared_stacks(const RunSettings& settings, Communicator& comm, RunResult& run) {
+  const auto stack_start = Clock::now();
+  const std::vector<char> bytes = on_rank0(comm, [&] {
+    Packer p;
+    p.put(std::uint64_t(settings.scenes.size()));
+    for (const std::string& name : settings.scenes) {
+      const std::vector<char> s = traced_stack(name, settings.stack).serialize();
+      p.put(std::uint64_t(s.size()));
+      p.bytes.insert(p.bytes.end(), s.begin(), s.end());
+    }
+    return p.bytes;
+  });
   std::vector<Stack> stacks;
-  {
-    const auto stack_start = Clock::now();
-    const std::vector<char> bytes = on_rank0(comm, [&] {
-      Packer p;
-      p.put(std::uint64_t(settings.scenes.size()));
-      for (const std::string& name : settings.scenes) {
-        scene::Scene scene;
-        try {
-          scene = scene::load_scene(name);
-        } catch (const scene::SceneError& e) { throw std::invalid_argument(e.what()); }
-        Stack stack = build_stack(name, scene, settings.stack);
-        if (stack.stats.fragments == 0)
-          throw std::invalid_argument(
-              fmt::format("scene {}: the stack is empty: no surface within the light frustum", name));
-        if (stack.stats.counted == 0)
-          throw std::invalid_argument(fmt::format("scene {}: the stack has {} fragments but none receives light "
-                                                  "(every surface faces away from it): nothing to evaluate",
-                                                  name, stack.stats.fragments));
-        const std::vector<char> s = stack.serialize();
-        p.put(std::uint64_t(s.size()));
-        p.bytes.insert(p.bytes.end(), s.begin(), s.end());
+  Unpacker u{bytes};
+  const auto count = u.get<std::uint64_t>();
+  for (std::uint64_t i = 0; i < count; ++i) {
+    const auto size = u.get<std::uint64_t>();
+    if (bytes.size() - u.at < size) throw std::runtime_error("evaluate: truncated stacks from rank 0");
+    stacks.push_back(Stack::deserialize(std::span<const char>(bytes.data() + u.at, std::size_t(size))));
+    u.at += std::size_t(size);
+  }
+  for (const Stack& s : stacks) {
+    run.stacks.push_back(s.stats);
+    run.stack_fingerprints.push_back(s.fingerprint());
+  }
+  run.stack_seconds = seconds_since(stack_start);
+  return stacks;
+}
+
+// The candidates of this rank: those the checkpoint has not finished, round-robin over the ranks.
+// Rank 0 reads the checkpoint into `done`; every rank learns which candidates it holds.
+std::vector<std::int64_t> candidates_of_rank(const RunSettings& settings, Communicator& comm,
+                                             const fs::path& checkpoint_dir, std::size_t scenes, RunResult& run,
+                                             std::map<std::int64_t, CandidateResult>& done) {
+  const std::string fingerprint = run_fingerprint(run.candidates, run.stack_fingerprints, settings);
+  const std::vector<char> bytes = on_rank0(comm, [&] {
+    done = open_checkpoint(checkpoint_dir, fingerprint, run.candidates, scenes, settings.fresh);
+    Packer p;
+    p.put(std::uint64_t(done.size()));
+    for (const auto& entry : done) p.put(entry.first);
+    return p.bytes;
+  });
+  Unpacker u{bytes};
+  const auto count = u.get<std::uint64_t>();
+  std::vector<char> finished(run.candidates.size(), 0);
+  for (std::uint64_t i = 0; i < count; ++i) finished[std::size_t(u.get<std::int64_t>())] = 1;
+  run.resumed = std::int64_t(count);
+  std::vector<std::int64_t> mine;
+  std::int64_t position = 0;
+  for (std::size_t i = 0; i < run.candidates.size(); ++i)
+    if (!finished[i] && position++ % comm.size() == comm.rank()) mine.push_back(std::int64_t(i));
+  return mine;
+}
+
+// One candidate over every stack (a singular basis: no sums, marked singular); counts its LPs.
+CandidateResult evaluate_candidate(const Candidate& candidate, std::int64_t index, const std::vector<Stack>& stacks,
+                                   const RunSettings& settings, std::atomic<std::int64_t>& lps) {
+  CandidateResult result;
+  result.index = index;
+  std::optional<GridBasis> basis;
+  if (candidate.technique == Technique::lp) {
+    try {
+      basis.emplace(prepare_basis(candidate, settings.stack.grid));
+    } catch (const SingularBasis&) { result.singular = true; }
+  }
+  if (!result.singular)
+    for (const Stack& stack : stacks) {
+      result.scenes.push_back(evaluate(stack, candidate, basis ? &*basis : nullptr, settings.evaluate));
+      lps += result.scenes.back().lps;
+    }
+  else
+    result.scenes.assign(stacks.size(), SceneSums{});
+  return result;
+}
+
+// This rank's candidates on a pool of threads, each result appended to the rank's checkpoint file as
+// it finishes; `timing` gets the rank's counts and seconds.
+std::vector<CandidateResult> compute_candidates(const std::vector<std::int64_t>& mine, const RunResult& run,
+                                                const std::vector<Stack>& stacks, const RunSettings& settings,
+                                                Communicator& comm, const fs::path& checkpoint_dir,
+                                                const std::function<void(const Progress&)>& progress,
+                                                RankTiming& timing) {
+  const int threads = settings.threads > 0 ? settings.threads : default_threads(comm);
+  CheckpointWriter writer(checkpoint_dir / fmt::format("rank{}.jsonl", comm.rank()));
+  std::vector<CandidateResult> computed(mine.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<std::int64_t> finished_here{0}, lps{0};
+  std::mutex mutex; // the checkpoint file, progress and the first error
+  std::exception_ptr error;
+  const auto compute_start = Clock::now();
+  const auto worker = [&] {
+    while (true) {
+      const std::size_t k = next++;
+      if (k >= mine.size()) return;
+      {
+        std::lock_guard lock(mutex);
+        if (error) return;
       }
-      return p.bytes;
-    });
+      try {
+        const Candidate& candidate = run.candidates[std::size_t(mine[k])];
+        computed[k] = evaluate_candidate(candidate, mine[k], stacks, settings, lps);
+        std::lock_guard lock(mutex);
+        writer.write(checkpoint_line(candidate, computed[k]));
+        const std::int64_t count = ++finished_here;
+        if (settings.stop_after >= 0 && count >= settings.stop_after) std::_Exit(3);
+        if (progress && comm.rank() == 0) progress({count, std::int64_t(mine.size()), seconds_since(compute_start)});
+      } catch (const std::exception& e) {
+        // Not an invalid_argument: an error of this rank alone (callers abort the other ranks).
+        std::lock_guard lock(mutex);
+        if (!error) error = std::make_exception_ptr(std::runtime_error(e.what()));
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < std::min<int>(threads, std::max<int>(1, int(mine.size()))); ++t) pool.emplace_back(worker);
+  for (std::thread& t : pool) t.join();
+  if (error) std::rethrow_exception(error);
+  if (progress && comm.rank() == 0 && mine.empty()) progress({0, 0, 0.0});
+
+  timing.rank = comm.rank();
+  timing.threads = threads;
+  timing.candidates = std::int64_t(mine.size());
+  timing.lps = lps;
+  timing.seconds = seconds_since(compute_start);
+  return computed;
+}
+
+// Every rank's results and timing gathered at rank 0, into `run` with the checkpoint's (`done`): one
+// result per candidate, by index.
+void gather_results(const std::vector<CandidateResult>& computed, const RankTiming& timing, std::size_t scenes,
+                    Communicator& comm, std::map<std::int64_t, CandidateResult>& done, RunResult& run) {
+  Packer p;
+  p.put(timing.rank), p.put(timing.threads), p.put(timing.candidates), p.put(timing.lps), p.put(timing.seconds);
+  p.put(std::uint64_t(computed.size()));
+  for (const CandidateResult& r : computed) {
+    p.put(r.index), p.put(std::int64_t(r.singular ? 1 : 0));
+    for (const SceneSums& s : r.scenes) put_sums(p, s);
+  }
+  const std::vector<std::vector<char>> all =
+      comm.size() > 1 ? comm.gather(p.bytes) : std::vector<std::vector<char>>{p.bytes};
+  if (comm.rank() != 0) return;
+  std::vector<std::optional<CandidateResult>> table(run.candidates.size());
+  for (auto& [index, r] : done) table[std::size_t(index)] = std::move(r);
+  for (const std::vector<char>& bytes : all) {
     Unpacker u{bytes};
+    RankTiming t;
+    t.rank = u.get<int>();
+    t.threads = u.get<int>();
+    t.candidates = u.get<std::int64_t>();
+    t.lps = u.get<std::int64_t>();
+    t.seconds = u.get<double>();
+    run.ranks.push_back(t);
     const auto count = u.get<std::uint64_t>();
     for (std::uint64_t i = 0; i < count; ++i) {
-      const auto size = u.get<std::uint64_t>();
-      if (bytes.size() - u.at < size) throw std::runtime_error("evaluate: truncated stacks from rank 0");
-      stacks.push_back(Stack::deserialize(std::span<const char>(bytes.data() + u.at, std::size_t(size))));
-      u.at += std::size_t(size);
+      CandidateResult r;
+      r.index = u.get<std::int64_t>();
+      r.singular = u.get<std::int64_t>() != 0;
+      for (std::size_t s = 0; s < scenes; ++s) r.scenes.push_back(get_sums(u));
+      table.at(std::size_t(r.index)) = std::move(r);
     }
-    for (const Stack& s : stacks) {
-      run.stacks.push_back(s.stats);
-      run.stack_fingerprints.push_back(s.fingerprint());
-    }
-    run.stack_seconds = seconds_since(stack_start);
   }
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    if (!table[i]) throw std::runtime_error(fmt::format("evaluate: no result for candidate {}", i));
+    run.results.push_back(std::move(*table[i]));
+  }
+}
 
-  // Checkpoint: rank 0 reads it; every rank learns which candidates are done.
+} // namespace
+
+RunResult run_evaluation(const RunSettings& settings, Communicator& comm,
+                         const std::function<void(const Progress&)>& progress) {
+  const auto start = Clock::now();
+  RunResult run = start_run(settings, comm);
+  const std::vector<Stack> stacks = shared_stacks(settings, comm, run);
   const fs::path checkpoint_dir = settings.out / "checkpoint";
-  const std::string fingerprint = run_fingerprint(run.candidates, run.stack_fingerprints, settings);
-  std::map<std::int64_t, CandidateResult> done;
-  {
-    const std::vector<char> bytes = on_rank0(comm, [&] {
-      done = open_checkpoint(checkpoint_dir, fingerprint, run.candidates, stacks.size(), settings.fresh);
-      Packer p;
-      p.put(std::uint64_t(done.size()));
-      for (const auto& entry : done) p.put(entry.first);
-      return p.bytes;
-    });
-    Unpacker u{bytes};
-    const auto count = u.get<std::uint64_t>();
-    std::vector<char> finished(run.candidates.size(), 0);
-    for (std::uint64_t i = 0; i < count; ++i) finished[std::size_t(u.get<std::int64_t>())] = 1;
-    run.resumed = std::int64_t(count);
-    // Round-robin over the ranks.
-    std::vector<std::int64_t> mine;
-    std::int64_t position = 0;
-    for (std::size_t i = 0; i < run.candidates.size(); ++i)
-      if (!finished[i] && position++ % comm.size() == comm.rank()) mine.push_back(std::int64_t(i));
-
-    // The work of this rank.
-    const int threads = settings.threads > 0 ? settings.threads : default_threads(comm);
-    CheckpointWriter writer(checkpoint_dir / fmt::format("rank{}.jsonl", comm.rank()));
-    std::vector<CandidateResult> computed(mine.size());
-    std::atomic<std::size_t> next{0};
-    std::atomic<std::int64_t> finished_here{0}, lps{0};
-    std::mutex mutex; // the checkpoint file, progress and the first error
-    std::exception_ptr error;
-    const auto compute_start = Clock::now();
-    const auto worker = [&] {
-      while (true) {
-        const std::size_t k = next++;
-        if (k >= mine.size()) return;
-        {
-          std::lock_guard lock(mutex);
-          if (error) return;
-        }
-        try {
-          const Candidate& candidate = run.candidates[std::size_t(mine[k])];
-          CandidateResult& result = computed[k];
-          result.index = mine[k];
-          std::optional<GridBasis> basis;
-          if (candidate.technique == Technique::lp) {
-            try {
-              basis.emplace(prepare_basis(candidate, settings.stack.grid));
-            } catch (const SingularBasis&) { result.singular = true; }
-          }
-          if (!result.singular)
-            for (const Stack& stack : stacks) {
-              result.scenes.push_back(evaluate(stack, candidate, basis ? &*basis : nullptr, settings.evaluate));
-              lps += result.scenes.back().lps;
-            }
-          else
-            result.scenes.assign(stacks.size(), SceneSums{});
-          std::lock_guard lock(mutex);
-          writer.write(checkpoint_line(candidate, result));
-          const std::int64_t count = ++finished_here;
-          if (settings.stop_after >= 0 && count >= settings.stop_after) std::_Exit(3);
-          if (progress && comm.rank() == 0) progress({count, std::int64_t(mine.size()), seconds_since(compute_start)});
-        } catch (const std::exception& e) {
-          // Not an invalid_argument: an error of this rank alone (callers abort the other ranks).
-          std::lock_guard lock(mutex);
-          if (!error) error = std::make_exception_ptr(std::runtime_error(e.what()));
-          return;
-        }
-      }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 0; t < std::min<int>(threads, std::max<int>(1, int(mine.size()))); ++t) pool.emplace_back(worker);
-    for (std::thread& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
-    if (progress && comm.rank() == 0 && mine.empty()) progress({0, 0, 0.0});
-
-    RankTiming timing;
-    timing.rank = comm.rank();
-    timing.threads = threads;
-    timing.candidates = std::int64_t(mine.size());
-    timing.lps = lps;
-    timing.seconds = seconds_since(compute_start);
-
-    // Gather at rank 0.
-    Packer p;
-    p.put(timing.rank), p.put(timing.threads), p.put(timing.candidates), p.put(timing.lps), p.put(timing.seconds);
-    p.put(std::uint64_t(computed.size()));
-    for (const CandidateResult& r : computed) {
-      p.put(r.index), p.put(std::int64_t(r.singular ? 1 : 0));
-      for (const SceneSums& s : r.scenes) put_sums(p, s);
-    }
-    const std::vector<std::vector<char>> all =
-        comm.size() > 1 ? comm.gather(p.bytes) : std::vector<std::vector<char>>{p.bytes};
-    if (comm.rank() == 0) {
-      std::vector<std::optional<CandidateResult>> table(run.candidates.size());
-      for (auto& [index, r] : done) table[std::size_t(index)] = std::move(r);
-      for (const std::vector<char>& bytes : all) {
-        Unpacker u{bytes};
-        RankTiming t;
-        t.rank = u.get<int>();
-        t.threads = u.get<int>();
-        t.candidates = u.get<std::int64_t>();
-        t.lps = u.get<std::int64_t>();
-        t.seconds = u.get<double>();
-        run.ranks.push_back(t);
-        const auto count = u.get<std::uint64_t>();
-        for (std::uint64_t i = 0; i < count; ++i) {
-          CandidateResult r;
-          r.index = u.get<std::int64_t>();
-          r.singular = u.get<std::int64_t>() != 0;
-          for (std::size_t s = 0; s < stacks.size(); ++s) r.scenes.push_back(get_sums(u));
-          table.at(std::size_t(r.index)) = std::move(r);
-        }
-      }
-      for (std::size_t i = 0; i < table.size(); ++i) {
-        if (!table[i]) throw std::runtime_error(fmt::format("evaluate: no result for candidate {}", i));
-        run.results.push_back(std::move(*table[i]));
-      }
-    }
-  }
+  std::map<std::int64_t, CandidateResult> done; // rank 0: what the checkpoint holds
+  const std::vector<std::int64_t> mine = candidates_of_rank(settings, comm, checkpoint_dir, stacks.size(), run, done);
+  RankTiming timing;
+  const std::vector<CandidateResult> computed =
+      compute_candidates(mine, run, stacks, settings, comm, checkpoint_dir, progress, timing);
+  gather_results(computed, timing, stacks.size(), comm, done, run);
   run.total_seconds = seconds_since(start);
   return run;
 }

@@ -72,26 +72,19 @@ CubeMap cube_from_equirect(int width, int height, const std::vector<glm::vec3>& 
     return rgb[std::size_t(q.y) * width + q.x];
   };
   const glm::vec2 cos_sin = rotation_cos_sin(rotation_deg);
-  CubeMap cube;
-  cube.size = size;
   const int ss = std::max(supersampling, 1);
-  for (int face = 0; face < 6; ++face) {
-    cube.faces[face].resize(std::size_t(size) * size);
-    for (int j = 0; j < size; ++j)
-      for (int i = 0; i < size; ++i) {
-        glm::vec3 sum(0.0f);
-        for (int b = 0; b < ss; ++b)
-          for (int a = 0; a < ss; ++a) {
-            const float u = face_coordinate(i, size, (a + 0.5f) / ss), v = face_coordinate(j, size, (b + 0.5f) / ss);
-            const glm::vec3 d = msm_probe_lookup_direction(msm_cube_direction(face, u, v), cos_sin);
-            const MsmBilinearTap tap = msm_equirect_tap(msm_equirect_of(d), extent);
-            sum += msm_bilinear(fetch(tap.p0), fetch(tap.p0 + glm::ivec2(1, 0)), fetch(tap.p0 + glm::ivec2(0, 1)),
-                                fetch(tap.p0 + glm::ivec2(1, 1)), tap.f);
-          }
-        cube.at(face, i, j) = sum / float(ss * ss);
+  return make_cube(size, [&](int face, int i, int j) {
+    glm::vec3 sum(0.0f);
+    for (int b = 0; b < ss; ++b)
+      for (int a = 0; a < ss; ++a) {
+        const float u = face_coordinate(i, size, (a + 0.5f) / ss), v = face_coordinate(j, size, (b + 0.5f) / ss);
+        const glm::vec3 d = msm_probe_lookup_direction(msm_cube_direction(face, u, v), cos_sin);
+        const MsmBilinearTap tap = msm_equirect_tap(msm_equirect_of(d), extent);
+        sum += msm_bilinear(fetch(tap.p0), fetch(tap.p0 + glm::ivec2(1, 0)), fetch(tap.p0 + glm::ivec2(0, 1)),
+                            fetch(tap.p0 + glm::ivec2(1, 1)), tap.f);
       }
-  }
-  return cube;
+    return sum / float(ss * ss);
+  });
 }
 
 Panorama load_equirect(const std::filesystem::path& file) {
@@ -158,15 +151,9 @@ CubeMap cube_from_cross(int width, int height, const std::vector<glm::vec3>& rgb
   if (!horizontal && !vertical)
     throw ProbeError(
         fmt::format("{}x{} is not a cube-map cross (4s x 3s horizontal or 3s x 4s vertical)", width, height));
-  CubeMap cube;
-  cube.size = horizontal ? width / 4 : height / 4;
-  check_size(cube.size);
-  for (int face = 0; face < 6; ++face) {
-    cube.faces[face].resize(std::size_t(cube.size) * cube.size);
-    for (int j = 0; j < cube.size; ++j)
-      for (int i = 0; i < cube.size; ++i) cube.at(face, i, j) = rgb[cross_index(face, i, j, cube.size, vertical)];
-  }
-  return cube;
+  const int size = horizontal ? width / 4 : height / 4;
+  check_size(size);
+  return make_cube(size, [&](int face, int i, int j) { return rgb[cross_index(face, i, j, size, vertical)]; });
 }
 
 std::vector<glm::vec3> cross_of_cube(const CubeMap& cube, bool vertical) {
@@ -196,19 +183,12 @@ CubeMap downsample_cube(const CubeMap& cube, int size) {
   if (cube.size % size != 0)
     throw ProbeError(fmt::format("cube faces of {}² cannot be box-filtered to {}² (not a divisor)", cube.size, size));
   const int k = cube.size / size;
-  CubeMap out;
-  out.size = size;
-  for (int face = 0; face < 6; ++face) {
-    out.faces[face].resize(std::size_t(size) * size);
-    for (int j = 0; j < size; ++j)
-      for (int i = 0; i < size; ++i) {
-        glm::dvec3 sum(0.0);
-        for (int b = 0; b < k; ++b)
-          for (int a = 0; a < k; ++a) sum += glm::dvec3(cube.at(face, i * k + a, j * k + b));
-        out.at(face, i, j) = glm::vec3(sum / double(k * k));
-      }
-  }
-  return out;
+  return make_cube(size, [&](int face, int i, int j) {
+    glm::dvec3 sum(0.0);
+    for (int b = 0; b < k; ++b)
+      for (int a = 0; a < k; ++a) sum += glm::dvec3(cube.at(face, i * k + a, j * k + b));
+    return glm::vec3(sum / double(k * k));
+  });
 }
 
 bool is_cube_faces_path(const std::filesystem::path& file) { return file.string().find("{face}") != std::string::npos; }
@@ -254,6 +234,13 @@ void write_cube_faces(const std::filesystem::path& pattern, const CubeMap& cube)
   }
 }
 
+PictureLayout picture_layout(int width, int height) {
+  if (width <= 0 || height <= 0) return PictureLayout::neither;
+  if (width == 2 * height) return PictureLayout::panorama;
+  if (4 * height == 3 * width || 4 * width == 3 * height) return PictureLayout::cross;
+  return PictureLayout::neither;
+}
+
 CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotation_deg) {
   check_size(size);
   if (is_cube_faces_path(file)) {
@@ -264,9 +251,10 @@ CubeMap load_probe_file(const std::filesystem::path& file, int size, float rotat
     } catch (const ProbeError& e) { throw ProbeError(fmt::format("{}: {}", file.string(), e.what())); }
   }
   Panorama picture = load_equirect(file);
-  if (picture.width == 2 * picture.height)
+  const PictureLayout layout = picture_layout(picture.width, picture.height);
+  if (layout == PictureLayout::panorama)
     return cube_from_equirect(picture.width, picture.height, picture.rgb, size, rotation_deg);
-  if (4 * picture.height != 3 * picture.width && 4 * picture.width != 3 * picture.height)
+  if (layout == PictureLayout::neither)
     throw ProbeError(fmt::format("{}: {}x{} is neither an equirectangular panorama (width = 2 height) nor a cube-map "
                                  "cross (4:3 or 3:4)",
                                  file.string(), picture.width, picture.height));
@@ -296,35 +284,27 @@ CubeMap make_sky_sun_probe(int size, glm::vec3 sky, glm::vec3 sun, glm::vec3 tow
   const glm::vec3 axis = glm::normalize(towards_sun);
   const float cos_radius = std::cos(sun_radius_rad);
   const float texel_angle = 2.5f / float(size); // bounds a texel's angular half-diagonal
-  CubeMap cube;
-  cube.size = size;
-  for (int face = 0; face < 6; ++face) {
-    cube.faces[face].resize(std::size_t(size) * size);
-    for (int j = 0; j < size; ++j)
-      for (int i = 0; i < size; ++i) {
-        const glm::vec3 d =
-            glm::normalize(msm_cube_direction(face, face_coordinate(i, size), face_coordinate(j, size)));
-        const float angle = std::acos(std::clamp(glm::dot(d, axis), -1.0f, 1.0f));
-        float covered;
-        if (angle < sun_radius_rad - texel_angle) {
-          covered = 1.0f;
-        } else if (angle > sun_radius_rad + texel_angle) {
-          covered = 0.0f;
-        } else { // the disc's edge crosses the texel: the share of 16² point samples inside
-          const int n = 16;
-          int inside = 0;
-          for (int b = 0; b < n; ++b)
-            for (int a = 0; a < n; ++a) {
-              const glm::vec3 ds = glm::normalize(msm_cube_direction(face, face_coordinate(i, size, (a + 0.5f) / n),
-                                                                     face_coordinate(j, size, (b + 0.5f) / n)));
-              inside += glm::dot(ds, axis) >= cos_radius;
-            }
-          covered = float(inside) / float(n * n);
+  return make_cube(size, [&](int face, int i, int j) {
+    const glm::vec3 d = glm::normalize(msm_cube_direction(face, face_coordinate(i, size), face_coordinate(j, size)));
+    const float angle = std::acos(std::clamp(glm::dot(d, axis), -1.0f, 1.0f));
+    float covered;
+    if (angle < sun_radius_rad - texel_angle) {
+      covered = 1.0f;
+    } else if (angle > sun_radius_rad + texel_angle) {
+      covered = 0.0f;
+    } else { // the disc's edge crosses the texel: the share of 16² point samples inside
+      const int n = 16;
+      int inside = 0;
+      for (int b = 0; b < n; ++b)
+        for (int a = 0; a < n; ++a) {
+          const glm::vec3 ds = glm::normalize(msm_cube_direction(face, face_coordinate(i, size, (a + 0.5f) / n),
+                                                                 face_coordinate(j, size, (b + 0.5f) / n)));
+          inside += glm::dot(ds, axis) >= cos_radius;
         }
-        cube.at(face, i, j) = sky + covered * (sun - sky);
-      }
-  }
-  return cube;
+      covered = float(inside) / float(n * n);
+    }
+    return sky + covered * (sun - sky);
+  });
 }
 
 glm::dvec3 integrate(const CubeMap& cube) {

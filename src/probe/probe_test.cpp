@@ -783,17 +783,10 @@ namespace {
 // A cube whose texels are their own unit directions (as colours) plus a texel-unique offset, so
 // that a misplaced or mirrored texel cannot go unnoticed.
 CubeMap direction_cube(int m) {
-  CubeMap cube;
-  cube.size = m;
-  for (int face = 0; face < 6; ++face) {
-    cube.faces[face].resize(std::size_t(m) * m);
-    for (int j = 0; j < m; ++j)
-      for (int i = 0; i < m; ++i) {
-        const float u = (2.0f * float(i) + 1.0f) / float(m) - 1.0f, v = (2.0f * float(j) + 1.0f) / float(m) - 1.0f;
-        cube.at(face, i, j) = glm::normalize(msm::msm_cube_direction(face, u, v)) + glm::vec3(2.0f);
-      }
-  }
-  return cube;
+  return make_cube(m, [m](int face, int i, int j) {
+    const float u = (2.0f * float(i) + 1.0f) / float(m) - 1.0f, v = (2.0f * float(j) + 1.0f) / float(m) - 1.0f;
+    return glm::normalize(msm::msm_cube_direction(face, u, v)) + glm::vec3(2.0f);
+  });
 }
 
 bool same_cube(const CubeMap& a, const CubeMap& b) { return a.size == b.size && a.faces == b.faces; }
@@ -891,6 +884,17 @@ TEST(CubeInputs, SixFaceFilesMakeTheCube) {
 }
 
 // Six faces of one size make the cube; anything else is refused with a message naming the problem.
+// The layout of a probe picture by its shape: what load_probe_file and the frame sequences read.
+TEST(CubeInputs, PictureLayoutIsToldByShape) {
+  EXPECT_EQ(picture_layout(64, 32), PictureLayout::panorama);
+  EXPECT_EQ(picture_layout(2, 1), PictureLayout::panorama);
+  EXPECT_EQ(picture_layout(16, 12), PictureLayout::cross); // horizontal, 4s x 3s
+  EXPECT_EQ(picture_layout(12, 16), PictureLayout::cross); // vertical, 3s x 4s
+  EXPECT_EQ(picture_layout(30, 20), PictureLayout::neither);
+  EXPECT_EQ(picture_layout(32, 32), PictureLayout::neither); // a single face
+  EXPECT_EQ(picture_layout(0, 0), PictureLayout::neither);
+}
+
 TEST(CubeInputs, BadLayoutsAreRefusedClearly) {
   const CubeMap cube = direction_cube(4);
   std::array<int, 6> sizes{4, 4, 4, 4, 4, 4};

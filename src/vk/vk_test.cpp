@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -135,18 +136,30 @@ TEST(ContextTest, SelectsDevicesByIndexNameAndEnvironment) {
   } catch (const std::runtime_error& e) { EXPECT_NE(std::string(e.what()).find("GPU"), std::string::npos) << e.what(); }
 }
 
-// The checks of the other tests can fail: a deliberate misuse is reported.
-TEST(ValidationTest, ReportsAnOutOfRangeBufferBarrier) {
-  ContextOptions options = quiet_options();
-  options.echo_validation = false;
-  std::shared_ptr<ValidationLog> log;
-  {
-    Context ctx(options);
-    if (!ctx.validation_enabled()) {
-      ASSERT_TRUE(test::validation_active(ctx));
+// A context whose validation messages are kept, not echoed, for tests that misuse Vulkan on
+// purpose; skipped where the validation layer is not installed. The log outlives the context, so
+// that what its destruction reports can be read.
+class ValidationTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ContextOptions options = quiet_options();
+    options.echo_validation = false;
+    context.emplace(options);
+    if (!context->validation_enabled()) {
+      ASSERT_TRUE(test::validation_active(*context));
       GTEST_SKIP() << "validation layer not installed";
     }
-    log = ctx.validation_log();
+    log = context->validation_log();
+  }
+
+  std::optional<Context> context;
+  std::shared_ptr<ValidationLog> log;
+};
+
+// The checks of the other tests can fail: a deliberate misuse is reported.
+TEST_F(ValidationTest, ReportsAnOutOfRangeBufferBarrier) {
+  {
+    const Context& ctx = *context;
     Buffer buffer = create_buffer(ctx, 256, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     ASSERT_EQ(log->count(), 0u) << ValidationLog::format(log->messages());
     submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
@@ -163,25 +176,16 @@ TEST(ValidationTest, ReportsAnOutOfRangeBufferBarrier) {
     })) << ValidationLog::format(messages);
     log->clear();
   }
+  context.reset();
   EXPECT_TRUE(test::no_validation_messages(*log)); // nothing else went wrong, destruction included
 }
 
 // ... and an object never destroyed is reported when the Context goes.
-TEST(ValidationTest, ReportsObjectsAliveAtDeviceDestruction) {
-  ContextOptions options = quiet_options();
-  options.echo_validation = false;
-  std::shared_ptr<ValidationLog> log;
-  {
-    Context ctx(options);
-    if (!ctx.validation_enabled()) {
-      ASSERT_TRUE(test::validation_active(ctx));
-      GTEST_SKIP() << "validation layer not installed";
-    }
-    log = ctx.validation_log();
-    VkSamplerCreateInfo info{.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .maxLod = 1.0f};
-    VkSampler leaked = VK_NULL_HANDLE;
-    MSM_VK_CHECK(vkCreateSampler(ctx.device(), &info, nullptr, &leaked));
-  }
+TEST_F(ValidationTest, ReportsObjectsAliveAtDeviceDestruction) {
+  VkSamplerCreateInfo info{.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .maxLod = 1.0f};
+  VkSampler leaked = VK_NULL_HANDLE;
+  MSM_VK_CHECK(vkCreateSampler(context->device(), &info, nullptr, &leaked));
+  context.reset();
   std::vector<ValidationMessage> messages = log->messages();
   EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const ValidationMessage& m) {
     return m.text.find("VkSampler") != std::string::npos;

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,6 +19,7 @@
 #include "msm/evaluate/report.h"
 #include "msm/evaluate/run.h"
 #include "msm/util/progress.h"
+#include "msm/util/text.h"
 #include "usage.h"
 
 namespace msm::tool {
@@ -29,12 +29,8 @@ using namespace msm::evaluate;
 
 std::vector<std::string> split_list(const std::vector<std::string>& items) {
   std::vector<std::string> out;
-  for (const std::string& item : items) {
-    std::stringstream in(item);
-    std::string part;
-    while (std::getline(in, part, ','))
-      if (!part.empty()) out.push_back(part);
-  }
+  for (const std::string& item : items)
+    for (std::string& part : util::split_nonempty(item, ',')) out.push_back(std::move(part));
   return out;
 }
 
@@ -42,12 +38,10 @@ class ProgressBar {
  public:
   ProgressBar(int rank, int size) : rank_(rank), size_(size) {}
   void operator()(const Progress& p) {
-    const double fraction = p.total ? double(p.done) / double(p.total) : 1.0;
-    const int width = 30, filled = int(std::lround(fraction * width));
-    const double left = fraction > 0.0 ? p.seconds * (1.0 - fraction) / fraction : 0.0;
-    fmt::print(stderr, "\rmsm evaluate [{}{}] {:3.0f}%  {}/{} candidates{}  {:.1f} s, {:.1f} s left ",
-               std::string(filled, '#'), std::string(width - filled, ' '), 100.0 * fraction, p.done, p.total,
-               size_ > 1 ? fmt::format(" (rank {} of {})", rank_, size_) : "", p.seconds, left);
+    const std::string detail = fmt::format("{}/{} candidates{}  ", p.done, p.total,
+                                           size_ > 1 ? fmt::format(" (rank {} of {})", rank_, size_) : "");
+    fmt::print(stderr, "\r{}",
+               util::progress_bar("msm evaluate", std::size_t(p.done), std::size_t(p.total), p.seconds, 30, detail));
     if (p.done == p.total) fmt::print(stderr, "\n");
     std::fflush(stderr);
   }

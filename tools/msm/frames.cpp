@@ -3,6 +3,7 @@
 
 #include "msm/image/io.h"
 #include "msm/probe/device_probe.h"
+#include "msm/util/clock.h"
 #include "msm/vk/commands.h"
 #include "msm/vk/timer.h"
 
@@ -38,7 +39,7 @@ void check_frames(const scene::Scene& scene, const Frames& o) {
     try {
       panorama = probe::load_equirect(scene.probe->file);
     } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-    if (panorama.width != 2 * panorama.height)
+    if (probe::picture_layout(panorama.width, panorama.height) != probe::PictureLayout::panorama)
       throw UsageError(fmt::format("--probe-rotation-speed {}: {} is a cube-map cross, which cannot be rotated",
                                    o.rotation_speed_deg, scene.probe->file.string()));
   }
@@ -58,7 +59,7 @@ class ProbeSequence {
       try {
         panorama = probe::load_equirect(p_.file);
       } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-      if (panorama.width == 2 * panorama.height) {
+      if (probe::picture_layout(panorama.width, panorama.height) == probe::PictureLayout::panorama) {
         for (glm::vec3& t : panorama.rgb) t *= p_.intensity;
         device_.set_panorama(panorama);
         return;
@@ -98,7 +99,7 @@ class ProbeSequence {
     } else {
       for (const MsmAreaLight& a : cut.lights) lights.push_back(scene::light_of_area_light(a));
     }
-    const double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double wall_ms = util::ms_since(start);
     const vk::TimerResults times = timer_.read();
     const double cube_ms = times.total("probe_cube"), tables_ms = times.total("probe_tables"),
                  cut_ms = times.total("probe_cut");
@@ -147,7 +148,7 @@ void render_frames(const vk::Context& ctx, render::Renderer& renderer, const sce
       try {
         renderer.move_objects(scene::at_frame(scene, k));
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      const double ms = util::ms_since(start);
       entry["objects_ms"] = ms;
       line += fmt::format("  {} moving object{} {:.2f} ms (moved on the host, uploaded)", moving, moving > 1 ? "s" : "",
                           ms);

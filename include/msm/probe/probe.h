@@ -30,6 +30,20 @@ struct CubeMap {
   const glm::vec3& at(int face, int i, int j) const { return faces[face][std::size_t(j) * size + i]; }
 };
 
+// A cube map of size² faces whose texel (face, i, j) is texel(face, i, j), filled face by face and
+// row by row.
+template <typename Texel>
+CubeMap make_cube(int size, Texel&& texel) {
+  CubeMap cube;
+  cube.size = size;
+  for (int face = 0; face < 6; ++face) {
+    cube.faces[face].resize(std::size_t(size) * size);
+    for (int j = 0; j < size; ++j)
+      for (int i = 0; i < size; ++i) cube.at(face, i, j) = texel(face, i, j);
+  }
+  return cube;
+}
+
 // Largest face size accepted (a 6 x 4096² RGB float cube map is 1.2 GB).
 inline constexpr int kMaxCubeSize = 4096;
 // Largest radiance a probe texel may hold, after its intensity (load_equirect, load_probe: a
@@ -65,6 +79,11 @@ struct Panorama {
 // An equirectangular EXR as it is (the checks and clamping of load_equirect_probe, no resampling):
 // what the device pipeline (DeviceProbe) resamples itself.
 Panorama load_equirect(const std::filesystem::path& file);
+// How a probe picture is laid out, told by its shape alone: a panorama is 2:1 (width = 2 height), a
+// cube-map cross 4:3 or 3:4 (cube_from_cross); any other shape, or an empty one, is neither. The one rule that
+// load_probe_file and the frame sequences' device probe read: only a panorama can be rotated.
+enum class PictureLayout { panorama, cross, neither };
+PictureLayout picture_layout(int width, int height);
 
 // An equirectangular EXR (any compression OpenEXR reads: ZIP, PIZ, DWAB, ...) as a cube map;
 // throws ProbeError naming the file (missing, not an EXR, no R, G and B channels, a non-finite
