@@ -609,7 +609,8 @@ uint64_t seed(const char* name) {
 }
 
 // 'count' inputs for function 'id', meaningful for it. The first 60 take the fixed texels at the
-// start of the pool (single depths at -1, 0, 1, ...) in turn; then random ones.
+// start of the pool (single depths at -1, 0, 1, ...) in turn; then random ones. Long on purpose:
+// one case per kernel function, a table read by function id, each case a few lines.
 std::vector<KernelIO> make_inputs(int id, int count) {
   Inputs g(seed(spec_of(id).name));
   std::vector<KernelIO> in(count);

@@ -139,6 +139,8 @@ MSM_FN KernelIO msm_kernel_result_blocker(BlockerResult o) {
   return KernelIO(vec4(o.depth, o.shadow, 0.0f, 0.0f), vec4(0.0f), uvec4(0u));
 }
 
+// The dispatcher that the compute shader and the C++ build both run. Long on purpose: one case per
+// function of the shared headers, a flat switch (GLSL has no function pointers).
 MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
   KernelIO r = KernelIO(vec4(0.0f), vec4(0.0f), uvec4(0u));
   Moments6 b6 = Moments6(vec3(x.a), vec3(x.b));
