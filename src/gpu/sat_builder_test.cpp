@@ -503,4 +503,26 @@ TEST(SoftFlow, TheShadersComposeItOnlyInSoftH) {
   EXPECT_GT(files, 50);
 }
 
+// Specialization constants are declared by name (frame.h's MSM_SPEC_*, shared.h's, the blur's,
+// the prefix sums' and rectify's ids), the names the host sets them by: no shader under src/ gives
+// a constant_id as a raw number, which another shader of its family could mean differently.
+TEST(SharedDeclarations, SpecializationConstantIdsAreNamed) {
+  const std::filesystem::path source(MSM_SOURCE_DIR);
+  int declared = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(source / "src")) {
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file() || (ext != ".glsl" && ext != ".comp" && ext != ".frag" && ext != ".vert")) continue;
+    std::ifstream in(entry.path());
+    std::string line;
+    while (std::getline(in, line)) {
+      const std::size_t at = line.find("constant_id");
+      if (at == std::string::npos) continue;
+      const std::size_t value = line.find_first_not_of(" =", at + std::strlen("constant_id"));
+      ++declared;
+      EXPECT_TRUE(value != std::string::npos && line.compare(value, 4, "MSM_") == 0) << entry.path() << ": " << line;
+    }
+  }
+  EXPECT_GT(declared, 15);
+}
+
 } // namespace
