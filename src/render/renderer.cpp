@@ -15,6 +15,7 @@
 #include "msm/noise/blue_noise.h"
 #include "msm/render/frame.h"
 #include "msm/render/rectification_uniforms.h"
+#include "msm/render/renderer_internals.h"
 #include "msm/sat.h"
 #include "msm/scattering.h"
 #include "msm/shading.h"
@@ -525,6 +526,8 @@ Renderer::Renderer(const vk::Context& ctx, const scene::Scene& scene) : impl_(st
 Renderer::~Renderer() = default;
 const scene::Scene& Renderer::scene() const noexcept { return impl_->scene; }
 void Renderer::check(const RenderSettings& s) const { impl_->check(s); }
+
+RenderResult Renderer::render(const RenderSettings& s) { return render(s, nullptr); }
 
 RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermediates) {
   Impl& m = *impl_;

@@ -11,7 +11,7 @@ ImageSpec moment_image_spec(const FrameConfig& config, int i) {
           .height = uint32_t(config.shadow_size * msm_technique_tiles(config.technique->id)),
           .mips = config.mip_levels,
           .layers = uint32_t(config.lights),
-          // Renderer::Intermediates reads the resolved and the filtered moments back.
+          // The renderer's Intermediates (renderer_internals.h) reads the resolved and the filtered moments back.
           .extra_usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT};
 }
 
