@@ -53,6 +53,7 @@
 #include "msm/bias.h"
 #include "msm/blocker.h"
 #include "msm/config.h"
+#include "msm/cssm.h"
 #include "msm/hamburger4.h"
 #include "msm/hamburger6.h"
 #include "msm/moments.h"
@@ -313,23 +314,146 @@ MSM_FN float msm_soft_shadow6(Moments6 q, float zf_biased, float umbra_epsilon, 
   return msm_overdarken(msm_hamburger6_lower(msm_soft_moments6(q, scale), zf_biased), 1.0f - umbra_epsilon);
 }
 
-// The whole per-pixel flow, with S(x, y) a fetch from the table (0 where x or y is -1), size the
-// map's size, W the kernel width the table was built for (n_t = W²), scale = msm_sat_scale(W * W):
-//   vec2 spread = msm_soft_spread(tan_half_extent, world_per_depth, world_per_texel); // per light
-//   vec2 hs = msm_soft_search_half_width(spread, zf, -1.0f, W);
-//   SatRect r = msm_soft_search_rect(uv * vec2(size), hs, size);
-//   uvec4 sum = msm_sat_rect_sum(S(r.hi.x, r.hi.y), S(r.lo.x - 1, r.hi.y), S(r.hi.x, r.lo.y - 1),
-//                                S(r.lo.x - 1, r.lo.y - 1));
-//   BlockerResult blocker = msm_soft_blocker4(msm_sat_rect_average(sum, msm_sat_rect_texels(r), scale), zf);
-//   if (msm_soft_in_umbra(blocker, MSM_SOFT_UMBRA_EPSILON)) return 1.0f;
-//   vec2 hp = msm_soft_penumbra_half_width(spread, zf, blocker.depth, W);
-//   SoftRegion region = msm_soft_region(uv * vec2(size), hp, size);
-//   SatFilter f = msm_sat_filter(region.lo, region.hi);
-//   SatSamples16 t; for j, i in 0..3: t.s[4 * j + i] = S(f.x[i], f.y[j]);
-//   float zb = zf - constant_bias - msm_soft_plane_bias(hp, receiver_gradient, 4); // 6: six moments
-//   return msm_soft_shadow4(msm_sat_filter_average(t, f, scale), zb, MSM_SOFT_UMBRA_EPSILON);
-// (six moments: msm_soft_blocker6(..., zf, scale) and msm_soft_shadow6(..., MSM_SOFT_UMBRA_EPSILON, scale)).
-
 MSM_END
 
 #endif // MSM_SOFT_H
+
+// ---- The per-pixel flow, composed once over the caller's table fetch ----
+// The steps above in their order, for the renderer's shader, the CPU and the device tests alike:
+// msm_soft_moment_flow (mssm4, mssm6, vssm) and msm_soft_cssm_flow (cssm8, cssm16). They read the
+// summed-area tables through the caller's fetch, uvec4 fetch(int x, int y, int table): S(x, y) of
+// table `table` (moments: 0, and 1 for the second table of six moments; CSSM: the tile), 0 where x
+// or y is -1 (CSSM: row -1 of tile t > 0 is the last row of tile t - 1, as the stacked table holds
+// it, which the rectangle sums subtract as they should). C++ passes the fetch first, a callable;
+// GLSL has no function parameters of function type, so the including shader defines the fetch
+// and names it with MSM_SOFT_FETCH before including this header (GLSL without MSM_SOFT_FETCH gets
+// the steps only). Outside the include guard: a shader may include soft.h earlier for the steps.
+// Further functions over the fetch (a test's) are written with the same four macros.
+#if (MSM_CPP || defined(MSM_SOFT_FETCH)) && !defined(MSM_SOFT_FLOW)
+#define MSM_SOFT_FLOW
+#if MSM_CPP
+// clang-format off
+#define MSM_SOFT_FLOW_FN template <class SoftFetch> inline
+// clang-format on
+#define MSM_SOFT_FETCH_PARAM SoftFetch fetch,
+#define MSM_SOFT_FETCH_ARG fetch,
+#define MSM_SOFT_TABLE(x, y, table) fetch(x, y, table)
+#else
+#define MSM_SOFT_FLOW_FN
+#define MSM_SOFT_FETCH_PARAM
+#define MSM_SOFT_FETCH_ARG
+#define MSM_SOFT_TABLE(x, y, table) MSM_SOFT_FETCH(x, y, table)
+#endif
+
+MSM_BEGIN
+
+// What the flow needs of the frame and the light.
+struct SoftSetup {
+  ivec2 size;          // the shadow map's size in texels (one tile of a CSSM table)
+  int kernel_width;    // W: the tables were built for kernels of at most W × W texels
+  uint scale;          // msm_sat_scale(W * W)
+  vec2 spread;         // msm_soft_spread of the light
+  float constant_bias; // [-1,1] depth, beside the receiver plane's bias
+  float umbra_epsilon; // ε_u (MSM_SOFT_UMBRA_EPSILON by default)
+  vec4 params;         // the technique's parameters (techniques.h)
+};
+// The fragment as the shadow map sees it.
+struct SoftFragment {
+  vec2 position;        // in texels: texel i covers [i, i + 1)
+  float depth;          // unbiased, [0,1]
+  vec2 depth_per_texel; // the receiver plane's slope in [-1,1] depth per texel along x and y
+};
+// The flow's result and the intermediate values the tests compare.
+struct SoftShadow {
+  float shadow;        // the shadow intensity
+  float blocker_depth; // the average blocker depth, [-1,1]
+  float search_shadow; // the blocker search region's shadow intensity
+  vec2 penumbra;       // the filter's half-widths in texels; 0 where the search ended the flow
+};
+
+// The sum over a grid rectangle (4 lookups, sat.h).
+MSM_SOFT_FLOW_FN uvec4 msm_soft_rect_sum(MSM_SOFT_FETCH_PARAM SatRect r, int table) {
+  return msm_sat_rect_sum(MSM_SOFT_TABLE(r.hi.x, r.hi.y, table), MSM_SOFT_TABLE(r.lo.x - 1, r.hi.y, table),
+                          MSM_SOFT_TABLE(r.hi.x, r.lo.y - 1, table), MSM_SOFT_TABLE(r.lo.x - 1, r.lo.y - 1, table));
+}
+// The nine-region box filter's average (16 lookups, sat.h).
+MSM_SOFT_FLOW_FN vec4 msm_soft_filter_average(MSM_SOFT_FETCH_PARAM SatFilter box, uint scale, int table) {
+  SatSamples16 t;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) t.s[4 * j + i] = MSM_SOFT_TABLE(box.x[i], box.y[j], table);
+  return msm_sat_filter_average(t, box, scale);
+}
+
+// Moment soft shadows with `moments` = 4 (mssm4: Θ4*, one table), 6 (mssm6: Θ6*, two tables) or 2
+// (vssm: (z, z²), one table): blocker search over the grid-aligned region, the technique's blocker
+// estimator, umbra early-out, penumbra, nine-region filter, the receiver plane's bias, the bound.
+MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup k, SoftFragment f, int moments) {
+  float zf = msm_signed_depth(f.depth);
+  vec2 hs = msm_soft_search_half_width(k.spread, zf, -1.0f, k.kernel_width);
+  SatRect r = msm_soft_search_rect(f.position, hs, k.size);
+  int texels = msm_sat_rect_texels(r);
+  vec4 q = msm_sat_rect_average(msm_soft_rect_sum(MSM_SOFT_FETCH_ARG r, 0), texels, k.scale);
+  BlockerResult blocker;
+  if (moments == 6) {
+    vec4 q1 = msm_sat_rect_average(msm_soft_rect_sum(MSM_SOFT_FETCH_ARG r, 1), texels, k.scale);
+    blocker = msm_soft_blocker6_select(msm_sat_join6(q, q1), zf, k.params, k.scale);
+  } else if (moments == 2) {
+    blocker = msm_soft_vssm_blocker(vec2(q.x, q.y), f.depth, k.params.w);
+  } else {
+    blocker = msm_soft_blocker4_select(q, zf, k.params, k.scale);
+  }
+  if (msm_soft_in_umbra(blocker, k.umbra_epsilon)) return SoftShadow(1.0f, blocker.depth, blocker.shadow, vec2(0.0f));
+
+  vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker.depth, k.kernel_width);
+  SoftRegion region = msm_soft_region(f.position, hp, k.size);
+  SatFilter box = msm_sat_filter(region.lo, region.hi);
+  float zb = zf - k.constant_bias - msm_soft_plane_bias(hp, f.depth_per_texel, moments);
+  vec4 t = msm_soft_filter_average(MSM_SOFT_FETCH_ARG box, k.scale, 0);
+  float shadow;
+  if (moments == 6) {
+    vec4 t1 = msm_soft_filter_average(MSM_SOFT_FETCH_ARG box, k.scale, 1);
+    shadow = msm_soft_shadow6(msm_sat_join6(t, t1), zb, k.umbra_epsilon, k.scale);
+  } else if (moments == 2) {
+    shadow = msm_soft_vssm_shadow(vec2(t.x, t.y), zb, k.params.w, k.umbra_epsilon);
+  } else {
+    shadow = msm_soft_shadow4(t, zb, k.umbra_epsilon, k.scale);
+  }
+  return SoftShadow(shadow, blocker.depth, blocker.shadow, hp);
+}
+
+// Convolution soft shadows (cssm.h): the blocker search sums every tile over the search region (4
+// lookups per tile), the filter the basis tiles over the penumbra (16 per tile). The receiver's own
+// surface lies at zf: the bias its plane needs over the search region keeps it out of the search,
+// as the bias over the filter region keeps it out of the penumbra (cssm.h's series is not a bound,
+// so the worst-case msm_soft_depth_bias). No blocker ends the flow lit.
+MSM_SOFT_FLOW_FN SoftShadow msm_soft_cssm_flow(MSM_SOFT_FETCH_PARAM SoftSetup k, SoftFragment f, CsmParams p) {
+  int tiles = msm_cssm_tiles(p.terms), basis = msm_cssm_basis_tiles(p.terms);
+  float zf = msm_signed_depth(f.depth);
+  vec2 hs = msm_soft_search_half_width(k.spread, zf, -1.0f, k.kernel_width);
+  SatRect r = msm_soft_search_rect(f.position, hs, k.size);
+  int texels = msm_sat_rect_texels(r);
+  float zs = zf - msm_soft_depth_bias(hs, f.depth_per_texel, k.constant_bias);
+  float xs = msm_csm_ranged_receiver(0.5f * (zs + 1.0f), p);
+  vec2 sums = vec2(0.0f);
+  for (int tile = 0; tile < tiles; ++tile)
+    sums += msm_cssm_search_terms(msm_sat_rect_average(msm_soft_rect_sum(MSM_SOFT_FETCH_ARG r, tile), texels, k.scale),
+                                  tile, xs, p);
+  BlockerResult blocker = msm_cssm_blocker(sums, 0.5f * (zs + 1.0f), p, k.params.w);
+  float blocker_depth = msm_signed_depth(blocker.depth);
+  if (!(blocker.shadow > 0.0f)) return SoftShadow(0.0f, blocker_depth, blocker.shadow, vec2(0.0f));
+
+  vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker_depth, k.kernel_width);
+  SoftRegion region = msm_soft_region(f.position, hp, k.size);
+  SatFilter box = msm_sat_filter(region.lo, region.hi);
+  float zb = zf - msm_soft_depth_bias(hp, f.depth_per_texel, k.constant_bias);
+  float xf = msm_csm_ranged_receiver(0.5f * (zb + 1.0f), p);
+  float series = 0.0f;
+  for (int tile = 0; tile < basis; ++tile)
+    series += msm_csm_texel_terms(msm_csm_from_unorm(msm_soft_filter_average(MSM_SOFT_FETCH_ARG box, k.scale, tile)),
+                                  xf, tile, p);
+  return SoftShadow(msm_csm_resolve(series, p), blocker_depth, blocker.shadow, hp);
+}
+
+MSM_END
+
+#endif // MSM_SOFT_FLOW

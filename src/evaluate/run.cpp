@@ -1,5 +1,6 @@
 // A whole evaluation over ranks and threads, with its checkpoint (run.h).
 #include "msm/evaluate/run.h"
+#include "msm/evaluate/run_internals.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -294,6 +295,8 @@ std::map<std::int64_t, CandidateResult> open_checkpoint(const fs::path& dir, con
   return done;
 }
 
+std::atomic<std::int64_t> g_stop_after{-1}; // run_internals.h
+
 int default_threads(const Communicator& comm) {
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   return std::max(1, int(cores) / std::max(1, comm.local_size()));
@@ -446,7 +449,7 @@ std::vector<CandidateResult> compute_candidates(const std::vector<std::int64_t>&
         std::lock_guard lock(mutex);
         writer.write(checkpoint_line(candidate, computed[k]));
         const std::int64_t count = ++finished_here;
-        if (settings.stop_after >= 0 && count >= settings.stop_after) std::_Exit(3);
+        if (const std::int64_t stop = g_stop_after; stop >= 0 && count >= stop) std::_Exit(3);
         if (progress && comm.rank() == 0) progress({count, std::int64_t(mine.size()), seconds_since(compute_start)});
       } catch (const std::exception& e) {
         // Not an invalid_argument: an error of this rank alone (callers abort the other ranks).
@@ -511,6 +514,8 @@ void gather_results(const std::vector<CandidateResult>& computed, const RankTimi
 }
 
 } // namespace
+
+void set_stop_after(std::int64_t candidates) { g_stop_after = candidates; }
 
 RunResult run_evaluation(const RunSettings& settings, Communicator& comm,
                          const std::function<void(const Progress&)>& progress) {

@@ -2,6 +2,7 @@
 
 #include "msm/sat.h"
 #include "msm/vk/commands.h"
+#include "shaders/sat_push.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -10,14 +11,6 @@
 namespace msm::gpu {
 
 namespace {
-
-// The push constants of every sat_*.comp (shaders/sat_common.glsl).
-struct SatPush {
-  glm::ivec2 size;
-  uint32_t scale;
-  uint32_t flags; // 1: UNORM16 texels, 2: two channels (RG)
-};
-static_assert(sizeof(SatPush) == 16, "SatPush must match the shaders' push constant block");
 
 bool unorm16_format(VkFormat format) {
   return format == VK_FORMAT_R16G16B16A16_UNORM || format == VK_FORMAT_R16G16_UNORM;
@@ -130,7 +123,7 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, 
     const SatImage& m = moments[i];
     bool two = two_channels(m.format);
     return SatPush{glm::ivec2(int(m.width), int(m.height)), scale,
-                   (unorm16_format(m.format) ? 1u : 0u) | (two ? 2u : 0u)};
+                   (unorm16_format(m.format) ? MSM_SAT_UNORM16 : 0u) | (two ? MSM_SAT_TWO_CHANNELS : 0u)};
   };
   // The program of each pass for table i: the table's format is part of the shader.
   auto program = [&](size_t i, const vk::Program& rgba, const vk::Program& rg) -> const vk::Program& {

@@ -9,10 +9,13 @@
 //  - the six-moment overload (two images, RGBA32F + RG32F) fills both tables;
 //  - the copy shaders that msm_sat_timing times beside the schemes (sat_copy.h) copy every texel,
 //    bitwise, and touch nothing else, at sizes that are not multiples of their groups;
-//  - the shared queries (sat.h's 4- and 16-lookup queries, soft.h's whole per-pixel flow) in a
-//    shader (shaders/test/sat_queries.comp, via soft_flow.h) agree with the same code on the CPU.
+//  - the shared queries (sat.h's 4- and 16-lookup queries) and soft.h's whole per-pixel flow, the
+//    functions the renderer's shading calls (mssm4, mssm6, vssm, cssm8, cssm16), in a shader
+//    (shaders/test/sat_queries.comp, via sat_queries.h) agree with the same code on the CPU; and the
+//    renderer's shaders compose that flow nowhere else.
 #include "msm/gpu/sat_builder.h"
 #include "msm/quantize.h"
+#include "msm/techniques.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 #include "sat_copy.h"
@@ -24,20 +27,15 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
+#include <string>
 #include <type_traits>
 #include <vector>
 
-namespace msm {
-namespace {
-const std::vector<uvec4>* g_table = nullptr; // the CPU table that sat_fetch reads
-int g_width = 0;
-} // namespace
-inline uvec4 sat_fetch(int x, int y) {
-  return (x < 0 || y < 0) ? uvec4(0u) : (*g_table)[size_t(y) * size_t(g_width) + size_t(x)];
-}
-} // namespace msm
-#include "shaders/test/soft_flow.h"
+#include "shaders/test/sat_queries.h"
 
 namespace {
 
@@ -342,89 +340,111 @@ TEST_F(SatBuilderTest, RejectsBadImages) {
 }
 
 // The queries on the device: sat.h's 4-lookup rectangle sum (bitwise), the nine-region box filter
-// and soft.h's whole flow (search, Eq. (4), umbra early-out, penumbra, nine-region filter, depth
-// bias (msm_soft_plane_bias), Hamburger bound, over-darkening) against the same code (soft_flow.h)
-// on the CPU, on a scene of occluder rectangles at several depths over a receiver. Differences
-// come from float division (2.5 ulp on Vulkan), the device's contractions and sqrt; msm_fma is
-// exact on both. Measured (lavapipe, 20000 queries, 148 umbra early-outs): rect sums bitwise,
-// filtered and blocker depth bitwise too, shadow max 7.3e-7 (8.1e-7 with the worst-case depth bias
-// before msm_soft_plane_bias). Tolerances (for other devices): 1e-6 (filtered), 1e-3 (depth,
-// shadow) with at most 0.2% of fragments beyond, for a branch taken differently at a threshold
-// (umbra, roots at zf).
-TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
-  SatBuilder builder(ctx());
+// and soft.h's whole flow (msm_soft_moment_flow: search, the technique's blocker estimator, umbra
+// early-out, penumbra, nine-region filter, the receiver plane's bias, the bound, over-darkening;
+// msm_soft_cssm_flow likewise) against the same code on the CPU (sat_queries.h), for each soft
+// technique with its default parameters, on a scene of occluder rectangles at several depths over
+// a sloped receiver. Differences come from float division (2.5 ulp on Vulkan), the device's
+// contractions and sqrt; msm_fma is exact on both. Measured (lavapipe, 20000 queries each): rect
+// sums and filtered values bitwise everywhere; shadow max 7.5e-7 (mssm4), 6e-8 (vssm), 1.0e-6 and
+// 1.7e-6 (cssm8, cssm16), blocker depth bitwise or within 2.4e-7; mssm6 (Eq. 19's roots): depth
+// max 1.0e-5, shadow max 1.8e-3, 15 fragments beyond 1e-3. Tolerances (for other devices): 1e-6
+// (filtered), 1e-3 (depth, shadow) with at most 0.2% of fragments beyond, for a branch taken
+// differently at a threshold (umbra, roots at zf).
+struct SoftFlowCase {
+  const char* name;
+  int technique;
+};
+class SoftFlowOnTheDevice : public vk::test::VulkanTest, public ::testing::WithParamInterface<SoftFlowCase> {};
+
+TEST_P(SoftFlowOnTheDevice, AgreesWithTheCpu) {
+  const int technique = GetParam().technique;
+  const bool cssm = msm_technique_is_cssm(technique);
+  const int moments = cssm ? 0 : (technique == MSM_TECH_MSSM6 ? 6 : (technique == MSM_TECH_VSSM ? 2 : 4));
+  const int frequencies = msm_technique_cssm_frequencies(technique), tiles = msm_technique_tiles(technique);
+  const vec4 params = msm_technique_default_params(technique);
   std::mt19937_64 rng(33);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   const int w = 128, h = 96, width = 27, nt = width * width;
   const uint scale = msm_sat_scale(nt);
-  // Receiver at z = 0.6 with a slope along x, occluders: random rectangles at -0.8 .. 0.4.
+  // Receiver at [0,1] depth 0.8 with a slope along x, occluders: random rectangles at 0.1 .. 0.7.
   const int centre = w / 2; // the receiver's slope pivots on the middle column
+  const float slope = 0.0005f;
   const auto at = [w](int x, int y) { return size_t(y) * size_t(w) + size_t(x); };
   std::vector<float> depth(size_t(w) * size_t(h));
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) depth[at(x, y)] = 0.6f + 0.001f * float(x - centre);
+    for (int x = 0; x < w; ++x) depth[at(x, y)] = 0.8f + slope * float(x - centre);
   for (int k = 0; k < 25; ++k) { // the first five large enough to hold umbrae
     int x0 = int(unit(rng) * w), y0 = int(unit(rng) * h), x1 = x0 + 2 + int(unit(rng) * (k < 5 ? 60 : 30)),
         y1 = y0 + 2 + int(unit(rng) * (k < 5 ? 50 : 20));
-    float z = -0.8f + 1.2f * unit(rng);
+    float z = 0.1f + 0.6f * unit(rng);
     for (int y = y0; y < std::min(y1, h); ++y)
       for (int x = x0; x < std::min(x1, w); ++x) depth[at(x, y)] = std::min(depth[at(x, y)], z);
   }
-  std::vector<vec4> m(depth.size());
-  for (size_t i = 0; i < m.size(); ++i) m[i] = msm_theta4_star(msm_moments4(depth[i]));
-  vk::Image moments = moment_image(ctx(), VK_FORMAT_R32G32B32A32_SFLOAT, w, h);
-  std::vector<vec4> seen = upload(ctx(), moments, m);
-  std::vector<uvec4> cpu = gpu::build_sat_cpu(seen, w, h, nt);
-  vk::Image table = table_image(ctx(), w, h);
+  // The tables as the renderer fills them: the technique's texels (CSSM: its tiles stacked along y).
+  std::vector<vec4> a(depth.size() * size_t(tiles)), b(depth.size());
+  for (size_t i = 0; i < depth.size(); ++i) {
+    MsmTexel texel = msm_technique_generate(technique, depth[i], params);
+    a[i] = texel.a;
+    b[i] = texel.b;
+    for (int t = 0; cssm && t < tiles; ++t)
+      a[size_t(t) * depth.size() + i] = msm_cssm_generate(depth[i], t, frequencies);
+  }
+  const std::vector<uvec4> cpu0 = gpu::build_sat_cpu(a, w, h * tiles, nt), cpu1 = gpu::build_sat_cpu(b, w, h, nt);
+  auto uploaded_table = [&](const std::vector<uvec4>& table, int rows) {
+    vk::Image image =
+        vk::create_image(ctx(), vk::ImageDesc{.width = uint32_t(w),
+                                              .height = uint32_t(rows),
+                                              .format = VK_FORMAT_R32G32B32A32_UINT,
+                                              .usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
+    std::vector<std::byte> bytes(table.size() * sizeof(uvec4));
+    std::memcpy(bytes.data(), table.data(), bytes.size());
+    vk::upload_image(ctx(), image, bytes, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+    return image;
+  };
+  vk::Image table0 = uploaded_table(cpu0, h * tiles), table1 = uploaded_table(cpu1, h);
 
-  struct Query {
-    vec4 region, fragment;
-  };
-  struct Push {
-    ivec2 size;
-    uint32_t scale;
-    int32_t kernel_width;
-    vec2 spread;
-    uint32_t count, pad;
-  };
-  static_assert(sizeof(SoftFlow) == 48 && sizeof(Query) == 32 && sizeof(Push) == 32);
+  static_assert(sizeof(SatQuery) == 32 && sizeof(SatQueryResult) == 48);
+  static_assert(sizeof(SatQueryPush) == 64 && offsetof(SatQueryPush, spread) == 16 &&
+                offsetof(SatQueryPush, moments) == 28 && offsetof(SatQueryPush, params) == 32 &&
+                offsetof(SatQueryPush, cssm) == 48); // std430, as sat_queries.comp reads them
   const uint32_t count = 20000;
-  std::vector<Query> queries(count);
-  for (Query& q : queries) {
+  std::vector<SatQuery> queries(count);
+  for (SatQuery& q : queries) {
     vec2 extent(0.01f + 25.99f * unit(rng) * unit(rng), 0.01f + 25.99f * unit(rng));
     vec2 lo(unit(rng) * (float(w) - extent.x), unit(rng) * (float(h) - extent.y));
     int px = int(unit(rng) * w), py = int(unit(rng) * h);
     q.region = vec4(lo, lo + extent);
-    q.fragment = vec4(float(px) + 0.5f, float(py) + 0.5f, 0.6f + 0.001f * float(px - centre), 0.001f);
+    q.fragment = vec4(float(px) + 0.5f, float(py) + 0.5f, 0.8f + slope * float(px - centre), 2.0f * slope);
   }
   vk::Buffer query_buffer =
-      vk::create_buffer(ctx(), sizeof(Query) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+      vk::create_buffer(ctx(), sizeof(SatQuery) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
   vk::Buffer result_buffer =
-      vk::create_buffer(ctx(), sizeof(SoftFlow) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
-  static_assert(std::is_standard_layout_v<Query>); // glm vectors: see gpu_math_test.cpp's KernelIO
+      vk::create_buffer(ctx(), sizeof(SatQueryResult) * count, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+  static_assert(std::is_standard_layout_v<SatQuery>); // glm vectors: see gpu_math_test.cpp's KernelIO
   // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, asserted above
-  std::memcpy(query_buffer.data(), queries.data(), sizeof(Query) * count);
-  vk::Program program = vk::create_program(
-      ctx(), "sat_queries.comp", {vk::Binding::storage_image, vk::Binding::storage_buffer, vk::Binding::storage_buffer},
-      sizeof(Push));
-  const vec2 spread(30.0f, 30.0f); // texels per unit of depth
+  std::memcpy(query_buffer.data(), queries.data(), sizeof(SatQuery) * count);
+  vk::Program program = vk::create_program(ctx(), "sat_queries.comp",
+                                           {vk::Binding::storage_image, vk::Binding::storage_image,
+                                            vk::Binding::storage_buffer, vk::Binding::storage_buffer},
+                                           sizeof(SatQueryPush));
+  const SatQueryPush push{ivec2(w, h), scale, width, vec2(30.0f), count, moments, params, ivec4(frequencies, 0, 0, 0)};
   vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
-    builder.record(cmd, moments, table, nt, Scheme::blocks);
-    vk::pipeline_barrier(
-        cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
-                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_READ_BIT));
-    vk::dispatch(cmd, program, vk::group_count(count, 64), 1, 1, {vk::Descriptor(table), query_buffer, result_buffer},
-                 Push{ivec2(w, h), scale, width, spread, count, 0});
+    vk::dispatch(cmd, program, vk::group_count(count, 64), 1, 1,
+                 {vk::Descriptor(table0), vk::Descriptor(table1), query_buffer, result_buffer}, push);
   });
-  std::vector<SoftFlow> gpu(count);
-  std::memcpy(static_cast<void*>(gpu.data()), result_buffer.data(), sizeof(SoftFlow) * count);
+  std::vector<SatQueryResult> gpu(count);
+  std::memcpy(static_cast<void*>(gpu.data()), result_buffer.data(), sizeof(SatQueryResult) * count);
 
-  g_table = &cpu;
-  g_width = w;
+  const auto fetch = [&](int x, int y, int table) {
+    int row = cssm ? y + table * h : y;
+    if (x < 0 || row < 0) return uvec4(0u);
+    return (!cssm && table == 1 ? cpu1 : cpu0)[at(x, row)];
+  };
   double filtered_max = 0.0, depth_max = 0.0, shadow_max = 0.0;
-  int rect_mismatches = 0, beyond = 0, umbra = 0, penumbra = 0, lit = 0;
+  int rect_mismatches = 0, beyond = 0, early = 0, penumbra = 0, lit = 0;
   for (uint32_t i = 0; i < count; ++i) {
-    SoftFlow c = msm_test_soft_flow(queries[i].region, queries[i].fragment, ivec2(w, h), scale, width, spread);
+    SatQueryResult c = msm_test_sat_query(fetch, queries[i], push);
     rect_mismatches += c.rect_sum != gpu[i].rect_sum ? 1 : 0;
     for (int k = 0; k < 4; ++k)
       filtered_max = std::max(filtered_max, double(std::abs(c.filtered[k] - gpu[i].filtered[k])));
@@ -432,19 +452,77 @@ TEST_F(SatBuilderTest, SharedQueriesAgreeOnTheDevice) {
     depth_max = std::max(depth_max, dd);
     shadow_max = std::max(shadow_max, ds);
     beyond += (dd > 1e-3 || ds > 1e-3) ? 1 : 0;
-    umbra += c.soft[3] == 0.0f ? 1 : 0;
+    early += c.soft[3] == 0.0f ? 1 : 0;
     penumbra += (c.soft[0] > 0.02f && c.soft[0] < 0.98f) ? 1 : 0;
     lit += c.soft[0] <= 0.02f ? 1 : 0;
   }
   std::printf(
-      "[sat-queries] %u queries (%d umbra early-outs, %d in penumbrae, %d lit): rect sums differ %d, filtered max "
-      "%.2e, blocker depth max %.2e, shadow max %.2e, beyond 1e-3: %d\n",
-      count, umbra, penumbra, lit, rect_mismatches, filtered_max, depth_max, shadow_max, beyond);
+      "[sat-queries] %s: %u queries (%d ended by the search, %d in penumbrae, %d lit): rect sums differ %d, filtered "
+      "max %.2e, blocker depth max %.2e, shadow max %.2e, beyond 1e-3: %d\n",
+      GetParam().name, count, early, penumbra, lit, rect_mismatches, filtered_max, depth_max, shadow_max, beyond);
   EXPECT_EQ(rect_mismatches, 0);
   EXPECT_LT(filtered_max, 1e-6);
   EXPECT_LE(beyond, int(count / 500));
-  EXPECT_GT(umbra, 100);
-  EXPECT_GT(penumbra, 500);
+  EXPECT_GT(early, 100);    // umbrae (moments) or no blocker (CSSM)
+  EXPECT_GT(penumbra, 500); // and the whole flow in between
+}
+INSTANTIATE_TEST_SUITE_P(SoftTechniques, SoftFlowOnTheDevice,
+                         ::testing::Values(SoftFlowCase{"mssm4", MSM_TECH_MSSM4}, SoftFlowCase{"mssm6", MSM_TECH_MSSM6},
+                                           SoftFlowCase{"vssm", MSM_TECH_VSSM}, SoftFlowCase{"cssm8", MSM_TECH_CSSM8},
+                                           SoftFlowCase{"cssm16", MSM_TECH_CSSM16}),
+                         [](const ::testing::TestParamInfo<SoftFlowCase>& info) { return info.param.name; });
+
+// The renderer's shaders compose the soft-shadow flow nowhere but in soft.h: the shading calls
+// msm_soft_moment_flow and msm_soft_cssm_flow, the functions the test above runs on the device, and
+// no shader calls the steps that only the flow composes (the moment tables' queries, the blocker
+// estimators, the umbra early-out, the receiver plane's bias, the bounds; PCSS and the hard CSM
+// technique compose their own, over the depth map).
+TEST(SoftFlow, TheShadersComposeItOnlyInSoftH) {
+  const std::filesystem::path source(MSM_SOURCE_DIR);
+  const auto read = [](const std::filesystem::path& file) {
+    std::ifstream in(file);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  const std::string shading = read(source / "src/render/shaders/shading_soft.glsl");
+  EXPECT_NE(shading.find("msm_soft_moment_flow("), std::string::npos);
+  EXPECT_NE(shading.find("msm_soft_cssm_flow("), std::string::npos);
+  const char* steps[] = {"msm_sat_rect_sum",    "msm_sat_rect_average", "msm_sat_filter_average", "msm_soft_blocker",
+                         "msm_soft_vssm_",      "msm_soft_shadow4",     "msm_soft_shadow6",       "msm_soft_plane_bias",
+                         "msm_soft_depth_bias", "msm_soft_in_umbra",    "msm_cssm_search_terms",  "msm_cssm_blocker"};
+  int files = 0;
+  for (const char* dir : {"src/render/shaders", "src/gpu/shaders"})
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(source / dir)) {
+      if (!entry.is_regular_file()) continue;
+      const std::string text = read(entry.path());
+      ++files;
+      for (const char* step : steps)
+        EXPECT_EQ(text.find(step), std::string::npos) << entry.path() << " calls " << step << " outside soft.h's flow";
+    }
+  EXPECT_GT(files, 50);
+}
+
+// Specialization constants are declared by name (frame.h's MSM_SPEC_*, shared.h's, the blur's,
+// the prefix sums' and rectify's ids), the names the host sets them by: no shader under src/ gives
+// a constant_id as a raw number, which another shader of its family could mean differently.
+TEST(SharedDeclarations, SpecializationConstantIdsAreNamed) {
+  const std::filesystem::path source(MSM_SOURCE_DIR);
+  int declared = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(source / "src")) {
+    const std::string ext = entry.path().extension().string();
+    if (!entry.is_regular_file() || (ext != ".glsl" && ext != ".comp" && ext != ".frag" && ext != ".vert")) continue;
+    std::ifstream in(entry.path());
+    std::string line;
+    while (std::getline(in, line)) {
+      const std::size_t at = line.find("constant_id");
+      if (at == std::string::npos) continue;
+      const std::size_t value = line.find_first_not_of(" =", at + std::strlen("constant_id"));
+      ++declared;
+      EXPECT_TRUE(value != std::string::npos && line.compare(value, 4, "MSM_") == 0) << entry.path() << ": " << line;
+    }
+  }
+  EXPECT_GT(declared, 15);
 }
 
 } // namespace

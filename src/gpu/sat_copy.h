@@ -5,6 +5,7 @@
 #pragma once
 
 #include "msm/vk/vk.h"
+#include "shaders/sat_push.h"
 
 #include <cstdint>
 #include <initializer_list>
@@ -37,11 +38,8 @@ inline constexpr Shader shaders[] = {
 };
 inline constexpr int count = int(std::size(shaders));
 
-// SatPush of sat_builder.cpp (sat_common.glsl); the copies read the size only.
-struct Push {
-  int width, height;
-  uint32_t scale = 0, flags = 0;
-};
+// The push constants of every sat_*.comp (shaders/sat_push.h); the copies read the size only.
+using Push = SatPush;
 
 inline std::vector<vk::Program> create_programs(const vk::Context& ctx) {
   using B = vk::Binding;
@@ -68,7 +66,7 @@ inline void record(VkCommandBuffer cmd, const vk::Program& program, const Shader
   case Walk::row: gx = vk::group_count(height, 64); break;
   case Walk::column: gx = vk::group_count(width, 64); break;
   }
-  vk::dispatch(cmd, program, gx, gy, 1, {src, dst}, Push{int(width), int(height)});
+  vk::dispatch(cmd, program, gx, gy, 1, {src, dst}, Push{glm::ivec2(int(width), int(height)), 0u, 0u});
 }
 
 } // namespace msm::gpu::sat_copy

@@ -1,8 +1,8 @@
 // Tests of msm::image: PNG/EXR round trips, atomic writes, read errors, metrics with known
 // answers, the false-colour error image and the failure-dump helper.
-#include "msm/image/compare.h"
 #include "msm/image/io.h"
 #include "msm/image/metrics.h"
+#include "msm/test/image_compare.h"
 
 #include <gtest/gtest.h>
 

@@ -5,8 +5,8 @@
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
 
-#include "msm/image/compare.h"
 #include "msm/image/metrics.h"
+#include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>

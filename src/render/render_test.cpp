@@ -3,12 +3,13 @@
 // the CPU single-source computation, the blur against the CPU Gaussian, finite resolves, and bad settings.
 #include "msm/render/renderer.h"
 
-#include "msm/image/compare.h"
 #include "msm/image/io.h"
 #include "msm/image/metrics.h"
 #include "msm/nonlinear.h"
 #include "msm/render/frame.h"
+#include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
+#include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
@@ -180,7 +181,7 @@ TEST_F(RenderTest, ResolvedMomentsEqualTheCpuComputationOnTheSameDepths) {
       s.msaa = msaa;
       s.shadow_size = 128;
       Intermediates in;
-      renderer.render(s, &in);
+      RendererInternals::render(renderer, s, in);
       const Technique& t = find_rendered_technique(name);
       glm::vec4 params = t.default_params();
       ASSERT_EQ(in.depth_samples.size(), size_t(128 * 128 * msaa));
@@ -409,7 +410,7 @@ TEST_F(RenderTest, ResolveWritesFiniteMoments) {
     RenderSettings s = small(name);
     s.shadow_size = 128;
     Intermediates in;
-    renderer.render(s, &in);
+    RendererInternals::render(renderer, s, in);
     for (const image::Image* image : {&in.moments, &in.moments1})
       for (float v : image->pixels()) ASSERT_TRUE(std::isfinite(v)) << name;
   }
@@ -456,9 +457,9 @@ TEST_F(RenderTest, OnePassFilterEqualsTheThreePassFilter) {
       s.shadow_size = 200; // not a multiple of the 128 x 128 strips: partial strips at the edges
       s.one_pass = false;
       Intermediates three, one;
-      renderer.render(s, &three);
+      RendererInternals::render(renderer, s, three);
       s.one_pass = true;
-      renderer.render(s, &one);
+      RendererInternals::render(renderer, s, one);
       ASSERT_EQ(one.moments.width(), 200);
       bool unorm = find_rendered_technique(name).formats[0] != TexelFormat::rgba32_float;
       double worst = 0;
@@ -559,7 +560,7 @@ TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
   linear.shadow_size = n;
   linear.one_pass = true;
   Intermediates lin;
-  renderer.render(linear, &lin);
+  RendererInternals::render(renderer, linear, lin);
   std::vector<glm::vec4> expected_moments = cpu_filtered(lin, linear.msaa);
   float worst_moment = 0;
   for (int i = 0; i < n * n; ++i)
@@ -573,7 +574,7 @@ TEST_F(RenderTest, NonLinearMapsEqualTheCpuPipeline) {
     RenderSettings s = small(name);
     s.shadow_size = n;
     Intermediates in;
-    renderer.render(s, &in);
+    RendererInternals::render(renderer, s, in);
     std::vector<glm::vec4> filtered = cpu_filtered(in, s.msaa);
     int identical = 0;
     double total = 0;

@@ -15,6 +15,7 @@
 #include "msm/noise/blue_noise.h"
 #include "msm/render/frame.h"
 #include "msm/render/rectification_uniforms.h"
+#include "msm/render/renderer_internals.h"
 #include "msm/sat.h"
 #include "msm/scattering.h"
 #include "msm/shading.h"
@@ -34,17 +35,10 @@
 
 namespace msm::render {
 
-// std140/std430 and the C++ structs agree (frame.h uses vec4/ivec4/mat4 members only).
-static_assert(sizeof(FrameUniforms) == 64 + 4 * 16 + 16 * 16 + 3 * 16 + 4 * 16 + 3 * 16);
-static_assert(offsetof(FrameUniforms, filter_weights) == 64 + 4 * 16);
-static_assert(offsetof(FrameUniforms, lights) == sizeof(FrameUniforms) - 32);
-static_assert(sizeof(LightUniforms) == 2 * 64 + 5 * 16);
 // The lights' storage buffer: the frame's lights, then each one's sub-lights after a summary entry
 // (at most 256 lights, 256 sub-lights and 256 summaries).
 constexpr std::size_t kLightSlots = 3 * MSM_MAX_LIGHTS;
-static_assert(sizeof(ObjectPush) == 64 && sizeof(ImagePassPush) == 16);
 static_assert(MSM_MAX_LIGHTS == scene::kMaxLights);
-static_assert(sizeof(RectificationUniforms) == 11 * 16); // the std430 array stride of the passes' rects[]
 
 namespace {
 
@@ -277,17 +271,10 @@ struct Renderer::Impl {
     return u;
   }
 
-  // The entry before a light's sub-lights (shading.glsl, sub_lights_irradiance): their linear part
-  // (scene::sub_lights_linear_part) in view_projection's 3 x 3 and its bounds in [3].xy, the
-  // rectangle's axes in normal_matrix[0] and [1].
+  // The entry before a light's sub-lights (frame.h's SubLightsSummary).
   static LightUniforms sub_lights_summary(const scene::DirectionalLight& light) {
     const scene::SubLightsLinearPart part = scene::sub_lights_linear_part(light);
-    LightUniforms summary{};
-    summary.view_projection = glm::mat4(part.irradiance_by_direction);
-    summary.view_projection[3] = glm::vec4(part.bounds, 0.0f, 1.0f);
-    summary.normal_matrix[0] = glm::vec4(part.x_axis, 0.0f);
-    summary.normal_matrix[1] = glm::vec4(part.y_axis, 0.0f);
-    return summary;
+    return msm_sub_lights_summary_entry({part.irradiance_by_direction, part.bounds, part.x_axis, part.y_axis});
   }
 
   // The settings are valid and this device can render them (RenderError naming what it lacks).
@@ -533,6 +520,8 @@ Renderer::Renderer(const vk::Context& ctx, const scene::Scene& scene) : impl_(st
 Renderer::~Renderer() = default;
 const scene::Scene& Renderer::scene() const noexcept { return impl_->scene; }
 void Renderer::check(const RenderSettings& s) const { impl_->check(s); }
+
+RenderResult Renderer::render(const RenderSettings& s) { return render(s, nullptr); }
 
 RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermediates) {
   Impl& m = *impl_;

@@ -9,8 +9,8 @@
 #include "msm/shading.h"
 #include "msm/techniques.h"
 
-#include "msm/image/compare.h"
 #include "msm/image/metrics.h"
+#include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>

@@ -8,6 +8,7 @@
 #include "render_common.h"
 
 #include "msm/image/io.h"
+#include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
 #include "msm/util/statistics.h"
 #include "msm/vk/vk.h"
@@ -142,7 +143,7 @@ std::map<std::string, double> host_pass_ms(render::Renderer& renderer, const ren
     std::map<size_t, double> ms;
     for (size_t k : counts) {
       Clock::time_point t0 = Clock::now();
-      renderer.submit_frame_prefix(s, k);
+      render::RendererInternals::submit_frame_prefix(renderer, s, k);
       ms[k] = ms_since(t0);
     }
     if (r >= 0)
@@ -180,7 +181,7 @@ void callgrind_prefixes(render::Renderer& renderer, const FrameOptions& frame, c
         if (instrumented) CALLGRIND_START_INSTRUMENTATION;
         for (size_t k = 0; k <= passes.size(); ++k) {
           CALLGRIND_ZERO_STATS;
-          renderer.submit_frame_prefix(s, k);
+          render::RendererInternals::submit_frame_prefix(renderer, s, k);
           if (instrumented) {
             std::string label =
                 fmt::format("msm-prefix {} {}x{} {} {} {}", name, s.width, s.height, size, k, k ? passes[k - 1] : "-");

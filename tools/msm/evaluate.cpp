@@ -18,6 +18,7 @@
 #include "msm/evaluate/mpi.h"
 #include "msm/evaluate/report.h"
 #include "msm/evaluate/run.h"
+#include "msm/evaluate/run_internals.h"
 #include "msm/util/progress.h"
 #include "msm/util/text.h"
 #include "usage.h"
@@ -136,7 +137,7 @@ void add_evaluate(CLI::App& app) {
     settings.threads = opt->threads;
     settings.evaluate.solve_lit = opt->solve_lit;
     settings.fresh = opt->fresh;
-    settings.stop_after = opt->stop_after;
+    evaluate::set_stop_after(opt->stop_after);
 
     const bool under_mpi = launched_by_mpi();
     if (under_mpi && !mpi_supported())

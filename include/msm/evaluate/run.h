@@ -37,9 +37,6 @@ struct RunSettings {
   int threads = 0; // per rank; 0: the machine's cores divided among its ranks
   EvaluateOptions evaluate;
   bool fresh = false; // discard an existing checkpoint instead of resuming
-  // Testing: after this many candidates of this rank are checkpointed, end the process at once
-  // (std::_Exit(3), as if killed). < 0: never.
-  std::int64_t stop_after = -1;
 };
 
 struct CandidateResult {

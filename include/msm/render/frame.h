@@ -1,7 +1,7 @@
 // Parameters the renderer's host code hands to its shaders, declared once for both (the
 // Falcor HostDeviceShared idea on top of msm/shared.h). Only vec4, ivec4 and mat4 members, so
-// that std140 (GLSL) and the C++ layout agree without implicit padding; the host checks sizes
-// and offsets with static_asserts (src/render/renderer.cpp).
+// that std140 (GLSL) and the C++ layout agree without implicit padding; the C++ build checks sizes
+// and offsets with the static_asserts at the end.
 #ifndef MSM_RENDER_FRAME_H
 #define MSM_RENDER_FRAME_H
 #include "msm/filter.h"
@@ -53,8 +53,31 @@ struct LightUniforms {
   vec4 rect_extent;     // xy: a rectangular light's half extents as tangents (0: a disc or a point,
                         // shaded by soft.z); the shading's msm_light_cosine takes both. zw: its
                         // sub-lights (w of them, 0: none): entry z of the same array their summary
-                        // (renderer.cpp, sub_lights_summary), [z + 1, z + 1 + w) the sub-lights
+                        // (SubLightsSummary below), [z + 1, z + 1 + w) the sub-lights
 };
+
+// The entry before a light's sub-lights in the lights' array: their linear part and the rectangle
+// that holds them all (scene::SubLightsLinearPart; shading.glsl's sub_lights_irradiance). It is an
+// entry of the same array, so it is stored in a LightUniforms's place and read back by name with
+// the two functions below, the only code that knows where each field sits: irradiance_by_direction
+// in view_projection's 3 × 3, bounds in view_projection[3].xy, the axes in normal_matrix[0] and [1].
+struct SubLightsSummary {
+  mat3 irradiance_by_direction; // msm_linear_irradiance's matrix
+  vec2 bounds;                  // the rectangle's tangent bounds (msm_light_tangent_bounds)
+  vec3 x_axis;                  // the rectangle's axes
+  vec3 y_axis;
+};
+MSM_FN LightUniforms msm_sub_lights_summary_entry(SubLightsSummary s) {
+  mat4 packed = mat4(s.irradiance_by_direction);
+  packed[3] = vec4(s.bounds, 0.0f, 1.0f);
+  mat4 axes = mat4(vec4(s.x_axis, 0.0f), vec4(s.y_axis, 0.0f), vec4(0.0f), vec4(0.0f));
+  vec4 zero = vec4(0.0f);
+  return LightUniforms(packed, axes, zero, zero, zero, zero, zero);
+}
+MSM_FN SubLightsSummary msm_sub_lights_summary(mat4 view_projection, mat4 normal_matrix) {
+  return SubLightsSummary(mat3(view_projection), vec2(view_projection[3][0], view_projection[3][1]),
+                          vec3(normal_matrix[0]), vec3(normal_matrix[1]));
+}
 
 // How the shading reads a filtered shadow map.
 const int MSM_LOOKUP_BILINEAR = 0; // hardware (tri)linear; for the non-linear maps: four decodes
@@ -73,18 +96,38 @@ struct ObjectPush {
   ivec4 light;         // x: the light (shadow-map layer) the shadow and translucent passes draw for
 };
 
+// Specialization-constant ids, one meaning each, set by the passes (src/render/passes) and declared
+// by the shaders with these names (constant_id = MSM_SPEC_...). The frame's shaders (frame.glsl and
+// those including it: the shading, translucent, moment-resolve, one-pass-filter and scattering
+// passes' shaders):
+#define MSM_SPEC_TECHNIQUE 0          // int: MSM_TECH_* (frame.glsl)
+#define MSM_SPEC_FILTER_RADIUS 1      // int: the one-pass filter's taps are 2 r + 1 (one_pass_filter.glsl)
+#define MSM_SPEC_FILTER_COLUMNS 2     // int: the one-pass filter's adjacent columns per thread
+#define MSM_SPEC_SPLIT_RG 3           // bool: four moments in two RG images (frame.glsl)
+#define MSM_SPEC_LIGHT_COUNT 4        // int: the frame's lights (light_loop.glsl)
+#define MSM_SPEC_LINEAR_RADIANCE 5    // bool: the shading writes linear radiance (shading.glsl)
+#define MSM_SPEC_PREFIX_SUM_MIPS 6    // bool: scatter.glsl reads the prefix sums' mips
+#define MSM_SPEC_DEPTH_SAMPLES 7      // int: the depth map's MSAA samples (shading_depth.glsl)
+#define MSM_SPEC_PCF_TAPS 8           // int: the PCF kernel's taps (shading_depth.glsl)
+#define MSM_SPEC_LOOKUP 9             // int: MSM_LOOKUP_* (frame.glsl)
+#define MSM_SPEC_TEXTURED_DRAWS 10    // bool: some draw has an albedo or opacity texture (shading.glsl)
+#define MSM_SPEC_SUB_LIGHTS 11        // bool: some light has sub-lights (shading.glsl)
+#define MSM_SPEC_FILTER_SAMPLES 12    // int: MSAA samples per texel of the one-pass filter
+#define MSM_SPEC_FRONT_BACK 13        // bool: the mean of front- and back-face depth (moment_resolve.glsl)
+#define MSM_SPEC_SCATTER_LAYERS 14    // int: transmittance layers per light (scatter.glsl)
+#define MSM_SPEC_SCATTER_BETA_MODE 15 // int: MSM_SCATTERING_BETA_* (scatter.glsl)
 // The blur's specialization constants (blur.comp, passes/blur_pass.cpp): id MSM_BLUR_SPEC_ID holds
 // the fetches per side, + 1 the centre weight, + 2 + i the offset and + 2 + MSM_BLUR_MAX_PAIRS + i
 // the weight of fetch i + 1 (msm_filter_pairs of the largest kernel: 16); + 2 + 2 MSM_BLUR_MAX_PAIRS
 // is true for bilinear fetches, false for each pair's two texels (exact: the 32-bit float maps).
-#define MSM_BLUR_SPEC_ID 10
+#define MSM_BLUR_SPEC_ID 100
 #define MSM_BLUR_MAX_PAIRS 16
 // The prefix sums' scheme (prefix_sums.glsl, RenderSettings::prefix_sums): true for the row sweep
 // (64 rows per group of 8 x 8 threads), false for Appendix C's (8 rows per group).
-#define MSM_PREFIX_ROWS_SPEC_ID 0
+#define MSM_PREFIX_ROWS_SPEC_ID 200
 // Rectify's resampling without the moment map (rectify.glsl, FrameConfig::on_the_fly_resampling):
 // true for the on-the-fly filter of the depth map's moments, false for its nearest texel.
-#define MSM_RECTIFY_ON_THE_FLY_SPEC_ID 1
+#define MSM_RECTIFY_ON_THE_FLY_SPEC_ID 201
 
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {
@@ -106,4 +149,19 @@ struct ScatteringPush {
 };
 
 MSM_END
+
+#if MSM_CPP
+#include <cstddef>
+// std140/std430 and the C++ structs agree (vec4/ivec4/mat4 members only).
+static_assert(sizeof(msm::FrameUniforms) == 544 && offsetof(msm::FrameUniforms, technique_params) == 64 &&
+              offsetof(msm::FrameUniforms, filter_weights) == 128 && offsetof(msm::FrameUniforms, lookup) == 384 &&
+              offsetof(msm::FrameUniforms, sample_offsets) == 432 && offsetof(msm::FrameUniforms, lights) == 512 &&
+              offsetof(msm::FrameUniforms, camera_viewport) == 528);
+static_assert(sizeof(msm::LightUniforms) == 208 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
+              offsetof(msm::LightUniforms, towards_light) == 128 && offsetof(msm::LightUniforms, rect_extent) == 192);
+static_assert(sizeof(msm::ObjectPush) == 64 && offsetof(msm::ObjectPush, light) == 48);
+static_assert(sizeof(msm::ImagePassPush) == 16);
+static_assert(sizeof(msm::ScatteringPush) == 128 && offsetof(msm::ScatteringPush, sky) == 112);
+#endif
+
 #endif // MSM_RENDER_FRAME_H

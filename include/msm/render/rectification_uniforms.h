@@ -34,4 +34,11 @@ MSM_FN RectifiedBounds msm_rectified_bounds_of(RectificationUniforms u) {
 }
 
 MSM_END
+
+#if MSM_CPP
+#include <cstddef>
+// The std430 array stride of the passes' rects[].
+static_assert(sizeof(msm::RectificationUniforms) == 11 * 16 && offsetof(msm::RectificationUniforms, map) == 10 * 16);
+#endif
+
 #endif // MSM_RENDER_RECTIFICATION_UNIFORMS_H

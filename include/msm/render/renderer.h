@@ -210,16 +210,8 @@ struct RenderResult {
   std::vector<LightPassTime> light_passes; // several lights: each light's share of the passes
 };
 
-// What tests compare against the CPU: the depth samples and the resolved moment image (before
-// the blur), read back when requested.
-struct Intermediates {
-  std::vector<float> depth_samples;  // shadow_size² x msaa, sample-major per texel, row-major
-  image::Image moments;              // resolve output of image 0 (as stored: UNORM/half/float);
-                                     // with the one-pass filter: its (filtered, encoded) output
-  std::vector<std::uint32_t> packed; // R32_UINT maps (msm-nl32): the texels as stored
-  image::Image moments1;             // of image 1 (6MSM), else empty
-  image::Image filtered;             // image 0 after blur (mip 0)
-};
+struct Intermediates;     // the internal header's (msm/render/renderer_internals.h, not installed)
+struct RendererInternals; // its access to the test hooks below
 
 // Owns the scene's GPU buffers and textures and the pipelines it has built (cached per
 // technique, MSAA and filter configuration). Externally synchronized; the Context outlives it.
@@ -236,7 +228,7 @@ class Renderer {
   void check(const RenderSettings& settings) const;
 
   // One frame, submitted and waited for, images read back.
-  RenderResult render(const RenderSettings& settings, Intermediates* intermediates = nullptr);
+  RenderResult render(const RenderSettings& settings);
 
   // One frame, submitted and waited for, nothing read back (an interactive viewer blits it): the
   // colour target (R8G8B8A8_SRGB, settings.width x height, left in TRANSFER_SRC_OPTIMAL, valid
@@ -272,6 +264,13 @@ class Renderer {
   // The passes of the frame these settings make, in the order the frame graph runs them.
   std::vector<std::string> frame_passes(const RenderSettings& settings);
 
+  const scene::Scene& scene() const noexcept;
+
+ private:
+  // The hooks of the tests and of msm bench, reached through RendererInternals only: the same frame
+  // as render() with the intermediates read back, and a frame cut after some passes.
+  friend struct RendererInternals;
+  RenderResult render(const RenderSettings& settings, Intermediates* intermediates);
   // One frame recorded up to and including its first `passes` passes (frame_passes order; 0:
   // none, only the submission), submitted and waited for, nothing read back. A profiler counts
   // each pass as the difference of two prefixes (msm bench --callgrind). Precondition: settings
@@ -279,9 +278,6 @@ class Renderer {
   // creation.
   void submit_frame_prefix(const RenderSettings& settings, std::size_t passes);
 
-  const scene::Scene& scene() const noexcept;
-
- private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

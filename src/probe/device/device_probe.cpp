@@ -8,23 +8,10 @@
 #include <fmt/format.h>
 
 #include "msm/vk/commands.h"
+#include "shaders/probe_push.h"
 
 namespace msm::probe {
 namespace {
-
-// The push constants of every probe_*.comp (shaders/probe_common.glsl), 48 bytes.
-struct ProbePush {
-  glm::ivec2 panorama{0};
-  int size = 0;
-  int supersampling = 4;
-  glm::vec2 cos_sin{1.0f, 0.0f};
-  float scale = 1.0f;
-  float inv_scale = 1.0f;
-  int count = 0;
-  int horizon_split = 0; // median_cut's horizon_split: ten first regions
-  int pad[2] = {0, 0};
-};
-static_assert(sizeof(ProbePush) == 48, "ProbePush must match probe_common.glsl");
 
 // probe_cut.comp's output buffer (std430).
 struct RegionOut {
@@ -131,7 +118,7 @@ void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk:
     throw ProbeError(fmt::format("{} lights: the median cut makes 1 to {}", count, kMaxDeviceLights));
   check_cut(count, size_, horizon_split_);
   if (!has_probe_) throw ProbeError("DeviceProbe::record: no probe set");
-  ProbePush push;
+  ProbePush push{};
   push.panorama = glm::ivec2(panorama_width_, panorama_height_);
   push.size = size_;
   push.supersampling = kSupersampling;

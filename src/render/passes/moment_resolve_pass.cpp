@@ -11,18 +11,19 @@ ImageSpec moment_image_spec(const FrameConfig& config, int i) {
           .height = uint32_t(config.shadow_size * msm_technique_tiles(config.technique->id)),
           .mips = config.mip_levels,
           .layers = uint32_t(config.lights),
-          // Renderer::Intermediates reads the resolved and the filtered moments back.
+          // The renderer's Intermediates (renderer_internals.h) reads the resolved and the filtered moments back.
           .extra_usage = VK_IMAGE_USAGE_TRANSFER_SRC_BIT};
 }
 
 void MomentResolvePass::prepare(const PassResources& r) {
   const FrameConfig& config = config_;
-  program_ = &r.programs.compute(
-      config.msaa == 1 ? "moment_resolve_1x.comp" : "moment_resolve.comp",
-      {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image, vk::Binding::storage_image,
-       vk::Binding::sampled_image},
-      sizeof(ImagePassPush),
-      {{0, uint32_t(config.technique->id)}, {3, config.split_rg() ? 1u : 0u}, {4, config.front_back ? 1u : 0u}});
+  program_ = &r.programs.compute(config.msaa == 1 ? "moment_resolve_1x.comp" : "moment_resolve.comp",
+                                 {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image,
+                                  vk::Binding::storage_image, vk::Binding::sampled_image},
+                                 sizeof(ImagePassPush),
+                                 {{MSM_SPEC_TECHNIQUE, uint32_t(config.technique->id)},
+                                  {MSM_SPEC_SPLIT_RG, config.split_rg() ? 1u : 0u},
+                                  {MSM_SPEC_FRONT_BACK, config.front_back ? 1u : 0u}});
 }
 
 void MomentResolvePass::reflect(PassBuilder& b) const {

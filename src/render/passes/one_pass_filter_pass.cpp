@@ -26,10 +26,10 @@ const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& c
       std::string(nl32 ? "one_pass_filter_nl32" : "one_pass_filter") + (config.msaa == 1 ? "_1x.comp" : ".comp");
   return programs.compute(shader, {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
                           sizeof(ImagePassPush),
-                          {{0, uint32_t(config.technique->id)},
-                           {1, uint32_t(radius)},
-                           {2, uint32_t(kOnePassColumns)},
-                           {4, uint32_t(config.msaa)}});
+                          {{MSM_SPEC_TECHNIQUE, uint32_t(config.technique->id)},
+                           {MSM_SPEC_FILTER_RADIUS, uint32_t(radius)},
+                           {MSM_SPEC_FILTER_COLUMNS, uint32_t(kOnePassColumns)},
+                           {MSM_SPEC_FILTER_SAMPLES, uint32_t(config.msaa)}});
 }
 
 } // namespace

@@ -23,13 +23,13 @@ void ScatteringPass::prepare(const PassResources& r) {
                      .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
                      .depth_write = false,
                      // One light: the loop over the lights and its layer folded to 0 (scatter.glsl).
-                     .constants = {{4, uint32_t(config_.lights)},
+                     .constants = {{MSM_SPEC_LIGHT_COUNT, uint32_t(config_.lights)},
                                    // The transmittance layers per light (scatter.glsl; 1: the paper's Δ(v)).
-                                   {5, uint32_t(config_.transmittance_layers)},
+                                   {MSM_SPEC_SCATTER_LAYERS, uint32_t(config_.transmittance_layers)},
                                    // App. D.5's mips of the prefix sums: the level per pixel only with them.
-                                   {6, config_.prefix_sum_mips > 1 ? 1u : 0u},
+                                   {MSM_SPEC_PREFIX_SUM_MIPS, config_.prefix_sum_mips > 1 ? 1u : 0u},
                                    // β: proportional, fixed or §5.3.1's adaptive (scattering.h).
-                                   {7, uint32_t(config_.scattering_beta)}}};
+                                   {MSM_SPEC_SCATTER_BETA_MODE, uint32_t(config_.scattering_beta)}}};
   program_ = &r.programs.graphics(d);
 }
 

@@ -48,18 +48,18 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
                      .depth_write = stage == Stage::opaque || stage == Stage::surfaces,
                      // What steers the shading's loops and branches is compiled in (frame.glsl, shading.glsl,
                      // shading_depth.glsl): the technique, the lights, the lookup, the MSAA samples, the PCF taps.
-                     .constants = {{0, uint32_t(technique.id)},
-                                   {3, config.split_rg() ? 1u : 0u},
-                                   {4, uint32_t(config.lights)},
-                                   {7, uint32_t(config.msaa)},
-                                   {8, uint32_t(config.taps)},
-                                   {9, uint32_t(config.lookup)},
-                                   {10, config.textured_draws ? 1u : 0u},
-                                   {11, config.sub_lights ? 1u : 0u}}};
+                     .constants = {{MSM_SPEC_TECHNIQUE, uint32_t(technique.id)},
+                                   {MSM_SPEC_SPLIT_RG, config.split_rg() ? 1u : 0u},
+                                   {MSM_SPEC_LIGHT_COUNT, uint32_t(config.lights)},
+                                   {MSM_SPEC_DEPTH_SAMPLES, uint32_t(config.msaa)},
+                                   {MSM_SPEC_PCF_TAPS, uint32_t(config.taps)},
+                                   {MSM_SPEC_LOOKUP, uint32_t(config.lookup)},
+                                   {MSM_SPEC_TEXTURED_DRAWS, config.textured_draws ? 1u : 0u},
+                                   {MSM_SPEC_SUB_LIGHTS, config.sub_lights ? 1u : 0u}}};
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
   if (msm_technique_is_scattering(technique.id)) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;
-    d.constants.push_back({5, 1u});
+    d.constants.push_back({MSM_SPEC_LINEAR_RADIANCE, 1u});
   }
   // Second moment image, blue noise, opacity texture, the green and blue channels' moment images
   // (coloured translucency), then the lights (binding 10); the same layout for every technique.

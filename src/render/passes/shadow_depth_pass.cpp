@@ -36,7 +36,7 @@ void ShadowDepthPass::prepare(const PassResources& r) {
 }
 
 void ShadowDepthPass::reflect(PassBuilder& b) const {
-  // Single-sampled depth is read back by copy (Renderer::Intermediates), MSAA depth by a shader.
+  // Single-sampled depth is read back by copy (Intermediates, renderer_internals.h), MSAA depth by a shader.
   b.create(back_ ? kShadowDepthBack : kShadowDepth,
            {.format = VK_FORMAT_D16_UNORM,
             .width = uint32_t(config_.shadow_size),

@@ -11,18 +11,19 @@ vk::GraphicsDesc translucent_desc(const FrameConfig& config) {
   bool split_rg = config.split_rg();
   std::string fragment = std::string(split_rg ? "translucent_moments2" : "translucent_moments") +
                          (config.msaa == 1 ? "_1x.frag" : ".frag");
-  vk::GraphicsDesc d{.name = std::string("translucent ") + std::string(config.technique->name),
-                     .vertex_shader = "translucent.vert",
-                     .fragment_shader = fragment,
-                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
-                                  vk::Binding::storage_buffer},
-                     .push_constant_size = sizeof(ObjectPush),
-                     .vertex_stride = sizeof(Vertex),
-                     .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
-                                    {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
-                     .color_formats = {config.formats()[0]},
-                     .alpha_blend = true,
-                     .constants = {{0, uint32_t(config.technique->id)}, {3, split_rg ? 1u : 0u}}};
+  vk::GraphicsDesc d{
+      .name = std::string("translucent ") + std::string(config.technique->name),
+      .vertex_shader = "translucent.vert",
+      .fragment_shader = fragment,
+      .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
+                   vk::Binding::storage_buffer},
+      .push_constant_size = sizeof(ObjectPush),
+      .vertex_stride = sizeof(Vertex),
+      .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                     {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+      .color_formats = {config.formats()[0]},
+      .alpha_blend = true,
+      .constants = {{MSM_SPEC_TECHNIQUE, uint32_t(config.technique->id)}, {MSM_SPEC_SPLIT_RG, split_rg ? 1u : 0u}}};
   if (split_rg) d.color_formats.push_back(config.formats()[1]);
   return d;
 }

@@ -11,14 +11,14 @@ layout(std430, binding = MSM_LIGHT_BINDING) readonly buffer LightBlock { LightUn
 
 // The technique (MSM_TECH_*, msm/techniques.h): a specialization constant, so that each pipeline
 // compiles one technique's path only.
-layout(constant_id = 0) const int kTechnique = 0;
+layout(constant_id = MSM_SPEC_TECHNIQUE) const int kTechnique = 0;
 // The shadow-map lookup (MSM_LOOKUP_*, FrameConfig::lookup): a specialization constant of the
 // shading, so that each pipeline compiles one lookup (llvmpipe runs both sides of a branch on a
 // uniform under a mask, and lavapipe recompiles a shader whose branches test uniforms).
-layout(constant_id = 9) const int kLookup = MSM_LOOKUP_BILINEAR;
+layout(constant_id = MSM_SPEC_LOOKUP) const int kLookup = MSM_LOOKUP_BILINEAR;
 // Four moments stored as two RG images (translucent occluders blend into the map: JCGT §3):
 // channels 0, 1 in image 0 and 2, 3 in image 1.
-layout(constant_id = 3) const bool kSplitRG = false;
+layout(constant_id = MSM_SPEC_SPLIT_RG) const bool kSplitRG = false;
 
 // Normalized 1D Gaussian weight of tap k in [0, taps).
 float kernel_weight(int k) { return frame.filter_weights[k / 4][k % 4]; }

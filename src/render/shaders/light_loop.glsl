@@ -4,7 +4,7 @@
 // lavapipe (Mesa 22.3) re-optimizes and recompiles a shader at every bind whose loop bound is a
 // uniform (it inlines the value to unroll the loop): about 0.8 s per frame of MSM-64 shading with
 // Mesa's shader cache off, and a cache lookup per frame with it on (docs/results.md).
-layout(constant_id = 4) const int kLightCount = 1;
+layout(constant_id = MSM_SPEC_LIGHT_COUNT) const int kLightCount = 1;
 const bool kOneLight = kLightCount == 1;
 
 // Frames with one light evaluate it outside any loop: do { body(l) } while (!kOneLight && ++l <

@@ -8,7 +8,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 // The mean of the front- and back-face depth (Kneiphof §4.2.3; FrameConfig::front_back).
-layout(constant_id = 4) const bool kFrontBack = false;
+layout(constant_id = MSM_SPEC_FRONT_BACK) const bool kFrontBack = false;
 #define MSM_DEPTH_BINDING 1
 #define MSM_BACK_DEPTH_BINDING 4
 #include "depth_map.glsl"

@@ -21,9 +21,9 @@
 #include "msm/techniques.h"
 #include "frame.glsl"
 
-layout(constant_id = 1) const int kRadius = 4;  // taps = 2 kRadius + 1; frame.filter_weights
-layout(constant_id = 2) const int kColumns = 4; // adjacent columns per thread
-layout(constant_id = 4) const int kSamples = 1; // MSAA samples per texel, = frame.kernel.y
+layout(constant_id = MSM_SPEC_FILTER_RADIUS) const int kRadius = 4;  // taps = 2 kRadius + 1; frame.filter_weights
+layout(constant_id = MSM_SPEC_FILTER_COLUMNS) const int kColumns = 4; // adjacent columns per thread
+layout(constant_id = MSM_SPEC_FILTER_SAMPLES) const int kSamples = 1; // MSAA samples per texel, = frame.kernel.y
 #define MSM_RESOLVE_SAMPLES kSamples
 layout(local_size_x = 32) in;
 

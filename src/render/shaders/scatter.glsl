@@ -21,9 +21,9 @@
 #ifdef MSM_SCATTER_PREFILTERED
 // K transmittance layers per light (rectification.h; 1: the paper's Δ(v)), light l's from K l (CSM:
 // eight image layers each, light l's layer k from 8 (K l + k)).
-layout(constant_id = 5) const int kLayers = 1;
-layout(constant_id = 6) const bool kPrefixSumMips = false; // FrameConfig::prefix_sum_mips > 1
-layout(constant_id = 7) const int kBetaMode = 0; // FrameConfig::scattering_beta: MSM_SCATTERING_BETA_*
+layout(constant_id = MSM_SPEC_SCATTER_LAYERS) const int kLayers = 1;
+layout(constant_id = MSM_SPEC_PREFIX_SUM_MIPS) const bool kPrefixSumMips = false; // FrameConfig::prefix_sum_mips > 1
+layout(constant_id = MSM_SPEC_SCATTER_BETA_MODE) const int kBetaMode = 0; // FrameConfig::scattering_beta: MSM_SCATTERING_BETA_*
 layout(binding = 3) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
 layout(std430, binding = 6) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 #ifdef MSM_SIX_MOMENTS

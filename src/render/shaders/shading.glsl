@@ -11,14 +11,14 @@
 #include "light_loop.glsl"
 // Scattering techniques: the colour attachment takes linear radiance (before exposure and tone
 // mapping), which the scattering pass composites with the medium's in-scattering.
-layout(constant_id = 5) const bool kLinearRadiance = false;
+layout(constant_id = MSM_SPEC_LINEAR_RADIANCE) const bool kLinearRadiance = false;
 // False where no draw of the frame has an albedo or opacity texture (FrameConfig::textured_draws):
 // lavapipe runs both sides of the branches on the draw's flags, so untextured draws paid for the
 // fetches (a GPU skips them either way).
-layout(constant_id = 10) const bool kTexturedDraws = true;
+layout(constant_id = MSM_SPEC_TEXTURED_DRAWS) const bool kTexturedDraws = true;
 // Whether some light of the frame has sub-lights (FrameConfig::sub_lights, a probe's "sub_lights"):
 // a constant, so that frames without them compile none of their loop.
-layout(constant_id = 11) const bool kSubLights = false;
+layout(constant_id = MSM_SPEC_SUB_LIGHTS) const bool kSubLights = false;
 
 layout(binding = 1) uniform sampler2D albedo_texture;
 layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
@@ -105,15 +105,15 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
 }
 
 // The unshadowed irradiance of light l's sub-lights (count of them, after their summary at entry
-// rect_extent.z of lights[]; frame.h, renderer.cpp's sub_lights_summary): where the summary's
+// rect_extent.z of lights[]; frame.h's SubLightsSummary): where the summary's
 // rectangle about the light's direction, which holds them all, is above the horizon of n, their
 // linear part (msm_linear_irradiance: one matrix product instead of a loop that reads each
 // sub-light), where it is below, nothing; else each one's rectangle cosine integral.
 vec3 sub_lights_irradiance(int l, vec3 n, int count) {
   int summary = int(lights[l].rect_extent.z);
-  int side = msm_tangent_rect_side(n, lights[l].towards_light.xyz, lights[summary].normal_matrix[0].xyz,
-                                   lights[summary].normal_matrix[1].xyz, lights[summary].view_projection[3].xy);
-  if (side > 0) return max(msm_linear_irradiance(mat3(lights[summary].view_projection), n), vec3(0.0f));
+  SubLightsSummary part = msm_sub_lights_summary(lights[summary].view_projection, lights[summary].normal_matrix);
+  int side = msm_tangent_rect_side(n, lights[l].towards_light.xyz, part.x_axis, part.y_axis, part.bounds);
+  if (side > 0) return max(msm_linear_irradiance(part.irradiance_by_direction, n), vec3(0.0f));
   if (side < 0) return vec3(0.0f);
   vec3 sum = vec3(0.0f);
   for (int k = summary + 1, end = k + count; k < end; ++k)

@@ -11,8 +11,8 @@
 // The depth map's MSAA samples and the PCF kernel's taps (FrameConfig::msaa, ::taps), compiled in:
 // as loop bounds read from the uniforms they made lavapipe recompile the shader per frame (see
 // kLightCount in shading.glsl).
-layout(constant_id = 7) const int kSamples = 1;
-layout(constant_id = 8) const int kTaps = 1;
+layout(constant_id = MSM_SPEC_DEPTH_SAMPLES) const int kSamples = 1;
+layout(constant_id = MSM_SPEC_PCF_TAPS) const int kTaps = 1;
 
 vec2 sample_offset(int k) {
   vec4 pair = frame.sample_offsets[k / 2];

@@ -1,5 +1,6 @@
-// The image-test helper of the renderer's tests (in the manner of Filament's and Mitsuba's image
-// tests): compare an image against a reference with tolerances; on failure dump the images.
+// The image-test helper of the tests (in the manner of Filament's and Mitsuba's image tests):
+// compare an image against a reference with tolerances; on failure dump the images. Test support
+// (msm_image_testing), not installed.
 //
 //   auto r = msm::image::compare(actual, reference, {.max_mae = 0.005, .max_share_above_3pct = 0.01},
 //                                {.failure_dir = "build/test-failures/" + test_name});

@@ -1,4 +1,4 @@
-#include "msm/image/compare.h"
+#include "msm/test/image_compare.h"
 #include "msm/image/io.h"
 
 #include <fmt/core.h>
