@@ -750,7 +750,7 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
         q.params = glm::vec4(0.0f);
         return q;
       }(),
-      "0 < δ1 <= δ2 <= 1");
+      "parameter delta1 = 0 is outside (0, 1]");
   rejects(
       [&] {
         auto q = s;
@@ -758,7 +758,7 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
         q.params = glm::vec4(0.1f, 0.01f, 1, 0);
         return q;
       }(),
-      "δ1 <= δ2");
+      "delta1 <= delta2");
   rejects(
       [&] {
         auto q = s;
@@ -766,7 +766,7 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
         q.params = glm::vec4(0.0f);
         return q;
       }(),
-      "minimum variance");
+      "parameter min_variance = 0 is outside (0, 1]");
   rejects(
       [&] {
         auto q = s;
@@ -774,7 +774,7 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
         q.params = glm::vec4(2.0f, 0.5f, 0.0f, 0.01f);
         return q;
       }(),
-      "scale y >= 1");
+      "parameter scale = 0.5 is outside [1, inf)");
   if (9u * 2048u > ctx().properties().limits.maxImageDimension2D)
     rejects(
         [&] {

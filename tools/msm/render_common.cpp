@@ -25,9 +25,12 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--filter", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
   cmd->add_option("--sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
   cmd->add_flag("--no-mipmaps", o.no_mipmaps, "No mip chain for the moment images");
-  cmd->add_option("--param", o.params, "Technique parameters x,y,z,w (see msm techniques)")
-      ->delimiter(',')
-      ->expected(4);
+  cmd->add_option("--set", o.parameters,
+                  "A technique parameter NAME=VALUE, repeatable (msm techniques NAME lists them: type, range, "
+                  "default, meaning)")
+      ->take_all();
+  // The positional vector of older versions: still read for one version, with a warning.
+  cmd->add_option("--param", o.params, "")->delimiter(',')->group("");
   cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
@@ -84,6 +87,8 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
 void finish_frame_options(FrameOptions& o) {
   if (!o.params.empty()) {
     if (o.params.size() != 4) throw UsageError("--param takes four comma-separated values");
+    fmt::print(stderr, "msm: warning: --param is deprecated and goes in the next version: set each parameter by "
+                       "name with --set NAME=VALUE (msm techniques NAME lists them)\n");
     o.settings.params = glm::vec4(o.params[0], o.params[1], o.params[2], o.params[3]);
   }
   o.settings.mipmaps = !o.no_mipmaps;
@@ -126,8 +131,18 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
     if (s.one_pass && *s.one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
       s.one_pass.reset();
   } catch (const render::RenderError&) {
-    // validate() reports the unknown name
+    return s; // validate() reports the unknown name
   }
+  const Technique& t = render::find_rendered_technique(technique);
+  ParameterValues values;
+  for (const std::string& assignment : options.parameters) {
+    try {
+      set_parameter(t, values, assignment);
+    } catch (const std::invalid_argument& e) {
+      throw render::RenderError(fmt::format("{}: --set {}", t.name, e.what()));
+    }
+  }
+  for (const auto& [name, value] : values) s.set_parameter(name, value);
   return s;
 }
 
@@ -189,7 +204,19 @@ void ensure_output_dir(const std::filesystem::path& dir) {
 nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, const vk::Context& ctx,
                            const render::RenderResult& result) {
   const Technique& t = render::find_rendered_technique(s.technique);
-  glm::vec4 p = s.params ? *s.params : t.default_params();
+  nlohmann::json parameters = nlohmann::json::object();
+  for (const Parameter* p : t.parameter_list()) {
+    const float v = s.parameter(p->name);
+    nlohmann::json& out = parameters[std::string(p->name)];
+    if (p->type == ParameterType::number)
+      out = v;
+    else if (p->type == ParameterType::integer)
+      out = int(v);
+    else if (p->type == ParameterType::flag)
+      out = v != 0.0f;
+    else
+      out = p->value_text(v);
+  }
   nlohmann::json passes = nlohmann::json::object();
   for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
   return {{"scene", scene.name},
@@ -197,8 +224,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"technique", s.technique},
           {"description", t.description},
           {"bits_per_texel", t.bits_per_texel},
-          {"params", {p.x, p.y, p.z, p.w}},
-          {"params_meaning", t.parameters},
+          {"parameters", parameters},
           {"width", s.width},
           {"height", s.height},
           {"shadow_size", s.shadow_size},
