@@ -47,20 +47,18 @@ float RenderSettings::resolved_depth_bias() const {
 }
 
 glm::vec4 RenderSettings::parameter_vector() const {
-  return params ? *params : find_rendered_technique(technique).default_params();
+  return msm::parameter_vector(find_rendered_technique(technique), parameters);
 }
 
 float RenderSettings::parameter(std::string_view name) const {
-  return parameter_vector()[find_rendered_technique(technique).parameter(name).slot];
+  return parameter_value(find_rendered_technique(technique), parameters, name);
 }
 
 void RenderSettings::set_parameter(std::string_view name, float value) {
-  glm::vec4 v = parameter_vector();
-  v[find_rendered_technique(technique).parameter(name).slot] = value;
-  params = v;
+  parameters[std::string(find_rendered_technique(technique).parameter(name).name)] = value;
 }
 
-void RenderSettings::reset_parameters() { params.reset(); }
+void RenderSettings::reset_parameters() { parameters.clear(); }
 
 std::string RenderSettings::parameter_text(std::string_view name) const {
   return find_rendered_technique(technique).parameter(name).value_text(parameter(name));
@@ -109,9 +107,11 @@ void RenderSettings::validate() const {
         fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size, kMaxOnePassTaps));
   if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
   finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
-  if (params)
-    for (int i = 0; i < 4; ++i)
-      if (!std::isfinite((*params)[i])) throw RenderError("technique parameters must be finite");
+  for (const auto& [name, value] : parameters) {
+    try {
+      t.parameter(name);
+    } catch (const std::invalid_argument& e) { throw RenderError(e.what()); }
+  }
   for (const Parameter* p : t.parameter_list())
     if (float v = parameter(p->name); !p->accepts(v))
       throw RenderError(

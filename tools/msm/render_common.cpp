@@ -3,6 +3,7 @@
 #include "msm/image/io.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
+#include "msm/viewer/view_file.h"
 
 #include <fmt/format.h>
 
@@ -89,7 +90,6 @@ void finish_frame_options(FrameOptions& o) {
     if (o.params.size() != 4) throw UsageError("--param takes four comma-separated values");
     fmt::print(stderr, "msm: warning: --param is deprecated and goes in the next version: set each parameter by "
                        "name with --set NAME=VALUE (msm techniques NAME lists them)\n");
-    o.settings.params = glm::vec4(o.params[0], o.params[1], o.params[2], o.params[3]);
   }
   o.settings.mipmaps = !o.no_mipmaps;
   using Lookup = render::RenderSettings::Lookup;
@@ -135,6 +135,8 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
   }
   const Technique& t = render::find_rendered_technique(technique);
   ParameterValues values;
+  for (const Parameter* p : t.parameter_list())
+    if (!options.params.empty()) values[std::string(p->name)] = options.params[size_t(p->slot)];
   for (const std::string& assignment : options.parameters) {
     try {
       set_parameter(t, values, assignment);
@@ -142,7 +144,7 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
       throw render::RenderError(fmt::format("{}: --set {}", t.name, e.what()));
     }
   }
-  for (const auto& [name, value] : values) s.set_parameter(name, value);
+  s.parameters = values;
   return s;
 }
 
@@ -204,56 +206,27 @@ void ensure_output_dir(const std::filesystem::path& dir) {
 nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& scene, const vk::Context& ctx,
                            const render::RenderResult& result) {
   const Technique& t = render::find_rendered_technique(s.technique);
-  nlohmann::json parameters = nlohmann::json::object();
-  for (const Parameter* p : t.parameter_list()) {
-    const float v = s.parameter(p->name);
-    nlohmann::json& out = parameters[std::string(p->name)];
-    if (p->type == ParameterType::number)
-      out = v;
-    else if (p->type == ParameterType::integer)
-      out = int(v);
-    else if (p->type == ParameterType::flag)
-      out = v != 0.0f;
-    else
-      out = p->value_text(v);
-  }
   nlohmann::json passes = nlohmann::json::object();
   for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
-  return {{"scene", scene.name},
-          {"scene_source", scene.source.string()},
-          {"technique", s.technique},
-          {"description", t.description},
-          {"bits_per_texel", t.bits_per_texel},
-          {"parameters", parameters},
-          {"width", s.width},
-          {"height", s.height},
-          {"shadow_size", s.shadow_size},
-          {"msaa", s.msaa},
-          {"filter_size", s.filter_size},
-          {"filter_sigma", s.filter_sigma},
-          {"mipmaps", s.mipmaps},
-          {"overdarken", s.overdarken},
-          {"normal_offset_texels", s.normal_offset},
-          {"depth_bias", s.resolved_depth_bias()},
-          {"receiver_plane_bias", s.receiver_plane_bias},
-          {"exposure", s.exposure},
-          {"lookup", s.lookup == render::RenderSettings::Lookup::bilinear  ? "bilinear"
-                     : s.lookup == render::RenderSettings::Lookup::nearest ? "nearest"
-                     : s.lookup == render::RenderSettings::Lookup::dither  ? "dither"
-                     : msm_technique_is_nonlinear(t.id)                    ? "dither (auto)"
-                                                                           : "bilinear (auto)"},
-          {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
-          {"frame", s.frame},
-          {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light().angular_extent_deg},
-          {"light_height_deg", s.light_height_deg ? nlohmann::json(*s.light_height_deg) : nlohmann::json()},
-          {"front_back_depth", s.front_back_depth},
-          {"soft_kernel", s.resolved_soft_kernel()},
-          {"translucent_occluders", s.translucent_occluders},
-          {"translucent_alpha_threshold", s.translucent_alpha_threshold},
-          {"coloured_translucency", s.coloured_translucency},
-          {"device", ctx.info().describe()},
-          {"gpu_ms", passes},
-          {"gpu_ms_total", result.total_ms}};
+  nlohmann::json out = {{"scene", scene.name},
+                        {"scene_source", scene.source.string()},
+                        {"description", t.description},
+                        {"bits_per_texel", t.bits_per_texel}};
+  // Every setting under its view-file key (msm/viewer/view_file.h: the one schema of the settings),
+  // then what the technique's defaults resolved to.
+  for (const std::string& key : viewer::setting_keys()) out[key] = viewer::setting_json(s, key);
+  const bool one_pass = s.one_pass.value_or(t.one_pass_default());
+  out["resolved"] = {{"depth_bias", s.resolved_depth_bias()},
+                     {"soft_kernel", s.resolved_soft_kernel()},
+                     {"lookup", s.lookup != render::RenderSettings::Lookup::automatic ? out["lookup"]
+                                : t.nonlinear()                                       ? "dither"
+                                                                                      : "bilinear"},
+                     {"filter_mode", one_pass ? "one-pass" : "three-pass"},
+                     {"light_extent_deg", s.light_extent_deg.value_or(scene.light().angular_extent_deg)}};
+  out["device"] = ctx.info().describe();
+  out["gpu_ms"] = passes;
+  out["gpu_ms_total"] = result.total_ms;
+  return out;
 }
 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,

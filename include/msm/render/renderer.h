@@ -78,11 +78,13 @@ struct RenderSettings {
   int filter_size = MSM_FILTER_DEFAULT_TAPS;     // Gaussian taps per axis (odd, 1..63; 1 = no blur)
   float filter_sigma = MSM_FILTER_DEFAULT_SIGMA; // in texels (msm/filter.h)
   bool mipmaps = true;                           // mip chain of the moment images (trilinear lookups)
-  std::optional<glm::vec4> params;               // technique parameters (msm/techniques.h); default: the papers'
+  // The technique's parameters by name (msm techniques NAME: type, range, default, meaning); those
+  // not given take the papers' defaults.
+  ParameterValues parameters;
   // The value of the technique's parameter of that name (msm/cpu/techniques.h); std::invalid_argument
   // if the technique has none of that name.
   float parameter(std::string_view name) const;
-  void set_parameter(std::string_view name, float value);  // validated by validate()
+  void set_parameter(std::string_view name, float value);  // std::invalid_argument: no such name
   void reset_parameters();                                 // every parameter to its default
   std::string parameter_text(std::string_view name) const; // as a user writes it: a choice's name, a number
   glm::vec4 parameter_vector() const;                      // the parameters as the shaders read them
