@@ -341,7 +341,7 @@ void add_bench(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
                                           "pixel, shadow map per texel)");
-  cmd->add_option("--techniques", opt->techniques, "Techniques or aliases (default: all)")->delimiter(',');
+  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases (default: all)")->delimiter(',');
   cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")
       ->delimiter(',')
       ->capture_default_str();
@@ -372,9 +372,8 @@ void add_bench(CLI::App& app) {
                   "Time the light-probe pipeline instead (an equirectangular EXR, or 'sky'): cube map, tables and "
                   "median cut on the device against face size and light count");
   cmd->add_option("--probe-sizes", opt->probe.sizes, "Face sizes for --probe")->delimiter(',')->capture_default_str();
-  cmd->add_option("--probe-lights", opt->probe.lights, "Light counts for --probe")
-      ->delimiter(',')
-      ->capture_default_str();
+  add_deprecated_option(cmd, "--probe-lights", "--lights", opt->probe.lights)->delimiter(',');
+  cmd->add_option("--lights", opt->probe.lights, "Light counts for --probe")->delimiter(',')->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt, cmd] {
     auto given = [cmd](const char* option) { return cmd->get_option(option)->count() > 0; };

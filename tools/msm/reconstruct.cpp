@@ -2,6 +2,7 @@
 // on the command line.
 #include "commands.h"
 #include "msm/cpu/techniques.h"
+#include "usage.h"
 #if MSM_TOOL_RENDER
 #include "msm/render/renderer.h"
 #endif
@@ -145,7 +146,8 @@ void add_reconstruct(CLI::App& app) {
   cmd->add_option("--depths", opt->depths, "Occluder depths in the kernel, in [0,1]")->required()->delimiter(',');
   cmd->add_option("--weights", opt->weights, "Filter weights (default: equal)")->delimiter(',');
   cmd->add_option("--zf", opt->zf, "Fragment depth in [0,1]")->required();
-  cmd->add_option("--technique,-t", opt->techniques, "Techniques or aliases to run (default: all)")->delimiter(',');
+  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases to run (default: all)")->delimiter(',');
+  add_deprecated_option(cmd, "--technique", "-t/--techniques", opt->techniques)->delimiter(',');
   cmd->add_flag("--json", opt->json, "Print JSON");
   cmd->callback([opt] {
     auto finite_unit = [](float x) { return std::isfinite(x) && x >= 0.0f && x <= 1.0f; };

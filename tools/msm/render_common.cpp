@@ -23,8 +23,10 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--height", s.height, "Image height in pixels")->capture_default_str();
   cmd->add_option("--shadow-size", s.shadow_size, "Shadow map texels per side")->capture_default_str();
   cmd->add_option("--msaa", s.msaa, "Shadow depth samples: 1, 4 or 8")->capture_default_str();
-  cmd->add_option("--filter", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
-  cmd->add_option("--sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
+  cmd->add_option("--filter-size", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
+  cmd->add_option("--filter-sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
+  add_deprecated_option(cmd, "--filter", "--filter-size", s.filter_size);
+  add_deprecated_option(cmd, "--sigma", "--filter-sigma", s.filter_sigma);
   cmd->add_flag("--no-mipmaps", o.no_mipmaps, "No mip chain for the moment images");
   cmd->add_option("--set", o.parameters,
                   "A technique parameter NAME=VALUE, repeatable (msm techniques NAME lists them: type, range, "

@@ -5,6 +5,7 @@
 #include "commands.h"
 #include "msm/render/renderer.h"
 #include "msm/vk/context.h"
+#include "usage.h"
 
 #include <nlohmann/json.hpp>
 
