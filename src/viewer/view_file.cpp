@@ -289,6 +289,8 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
   try {
     j = json::parse(text, nullptr, true, true);
   } catch (const json::parse_error& e) { throw ViewError(fmt::format("{}: malformed JSON: {}", name, e.what())); }
+  // A render's JSON output holds its view under "view" (msm render --view renders it again).
+  if (j.is_object() && !j.contains("msm_view") && j.contains("view") && j["view"].is_object()) j = json(j["view"]);
   try {
     check_keys(j, "", {"msm_view", "scene", "camera", "lights", "settings", "object_frame"});
     if (!j.contains("msm_view") || j["msm_view"] != 1) fail("/msm_view", "required, and only version 1 exists");

@@ -47,8 +47,8 @@ void add_render(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--view", opt->view,
-                  "A view file of msm view (scene, camera, lights, every setting): renders exactly that view; only "
-                  "-t, -o and --device go with it");
+                  "A view file of msm view (scene, camera, lights, every setting), or a render's JSON output: "
+                  "renders exactly that view; only -t, -o and --device go with it");
   add_frame_options(cmd, opt->frame);
   cmd->add_option("--frames", opt->frames.frames,
                   "Frames to render of a dynamic scene, with their timings: each frame splits the scene's (turned) "
@@ -76,7 +76,8 @@ void add_render(CLI::App& app) {
       for (const CLI::Option* o : cmd->get_options()) {
         const std::vector<std::string>& long_names = o->get_lnames();
         std::string name = long_names.empty() ? o->get_name() : long_names.front();
-        if (o->count() > 0 && name != "view" && name != "out" && name != "technique" && name != "device")
+        if (o->count() > 0 && name != "view" && name != "out" && name != "techniques" && name != "technique" &&
+            name != "device")
           throw UsageError(fmt::format("--view sets the scene and every setting; --{} cannot go with it", name));
       }
       try {

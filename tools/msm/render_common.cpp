@@ -136,7 +136,7 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
     return s; // validate() reports the unknown name
   }
   const Technique& t = render::find_rendered_technique(technique);
-  ParameterValues values;
+  ParameterValues values = s.parameters; // a view file's, then the command line's
   for (const Parameter* p : t.parameter_list())
     if (!options.params.empty()) values[std::string(p->name)] = options.params[size_t(p->slot)];
   for (const std::string& assignment : options.parameters) {
@@ -225,6 +225,12 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                                                                                       : "bilinear"},
                      {"filter_mode", one_pass ? "one-pass" : "three-pass"},
                      {"light_extent_deg", s.light_extent_deg.value_or(scene.light().angular_extent_deg)}};
+  // The view file of this render: msm render --view takes this JSON and renders the same again.
+  viewer::View view;
+  view.scene = scene.source.string().starts_with("builtin:") ? scene.name : scene.source.string();
+  view.camera = scene.camera;
+  view.settings = s;
+  out["view"] = viewer::view_json(view);
   out["device"] = ctx.info().describe();
   out["gpu_ms"] = passes;
   out["gpu_ms_total"] = result.total_ms;
