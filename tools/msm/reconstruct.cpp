@@ -61,7 +61,7 @@ void print_technique(const Technique& t) {
   }
   fmt::print("parameters (--set NAME=VALUE):\n");
   for (const Parameter* p : t.parameter_list()) {
-    fmt::print("  {:<18} {:<8} {:<34} default {}\n", p->name, type_name(p->type), p->range_text(),
+    fmt::print("  {:<18} {:<8} {:<36} default {}\n", p->name, type_name(p->type), p->range_text(),
                p->value_text(p->default_value));
     fmt::print("  {:<18} {}\n", "", p->meaning);
     for (const ParameterChoice& c : p->choices) fmt::print("  {:<18}   {}: {}\n", "", c.name, c.meaning);
