@@ -59,6 +59,25 @@ const float MSM_SOFT6_DELTA2 = 0.1f;
 // (~22.5 bits for a 27² kernel: quantization errors of a few 1e-7 in the variance).
 const float MSM_VSSM_MIN_VARIANCE = 1.0e-6f;
 
+// --- Depth bias: subtracted from the fragment's [0,1] shadow-map depth (RenderSettings::depth_bias) ---
+// Depth-based techniques: the 16-bit depth map rounds to steps of 1.5e-5; a bias above that keeps
+// a receiver from shadowing itself.
+const float MSM_DEPTH_BIAS_DEPTH_MAP = 2.0e-5f;
+// Linearly filtered moments: they come from the rounded D16 depths while the fragment's depth is a
+// float, so a receiver lit straight down is compared against its own texels up to half a step
+// (7.6e-6) too far, which the float techniques' tiny moment bias (3e-7) does not absorb
+// (msm-hamburger-128 read bare ground as shadowed).
+const float MSM_DEPTH_BIAS_FILTERED = 1.0e-5f;
+// Non-linearly quantized moments: HPG §5 uses a constant 1e-3 in [-1,1] depth for all results; it
+// is half a bin of msm-nl32's 10-bit depths (1/1023), which otherwise shadow a flat receiver facing
+// the light wherever its depth rounds towards the light.
+const float MSM_DEPTH_BIAS_NONLINEAR = 5.0e-4f;
+// Soft shadows of an area light: the 32-bit tables keep ~22 bits of a 27² kernel's moments, plus
+// the moment bias: 1e-3 in [-1,1] depth (JCGT §4.4's constant part). PCSS gets the same constant:
+// its receiver planes are exact for planar receivers only, and across a 15-texel kernel curved ones
+// (the models scene's knots) would shadow themselves (MAE 0.018 at 2e-5, 0.006 at 5e-4).
+const float MSM_DEPTH_BIAS_AREA_LIGHT = 5.0e-4f;
+
 // --- Shading ---
 // JCGT §2.6: shadow intensity divided by 98% and clamped hides leaking below 2%.
 const float MSM_OVERDARKEN_DEFAULT = 0.98f;

@@ -61,6 +61,9 @@ MSM_FN vec2 msm_cssm_search_terms(vec4 average, int tile, float xf, CsmParams p)
 // receiver depth zf in [0,1]: E[z f] / E[f] with E[f] = 1/2 + sums.x, clamped to [0, zf]. `shadow`
 // is the blockers' share E[f] rescaled like CSM's (msm_csm_resolve): below `min_share` the region
 // holds no blocker (the receiver's own depth counts 1/2 in the series) and the fragment is lit.
+// The default min_share: a region whose rescaled share stays below 1% holds no blocker, as the
+// damped series' ringing around a lone receiver stays below it.
+const float MSM_CSSM_MIN_BLOCKER_SHARE = 0.01f;
 MSM_FN BlockerResult msm_cssm_blocker(vec2 sums, float zf, CsmParams p, float min_share) {
   float share = 0.5f + sums.x;
   float shadow = msm_csm_resolve(sums.x, p);

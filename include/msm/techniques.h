@@ -171,7 +171,7 @@ MSM_FN vec4 msm_technique_default_params(int t) {
   if (t == MSM_TECH_VSSM) return vec4(0.0f, 0.0f, 0.0f, MSM_VSSM_MIN_VARIANCE);
   // CSSM: x damping, y scale, z offset of CSM (baselines.h), w the blockers' least share (cssm.h).
   if (msm_technique_is_cssm(t))
-    return vec4(MSM_CSM_DAMPING_DEFAULT, MSM_CSM_SCALE_DEFAULT, MSM_CSM_OFFSET_DEFAULT, 0.01f);
+    return vec4(MSM_CSM_DAMPING_DEFAULT, MSM_CSM_SCALE_DEFAULT, MSM_CSM_OFFSET_DEFAULT, MSM_CSSM_MIN_BLOCKER_SHARE);
   return vec4(0.0f);
 }
 

@@ -1,6 +1,8 @@
-// The technique table's names and aliases (msm/cpu/techniques.h).
+// The technique table (msm/cpu/techniques.h): names and aliases, its declarations against the
+// shared header the shaders read (msm/techniques.h), its named parameters.
 #include "msm/cpu/techniques.h"
 #include "msm/msm.h"
+#include "msm/techniques.h"
 #include "test_distributions.h"
 
 #include <gtest/gtest.h>
@@ -56,6 +58,104 @@ TEST(TechniqueTable, UnknownNameSuggestsTheNearest) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string(e.what()).find("did you mean"), std::string::npos) << e.what();
   }
+}
+
+// The table's categories are what the shaders' variant selection and the shared header's
+// functions of the id say (the shaders read those), for every rendered technique.
+TEST(TechniqueTable, CategoriesAgreeWithTheSharedHeader) {
+  for (const Technique& t : techniques()) {
+    SCOPED_TRACE(t.name);
+    if (!t.rendered()) {
+      EXPECT_EQ(t.id, -1);
+      EXPECT_TRUE(t.on_cpu());
+      continue;
+    }
+    ASSERT_GE(t.id, 0);
+    EXPECT_EQ(&technique_by_id(t.id), &t);
+    EXPECT_EQ(t.depth_based(), msm_technique_is_depth_based(t.id));
+    EXPECT_EQ(t.soft(), msm_technique_is_soft(t.id));
+    EXPECT_EQ(t.nonlinear(), msm_technique_is_nonlinear(t.id));
+    EXPECT_EQ(t.area_light, msm_technique_is_area_light(t.id));
+    EXPECT_EQ(t.six_moments, msm_technique_is_six_moments(t.id));
+    EXPECT_EQ(t.scatters(), msm_technique_is_scattering(t.id));
+    EXPECT_EQ(t.prefiltered_scattering(), msm_technique_is_prefiltered_scattering(t.id));
+    EXPECT_EQ(t.scattering == Scattering::march, msm_technique_march_samples(t.id) > 0);
+    EXPECT_EQ(t.scattering == Scattering::prefiltered_csm, t.id == MSM_TECH_SCATTER_CSM32);
+    EXPECT_EQ(t.shading == ShadingVariant::soft, t.soft());
+    EXPECT_EQ(t.shading == ShadingVariant::depth, t.depth_based());
+    EXPECT_EQ(t.shading == ShadingVariant::nl64, t.id == MSM_TECH_NL64);
+    EXPECT_EQ(t.shading == ShadingVariant::nl32, t.id == MSM_TECH_NL32);
+    // Translucent occluders blend into one linear moment image.
+    EXPECT_EQ(t.translucency, !t.depth_based() && !t.nonlinear() && !t.soft() && t.formats[1] == TexelFormat::none);
+    // The per-pixel filters shade deferred by default.
+    EXPECT_EQ(t.deferred_shading_default, t.id == MSM_TECH_PCF || t.area_light);
+    EXPECT_EQ(t.default_soft_kernel > 0, t.area_light);
+    EXPECT_LE(t.default_soft_kernel, t.max_soft_kernel);
+    // Depth bias: the area lights' and the non-linear maps' constant, the depth maps' rounding, the
+    // filtered moments' D16 rounding (config.h).
+    const float bias = t.area_light      ? MSM_DEPTH_BIAS_AREA_LIGHT
+                       : t.nonlinear()   ? MSM_DEPTH_BIAS_NONLINEAR
+                       : t.depth_based() ? MSM_DEPTH_BIAS_DEPTH_MAP
+                                         : MSM_DEPTH_BIAS_FILTERED;
+    EXPECT_EQ(t.depth_bias, bias);
+  }
+}
+
+// Every declared parameter's default is the papers' value in its slot of the vec4 the shaders read
+// (msm_technique_default_params), inside its own range; slots and names are unique per technique.
+TEST(TechniqueTable, ParametersDeclareTheShadersDefaults) {
+  int declared = 0;
+  for (const Technique& t : techniques()) {
+    SCOPED_TRACE(t.name);
+    std::set<int> slots;
+    std::set<std::string_view> names;
+    for (const Parameter* p : t.parameter_list()) {
+      SCOPED_TRACE(p->name);
+      ++declared;
+      EXPECT_TRUE(slots.insert(p->slot).second);
+      EXPECT_TRUE(names.insert(p->name).second);
+      ASSERT_TRUE(p->slot >= 0 && p->slot < 4);
+      EXPECT_EQ(p->default_value, t.default_params()[p->slot]);
+      EXPECT_TRUE(p->accepts(p->default_value)) << p->range_text();
+      EXPECT_FALSE(p->meaning.empty());
+      EXPECT_EQ(&t.parameter(p->name), p);
+      EXPECT_EQ(p->parse(p->value_text(p->default_value)), p->default_value);
+    }
+    EXPECT_EQ(parameter_vector(t, {}), t.default_params());
+  }
+  EXPECT_GT(declared, 40);
+}
+
+TEST(TechniqueTable, ParametersAreSetByNameAndValidated) {
+  const Technique& scatter = find_technique("scatter-msm6-96");
+  ParameterValues values;
+  set_parameter(scatter, values, "beta=adaptive");
+  set_parameter(scatter, values, "layers=4");
+  set_parameter(scatter, values, "resampling=filtered");
+  EXPECT_EQ(parameter_vector(scatter, values), glm::vec4(1.0f, 0.0f, float(MSM_SCATTERING_BETA_ADAPTIVE), 4.0f));
+  EXPECT_EQ(parameter_value(scatter, values, "beta"), float(MSM_SCATTERING_BETA_ADAPTIVE));
+  EXPECT_EQ(parameter_value(scatter, values, "fixed_beta"), 0.0f);
+  auto refused = [](const Technique& t, std::string_view assignment, std::string_view message) {
+    ParameterValues v;
+    try {
+      set_parameter(t, v, assignment);
+      ADD_FAILURE() << assignment << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  refused(scatter, "layers=2.5", "layers = '2.5' is outside integer in [0, 16]");
+  refused(scatter, "layers=17", "outside integer in [0, 16]");
+  refused(scatter, "beta=adaptiv", "not one of proportional, fixed or adaptive (did you mean adaptive?)");
+  refused(scatter, "layer=2", "unknown parameter 'layer' of scatter-msm6-96 (did you mean layers?)");
+  refused(scatter, "layers", "write NAME=VALUE");
+  refused(find_technique("msm"), "moment_bias=-1", "moment_bias = '-1' is outside [0, 1]");
+  refused(find_technique("msm"), "moment_bias=nan", "outside [0, 1]");
+  refused(find_technique("vsm"), "min_variance=0", "outside (0, 1]");
+  refused(find_technique("pcf"), "x=1", "pcf has no parameters");
+  // A value set in the vec4's slot is checked too.
+  EXPECT_THROW(parameter_vector(find_technique("msm"), {{"moment_bias", -1.0f}}), std::invalid_argument);
+  EXPECT_THROW(parameter_vector(find_technique("msm"), {{"bias", 0.0f}}), std::invalid_argument);
 }
 
 // The hard CSM technique (csm-4) on receivers at the far plane of a fitted map: the plate of

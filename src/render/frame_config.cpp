@@ -1,7 +1,5 @@
 #include "frame_config.h"
 
-#include "msm/techniques.h"
-
 #include <fmt/format.h>
 
 namespace msm::render {
@@ -53,7 +51,7 @@ int FrameConfig::moment_images() const {
 
 FrameConfig FrameConfig::resampling_moments() const {
   FrameConfig m;
-  m.technique = &technique_by_id(MSM_TECH_HAMBURGER_128_UNIT);
+  m.technique = &find_technique(kResamplingMomentsTechnique);
   m.width = width;
   m.height = height;
   m.shadow_size = shadow_size;

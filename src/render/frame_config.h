@@ -8,7 +8,9 @@
 #include <vulkan/vulkan.h>
 
 #include <array>
+#include <bit>
 #include <string>
+#include <string_view>
 
 namespace msm::render {
 
@@ -41,23 +43,23 @@ struct FrameConfig {
   // Whether any light of the frame has sub-lights (scene::DirectionalLight::sub_lights): the
   // shading's kSubLights (shading.glsl), which sums them for the light's unshadowed irradiance.
   bool sub_lights = false;
-  // Prefiltered scattering, resampling with filtering (JCGT §5.2; technique parameter x = 1): the
+  // Prefiltered scattering, resampling with filtering (JCGT §5.2; parameter resampling = filtered): the
   // frame also makes each light's blurred, mipmapped 4-moment map (moment_resolve, blur and mipmaps
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).
   bool filtered_resampling = false;
   uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
-  // Prefiltered scattering, parameter x = 2: the earlier on-the-fly filter of rectify (a bilinear
+  // Prefiltered scattering, parameter resampling = bilinear-moments: the earlier on-the-fly filter of rectify (a bilinear
   // sample of the depth map's texels' moments). A specialization constant of rectify, as lavapipe
   // runs both sides of a branch on a uniform: the unfiltered resampling paid for this path (16-20%
   // of the pass, docs/results.md).
   bool on_the_fly_resampling = false;
-  // Prefiltered scattering: K transmittance layers (rectification.h; technique parameter w): K prefix
+  // Prefiltered scattering: K transmittance layers (rectification.h; parameter layers): K prefix
   // sums per light with the steps Δ_k, mixed per pixel at its own Δ; 1 = the paper's Δ(v) per row.
   int transmittance_layers = 1;
   // RenderSettings::prefix_sums: the row sweep instead of the Appendix C scheme (prefix_sums.glsl).
   bool prefix_sums_appendix_c = false;
   uint32_t prefix_sum_mips = 1; // RenderSettings::prefix_sum_mips: the prefix sums' levels (1: none)
-  // Prefiltered scattering's β (technique parameter z; scattering.h): MSM_SCATTERING_BETA_* as a
+  // Prefiltered scattering's β (parameter beta; scattering.h): MSM_SCATTERING_BETA_* as a
   // specialization constant, so that lavapipe, which runs both sides of a branch on a uniform,
   // runs one: with z read from the uniform the six-moment pass cost 28% more (callgrind, tower,
   // 640x360, 512²: 393.1 M against 308.2 M instructions).
@@ -81,13 +83,16 @@ struct FrameConfig {
   // the blur, b2 − b1², keeps the float's precision where 16 bits would round it to a few units of
   // 2^-16 and need a bias), the frame's size, samples, lights and filter; no translucency.
   FrameConfig resampling_moments() const;
+  static constexpr std::string_view kResamplingMomentsTechnique = "msm-hamburger-128-unit";
   bool blur_writes_mip1() const { return !one_pass && taps > 1 && mip_levels > 1 && shadow_size % 2 == 0; }
 };
 
 VkFormat vk_format(TexelFormat format);
+// Levels of a full mip chain of a square image of that side (down to 1 x 1).
+inline uint32_t full_mip_chain(int size) { return uint32_t(std::bit_width(uint32_t(size))); }
 
 // Names of the frame's images (the frame graph's resources).
-// Prefiltered scattering's transmittance layers when the technique's parameter w is 0: the paper's
+// Prefiltered scattering's transmittance layers when the technique's parameter layers is 0: the paper's
 // single Δ(v). 4 layers have 0.4-0.6x its error on the tower and the gate, but on lavapipe they make
 // the scattering pass 1.4-2x as costly, below the 10x margin to ray marching (docs/results.md,
 // "Single scattering: transmittance layers").

@@ -74,10 +74,10 @@ TEST(Limits, RectifiedMapsAreCountedPerLight) {
     s.lights.resize(3); // the frame's lights instead of the scene's
     EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], 3 * per_light + (march[2] - march[1]) * 2);
     s.lights.clear();
-    s.params = glm::vec4(0.0f, 0.0f, 0.0f, 4.0f); // four transmittance layers: four prefix sums
+    s.parameters = {{"layers", 4.0f}}; // four transmittance layers: four prefix sums
     EXPECT_EQ(render::transmittance_layers(s), 4);
     EXPECT_EQ(render::estimated_bytes(s, 0, 1) - march[1], std::uint64_t(2048) * 2048 * (bytes.x + 4 * bytes.y));
-    s.params.reset();
+    s.reset_parameters();
   }
 }
 

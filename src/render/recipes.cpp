@@ -2,21 +2,19 @@
 
 #include "passes/pass.h"
 
-#include "msm/techniques.h"
-
 namespace msm::render {
 
 std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
   std::vector<std::unique_ptr<Pass>> passes;
   passes.push_back(std::make_unique<ShadowDepthPass>(c));
   if (c.front_back) passes.push_back(std::make_unique<ShadowDepthPass>(c, true)); // Kneiphof §4.2.3
-  int id = c.technique->id;
-  if (msm_technique_is_depth_based(id)) {
+  const Technique& t = *c.technique;
+  if (t.depth_based()) {
     // plain, pcf, pcss read the depth map itself.
   } else if (c.one_pass) { // HPG 2017: resolve, blur and encoding in one dispatch
     passes.push_back(std::make_unique<OnePassFilterPass>(c));
     if (c.mip_levels > 1) passes.push_back(std::make_unique<MipmapPass>(c, 0));
-  } else if (msm_technique_is_soft(id)) { // tables instead of blur and mips
+  } else if (t.soft()) { // tables instead of blur and mips
     passes.push_back(std::make_unique<MomentResolvePass>(c));
     passes.push_back(std::make_unique<SatPass>(c));
   } else {
@@ -31,7 +29,7 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
   }
   if (c.deferred) passes.push_back(std::make_unique<SurfacesPass>(c));
   passes.push_back(std::make_unique<ShadingPass>(c));
-  if (msm_technique_is_prefiltered_scattering(id)) {
+  if (t.prefiltered_scattering()) {
     if (c.filtered_resampling) { // the blurred, mipmapped 4-moment map that rectify samples (§5.2)
       const FrameConfig m = c.resampling_moments();
       passes.push_back(std::make_unique<MomentResolvePass>(m));
@@ -42,26 +40,20 @@ std::vector<std::unique_ptr<Pass>> recipe(const FrameConfig& c) {
     passes.push_back(std::make_unique<PrefixSumPass>(c));
     if (c.prefix_sum_mips > 1) passes.push_back(std::make_unique<PrefixSumMipmapPass>(c));
   }
-  if (msm_technique_is_scattering(id)) passes.push_back(std::make_unique<ScatteringPass>(c));
+  if (t.scatters()) passes.push_back(std::make_unique<ScatteringPass>(c));
   return passes;
 }
 
 std::vector<std::string> frame_outputs() { return {kColor, kShadowBuffer}; }
 
 std::vector<std::string> frame_outputs(const FrameConfig& c) {
-  if (msm_technique_is_scattering(c.technique->id)) return {kColor, kShadowBuffer, kScattering};
+  if (c.technique->scatters()) return {kColor, kShadowBuffer, kScattering};
   return frame_outputs();
 }
 
-bool supports_deferred_shading(const Technique& technique) {
-  int id = technique.id;
-  return msm_technique_is_depth_based(id) || msm_technique_is_soft(id);
-}
+bool supports_deferred_shading(const Technique& technique) { return technique.deferred_shading_supported(); }
 
-bool default_deferred_shading(const Technique& technique) {
-  int id = technique.id;
-  return id == MSM_TECH_PCF || id == MSM_TECH_PCSS || msm_technique_is_soft(id);
-}
+bool default_deferred_shading(const Technique& technique) { return technique.deferred_shading_default; }
 
 std::vector<std::string> technique_passes(const Technique& technique, bool translucent, bool coloured) {
   RenderSettings defaults;
@@ -72,8 +64,9 @@ std::vector<std::string> technique_passes(const Technique& technique, bool trans
   c.shadow_size = defaults.shadow_size;
   c.msaa = defaults.msaa;
   c.taps = defaults.filter_size;
-  c.one_pass = msm_technique_is_nonlinear(technique.id);
-  c.mip_levels = defaults.mipmaps && !c.one_pass && !msm_technique_is_soft(technique.id) ? 11 : 1;
+  c.one_pass = technique.one_pass_default();
+  // The full chain of the default shadow map's size (the device's blit support aside).
+  c.mip_levels = defaults.mipmaps && technique.mipmapped() ? full_mip_chain(defaults.shadow_size) : 1;
   c.translucent = translucent && supports_translucency(technique);
   c.coloured = c.translucent && coloured;
   c.deferred = default_deferred_shading(technique);

@@ -415,10 +415,10 @@ TEST_F(RenderTest, ResolveWritesFiniteMoments) {
       for (float v : image->pixels()) ASSERT_TRUE(std::isfinite(v)) << name;
   }
   RenderSettings overflow = small("esm-32");
-  overflow.params = glm::vec4(0.0f, 100.0f, 0.0f, 0.0f); // exp(100) > the largest float
+  overflow.parameters = {{"exponent", 100.0f}}; // exp(100) > the largest float
   EXPECT_THROW(overflow.validate(), RenderError);
   RenderSettings half = small("evsm2-32");
-  half.params = glm::vec4(0.0f, 5.6f, 5.54f, 1e-4f); // exp(2 x 5.6) > the largest half
+  half.parameters = {{"positive_exponent", 5.6f}}; // exp(2 x 5.6) > the largest half
   EXPECT_THROW(half.validate(), RenderError);
 }
 
@@ -431,7 +431,7 @@ TEST_F(RenderTest, ParametersReachTheShaders) {
   RenderSettings dark = small("vsm-32");
   dark.overdarken = 0.8f;
   RenderSettings loose = small("vsm-32");
-  loose.params = find_rendered_technique("vsm-32").default_params() + glm::vec4(0.0f, 0.0f, 0.0f, 0.01f);
+  loose.parameters = {{"min_variance", find_rendered_technique("vsm-32").default_params().w + 0.01f}};
   image::Image darker = visibility(renderer.render(dark)), brighter = visibility(renderer.render(loose));
   int darkened = 0, brightened = 0;
   for (size_t i = 0; i < base.pixels().size(); ++i) {
@@ -716,10 +716,17 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
   rejects(
       [&] {
         auto q = s;
-        q.params = glm::vec4(NAN);
+        q.parameters = {{"moment_bias", NAN}};
         return q;
       }(),
-      "finite");
+      "parameter moment_bias = nan is outside [0, 1]");
+  rejects(
+      [&] {
+        auto q = s;
+        q.parameters = {{"moment_bais", 1e-4f}};
+        return q;
+      }(),
+      "unknown parameter 'moment_bais' of msm-hamburger-64 (did you mean moment_bias?)");
   rejects(
       [&] {
         auto q = s;
@@ -748,34 +755,34 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
       [&] {
         auto q = s;
         q.technique = "mssm4";
-        q.params = glm::vec4(0.0f);
+        q.parameters = {{"delta1", 0.0f}};
         return q;
       }(),
-      "0 < δ1 <= δ2 <= 1");
+      "parameter delta1 = 0 is outside (0, 1]");
   rejects(
       [&] {
         auto q = s;
         q.technique = "mssm6";
-        q.params = glm::vec4(0.1f, 0.01f, 1, 0);
+        q.parameters = {{"delta1", 0.1f}, {"delta2", 0.01f}};
         return q;
       }(),
-      "δ1 <= δ2");
+      "delta1 <= delta2");
   rejects(
       [&] {
         auto q = s;
         q.technique = "vssm";
-        q.params = glm::vec4(0.0f);
+        q.parameters = {{"min_variance", 0.0f}};
         return q;
       }(),
-      "minimum variance");
+      "parameter min_variance = 0 is outside (0, 1]");
   rejects(
       [&] {
         auto q = s;
         q.technique = "cssm8";
-        q.params = glm::vec4(2.0f, 0.5f, 0.0f, 0.01f);
+        q.parameters = {{"scale", 0.5f}};
         return q;
       }(),
-      "scale y >= 1");
+      "parameter scale = 0.5 is outside [1, inf)");
   if (9u * 2048u > ctx().properties().limits.maxImageDimension2D)
     rejects(
         [&] {

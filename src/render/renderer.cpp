@@ -192,7 +192,7 @@ struct Renderer::Impl {
   FrameUniforms frame_uniforms(const RenderSettings& s, const Technique& technique) const {
     FrameUniforms u{};
     u.camera_view_projection = scene.camera_view_projection(float(s.width) / float(s.height));
-    u.technique_params = s.params ? *s.params : technique.default_params();
+    u.technique_params = s.parameter_vector();
     bool area_light = msm_technique_is_area_light(technique.id);
     float depth_bias = s.resolved_depth_bias();
     // The tables' techniques bias in soft.h (u.soft.z); PCSS, like every other, in the fragment depth.
@@ -314,8 +314,7 @@ struct Renderer::Impl {
     check(s);
     const Technique& technique = find_rendered_technique(s.technique);
     const std::vector<scene::DirectionalLight>& frame_lights = lights_of(s);
-    int id = technique.id;
-    bool one_pass = s.one_pass.value_or(msm_technique_is_nonlinear(id));
+    bool one_pass = s.one_pass.value_or(technique.one_pass_default());
     bool translucent =
         s.translucent_occluders && !gpu.translucent.empty() && supports_translucency(technique) && !one_pass;
     FrameConfig c{.technique = &technique,
@@ -329,7 +328,7 @@ struct Renderer::Impl {
                   .one_pass = one_pass,
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
-                  .soft_kernel = msm_technique_is_soft(id) ? s.resolved_soft_kernel() : 0,
+                  .soft_kernel = technique.soft() ? s.resolved_soft_kernel() : 0,
                   .lookup = resolved_lookup(s, technique),
 
                   .deferred = s.deferred_shading.value_or(default_deferred_shading(technique)) &&
@@ -340,32 +339,30 @@ struct Renderer::Impl {
                   .front_back = s.front_back_depth};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
-    c.mip_levels = mip_chain_levels(ctx,
-                                    s.mipmaps && !msm_technique_is_depth_based(id) && !msm_technique_is_nonlinear(id) &&
-                                        !msm_technique_is_soft(id),
-                                    c.formats(), c.moment_images(), s.shadow_size);
-    if (!msm_technique_is_nonlinear(id))
+    c.mip_levels =
+        mip_chain_levels(ctx, s.mipmaps && technique.mipmapped(), c.formats(), c.moment_images(), s.shadow_size);
+    if (!technique.nonlinear())
       for (int i = 0; i < c.moment_images(); ++i)
         if (!has_features(ctx, c.formats()[size_t(i)], VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
           throw RenderError(fmt::format("{} cannot filter format {} linearly ({})", ctx.info().name,
                                         int(c.formats()[size_t(i)]), technique.name));
-    // Resampling with filtering (JCGT §5.2) from the frame's blurred, mipmapped 4-moment map: the
-    // prefiltered techniques' parameter x = 1 adds its passes (recipe, FrameConfig::resampling_moments).
-    const glm::vec4 params = s.params ? *s.params : technique.default_params();
-    // Transmittance layers (rectification.h): parameter w = K in 1..8, 0 the default.
-    if (msm_technique_is_prefiltered_scattering(id)) {
+    // Prefiltered scattering: the transmittance layers (rectification.h), the β and the resampling,
+    // whose filtered kind (JCGT §5.2) adds the passes of the frame's blurred, mipmapped 4-moment map
+    // (recipe, FrameConfig::resampling_moments).
+    const std::string resampling = technique.prefiltered_scattering() ? s.parameter_text("resampling") : "none";
+    if (technique.prefiltered_scattering()) {
       c.transmittance_layers = transmittance_layers(s);
       c.prefix_sums_appendix_c = s.prefix_sums == RenderSettings::PrefixSums::appendix_c;
       c.prefix_sum_mips = mip_chain_levels(ctx, s.prefix_sum_mips, c.prefix_sum_formats(), 2, s.shadow_size);
-      c.scattering_beta = msm_scattering_beta_mode(params.z);
-      c.on_the_fly_resampling = params.x != 0.0f && params.x != 1.0f;
+      c.scattering_beta = technique.has_parameter("beta") ? int(s.parameter("beta")) : MSM_SCATTERING_BETA_PROPORTIONAL;
+      c.on_the_fly_resampling = resampling == "bilinear-moments";
     }
-    if (msm_technique_is_prefiltered_scattering(id) && params.x == 1.0f) {
+    if (resampling == "filtered") {
       c.filtered_resampling = true;
       const VkFormat f = c.resampling_moments().formats()[0];
       if (!has_features(ctx, f, VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
         throw RenderError(fmt::format("{} cannot filter RGBA32F linearly: the filtered resampling of {} needs it "
-                                      "(--param 0,0,0,0 resamples without filtering)",
+                                      "(--set resampling=none resamples without filtering)",
                                       ctx.info().name, technique.name));
       c.resampling_mips = mip_chain_levels(ctx, s.mipmaps, std::array<VkFormat, 1>{f}, 1, s.shadow_size);
     }
@@ -395,7 +392,7 @@ struct Renderer::Impl {
     // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, see above
     std::memcpy(lights.data(), light_data.data(), light_data.size() * sizeof(LightUniforms));
     scattering = scattering_push(s, technique);
-    if (msm_technique_is_prefiltered_scattering(technique.id)) {
+    if (technique.prefiltered_scattering()) {
       std::vector<RectificationUniforms> r;
       for (const scene::DirectionalLight& light : frame_lights) r.push_back(rectification_uniforms(s, light));
       // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout (vec4 members only)

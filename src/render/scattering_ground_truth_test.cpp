@@ -129,13 +129,13 @@ const std::map<std::string, std::map<std::string, Measured>> kMeasured = {
 double mae_bound(double measured) { return std::max(1.5 * measured, measured + 0.004); }
 double share_bound(double measured) { return measured + 0.05; }
 
-RenderSettings settings(std::string technique, glm::vec4 params = glm::vec4(0.0f), bool prefix_sum_mips = false) {
+RenderSettings settings(std::string technique, ParameterValues parameters = {}, bool prefix_sum_mips = false) {
   RenderSettings s;
   s.technique = std::move(technique);
   s.width = kWidth;
   s.height = kHeight;
   s.shadow_size = kShadowSize;
-  s.params = params;
+  s.parameters = parameters;
   s.prefix_sum_mips = prefix_sum_mips;
   return s;
 }
@@ -175,22 +175,21 @@ std::map<std::string, image::Metrics> check_scene(Renderer& renderer, const std:
   auto scene_measured = kMeasured.find(name);
   struct Run {
     std::string name;
-    glm::vec4 params;
+    ParameterValues params;
     bool mips = false;
   };
   std::vector<Run> runs;
-  for (const std::string& technique : kTechniques) runs.push_back({technique, glm::vec4(0.0f)});
+  for (const std::string& technique : kTechniques) runs.push_back({technique, {}});
   // Resampling with filtering from the blurred, mipmapped moment map (§5.2): "<technique>+filtered".
   for (const std::string& technique : kFilteredTechniques)
-    runs.push_back({technique + "+filtered", glm::vec4(1.0f, 0.0f, 0.0f, 0.0f)});
+    runs.push_back({technique + "+filtered", {{"resampling", 1.0f}}});
   // K transmittance layers instead of the single Δ(v) per row (rectification.h): "<technique>+layers".
-  for (const std::string& technique : kFilteredTechniques)
-    runs.push_back({technique + "+layers", glm::vec4(0.0f, 0.0f, 0.0f, 4.0f)});
+  for (const std::string& technique : kFilteredTechniques) runs.push_back({technique + "+layers", {{"layers", 4.0f}}});
   // App. D.5's mips of the prefix sums, read at the pixel's footprint across the rows: "<technique>+mips".
-  for (const std::string& technique : kFilteredTechniques) runs.push_back({technique + "+mips", glm::vec4(0.0f), true});
-  // §5.3.1's adaptive β instead of the proportional one (z = 2): "<technique>+adaptive".
+  for (const std::string& technique : kFilteredTechniques) runs.push_back({technique + "+mips", {}, true});
+  // §5.3.1's adaptive β instead of the proportional one: "<technique>+adaptive".
   for (const char* technique : {"scatter-msm4-64", "scatter-msm6-96"})
-    runs.push_back({std::string(technique) + "+adaptive", glm::vec4(0.0f, 0.0f, 2.0f, 0.0f)});
+    runs.push_back({std::string(technique) + "+adaptive", {{"beta", 2.0f}}});
   for (const auto& [technique, params, mips] : runs) {
     SCOPED_TRACE(technique);
     RenderResult r = renderer.render(settings(technique.substr(0, technique.find('+')), params, mips));
@@ -251,13 +250,14 @@ TEST_F(ScatteringGroundTruthTest, Tower) {
   struct Variant {
     const char* technique;
     const char* beta;
-    glm::vec4 params;
+    ParameterValues params;
   };
-  const Variant variants[] = {
-      {"scatter-msm4-64", "adaptive", glm::vec4(0, 0, 2, 0)}, {"scatter-msm4-64", "half", glm::vec4(0, 0.5f, 1, 0)},
-      {"scatter-msm4-64", "one", glm::vec4(0, 1.0f, 1, 0)},   {"scatter-msm4-64", "proportional", glm::vec4(0.0f)},
-      {"scatter-msm6-96", "adaptive", glm::vec4(0, 0, 2, 0)}, {"scatter-msm6-96", "half", glm::vec4(0, 0.5f, 1, 0)},
-      {"scatter-msm6-96", "one", glm::vec4(0, 1.0f, 1, 0)},   {"scatter-msm6-96", "proportional", glm::vec4(0.0f)}};
+  const ParameterValues adaptive = {{"beta", 2.0f}}, half = {{"beta", 1.0f}, {"fixed_beta", 0.5f}},
+                        one = {{"beta", 1.0f}, {"fixed_beta", 1.0f}};
+  const Variant variants[] = {{"scatter-msm4-64", "adaptive", adaptive}, {"scatter-msm4-64", "half", half},
+                              {"scatter-msm4-64", "one", one},           {"scatter-msm4-64", "proportional", {}},
+                              {"scatter-msm6-96", "adaptive", adaptive}, {"scatter-msm6-96", "half", half},
+                              {"scatter-msm6-96", "one", one},           {"scatter-msm6-96", "proportional", {}}};
   std::vector<image::Image> images;
   for (const Variant& v : variants)
     images.push_back(visible_fraction(renderer.render(settings(v.technique, v.params))));
@@ -318,9 +318,8 @@ TEST_F(ScatteringGroundTruthTest, Gate) {
         c.position += step;
         c.target += step;
         renderer.set_camera(c);
-        image::Image v =
-            visible_fraction(renderer.render(filtered == 3 ? settings(technique, glm::vec4(0.0f), true)
-                                                           : settings(technique, glm::vec4(float(filtered), 0, 0, 0))));
+        image::Image v = visible_fraction(renderer.render(
+            filtered == 3 ? settings(technique, {}, true) : settings(technique, {{"resampling", float(filtered)}})));
         if (frame > 0) change[filtered] += image::compute_metrics(v, previous).mae / 7.0;
         previous = v;
       }

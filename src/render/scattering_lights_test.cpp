@@ -40,10 +40,10 @@ scene::Scene two_lights() {
   return scene::load_scene_file(std::filesystem::path(MSM_TEST_DATA_DIR) / "gate_two_lights.json");
 }
 
-RenderSettings settings(const std::string& technique, glm::vec4 params = glm::vec4(0.0f)) {
+RenderSettings settings(const std::string& technique, ParameterValues parameters = {}) {
   RenderSettings s;
   s.technique = technique;
-  s.params = params;
+  s.parameters = parameters;
   s.width = kWidth;
   s.height = kHeight;
   s.shadow_size = kShadowSize;
@@ -70,16 +70,17 @@ TEST_F(ScatteringLightsTest, ScatteringIsTheSumOverTheLights) {
   const scene::Medium& medium = *scene.medium;
   Renderer renderer(ctx(), scene);
   // Every technique, and the prefiltered ones with filtered resampling from each light's own blurred,
-  // mipmapped moment map (JCGT §5.2, parameter x = 1).
-  std::vector<std::pair<std::string, glm::vec4>> runs;
-  for (const std::string& technique : kTechniques) runs.emplace_back(technique, glm::vec4(0.0f));
+  // mipmapped moment map (JCGT §5.2, resampling = filtered).
+  std::vector<std::pair<std::string, ParameterValues>> runs;
+  for (const std::string& technique : kTechniques) runs.emplace_back(technique, ParameterValues{});
   for (const char* technique : {"scatter-csm-32", "scatter-msm4-64", "scatter-msm6-96"})
-    runs.emplace_back(technique, glm::vec4(1.0f, 0.0f, 0.0f, 0.0f));
-  // And with 4 transmittance layers (parameter w): light l's layers K l .. K l + K − 1.
+    runs.emplace_back(technique, ParameterValues{{"resampling", 1.0f}});
+  // And with 4 transmittance layers: light l's layers K l .. K l + K − 1.
   for (const char* technique : {"scatter-csm-32", "scatter-msm4-64", "scatter-msm6-96"})
-    runs.emplace_back(technique, glm::vec4(0.0f, 0.0f, 0.0f, 4.0f));
+    runs.emplace_back(technique, ParameterValues{{"layers", 4.0f}});
   for (const auto& [technique, params] : runs) {
-    SCOPED_TRACE(technique + (params.x == 1.0f ? " filtered" : "") + (params.w == 4.0f ? " layers" : ""));
+    SCOPED_TRACE(technique + (params.contains("resampling") ? " filtered" : "") +
+                 (params.contains("layers") ? " layers" : ""));
     const RenderResult both = renderer.render(settings(technique, params));
     RenderResult alone[2];
     for (int l = 0; l < 2; ++l) {
@@ -120,8 +121,8 @@ TEST_F(ScatteringLightsTest, ScatteringIsTheSumOverTheLights) {
       }
     fmt::print("[two lights] {:<18}{} sum of the lights: worst relative error {:.2e}; visible fraction: worst {:.2e}; "
                "the second light's share of the blue in-scattering {:.2f}\n",
-               technique, params.x == 1.0f ? " filtered" : (params.w == 4.0f ? " layers" : ""), worst_relative,
-               worst_visible, second_share);
+               technique, params.contains("resampling") ? " filtered" : (params.contains("layers") ? " layers" : ""),
+               worst_relative, worst_visible, second_share);
     // The second light matters: it brings about half of the blue in-scattering (measured 0.50-0.55; 0.50-0.51
     // with filtered resampling).
     EXPECT_GT(second_share, 0.4);

@@ -199,7 +199,7 @@ TEST_F(ScatteringTest, PrefilteredAgreesWithRayMarching) {
       for (const Bound& b : bounds) {
         SCOPED_TRACE(b.technique);
         RenderSettings s = settings(b.technique);
-        s.params = glm::vec4(0.0f, 0.0f, beta_mode, 0.0f);
+        if (find_rendered_technique(b.technique).has_parameter("beta")) s.parameters = {{"beta", beta_mode}};
         RenderResult prefiltered = renderer.render(s);
         for (float v : prefiltered.scattering.pixels()) ASSERT_TRUE(std::isfinite(v));
         auto [mae, worst] = visible_difference(prefiltered, march);
@@ -222,7 +222,8 @@ TEST_F(ScatteringTest, PrefilteredAgreesWithRayMarching) {
       for (const Bound& b : {bounds[0], bounds[2]}) {
         const char* technique = b.technique;
         RenderSettings filtered = settings(technique);
-        filtered.params = glm::vec4(1.0f, 0.0f, beta_mode, 0.0f);
+        filtered.parameters = {{"resampling", 1.0f}}; // filtered
+        if (find_rendered_technique(technique).has_parameter("beta")) filtered.parameters["beta"] = beta_mode;
         RenderResult r = renderer.render(filtered);
         for (float v : r.scattering.pixels()) ASSERT_TRUE(std::isfinite(v));
         auto [mae, worst] = visible_difference(r, march);
@@ -248,10 +249,12 @@ TEST_F(ScatteringTest, PrefixSumSchemesAgree) {
   for (const char* technique :
        {"scatter-msm4-64", "scatter-msm6-64", "scatter-msm6-96", "scatter-msm6-192", "scatter-csm-32"})
     for (float layers : {0.0f, 3.0f}) {
-      SCOPED_TRACE(fmt::format("{}, --param 0,0,2,{}", technique, layers));
+      SCOPED_TRACE(fmt::format("{}, beta=adaptive layers={}", technique, layers));
       RenderSettings s = settings(technique);
       s.shadow_size = 200;
-      s.params = glm::vec4(0.0f, 0.0f, 2.0f, layers); // §5.3.1's β: its darker estimate makes the count below
+      s.parameters = {{"layers", layers}};
+      if (find_rendered_technique(technique).has_parameter("beta"))
+        s.parameters["beta"] = 2.0f; // §5.3.1's β: its darker estimate makes the count below
       s.prefix_sums = RenderSettings::PrefixSums::rows;
       RenderResult rows = renderer.render(s);
       s.prefix_sums = RenderSettings::PrefixSums::appendix_c;

@@ -17,7 +17,7 @@ namespace msm::render {
 std::vector<const Technique*> rendered_techniques() {
   std::vector<const Technique*> out;
   for (const Technique& t : techniques())
-    if (t.rendered) out.push_back(&t);
+    if (t.rendered()) out.push_back(&t);
   return out;
 }
 
@@ -39,40 +39,34 @@ const Technique& find_rendered_technique(std::string_view name) {
                                 technique_suggestion(name, names), valid));
 }
 
-bool supports_translucency(const Technique& t) {
-  return !msm_technique_is_depth_based(t.id) && !msm_technique_is_nonlinear(t.id) && !msm_technique_is_soft(t.id) &&
-         t.formats[1] == TexelFormat::none;
-}
-
-int max_soft_kernel(int technique_id) {
-  if (technique_id == MSM_TECH_PCSS) return kMaxPcssKernel;
-  if (technique_id == MSM_TECH_MSSM4) return MSM_SOFT_MAX_KERNEL_WIDTH4;
-  if (technique_id == MSM_TECH_MSSM6) return MSM_SOFT_MAX_KERNEL_WIDTH6;
-  return 255;
-}
+bool supports_translucency(const Technique& t) { return t.translucency; }
 
 int RenderSettings::resolved_soft_kernel() const {
   if (soft_kernel != 0) return soft_kernel;
-  return find_rendered_technique(technique).id == MSM_TECH_PCSS ? kDefaultPcssKernel : kDefaultSatKernel;
+  const Technique& t = find_rendered_technique(technique);
+  return t.area_light ? t.default_soft_kernel : kSatKernelDefault;
 }
 
 float RenderSettings::resolved_depth_bias() const {
-  if (depth_bias) return *depth_bias;
-  int id = find_rendered_technique(technique).id;
-  // Soft shadows: the 32-bit tables keep ~22 bits of a 27² kernel's moments, plus the moment
-  // bias: 1e-3 in [-1,1] depth (JCGT §4.4's constant part). PCSS gets the same constant: its
-  // receiver planes are exact for planar receivers only, and across a 15-texel kernel curved ones
-  // (the models scene's knots) would shadow themselves (MAE 0.018 at 2e-5, 0.006 at 5e-4).
-  if (msm_technique_is_area_light(id)) return 5e-4f;
-  // Depth-based: 16-bit depth rounding (a step is 1.5e-5). Filtered: the moments come from the
-  // rounded D16 depths, the fragment's depth is a float: a receiver lit straight down is compared
-  // against its own texels up to half a step (7.6e-6) too far, which the float techniques' tiny
-  // moment bias (3e-7) does not absorb (msm-hamburger-128 read bare ground as shadowed).
-  // Non-linear maps: HPG §5 uses a constant 1e-3 in [-1,1] depth for all results; it is half a
-  // bin of msm-nl32's 10-bit depths (1/1023), which otherwise shadow a flat receiver facing the
-  // light wherever its depth rounds towards the light.
-  if (msm_technique_is_nonlinear(id)) return 5e-4f;
-  return msm_technique_is_depth_based(id) ? 2e-5f : 1e-5f;
+  return depth_bias ? *depth_bias : find_rendered_technique(technique).depth_bias;
+}
+
+glm::vec4 RenderSettings::parameter_vector() const {
+  return msm::parameter_vector(find_rendered_technique(technique), parameters);
+}
+
+float RenderSettings::parameter(std::string_view name) const {
+  return parameter_value(find_rendered_technique(technique), parameters, name);
+}
+
+void RenderSettings::set_parameter(std::string_view name, float value) {
+  parameters[std::string(find_rendered_technique(technique).parameter(name).name)] = value;
+}
+
+void RenderSettings::reset_parameters() { parameters.clear(); }
+
+std::string RenderSettings::parameter_text(std::string_view name) const {
+  return find_rendered_technique(technique).parameter(name).value_text(parameter(name));
 }
 
 void RenderSettings::validate() const {
@@ -98,34 +92,29 @@ void RenderSettings::validate() const {
   finite("exposure", exposure, 1e-6f, 1e6f);
   if (depth_bias) finite("depth bias", *depth_bias, -1.0f, 1.0f);
   const Technique& t = find_rendered_technique(technique);
-  bool nonlinear = msm_technique_is_nonlinear(t.id);
+  bool nonlinear = t.nonlinear();
   if (one_pass && !*one_pass && nonlinear)
     throw RenderError(fmt::format("{} needs the one-pass filter (it stores Φ of the filtered moments)", technique));
-  bool uses_one_pass = one_pass.value_or(nonlinear);
-  if (uses_one_pass && msm_technique_is_soft(t.id))
+  bool uses_one_pass = one_pass.value_or(t.one_pass_default());
+  if (uses_one_pass && t.soft())
     throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
   if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
   if (light_height_deg) finite("light height", *light_height_deg, 0.0f, 89.0f);
-  if (front_back_depth && !msm_technique_is_soft(t.id))
+  if (front_back_depth && !t.soft())
     throw RenderError(fmt::format("front-and-back-face depth applies to the moment soft shadows (mssm4, mssm6, "
                                   "vssm, cssm8, cssm16), not to {}",
                                   technique));
-  if (soft_kernel != 0) {
-    // Moment tables: the bias that covers their rounding (log2((2^32 - 1) / W²) bits) keeps a
-    // plane of one depth reconstructible up to max_soft_kernel only (soft.h).
-    int widest = max_soft_kernel(t.id);
-    if (soft_kernel < 3 || soft_kernel > widest) {
-      bool precision = soft_kernel > widest && (t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6);
-      std::string why =
-          precision ? fmt::format(" for {}: its 32-bit summed-area tables keep log2((2^32 - 1) / W²) = {:.1f} bits per "
-                                  "moment at W = {}, a rounding coarser than its moment bias covers (a plane of one "
-                                  "depth is not reconstructed above W = {})",
-                                  technique, std::log2(4294967295.0 / (double(soft_kernel) * double(soft_kernel))),
-                                  soft_kernel, widest)
-                    : std::string();
-      throw RenderError(fmt::format("soft kernel = {} is outside [3, {}]{}", soft_kernel, widest, why));
-    }
-  }
+  if (soft_kernel != 0 && t.area_light && soft_kernel > t.max_soft_kernel && t.max_soft_kernel < kSatKernelMax &&
+      t.recipe == Recipe::summed_area_tables)
+    // Moment tables: the bias that covers their rounding (log2((2^32 - 1) / W²) bits) keeps a plane
+    // of one depth reconstructible up to the row's max_soft_kernel only (soft.h).
+    throw RenderError(fmt::format(
+        "soft kernel = {} is outside [3, {}] for {}: its 32-bit summed-area tables keep log2((2^32 - 1) / W²) = "
+        "{:.1f} bits per moment at W = {}, a rounding coarser than its moment bias covers (a plane of one depth is "
+        "not reconstructed above W = {})",
+        soft_kernel, t.max_soft_kernel, technique, std::log2(4294967295.0 / (double(soft_kernel) * double(soft_kernel))),
+        soft_kernel, t.max_soft_kernel));
+  if (soft_kernel != 0) range("soft kernel", soft_kernel, 3, t.area_light ? t.max_soft_kernel : kSatKernelMax);
   if (uses_one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
   if (uses_one_pass && filter_size > kMaxOnePassTaps)
@@ -133,32 +122,23 @@ void RenderSettings::validate() const {
         fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size, kMaxOnePassTaps));
   if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
   finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
-  if (params) {
-    for (int i = 0; i < 4; ++i)
-      if (!std::isfinite((*params)[i])) throw RenderError("technique parameters must be finite");
-    const glm::vec4& p = *params;
-    // The blocker estimators divide by δ1 + (blocker mass) and VSSM by the variance.
-    if ((t.id == MSM_TECH_MSSM4 || t.id == MSM_TECH_MSSM6) && !(p.x > 0.0f && p.x <= p.y && p.y <= 1.0f))
-      throw RenderError(
-          fmt::format("{}: parameters x = δ1 = {} and y = δ2 = {} need 0 < δ1 <= δ2 <= 1", technique, p.x, p.y));
-    // Prefiltered scattering: w = the transmittance layers K (0: the default).
-    if (msm_technique_is_prefiltered_scattering(t.id) &&
-        !(p.w >= 0.0f && p.w <= float(MSM_RECT_MAX_LAYERS) && p.w == std::floor(p.w)))
-      throw RenderError(fmt::format("{}: parameter w = transmittance layers = {} must be an integer in 0..{} (0: the "
-                                    "default)",
-                                    technique, p.w, MSM_RECT_MAX_LAYERS));
-    if (msm_technique_is_cssm(t.id) &&
-        !(p.x >= 0.0f && p.y >= 1.0f && p.z >= 0.0f && p.z < 1.0f && p.w >= 0.0f && p.w < 1.0f))
-      throw RenderError(fmt::format("{}: parameters need damping x >= 0, scale y >= 1, offset z in [0, 1) and least "
-                                    "blocker share w in [0, 1) (got {}, {}, {}, {})",
-                                    technique, p.x, p.y, p.z, p.w));
-    if (t.id == MSM_TECH_VSSM && !(p.w > 0.0f))
-      throw RenderError(fmt::format("vssm: parameter w = minimum variance = {} must be positive", p.w));
+  for (const auto& [name, value] : parameters) {
+    try {
+      t.parameter(name);
+    } catch (const std::invalid_argument& e) { throw RenderError(e.what()); }
   }
+  for (const Parameter* p : t.parameter_list())
+    if (float v = parameter(p->name); !p->accepts(v))
+      throw RenderError(
+          fmt::format("{}: parameter {} = {} is outside {}", technique, p->name, p->value_text(v), p->range_text()));
+  // The blocker estimators count the mass at the fragment's depth between δ1 and δ2.
+  if (t.has_parameter("delta2") && !(parameter("delta1") <= parameter("delta2")))
+    throw RenderError(fmt::format("{}: parameters need delta1 <= delta2 (got {} and {})", technique,
+                                  parameter("delta1"), parameter("delta2")));
   // The blur does not guard against non-finite texels: the resolve must not make any. The warps are
   // monotone in depth, so the ends of the depth range bound every texel.
-  if (!msm_technique_is_depth_based(t.id) && !nonlinear) {
-    glm::vec4 p = params.value_or(t.default_params());
+  if (!t.depth_based() && !nonlinear) {
+    glm::vec4 p = parameter_vector();
     for (float depth : {0.0f, 1.0f}) {
       MsmTexel texel = msm_technique_generate(t.id, depth, p);
       for (int image = 0; image < 2; ++image) {
@@ -200,9 +180,9 @@ std::uint64_t texel_bytes(TexelFormat f) {
 
 int transmittance_layers(const RenderSettings& s) {
   const Technique& t = find_rendered_technique(s.technique);
-  if (!msm_technique_is_prefiltered_scattering(t.id)) return 1;
-  const float w = s.params ? s.params->w : t.default_params().w;
-  return w == 0.0f ? kDefaultTransmittanceLayers : int(w);
+  if (!t.prefiltered_scattering()) return 1;
+  const float layers = s.parameter("layers");
+  return layers == 0.0f ? kDefaultTransmittanceLayers : int(layers);
 }
 
 std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights) {
@@ -212,8 +192,7 @@ std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, 
   const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
   // Prefiltered scattering: every light's rectified map and prefix sums (K transmittance layers),
   // shadow size² each.
-  glm::ivec2 scatter =
-      msm_technique_is_prefiltered_scattering(t.id) ? msm_technique_scatter_map_bytes(t.id) : glm::ivec2(0);
+  glm::ivec2 scatter = t.prefiltered_scattering() ? msm_technique_scatter_map_bytes(t.id) : glm::ivec2(0);
   scatter.y *= transmittance_layers(s);
   return triangles * limits::kRendererBytesPerTriangle +
          std::uint64_t(s.width) * std::uint64_t(s.height) * limits::kRendererBytesPerPixel +

@@ -159,14 +159,13 @@ TEST_F(SoftShadowTest, UpperBoundBlockerDepthLeaksLessThanEquation4) {
     reference::Result truth = area_light_truth(scene, width, height, 10.0);
     image::Image mask = truth.visibility.channel("background");
     Renderer renderer(ctx(), scene);
-    auto measure = [&](std::optional<glm::vec4> params) {
+    auto measure = [&](ParameterValues parameters) {
       RenderSettings s = soft_settings("mssm6", width, height, 10.0f);
-      s.params = params;
+      s.parameters = parameters;
       image::Image v = renderer.render(s).shadow.channel("visibility");
       return image::compute_metrics(v, truth.visibility.channel("visibility"), {.mask = &mask});
     };
-    image::Metrics eq19 = measure(std::nullopt),
-                   eq4 = measure(glm::vec4(MSM_BLOCKER_EPSILON, MSM_BLOCKER_EPSILON, 0, 0));
+    image::Metrics eq19 = measure({}), eq4 = measure({{"delta2", MSM_BLOCKER_EPSILON}, {"blocker_estimate", 0.0f}});
     fmt::print("{} 10°: mssm6 light leaking Eq. (19) {:.5f}, Eq. (4) {:.5f} (ratio {:.2f}); MAE {:.5f}, {:.5f}\n", name,
                eq19.light_leaking, eq4.light_leaking, eq19.light_leaking / eq4.light_leaking, eq19.mae, eq4.mae);
     const bool fence = std::string(name) == "fence";

@@ -2,7 +2,6 @@
 // setter, so a script exercises what the panel does.
 #include "viewer_state.h"
 
-#include "msm/techniques.h"
 #include "msm/vk/context.h"
 #include "msm/vk/swapchain.h"
 
@@ -52,6 +51,38 @@ std::vector<std::string> technique_names() {
 // A setting through the view file's setter (the one `set KEY VALUE` uses).
 void set(render::RenderSettings& s, const char* key, const nlohmann::json& value) { apply_setting(s, key, value); }
 
+// One widget per declared parameter of the technique (msm/cpu/techniques.h), its meaning as the
+// tooltip; a value outside the declared range is not set.
+void technique_parameters(render::RenderSettings& s, const Technique& t) {
+  for (const Parameter* p : t.parameter_list()) {
+    const std::string label(p->name);
+    float value = s.parameter(p->name);
+    bool changed = false;
+    switch (p->type) {
+    case ParameterType::choice: {
+      std::string choice = p->value_text(value);
+      std::vector<std::string> names;
+      for (const ParameterChoice& c : p->choices) names.emplace_back(c.name);
+      if (choose(label.c_str(), choice, names)) value = p->parse(choice), changed = true;
+      break;
+    }
+    case ParameterType::flag: {
+      bool on = value != 0.0f;
+      if (ImGui::Checkbox(label.c_str(), &on)) value = on ? 1.0f : 0.0f, changed = true;
+      break;
+    }
+    case ParameterType::integer: {
+      int v = int(value);
+      if (ImGui::InputInt(label.c_str(), &v)) value = float(v), changed = true;
+      break;
+    }
+    case ParameterType::number: changed = ImGui::InputFloat(label.c_str(), &value, 0.0f, 0.0f, "%.3g"); break;
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s (%s)", std::string(p->meaning).c_str(), p->range_text().c_str());
+    if (changed && p->accepts(value)) s.set_parameter(p->name, value);
+  }
+}
+
 } // namespace
 
 glm::vec3 Viewer::light_direction() const {
@@ -76,11 +107,10 @@ void Viewer::set_technique(const std::string& name) {
   std::string canonical(canonical_technique_name(name));
   if (canonical == view.settings.technique) return;
   set(view.settings, "technique", canonical);
-  view.settings.params.reset(); // another technique's parameters mean something else
+  view.settings.reset_parameters(); // another technique's parameters mean something else
   // Front- and back-face averaged depth (Kneiphof §4.2.3) is for the soft techniques only
   // (RenderSettings::validate): off for any other, which would refuse it.
-  if (!msm_technique_is_soft(render::find_rendered_technique(view.settings.technique).id))
-    view.settings.front_back_depth = false;
+  if (!render::find_rendered_technique(view.settings.technique).soft()) view.settings.front_back_depth = false;
 }
 
 void Viewer::set_split(const std::string& name) {
@@ -257,19 +287,7 @@ void Viewer::panel() {
 
   if (ImGui::CollapsingHeader("Technique settings", ImGuiTreeNodeFlags_DefaultOpen)) {
     const Technique& t = render::find_rendered_technique(s.technique);
-    bool defaults = !s.params;
-    if (ImGui::Checkbox("papers' parameters", &defaults)) {
-      if (defaults)
-        s.params.reset();
-      else
-        s.params = t.default_params();
-    }
-    if (s.params) {
-      ImGui::InputFloat4("params", &s.params->x, "%.3g");
-      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%.*s", int(t.parameters.size()), t.parameters.data());
-    } else if (!t.parameters.empty()) {
-      ImGui::TextWrapped("%.*s", int(t.parameters.size()), t.parameters.data());
-    }
+    technique_parameters(s, t);
     bool own_bias = s.depth_bias.has_value();
     if (ImGui::Checkbox("depth bias", &own_bias)) {
       if (own_bias)
@@ -293,8 +311,8 @@ void Viewer::panel() {
     if (choose("filter", mode, {"auto", "one-pass", "three-pass"})) set(s, "filter_mode", mode);
     std::string lookup = setting_json(s, "lookup").get<std::string>();
     if (choose("lookup", lookup, {"auto", "bilinear", "nearest", "dither"})) set(s, "lookup", lookup);
-    if (msm_technique_is_soft(t.id) || msm_technique_is_area_light(t.id)) {
-      ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, render::max_soft_kernel(t.id));
+    if (t.area_light) {
+      ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.max_soft_kernel);
       // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
       // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
       const scene::DirectionalLight drawn =
@@ -320,7 +338,7 @@ void Viewer::panel() {
     }
     // Kneiphof §4.2.3: the moments of the mean of the nearest front- and back-face depth (a second
     // depth pass); the soft techniques only, greyed out for the others.
-    ImGui::BeginDisabled(!msm_technique_is_soft(t.id));
+    ImGui::BeginDisabled(!t.soft());
     ImGui::Checkbox("front+back face depth", &s.front_back_depth);
     ImGui::EndDisabled();
     ImGui::Checkbox("translucent occluders", &s.translucent_occluders);

@@ -67,6 +67,46 @@ const char* lookup_name(Lookup l) {
   }
 }
 
+// The technique's parameters by name (msm techniques NAME): numbers, integers, true/false, a
+// choice by its name.
+json parameters_json(const render::RenderSettings& s) {
+  json out = json::object();
+  for (const Parameter* p : render::find_rendered_technique(s.technique).parameter_list()) {
+    const float v = s.parameter(p->name);
+    json& value = out[std::string(p->name)];
+    if (p->type == ParameterType::number)
+      value = v;
+    else if (p->type == ParameterType::integer)
+      value = int(v);
+    else if (p->type == ParameterType::flag)
+      value = v != 0.0f;
+    else
+      value = p->value_text(v);
+  }
+  return out;
+}
+
+// The inverse, validated against the technique's declarations (the technique comes first in
+// setting_keys(), so that a file's names are its parameters'). Null: every default.
+void set_parameters(render::RenderSettings& s, const json& v) {
+  if (v.is_null()) return s.reset_parameters();
+  if (!v.is_object()) fail("parameters", fmt::format("expected {{\"NAME\": value, ...}} or null, got {}", v.dump()));
+  const Technique& t = render::find_rendered_technique(s.technique);
+  ParameterValues values;
+  for (const auto& [name, value] : v.items()) {
+    const std::string where = "parameters/" + name;
+    if (!value.is_string() && !value.is_boolean() && !value.is_number())
+      fail(where, fmt::format("expected a number, true/false or a name, got {}", value.dump()));
+    const std::string text = value.is_string()    ? value.get<std::string>()
+                             : value.is_boolean() ? (value.get<bool>() ? "on" : "off")
+                                                  : value.dump();
+    try {
+      set_parameter(t, values, name + "=" + text);
+    } catch (const std::invalid_argument& e) { fail(where, e.what()); }
+  }
+  s.parameters = values;
+}
+
 } // namespace
 
 std::vector<std::string> setting_keys() {
@@ -78,7 +118,7 @@ std::vector<std::string> setting_keys() {
           "filter_size",
           "filter_sigma",
           "mipmaps",
-          "params",
+          "parameters",
           "overdarken",
           "normal_offset",
           "depth_bias",
@@ -86,7 +126,7 @@ std::vector<std::string> setting_keys() {
           "exposure",
           "lookup",
           "filter_mode",
-          "frame",
+          "noise_frame",
           "translucent_occluders",
           "coloured_translucency",
           "alpha_threshold",
@@ -116,14 +156,11 @@ void apply_setting(render::RenderSettings& s, std::string_view key, const json& 
     s.filter_sigma = number(key, v);
   else if (key == "mipmaps")
     s.mipmaps = boolean(key, v);
-  else if (key == "params") {
-    if (v.is_null())
-      s.params.reset();
-    else if (!v.is_array() || v.size() != 4)
-      fail(key, fmt::format("expected [x, y, z, w] or null (the technique's defaults), got {}", v.dump()));
-    else
-      s.params = glm::vec4(number(key, v[0]), number(key, v[1]), number(key, v[2]), number(key, v[3]));
-  } else if (key == "overdarken")
+  else if (key == "parameters")
+    set_parameters(s, v);
+  else if (key == "params") // the positional vector of older versions
+    fail(key, "replaced by \"parameters\", each by name (msm techniques NAME lists them)");
+  else if (key == "overdarken")
     s.overdarken = number(key, v);
   else if (key == "normal_offset")
     s.normal_offset = number(key, v);
@@ -158,7 +195,7 @@ void apply_setting(render::RenderSettings& s, std::string_view key, const json& 
       s.one_pass = false;
     else
       fail(key, fmt::format("'{}': expected auto, one-pass or three-pass", m));
-  } else if (key == "frame")
+  } else if (key == "noise_frame")
     s.frame = integer(key, v);
   else if (key == "translucent_occluders")
     s.translucent_occluders = boolean(key, v);
@@ -193,7 +230,7 @@ json setting_json(const render::RenderSettings& s, std::string_view key) {
   if (key == "filter_size") return s.filter_size;
   if (key == "filter_sigma") return s.filter_sigma;
   if (key == "mipmaps") return s.mipmaps;
-  if (key == "params") return s.params ? json::array({s.params->x, s.params->y, s.params->z, s.params->w}) : json();
+  if (key == "parameters") return parameters_json(s);
   if (key == "overdarken") return s.overdarken;
   if (key == "normal_offset") return s.normal_offset;
   if (key == "depth_bias") return s.depth_bias ? json(*s.depth_bias) : json();
@@ -201,7 +238,7 @@ json setting_json(const render::RenderSettings& s, std::string_view key) {
   if (key == "exposure") return s.exposure;
   if (key == "lookup") return lookup_name(s.lookup);
   if (key == "filter_mode") return !s.one_pass ? "auto" : *s.one_pass ? "one-pass" : "three-pass";
-  if (key == "frame") return s.frame;
+  if (key == "noise_frame") return s.frame;
   if (key == "translucent_occluders") return s.translucent_occluders;
   if (key == "coloured_translucency") return s.coloured_translucency;
   if (key == "alpha_threshold") return s.translucent_alpha_threshold;
@@ -252,6 +289,8 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
   try {
     j = json::parse(text, nullptr, true, true);
   } catch (const json::parse_error& e) { throw ViewError(fmt::format("{}: malformed JSON: {}", name, e.what())); }
+  // A render's JSON output holds its view under "view" (msm render --view renders it again).
+  if (j.is_object() && !j.contains("msm_view") && j.contains("view") && j["view"].is_object()) j = json(j["view"]);
   try {
     check_keys(j, "", {"msm_view", "scene", "camera", "lights", "settings", "object_frame"});
     if (!j.contains("msm_view") || j["msm_view"] != 1) fail("/msm_view", "required, and only version 1 exists");
@@ -321,7 +360,12 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
     if (j.contains("settings")) {
       const json& s = j["settings"];
       if (!s.is_object()) fail("/settings", "expected an object");
-      for (const auto& [key, value] : s.items()) {
+      // The technique first: the parameters are its own.
+      std::vector<std::pair<std::string, json>> items;
+      if (s.contains("technique")) items.emplace_back("technique", s["technique"]);
+      for (const auto& [key, value] : s.items())
+        if (key != "technique") items.emplace_back(key, value);
+      for (const auto& [key, value] : items) {
         try {
           apply_setting(v.settings, key, value);
         } catch (const ViewError& e) { throw ViewError(fmt::format("/settings/{}", e.what())); }

@@ -44,7 +44,7 @@ TEST(ViewFile, RoundTripIsExact) {
   s.filter_size = 5;
   s.filter_sigma = 1.7f;
   s.mipmaps = false;
-  s.params = glm::vec4(0.1f, 0.2f, 0.3f, 1e-7f);
+  s.parameters = {{"min_variance", 1e-7f}};
   s.depth_bias = 3e-5f;
   s.lookup = render::RenderSettings::Lookup::nearest;
   s.one_pass = false;
@@ -61,7 +61,9 @@ TEST(ViewFile, RoundTripIsExact) {
   EXPECT_EQ(back.camera->position, c.position); // bit-identical floats, not close ones
   EXPECT_EQ(back.camera->near, c.near);
   EXPECT_EQ(back.settings.lights.at(0).towards_light, l.towards_light);
-  EXPECT_EQ(*back.settings.params, *s.params);
+  EXPECT_EQ(back.settings.parameters, s.parameters);
+  EXPECT_EQ(j["settings"]["parameters"].size(), 1u); // by name
+  EXPECT_EQ(j["settings"]["parameters"]["min_variance"].get<float>(), 1e-7f);
   EXPECT_EQ(*back.settings.depth_bias, *s.depth_bias);
   EXPECT_EQ(back.settings.lookup, s.lookup);
   EXPECT_EQ(back.settings.one_pass, s.one_pass);
@@ -74,7 +76,7 @@ TEST(ViewFile, DefaultsStayDefaults) {
   EXPECT_EQ(v.scene, "fence");
   EXPECT_FALSE(v.camera); // the scene's
   EXPECT_TRUE(v.settings.lights.empty());
-  EXPECT_FALSE(v.settings.params);
+  EXPECT_TRUE(v.settings.parameters.empty());
   EXPECT_FALSE(v.settings.depth_bias);
   EXPECT_FALSE(v.settings.light_extent_deg);
   EXPECT_FALSE(v.settings.light_height_deg);
@@ -144,6 +146,22 @@ TEST(ViewFile, BadInputNamesTheKey) {
             std::string::npos);
   EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"msaa": "four"}})").find("/settings/msaa: expected an integer"),
             std::string::npos);
+  // Parameters by name, validated against the technique's declarations whatever the keys' order.
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"parameters": {"betta": "fixed"}, "technique": "scatter-msm6-96"}})")
+                .find("v.json: /settings/parameters/betta: unknown parameter 'betta' of scatter-msm6-96 (did you "
+                      "mean beta?)"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"technique": "msm", "parameters": {"moment_bias": -1}}})")
+                .find("/settings/parameters/moment_bias: moment_bias = '-1' is outside [0, 1]"),
+            std::string::npos);
+  EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"params": [0, 0, 0, 0]}})")
+                .find("/settings/params: replaced by \"parameters\", each by name (msm techniques NAME lists them)"),
+            std::string::npos);
+  View named = parse_view(
+      R"({"msm_view": 1, "settings": {"parameters": {"beta": "adaptive", "layers": 4}, "technique": "scatter-msm6-96"}})",
+      "v.json");
+  EXPECT_EQ(named.settings.parameter_text("beta"), "adaptive");
+  EXPECT_EQ(named.settings.parameter("layers"), 4.0f);
   EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"technique": "nope"}})").find("unknown technique 'nope'"),
             std::string::npos);
   EXPECT_NE(bad(R"({"msm_view": 1, "settings": {"filter_size": 8}})").find("filter size = 8 must be odd"),
@@ -180,13 +198,14 @@ TEST(ViewFile, SaveIsAtomicAndLoadsBack) {
 }
 
 TEST(Script, ParsesActionsAndComments) {
-  std::vector<Action> a = parse_script("# comment\n\ntechnique msm  # trailing\nset params [0, 0, 0, 3e-5]\n"
-                                       "set lookup nearest\nresize 640 360\nquit\n",
-                                       "s.txt");
+  std::vector<Action> a =
+      parse_script("# comment\n\ntechnique msm  # trailing\nset parameters {\"moment_bias\": 3e-5}\n"
+                   "set lookup nearest\nresize 640 360\nquit\n",
+                   "s.txt");
   ASSERT_EQ(a.size(), 5u);
   EXPECT_EQ(a[0].verb, "technique");
   EXPECT_EQ(a[0].line, 3);
-  EXPECT_EQ(a[1].args.at(1), "[0, 0, 0, 3e-5]"); // the rest of the line
+  EXPECT_EQ(a[1].args.at(1), "{\"moment_bias\": 3e-5}"); // the rest of the line
   EXPECT_EQ(setting_value(a[2].args.at(1)), "nearest");
   EXPECT_EQ(a[4].where, "s.txt:7");
 }

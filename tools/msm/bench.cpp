@@ -11,6 +11,7 @@
 #include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
 #include "msm/util/statistics.h"
+#include "msm/viewer/view_file.h"
 #include "msm/vk/vk.h"
 
 #include <fmt/core.h>
@@ -263,8 +264,8 @@ std::string scattering_markdown(nlohmann::json& results, const std::vector<std::
     for (nlohmann::json& entry : results) {
       if (!entry.contains("scattering")) continue;
       md += fmt::format("| {} |", entry["technique"].get<std::string>());
-      const bool prefiltered = msm_technique_is_prefiltered_scattering(
-          render::find_rendered_technique(entry["technique"].get<std::string>()).id);
+      const bool prefiltered =
+          render::find_rendered_technique(entry["technique"].get<std::string>()).prefiltered_scattering();
       for (auto [w, h] : resolutions) {
         std::string key = fmt::format("{}x{}", w, h);
         nlohmann::json& v = entry["scattering"][key];
@@ -341,7 +342,7 @@ void add_bench(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
                                           "pixel, shadow map per texel)");
-  cmd->add_option("--techniques", opt->techniques, "Techniques or aliases (default: all)")->delimiter(',');
+  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases (default: all)")->delimiter(',');
   cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")
       ->delimiter(',')
       ->capture_default_str();
@@ -372,9 +373,8 @@ void add_bench(CLI::App& app) {
                   "Time the light-probe pipeline instead (an equirectangular EXR, or 'sky'): cube map, tables and "
                   "median cut on the device against face size and light count");
   cmd->add_option("--probe-sizes", opt->probe.sizes, "Face sizes for --probe")->delimiter(',')->capture_default_str();
-  cmd->add_option("--probe-lights", opt->probe.lights, "Light counts for --probe")
-      ->delimiter(',')
-      ->capture_default_str();
+  add_deprecated_option(cmd, "--probe-lights", "--lights", opt->probe.lights)->delimiter(',');
+  cmd->add_option("--lights", opt->probe.lights, "Light counts for --probe")->delimiter(',')->capture_default_str();
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt, cmd] {
     auto given = [cmd](const char* option) { return cmd->get_option(option)->count() > 0; };
@@ -408,7 +408,7 @@ void add_bench(CLI::App& app) {
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     if (opt->scattering)
       for (const std::string& name : names)
-        if (!msm_technique_is_scattering(render::find_rendered_technique(name).id))
+        if (!render::find_rendered_technique(name).scatters())
           throw UsageError(fmt::format("--scattering: '{}' is not a scattering technique (msm techniques)", name));
     if (!opt->callgrind && !opt->scattering && std::find(names.begin(), names.end(), "pcf") == names.end())
       names.insert(names.begin(), "pcf");
@@ -459,21 +459,22 @@ void add_bench(CLI::App& app) {
       return renderer.time_frames(s, opt->frames);
     };
     // --scattering: the shadow-map sizes only for the rectified map of the prefiltered techniques.
-    auto sizes_for = [&](int id) {
-      return opt->scattering && !msm_technique_is_prefiltered_scattering(id) ? std::vector<int>{} : opt->shadow_sizes;
+    auto sizes_for = [&](const Technique& t) {
+      return opt->scattering && !t.prefiltered_scattering() ? std::vector<int>{} : opt->shadow_sizes;
     };
     nlohmann::json results = nlohmann::json::array();
     std::map<std::string, std::map<std::string, double>> per_unit; // technique -> config -> ns per unit
     size_t total = 0, done = 0;
     for (const std::string& name : names)
-      total += resolutions.size() + sizes_for(render::find_rendered_technique(name).id).size();
+      total += resolutions.size() + sizes_for(render::find_rendered_technique(name)).size();
     for (const std::string& name : names) {
       nlohmann::json entry = {{"technique", name},
+                              {"parameters", viewer::setting_json(settings_for(opt->frame, name), "parameters")},
                               {"shading", nlohmann::json::object()},
                               {"shadow_map", nlohmann::json::object()},
                               {"passes", nlohmann::json::object()}};
-      const int id = render::find_rendered_technique(name).id;
-      const bool scatters = msm_technique_is_scattering(id), prefiltered = msm_technique_is_prefiltered_scattering(id);
+      const Technique& technique = render::find_rendered_technique(name);
+      const bool scatters = technique.scatters(), prefiltered = technique.prefiltered_scattering();
       for (auto [w, h] : resolutions) {
         render::RenderSettings s = settings_for(opt->frame, name);
         s.width = w;
@@ -499,7 +500,7 @@ void add_bench(CLI::App& app) {
             entry["passes"][p.name] = {{"median_ms", ps.median}, {"p10_ms", ps.p10}, {"p90_ms", ps.p90}};
           }
       }
-      for (int size : sizes_for(id)) {
+      for (int size : sizes_for(technique)) {
         render::RenderSettings s = settings_for(opt->frame, name);
         s.width = 320; // the shadow-map passes do not depend on the image size
         s.height = 180;
@@ -515,7 +516,7 @@ void add_bench(CLI::App& app) {
                 scatter = pass_sum(frames, {"scattering"});
           std::map<std::string, double> host =
               host_pass_ms(renderer, s, {"rectify", "prefix_sums", "scattering"}, opt->repeats);
-          const glm::ivec2 bytes = msm_technique_scatter_map_bytes(id);
+          const glm::ivec2 bytes = msm_technique_scatter_map_bytes(technique.id);
           const double texels = double(size) * size;
           // The prefix sums read the rectified map and write their layer once per transmittance layer.
           const auto copy_bytes = VkDeviceSize(texels * (bytes.x + bytes.y) / 2 * render::transmittance_layers(s));
@@ -576,7 +577,7 @@ void add_bench(CLI::App& app) {
       const std::string name = entry["technique"];
       for (auto& [key, value] : entry["shading"].items()) {
         if (with_pcf) value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
-        if (with_pcss && msm_technique_is_area_light(render::find_rendered_technique(name).id))
+        if (with_pcss && render::find_rendered_technique(name).area_light)
           value["ratio_to_pcss"] = per_unit[name]["shading " + key] / per_unit["pcss"]["shading " + key];
       }
       if (with_pcf)

@@ -253,7 +253,7 @@ void add_demo(CLI::App& app) {
               "scattering, and image-based lighting (a probe cut into 16-256 area lights) against the whole "
               "probe, in between");
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
-  cmd->add_option("--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
+  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
       ->delimiter(',');
   cmd->add_option("--soft-scene", opt->soft_scene, "Scene of the soft-shadow part")->capture_default_str();
   cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques or aliases (\"\": skip the soft part)")

@@ -106,7 +106,7 @@ void add_evaluate(CLI::App& app) {
   cmd->add_option("--candidates", opt->candidates,
                   "Candidate list: named | all:K | sample:K:N[:SEED] | f1+f2+.. | power4, trig4, vsm, esm, .. "
                   "(comma-separated; default named; --functions lists the 37 functions)");
-  cmd->add_option("--out", opt->out, "Output directory (default out/evaluate)");
+  cmd->add_option("-o,--out", opt->out, "Output directory (default out/evaluate)");
   cmd->add_option("--size", opt->stack.size, "Shadow map texels per side (default 128)");
   cmd->add_option("--grid", opt->stack.grid, "Depth grid points on [0,1] (default 1025)");
   cmd->add_option("--filter-size", opt->stack.filter_taps, "Gaussian taps per axis, odd (default 9)");

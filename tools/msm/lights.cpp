@@ -17,6 +17,7 @@
 #include "msm/image/io.h"
 #include "msm/probe/probe.h"
 #include "msm/scene/scene.h"
+#include "usage.h"
 
 namespace msm::tool {
 namespace {
@@ -100,7 +101,7 @@ nlohmann::json vec(glm::vec3 v) { return {v.x, v.y, v.z}; }
 void run(const LightsOptions& o) {
   // Checked here, not by CLI11, so that a bad value is a failed command (exit 2) naming the range.
   if (o.count < 1 || o.count > 256)
-    throw UsageError(fmt::format("--count {}: the median cut makes 1 to 256 lights", o.count));
+    throw UsageError(fmt::format("--lights {}: the median cut makes 1 to 256 lights", o.count));
   if (o.sub_lights < 0 || o.sub_lights > 256)
     throw UsageError(fmt::format("--sub-lights {}: expected 0 (none) to 256", o.sub_lights));
   if (o.size < 1 || o.size > probe::kMaxCubeSize)
@@ -262,7 +263,8 @@ void add_lights(CLI::App& app) {
         "lights", "A light probe's area lights by the median cut (Kneiphof 2017): direction, extents, solid angle, "
                   "irradiance; a picture of the regions");
     cmd->add_option("--probe", o->probe, probe_help)->required();
-    cmd->add_option("--count", o->count, "Number of area lights (median-cut regions), 1 to 256 (default 32)");
+    cmd->add_option("--lights", o->count, "Number of area lights (median-cut regions), 1 to 256 (default 32)");
+    add_deprecated_option(cmd, "--count", "--lights", o->count);
     cmd->add_flag("--json", o->json, "Print the lights as JSON");
     cmd->add_option("--size", o->size, "Cube-map face size in texels (default 128)");
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
@@ -272,12 +274,12 @@ void add_lights(CLI::App& app) {
                     "Write the cube map the cut sees (--size, --rotation, --intensity applied) as six EXR faces named "
                     "by a path with \"{face}\" (px nx py ny pz nz): a probe for scenes and --probe");
     cmd->add_flag("--horizon-split", o->horizon_split,
-                  "Start the cut from the side faces halved at the horizon (10 regions: --count 10 to 256, even "
+                  "Start the cut from the side faces halved at the horizon (10 regions: --lights 10 to 256, even "
                   "--size), so that no light straddles the horizon");
     cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
     cmd->add_option("--sub-lights", o->sub_lights,
                     "Each light's sub-lights: the lights of the cut into this many regions inside its region, as a "
-                    "scene's \"sub_lights\" shades them (listed by --json; 0, or no more than --count: none)");
+                    "scene's \"sub_lights\" shades them (listed by --json; 0, or no more than --lights: none)");
     cmd->callback([o] { run(*o); });
   }
   {

@@ -153,7 +153,7 @@ void add_reference(CLI::App& app) {
   cmd->add_option("--probe-rotation-speed", opt->probe_rotation_speed,
                   "Degrees the scene's light probe turns about +Y per frame (with --frame)");
   cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
-  cmd->add_option("--out", opt->out, "Output directory (default out/reference)");
+  cmd->add_option("-o,--out", opt->out, "Output directory (default out/reference)");
   cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
   cmd->add_flag("--progress", opt->progress,
                 "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth of the "

@@ -41,13 +41,14 @@ void add_render(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
                                            "EXR and JSON per technique)");
-  cmd->add_option("--technique,-t", opt->techniques,
+  add_deprecated_option(cmd, "--technique", "-t/--techniques", opt->techniques)->delimiter(',');
+  cmd->add_option("-t,--techniques", opt->techniques,
                   "Technique or alias, comma-separated list, or 'all' (msm techniques lists them)")
       ->capture_default_str();
   cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
   cmd->add_option("--view", opt->view,
-                  "A view file of msm view (scene, camera, lights, every setting): renders exactly that view; only "
-                  "-t, -o and --device go with it");
+                  "A view file of msm view (scene, camera, lights, every setting), or a render's JSON output: "
+                  "renders exactly that view; only -t, -o and --device go with it");
   add_frame_options(cmd, opt->frame);
   cmd->add_option("--frames", opt->frames.frames,
                   "Frames to render of a dynamic scene, with their timings: each frame splits the scene's (turned) "
@@ -75,7 +76,8 @@ void add_render(CLI::App& app) {
       for (const CLI::Option* o : cmd->get_options()) {
         const std::vector<std::string>& long_names = o->get_lnames();
         std::string name = long_names.empty() ? o->get_name() : long_names.front();
-        if (o->count() > 0 && name != "view" && name != "out" && name != "technique" && name != "device")
+        if (o->count() > 0 && name != "view" && name != "out" && name != "techniques" && name != "technique" &&
+            name != "device")
           throw UsageError(fmt::format("--view sets the scene and every setting; --{} cannot go with it", name));
       }
       try {
@@ -84,7 +86,7 @@ void add_render(CLI::App& app) {
         opt->frame.scene = view.scene;
         view_camera = view.camera;
         view_object_frame = view.object_frame;
-        if (cmd->count("--technique") == 0) opt->techniques = view.settings.technique;
+        if (cmd->count("--techniques") + cmd->count("--technique") == 0) opt->techniques = view.settings.technique;
       } catch (const viewer::ViewError& e) { throw UsageError(e.what()); }
     } else {
       finish_frame_options(opt->frame);
@@ -94,7 +96,7 @@ void add_render(CLI::App& app) {
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     else
       names = canonical_technique_names(split(opt->techniques));
-    if (names.empty()) throw UsageError("--technique: no technique given");
+    if (names.empty()) throw UsageError("--techniques: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view_camera) scene.camera = *view_camera;

@@ -3,6 +3,7 @@
 #include "msm/image/io.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
+#include "msm/viewer/view_file.h"
 
 #include <fmt/format.h>
 
@@ -22,12 +23,17 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   cmd->add_option("--height", s.height, "Image height in pixels")->capture_default_str();
   cmd->add_option("--shadow-size", s.shadow_size, "Shadow map texels per side")->capture_default_str();
   cmd->add_option("--msaa", s.msaa, "Shadow depth samples: 1, 4 or 8")->capture_default_str();
-  cmd->add_option("--filter", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
-  cmd->add_option("--sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
+  cmd->add_option("--filter-size", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
+  cmd->add_option("--filter-sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
+  add_deprecated_option(cmd, "--filter", "--filter-size", s.filter_size);
+  add_deprecated_option(cmd, "--sigma", "--filter-sigma", s.filter_sigma);
   cmd->add_flag("--no-mipmaps", o.no_mipmaps, "No mip chain for the moment images");
-  cmd->add_option("--param", o.params, "Technique parameters x,y,z,w (see msm techniques)")
-      ->delimiter(',')
-      ->expected(4);
+  cmd->add_option("--set", o.parameters,
+                  "A technique parameter NAME=VALUE, repeatable (msm techniques NAME lists them: type, range, "
+                  "default, meaning)")
+      ->take_all();
+  // The positional vector of older versions: still read for one version, with a warning.
+  cmd->add_option("--param", o.params, "")->delimiter(',')->group("");
   cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
   cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
   cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
@@ -92,7 +98,8 @@ void finish_frame_options(FrameOptions& o) {
   o.settings.frame = o.noise_frame.value_or(o.animation_frame);
   if (!o.params.empty()) {
     if (o.params.size() != 4) throw UsageError("--param takes four comma-separated values");
-    o.settings.params = glm::vec4(o.params[0], o.params[1], o.params[2], o.params[3]);
+    fmt::print(stderr, "msm: warning: --param is deprecated and goes in the next version: set each parameter by "
+                       "name with --set NAME=VALUE (msm techniques NAME lists them)\n");
   }
   o.settings.mipmaps = !o.no_mipmaps;
   using Lookup = render::RenderSettings::Lookup;
@@ -143,8 +150,20 @@ render::RenderSettings settings_for(const FrameOptions& options, const std::stri
     if (s.one_pass && *s.one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
       s.one_pass.reset();
   } catch (const render::RenderError&) {
-    // validate() reports the unknown name
+    return s; // validate() reports the unknown name
   }
+  const Technique& t = render::find_rendered_technique(technique);
+  ParameterValues values = s.parameters; // a view file's, then the command line's
+  for (const Parameter* p : t.parameter_list())
+    if (!options.params.empty()) values[std::string(p->name)] = options.params[size_t(p->slot)];
+  for (const std::string& assignment : options.parameters) {
+    try {
+      set_parameter(t, values, assignment);
+    } catch (const std::invalid_argument& e) {
+      throw render::RenderError(fmt::format("{}: --set {}", t.name, e.what()));
+    }
+  }
+  s.parameters = values;
   return s;
 }
 
@@ -221,47 +240,36 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                            const std::vector<std::string>& warnings, const vk::Context& ctx,
                            const render::RenderResult& result) {
   const Technique& t = render::find_rendered_technique(s.technique);
-  glm::vec4 p = s.params ? *s.params : t.default_params();
   nlohmann::json passes = nlohmann::json::object();
   for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
-  return {{"scene", scene.name},
-          {"scene_source", scene.source.string()},
-          {"technique", s.technique},
-          {"description", t.description},
-          {"bits_per_texel", t.bits_per_texel},
-          {"params", {p.x, p.y, p.z, p.w}},
-          {"params_meaning", t.parameters},
-          {"width", s.width},
-          {"height", s.height},
-          {"shadow_size", s.shadow_size},
-          {"msaa", s.msaa},
-          {"filter_size", s.filter_size},
-          {"filter_sigma", s.filter_sigma},
-          {"mipmaps", s.mipmaps},
-          {"overdarken", s.overdarken},
-          {"normal_offset_texels", s.normal_offset},
-          {"depth_bias", s.resolved_depth_bias()},
-          {"receiver_plane_bias", s.receiver_plane_bias},
-          {"exposure", s.exposure},
-          {"lookup", s.lookup == render::RenderSettings::Lookup::bilinear  ? "bilinear"
-                     : s.lookup == render::RenderSettings::Lookup::nearest ? "nearest"
-                     : s.lookup == render::RenderSettings::Lookup::dither  ? "dither"
-                     : msm_technique_is_nonlinear(t.id)                    ? "dither (auto)"
-                                                                           : "bilinear (auto)"},
-          {"filter_mode", s.one_pass.value_or(msm_technique_is_nonlinear(t.id)) ? "one-pass" : "three-pass"},
-          {"frame", frame},
-          {"noise_frame", s.frame},
-          {"light_extent_deg", s.light_extent_deg ? *s.light_extent_deg : scene.light().angular_extent_deg},
-          {"light_height_deg", s.light_height_deg ? nlohmann::json(*s.light_height_deg) : nlohmann::json()},
-          {"front_back_depth", s.front_back_depth},
-          {"soft_kernel", s.resolved_soft_kernel()},
-          {"translucent_occluders", s.translucent_occluders},
-          {"translucent_alpha_threshold", s.translucent_alpha_threshold},
-          {"coloured_translucency", s.coloured_translucency},
-          {"device", ctx.info().describe()},
-          {"gpu_ms", passes},
-          {"gpu_ms_total", result.total_ms},
-          {"warnings", warnings}};
+  nlohmann::json out = {{"scene", scene.name},
+                        {"scene_source", scene.source.string()},
+                        {"description", t.description},
+                        {"bits_per_texel", t.bits_per_texel}};
+  // Every setting under its view-file key (msm/viewer/view_file.h: the one schema of the settings),
+  // then what the technique's defaults resolved to.
+  for (const std::string& key : viewer::setting_keys()) out[key] = viewer::setting_json(s, key);
+  const bool one_pass = s.one_pass.value_or(t.one_pass_default());
+  out["resolved"] = {{"depth_bias", s.resolved_depth_bias()},
+                     {"soft_kernel", s.resolved_soft_kernel()},
+                     {"lookup", s.lookup != render::RenderSettings::Lookup::automatic ? out["lookup"]
+                                : t.nonlinear()                                       ? "dither"
+                                                                                      : "bilinear"},
+                     {"filter_mode", one_pass ? "one-pass" : "three-pass"},
+                     {"light_extent_deg", s.light_extent_deg.value_or(scene.light().angular_extent_deg)}};
+  // The view file of this render: msm render --view takes this JSON and renders the same again.
+  viewer::View view;
+  view.scene = scene.source.string().starts_with("builtin:") ? scene.name : scene.source.string();
+  view.camera = scene.camera;
+  view.settings = s;
+  view.object_frame = frame;
+  out["view"] = viewer::view_json(view);
+  out["frame"] = frame; // the animated objects' frame (the view's object_frame)
+  out["warnings"] = warnings;
+  out["device"] = ctx.info().describe();
+  out["gpu_ms"] = passes;
+  out["gpu_ms_total"] = result.total_ms;
+  return out;
 }
 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,

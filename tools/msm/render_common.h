@@ -6,6 +6,7 @@
 #include "msm/image/io.h"
 #include "msm/render/renderer.h"
 #include "msm/vk/context.h"
+#include "usage.h"
 
 #include <nlohmann/json.hpp>
 
@@ -19,9 +20,10 @@ namespace msm::tool {
 
 struct FrameOptions {
   render::RenderSettings settings;
-  std::string scene = "fence"; // built-in name or scene file
-  std::string device;          // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
-  std::vector<float> params;   // technique parameter override (4 values)
+  std::string scene = "fence";         // built-in name or scene file
+  std::string device;                  // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
+  std::vector<std::string> parameters; // --set NAME=VALUE, for each technique
+  std::vector<float> params;           // the deprecated --param x,y,z,w
   bool no_mipmaps = false;
   std::string lookup = "auto";      // auto, bilinear, nearest, dither
   std::string filter_mode = "auto"; // auto, one-pass, three-pass
@@ -34,7 +36,7 @@ struct FrameOptions {
   std::optional<int> noise_frame;
 };
 
-// --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --param,
+// --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --set,
 // --overdarken, --normal-offset, --depth-bias, --exposure, --device.
 void add_frame_options(CLI::App* cmd, FrameOptions& options);
 // Applies the parsed options to options.settings; UsageError for bad values.

@@ -65,13 +65,10 @@ std::vector<std::string> technique_passes(const Technique& technique, bool trans
 inline constexpr int kMaxImageSide = 16384;
 inline constexpr long long kMaxImagePixels = 64ll << 20; // 64 Mpixels
 inline constexpr int kMaxShadowSize = 8192;
-inline constexpr int kMaxOnePassTaps = 17;    // radius 8 in one_pass_filter.glsl
-inline constexpr int kDefaultSatKernel = 27;  // JCGT §4.5: a 27² search region
-inline constexpr int kDefaultPcssKernel = 15; // the PCSS baseline's 15² search
-inline constexpr int kMaxPcssKernel = 63;     // 63² taps per pixel and loop
-// The widest soft kernel W a technique takes: kMaxPcssKernel for PCSS; for the moment tables 255,
-// less where the moment bias no longer covers the tables' rounding (mssm4 127, mssm6 111: soft.h).
-int max_soft_kernel(int technique_id);
+inline constexpr int kMaxOnePassTaps = 17;                  // radius 8 in one_pass_filter.glsl
+inline constexpr int kDefaultSatKernel = kSatKernelDefault; // msm/cpu/techniques.h
+inline constexpr int kDefaultPcssKernel = kPcssKernelDefault;
+inline constexpr int kMaxPcssKernel = kPcssKernelMax;
 
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
@@ -81,16 +78,20 @@ struct RenderSettings {
   int filter_size = MSM_FILTER_DEFAULT_TAPS;     // Gaussian taps per axis (odd, 1..63; 1 = no blur)
   float filter_sigma = MSM_FILTER_DEFAULT_SIGMA; // in texels (msm/filter.h)
   bool mipmaps = true;                           // mip chain of the moment images (trilinear lookups)
-  std::optional<glm::vec4> params;               // technique parameters (msm/techniques.h); default: the papers'
-  float overdarken = 1.0f;                       // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
-  float normal_offset = 0.0f;                    // lookup offset along the normal, in shadow-map texels
-  std::optional<float> depth_bias;               // subtracted from the fragment depth ([0,1] units); default:
-                                                 // 2e-5 for the depth-based techniques (16-bit depth rounding),
-                                                 // 5e-4 for the soft ones (the constant of JCGT §4.4's bias),
-                                                 // 1e-5 for the filtered ones (the D16 rounding that their
-                                                 // moment bias does not cover), 5e-4 for the non-linear ones
-                                                 // (HPG §5: 1e-3 in [-1,1] depth)
-  float resolved_depth_bias() const;             // depth_bias or the technique's default
+  // The technique's parameters by name (msm techniques NAME: type, range, default, meaning); those
+  // not given take the papers' defaults.
+  ParameterValues parameters;
+  // The value of the technique's parameter of that name (msm/cpu/techniques.h); std::invalid_argument
+  // if the technique has none of that name.
+  float parameter(std::string_view name) const;
+  void set_parameter(std::string_view name, float value);  // std::invalid_argument: no such name
+  void reset_parameters();                                 // every parameter to its default
+  std::string parameter_text(std::string_view name) const; // as a user writes it: a choice's name, a number
+  glm::vec4 parameter_vector() const;                      // the parameters as the shaders read them
+  float overdarken = 1.0f;                                 // shadow / factor, clamped (JCGT §2.6 uses 0.98); 1 = off
+  float normal_offset = 0.0f;                              // lookup offset along the normal, in shadow-map texels
+  std::optional<float> depth_bias;   // subtracted from the fragment depth ([0,1] units); default: the technique's
+  float resolved_depth_bias() const; // depth_bias or the technique's default
   // Receiver-plane bias of the filtered techniques (msm/bias.h): the fragment depth moves towards
   // the light by the spread of the receiver's own depth over the kernel (σ = slope x the kernel's
   // standard deviation, mips included) times what the technique's bound needs on a plane (4MSM: 1,

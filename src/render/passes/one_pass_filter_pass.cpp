@@ -21,7 +21,8 @@ const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& c
     throw RenderError(fmt::format("the one-pass filter with {} taps needs {} bytes of shared memory; {} has {}",
                                   config.taps, shared, ctx.info().name,
                                   ctx.properties().limits.maxComputeSharedMemorySize));
-  bool nl32 = config.technique->id == MSM_TECH_NL32;
+  // The 32-bit map packs its texel into one integer: its own shader (the others store a vec4).
+  bool nl32 = config.technique->formats[0] == TexelFormat::r32_uint;
   std::string shader =
       std::string(nl32 ? "one_pass_filter_nl32" : "one_pass_filter") + (config.msaa == 1 ? "_1x.comp" : ".comp");
   return programs.compute(shader, {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},

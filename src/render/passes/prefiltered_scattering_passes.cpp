@@ -11,7 +11,7 @@ constexpr VkImageLayout kReadOnly = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
 uint32_t size(const FrameConfig& c) { return uint32_t(c.shadow_size); } // the rectified map's side
 int representation6(const FrameConfig& c) { return msm_technique_scatter_representation6(c.technique->id); }
 // Klehm et al.'s convolution shadow map: 32 coefficients in the layers of one array image.
-bool csm(const FrameConfig& c) { return c.technique->id == MSM_TECH_SCATTER_CSM32; }
+bool csm(const FrameConfig& c) { return c.technique->scattering == Scattering::prefiltered_csm; }
 constexpr uint32_t kCsmLayers = MSM_CSM_MAX_TEXELS;
 // Transmittance layers (rectification.h): K prefix sums per light, with K steps Δ_k.
 uint32_t layers(const FrameConfig& c) { return uint32_t(c.transmittance_layers); }

@@ -4,14 +4,14 @@
 
 namespace msm::render {
 
-bool ScatteringPass::prefiltered() const { return msm_technique_is_prefiltered_scattering(config_.technique->id); }
+bool ScatteringPass::prefiltered() const { return config_.technique->prefiltered_scattering(); }
 bool ScatteringPass::six_moments() const { return msm_technique_scatter_representation6(config_.technique->id) >= 0; }
 
 void ScatteringPass::prepare(const PassResources& r) {
   vk::GraphicsDesc d{.name = std::string("scattering ") + std::string(config_.technique->name),
                      .vertex_shader = "fullscreen.vert",
                      .fragment_shader = six_moments() ? "scatter_prefiltered6.frag"
-                                        : config_.technique->id == MSM_TECH_SCATTER_CSM32
+                                        : config_.technique->scattering == Scattering::prefiltered_csm
                                             ? "scatter_prefiltered_csm.frag"
                                         : prefiltered()     ? "scatter_prefiltered.frag"
                                         : config_.msaa == 1 ? "scatter_march_1x.frag"

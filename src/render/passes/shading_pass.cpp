@@ -16,19 +16,26 @@ namespace {
 enum class Stage { opaque, translucent, surfaces, deferred };
 
 std::string fragment_shader(const FrameConfig& config, Stage stage) {
-  int id = config.technique->id;
   if (stage == Stage::surfaces) return "surfaces.frag";
   bool deferred = stage == Stage::deferred;
-  if (msm_technique_is_depth_based(id)) {
-    std::string family = deferred ? "shading_depth_deferred" : "shading_depth";
-    return family + (config.msaa == 1 ? "_1x.frag" : ".frag");
+  switch (config.technique->shading) {
+  case ShadingVariant::depth:
+    return std::string(deferred ? "shading_depth_deferred" : "shading_depth") +
+           (config.msaa == 1 ? "_1x.frag" : ".frag");
+  case ShadingVariant::soft: return deferred ? "shading_soft_deferred.frag" : "shading_soft.frag";
+  case ShadingVariant::none: break;
+  case ShadingVariant::moments:
+  case ShadingVariant::nl64:
+  case ShadingVariant::nl32:
+    if (deferred) throw RenderError(fmt::format("{}: no deferred shading", config.technique->name));
+    break;
   }
-  if (msm_technique_is_soft(id)) return deferred ? "shading_soft_deferred.frag" : "shading_soft.frag";
-  if (deferred) throw RenderError(fmt::format("{}: no deferred shading", config.technique->name));
-  return id == MSM_TECH_NL64   ? "shading_nl64.frag"
-         : id == MSM_TECH_NL32 ? "shading_nl32.frag"
-         : config.coloured     ? "shading_moments_rgb.frag"
-                               : "shading_moments.frag";
+  switch (config.technique->shading) {
+  case ShadingVariant::nl64: return "shading_nl64.frag";
+  case ShadingVariant::nl32: return "shading_nl32.frag";
+  case ShadingVariant::moments: return config.coloured ? "shading_moments_rgb.frag" : "shading_moments.frag";
+  default: throw RenderError(fmt::format("{}: not rendered", config.technique->name));
+  }
 }
 
 vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
@@ -57,7 +64,7 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
                                    {MSM_SPEC_TEXTURED_DRAWS, config.textured_draws ? 1u : 0u},
                                    {MSM_SPEC_SUB_LIGHTS, config.sub_lights ? 1u : 0u}}};
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
-  if (msm_technique_is_scattering(technique.id)) {
+  if (technique.scatters()) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;
     d.constants.push_back({MSM_SPEC_LINEAR_RADIANCE, 1u});
   }
@@ -109,9 +116,8 @@ vk::GraphicsDesc background_desc(const FrameConfig& config) {
 // declared binding needs a valid descriptor), the blue noise and the lights.
 std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameConfig& config, bool shadow_maps) {
   const GpuScene& scene = c.frame.scene;
-  int id = config.technique->id;
-  bool depth_based = msm_technique_is_depth_based(id), soft = msm_technique_is_soft(id),
-       nonlinear = msm_technique_is_nonlinear(id);
+  const Technique& t = *config.technique;
+  bool depth_based = t.depth_based(), soft = t.soft(), nonlinear = t.nonlinear();
   auto array_of = [&](const std::string& name, VkSampler sampler) {
     return vk::Descriptor(c.image(name).array_view, kReadOnly, sampler);
   };
@@ -199,17 +205,17 @@ void ShadingPass::prepare(const PassResources& r) {
 
 void ShadingPass::reflect(PassBuilder& b) const {
   const VkPipelineStageFlags2 fragment = VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT;
-  int id = config_.technique->id;
-  if (msm_technique_is_depth_based(id)) {
+  const Technique& t = *config_.technique;
+  if (t.depth_based()) {
     b.read(kShadowDepth, use::sampled(fragment));
-  } else if (msm_technique_is_soft(id)) {
+  } else if (t.soft()) {
     for (int i = 0; i < config_.moment_images(); ++i) b.read(sat_table(i), use::sampled(fragment));
   } else {
     for (int channel = 0; channel < config_.channels(); ++channel)
       for (int i = 0; i < config_.moment_images(); ++i) b.read(moment_image(channel, i), use::sampled(fragment));
   }
   uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
-  if (msm_technique_is_scattering(id))
+  if (t.scatters())
     b.create(kSurfaceRadiance, {.format = VK_FORMAT_R16G16B16A16_SFLOAT, .width = w, .height = h},
              use::color_attachment());
   else
@@ -226,7 +232,7 @@ void ShadingPass::reflect(PassBuilder& b) const {
 void ShadingPass::execute(const PassContext& c) const {
   const GpuScene& scene = c.frame.scene;
   // Scattering techniques: the linear radiance (the sky's too), composited by the scattering pass.
-  bool scatters = msm_technique_is_scattering(config_.technique->id);
+  bool scatters = config_.technique->scatters();
   const GraphImage& color = c.image(scatters ? kSurfaceRadiance : kColor);
   const GraphImage& shadow_buffer = c.image(kShadowBuffer);
   VkExtent2D size{uint32_t(config_.width), uint32_t(config_.height)};
