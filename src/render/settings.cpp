@@ -25,7 +25,7 @@ const Technique& find_rendered_technique(std::string_view name) {
   std::string_view canonical = canonical_technique_name(name);
   // A technique of the table that only the CPU runs (msm techniques lists it) is known, not unknown.
   for (const Technique& t : techniques())
-    if (t.name == canonical && !t.rendered)
+    if (t.name == canonical && !t.rendered())
       throw RenderError(
           fmt::format("{} runs on the CPU only (msm reconstruct -t {}); the renderer does not draw it", name, t.name));
   std::string valid;

@@ -23,14 +23,24 @@ bool is_truetype(const std::string& bytes) {
 
 std::filesystem::path default_font_file() { return MSM_VIEWER_FONT_FILE; }
 
+std::vector<std::string_view> technique_texts(const Technique& technique) {
+  std::vector<std::string_view> texts = {technique.name};
+  for (const Parameter& p : technique.parameters) {
+    if (!p.declared()) continue;
+    texts.push_back(p.name);
+    texts.push_back(p.meaning);
+    for (const ParameterChoice& c : p.choices) texts.push_back(c.meaning);
+  }
+  return texts;
+}
+
 ImVector<ImWchar> panel_glyph_ranges() {
   ImFontGlyphRangesBuilder builder;
   // Basic Latin and Latin-1 (Dear ImGui's default ranges), Greek and Coptic.
   static const ImWchar blocks[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0};
   builder.AddRanges(blocks);
   for (const Technique& t : techniques()) {
-    builder.AddText(t.name.data(), t.name.data() + t.name.size());
-    builder.AddText(t.parameters.data(), t.parameters.data() + t.parameters.size());
+    for (std::string_view text : technique_texts(t)) builder.AddText(text.data(), text.data() + text.size());
   }
   ImVector<ImWchar> ranges;
   builder.BuildRanges(&ranges);

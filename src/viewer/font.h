@@ -2,10 +2,14 @@
 // techniques' parameter help names δ1, ε, θ, ξ, ...), which Dear ImGui's built-in font lacks.
 #pragma once
 
+#include "msm/cpu/techniques.h"
+
 #include <imgui.h>
 
 #include <filesystem>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace msm::viewer {
 
@@ -15,6 +19,8 @@ std::filesystem::path default_font_file();
 
 // The characters the panel draws: Dear ImGui's default ranges (Latin-1), the Greek and Coptic block
 // and every character of the techniques' names and parameter help (msm::techniques()).
+// The texts the panel shows of a technique: its name and its parameters' names, meanings and choices.
+std::vector<std::string_view> technique_texts(const Technique& technique);
 ImVector<ImWchar> panel_glyph_ranges();
 
 struct PanelFont {

@@ -37,7 +37,7 @@ TEST(PanelFont, HasEveryLetterOfTheParameterHelp) {
   ASSERT_TRUE(atlas.fonts().Build());
   int greek = 0;
   for (const Technique& t : techniques())
-    for (std::string_view text : {t.name, t.parameters})
+    for (std::string_view text : technique_texts(t))
       for (ImWchar c : code_points(text)) {
         EXPECT_NE(font.font->FindGlyphNoFallback(c), nullptr)
             << "U+" << std::hex << int(c) << " of " << t.name << ": " << text;
