@@ -224,6 +224,8 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
   glm::vec4 p = s.params ? *s.params : t.default_params();
   nlohmann::json passes = nlohmann::json::object();
   for (const render::PassTime& pass : result.passes) passes[pass.name] = pass.ms;
+  std::vector<std::string> all_warnings = warnings; // the scene's, then the render's own
+  all_warnings.insert(all_warnings.end(), result.warnings.begin(), result.warnings.end());
   return {{"scene", scene.name},
           {"scene_source", scene.source.string()},
           {"technique", s.technique},
@@ -261,7 +263,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
           {"device", ctx.info().describe()},
           {"gpu_ms", passes},
           {"gpu_ms_total", result.total_ms},
-          {"warnings", warnings}};
+          {"warnings", all_warnings}};
 }
 
 void write_render(const std::filesystem::path& dir, const std::string& stem, const render::RenderResult& result,

@@ -10,6 +10,7 @@
 layout(binding = 2) uniform usampler2DArray sat_table;
 layout(binding = 3) uniform usampler2DArray sat_table1; // six moments: b4, b6; else the first again
 #include "shading.glsl"
+#include "soft_clamps.glsl"
 
 uvec4 table(int x, int y) { return x < 0 || y < 0 ? uvec4(0u) : texelFetch(sat_table, ivec3(x, y, shadow_layer), 0); }
 uvec4 table1(int x, int y) { return x < 0 || y < 0 ? uvec4(0u) : texelFetch(sat_table1, ivec3(x, y, shadow_layer), 0); }
@@ -49,6 +50,8 @@ float cssm_intensity(ShadowLookup s, ivec2 map, int width, uint scale, vec2 spre
     sums += msm_cssm_search_terms(msm_sat_rect_average(sum, texels, scale), tile, xs, p);
   }
   BlockerResult blocker = msm_cssm_blocker(sums, 0.5f * (zs + 1.0f), p, frame.technique_params.w);
+  count_soft_lookup(blocker.shadow > 0.0f &&
+                    msm_soft_penumbra_clamped(spread, zf, msm_signed_depth(blocker.depth), width));
   if (!(blocker.shadow > 0.0f)) return 0.0f;
 
   vec2 hp = msm_soft_penumbra_half_width(spread, zf, msm_signed_depth(blocker.depth), width);
@@ -90,7 +93,9 @@ float shadow_intensity(ShadowLookup s) {
     blocker =
         vssm ? msm_soft_vssm_blocker(vec2(q.x, q.y), s.z, params.w) : msm_soft_blocker4_select(q, zf, params, scale);
   }
-  if (msm_soft_in_umbra(blocker, frame.soft.w)) return 1.0f;
+  bool umbra = msm_soft_in_umbra(blocker, frame.soft.w);
+  count_soft_lookup(!umbra && msm_soft_penumbra_clamped(spread, zf, blocker.depth, width));
+  if (umbra) return 1.0f;
 
   vec2 hp = msm_soft_penumbra_half_width(spread, zf, blocker.depth, width);
   SoftRegion region = msm_soft_region(position, hp, map);
