@@ -85,10 +85,22 @@ MSM_FN vec2 msm_soft_spread(vec2 tan_half_extent, float world_per_depth, vec2 wo
 // spread · depth_distance, clamped to [0.5, (W - 1) / 2] texels with W = max_kernel_width >= 2
 // (the queries then touch at most W texels per axis: n_t = W²). Negative distances (a blocker
 // depth behind the receiver: not a blocker) give the minimum.
+MSM_FN float msm_soft_largest_half_width(int max_kernel_width) { return max(0.5f * float(max_kernel_width - 1), 0.5f); }
+MSM_FN vec2 msm_soft_unclamped_half_width(vec2 spread, float depth_distance) {
+  return spread * max(depth_distance, 0.0f);
+}
 MSM_FN vec2 msm_soft_kernel_half_width(vec2 spread, float depth_distance, int max_kernel_width) {
-  float largest = max(0.5f * float(max_kernel_width - 1), 0.5f);
-  vec2 h = spread * max(depth_distance, 0.0f);
+  float largest = msm_soft_largest_half_width(max_kernel_width);
+  vec2 h = msm_soft_unclamped_half_width(spread, depth_distance);
   return vec2(min(max(h.x, 0.5f), largest), min(max(h.y, 0.5f), largest));
+}
+
+// Whether msm_soft_kernel_half_width cut the region down to the kernel along some axis: the light's
+// penumbra (or blocker search region) is then wider than the kernel, and a penumbra there is too
+// sharp (a wide area light's penumbra reaches its full width only up to the kernel's).
+MSM_FN bool msm_soft_kernel_clamped(vec2 spread, float depth_distance, int max_kernel_width) {
+  vec2 h = msm_soft_unclamped_half_width(spread, depth_distance);
+  return max(h.x, h.y) > msm_soft_largest_half_width(max_kernel_width);
 }
 
 // Blocker search half-width: blockers between the near plane (near_depth; -1 for [-1,1] depth)
@@ -100,6 +112,13 @@ MSM_FN vec2 msm_soft_search_half_width(vec2 spread, float zf, float near_depth, 
 // Penumbra (filter) half-width for blockers at the average blocker depth.
 MSM_FN vec2 msm_soft_penumbra_half_width(vec2 spread, float zf, float blocker_depth, int max_kernel_width) {
   return msm_soft_kernel_half_width(spread, zf - blocker_depth, max_kernel_width);
+}
+
+// Whether the penumbra region was clamped to the kernel (the renderer counts these lookups and warns
+// above a share: RenderResult::soft_kernel_clamps). The blocker search is not counted: it is clamped
+// by design (JCGT's fixed 27² search region) for most receivers of any scene.
+MSM_FN bool msm_soft_penumbra_clamped(vec2 spread, float zf, float blocker_depth, int max_kernel_width) {
+  return msm_soft_kernel_clamped(spread, zf - blocker_depth, max_kernel_width);
 }
 
 // A region [center - h, center + h] in texel units (texel i covers [i, i + 1); a shadow-map
@@ -369,6 +388,7 @@ struct SoftShadow {
   float blocker_depth; // the average blocker depth, [-1,1]
   float search_shadow; // the blocker search region's shadow intensity
   vec2 penumbra;       // the filter's half-widths in texels; 0 where the search ended the flow
+  bool penumbra_clamped; // the penumbra was wider than the kernel (msm_soft_penumbra_clamped)
 };
 
 // The sum over a grid rectangle (4 lookups, sat.h).
@@ -402,7 +422,8 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup 
   } else {
     blocker = msm_soft_blocker4_select(q, zf, k.params, k.scale);
   }
-  if (msm_soft_in_umbra(blocker, k.umbra_epsilon)) return SoftShadow(1.0f, blocker.depth, blocker.shadow, vec2(0.0f));
+  if (msm_soft_in_umbra(blocker, k.umbra_epsilon))
+    return SoftShadow(1.0f, blocker.depth, blocker.shadow, vec2(0.0f), false);
 
   vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker.depth, k.kernel_width);
   SoftRegion region = msm_soft_region(f.position, hp, k.size);
@@ -418,7 +439,8 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup 
   } else {
     shadow = msm_soft_shadow4(t, zb, k.umbra_epsilon, k.scale);
   }
-  return SoftShadow(shadow, blocker.depth, blocker.shadow, hp);
+  return SoftShadow(shadow, blocker.depth, blocker.shadow, hp,
+                    msm_soft_penumbra_clamped(k.spread, zf, blocker.depth, k.kernel_width));
 }
 
 // Convolution soft shadows (cssm.h): the blocker search sums every tile over the search region (4
@@ -440,7 +462,7 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_cssm_flow(MSM_SOFT_FETCH_PARAM SoftSetup k,
                                   tile, xs, p);
   BlockerResult blocker = msm_cssm_blocker(sums, 0.5f * (zs + 1.0f), p, k.params.w);
   float blocker_depth = msm_signed_depth(blocker.depth);
-  if (!(blocker.shadow > 0.0f)) return SoftShadow(0.0f, blocker_depth, blocker.shadow, vec2(0.0f));
+  if (!(blocker.shadow > 0.0f)) return SoftShadow(0.0f, blocker_depth, blocker.shadow, vec2(0.0f), false);
 
   vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker_depth, k.kernel_width);
   SoftRegion region = msm_soft_region(f.position, hp, k.size);
@@ -451,7 +473,8 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_cssm_flow(MSM_SOFT_FETCH_PARAM SoftSetup k,
   for (int tile = 0; tile < basis; ++tile)
     series += msm_csm_texel_terms(msm_csm_from_unorm(msm_soft_filter_average(MSM_SOFT_FETCH_ARG box, k.scale, tile)),
                                   xf, tile, p);
-  return SoftShadow(msm_csm_resolve(series, p), blocker_depth, blocker.shadow, hp);
+  return SoftShadow(msm_csm_resolve(series, p), blocker_depth, blocker.shadow, hp,
+                    msm_soft_penumbra_clamped(k.spread, zf, blocker_depth, k.kernel_width));
 }
 
 MSM_END

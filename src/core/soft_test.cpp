@@ -143,6 +143,22 @@ TEST(SoftShadows, KernelSizesByHand) {
   EXPECT_NEAR(msm_soft_depth_bias(vec2(4.0f, 2.0f), vec2(0.001f, -0.002f), 1e-4f), 0.0096f, 1e-7f);
 }
 
+// The clamp report says exactly when the half-width was cut to (W - 1) / 2 = 13 (W = 27): the
+// unclamped reach of KernelSizesByHand's light is 40 texels per unit of depth.
+TEST(SoftShadows, ClampReportMatchesTheClamp) {
+  vec2 spread = msm_soft_spread(vec2(0.05f), 50.0f, vec2(0.0625f));
+  EXPECT_TRUE(msm_soft_penumbra_clamped(spread, 0.5f, -1.0f, W));            // 60 -> 13
+  EXPECT_FALSE(msm_soft_penumbra_clamped(spread, -0.8f, -0.7f, W));          // not a blocker: the minimum
+  EXPECT_FALSE(msm_soft_penumbra_clamped(spread, -0.8f, -0.9f, W));          // 4 texels
+  EXPECT_TRUE(msm_soft_penumbra_clamped(vec2(40.0f, 1.0f), 0.0f, -0.5f, W)); // x alone: 20 -> 13
+  EXPECT_TRUE(msm_soft_penumbra_clamped(vec2(1.0f, 40.0f), 0.0f, -0.5f, W)); // y alone
+  // Against the clamp itself, over reaches about the limit.
+  for (float reach = 0.0f; reach < 30.0f; reach += 0.25f) {
+    vec2 h = msm_soft_kernel_half_width(vec2(reach, 0.0f), 1.0f, W);
+    EXPECT_EQ(msm_soft_kernel_clamped(vec2(reach, 0.0f), 1.0f, W), h.x < reach) << reach;
+  }
+}
+
 // Whatever the spread, centre and map size, the search rectangle and the filter region's touched
 // block hold at most W texels per axis (so every query is exact: sat.h), and regions are valid.
 TEST(SoftShadows, KernelsStayWithinTheTableLimit) {

@@ -114,6 +114,7 @@ struct FrameResources {
   ScatteringPush scattering{};                 // the camera rays of the scattering pass and the background
   const vk::Buffer* rectification = nullptr;   // RectificationUniforms per light (render/rectification_uniforms.h)
   const vk::Sampler* repeat_sampler = nullptr; // linear, repeat: the prefix sums (v wraps on the circle)
+  const vk::Buffer* soft_clamps = nullptr;     // two uints: soft lookups unclamped, clamped (soft_clamps.glsl)
 };
 
 // An allocated image and its views: the whole array (2D_ARRAY, every mip: for the shading), and per

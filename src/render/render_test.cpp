@@ -510,6 +510,39 @@ TEST_F(RenderTest, DeferredShadingEqualsForwardShading) {
   }
 }
 
+// The device's count of soft lookups whose penumbra the kernel clamps (soft.h): the disc scene's
+// camera sees only ground, each pixel one lookup (deferred shading), so the lookups are the pixels.
+// An 89° light's penumbrae exceed every kernel: most lookups clamped, a warning naming the share;
+// a 4° light's (6 texels of a 128² map) fit: none, no warning. Non-soft techniques count nothing.
+TEST_F(RenderTest, SoftKernelClampsAreCountedAndWarned) {
+  Renderer renderer(ctx(), scene::builtin_scene("disc"));
+  for (const char* name : {"mssm4", "mssm6", "vssm", "pcss", "cssm8"}) {
+    SCOPED_TRACE(name);
+    RenderSettings s = small(name);
+    s.width = 96;
+    s.height = 54;
+    s.shadow_size = 128;
+    s.msaa = 1;
+    s.light_extent_deg = 89.0f;
+    RenderResult wide = renderer.render(s);
+    EXPECT_EQ(wide.soft_kernel_clamps.lookups, std::uint64_t(s.width * s.height));
+    EXPECT_GT(wide.soft_kernel_clamps.share(), 0.1);
+    ASSERT_EQ(wide.warnings.size(), 1u);
+    EXPECT_NE(
+        wide.warnings[0].find(fmt::format("had their penumbra clamped to the {}-texel", s.resolved_soft_kernel())),
+        std::string::npos)
+        << wide.warnings[0];
+    s.light_extent_deg = 4.0f;
+    RenderResult narrow = renderer.render(s);
+    EXPECT_EQ(narrow.soft_kernel_clamps.lookups, std::uint64_t(s.width * s.height));
+    EXPECT_EQ(narrow.soft_kernel_clamps.clamped, 0u);
+    EXPECT_TRUE(narrow.warnings.empty());
+  }
+  RenderSettings pcf = small("pcf");
+  pcf.light_extent_deg = 89.0f;
+  EXPECT_EQ(renderer.render(pcf).soft_kernel_clamps.lookups, 0u);
+}
+
 // The non-linear maps from the GPU against the CPU single-source pipeline on the same depth
 // samples. The CPU repeats the one-pass filter's float arithmetic in its order (sum of the
 // samples' moments times the reciprocal of the count, then weight x value over the taps

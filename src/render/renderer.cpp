@@ -136,6 +136,7 @@ struct Renderer::Impl {
   GpuScene gpu;
   vk::Buffer uniforms, lights;
   vk::Buffer rectification; // RectificationUniforms per light (prefiltered scattering)
+  vk::Buffer soft_clamps;   // the soft lookups unclamped and clamped (soft_clamps.glsl), zeroed per frame
   vk::GpuTimer timer;
   vk::Image noise;
   vk::Sampler point_sampler, linear_sampler;
@@ -158,6 +159,8 @@ struct Renderer::Impl {
                                  vk::Memory::host)),
         rectification(vk::create_buffer(c, sizeof(RectificationUniforms) * MSM_MAX_LIGHTS,
                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host)),
+        soft_clamps(
+            vk::create_buffer(c, 2 * sizeof(std::uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host)),
         timer(c, 32), noise(upload_blue_noise(c)), point_sampler(vk::create_sampler(c, VK_FILTER_NEAREST)),
         linear_sampler(vk::create_sampler(c, VK_FILTER_LINEAR)),
         repeat_sampler(vk::create_sampler(c, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT)), programs(c),
@@ -377,6 +380,7 @@ struct Renderer::Impl {
     // standard); their bytes are the std140/std430 layout the shaders read (frame.h).
     static_assert(std::is_standard_layout_v<FrameUniforms> && std::is_standard_layout_v<LightUniforms>);
     std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation)
+    std::ranges::fill(soft_clamps.mapped<std::uint32_t>(), 0u);
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
@@ -441,6 +445,12 @@ struct Renderer::Impl {
     resources.scattering = scattering;
     resources.rectification = &rectification;
     resources.repeat_sampler = &repeat_sampler;
+    resources.soft_clamps = &soft_clamps;
+    // The previous frame's counts were written by its shading: ordered before this frame's.
+    vk::pipeline_barrier(
+        cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
+                                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT,
+                                VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
     graph->record(cmd, timer, resources, config, stop_after);
   }
 
@@ -513,6 +523,15 @@ struct Renderer::Impl {
   }
 };
 
+std::optional<std::string> soft_kernel_clamp_warning(const SoftKernelClamps& clamps, int kernel_width) {
+  if (!(clamps.share() > kSoftKernelClampWarnShare)) return std::nullopt;
+  return fmt::format(
+      "warning: {:.2f}% of the soft shadow lookups ({} of {}) had their penumbra clamped to the {}-texel "
+      "soft kernel: there the penumbrae are narrower than the light makes them "
+      "(a wider soft kernel or a smaller shadow map reaches further)",
+      100.0 * clamps.share(), clamps.clamped, clamps.lookups, kernel_width);
+}
+
 Renderer::Renderer(const vk::Context& ctx, const scene::Scene& scene) : impl_(std::make_unique<Impl>(ctx, scene)) {}
 Renderer::~Renderer() = default;
 const scene::Scene& Renderer::scene() const noexcept { return impl_->scene; }
@@ -528,6 +547,10 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   RenderResult r;
   m.read_times(r.passes, m.config.lights > 1 ? &r.light_passes : nullptr);
   for (const PassTime& p : r.passes) r.total_ms += p.ms;
+  std::span<const std::uint32_t> clamps = m.soft_clamps.mapped<const std::uint32_t>();
+  r.soft_kernel_clamps = {.lookups = std::uint64_t(clamps[0]) + clamps[1], .clamped = clamps[1]};
+  if (std::optional<std::string> w = soft_kernel_clamp_warning(r.soft_kernel_clamps, s.resolved_soft_kernel()))
+    r.warnings.push_back(*w);
   const FrameGraph& g = *m.graph;
   std::string moments0 = moment_image(0, 0);
   if (intermediates && g.has_image(moments0) && m.config.formats()[0] != VK_FORMAT_R32_UINT)

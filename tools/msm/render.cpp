@@ -147,6 +147,7 @@ void add_render(CLI::App& app) {
       try {
         result = renderer.render(s);
       } catch (const render::RenderError& e) { throw UsageError(e.what()); }
+      for (const std::string& w : result.warnings) fmt::print(stderr, "msm render: {} ({})\n", w, names[i]);
       if (i == 0) ensure_output_dir(opt->out);
       write_render(files, opt->out, names[i], result, render_json(s, scene, frame, warnings, *ctx, result));
       double wall_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

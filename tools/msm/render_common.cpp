@@ -265,7 +265,9 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
   view.object_frame = frame;
   out["view"] = viewer::view_json(view);
   out["frame"] = frame; // the animated objects' frame (the view's object_frame)
-  out["warnings"] = warnings;
+  std::vector<std::string> all_warnings = warnings; // the scene's, then the render's own
+  all_warnings.insert(all_warnings.end(), result.warnings.begin(), result.warnings.end());
+  out["warnings"] = all_warnings;
   out["device"] = ctx.info().describe();
   out["gpu_ms"] = passes;
   out["gpu_ms_total"] = result.total_ms;

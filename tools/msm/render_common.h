@@ -81,7 +81,8 @@ void ensure_output_dir(const std::filesystem::path& dir);
 void check_output_dir(const std::filesystem::path& dir);
 
 // Every setting of a render (technique parameters included), the scene's frame (--frame) and the
-// warnings printed for it (scene::shadow_framing_warnings), and its pass times.
+// warnings printed for it (scene::shadow_framing_warnings) followed by the render's own
+// (RenderResult::warnings), and its pass times.
 nlohmann::json render_json(const render::RenderSettings& settings, const scene::Scene& scene, int frame,
                            const std::vector<std::string>& warnings, const vk::Context& ctx,
                            const render::RenderResult& result);

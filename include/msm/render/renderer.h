@@ -195,6 +195,15 @@ struct LightPassTime {
   double ms = 0;
 };
 
+// The soft techniques' shadow lookups (one per shaded fragment and light) and how many of them had
+// their penumbra clamped to the kernel width W (soft.h, msm_soft_penumbra_clamped):
+// there the penumbra is narrower than the light makes it (a wide area light needs a wider kernel).
+struct SoftKernelClamps {
+  std::uint64_t lookups = 0;
+  std::uint64_t clamped = 0;
+  double share() const noexcept { return lookups ? double(clamped) / double(lookups) : 0.0; }
+};
+
 struct RenderResult {
   image::Image color;                      // linear RGB decoded from the sRGB target (write_png re-encodes exactly)
   std::vector<std::uint8_t> color_srgb8;   // the sRGB target's bytes as read back, R,G,B (alpha dropped): what
@@ -209,10 +218,21 @@ struct RenderResult {
   std::vector<PassTime> passes;            // in execution order; empty where the queue has no timestamps
   double total_ms = 0;                     // sum of the passes
   std::vector<LightPassTime> light_passes; // several lights: each light's share of the passes
+  SoftKernelClamps soft_kernel_clamps;     // soft techniques (mssm4/6, vssm, pcss, cssm8/16); else zeros
+  std::vector<std::string> warnings;       // where the result is known degraded (soft_kernel_clamp_warning)
 };
 
 struct Intermediates;     // the internal header's (msm/render/renderer_internals.h, not installed)
 struct RendererInternals; // its access to the test hooks below
+
+// The share of soft lookups clamped above which a render warns: 0.1%, about a pixel-wide band along
+// the shadows' edges of a 1024² image (a clamped penumbra is a band of the penumbra's width, far
+// wider), while a default scene's occasional grazing lookup stays well below it.
+inline constexpr double kSoftKernelClampWarnShare = 1e-3;
+
+// The warning for a render whose share of clamped lookups exceeds kSoftKernelClampWarnShare, naming
+// the share and the kernel width; nothing otherwise.
+std::optional<std::string> soft_kernel_clamp_warning(const SoftKernelClamps& clamps, int kernel_width);
 
 // Owns the scene's GPU buffers and textures and the pipelines it has built (cached per
 // technique, MSAA and filter configuration). Externally synchronized; the Context outlives it.

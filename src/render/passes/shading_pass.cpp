@@ -84,8 +84,11 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
     d.vertex_stride = 0;
     d.attributes.clear();
     d.depth_compare = VK_COMPARE_OP_ALWAYS; // the translucent draws after it test against the surfaces
-    for (int i = 0; i < 3; ++i) d.bindings.push_back(vk::Binding::sampled_image);
   }
+  // The surfaces (deferred; white images in the forward passes), then the soft techniques' count of
+  // lookups clamped by the kernel (binding 14, soft_clamps.glsl).
+  for (int i = 0; i < 3; ++i) d.bindings.push_back(vk::Binding::sampled_image);
+  d.bindings.push_back(vk::Binding::storage_buffer);
   return d;
 }
 
@@ -111,9 +114,10 @@ vk::GraphicsDesc background_desc(const FrameConfig& config) {
           .constants = {{5, linear ? 1u : 0u}}};
 }
 
-// The shading's bindings 0-10 but the per-draw textures (1 and 5): the uniforms, the shadow maps of
+// The shading's bindings 0-14 but the per-draw textures (1 and 5): the uniforms, the shadow maps of
 // the technique (a white image of the declared kind in the bindings it does not read: every
-// declared binding needs a valid descriptor), the blue noise and the lights.
+// declared binding needs a valid descriptor), the blue noise, the lights, white images in place of
+// the deferred pass's surfaces and the soft techniques' clamp counts.
 std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameConfig& config, bool shadow_maps) {
   const GpuScene& scene = c.frame.scene;
   const Technique& t = *config.technique;
@@ -143,9 +147,21 @@ std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameC
       for (int i = 0; i < 2; ++i)
         colour[size_t(2 * (channel - 1) + i)] =
             array_of(moment_image(channel, std::min(i, config.moment_images() - 1)), moment_sampler);
-  return {
-      vk::Descriptor(c.frame.uniforms), white, first, second, noise, white, colour[0], colour[1], colour[2], colour[3],
-      vk::Descriptor(c.frame.lights)};
+  return {vk::Descriptor(c.frame.uniforms),
+          white,
+          first,
+          second,
+          noise,
+          white,
+          colour[0],
+          colour[1],
+          colour[2],
+          colour[3],
+          vk::Descriptor(c.frame.lights),
+          white,
+          white,
+          white,
+          vk::Descriptor(*c.frame.soft_clamps)};
 }
 
 // Draws the scene's `draws` (in that order) with `program`, each with its textures (bindings 1, 5).
@@ -246,8 +262,9 @@ void ShadingPass::execute(const PassContext& c) const {
   std::vector<vk::Descriptor> descriptors = frame_descriptors(c, config_, true);
   if (config_.deferred) { // one full-screen triangle over the surfaces
     std::vector<vk::Descriptor> deferred = descriptors;
+    size_t binding = 11;
     for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo})
-      deferred.emplace_back(c.image(name).layer_views[0], kReadOnly, c.frame.point_sampler);
+      deferred[binding++] = vk::Descriptor(c.image(name).layer_views[0], kReadOnly, c.frame.point_sampler);
     vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
     ObjectPush none{};
     vk::bind_program(c.cmd, *program_, deferred, std::as_bytes(std::span(&none, 1)));

@@ -4,6 +4,7 @@
 // t = i0 + f, over taps + 1 texels, and every MSAA sample counts 1 / samples.
 #include "msm/soft.h"
 #include "shading.glsl"
+#include "soft_clamps.glsl"
 #define MSM_DEPTH_BINDING 2
 #define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
@@ -55,6 +56,8 @@ float pcss_shadow(ShadowLookup s) {
   for (int y = r.lo.y; y <= r.hi.y; ++y)
     for (int x = r.lo.x; x <= r.hi.x; ++x) blockers += texel_blockers(ivec2(x, y), s);
   BlockerResult blocker = msm_soft_pcss_blocker(blockers.y, blockers.x, float(msm_sat_rect_texels(r) * samples), s.z);
+  bool filtered = blocker.shadow > 0.0f && blocker.shadow < 1.0f;
+  count_soft_lookup(filtered && msm_soft_penumbra_clamped(spread, zf, msm_signed_depth(blocker.depth), width));
   if (blocker.shadow <= 0.0f) return 0.0f;
   // Every sample of the search region blocks: so does every one of the smaller filter region.
   if (blocker.shadow >= 1.0f) return 1.0f;

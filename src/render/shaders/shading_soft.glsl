@@ -7,6 +7,7 @@
 layout(binding = 2) uniform usampler2DArray sat_table;
 layout(binding = 3) uniform usampler2DArray sat_table1; // six moments: b4, b6; else the first again
 #include "shading.glsl"
+#include "soft_clamps.glsl"
 
 // soft.h's fetch: S(x, y) of the light's table `table`. Six moments: table 1 is the second table.
 // CSSM: tile `table` lies `table` shadow-map heights further along y; its row -1 is the previous
@@ -27,9 +28,14 @@ float shadow_intensity(ShadowLookup s) {
                           frame.technique_params);
   // The receiver plane's slope: ShadowLookup's is in [0,1] depth per texel, soft.h's in [-1,1].
   SoftFragment f = SoftFragment(s.t + 0.5f, s.z, 2.0f * s.depth_per_texel);
-  if (msm_technique_is_cssm(kTechnique))
-    return msm_soft_cssm_flow(k, f, msm_cssm_params(msm_technique_cssm_frequencies(kTechnique), frame.technique_params))
-        .shadow;
+  if (msm_technique_is_cssm(kTechnique)) {
+    SoftShadow r =
+        msm_soft_cssm_flow(k, f, msm_cssm_params(msm_technique_cssm_frequencies(kTechnique), frame.technique_params));
+    count_soft_lookup(r.penumbra_clamped);
+    return r.shadow;
+  }
   int moments = kTechnique == MSM_TECH_MSSM6 ? 6 : (kTechnique == MSM_TECH_VSSM ? 2 : 4);
-  return msm_soft_moment_flow(k, f, moments).shadow;
+  SoftShadow r = msm_soft_moment_flow(k, f, moments);
+  count_soft_lookup(r.penumbra_clamped);
+  return r.shadow;
 }
