@@ -384,10 +384,10 @@ struct SoftFragment {
 };
 // The flow's result and the intermediate values the tests compare.
 struct SoftShadow {
-  float shadow;        // the shadow intensity
-  float blocker_depth; // the average blocker depth, [-1,1]
-  float search_shadow; // the blocker search region's shadow intensity
-  vec2 penumbra;       // the filter's half-widths in texels; 0 where the search ended the flow
+  float shadow;          // the shadow intensity
+  float blocker_depth;   // the average blocker depth, [-1,1]
+  float search_shadow;   // the blocker search region's shadow intensity
+  vec2 penumbra;         // the filter's half-widths in texels; 0 where the search ended the flow
   bool penumbra_clamped; // the penumbra was wider than the kernel (msm_soft_penumbra_clamped)
 };
 

@@ -70,9 +70,7 @@ TEST(reference_sampling, PointAlongFirstStratifiesTheFirstCoordinateOverAllSampl
       EXPECT_LT(p.y, 1.0);
       second += p.y;
     }
-    if (n == 4096) {
-      EXPECT_NEAR(second / n, 0.5, 5.0 * std::sqrt(1.0 / 12.0 / n));
-    }
+    if (n == 4096) { EXPECT_NEAR(second / n, 0.5, 5.0 * std::sqrt(1.0 / 12.0 / n)); }
   }
   const SampleSet independent(msm::reference::Sampler::independent, 64);
   Rng rng(11);

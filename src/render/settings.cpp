@@ -112,8 +112,8 @@ void RenderSettings::validate() const {
         "soft kernel = {} is outside [3, {}] for {}: its 32-bit summed-area tables keep log2((2^32 - 1) / W²) = "
         "{:.1f} bits per moment at W = {}, a rounding coarser than its moment bias covers (a plane of one depth is "
         "not reconstructed above W = {})",
-        soft_kernel, t.max_soft_kernel, technique, std::log2(4294967295.0 / (double(soft_kernel) * double(soft_kernel))),
-        soft_kernel, t.max_soft_kernel));
+        soft_kernel, t.max_soft_kernel, technique,
+        std::log2(4294967295.0 / (double(soft_kernel) * double(soft_kernel))), soft_kernel, t.max_soft_kernel));
   if (soft_kernel != 0) range("soft kernel", soft_kernel, 3, t.area_light ? t.max_soft_kernel : kSatKernelMax);
   if (uses_one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));

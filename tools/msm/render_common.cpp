@@ -264,7 +264,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
   view.settings = s;
   view.object_frame = frame;
   out["view"] = viewer::view_json(view);
-  out["frame"] = frame; // the animated objects' frame (the view's object_frame)
+  out["frame"] = frame;                             // the animated objects' frame (the view's object_frame)
   std::vector<std::string> all_warnings = warnings; // the scene's, then the render's own
   all_warnings.insert(all_warnings.end(), result.warnings.begin(), result.warnings.end());
   out["warnings"] = all_warnings;
