@@ -16,4 +16,11 @@ if hits=$(grep -rnIE 'issue #?[0-9]|\bsessions?\b|\bbranch(es)? [a-z0-9]+-[a-z0-
   fail "history words (issue numbers, sessions, branch names) in code or docs:"
   echo "$hits" >&2
 fi
+# Technique ids are compared only by the table (its header and rows), the shared headers and the
+# shaders' variant selection (and by tests, which check those against each other).
+if hits=$(grep -rlI 'MSM_TECH_' src tools bench include | grep -vE \
+  '^include/msm/[a-z0-9_]+\.h$|^include/msm/render/frame\.h$|^include/msm/cpu/techniques\.h$|^src/core/techniques\.cpp$|^src/render/shaders/[a-z0-9_]+\.glsl$|_test\.cpp$|^src/core/gpu/kernels\.h$'); then
+  fail "technique ids compared outside the technique table, the shared headers and the shaders:"
+  echo "$hits" >&2
+fi
 exit $failed
