@@ -20,6 +20,7 @@
 #include "msm/probe/probe.h"
 #include "msm/scattering.h"
 #include "msm/shading.h"
+#include "msm/util/clock.h"
 #include "msm/util/limits.h"
 
 namespace msm::reference {
@@ -149,10 +150,6 @@ EffectFunction effect_function(Effect effect) {
   throw std::invalid_argument("unknown effect");
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 Result render_in_arena(const scene::Scene& scene, const Settings& settings);
 
 } // namespace
@@ -180,7 +177,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   std::optional<EnvironmentLighting> lighting;
   if (environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
   const Tracer tracer(scene);
-  result.build_seconds = seconds_since(start);
+  result.build_seconds = util::seconds_since(start);
 
   EffectContext ctx{
       tracer, settings, scene.light_frame(), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
@@ -395,12 +392,12 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         std::lock_guard lock(progress_mutex);
         if (done > progress_reported) {
           progress_reported = done;
-          settings.progress(Progress{done, std::size_t(H), seconds_since(start)});
+          settings.progress(Progress{done, std::size_t(H), util::seconds_since(start)});
         }
       }
     }
   });
-  result.render_seconds = seconds_since(trace_start);
+  result.render_seconds = util::seconds_since(trace_start);
   result.rays = rays.load();
   double sum = 0.0;
   for (int y = 0; y < H; ++y) {

@@ -10,6 +10,7 @@
 #include "msm/image/io.h"
 #include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
+#include "msm/util/clock.h"
 #include "msm/util/statistics.h"
 #include "msm/viewer/view_file.h"
 #include "msm/vk/vk.h"
@@ -53,7 +54,6 @@ Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const s
 }
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 // The copy-bandwidth bound of the prefix sums (JCGT App. C): a vkCmdCopyBuffer of `bytes`, half of
 // what the prefix sums read and write per frame, so that the copy reads and writes as many bytes
@@ -88,13 +88,13 @@ CopyTimes copy_times(const vk::Context& ctx, VkDeviceSize bytes, int repeats) {
   for (int r = -1; r < repeats; ++r) {
     Clock::time_point t0 = Clock::now();
     vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) { vk::pipeline_barrier(cmd, before); });
-    double empty = ms_since(t0);
+    double empty = util::ms_since(t0);
     t0 = Clock::now();
     vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
       vk::pipeline_barrier(cmd, before);
       copy(cmd);
     });
-    double full = ms_since(t0);
+    double full = util::ms_since(t0);
     vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
       vk::pipeline_barrier(cmd, before);
       timer.reset(cmd);
@@ -145,7 +145,7 @@ std::map<std::string, double> host_pass_ms(render::Renderer& renderer, const ren
     for (size_t k : counts) {
       Clock::time_point t0 = Clock::now();
       render::RendererInternals::submit_frame_prefix(renderer, s, k);
-      ms[k] = ms_since(t0);
+      ms[k] = util::ms_since(t0);
     }
     if (r >= 0)
       for (const auto& [name, k] : index) differences[name].push_back(ms[k + 1] - ms[k]);

@@ -25,7 +25,9 @@
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
 #include "msm/shading.h"
+#include "msm/util/clock.h"
 #include "msm/util/limits.h"
+#include "msm/util/output_dir.h"
 #include "msm/util/progress.h"
 #include "reference_look.h"
 
@@ -34,41 +36,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using msm::reference::Settings;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// Creates DIR and checks that a file can be written there, before any long render.
-void prepare_output(const fs::path& dir) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw UsageError(fmt::format("--out {}: cannot create the directory: {}", dir.string(), ec.message()));
-  if (!fs::is_directory(dir, ec)) throw UsageError(fmt::format("--out {}: not a directory", dir.string()));
-  const fs::path probe = dir / fmt::format(".msm-reference-probe.{}", ::getpid());
-  {
-    std::ofstream out(probe, std::ios::binary);
-    if (!out || !(out << "probe") || !out.flush()) {
-      fs::remove(probe, ec);
-      throw UsageError(fmt::format("--out {}: the directory is not writable", dir.string()));
-    }
-  }
-  fs::remove(probe, ec);
-}
-
-// A one-line progress bar on stderr.
-class ProgressBar {
- public:
-  void operator()(const msm::reference::Progress& p) {
-    const double fraction = p.rows_total ? double(p.rows_done) / double(p.rows_total) : 1.0;
-    const int width = 40, filled = int(std::lround(fraction * width));
-    const double eta = fraction > 0.0 ? p.seconds * (1.0 - fraction) / fraction : 0.0;
-    fmt::print(stderr, "\rmsm reference [{}{}] {:3.0f}%  {:.1f} s, {:.1f} s left ", std::string(filled, '#'),
-               std::string(width - filled, ' '), 100.0 * fraction, p.seconds, eta);
-    if (p.rows_done == p.rows_total) fmt::print(stderr, "\n");
-    std::fflush(stderr);
-  }
-};
 
 // The light as traced, the scene's as declared and the command line's overrides of it (each given
 // one; none: the scene's light exactly).
@@ -236,10 +203,15 @@ void add_reference(CLI::App& app) {
     } catch (const msm::limits::LimitError& e) {
       throw UsageError(fmt::format("{}: {}", scene.source.string(), e.what()));
     }
-    const double load_seconds = seconds_since(start);
+    const double load_seconds = util::seconds_since(start);
     const fs::path out = opt->out;
-    prepare_output(out);
-    ProgressBar bar;
+    if (const auto problem = util::prepare_output_dir(out, "msm-reference-probe"))
+      throw UsageError(fmt::format("--out {}: {}", out.string(), *problem));
+    auto bar = [](const msm::reference::Progress& p) {
+      fmt::print(stderr, "\r{}", util::progress_bar("msm reference", p.rows_done, p.rows_total, p.seconds, 40));
+      if (p.rows_done == p.rows_total) fmt::print(stderr, "\n");
+      std::fflush(stderr);
+    };
     if (opt->progress || ::isatty(::fileno(stderr))) {
       settings.progress = bar;
     } else {
@@ -334,8 +306,8 @@ void add_reference(CLI::App& app) {
     j["seconds"] = {{"load", load_seconds},
                     {"build", result.build_seconds},
                     {"render", result.render_seconds},
-                    {"write_images", seconds_since(write_start)},
-                    {"total", seconds_since(start)}};
+                    {"write_images", util::seconds_since(write_start)},
+                    {"total", util::seconds_since(start)}};
     const std::string text = j.dump(2) + "\n";
     try {
       files.add(out / "reference.json", {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});

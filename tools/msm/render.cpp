@@ -2,6 +2,7 @@
 #include "frames.h"
 #include "render_common.h"
 
+#include "msm/util/text.h"
 #include "msm/viewer/view_file.h"
 
 #include <fmt/core.h>
@@ -11,21 +12,7 @@
 #include <optional>
 
 namespace msm::tool {
-namespace {
-
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (start <= list.size()) {
-    size_t end = list.find(',', start);
-    if (end == std::string::npos) end = list.size();
-    if (end > start) out.push_back(list.substr(start, end - start));
-    start = end + 1;
-  }
-  return out;
-}
-
-} // namespace
+namespace {} // namespace
 
 void add_render(CLI::App& app) {
   struct Options {
@@ -95,7 +82,7 @@ void add_render(CLI::App& app) {
     if (opt->techniques == "all")
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
     else
-      names = canonical_technique_names(split(opt->techniques));
+      names = canonical_technique_names(util::split_nonempty(opt->techniques, ','));
     if (names.empty()) throw UsageError("--techniques: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);

@@ -6,7 +6,7 @@
 #include "msm/light_probe.h"
 #include "frame.glsl"
 
-layout(constant_id = 5) const bool kLinearRadiance = false;
+layout(constant_id = MSM_SPEC_LINEAR_RADIANCE) const bool kLinearRadiance = false;
 
 layout(binding = 1) uniform sampler2DArray probe; // six faces of linear RGB radiance
 layout(push_constant) uniform Push { ScatteringPush scatter; };
