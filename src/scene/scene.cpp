@@ -346,8 +346,10 @@ class Parser {
     const std::string phase = find(j, "phase") ? string(*find(j, "phase"), ptr + "/phase") : "isotropic";
     if (phase == "henyey_greenstein") {
       const json* g = find(j, "g");
-      if (!g) fail(ptr + "/g", "required key missing (the Henyey-Greenstein asymmetry, in (-1, 1))");
-      m.g = number_in(*g, ptr + "/g", -1.0f, 1.0f, true, true);
+      if (!g) fail(ptr + "/g", "required key missing (the Henyey-Greenstein asymmetry, in [-0.9999, 0.9999])");
+      // |g| <= 0.9999: beyond it the phase function's peak is narrower than two float unit vectors
+      // can resolve (scattering.h: 1 - cos θ from |u - v|² holds to about 3e-4 rad).
+      m.g = number_in(*g, ptr + "/g", -0.9999f, 0.9999f, false, false);
     } else if (phase == "isotropic") {
       if (find(j, "g")) fail(ptr + "/g", "only allowed with \"phase\": \"henyey_greenstein\"");
     } else {
