@@ -149,7 +149,7 @@ constexpr ParameterChoice kBlockerEstimates[] = {
     {"jcgt", 0.0f, "JCGT Eq. 4: the fragment depth weighted by δ1"},
     {"upper-bound", 1.0f, "Kneiphof's upper-bound blocker depth (Eq. 19), the mass at zf clamped to [δ1, δ2]"},
 };
-constexpr std::array<Parameter, 4> soft_moment_parameters(float delta2, float estimate) {
+std::array<Parameter, 4> soft_moment_parameters(float delta2, float estimate) {
   return {Parameter{.name = "delta1",
                     .slot = 0,
                     .default_value = MSM_BLOCKER_EPSILON,
@@ -172,7 +172,7 @@ constexpr std::array<Parameter, 4> soft_moment_parameters(float delta2, float es
                     .meaning = "how the average blocker depth is estimated from the search region's moments"}};
 }
 
-constexpr std::array<Parameter, 4> kCssmParameters = {
+const std::array<Parameter, 4> kCssmParameters = {
     Parameter{.name = "damping",
               .slot = 0,
               .default_value = MSM_CSM_DAMPING_DEFAULT,
