@@ -227,6 +227,24 @@ void clip_polygon(std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratc
   poly.swap(scratch);
 }
 
+// Clips a clip-space polygon to -w <= x, y <= w and z <= w, and with `near` to z >= 0 as well
+// (Vulkan's depth range).
+void clip_to_box(std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch, bool near) {
+  for (int plane = 0; plane < 6 && !poly.empty(); ++plane) {
+    if (plane == 4 && !near) continue;
+    clip_polygon(poly, scratch, [plane](const glm::dvec4& p) {
+      switch (plane) {
+      case 0: return p.w + p.x;
+      case 1: return p.w - p.x;
+      case 2: return p.w + p.y;
+      case 3: return p.w - p.y;
+      case 4: return p.z;
+      default: return p.w - p.z;
+      }
+    });
+  }
+}
+
 // Whether the triangle's part selected by `clip` (world points, w = 1) meets the light's map box:
 // clip-space x and y in [-1, 1] and depth at most 1 (orthographic: w stays 1).
 template <class Clip>
@@ -235,16 +253,7 @@ bool meets_map(const glm::dmat4& light_vp, std::array<glm::dvec4, 3> triangle, C
   poly.assign(triangle.begin(), triangle.end());
   clip(poly, scratch);
   for (glm::dvec4& p : poly) p = light_vp * p;
-  for (int plane = 0; plane < 5 && !poly.empty(); ++plane)
-    clip_polygon(poly, scratch, [plane](const glm::dvec4& p) {
-      switch (plane) {
-      case 0: return p.w + p.x;
-      case 1: return p.w - p.x;
-      case 2: return p.w + p.y;
-      case 3: return p.w - p.y;
-      default: return p.w - p.z;
-      }
-    });
+  clip_to_box(poly, scratch, false);
   return !poly.empty();
 }
 
@@ -259,17 +268,7 @@ std::vector<FramingMiss> shadow_framing_misses(const Scene& scene, int width, in
   // The part of a triangle inside the camera's view frustum, back in world space (w = 1).
   const auto visible_part = [&](std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch) {
     for (glm::dvec4& p : poly) p = camera_vp * p;
-    for (int plane = 0; plane < 6 && !poly.empty(); ++plane)
-      clip_polygon(poly, scratch, [plane](const glm::dvec4& p) {
-        switch (plane) {
-        case 0: return p.w + p.x;
-        case 1: return p.w - p.x;
-        case 2: return p.w + p.y;
-        case 3: return p.w - p.y;
-        case 4: return p.z;
-        default: return p.w - p.z;
-        }
-      });
+    clip_to_box(poly, scratch, true);
     for (glm::dvec4& p : poly) {
       p = camera_inverse * p;
       p /= p.w;
