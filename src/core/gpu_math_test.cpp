@@ -143,7 +143,7 @@ const Spec kSpecs[] = {
     // Bounds: measured 1.2e-3 / 4.4e-5 with the edge classes (6 seeds).
     {MSM_K_HAMBURGER4_BOUNDS, "hamburger4_bounds", Metric::abs, A2, Layout::none, 0.01, 2e-4},
     {MSM_K_HAMBURGER4_CANONICAL, "hamburger4_canonical", Metric::abs, AB3, Layout::none, 0.5, 1e-3, 1.0, Nodes, 3},
-    // Hausdorff: its four-atom branch once divided rounding noise by rounding noise for
+    // Hausdorff: its four-atom case once divided rounding noise by rounding noise for
     // receivers ~1e-4 behind a surface and differed by up to 1 (p99.9 6.4e-4); from the moments of
     // (z - lo)(hi - z) dZ, with the noise resolved to one side, it differs by 1.5e-3 / 4.0e-5
     // (6 seeds, a third of the inputs from the edge classes, see edge_pool).

@@ -349,7 +349,7 @@ TEST_F(SatBuilderTest, RejectsBadImages) {
 // sums and filtered values bitwise everywhere; shadow max 7.5e-7 (mssm4), 6e-8 (vssm), 1.0e-6 and
 // 1.7e-6 (cssm8, cssm16), blocker depth bitwise or within 2.4e-7; mssm6 (Eq. 19's roots): depth
 // max 1.0e-5, shadow max 1.8e-3, 15 fragments beyond 1e-3. Tolerances (for other devices): 1e-6
-// (filtered), 1e-3 (depth, shadow) with at most 0.2% of fragments beyond, for a branch taken
+// (filtered), 1e-3 (depth, shadow) with at most 0.2% of fragments beyond, for a path taken
 // differently at a threshold (umbra, roots at zf).
 struct SoftFlowCase {
   const char* name;

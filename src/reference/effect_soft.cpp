@@ -47,7 +47,7 @@ EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& r
   // Directions of a batch first, then the rays (as effect_filtered, and why: kSampleBatch). The
   // points come from the generator in double precision (the same random numbers in the same
   // order), the directions in single precision, which is what Embree traces: the loops over a
-  // whole batch have no branch and no call, and the compiler vectorizes them.
+  // whole batch have no conditional and no call, and the compiler vectorizes them.
   const float half_x = float(ctx.half_x), half_y = float(ctx.half_y);
   const glm::vec3 towards(ctx.towards_light), light_x(ctx.light_x), light_y(ctx.light_y);
   alignas(64) float ux[kSampleBatch], uy[kSampleBatch], dx[kSampleBatch], dy[kSampleBatch], dz[kSampleBatch];

@@ -76,7 +76,7 @@ TEST_F(BackgroundTest, ProbeLitSceneShowsTheProbesRadianceByHand) {
 // show the neighbouring texel.
 TEST_F(BackgroundTest, RendererAndRayTracerShowTheSameProbe) {
   const std::string probe = "/usr/share/blender/datafiles/studiolights/world/interior.exr";
-  if (!std::filesystem::exists(probe)) GTEST_SKIP() << probe << " is missing (Debian: blender-data)";
+  ASSERT_TRUE(std::filesystem::exists(probe)) << probe << " is missing (Debian: blender-data, scripts/bootstrap.sh)";
   scene::Scene scene = sky_probe();
   scene::set_probe(scene, probe);
   scene::set_probe_light_count(scene, 4);

@@ -149,69 +149,6 @@ LightBox fit_light_frustum(const Scene& scene, const glm::mat4& light_view, bool
   return box;
 }
 
-TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size) {
-  TexelCoverage c;
-  if (width <= 0 || height <= 0 || shadow_size <= 0) return c;
-  const glm::dmat4 camera_vp =
-      glm::dmat4(scene.camera.projection(float(width) / float(height))) * glm::dmat4(scene.camera.view());
-  const glm::dmat4 light_vp(scene.light_view_projection());
-  // One texel in world units: the orthographic box's width and height over the map's texels.
-  const glm::dmat4 light_inv = glm::inverse(light_vp);
-  c.texel_size = 2.0 * std::max(glm::length(glm::dvec3(light_inv[0])), glm::length(glm::dvec3(light_inv[1]))) /
-                 double(shadow_size);
-  // The nearest surface inside the view frustum: clip each triangle to it in clip space (w is the
-  // view depth) and keep the smallest w of the clipped polygon. Surfaces hidden behind others count
-  // too: the bound is meant for the closest surface the camera shows, which is never hidden.
-  const glm::dmat4 camera_inverse = glm::inverse(camera_vp);
-  double nearest = std::numeric_limits<double>::infinity();
-  glm::dvec3 nearest_point(0.0);
-  std::vector<glm::dvec4> poly, next;
-  const auto inside = [](const glm::dvec4& p, int plane) {
-    switch (plane) {
-    case 0: return p.w + p.x;
-    case 1: return p.w - p.x;
-    case 2: return p.w + p.y;
-    case 3: return p.w - p.y;
-    case 4: return p.z;
-    default: return p.w - p.z;
-    }
-  };
-  for (const Object& o : scene.objects) {
-    const Mesh& m = o.mesh;
-    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-      poly.clear();
-      for (int k = 0; k < 3; ++k)
-        poly.push_back(camera_vp * glm::dvec4(glm::dvec3(m.positions[m.indices[3 * t + std::size_t(k)]]), 1.0));
-      for (int plane = 0; plane < 6 && !poly.empty(); ++plane) {
-        next.clear();
-        for (std::size_t i = 0; i < poly.size(); ++i) {
-          const glm::dvec4 &a = poly[i], &b = poly[(i + 1) % poly.size()];
-          const double da = inside(a, plane), db = inside(b, plane);
-          if (da >= 0.0) next.push_back(a);
-          if ((da >= 0.0) != (db >= 0.0)) next.push_back(a + (da / (da - db)) * (b - a));
-        }
-        poly.swap(next);
-      }
-      for (const glm::dvec4& p : poly)
-        if (p.w < nearest) {
-          nearest = p.w;
-          const glm::dvec4 world = camera_inverse * p;
-          nearest_point = glm::dvec3(world) / world.w;
-        }
-    }
-  }
-  if (!std::isfinite(nearest)) return c; // the camera sees nothing
-  c.visible = true;
-  c.distance = nearest;
-  c.where = glm::vec3(nearest_point);
-  // Pixels per world unit across the view direction at view depth w: height / (2 w tan(fov/2)).
-  const double pixels_per_unit =
-      double(height) / (2.0 * nearest * std::tan(double(scene.camera.fov_y_deg) * std::numbers::pi / 360.0));
-  c.pixels_per_texel = c.texel_size * pixels_per_unit;
-  c.aspect_beyond_fit = scene.shadow.mode == ShadowFraming::Mode::fit && double(width) / height > kFitMaxAspect;
-  return c;
-}
-
 namespace {
 
 // Sutherland–Hodgman: the part of the convex polygon where inside(p) >= 0 (a linear function).
@@ -244,6 +181,54 @@ void clip_to_box(std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch
     });
   }
 }
+
+} // namespace
+
+TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size) {
+  TexelCoverage c;
+  if (width <= 0 || height <= 0 || shadow_size <= 0) return c;
+  const glm::dmat4 camera_vp =
+      glm::dmat4(scene.camera.projection(float(width) / float(height))) * glm::dmat4(scene.camera.view());
+  const glm::dmat4 light_vp(scene.light_view_projection());
+  // One texel in world units: the orthographic box's width and height over the map's texels.
+  const glm::dmat4 light_inv = glm::inverse(light_vp);
+  c.texel_size = 2.0 * std::max(glm::length(glm::dvec3(light_inv[0])), glm::length(glm::dvec3(light_inv[1]))) /
+                 double(shadow_size);
+  // The nearest surface inside the view frustum: clip each triangle to it in clip space (w is the
+  // view depth) and keep the smallest w of the clipped polygon. Surfaces hidden behind others count
+  // too: the bound is meant for the closest surface the camera shows, which is never hidden.
+  const glm::dmat4 camera_inverse = glm::inverse(camera_vp);
+  double nearest = std::numeric_limits<double>::infinity();
+  glm::dvec3 nearest_point(0.0);
+  std::vector<glm::dvec4> poly, next;
+  for (const Object& o : scene.objects) {
+    const Mesh& m = o.mesh;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      poly.clear();
+      for (int k = 0; k < 3; ++k)
+        poly.push_back(camera_vp * glm::dvec4(glm::dvec3(m.positions[m.indices[3 * t + std::size_t(k)]]), 1.0));
+      clip_to_box(poly, next, true);
+      for (const glm::dvec4& p : poly)
+        if (p.w < nearest) {
+          nearest = p.w;
+          const glm::dvec4 world = camera_inverse * p;
+          nearest_point = glm::dvec3(world) / world.w;
+        }
+    }
+  }
+  if (!std::isfinite(nearest)) return c; // the camera sees nothing
+  c.visible = true;
+  c.distance = nearest;
+  c.where = glm::vec3(nearest_point);
+  // Pixels per world unit across the view direction at view depth w: height / (2 w tan(fov/2)).
+  const double pixels_per_unit =
+      double(height) / (2.0 * nearest * std::tan(double(scene.camera.fov_y_deg) * std::numbers::pi / 360.0));
+  c.pixels_per_texel = c.texel_size * pixels_per_unit;
+  c.aspect_beyond_fit = scene.shadow.mode == ShadowFraming::Mode::fit && double(width) / height > kFitMaxAspect;
+  return c;
+}
+
+namespace {
 
 // Whether the triangle's part selected by `clip` (world points, w = 1) meets the light's map box:
 // clip-space x and y in [-1, 1] and depth at most 1 (orthographic: w stays 1).

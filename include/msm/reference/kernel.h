@@ -42,7 +42,7 @@ class FilterKernel {
   // the tap whose cumulative weight interval holds u, then the tent's inverse CDF of u rescaled
   // within that interval. Measure-preserving, so stratified u give stratified offsets per tap.
   // The ray tracer calls it twice per filtered sample: the tap is found through a table of
-  // buckets of u (not a search from tap 0), and the rest has no branch on u.
+  // buckets of u (not a search from tap 0), and the rest has no conditional on u.
   double sample(double u) const;
 
  private:
