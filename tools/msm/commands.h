@@ -14,6 +14,7 @@ void add_compare(CLI::App& app);
 void add_lights(CLI::App& app); // msm lights, and msm probe: its alias of the first release
 void add_reference(CLI::App& app);
 void add_render(CLI::App& app);
+void add_report(CLI::App& app);
 void add_scenes(CLI::App& app);
 void add_view(CLI::App& app);
 

@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
   msm::tool::add_demo(app);
   msm::tool::add_bench(app);
   msm::tool::add_render(app);
+  msm::tool::add_report(app);
   msm::tool::add_scenes(app);
   msm::tool::add_view(app);
 #endif

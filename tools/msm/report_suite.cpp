@@ -1,0 +1,66 @@
+#include "report_suite.h"
+
+#include "commands.h"
+
+#include <fmt/core.h>
+#include <fmt/ranges.h>
+
+namespace msm::tool {
+namespace {
+
+using reference::Effect;
+
+// The filtered hard-shadow techniques of the 2015 paper and JCGT 2017 at their storage sizes, from
+// 16 (PCF, the reference of filtered hard shadows) to 128 bits per texel.
+std::vector<SuiteTechnique> filtered_techniques() {
+  return {{"pcf", {}},      {"vsm-32", {}},   {"evsm4-64", {}},         {"msm-hamburger-64", {}},
+          {"msm-nl64", {}}, {"msm-nl32", {}}, {"msm-hamburger-128", {}}};
+}
+
+// Soft shadows of a directional area light: moment soft shadows and their baselines (JCGT §4).
+std::vector<SuiteTechnique> soft_techniques() { return {{"mssm4", {}}, {"mssm6", {}}, {"vssm", {}}, {"pcss", {}}}; }
+
+// Single scattering (JCGT §5): ray marching against the prefiltered moments.
+std::vector<SuiteTechnique> scattering_techniques() {
+  return {{"scatter-march-32", {}},
+          {"scatter-march-128", {}},
+          {"scatter-csm-32", {}},
+          {"scatter-msm4-64", {}},
+          {"scatter-msm6-96", {}}};
+}
+
+std::vector<Suite> declared_suites() {
+  Suite quick{"quick",
+              "Two small scenes at 320 x 180: filtered hard shadows on the fence, soft shadows of the models; under a "
+              "minute on a CPU device",
+              {{"fence-filtered", "fence", Effect::filtered, 320, 180, 512, 64, filtered_techniques()},
+               {"models-soft", "models", Effect::soft, 320, 180, 512, 64, soft_techniques()}}};
+  Suite full{"full",
+             "Every kind of shadow the renderer draws on the scenes that show its failure modes, at 640 x 360",
+             {{"fence-filtered", "fence", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
+              {"railing-filtered", "railing", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
+              {"pillar_wall-filtered", "pillar_wall", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
+              {"stair-filtered", "stair", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
+              // A 4° light: its penumbra within every technique's kernel (the disc's own 10° is wider).
+              {"disc-soft", "disc", Effect::soft, 640, 360, 1024, 64, soft_techniques(), 4.0f},
+              {"models-soft", "models", Effect::soft, 640, 360, 1024, 64, soft_techniques()},
+              {"trees-scattering", "trees", Effect::scattering, 320, 180, 1024, 32, scattering_techniques()}}};
+  return {quick, full};
+}
+
+} // namespace
+
+std::vector<std::string> suite_names() {
+  std::vector<std::string> names;
+  for (const Suite& s : declared_suites()) names.push_back(s.name);
+  return names;
+}
+
+const Suite& find_suite(const std::string& name) {
+  static const std::vector<Suite> suites = declared_suites();
+  for (const Suite& s : suites)
+    if (s.name == name) return s;
+  throw UsageError(fmt::format("--suite {}: expected {}", name, fmt::join(suite_names(), ", ")));
+}
+
+} // namespace msm::tool
