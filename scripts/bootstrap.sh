@@ -18,7 +18,16 @@ packages=(
   libglfw3-dev libimgui-dev xvfb xauth  # msm view (GLFW, Dear ImGui) and its tests in a virtual X server
   fonts-dejavu-core  # the font of msm view's panel (Greek letters of the parameter help)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
+  python3-matplotlib chromium nodejs  # msm report's charts, and its page's test in headless Chromium
 )
+command -v npm >/dev/null || packages+=(npm) # a nodejs from elsewhere (NodeSource) brings its own npm
+
+# web/'s npm packages (playwright-core drives Chromium in tests/browser), from its lockfile.
+web_packages() {
+  local web
+  web="$(dirname "$0")/../web"
+  [[ -d "$web/node_modules" ]] || (cd "$web" && npm ci --no-audit --no-fund)
+}
 
 missing=()
 for p in "${packages[@]}"; do
@@ -28,6 +37,7 @@ done
 
 if ((${#missing[@]} == 0)); then
   echo "bootstrap: all ${#packages[@]} packages present"
+  web_packages
   exit 0
 fi
 
@@ -38,3 +48,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${sudo[@]}" apt-get update -qq
 "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+web_packages
