@@ -139,7 +139,7 @@ def cost_chart(run, row, out):
         left = [a + b for a, b in zip(left, ms)]
     ax.invert_yaxis()
     ax.set_xlabel("GPU time per frame (ms), " + run["timing"].split(",")[0])
-    ax.set_title(f"{row['id']}: {row['width']}x{row['height']}, shadow map {row['shadow_size']}², "
+    ax.set_title(f"{row['id']}: {row['width']}x{row['height']}, shadow map {row['shadow_size']}²\n"
                  f"on {device_name(run)}")
     ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
@@ -159,10 +159,48 @@ def error_bits_chart(run, out):
     ax.set_yscale("log")
     ax.set_xlabel("bits per texel of the shadow map")
     ax.set_ylabel("MAE against the ray-traced truth")
-    ax.set_title(f"Error against storage, suite {run['suite']['name']}, on {device_name(run)}")
+    ax.set_title(f"Error against storage, suite {run['suite']['name']}\non {device_name(run)}")
     ax.legend(fontsize=7)
     fig.tight_layout()
     return save(fig, out, "error-bits.svg")
+
+
+def resolution_charts(run, out):
+    """GPU time per frame against the output's pixels (one shadow-map size) and against the shadow map's
+    side (one output size), per technique, for every scene the suite measures at several sizes (the
+    shapes of the 2015 paper's timing figure and JCGT's Fig. 20)."""
+    charts = []
+    groups = {}
+    for row in run["rows"]:
+        groups.setdefault((row["scene"], row["truth"]["effect"]), []).append(row)
+    for (scene, effect), rows in groups.items():
+        for axis, fixed, x_of, label in (
+                ("output", "shadow_size", lambda r: r["width"] * r["height"] / 1e6, "output megapixels"),
+                ("shadow-map", "width", lambda r: r["shadow_size"], "shadow map texels per side")):
+            by_fixed = {}
+            for r in rows:
+                by_fixed.setdefault((r[fixed], r["height"] if fixed == "width" else 0), []).append(r)
+            for (fixed_value, _), series in by_fixed.items():
+                xs = sorted({x_of(r) for r in series})
+                if len(xs) < 2:
+                    continue
+                series = sorted(series, key=x_of)
+                fig, ax = plt.subplots(figsize=(6, 3.6))
+                for t in series[0]["techniques"]:
+                    points = [(x_of(r), u["gpu_ms_total"]) for r in series for u in r["techniques"]
+                              if u["name"] == t["name"]]
+                    ax.plot([p[0] for p in points], [p[1] for p in points], marker="o", label=t["name"])
+                ax.set_xlabel(label)
+                ax.set_ylabel("GPU ms per frame")
+                ax.set_xscale("log", base=2)
+                ax.set_yscale("log")
+                held = (f"shadow map {fixed_value}²" if fixed == "shadow_size"
+                        else f"{series[0]['width']}x{series[0]['height']}")
+                ax.set_title(f"{scene} ({effect}): time against {axis} resolution, {held}\non {device_name(run)}")
+                ax.legend(fontsize=6)
+                fig.tight_layout()
+                charts.append(save(fig, out, f"{scene}-{effect}-{axis}-cost.svg"))
+    return charts
 
 
 def legend_chart(error_range, out):
@@ -190,7 +228,7 @@ def compare_chart(a, b, row_a, row_b, out):
         ax.invert_yaxis()
         ax.set_xlabel(label)
         ax.legend(fontsize=7)
-    fig.suptitle(f"{row_a['id']}: A on {device_name(a)}, B on {device_name(b)}", fontsize=9)
+    fig.suptitle(f"{row_a['id']}: A on {device_name(a)},\nB on {device_name(b)}", fontsize=9)
     fig.tight_layout()
     return save(fig, out, f"{row_a['id']}-compare.svg")
 
@@ -286,6 +324,10 @@ def single_page(run, out, prefix):
         parts.append(inset_dialogs(row, prefix, dialog_id))
         parts.append(metrics_table(row))
         parts.append(f"<p class=charts><img src='{cost_chart(run, row, out)}' alt='GPU time per pass'></p></section>")
+    charts = resolution_charts(run, out)
+    if charts:
+        parts.append("<h2>Cost against resolution</h2><p class=charts>" +
+                     "".join(f"<img src='{c}' alt='time against resolution'>" for c in charts) + "</p>")
     parts.append(f"<h2>Error against bits per texel</h2><p class=charts><img src='{error_bits_chart(run, out)}' "
                  "alt='error against bits per texel'></p>")
     return page(f"msm report: suite {run['suite']['name']} on {device_name(run)}", "\n".join(parts))

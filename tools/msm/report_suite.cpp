@@ -41,6 +41,11 @@ std::vector<Suite> declared_suites() {
               {"railing-filtered", "railing", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
               {"pillar_wall-filtered", "pillar_wall", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
               {"stair-filtered", "stair", Effect::filtered, 640, 360, 1024, 64, filtered_techniques()},
+              // The fence at other output and shadow-map sizes: cost against resolution.
+              {"fence-filtered-320x180", "fence", Effect::filtered, 320, 180, 1024, 64, filtered_techniques()},
+              {"fence-filtered-1280x720", "fence", Effect::filtered, 1280, 720, 1024, 64, filtered_techniques()},
+              {"fence-filtered-map512", "fence", Effect::filtered, 640, 360, 512, 64, filtered_techniques()},
+              {"fence-filtered-map2048", "fence", Effect::filtered, 640, 360, 2048, 64, filtered_techniques()},
               // A 4° light: its penumbra within every technique's kernel (the disc's own 10° is wider).
               {"disc-soft", "disc", Effect::soft, 640, 360, 1024, 64, soft_techniques(), 4.0f},
               {"models-soft", "models", Effect::soft, 640, 360, 1024, 64, soft_techniques()},
