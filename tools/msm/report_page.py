@@ -45,7 +45,7 @@ body{font-family:system-ui,sans-serif;margin:1.5em;color:#222;max-width:1400px}
 h1{font-size:1.5em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ccc}
 .meta{font-size:.85em;color:#555}.meta code{font-size:.95em}
 .grid{display:flex;flex-wrap:wrap;gap:8px}
-figure{margin:0;font-size:.8em}figure img{display:block;image-rendering:pixelated}
+figure{margin:0;font-size:.8em}figure img{display:block;image-rendering:pixelated;width:256px;height:auto}
 .frame{position:relative;display:inline-block}
 .inset-box{position:absolute;border:2px solid #ff0;box-sizing:border-box;cursor:zoom-in}
 .inset-box span{position:absolute;top:0;left:0;background:#ff0;color:#000;font-size:10px;padding:0 2px}
@@ -57,7 +57,7 @@ tr.differs td{background:#ffe9a8}td.changed{font-weight:bold;color:#a00}
 .legend img{height:60px}.charts img{max-width:100%}
 button.inset{cursor:zoom-in;padding:0;border:2px solid #ff0;background:none;margin-right:4px}
 button.inset img{display:block;height:48px;image-rendering:pixelated}
-dialog{max-width:95vw}dialog .grid figure img{height:200px}
+dialog{max-width:95vw}dialog .grid figure img{width:auto;height:200px}
 .summary{background:#f6f6f6;padding:.5em 1em;border-left:4px solid #888}
 """
 
@@ -148,19 +148,24 @@ def cost_chart(run, row, out):
 
 def error_bits_chart(run, out):
     """Error against bits per texel, one series per row (the storage trade-off of the papers)."""
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for row in run["rows"]:
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    named = set()  # each technique named once, at its first point
+    markers = "osD^v<>ph*"
+    for k, row in enumerate(run["rows"]):
         xs = [t["bits_per_texel"] for t in row["techniques"]]
         ys = [max(t["metrics"]["mae"], 1e-6) for t in row["techniques"]]
-        ax.scatter(xs, ys, label=row["id"])
+        ax.scatter(xs, ys, label=row["id"], marker=markers[k % len(markers)],
+                   color=plt.get_cmap("tab20").colors[k % 20])
         for t, x, y in zip(row["techniques"], xs, ys):
-            ax.annotate(t["name"], (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
+            if t["name"] not in named:
+                ax.annotate(t["name"], (x, y), fontsize=6, xytext=(3, 2), textcoords="offset points")
+                named.add(t["name"])
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
     ax.set_xlabel("bits per texel of the shadow map")
     ax.set_ylabel("MAE against the ray-traced truth")
     ax.set_title(f"Error against storage, suite {run['suite']['name']}\non {device_name(run)}")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     return save(fig, out, "error-bits.svg")
 
@@ -255,9 +260,10 @@ def image_grid(row, prefix, dialog_id):
              f"alt='ray-traced truth'>{boxes}</div><figcaption>ray traced ({esc(truth['effect'])}, "
              f"{truth['samples']} spp)</figcaption></figure>"]
     for t in row["techniques"]:
-        cells.append(f"<figure><img src='{esc(prefix + t['images']['render'])}' width={w} height={h} "
-                     f"alt='{esc(t['name'])}'><img src='{esc(prefix + t['images']['error'])}' width={w} height={h} "
-                     f"alt='{esc(t['name'])} error'><figcaption><b>{esc(t['name'])}</b> MAE "
+        render, error = esc(prefix + t["images"]["render"]), esc(prefix + t["images"]["error"])
+        cells.append(f"<figure><a href='{render}'><img src='{render}' width={w} height={h} alt='{esc(t['name'])}'></a>"
+                     f"<a href='{error}'><img src='{error}' width={w} height={h} alt='{esc(t['name'])} error'></a>"
+                     f"<figcaption><b>{esc(t['name'])}</b> MAE "
                      f"{t['metrics']['mae']:.4f}</figcaption></figure>")
     return "<div class=grid>" + "".join(cells) + "</div>"
 
