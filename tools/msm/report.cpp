@@ -227,18 +227,23 @@ ordered_json run_row(const vk::Context& ctx, const Suite& suite, const SuiteRow&
   std::vector<render::RenderSettings> settings;
   for (const SuiteTechnique& t : row.techniques) settings.push_back(technique_settings(row, t, options));
   scene::Scene scene = load_scene_or_fail(row.scene);
+  if (row.probe_lights) try {
+      scene::set_probe_light_count(scene, *row.probe_lights);
+    } catch (const scene::SceneError& e) { throw UsageError(fmt::format("suite row {}: {}", row.id, e.what())); }
   const reference::Settings rs = truth_settings(row, settings.front());
   fmt::print(stderr, "msm report: {} ({} {}x{}): ray tracing the {} truth, {} samples per pixel ...\n", row.id,
              scene.name, row.width, row.height, reference::to_string(row.truth), row.samples);
   const reference::Result truth = reference::render(scene, rs);
   const bool scattering = row.truth == reference::Effect::scattering;
-  const image::Image reference = truth.visibility.channel("visibility");
+  const bool environment = row.truth == reference::Effect::environment;
   // Scattering: every view ray counts (JCGT §5's visible fraction); otherwise the surfaces only.
   const image::Image mask =
       scattering ? image::Image(row.width, row.height, 1) : truth.visibility.channel("background");
   const image::Image truth_rgb =
       scattering ? image::tone_map(truth.radiance, {std::log2(settings.front().exposure), image::ToneCurve::aces})
                  : reference_look(truth, settings.front().exposure);
+  // Environment: the luminance of the look (as msm demo's image-based-lighting part measures it).
+  const image::Image reference = environment ? image::select_signal(truth_rgb) : truth.visibility.channel("visibility");
 
   render::Renderer renderer(ctx, scene);
   std::vector<Measured> measured;
@@ -250,7 +255,9 @@ ordered_json run_row(const vk::Context& ctx, const Suite& suite, const SuiteRow&
       m.result = renderer.render(s);
       time_passes(renderer, s, suite.timed_frames, m.result);
     } catch (const render::RenderError& e) { throw UsageError(fmt::format("{}: {}", row.id, e.what())); }
-    m.signal = scattering ? m.result.scattering.channel("visible_fraction") : m.result.shadow.channel("visibility");
+    m.signal = scattering    ? m.result.scattering.channel("visible_fraction")
+               : environment ? image::select_signal(m.result.color)
+                             : m.result.shadow.channel("visibility");
     measured.push_back(std::move(m));
   }
 
@@ -299,8 +306,10 @@ ordered_json run_row(const vk::Context& ctx, const Suite& suite, const SuiteRow&
             {"samples", truth.samples},
             {"seconds", truth.build_seconds + truth.render_seconds},
             {"light_extent_deg", truth.light_extent_deg}, // as traced (soft)
-            {"signal", scattering ? "visible fraction of each view ray, every pixel"
-                                  : "visibility of the surfaces, background excluded"},
+            {"signal", scattering    ? "visible fraction of each view ray, every pixel"
+                       : environment ? "luminance of the tone-mapped image, background excluded"
+                                     : "visibility of the surfaces, background excluded"},
+            {"probe_lights", scene.probe ? scene.probe->lights : 0},
             {"images", truth_images}}},
           {"error_range", kErrorRange},
           {"insets", inset_rects},

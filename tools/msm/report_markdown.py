@@ -32,7 +32,8 @@ COLUMNS = [  # heading, key under a technique's "metrics", format
 
 def row_section(run, row):
     truth = row["truth"]
-    light = f", light {truth['light_extent_deg']:g}°" if truth["effect"] == "soft" else ""
+    light = (f", light {truth['light_extent_deg']:g}°" if truth["effect"] == "soft" else
+             f", the probe cut into {truth['probe_lights']} lights" if truth["effect"] == "environment" else "")
     lines = [f"**{row['scene']}**, {truth['effect']} ({row['width']}×{row['height']}, shadow map "
              f"{row['shadow_size']}², truth {truth['samples']} samples per pixel{light}; row `{row['id']}`):",
              "",

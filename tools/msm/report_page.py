@@ -308,8 +308,9 @@ def metrics_table(row):
 
 def row_title(row):
     truth = row["truth"]
+    lights = f", the probe cut into {truth['probe_lights']} lights" if truth["effect"] == "environment" else ""
     return (f"{esc(row['scene'])}: {esc(truth['effect'])} shadows, {row['width']}x{row['height']}, shadow map "
-            f"{row['shadow_size']}²")
+            f"{row['shadow_size']}²{lights}")
 
 
 def page(title, body):

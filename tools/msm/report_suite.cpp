@@ -29,6 +29,11 @@ std::vector<SuiteTechnique> scattering_techniques() {
           {"scatter-msm6-96", {}}};
 }
 
+// Image-based lighting (Kneiphof): a probe cut into area lights with soft shadows, or into 256 point
+// lights with hard ones, against the whole probe.
+std::vector<SuiteTechnique> area_light_techniques() { return {{"mssm6", {}}, {"mssm4", {}}, {"pcss", {}}}; }
+std::vector<SuiteTechnique> point_light_techniques() { return {{"msm-hamburger-64", {}}, {"pcf", {}}}; }
+
 std::vector<Suite> declared_suites() {
   Suite quick{"quick",
               "Two small scenes at 320 x 180: filtered hard shadows on the fence, soft shadows of the models; under a "
@@ -49,7 +54,12 @@ std::vector<Suite> declared_suites() {
               // A 4° light: its penumbra within every technique's kernel (the disc's own 10° is wider).
               {"disc-soft", "disc", Effect::soft, 640, 360, 1024, 64, soft_techniques(), 4.0f},
               {"models-soft", "models", Effect::soft, 640, 360, 1024, 64, soft_techniques()},
-              {"trees-scattering", "trees", Effect::scattering, 320, 180, 1024, 32, scattering_techniques()}}};
+              {"trees-scattering", "trees", Effect::scattering, 320, 180, 1024, 32, scattering_techniques()},
+              // One shadow map per light: the paper's 256² (Kneiphof §6).
+              {"sky_probe-32-lights", "sky_probe", Effect::environment, 320, 180, 256, 256, area_light_techniques(),
+               std::nullopt, 32},
+              {"sky_probe-256-lights", "sky_probe", Effect::environment, 320, 180, 256, 256, point_light_techniques(),
+               std::nullopt, 256}}};
   return {quick, full};
 }
 

@@ -24,7 +24,8 @@ struct SuiteRow {
   std::string scene; // a built-in scene or a scene file
   // The ray-traced truth the techniques are measured against: filtered (the renderer's shadow map
   // and filter traced), soft (the scene's area light), scattering (the visible fraction of each
-  // view ray, every pixel compared).
+  // view ray, every pixel compared), environment (the whole light probe of the scene; compared is
+  // the luminance of the tone-mapped images, the lights' extraction and the shadows together).
   reference::Effect truth = reference::Effect::filtered;
   int width = 320, height = 180, shadow_size = 512;
   int samples = 64; // of the truth, per pixel
@@ -32,6 +33,8 @@ struct SuiteRow {
   // Soft shadows: a disc light of this angular diameter in degrees instead of the scene's light,
   // in the renders and the truth alike.
   std::optional<float> light_extent_deg;
+  // Image-based lighting: the scene's probe cut into this many area lights (default: the scene's).
+  std::optional<int> probe_lights;
 };
 
 struct Suite {
