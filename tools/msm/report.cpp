@@ -359,6 +359,7 @@ void run_suite(const ReportOptions& options) {
     throw UsageError(fmt::format("--out {}: {}", options.out, *problem));
   const auto start = std::chrono::steady_clock::now();
   const std::string started = utc_now();
+  const ordered_json build = build_json(); // the source as the run starts
   std::unique_ptr<vk::Context> ctx = open_device(options.device);
   fmt::print(stderr, "msm report: suite '{}' ({} rows) on {}\n", suite.name, suite.rows.size(), ctx->info().name);
   image::FileSet files;
@@ -372,7 +373,7 @@ void run_suite(const ReportOptions& options) {
       {"seconds", seconds_since(start)},
       {"device", device_json(*ctx)},
       {"host", host_json()},
-      {"build", build_json()},
+      {"build", build},
       {"timing", fmt::format("GPU timestamps per pass, median of {} frames after the first", suite.timed_frames)},
       {"rows", rows}};
   const std::string text = results.dump(2) + "\n";

@@ -14,7 +14,11 @@ import json
 import os
 import sys
 
-import matplotlib
+try:
+    import matplotlib
+except ImportError:
+    sys.exit(f"report_page: {sys.executable} has no matplotlib: run Debian's /usr/bin/python3 (python3-matplotlib; "
+             "scripts/bootstrap.sh installs it), or name another Python in MSM_PYTHON")
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
