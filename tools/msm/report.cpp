@@ -10,6 +10,7 @@
 #include "msm/image/metrics.h"
 #include "msm/reference/reference.h"
 #include "msm/techniques.h"
+#include "msm/util/limits.h"
 #include "msm/util/output_dir.h"
 #include "msm/util/statistics.h"
 #include "msm/version.h"
@@ -152,6 +153,19 @@ reference::Settings truth_settings(const SuiteRow& row, const render::RenderSett
   rs.filter_sigma = frame.filter_sigma;
   if (row.light_extent_deg) rs.light_extent_deg = *row.light_extent_deg;
   return rs;
+}
+
+// Every technique's settings are valid, and the row's renders and truth within the limits shared
+// with msm render and msm reference (msm/util/limits.h): UsageError naming the row otherwise.
+void check_row(const SuiteRow& row, const ReportOptions& options) {
+  const scene::Scene scene = load_scene_or_fail(row.scene);
+  try {
+    for (const SuiteTechnique& t : row.techniques) {
+      const render::RenderSettings s = technique_settings(row, t, options);
+      render::check_limits(s, scene.triangle_count(), scene.lights.size());
+      reference::check_limits(truth_settings(row, s), scene.triangle_count());
+    }
+  } catch (const limits::LimitError& e) { throw UsageError(fmt::format("suite row {}: {}", row.id, e.what())); }
 }
 
 // What one technique measured on a row.
@@ -353,14 +367,13 @@ void write_page(const std::vector<std::string>& results, const std::string& out)
 void run_suite(const ReportOptions& options) {
   const Suite& suite = find_suite(options.suite);
   check_overrides(suite, options);
-  for (const SuiteRow& row : suite.rows)
-    for (const SuiteTechnique& t : row.techniques) technique_settings(row, t, options); // refused before any work
-  if (const auto problem = util::prepare_output_dir(options.out, "msm-report-probe"))
-    throw UsageError(fmt::format("--out {}: {}", options.out, *problem));
+  for (const SuiteRow& row : suite.rows) check_row(row, options); // refused before any work
   const auto start = std::chrono::steady_clock::now();
   const std::string started = utc_now();
-  const ordered_json build = build_json(); // the source as the run starts
-  std::unique_ptr<vk::Context> ctx = open_device(options.device);
+  const ordered_json build = build_json();                        // the source as the run starts
+  std::unique_ptr<vk::Context> ctx = open_device(options.device); // no device: no output directory either
+  if (const auto problem = util::prepare_output_dir(options.out, "msm-report-probe"))
+    throw UsageError(fmt::format("--out {}: {}", options.out, *problem));
   fmt::print(stderr, "msm report: suite '{}' ({} rows) on {}\n", suite.name, suite.rows.size(), ctx->info().name);
   image::FileSet files;
   ordered_json rows = ordered_json::array();
