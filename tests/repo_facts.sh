@@ -11,7 +11,7 @@ fail() { echo "repo facts: $*" >&2; failed=1; }
 words=$(wc -w < README.md)
 ((words < 1000)) || fail "README.md has $words words (limit 999)"
 
-paths=(src include tools scenes README.md docs/architecture.md docs/techniques.md docs/usage.md docs/viewer.md)
+paths=(src include tools scenes README.md docs/architecture.md docs/techniques.md docs/usage.md docs/viewer.md docs/results.md)
 if hits=$(grep -rnIE 'issue #?[0-9]|\bsessions?\b|\bbranch(es)? [a-z0-9]+-[a-z0-9-]+' "${paths[@]}"); then
   fail "history words (issue numbers, sessions, branch names) in code or docs:"
   echo "$hits" >&2
@@ -21,6 +21,23 @@ fi
 if hits=$(grep -rlI 'MSM_TECH_' src tools bench include | grep -vE \
   '^include/msm/[a-z0-9_]+\.h$|^include/msm/render/frame\.h$|^include/msm/cpu/techniques\.h$|^src/core/techniques\.cpp$|^src/render/shaders/[a-z0-9_]+\.glsl$|_test\.cpp$|^src/core/gpu/kernels\.h$'); then
   fail "technique ids compared outside the technique table, the shared headers and the shaders:"
+  echo "$hits" >&2
+fi
+# A citation of docs/results.md by title ("docs/results.md, \"Title\"", the title possibly cut at the end
+# of a line) names the start of one of its headings.
+if ! hits=$(python3 - <<'EOF'
+import re, subprocess
+headings = [l.lstrip("#").strip() for l in open("docs/results.md", encoding="utf-8") if l.startswith("#")]
+grep = ["grep", "-rnIE", "--exclude=repo_facts.sh", 'results\\.md[,:]? *\\(?"', "src", "include", "tools", "scripts", "tests", "bench", "docs",
+        "README.md"]
+lines = subprocess.run(grep, capture_output=True, text=True).stdout.splitlines()
+for line in lines:
+    title = re.search(r'results\.md[,:]? *\(?"([^"]+)"?', line).group(1).rstrip()
+    if not any(h.startswith(title) for h in headings):
+        print(line)
+EOF
+) || [[ -n $hits ]]; then
+  fail "citations of docs/results.md whose title is none of its headings:"
   echo "$hits" >&2
 fi
 exit $failed
