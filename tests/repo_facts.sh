@@ -23,18 +23,26 @@ if hits=$(grep -rlI 'MSM_TECH_' src tools bench include | grep -vE \
   fail "technique ids compared outside the technique table, the shared headers and the shaders:"
   echo "$hits" >&2
 fi
-# A citation of docs/results.md by title ("docs/results.md, \"Title\"", the title possibly cut at the end
-# of a line) names the start of one of its headings.
+# A citation of docs/results.md by title ("docs/results.md, \"Title\"", the title possibly wrapped onto the
+# next line or cut at the end of one) names the start of one of its headings.
 if ! hits=$(python3 - <<'EOF'
-import re, subprocess
+import os, re
 headings = [l.lstrip("#").strip() for l in open("docs/results.md", encoding="utf-8") if l.startswith("#")]
-grep = ["grep", "-rnIE", "--exclude=repo_facts.sh", 'results\\.md[,:]? *\\(?"', "src", "include", "tools", "scripts", "tests", "bench", "docs",
-        "README.md"]
-lines = subprocess.run(grep, capture_output=True, text=True).stdout.splitlines()
-for line in lines:
-    title = re.search(r'results\.md[,:]? *\(?"([^"]+)"?', line).group(1).rstrip()
-    if not any(h.startswith(title) for h in headings):
-        print(line)
+citation = re.compile(r'results\.md[,:]?[ \t]*(?:\n[ \t]*(?://|#|\*|--)?[ \t]*)?\(?"([^"]{1,200})"')
+line_break = re.compile(r'[ \t]*\n[ \t]*(?://+|#|\*|--)?[ \t]*')
+for top in ["src", "include", "tools", "scripts", "tests", "bench", "docs", "README.md"]:
+    files = [top] if os.path.isfile(top) else [os.path.join(d, f) for d, _, fs in os.walk(top) for f in fs]
+    for path in files:
+        if path in ("docs/results.md", "tests/repo_facts.sh"):
+            continue
+        try:
+            text = open(path, encoding="utf-8").read()
+        except (UnicodeDecodeError, OSError):
+            continue
+        for m in citation.finditer(text):
+            title = line_break.sub(" ", m.group(1)).strip()
+            if not any(h.startswith(title) for h in headings):
+                print(f"{path}:{text.count(chr(10), 0, m.start()) + 1}: {title}")
 EOF
 ) || [[ -n $hits ]]; then
   fail "citations of docs/results.md whose title is none of its headings:"
