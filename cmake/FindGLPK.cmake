@@ -1,10 +1,3 @@
 # Finds GLPK (Debian: libglpk-dev) and defines the imported target GLPK::GLPK.
-find_path(GLPK_INCLUDE_DIR glpk.h)
-find_library(GLPK_LIBRARY NAMES glpk)
-include(FindPackageHandleStandardArgs)
-find_package_handle_standard_args(GLPK REQUIRED_VARS GLPK_LIBRARY GLPK_INCLUDE_DIR)
-if(GLPK_FOUND AND NOT TARGET GLPK::GLPK)
-  add_library(GLPK::GLPK UNKNOWN IMPORTED)
-  set_target_properties(GLPK::GLPK PROPERTIES IMPORTED_LOCATION ${GLPK_LIBRARY}
-    INTERFACE_INCLUDE_DIRECTORIES ${GLPK_INCLUDE_DIR})
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/MsmFindImported.cmake)
+msm_find_imported(GLPK GLPK::GLPK glpk.h glpk)

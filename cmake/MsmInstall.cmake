@@ -65,5 +65,6 @@ function(msm_install_components)
   write_basic_package_version_file(${PROJECT_BINARY_DIR}/msmConfigVersion.cmake COMPATIBILITY SameMinorVersion)
   install(FILES ${PROJECT_BINARY_DIR}/msmConfig.cmake ${PROJECT_BINARY_DIR}/msmConfigVersion.cmake
     ${PROJECT_SOURCE_DIR}/cmake/FindGLPK.cmake ${PROJECT_SOURCE_DIR}/cmake/Findlibdeflate.cmake
+    ${PROJECT_SOURCE_DIR}/cmake/MsmFindImported.cmake
     DESTINATION ${destination})
 endfunction()

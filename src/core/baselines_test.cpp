@@ -16,6 +16,7 @@
 #include <functional>
 #include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -37,6 +38,17 @@ double random_fragment_depth(std::mt19937_64& rng, const test::Distribution& d, 
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   if (unit(rng) < 0.5) return lo - 0.1 * (hi - lo) + 1.2 * (hi - lo) * unit(rng);
   return d.z[size_t(unit(rng) * double(d.z.size())) % d.z.size()] + (unit(rng) - 0.5) * 0.02 * (hi - lo);
+}
+
+// A random distribution on [0,1] and a random fragment depth for it, clamped to [min_zf, 1].
+struct UnitCase {
+  test::Distribution d;
+  double zf;
+};
+UnitCase unit_case(std::mt19937_64& rng, double min_zf = 0.0) {
+  test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
+  double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), min_zf, 1.0);
+  return {std::move(d), zf};
 }
 
 // Cantelli's inequality, by hand, in double.
@@ -296,8 +308,7 @@ TEST(LowerBound, Vsm) {
   std::mt19937_64 rng(31);
   LowerBoundCheck f{"VSM 64-bit float, min var 1e-6", 1e-5}, q{"VSM 32-bit theta2 unorm16", 2e-3};
   for (int i = 0; i < 30000; ++i) {
-    test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-    double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), 0.0, 1.0);
+    const auto [d, zf] = unit_case(rng);
     double truth = test::cdf_less(d, zf);
     f.add(msm_vsm_shadow(vsm_float_moments(d), float(zf)), truth);
     q.add(msm_vsm_shadow_theta2(vsm_theta2_unorm16_moments(d), float(zf)), truth);
@@ -365,8 +376,7 @@ TEST(LowerBound, CsmWithDefaultParameters) {
   std::mt19937_64 rng(34);
   LowerBoundCheck check{"CSM M=1..16, defaults", 1e-5};
   for (int i = 0; i < 6000; ++i) {
-    test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-    double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), 0.0, 1.0);
+    const auto [d, zf] = unit_case(rng);
     CsmMoments m = csm_float_moments(d, MSM_CSM_MAX_TERMS);
     CsmParams p = msm_csm_default_params();
     p.terms = 1 + i % MSM_CSM_MAX_TERMS;
@@ -377,6 +387,19 @@ TEST(LowerBound, CsmWithDefaultParameters) {
 
 // ------------------------------------------------------------------------------------------------
 // ESM
+
+// A random ESM case: a distribution on [0,1], a fragment depth in [min_zf, 1], the exponential
+// moment b = E exp(c z), and the LP's bounds on the exponential basis over the grid.
+struct EsmCase {
+  double zf, b;
+  oracle::LpBounds lp;
+};
+EsmCase esm_case(std::mt19937_64& rng, const std::vector<double>& grid, double c, double min_zf) {
+  const auto [d, zf] = unit_case(rng, min_zf);
+  std::vector<double> b = {expect(d, [c](double z) { return std::exp(c * z); })};
+  oracle::LpBounds lp = oracle::lp_bounds(grid, oracle::exponential_basis(std::vector<double>{c}), b, zf);
+  return {zf, b[0], lp};
+}
 
 // ESM is the sharp bound of the exponential basis over I = R (2015 §3): against the LP (the
 // oracle's exponential basis factory, b(z) = exp(c z)) on a grid [lo, 1] of 2001 points whose
@@ -391,20 +414,15 @@ TEST(Esm, EqualsTheLinearProgramForTheExponentialBasis) {
     std::mt19937_64 rng(41);
     const double lo = -25.0 / c, tolerance = 1e-5;
     std::vector<double> grid = oracle::uniform_grid(lo, 1.0, 2001);
-    oracle::Basis basis = oracle::exponential_basis(std::vector<double>{c});
     ErrorStats err;
     int positive = 0;
     for (int i = 0; i < 200; ++i) {
-      test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-      double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), 0.0, 1.0);
-      std::vector<double> b = {expect(d, [c](double z) { return std::exp(c * z); })};
-      oracle::LpBounds lp = oracle::lp_bounds(grid, basis, b, zf);
-      ASSERT_TRUE(lp.feasible) << lp.status << " c " << c << " b " << b[0] << " zf " << zf;
-      float s = msm_esm_shadow(float(b[0]), float(zf), float(c));
+      const auto [zf, b, lp] = esm_case(rng, grid, c, 0.0);
+      ASSERT_TRUE(lp.feasible) << lp.status << " c " << c << " b " << b << " zf " << zf;
+      float s = msm_esm_shadow(float(b), float(zf), float(c));
       positive += s > 0.0f;
       err.add(s - lp.lower);
-      EXPECT_NEAR(s, lp.lower, tolerance)
-          << "c " << c << " b " << b[0] << " zf " << zf << " LP residual " << lp.residual;
+      EXPECT_NEAR(s, lp.lower, tolerance) << "c " << c << " b " << b << " zf " << zf << " LP residual " << lp.residual;
     }
     std::printf("[esm vs LP, c = %g, grid [%g,1]] n %zu (shadow > 0: %d) p90 %.2e max %.2e\n", c, lo, err.errors.size(),
                 positive, err.quantile(0.9), err.max());
@@ -419,17 +437,13 @@ TEST(Esm, IsNotSharpOnTheUnitInterval) {
   const double c = 5.0;
   std::mt19937_64 rng(42);
   std::vector<double> grid = oracle::uniform_grid(0.0, 1.0, 1001);
-  oracle::Basis basis = oracle::exponential_basis(std::vector<double>{c});
   double largest_gain = 0.0;
   for (int i = 0; i < 100; ++i) {
-    test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-    double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), 0.001, 1.0);
-    std::vector<double> b = {expect(d, [c](double z) { return std::exp(c * z); })};
-    oracle::LpBounds lp = oracle::lp_bounds(grid, basis, b, zf);
+    const auto [zf, b, lp] = esm_case(rng, grid, c, 0.001);
     ASSERT_TRUE(lp.feasible) << lp.status;
-    double sharp = std::clamp(1.0 - (b[0] - 1.0) / (std::exp(c * zf) - 1.0), 0.0, 1.0);
+    double sharp = std::clamp(1.0 - (b - 1.0) / (std::exp(c * zf) - 1.0), 0.0, 1.0);
     EXPECT_NEAR(lp.lower, sharp, 1e-6); // LP simplex tolerance
-    float s = msm_esm_shadow(float(b[0]), float(zf), float(c));
+    float s = msm_esm_shadow(float(b), float(zf), float(c));
     EXPECT_LE(s, sharp + 1e-5);
     largest_gain = std::max(largest_gain, sharp - s);
   }
@@ -442,8 +456,7 @@ TEST(Esm, UnitDepthWithCEqualsSignedDepthWithHalfC) {
   std::mt19937_64 rng(43);
   ErrorStats err;
   for (int i = 0; i < 20000; ++i) {
-    test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-    double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), 0.0, 1.0);
+    const auto [d, zf] = unit_case(rng);
     float bu = float(expect(d, [](double z) { return std::exp(80.0 * z); }));
     float bs = float(expect(d, [](double z) { return std::exp(40.0 * (2.0 * z - 1.0)); }));
     err.add(msm_esm_shadow(bu, float(zf), 80.0f) - msm_esm_shadow(bs, float(2.0 * zf - 1.0), 40.0f));
@@ -678,8 +691,7 @@ TEST(Csm, SeriesMatchesDoublePrecision) {
   std::mt19937_64 rng(61);
   ErrorStats err;
   for (int i = 0; i < 3000; ++i) {
-    test::Distribution d = test::random_distribution(rng, 0.0, 1.0);
-    double zf = std::clamp(random_fragment_depth(rng, d, 0.0, 1.0), 0.0, 1.0);
+    const auto [d, zf] = unit_case(rng);
     int terms = 1 + i % 16;
     double damping = (i % 3) * 1.0;
     CsmParams p = CsmParams(terms, float(damping), 1.0f, 0.0f);

@@ -193,6 +193,28 @@ struct Tally {
   }
 };
 
+// A storage path's lower and upper bounds against the range of Algorithm 1 over the box.
+struct BoundTallies {
+  Tally lower, upper;
+  explicit BoundTallies(const std::string& path)
+      : lower{path, 0, 0, {}, 0.0}, upper{path + " (upper)", 0, 0, {}, 0.0} {}
+  // Counts a case; false where no vector of the box is inside the moment space (no range).
+  bool add(const test::BoundRange& range, vec2 bounds) {
+    ++lower.cases, ++upper.cases;
+    if (range.feasible == 0) {
+      ++lower.outside, ++upper.outside;
+      return false;
+    }
+    lower.add_distance(range.lower_distance(bounds.x));
+    upper.add_distance(range.upper_distance(bounds.y));
+    return true;
+  }
+  void print() {
+    lower.print();
+    upper.print();
+  }
+};
+
 // ================================ Tests ================================
 
 // Hamburger 4MSM (lower and upper bound) on every four-moment storage path, every class: inside
@@ -206,7 +228,7 @@ struct Tally {
 TEST(Edges, Hamburger4AgainstAlgorithm1OnEveryStoragePath) {
   for (const Path4& path : paths4()) {
     std::mt19937_64 rng(1900);
-    Tally lower{std::string(path.name), 0, 0, {}, 0.0}, upper{std::string(path.name) + " (upper)", 0, 0, {}, 0.0};
+    BoundTallies tallies(path.name);
     for (int i = 0; i < 4000; ++i) {
       Case c = make_case(i % 4, rng);
       vec4 b = path.biased(c);
@@ -214,26 +236,21 @@ TEST(Edges, Hamburger4AgainstAlgorithm1OnEveryStoragePath) {
       vec2 bounds = msm_hamburger4_bounds(b, zf);
       ASSERT_TRUE(bounds.x >= 0.0f && bounds.x <= bounds.y && bounds.y <= 1.0f) << path.name << " case " << i;
       test::BoundRange range = test::hamburger_range(as_vector(b), zf, kUlps, kRandom, rng);
-      ++lower.cases, ++upper.cases;
-      if (range.feasible == 0) {
-        ++lower.outside, ++upper.outside;
+      if (!tallies.add(range, bounds)) {
         MomentBias4 bias = msm_moment_bias(path.unit ? MSM_REP_UNIT_FLOAT : MSM_REP_SIGNED_FLOAT);
         double cdf = path.unit ? biased_cdf(c.du, zf, bias.alpha, bstar_unit())
                                : biased_cdf(c.d, zf, bias.alpha, bstar_signed(bias.bstar[1]));
-        lower.darker_outside = std::max(lower.darker_outside, double(bounds.x) - cdf);
+        tallies.lower.darker_outside = std::max(tallies.lower.darker_outside, double(bounds.x) - cdf);
         continue;
       }
-      lower.add_distance(range.lower_distance(bounds.x));
-      upper.add_distance(range.upper_distance(bounds.y));
       if (range.lower_distance(bounds.x) > 1e-5 && std::getenv("MSM_EDGES_VERBOSE"))
         std::printf("  %s %s zf %.9g b (%.9g %.9g %.9g %.9g): lower %.6g range [%.6g, %.6g] (%d feasible)\n", path.name,
                     c.kind, zf, b[0], b[1], b[2], b[3], bounds.x, range.lower_min, range.lower_max, range.feasible);
     }
-    lower.print();
-    upper.print();
-    EXPECT_LE(lower.quantile(1.0), 1e-5) << path.name;
-    EXPECT_LE(upper.quantile(1.0), 5e-4) << path.name;
-    EXPECT_LE(lower.darker_outside, 0.05) << path.name;
+    tallies.print();
+    EXPECT_LE(tallies.lower.quantile(1.0), 1e-5) << path.name;
+    EXPECT_LE(tallies.upper.quantile(1.0), 5e-4) << path.name;
+    EXPECT_LE(tallies.lower.darker_outside, 0.05) << path.name;
   }
 }
 
@@ -318,7 +335,7 @@ TEST(Edges, Hausdorff4AgainstTheLinearProgram) {
 TEST(Edges, Hamburger6AgainstAlgorithm1OnEveryStoragePath) {
   for (const Path6& path : paths6()) {
     std::mt19937_64 rng(1902);
-    Tally lower{std::string(path.name), 0, 0, {}, 0.0}, upper{std::string(path.name) + " (upper)", 0, 0, {}, 0.0};
+    BoundTallies tallies(path.name);
     for (int i = 0; i < 2000; ++i) {
       Case c = make_case(i % 4, rng);
       Moments6 b = path.biased(c);
@@ -327,20 +344,12 @@ TEST(Edges, Hamburger6AgainstAlgorithm1OnEveryStoragePath) {
       float beta = float(i % 5) / 4.0f, blend = msm_hamburger6_blend(b, zf, beta);
       ASSERT_TRUE(bounds.x >= 0.0f && bounds.x <= bounds.y && bounds.y <= 1.0f) << path.name << " case " << i;
       ASSERT_TRUE(blend >= bounds.x && blend <= bounds.y) << path.name << " case " << i;
-      test::BoundRange range = test::hamburger_range(as_vector(b), zf, kUlps, kRandom, rng);
-      ++lower.cases, ++upper.cases;
-      if (range.feasible == 0) {
-        ++lower.outside, ++upper.outside;
-        continue;
-      }
-      lower.add_distance(range.lower_distance(bounds.x));
-      upper.add_distance(range.upper_distance(bounds.y));
+      tallies.add(test::hamburger_range(as_vector(b), zf, kUlps, kRandom, rng), bounds);
     }
-    lower.print();
-    upper.print();
-    EXPECT_EQ(lower.outside, 0) << path.name;
-    EXPECT_LE(lower.quantile(1.0), 5e-3) << path.name;
-    EXPECT_LE(upper.quantile(1.0), 5e-3) << path.name;
+    tallies.print();
+    EXPECT_EQ(tallies.lower.outside, 0) << path.name;
+    EXPECT_LE(tallies.lower.quantile(1.0), 5e-3) << path.name;
+    EXPECT_LE(tallies.upper.quantile(1.0), 5e-3) << path.name;
   }
 }
 

@@ -490,6 +490,10 @@ class Inputs {
 
   float uni(float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng_); }
   bool chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < p; }
+  // A stored 16-bit texel: half the time the quantized encoding of a valid vector, else any.
+  vec4 unorm16_or_any(vec4 encoding) {
+    return chance(0.5) ? msm_quantize_unorm16(encoding) : vec4(uni(0, 1), uni(0, 1), uni(0, 1), uni(0, 1));
+  }
   int integer(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
   uint32_t word() { return uint32_t(rng_()); }
   float log_uniform(float lo, float hi) { return std::exp(uni(std::log(lo), std::log(hi))); }
@@ -635,10 +639,7 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       break;
     case MSM_K_UNIT_TO_SIGNED:
     case MSM_K_THETA4: x.a = t.unit4(); break;
-    case MSM_K_THETA4_INVERSE:
-      x.a = g.chance(0.5) ? msm_quantize_unorm16(msm_theta4(t.unit4()))
-                          : vec4(g.uni(0, 1), g.uni(0, 1), g.uni(0, 1), g.uni(0, 1));
-      break;
+    case MSM_K_THETA4_INVERSE: x.a = g.unorm16_or_any(msm_theta4(t.unit4())); break;
     case MSM_K_THETA4_STAR:
     case MSM_K_TWO_DEPTHS:
     case MSM_K_NL_FROM_MOMENTS: {
@@ -647,10 +648,7 @@ std::vector<KernelIO> make_inputs(int id, int count) {
       x.a = (id == MSM_K_THETA4_STAR || g.chance(0.1)) ? b : msm_apply_bias(b, msm_moment_bias(MSM_REP_SIGNED_FLOAT));
       break;
     }
-    case MSM_K_THETA4_STAR_INVERSE:
-      x.a = g.chance(0.5) ? msm_quantize_unorm16(msm_theta4_star(t.signed4()))
-                          : vec4(g.uni(0, 1), g.uni(0, 1), g.uni(0, 1), g.uni(0, 1));
-      break;
+    case MSM_K_THETA4_STAR_INVERSE: x.a = g.unorm16_or_any(msm_theta4_star(t.signed4())); break;
     case MSM_K_THETA6_STAR:
     case MSM_K_APPLY_BIAS6:
       x.a = vec4(t.signed6().odd, 0.0f);

@@ -114,11 +114,7 @@ TEST(Hamburger4, ExactForUpToTwoDepths) {
     vec4 b = msm_apply_bias(test::moments4f(d), msm_moment_bias(MSM_REP_SIGNED_FLOAT));
     err.add(msm_hamburger4_lower(b, zf) - test::cdf_less(d, zf));
   }
-  std::printf("[hamburger4 exactness, <= 2 depths] n %zu p99 %.2e max %.2e\n", err.errors.size(), err.quantile(0.99),
-              err.max());
-  EXPECT_GT(err.errors.size(), 8000u);
-  EXPECT_LT(err.quantile(0.99), 5e-4);
-  EXPECT_LT(err.max(), 1e-2);
+  err.expect_below("hamburger4 exactness, <= 2 depths", 8001, 0.99, 5e-4, 1e-2);
 }
 
 // The canonical distribution reproduces b0..b4 (it is what the blocker search averages).

@@ -29,6 +29,11 @@ struct View {
     auto corner = [&](double x, double y) { return glm::vec3(camera + far * direction(x, y)); };
     return glm::mat4x3(corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)); // in order around the quad
   }
+  // The rectification of this view (in float, as the shaders compute it) and its bounds.
+  msm::RectificationFrame frame() const {
+    return msm::msm_rectification_frame(glm::vec3(camera), glm::vec3(towards_light));
+  }
+  msm::RectifiedBounds bounds() const { return msm::msm_rectification_bounds(frame(), far_corners()); }
 };
 
 dvec3 random_unit(std::mt19937& rng) {
@@ -143,9 +148,8 @@ TEST(Rectification, DepthGrowsAwayFromTheLightAlongALightRay) {
 TEST(Rectification, CoversEveryPixelOf64Views) {
   int with_epipole = 0;
   for (const View& view : configurations()) {
-    const msm::RectificationFrame f =
-        msm::msm_rectification_frame(glm::vec3(view.camera), glm::vec3(view.towards_light));
-    const msm::RectifiedBounds b = msm::msm_rectification_bounds(f, view.far_corners());
+    const msm::RectificationFrame f = view.frame();
+    const msm::RectifiedBounds b = view.bounds();
     if (b.phi_span == msm::MSM_TWO_PI) ++with_epipole;
     ASSERT_GT(b.r_max, 0.0f);
     ASSERT_GT(b.theta_max, b.theta_min);
@@ -191,9 +195,8 @@ TEST(Rectification, SliceInclinationsAreTheViewsInThatSlice) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int checked = 0;
   for (const View& view : configurations()) {
-    const msm::RectificationFrame f =
-        msm::msm_rectification_frame(glm::vec3(view.camera), glm::vec3(view.towards_light));
-    const msm::RectifiedBounds b = msm::msm_rectification_bounds(f, view.far_corners());
+    const msm::RectificationFrame f = view.frame();
+    const msm::RectifiedBounds b = view.bounds();
     auto in_view = [&](double theta, double phi) {
       const dvec3 d = std::sin(theta) * std::cos(phi) * dvec3(f.x_axis) +
                       std::sin(theta) * std::sin(phi) * dvec3(f.y_axis) + std::cos(theta) * dvec3(f.z_axis);
@@ -229,9 +232,8 @@ TEST(Rectification, InverseMapsTexelsToTheirLightRays) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (const View& view : configurations()) {
-    const msm::RectificationFrame f =
-        msm::msm_rectification_frame(glm::vec3(view.camera), glm::vec3(view.towards_light));
-    const msm::RectifiedBounds b = msm::msm_rectification_bounds(f, view.far_corners());
+    const msm::RectificationFrame f = view.frame();
+    const msm::RectifiedBounds b = view.bounds();
     for (int k = 0; k < 8; ++k) {
       const glm::vec2 uv(float(u(rng)), float(u(rng)));
       const glm::vec3 p = msm::msm_rectified_light_ray_point(f, b, uv);
@@ -317,9 +319,8 @@ TEST(Rectification, ResamplingLevelIsTheTexelsFootprintInTheShadowMap) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int above_zero = 0;
   for (const View& view : configurations()) {
-    const msm::RectificationFrame f =
-        msm::msm_rectification_frame(glm::vec3(view.camera), glm::vec3(view.towards_light));
-    const msm::RectifiedBounds b = msm::msm_rectification_bounds(f, view.far_corners());
+    const msm::RectificationFrame f = view.frame();
+    const msm::RectifiedBounds b = view.bounds();
     const int width = 1 << (8 + int(4.0 * u(rng))), height = width;
     // Shadow-map texels per world unit, the light's x axis at angle a to the frame's, either hand.
     const double scale = std::exp(std::log(0.05) + u(rng) * std::log(4000.0)), a = 2.0 * M_PI * u(rng);
@@ -360,9 +361,8 @@ TEST(Rectification, TransmittanceLayersCoverEveryViewRaysStep) {
   const float width = 512.0f;
   int clamped_hi = 0, inside = 0;
   for (const View& view : configurations()) {
-    const msm::RectificationFrame f =
-        msm::msm_rectification_frame(glm::vec3(view.camera), glm::vec3(view.towards_light));
-    const msm::RectifiedBounds b = msm::msm_rectification_bounds(f, view.far_corners());
+    const msm::RectificationFrame f = view.frame();
+    const msm::RectifiedBounds b = view.bounds();
     for (float sigma : {0.001f, 0.03f, 0.5f}) {
       const glm::vec2 range = msm::msm_transmittance_layer_range(b, sigma, width);
       ASSERT_GT(range.x, 0.0f);

@@ -5,6 +5,7 @@
 // upper-bound variant (Eq. 19); umbra early-out and over-darkening; the depth bias on a sloped
 // receiver.
 #include "msm/soft.h"
+#include "test_distributions.h"
 #include "test_tables.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -23,6 +25,45 @@ using test::Table;
 
 constexpr int W = 27; // kernel width: n_t = W² = 729 (JCGT's 27² search region)
 constexpr int kTexels = W * W;
+
+// The summed-area tables of a size × size moment map as the renderer stores them: four moments as
+// Θ*, six as Θ* split in two. moments(x, y) gives texel (x, y)'s power moments {b4, b6}, called
+// row by row.
+struct MomentTables {
+  Table t4, t6a, t6b;
+};
+template <class Moments>
+MomentTables moment_tables(int size, uint scale, const Moments& moments) {
+  std::vector<vec4> m4(size * size), m6a(size * size), m6b(size * size);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const auto [b4, b6] = moments(x, y);
+      m4[size_t(y * size + x)] = msm_theta4_star(b4);
+      SatTexels6 s6 = msm_sat_split6(msm_theta6_star(b6));
+      m6a[size_t(y * size + x)] = s6.a;
+      m6b[size_t(y * size + x)] = s6.b;
+    }
+  return {test::build(m4, size, size, scale), test::build(m6a, size, size, scale), test::build(m6b, size, size, scale)};
+}
+
+// Vulkan's standard 4x sample positions within a texel.
+const vec2 kMsaaSamples[4] = {vec2(0.375f, 0.125f), vec2(0.875f, 0.375f), vec2(0.125f, 0.625f), vec2(0.625f, 0.875f)};
+
+// The tables of a planar receiver rendered with 4x MSAA: each texel the mean of the moments of its
+// samples' depths plane(p).
+template <class Plane>
+MomentTables plane_tables(const Plane& plane, int size, uint scale) {
+  return moment_tables(size, scale, [&](int x, int y) {
+    vec4 b4(0.0f);
+    Moments6 b6{vec3(0.0f), vec3(0.0f)};
+    for (vec2 o : kMsaaSamples) {
+      float z = plane(vec2(float(x), float(y)) + o);
+      b4 += 0.25f * msm_moments4(z);
+      b6 = msm_moments6_scale_add(b6, msm_moments6(z), 0.25f);
+    }
+    return std::pair{b4, b6};
+  });
+}
 
 // A 40 × 40 Θ4* moment map whose 27 × 27 block at (6, 5) holds `depths` (one per texel, in
 // random positions; depths.size() == 729) and whose other texels hold random depths, so that the
@@ -39,20 +80,15 @@ Region region_of(std::mt19937_64& rng, std::vector<float> depths) {
   const int size = 40;
   std::shuffle(depths.begin(), depths.end(), rng);
   std::uniform_real_distribution<float> any(-1.0f, 1.0f);
-  std::vector<vec4> m4(size * size), m6a(size * size), m6b(size * size);
   Region r;
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      bool inside = x >= r.rect.lo.x && x <= r.rect.hi.x && y >= r.rect.lo.y && y <= r.rect.hi.y;
-      float z = inside ? depths[size_t((y - r.rect.lo.y) * W + (x - r.rect.lo.x))] : any(rng);
-      m4[size_t(y * size + x)] = msm_theta4_star(msm_moments4(z));
-      SatTexels6 s6 = msm_sat_split6(msm_theta6_star(msm_moments6(z)));
-      m6a[size_t(y * size + x)] = s6.a;
-      m6b[size_t(y * size + x)] = s6.b;
-    }
-  r.t4 = test::build(m4, size, size, r.scale);
-  r.t6a = test::build(m6a, size, size, r.scale);
-  r.t6b = test::build(m6b, size, size, r.scale);
+  MomentTables t = moment_tables(size, r.scale, [&](int x, int y) {
+    bool inside = x >= r.rect.lo.x && x <= r.rect.hi.x && y >= r.rect.lo.y && y <= r.rect.hi.y;
+    float z = inside ? depths[size_t((y - r.rect.lo.y) * W + (x - r.rect.lo.x))] : any(rng);
+    return std::pair{msm_moments4(z), msm_moments6(z)};
+  });
+  r.t4 = std::move(t.t4);
+  r.t6a = std::move(t.t6a);
+  r.t6b = std::move(t.t6b);
   return r;
 }
 
@@ -79,15 +115,7 @@ Truth truth(const std::vector<float>& depths, float zf, double epsilon) {
   return {n > 0.0 ? sum / n : double(zf), w, (epsilon * zf + wz) / (epsilon + w)};
 }
 
-struct Stats {
-  std::vector<double> e;
-  void add(double v) { e.push_back(std::abs(v)); }
-  double q(double p) {
-    std::sort(e.begin(), e.end());
-    return e.empty() ? 0.0 : e[size_t(p * double(e.size() - 1))];
-  }
-  double max() { return q(1.0); }
-};
+using Stats = test::ErrorStats;
 
 // ---------------------------------------------------------------------------------------------
 
@@ -241,11 +269,11 @@ TEST(SoftShadows, FourMomentBlockerDepthMatchesTheExactMean) {
   }
   std::printf("[soft, 4 moments via SAT] one occluder: depth vs Eq. (4) max %.2e, vs exact mean max %.2e, shadow max "
               "%.2e; two occluders: depth vs Eq. (4) p99 %.2e max %.2e, shadow p99 %.2e max %.2e\n",
-              one_eq4.max(), one_mean.max(), one_shadow.max(), two_eq4.q(0.99), two_eq4.max(), two_shadow.q(0.99),
-              two_shadow.max());
-  EXPECT_LT(two_eq4.q(0.99), 0.04);
+              one_eq4.max(), one_mean.max(), one_shadow.max(), two_eq4.quantile(0.99), two_eq4.max(),
+              two_shadow.quantile(0.99), two_shadow.max());
+  EXPECT_LT(two_eq4.quantile(0.99), 0.04);
   EXPECT_LT(two_eq4.max(), 0.1);
-  EXPECT_LT(two_shadow.q(0.99), 0.02);
+  EXPECT_LT(two_shadow.quantile(0.99), 0.02);
   EXPECT_LT(two_shadow.max(), 0.05);
 }
 
@@ -295,13 +323,13 @@ TEST(SoftShadows, SixMomentBlockerDepthMatchesTheExactMean) {
   }
   std::printf("[soft, 6 moments via SAT] depth vs Eq. (4), relative: 1 occluder p99 %.2e max %.2e; 2: p99 %.2e max "
               "%.2e; 3: p99 %.2e max %.2e; shadow p99 %.2e / %.2e / %.2e, max %.2e / %.2e / %.2e\n",
-              depth[0].q(0.99), depth[0].max(), depth[1].q(0.99), depth[1].max(), depth[2].q(0.99), depth[2].max(),
-              shadow[0].q(0.99), shadow[1].q(0.99), shadow[2].q(0.99), shadow[0].max(), shadow[1].max(),
-              shadow[2].max());
+              depth[0].quantile(0.99), depth[0].max(), depth[1].quantile(0.99), depth[1].max(), depth[2].quantile(0.99),
+              depth[2].max(), shadow[0].quantile(0.99), shadow[1].quantile(0.99), shadow[2].quantile(0.99),
+              shadow[0].max(), shadow[1].max(), shadow[2].max());
   for (int k = 0; k < 3; ++k) {
-    EXPECT_LT(depth[k].q(0.99), depth_p99[k]) << k + 1 << " occluders";
+    EXPECT_LT(depth[k].quantile(0.99), depth_p99[k]) << k + 1 << " occluders";
     EXPECT_LT(depth[k].max(), depth_max[k]) << k + 1 << " occluders";
-    EXPECT_LT(shadow[k].q(0.99), shadow_p99[k]) << k + 1 << " occluders";
+    EXPECT_LT(shadow[k].quantile(0.99), shadow_p99[k]) << k + 1 << " occluders";
     EXPECT_LT(shadow[k].max(), shadow_max[k]) << k + 1 << " occluders";
   }
 }
@@ -544,8 +572,8 @@ TEST(SoftShadows, DepthBiasGrowingWithTheFilterRemovesSelfShadowing) {
     EXPECT_LT(biased, 0.01f) << "case " << i;
   }
   std::printf("[soft, depth bias] sloped receivers: unbiased shadow min %.3f median %.3f, biased max %.2e\n",
-              unbiased_all.q(0.0), unbiased_all.q(0.5), biased_max);
-  EXPECT_GT(unbiased_all.q(0.5), 0.15);
+              unbiased_all.quantile(0.0), unbiased_all.quantile(0.5), biased_max);
+  EXPECT_GT(unbiased_all.quantile(0.5), 0.15);
 }
 
 } // namespace
@@ -632,9 +660,10 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
     }
     std::printf("[soft, plane bias] %d moments: shadow at the bias max %.2e; exact bound at 0.9 of it min %.4f "
                 "median %.4f; rendered at 0.5 of it min %.4f median %.4f\n",
-                moments, at_max, exact_below.q(0.0), exact_below.q(0.5), rendered_half.q(0.0), rendered_half.q(0.5));
-    EXPECT_GT(exact_below.q(0.0), 1e-4) << moments << " moments";
-    EXPECT_GT(rendered_half.q(0.5), 0.02) << moments << " moments";
+                moments, at_max, exact_below.quantile(0.0), exact_below.quantile(0.5), rendered_half.quantile(0.0),
+                rendered_half.quantile(0.5));
+    EXPECT_GT(exact_below.quantile(0.0), 1e-4) << moments << " moments";
+    EXPECT_GT(rendered_half.quantile(0.5), 0.02) << moments << " moments";
   }
 
   // A real table: the plane's depths at each texel's four MSAA samples, the fragment at a random
@@ -651,26 +680,7 @@ TEST(SoftShadows, PlaneBiasIsTheLeastThatKeepsTheReceiversPlaneUnshadowed) {
     if (i % 2) g.x = -g.x;
     float z0 = -0.2f + 0.4f * unit(rng);
     auto plane = [&](vec2 p) { return z0 + g.x * (p.x - 24.5f) + g.y * (p.y - 24.5f); };
-    std::vector<vec4> m4(size * size), m6a(size * size), m6b(size * size);
-    for (int y = 0; y < size; ++y)
-      for (int x = 0; x < size; ++x) {
-        // Vulkan's standard 4x sample positions, each texel the mean of its samples' moments.
-        const vec2 samples[4] = {vec2(0.375f, 0.125f), vec2(0.875f, 0.375f), vec2(0.125f, 0.625f),
-                                 vec2(0.625f, 0.875f)};
-        vec4 b4(0.0f);
-        Moments6 b6{vec3(0.0f), vec3(0.0f)};
-        for (vec2 o : samples) {
-          float z = plane(vec2(float(x), float(y)) + o);
-          b4 += 0.25f * msm_moments4(z);
-          b6 = msm_moments6_scale_add(b6, msm_moments6(z), 0.25f);
-        }
-        m4[size_t(y * size + x)] = msm_theta4_star(b4);
-        SatTexels6 s6 = msm_sat_split6(msm_theta6_star(b6));
-        m6a[size_t(y * size + x)] = s6.a;
-        m6b[size_t(y * size + x)] = s6.b;
-      }
-    Table t4 = test::build(m4, size, size, scale), t6a = test::build(m6a, size, size, scale),
-          t6b = test::build(m6b, size, size, scale);
+    const auto [t4, t6a, t6b] = plane_tables(plane, size, scale);
     vec2 center(24.0f + unit(rng), 24.0f + unit(rng));
     vec2 h = (i % 4 == 0) ? vec2(0.5f + unit(rng), 0.5f + unit(rng))
                           : vec2(0.5f + 12.5f * unit(rng), 0.5f + 12.5f * unit(rng));
@@ -758,7 +768,6 @@ TEST(SoftShadows, PlaneBiasAgainstTheTablesExactLeastBias) {
   };
   const Band bands[] = {
       {0.5f, 2.0f, 0.6, 2.5}, {2.0f, 4.0f, 0.85, 1.15}, {4.0f, 8.0f, 0.95, 1.05}, {8.0f, 13.0f, 0.98, 1.02}};
-  const vec2 samples[4] = {vec2(0.375f, 0.125f), vec2(0.875f, 0.375f), vec2(0.125f, 0.625f), vec2(0.625f, 0.875f)};
   const int size = 40;
   const uint scale = msm_sat_scale(kTexels);
   std::mt19937_64 rng(35);
@@ -779,7 +788,7 @@ TEST(SoftShadows, PlaneBiasAgainstTheTablesExactLeastBias) {
           const double w = double(msm_soft_texel_overlap(x, r.lo.x, r.hi.x)) *
                            double(msm_soft_texel_overlap(y, r.lo.y, r.hi.y)) /
                            (double(r.hi.x - r.lo.x) * double(r.hi.y - r.lo.y));
-          for (vec2 o : samples) {
+          for (vec2 o : kMsaaSamples) {
             const double offset = (double(g.x) * (x + o.x - center.x) + double(g.y) * (y + o.y - center.y)) / range;
             double p = 0.25 * w;
             for (double& m : mu) {
@@ -798,23 +807,7 @@ TEST(SoftShadows, PlaneBiasAgainstTheTablesExactLeastBias) {
       if (band.lo >= 2.0f) continue;
       // The renderer's path where the bias may fall short: the plane's table, the 1e-3 constant bias.
       auto plane = [&](vec2 p) { return 0.1f + g.x * (p.x - center.x) + g.y * (p.y - center.y); };
-      std::vector<vec4> m4(size * size), m6a(size * size), m6b(size * size);
-      for (int y = 0; y < size; ++y)
-        for (int x = 0; x < size; ++x) {
-          vec4 b4(0.0f);
-          Moments6 b6{vec3(0.0f), vec3(0.0f)};
-          for (vec2 o : samples) {
-            float z = plane(vec2(float(x), float(y)) + o);
-            b4 += 0.25f * msm_moments4(z);
-            b6 = msm_moments6_scale_add(b6, msm_moments6(z), 0.25f);
-          }
-          m4[size_t(y * size + x)] = msm_theta4_star(b4);
-          SatTexels6 s6 = msm_sat_split6(msm_theta6_star(b6));
-          m6a[size_t(y * size + x)] = s6.a;
-          m6b[size_t(y * size + x)] = s6.b;
-        }
-      Table t4 = test::build(m4, size, size, scale), t6a = test::build(m6a, size, size, scale),
-            t6b = test::build(m6b, size, size, scale);
+      const auto [t4, t6a, t6b] = plane_tables(plane, size, scale);
       SatFilter f = msm_sat_filter(r.lo, r.hi);
       const float zf = plane(center);
       shadow_max[0] = std::max(shadow_max[0],

@@ -3,6 +3,7 @@
 #include "msm/cpu/techniques.h"
 #include "msm/msm.h"
 #include "msm/techniques.h"
+#include "msm/test/thrown.h"
 #include "test_distributions.h"
 
 #include <gtest/gtest.h>
@@ -44,20 +45,12 @@ TEST(TechniqueTable, AliasesOfTheIssue) {
 }
 
 TEST(TechniqueTable, UnknownNameSuggestsTheNearest) {
-  try {
-    find_technique("msm-hamburger-46");
-    FAIL() << "accepted";
-  } catch (const std::invalid_argument& e) {
-    std::string what = e.what();
-    EXPECT_NE(what.find("unknown technique 'msm-hamburger-46' (did you mean msm-hamburger-64"), std::string::npos)
-        << what;
-  }
-  try {
-    find_technique("nope");
-    FAIL() << "accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string(e.what()).find("did you mean"), std::string::npos) << e.what();
-  }
+  const std::string what = test::thrown_message<std::invalid_argument>([] { find_technique("msm-hamburger-46"); });
+  EXPECT_NE(what.find("unknown technique 'msm-hamburger-46' (did you mean msm-hamburger-64"), std::string::npos)
+      << what;
+  const std::string nope = test::thrown_message<std::invalid_argument>([] { find_technique("nope"); });
+  EXPECT_NE(nope.find("unknown technique 'nope'"), std::string::npos) << nope;
+  EXPECT_EQ(nope.find("did you mean"), std::string::npos) << nope;
 }
 
 // The table's categories are what the shaders' variant selection and the shared header's

@@ -4,7 +4,9 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <glm/glm.hpp>
+#include <gtest/gtest.h>
 #include <random>
 #include <vector>
 
@@ -41,6 +43,14 @@ struct ErrorStats {
     return errors.empty() ? 0.0 : errors[size_t(q * double(errors.size() - 1))];
   }
   double max() { return quantile(1.0); }
+  // Prints "[label] n N pQ E max M" and expects at least min_count errors, their q-quantile below
+  // quantile_bound and their maximum below max_bound.
+  void expect_below(const char* label, std::size_t min_count, double q, double quantile_bound, double max_bound) {
+    std::printf("[%s] n %zu p%.0f %.2e max %.2e\n", label, errors.size(), 100.0 * q, quantile(q), max());
+    EXPECT_GE(errors.size(), min_count) << label;
+    EXPECT_LT(quantile(q), quantile_bound) << label;
+    EXPECT_LT(max(), max_bound) << label;
+  }
 };
 
 } // namespace msm::test

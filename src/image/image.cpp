@@ -195,8 +195,9 @@ Image tone_map(const Image& image, const ToneMap& tone) {
   return out;
 }
 
-std::vector<std::uint8_t> to_srgb8(const Image& image) {
-  const int alpha = image.find_channel("A");
+std::vector<std::uint8_t> to_srgb8(const Image& image) { return to_srgb8(image, image.find_channel("A")); }
+
+std::vector<std::uint8_t> to_srgb8(const Image& image, int alpha) {
   const int n = image.channels();
   auto px = image.pixels();
   std::vector<std::uint8_t> out(px.size());

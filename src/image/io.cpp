@@ -544,17 +544,7 @@ std::vector<std::uint8_t> encode_png(const fs::path& path, const Image& image) {
   require_image(path, image);
   const int n = image.channels();
   const int alpha = (n == 2 || n == 4) ? n - 1 : -1; // by position, whatever the channel's name
-  auto px = image.pixels();
-  std::vector<std::uint8_t> data(px.size());
-  for (std::size_t i = 0; i < px.size(); ++i) {
-    if (int(i % std::size_t(n)) == alpha) {
-      float a = px[i];
-      data[i] = static_cast<std::uint8_t>(std::lround(255.0 * (a > 0.0f ? (a < 1.0f ? a : 1.0f) : 0.0f)));
-    } else {
-      data[i] = linear_to_srgb8(px[i]);
-    }
-  }
-  return encode_png8(path, image.width(), image.height(), n, data);
+  return encode_png8(path, image.width(), image.height(), n, to_srgb8(image, alpha));
 }
 
 void write_png(const fs::path& path, const Image& image) { write_file_atomic(path, encode_png(path, image)); }

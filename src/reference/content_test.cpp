@@ -115,13 +115,16 @@ TEST(reference_masked, CutOutsCastNoShadowAndAreSeenThrough) {
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 8; ++x) alpha.at(x, y) = x < 4 ? 1.0f : 0.0f;
   msm::image::write_png(dir.path() / "alpha.png", alpha);
-  const auto scene = load(R"({"msm_scene": 1, "camera": {"position": [0, 3, 0.01], "target": [0, 0, 0],
-      "fov_y_deg": 40}, "light": {"towards_light": [0, 1, 0]},
+  // The quad and the ground, seen by this camera.
+  auto cutout_scene = [&](const std::string& camera) {
+    return load(R"({"msm_scene": 1, "camera": )" + camera + R"(, "light": {"towards_light": [0, 1, 0]},
       "objects": [{"name": "ground", "primitive": {"type": "plane", "size": [4, 4]}},
                   {"name": "cutout", "primitive": {"type": "plane", "size": [1, 1]},
                    "transform": {"translate": [0, 1, 0]},
                    "material": {"opacity_texture": "alpha.png", "alpha_cutoff": 0.5}}]})",
-                          dir.path());
+                dir.path());
+  };
+  const auto scene = cutout_scene(R"({"position": [0, 3, 0.01], "target": [0, 0, 0], "fov_y_deg": 40})");
   ASSERT_TRUE(scene.materials.at(scene.objects[1].material).masked());
   for (const Effect effect : {Effect::hard, Effect::translucent}) {
     SCOPED_TRACE(std::string(to_string(effect)));
@@ -137,13 +140,7 @@ TEST(reference_masked, CutOutsCastNoShadowAndAreSeenThrough) {
     EXPECT_EQ(r.visibility.at(44, 32, 0), 1.0f) << "and lit through it";
   }
   // The shadow on the ground, seen from between the quad and the ground.
-  const auto below = load(R"({"msm_scene": 1, "camera": {"position": [0, 0.5, 0.01], "target": [0, 0, 0],
-      "fov_y_deg": 90}, "light": {"towards_light": [0, 1, 0]},
-      "objects": [{"name": "ground", "primitive": {"type": "plane", "size": [4, 4]}},
-                  {"name": "cutout", "primitive": {"type": "plane", "size": [1, 1]},
-                   "transform": {"translate": [0, 1, 0]},
-                   "material": {"opacity_texture": "alpha.png", "alpha_cutoff": 0.5}}]})",
-                          dir.path());
+  const auto below = cutout_scene(R"({"position": [0, 0.5, 0.01], "target": [0, 0, 0], "fov_y_deg": 90})");
   Settings s;
   s.width = 64;
   s.height = 64;

@@ -32,6 +32,7 @@
 #include "msm/reference/reference.h"
 #include "msm/scattering.h"
 #include "msm/scene/scene.h"
+#include "msm/test/reference_settings.h"
 
 namespace {
 
@@ -269,11 +270,7 @@ TEST(reference_filtered, EdgeProfileMatchesTheKernel) {
     const LightFrame frame = scene.light_frame();
     EXPECT_NEAR(frame.extent.x, 6.0, 1e-5);
     EXPECT_NEAR(frame.extent.y, 8.0, 1e-5);
-    Settings s;
-    s.effect = Effect::filtered;
-    s.width = 96;
-    s.height = 8;
-    s.samples = 4096;
+    Settings s = msm::test::reference_settings(Effect::filtered, 96, 8, 4096);
     s.shadow_size = 256;
     s.seed = 7;
     const Result r = render(scene, s);
@@ -358,19 +355,18 @@ struct DiscScene {
 };
 
 struct SoftErrors {
-  double rms = 0.0;
-  int penumbra = 0;
+  double rms = 0.0, worst = 0.0; // over the penumbra; over every pixel
+  int penumbra = 0, umbra = 0, lit = 0;
 };
 
-SoftErrors soft_errors(const DiscScene& ds, Sampler sampler, int samples, std::uint64_t seed, bool check_bound) {
-  Settings s;
-  s.effect = Effect::soft;
-  s.width = s.height = 64;
-  s.samples = samples;
-  s.seed = seed;
-  s.sampler = sampler;
+// The ray-traced soft visibility of the disc scene against disc_occluder_visibility at each
+// pixel's ground point. With check_bound, every pixel within 4 standard errors (of independent
+// sampling, an upper bound for the stratified sampler) + 1e-4 (the model's own error, see
+// analytic.h), with all its samples taken.
+SoftErrors soft_errors(const DiscScene& ds, const Settings& s, bool check_bound) {
   const Result r = render(ds.scene, s);
   EXPECT_NEAR(r.light_extent_deg, 10.0, 1e-12);
+  EXPECT_EQ(r.background_pixels, 0u);
   double sum2 = 0.0;
   SoftErrors e;
   for (int y = 0; y < s.height; ++y)
@@ -380,18 +376,29 @@ SoftErrors soft_errors(const DiscScene& ds, Sampler sampler, int samples, std::u
       const double v = channel(r.visibility, "visibility", x, y);
       const double se = channel(r.visibility, "std_error", x, y);
       if (check_bound) {
-        EXPECT_EQ(channel(r.visibility, "sample_count", x, y), float(samples));
-        const double iid = std::sqrt(expected * (1.0 - expected) / samples);
+        EXPECT_EQ(channel(r.visibility, "sample_count", x, y), float(s.samples));
+        const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
         EXPECT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-4)
             << "pixel " << x << "," << y << " expected " << expected << " got " << v << " se " << se;
       }
+      e.worst = std::max(e.worst, std::abs(v - expected));
       if (expected > 0.01 && expected < 0.99) {
         sum2 += (v - expected) * (v - expected);
         ++e.penumbra;
       }
+      e.umbra += expected == 0.0;
+      e.lit += expected == 1.0;
     }
   e.rms = std::sqrt(sum2 / e.penumbra);
   return e;
+}
+
+// The same at 64 x 64 with this sampler, sample count and seed.
+SoftErrors soft_errors(const DiscScene& ds, Sampler sampler, int samples, std::uint64_t seed, bool check_bound) {
+  Settings s = msm::test::reference_settings(Effect::soft, 64, 64, samples);
+  s.seed = seed;
+  s.sampler = sampler;
+  return soft_errors(ds, s, check_bound);
 }
 
 } // namespace
@@ -472,43 +479,16 @@ TEST(reference_soft, DiscVisibilityFormulaMatchesNumericIntegration) {
 // 4 standard errors (of independent sampling, an upper bound for the stratified sampler) + 1e-4
 // (the model's own error, see analytic.h); RMS over the penumbra below 0.01 at 256 samples.
 TEST(reference_soft, DiscLightOverDiscOccluderMatchesTheCircleIntersection) {
-  const DiscScene ds(10.0);
-  const Scene scene = msm::scene::builtin_scene("disc");
-  Settings s;
-  s.effect = Effect::soft;
-  s.width = 160;
-  s.height = 90;
-  s.samples = 256;
+  Settings s = msm::test::reference_settings(Effect::soft, 160, 90, 256);
   s.seed = 3;
-  const Result r = render(scene, s);
-  EXPECT_NEAR(r.light_extent_deg, 10.0, 1e-12);
-  EXPECT_EQ(r.background_pixels, 0u);
-  double sum2 = 0.0, worst = 0.0;
-  int penumbra = 0, umbra = 0, lit = 0;
-  for (int y = 0; y < s.height; ++y)
-    for (int x = 0; x < s.width; ++x) {
-      const glm::dvec3 p = ground_point(ds.camera, x, y, s.width, s.height);
-      const double expected = disc_occluder_visibility(p, 10.0);
-      const double v = channel(r.visibility, "visibility", x, y);
-      const double se = channel(r.visibility, "std_error", x, y);
-      const double iid = std::sqrt(expected * (1.0 - expected) / s.samples);
-      ASSERT_LE(std::abs(v - expected), 4.0 * std::max(se, iid) + 1e-4)
-          << "pixel " << x << "," << y << " expected " << expected << " got " << v << " se " << se;
-      worst = std::max(worst, std::abs(v - expected));
-      if (expected > 0.01 && expected < 0.99) {
-        sum2 += (v - expected) * (v - expected);
-        ++penumbra;
-      }
-      umbra += expected == 0.0;
-      lit += expected == 1.0;
-    }
+  const SoftErrors e = soft_errors(DiscScene(10.0), s, true);
   // The view holds the whole shadow: umbra (r < 0.1625), penumbra ring and lit ground.
-  EXPECT_GT(penumbra, 3500);
-  EXPECT_GT(umbra, 1000);
-  EXPECT_GT(lit, 5000);
-  const double rms = std::sqrt(sum2 / penumbra);
-  EXPECT_LT(rms, 0.01);
-  RecordProperty("rms_max_error_256_stratified", num(rms) + " " + num(worst) + " over " + std::to_string(penumbra));
+  EXPECT_GT(e.penumbra, 3500);
+  EXPECT_GT(e.umbra, 1000);
+  EXPECT_GT(e.lit, 5000);
+  EXPECT_LT(e.rms, 0.01);
+  RecordProperty("rms_max_error_256_stratified",
+                 num(e.rms) + " " + num(e.worst) + " over " + std::to_string(e.penumbra));
 }
 
 // Plain Monte Carlo (independent samples): the RMS error halves when the samples quadruple
@@ -541,11 +521,7 @@ TEST(reference_soft, RectangleLightOverHalfPlaneIsALinearRamp) {
   const double h = 1.0, tw = std::tan(4.0 * kPi / 180.0);
   const CameraSpec camera{{0.0, 0.06, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
   const Scene scene = make_scene(camera, light_json({0, 1, 0}), ground_and_half_plane(h));
-  Settings s;
-  s.effect = Effect::soft;
-  s.width = 96;
-  s.height = 8;
-  s.samples = 256;
+  Settings s = msm::test::reference_settings(Effect::soft, 96, 8, 256);
   s.light_shape = LightShape::rectangle;
   s.light_width_deg = 8.0;
   s.light_height_deg = 20.0;
@@ -576,11 +552,7 @@ TEST(reference_soft, SceneRectangleLightIsTracedAsDeclared) {
   const std::string light =
       R"("light": {"towards_light": [0, 1, 0], "angular_extent_deg": 8, "angular_height_deg": 20})";
   const Scene scene = make_scene(camera, light, ground_and_half_plane(1.0));
-  Settings s;
-  s.effect = Effect::soft;
-  s.width = 48;
-  s.height = 8;
-  s.samples = 64;
+  Settings s = msm::test::reference_settings(Effect::soft, 48, 8, 64);
   const Result declared = render(scene, s);
   EXPECT_EQ(declared.light_shape, LightShape::rectangle);
   EXPECT_DOUBLE_EQ(declared.light_width_deg, 8.0);
@@ -640,10 +612,7 @@ TEST(reference_soft, RadianceIntegratesTheCosineOverTheLightAndItsHorizon) {
     const double e = elevation * kPi / 180.0;
     const glm::dvec3 towards(0.0, std::sin(e), std::cos(e));
     const Scene scene = make_scene(camera, light_json(towards, 60.0), ground);
-    Settings s;
-    s.effect = Effect::soft;
-    s.width = s.height = 16;
-    s.samples = 256;
+    Settings s = msm::test::reference_settings(Effect::soft, 16, 16, 256);
     const Result r = render(scene, s);
     ASSERT_EQ(r.background_pixels, 0u);
     const double lit = msm::msm_cone_cosine(float(towards.y), float(kPi / 6.0));
@@ -843,11 +812,7 @@ TEST(reference_scattering, ClearAirIsTheClosedForm) {
                                  R"({"name": "ground", "primitive": {"type": "plane", "size": [20, 20]},
                                      "material": {"albedo": [0.5, 0.5, 0.5]}})",
                                  kMediumJson);
-  Settings s;
-  s.effect = Effect::scattering;
-  s.width = 64;
-  s.height = 48;
-  s.samples = 16;
+  Settings s = msm::test::reference_settings(Effect::scattering, 64, 48, 16);
   const Result r = render(scene, s);
   ASSERT_EQ(r.visibility.channel_names(),
             (std::vector<std::string>{"visibility", "background", "sample_count", "std_error"}));
@@ -890,11 +855,7 @@ TEST(reference_scattering, HalfPlaneShadowIsTheClosedForm) {
   const double h = 1.0, sigma = 0.3;
   const CameraSpec camera{{0.3, 0.6, 1.5}, {-0.6, 0.0, -0.5}};
   const Scene scene = make_scene(camera, light_json({0, 1, 0}), ground_and_half_plane(h, true), kMediumJson);
-  Settings s;
-  s.effect = Effect::scattering;
-  s.width = 80;
-  s.height = 60;
-  s.samples = 64;
+  Settings s = msm::test::reference_settings(Effect::scattering, 80, 60, 64);
   const Result r = render(scene, s);
   const double inf = std::numeric_limits<double>::infinity();
   double worst = 0.0, mean_error = 0.0, partial = 0;
@@ -937,11 +898,7 @@ TEST(reference_scattering, NoMediumAndCameraInsideAnOccluder) {
   const CameraSpec camera{{0.0, 1.0, 0.0}, {0.0, 0.0, -3.0}};
   const std::string objects = ground_and_half_plane(2.0) + R"(, {"name": "box", "primitive": {"type": "box",
       "size": [1, 1, 1]}, "transform": {"translate": [0, 1, 0]}})";
-  Settings s;
-  s.effect = Effect::scattering;
-  s.width = 24;
-  s.height = 16;
-  s.samples = 32;
+  Settings s = msm::test::reference_settings(Effect::scattering, 24, 16, 32);
   expect_invalid([&] { render(make_scene(camera, light_json({0.2, 1, 0.1}), objects), s); }, "medium");
   const Result r = render(make_scene(camera, light_json({0.2, 1, 0.1}), objects, kMediumJson), s);
   for (int y = 0; y < s.height; ++y)
@@ -965,11 +922,7 @@ TEST(reference_scattering, TwoLightsScatterTheSumOfEach) {
       {"towards_light": [0.6, 0.7, 0.2], "irradiance": [1.5, 0.8, 0.3]}])";
   const Scene both = make_scene(camera, lights, ground_and_half_plane(1.0, true), kMediumJson);
   ASSERT_EQ(both.lights.size(), 2u);
-  Settings s;
-  s.effect = Effect::scattering;
-  s.width = 48;
-  s.height = 36;
-  s.samples = 64;
+  Settings s = msm::test::reference_settings(Effect::scattering, 48, 36, 64);
   const Result r = render(both, s);
   Result alone[2];
   for (int l = 0; l < 2; ++l) {
@@ -1014,11 +967,7 @@ TEST(reference_scattering, TwoLightsScatterTheSumOfEach) {
 // the tower's view ray into the light ends on the tower just below its parapet, so the rays around
 // it are dark while most of the image is lit.
 TEST(reference_scattering, BuiltinScenesHaveShafts) {
-  Settings s;
-  s.effect = Effect::scattering;
-  s.width = 64;
-  s.height = 36;
-  s.samples = 16;
+  Settings s = msm::test::reference_settings(Effect::scattering, 64, 36, 16);
   for (const char* name : {"tower", "trees", "gate", "room"}) {
     SCOPED_TRACE(name);
     const Scene scene = msm::scene::builtin_scene(name);
@@ -1059,10 +1008,7 @@ TEST(reference_scattering, BuiltinScenesHaveShafts) {
 
 TEST(reference_determinism, SameSeedSameImageForAnyThreadCount) {
   const DiscScene ds(10.0);
-  Settings s;
-  s.effect = Effect::soft;
-  s.width = s.height = 32;
-  s.samples = 16;
+  Settings s = msm::test::reference_settings(Effect::soft, 32, 32, 16);
   s.seed = 42;
   Result one, many, again;
   {

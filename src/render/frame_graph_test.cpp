@@ -8,6 +8,7 @@
 #include "msm/image/metrics.h"
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
+#include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
 
 #include <gtest/gtest.h>
@@ -134,14 +135,7 @@ TEST(FrameGraph, RefusesAnInputWithoutProducer) {
 
 class MultiLightTest : public vk::test::VulkanTest {};
 
-RenderSettings small(std::string technique) {
-  RenderSettings s;
-  s.technique = std::move(technique);
-  s.width = 160;
-  s.height = 90;
-  s.shadow_size = 256;
-  return s;
-}
+RenderSettings small(std::string technique) { return test::render_settings(std::move(technique), 160, 90, 256); }
 
 // Every light's shadow comes from its own layer: with light B switched off (no irradiance), a frame
 // of {A, B} equals the frame of A alone, and with A off it equals B alone (a mix-up of layers or

@@ -8,20 +8,12 @@
 namespace msm::render {
 namespace {
 
-vk::Image upload_rgba8(const vk::Context& ctx, int width, int height, std::span<const std::uint8_t> rgba) {
+// A sampled texture of 8-bit texels: rgba (R8G8B8A8_SRGB) or opacity (R8_UNORM).
+vk::Image upload_texture(const vk::Context& ctx, VkFormat format, int width, int height,
+                         std::span<const std::uint8_t> texels) {
   vk::Image image = vk::create_image(ctx, {.width = uint32_t(width),
                                            .height = uint32_t(height),
-                                           .format = VK_FORMAT_R8G8B8A8_SRGB,
-                                           .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
-  vk::upload_image(ctx, image, std::as_bytes(rgba), VK_IMAGE_LAYOUT_UNDEFINED,
-                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-  return image;
-}
-
-vk::Image upload_r8(const vk::Context& ctx, int width, int height, std::span<const std::uint8_t> texels) {
-  vk::Image image = vk::create_image(ctx, {.width = uint32_t(width),
-                                           .height = uint32_t(height),
-                                           .format = VK_FORMAT_R8_UNORM,
+                                           .format = format,
                                            .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT});
   vk::upload_image(ctx, image, std::as_bytes(texels), VK_IMAGE_LAYOUT_UNDEFINED,
                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
@@ -103,7 +95,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
       auto [it, inserted] = texture_index.try_emplace(material.albedo_texture, int(textures.size()));
       if (inserted) {
         scene::Image texels = scene::albedo_image(material);
-        textures.push_back(upload_rgba8(ctx, texels.width, texels.height, texels.rgba));
+        textures.push_back(upload_texture(ctx, VK_FORMAT_R8G8B8A8_SRGB, texels.width, texels.height, texels.rgba));
       }
       draw.texture = it->second;
     }
@@ -112,7 +104,8 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
       // textures are small).
       scene::OpacityImage opacity = scene::opacity_image(material);
       draw.opacity_texture = int(opacity_textures.size());
-      opacity_textures.push_back(upload_r8(ctx, opacity.width, opacity.height, opacity.values));
+      opacity_textures.push_back(
+          upload_texture(ctx, VK_FORMAT_R8_UNORM, opacity.width, opacity.height, opacity.values));
     }
     draw.double_sided = material.double_sided;
     draw.push.albedo_opacity = glm::vec4(material.albedo, material.opacity);
@@ -129,7 +122,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
   indices = vk::create_buffer(ctx, g.indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   vk::upload_buffer(ctx, indices, std::as_bytes(std::span(g.indices)));
   const std::uint8_t white_texel[4] = {255, 255, 255, 255};
-  white = upload_rgba8(ctx, 1, 1, white_texel);
+  white = upload_texture(ctx, VK_FORMAT_R8G8B8A8_SRGB, 1, 1, white_texel);
   white_array = vk::create_image_view(ctx, white.handle(), white.format(), VK_IMAGE_ASPECT_COLOR_BIT,
                                       VK_IMAGE_VIEW_TYPE_2D_ARRAY, 0, 1, 0, 1);
   texture_sampler = vk::create_sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);

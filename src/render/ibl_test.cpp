@@ -16,6 +16,7 @@
 #include "msm/shading.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/reference_settings.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>
@@ -38,12 +39,8 @@ struct Truth {
 };
 
 Truth truth(const scene::Scene& scene, bool probe_lights, int samples) {
-  reference::Settings rs;
-  rs.effect = reference::Effect::environment;
+  reference::Settings rs = test::reference_settings(reference::Effect::environment, kWidth, kHeight, samples);
   rs.probe_lights = probe_lights;
-  rs.width = kWidth;
-  rs.height = kHeight;
-  rs.samples = samples;
   const reference::Result r = reference::render(scene, rs);
   return {image::tone_map(r.radiance, {0.0, image::ToneCurve::aces}), r.visibility.channel("background")};
 }

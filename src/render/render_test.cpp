@@ -10,6 +10,7 @@
 #include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
 #include "msm/test/image_compare.h"
+#include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
@@ -22,6 +23,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
 
 namespace msm::render {
@@ -35,11 +37,7 @@ class RenderTest : public vk::test::VulkanTest {};
 // Small images, the default kernel (9 taps, sigma 2.4), 4x MSAA, no mips: the techniques see
 // exactly the kernel that PCF evaluates.
 RenderSettings small(std::string technique) {
-  RenderSettings s;
-  s.technique = std::move(technique);
-  s.width = 240;
-  s.height = 135;
-  s.shadow_size = 512;
+  RenderSettings s = test::render_settings(std::move(technique), 240, 135, 512);
   s.msaa = 4;
   s.mipmaps = false;
   return s;
@@ -682,181 +680,72 @@ TEST_F(RenderTest, NonLinear64MatchesFloatMsmWithNearestLookups) {
 
 TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
   Renderer renderer(ctx(), scene::builtin_scene("column"));
-  auto rejects = [&](RenderSettings s, const std::string& needle) {
+  const RenderSettings s = small("msm-hamburger-64");
+  // s with `change` made is refused with a message that mentions needle.
+  auto rejects = [&](const std::function<void(RenderSettings&)>& change, const std::string& needle) {
+    RenderSettings q = s;
+    change(q);
     try {
-      renderer.render(s);
+      renderer.render(q);
       ADD_FAILURE() << "accepted; expected an error mentioning " << needle;
     } catch (const RenderError& e) { EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what(); }
   };
-  RenderSettings s = small("msm-hamburger-64");
+  // The technique with `change` made is refused likewise.
+  auto rejects_technique = [&](const char* technique, const std::function<void(RenderSettings&)>& change,
+                               const std::string& needle) {
+    rejects(
+        [&](RenderSettings& q) {
+          q.technique = technique;
+          change(q);
+        },
+        needle);
+  };
+  // The technique with these parameters is refused likewise.
+  auto rejects_parameters = [&](const char* technique, const ParameterValues& parameters, const std::string& needle) {
+    rejects_technique(
+        technique, [&](RenderSettings& q) { q.parameters = parameters; }, needle);
+  };
+  rejects([](RenderSettings& q) { q.technique = "nope"; }, "unknown technique 'nope'");
+  rejects([](RenderSettings& q) { q.width = 0; }, "width = 0");
+  rejects([](RenderSettings& q) { q.height = 1000000; }, "height = 1000000");
   rejects(
-      [&] {
-        auto q = s;
-        q.technique = "nope";
-        return q;
-      }(),
-      "unknown technique 'nope'");
-  rejects(
-      [&] {
-        auto q = s;
-        q.width = 0;
-        return q;
-      }(),
-      "width = 0");
-  rejects(
-      [&] {
-        auto q = s;
-        q.height = 1000000;
-        return q;
-      }(),
-      "height = 1000000");
-  rejects(
-      [&] {
-        auto q = s;
+      [](RenderSettings& q) {
         q.width = 16384;
         q.height = 16384;
-        return q;
-      }(),
+      },
       "pixels");
+  rejects([](RenderSettings& q) { q.shadow_size = 1000000; }, "shadow size");
+  rejects([](RenderSettings& q) { q.msaa = 2; }, "msaa = 2");
+  rejects([](RenderSettings& q) { q.filter_size = 8; }, "odd");
+  rejects([](RenderSettings& q) { q.filter_sigma = NAN; }, "filter sigma");
+  rejects_parameters("msm-hamburger-64", {{"moment_bias", NAN}}, "parameter moment_bias = nan is outside [0, 1]");
+  rejects_parameters("msm-hamburger-64", {{"moment_bais", 1e-4f}},
+                     "unknown parameter 'moment_bais' of msm-hamburger-64 (did you mean moment_bias?)");
+  rejects_technique(
+      "msm-nl64", [](RenderSettings& q) { q.one_pass = false; }, "needs the one-pass filter");
+  rejects_technique(
+      "msm6-96", [](RenderSettings& q) { q.one_pass = true; }, "one moment image");
   rejects(
-      [&] {
-        auto q = s;
-        q.shadow_size = 1000000;
-        return q;
-      }(),
-      "shadow size");
-  rejects(
-      [&] {
-        auto q = s;
-        q.msaa = 2;
-        return q;
-      }(),
-      "msaa = 2");
-  rejects(
-      [&] {
-        auto q = s;
-        q.filter_size = 8;
-        return q;
-      }(),
-      "odd");
-  rejects(
-      [&] {
-        auto q = s;
-        q.filter_sigma = NAN;
-        return q;
-      }(),
-      "filter sigma");
-  rejects(
-      [&] {
-        auto q = s;
-        q.parameters = {{"moment_bias", NAN}};
-        return q;
-      }(),
-      "parameter moment_bias = nan is outside [0, 1]");
-  rejects(
-      [&] {
-        auto q = s;
-        q.parameters = {{"moment_bais", 1e-4f}};
-        return q;
-      }(),
-      "unknown parameter 'moment_bais' of msm-hamburger-64 (did you mean moment_bias?)");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "msm-nl64";
-        q.one_pass = false;
-        return q;
-      }(),
-      "needs the one-pass filter");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "msm6-96";
-        q.one_pass = true;
-        return q;
-      }(),
-      "one moment image");
-  rejects(
-      [&] {
-        auto q = s;
+      [](RenderSettings& q) {
         q.one_pass = true;
         q.filter_size = 19;
-        return q;
-      }(),
+      },
       "at most 17 taps");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "mssm4";
-        q.parameters = {{"delta1", 0.0f}};
-        return q;
-      }(),
-      "parameter delta1 = 0 is outside (0, 1]");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "mssm6";
-        q.parameters = {{"delta1", 0.1f}, {"delta2", 0.01f}};
-        return q;
-      }(),
-      "delta1 <= delta2");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "vssm";
-        q.parameters = {{"min_variance", 0.0f}};
-        return q;
-      }(),
-      "parameter min_variance = 0 is outside (0, 1]");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "cssm8";
-        q.parameters = {{"scale", 0.5f}};
-        return q;
-      }(),
-      "parameter scale = 0.5 is outside [1, inf)");
+  rejects_parameters("mssm4", {{"delta1", 0.0f}}, "parameter delta1 = 0 is outside (0, 1]");
+  rejects_parameters("mssm6", {{"delta1", 0.1f}, {"delta2", 0.01f}}, "delta1 <= delta2");
+  rejects_parameters("vssm", {{"min_variance", 0.0f}}, "parameter min_variance = 0 is outside (0, 1]");
+  rejects_parameters("cssm8", {{"scale", 0.5f}}, "parameter scale = 0.5 is outside [1, inf)");
   if (9u * 2048u > ctx().properties().limits.maxImageDimension2D)
-    rejects(
-        [&] {
-          auto q = s;
-          q.technique = "cssm16";
-          q.shadow_size = 2048;
-          return q;
-        }(),
-        "stacks 9 shadow maps");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "pcss";
-        q.soft_kernel = 64;
-        return q;
-      }(),
-      "soft kernel = 64");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "mssm4";
-        q.soft_kernel = 256;
-        return q;
-      }(),
-      "soft kernel = 256");
-  rejects(
-      [&] {
-        auto q = s;
-        q.technique = "mssm4";
-        q.one_pass = true;
-        return q;
-      }(),
-      "summed-area table");
+    rejects_technique(
+        "cssm16", [](RenderSettings& q) { q.shadow_size = 2048; }, "stacks 9 shadow maps");
+  rejects_technique(
+      "pcss", [](RenderSettings& q) { q.soft_kernel = 64; }, "soft kernel = 64");
+  rejects_technique(
+      "mssm4", [](RenderSettings& q) { q.soft_kernel = 256; }, "soft kernel = 256");
+  rejects_technique(
+      "mssm4", [](RenderSettings& q) { q.one_pass = true; }, "summed-area table");
   if (!vk::supports_attachment(ctx(), VK_FORMAT_D16_UNORM, VK_SAMPLE_COUNT_8_BIT))
-    rejects(
-        [&] {
-          auto q = s;
-          q.msaa = 8;
-          return q;
-        }(),
-        "8x MSAA");
+    rejects([](RenderSettings& q) { q.msaa = 8; }, "8x MSAA");
   // The renderer still works afterwards.
   EXPECT_NO_THROW(renderer.render(s));
 }

@@ -9,6 +9,8 @@
 #include "msm/render/renderer.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/reference_settings.h"
+#include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>
@@ -28,10 +30,6 @@ namespace {
 class ScatteringGroundTruthTest : public vk::test::VulkanTest {};
 
 constexpr int kWidth = 160, kHeight = 90, kShadowSize = 512, kReferenceSamples = 256;
-
-const std::vector<std::string> kTechniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
-                                              "scatter-msm4-64",  "scatter-msm6-64",   "scatter-msm6-96",
-                                              "scatter-msm6-192"};
 
 const std::vector<std::string> kFilteredTechniques = {"scatter-csm-32", "scatter-msm4-64", "scatter-msm6-96"};
 
@@ -130,11 +128,7 @@ double mae_bound(double measured) { return std::max(1.5 * measured, measured + 0
 double share_bound(double measured) { return measured + 0.05; }
 
 RenderSettings settings(std::string technique, ParameterValues parameters = {}, bool prefix_sum_mips = false) {
-  RenderSettings s;
-  s.technique = std::move(technique);
-  s.width = kWidth;
-  s.height = kHeight;
-  s.shadow_size = kShadowSize;
+  RenderSettings s = test::render_settings(std::move(technique), kWidth, kHeight, kShadowSize);
   s.parameters = parameters;
   s.prefix_sum_mips = prefix_sum_mips;
   return s;
@@ -143,11 +137,8 @@ RenderSettings settings(std::string technique, ParameterValues parameters = {}, 
 image::Image visible_fraction(const RenderResult& r) { return r.scattering.channel("visible_fraction"); }
 
 reference::Result ground_truth(const scene::Scene& scene) {
-  reference::Settings r;
-  r.effect = reference::Effect::scattering;
-  r.width = kWidth;
-  r.height = kHeight;
-  r.samples = kReferenceSamples;
+  const reference::Settings r =
+      test::reference_settings(reference::Effect::scattering, kWidth, kHeight, kReferenceSamples);
   return reference::render(scene, r);
 }
 
@@ -179,7 +170,7 @@ std::map<std::string, image::Metrics> check_scene(Renderer& renderer, const std:
     bool mips = false;
   };
   std::vector<Run> runs;
-  for (const std::string& technique : kTechniques) runs.push_back({technique, {}});
+  for (const std::string& technique : test::scattering_techniques()) runs.push_back({technique, {}});
   // Resampling with filtering from the blurred, mipmapped moment map (§5.2): "<technique>+filtered".
   for (const std::string& technique : kFilteredTechniques)
     runs.push_back({technique + "+filtered", {{"resampling", 1.0f}}});

@@ -11,6 +11,8 @@
 
 #include "msm/image/metrics.h"
 #include "msm/scattering.h"
+#include "msm/test/reference_settings.h"
+#include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>
@@ -32,21 +34,13 @@ class ScatteringLightsTest : public vk::test::VulkanTest {};
 
 constexpr int kWidth = 160, kHeight = 90, kShadowSize = 512, kReferenceSamples = 256;
 
-const std::vector<std::string> kTechniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
-                                              "scatter-msm4-64",  "scatter-msm6-64",   "scatter-msm6-96",
-                                              "scatter-msm6-192"};
-
 scene::Scene two_lights() {
   return scene::load_scene_file(std::filesystem::path(MSM_TEST_DATA_DIR) / "gate_two_lights.json");
 }
 
 RenderSettings settings(const std::string& technique, ParameterValues parameters = {}) {
-  RenderSettings s;
-  s.technique = technique;
+  RenderSettings s = test::render_settings(technique, kWidth, kHeight, kShadowSize);
   s.parameters = parameters;
-  s.width = kWidth;
-  s.height = kHeight;
-  s.shadow_size = kShadowSize;
   return s;
 }
 
@@ -72,7 +66,7 @@ TEST_F(ScatteringLightsTest, ScatteringIsTheSumOverTheLights) {
   // Every technique, and the prefiltered ones with filtered resampling from each light's own blurred,
   // mipmapped moment map (JCGT §5.2, resampling = filtered).
   std::vector<std::pair<std::string, ParameterValues>> runs;
-  for (const std::string& technique : kTechniques) runs.emplace_back(technique, ParameterValues{});
+  for (const std::string& technique : test::scattering_techniques()) runs.emplace_back(technique, ParameterValues{});
   for (const char* technique : {"scatter-csm-32", "scatter-msm4-64", "scatter-msm6-96"})
     runs.emplace_back(technique, ParameterValues{{"resampling", 1.0f}});
   // And with 4 transmittance layers: light l's layers K l .. K l + K − 1.
@@ -152,15 +146,12 @@ double inscattered_bound(double measured) { return std::max(1.5 * measured, meas
 
 TEST_F(ScatteringLightsTest, TwoLightsAgreeWithTheGroundTruth) {
   const scene::Scene scene = two_lights();
-  reference::Settings r;
-  r.effect = reference::Effect::scattering;
-  r.width = kWidth;
-  r.height = kHeight;
-  r.samples = kReferenceSamples;
+  const reference::Settings r =
+      test::reference_settings(reference::Effect::scattering, kWidth, kHeight, kReferenceSamples);
   const reference::Result truth = reference::render(scene, r);
   const image::Image truth_visibility = truth.visibility.channel("visibility");
   Renderer renderer(ctx(), scene);
-  for (const std::string& technique : kTechniques) {
+  for (const std::string& technique : test::scattering_techniques()) {
     SCOPED_TRACE(technique);
     const RenderResult result = renderer.render(settings(technique));
     const image::Metrics m = image::compute_metrics(result.scattering.channel("visible_fraction"), truth_visibility);

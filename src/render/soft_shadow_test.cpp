@@ -11,6 +11,8 @@
 
 #include "msm/image/metrics.h"
 #include "msm/test/image_compare.h"
+#include "msm/test/reference_settings.h"
+#include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>
@@ -36,23 +38,15 @@ const std::vector<std::string> kSoftTechniques = {"mssm4", "mssm6", "vssm", "pcs
 // own shape where shape is).
 reference::Result area_light_truth(const scene::Scene& scene, int width, int height, std::optional<double> extent_deg,
                                    int samples = 64, std::optional<reference::LightShape> shape = std::nullopt) {
-  reference::Settings rs;
-  rs.effect = reference::Effect::soft;
+  reference::Settings rs = test::reference_settings(reference::Effect::soft, width, height, samples);
   rs.light_shape = shape;
   rs.light_extent_deg = extent_deg;
-  rs.width = width;
-  rs.height = height;
-  rs.samples = samples;
   return reference::render(scene, rs);
 }
 
 RenderSettings soft_settings(const std::string& technique, int width, int height, float extent_deg,
                              int shadow_size = 512) {
-  RenderSettings s;
-  s.technique = technique;
-  s.width = width;
-  s.height = height;
-  s.shadow_size = shadow_size;
+  RenderSettings s = test::render_settings(technique, width, height, shadow_size);
   s.light_extent_deg = extent_deg;
   return s;
 }

@@ -5,6 +5,7 @@
 #include "msm/render/renderer.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
 
 #include <fmt/format.h>
@@ -36,22 +37,14 @@ scene::Scene stack(int k, float alpha) {
 }
 
 RenderSettings settings(const std::string& technique) {
-  RenderSettings s;
-  s.technique = technique;
-  s.width = 96;
-  s.height = 72;
-  s.shadow_size = 256;
+  RenderSettings s = test::render_settings(technique, 96, 72, 256);
   s.mipmaps = false;
   return s;
 }
 
 // The scene tests (smoke, glass): 240x135, 512² map, mips on, the receiver-plane bias as given.
 RenderSettings scene_settings(const std::string& technique, float receiver_plane_bias) {
-  RenderSettings s;
-  s.technique = technique;
-  s.width = 240;
-  s.height = 135;
-  s.shadow_size = 512;
+  RenderSettings s = test::render_settings(technique, 240, 135, 512);
   s.receiver_plane_bias = receiver_plane_bias;
   // No mip blur: the ray-traced transmittance is unfiltered (as in the other ground-truth tests).
   s.mipmaps = false;

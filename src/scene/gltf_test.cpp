@@ -31,6 +31,15 @@ using msm::test::TempDir;
 // (alpha 255, 0, 255, 0 in that order: the right column is transparent).
 GltfTexture corners_texture() { return {2, 2, {255, 0, 0, 255, 0, 255, 0, 0, 0, 0, 255, 255, 255, 255, 255, 0}}; }
 
+// One quad in the y = 0 plane facing up, its material "t" textured with corners_texture().
+GltfModel textured_quad() {
+  GltfModel model;
+  model.textures = {corners_texture()};
+  model.materials = {{.name = "t", .texture = 0}};
+  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
+  return model;
+}
+
 std::string scene_json(const std::string& mesh, const std::string& material = "") {
   return R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, "objects": [{"name": "m", "mesh": ")" + mesh +
          "\"" + (material.empty() ? "" : R"(, "material": )" + material) + "}]}";
@@ -146,19 +155,7 @@ TEST(GltfImport, TwoMaterialsOnOneMesh) {
 // translucent occluder, OPAQUE ignores alpha; double-sidedness and transmission are read.
 TEST(GltfImport, AlphaModesAndTransmission) {
   TempDir dir("msm_gltf_test");
-  GltfModel model;
-  model.textures = {corners_texture()};
-  model.materials = {{.name = "mask",
-                      .base_color = {1, 1, 1, 0.9f},
-                      .texture = 0,
-                      .alpha_mode = "MASK",
-                      .alpha_cutoff = 0.3f,
-                      .double_sided = true},
-                     {.name = "blend", .base_color = {1, 1, 1, 0.5f}, .alpha_mode = "BLEND"},
-                     {.name = "opaque", .base_color = {0.5f, 0.5f, 0.5f, 0.2f}, .texture = 0},
-                     {.name = "glass", .base_color = {1, 0.5f, 0.25f, 1}, .transmission = 0.8f}};
-  for (int i = 0; i < 4; ++i) model.primitives.push_back(quad({2.0f * i, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, i));
-  write_gltf(dir.path() / "alpha.gltf", model);
+  write_gltf(dir.path() / "alpha.gltf", alpha_modes_model(corners_texture()));
   const Scene s = load(dir, scene_json("alpha.gltf"));
   ASSERT_EQ(s.objects.size(), 4u);
   auto material = [&](const std::string& name) -> const Material& {
@@ -201,10 +198,7 @@ TEST(GltfImport, AlphaModesAndTransmission) {
 // order of the picture kept (row 0 on top).
 TEST(GltfImport, EmbeddedAndExternalTextures) {
   TempDir dir("msm_gltf_test");
-  GltfModel model;
-  model.textures = {corners_texture()};
-  model.materials = {{.name = "t", .texture = 0}};
-  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
+  const GltfModel model = textured_quad();
   write_gltf(dir.path() / "data.gltf", model);
   write_gltf(dir.path() / "files.gltf", model, true);
   write_gltf(dir.path() / "binary.glb", model);
@@ -237,10 +231,7 @@ TEST(GltfImport, EmbeddedAndExternalTextures) {
 // "unknown image type".
 TEST(GltfImport, UndecodableTexturesAreNamed) {
   TempDir dir("msm_gltf_test");
-  GltfModel model;
-  model.textures = {corners_texture()};
-  model.materials = {{.name = "t", .texture = 0}};
-  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0));
+  const GltfModel model = textured_quad();
   write_gltf(dir.path() / "files.gltf", model, true);
   const std::string ktx2_magic = "\xABKTX 20\xBB\r\n\x1A\n" + std::string(20, '\0');
   const auto texture_error = [&](const std::string& bytes) -> std::string {

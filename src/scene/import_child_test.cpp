@@ -68,6 +68,12 @@ std::string import_error(const fs::path& file) {
   return "";
 }
 
+// import_model(file) fails with a SceneError whose message contains `expected`.
+void expect_import_error(const fs::path& file, const std::string& expected) {
+  const std::string what = import_error(file);
+  EXPECT_NE(what.find(expected), std::string::npos) << what;
+}
+
 void say(const char* text) { (void)!::write(2, text, std::strlen(text)); }
 
 // The importer still works (this process survived the child).
@@ -108,23 +114,12 @@ void expect_same(const std::vector<ModelPart>& a, const std::vector<ModelPart>& 
   }
 }
 
-// A glTF of two materials sharing one embedded texture (MASK: albedo and opacity from it), a
-// BLEND one and an untextured one.
+// A .glb of the four alpha-mode materials (alpha_modes_model): MASK (albedo and opacity) and
+// OPAQUE share one embedded texture.
 fs::path write_textured(const TempDir& dir) {
   using namespace msm::scene::testing;
-  GltfModel model;
-  GltfTexture texture{.width = 2, .height = 2, .rgba = {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 9, 9, 9, 255}};
-  model.textures = {texture};
-  model.materials = {{.name = "mask",
-                      .base_color = {1, 1, 1, 0.9f},
-                      .texture = 0,
-                      .alpha_mode = "MASK",
-                      .alpha_cutoff = 0.3f,
-                      .double_sided = true},
-                     {.name = "textured", .base_color = {0.5f, 0.5f, 0.5f, 1}, .texture = 0},
-                     {.name = "blend", .base_color = {1, 1, 1, 0.5f}, .alpha_mode = "BLEND"},
-                     {.name = "glass", .base_color = {1, 0.5f, 0.25f, 1}, .transmission = 0.8f}};
-  for (int i = 0; i < 4; ++i) model.primitives.push_back(quad({2.0f * i, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, i));
+  GltfModel model = alpha_modes_model(
+      {.width = 2, .height = 2, .rgba = {255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 9, 9, 9, 255}});
   const fs::path file = dir.path() / "textured.glb";
   write_gltf(file, model);
   return file;
@@ -132,57 +127,51 @@ fs::path write_textured(const TempDir& dir) {
 
 } // namespace
 
+// Each test's folder, with a cube to import in it.
+class ImportChild : public ::testing::Test {
+ protected:
+  TempDir dir{"msm_import_child_test"};
+  const fs::path cube = dir.write("cube.obj", kCube);
+};
+
 // A segmentation fault inside the child: the message names the file and the signal, what the
 // child printed is quoted (its stdout and stderr go to the parent, not to the terminal), and the
 // next import works.
-TEST(ImportChild, CrashIsASceneError) {
-  TempDir dir("msm_import_child_test");
-  const fs::path cube = dir.write("cube.obj", kCube);
+TEST_F(ImportChild, CrashIsASceneError) {
   {
     Hook hook([] {
       (void)!::write(1, "the child says this\n", 20);
       std::raise(SIGSEGV);
     });
-    const std::string what = import_error(cube);
-    EXPECT_NE(what.find("cube.obj: Assimp crashed while reading the mesh (signal 11, Segmentation fault: "
-                        "the child says this)"),
-              std::string::npos)
-        << what;
+    expect_import_error(cube, "cube.obj: Assimp crashed while reading the mesh (signal 11, Segmentation fault: "
+                              "the child says this)");
   }
   expect_cube(cube);
 }
 
 // An abort (a heap check of the C library), and an exit with a sanitizer's status after its report.
-TEST(ImportChild, AbortAndSanitizerExit) {
-  TempDir dir("msm_import_child_test");
-  const fs::path cube = dir.write("cube.obj", kCube);
+TEST_F(ImportChild, AbortAndSanitizerExit) {
   {
     Hook hook([] {
       say("malloc(): corrupted top size\n");
       std::abort();
     });
-    const std::string what = import_error(cube);
-    EXPECT_NE(what.find("Assimp crashed while reading the mesh (signal 6, Aborted: malloc(): corrupted top size)"),
-              std::string::npos)
-        << what;
+    expect_import_error(cube,
+                        "Assimp crashed while reading the mesh (signal 6, Aborted: malloc(): corrupted top size)");
   }
   {
     Hook hook([] {
       say("\n==4242==ERROR: AddressSanitizer: heap-use-after-free on address 0x6020\nmore lines\n");
       ::_exit(1);
     });
-    const std::string what = import_error(cube);
-    EXPECT_NE(what.find("(exit status 1: ==4242==ERROR: AddressSanitizer: heap-use-after-free on address 0x6020)"),
-              std::string::npos)
-        << what;
+    expect_import_error(cube,
+                        "(exit status 1: ==4242==ERROR: AddressSanitizer: heap-use-after-free on address 0x6020)");
   }
   expect_cube(cube);
 }
 
 // An endless loop: killed after MSM_IMPORT_TIMEOUT_S (1 s here; the default is 600 s).
-TEST(ImportChild, EndlessLoopEndsAtTheTimeout) {
-  TempDir dir("msm_import_child_test");
-  const fs::path cube = dir.write("cube.obj", kCube);
+TEST_F(ImportChild, EndlessLoopEndsAtTheTimeout) {
   EXPECT_EQ(detail::import_timeout_seconds(), 600.0);
   {
     Hook hook(
@@ -204,12 +193,10 @@ TEST(ImportChild, EndlessLoopEndsAtTheTimeout) {
 // A runaway allocation ends at the child's address-space limit (this process's own plus
 // MSM_MAX_MEMORY_MB): std::bad_alloc in the child, a SceneError here. The hook stops at 64 GiB of
 // untouched blocks, so that a missing limit fails the test instead of exhausting the machine.
-TEST(ImportChild, RunawayAllocationEndsAtTheMemoryLimit) {
+TEST_F(ImportChild, RunawayAllocationEndsAtTheMemoryLimit) {
 #ifdef MSM_TEST_SANITIZED
   GTEST_SKIP() << "no address-space limit under sanitizers (their shadow memory reserves terabytes)";
 #else
-  TempDir dir("msm_import_child_test");
-  const fs::path cube = dir.write("cube.obj", kCube);
   {
     Hook hook(
         [] {
@@ -217,20 +204,16 @@ TEST(ImportChild, RunawayAllocationEndsAtTheMemoryLimit) {
           for (int i = 0; i < 64 * 1024; ++i) blocks.emplace_back(new char[1 << 20]);
         },
         "MSM_MAX_MEMORY_MB", "64");
-    const std::string what = import_error(cube);
-    EXPECT_NE(what.find("cube.obj: Assimp ran out of memory reading the mesh (the limit is 64 MiB: MSM_MAX_MEMORY_MB "
-                        "raises it)"),
-              std::string::npos)
-        << what;
+    expect_import_error(cube,
+                        "cube.obj: Assimp ran out of memory reading the mesh (the limit is 64 MiB: MSM_MAX_MEMORY_MB "
+                        "raises it)");
   }
   expect_cube(cube);
 #endif
 }
 
 // The child's SceneError comes back with its three parts.
-TEST(ImportChild, SceneErrorTravelsBack) {
-  TempDir dir("msm_import_child_test");
-  const fs::path cube = dir.write("cube.obj", kCube);
+TEST_F(ImportChild, SceneErrorTravelsBack) {
   Hook hook([] { throw SceneError("some.obj", "/objects/1", "a problem found in the child"); });
   try {
     (void)import_model(cube);
@@ -244,8 +227,7 @@ TEST(ImportChild, SceneErrorTravelsBack) {
 
 // The result larger than MSM_MAX_MEMORY_MB: refused (by the parent's read cap, or by the child's
 // address-space limit before it), never read without end.
-TEST(ImportChild, ResultOverTheMemoryLimitIsRefused) {
-  TempDir dir("msm_import_child_test");
+TEST_F(ImportChild, ResultOverTheMemoryLimitIsRefused) {
   std::string text;
   const int n =
       60000; // a fan of triangles (0 0 0), (i 1 0), (i+1 1 0): 60,002 vertices of 32 B and 60,000 triangles of 12 B: 2.6 MB
@@ -255,16 +237,14 @@ TEST(ImportChild, ResultOverTheMemoryLimitIsRefused) {
   const fs::path fan = dir.write("fan.obj", text);
   {
     Hook hook(nullptr, "MSM_MAX_MEMORY_MB", "1");
-    const std::string what = import_error(fan);
-    EXPECT_NE(what.find("MSM_MAX_MEMORY_MB"), std::string::npos) << what;
+    expect_import_error(fan, "MSM_MAX_MEMORY_MB");
   }
   EXPECT_EQ(import_mesh(fan).triangle_count(), std::size_t(n));
 }
 
 // The parts through the child equal those of the in-process import: materials, the embedded
 // texture's texels, one Image shared by the material's albedo and opacity as before.
-TEST(ImportChild, PartsComeBackExactly) {
-  TempDir dir("msm_import_child_test");
+TEST_F(ImportChild, PartsComeBackExactly) {
   const fs::path file = write_textured(dir);
   const std::vector<ModelPart> here = detail::import_model_in_process(file);
   const std::vector<ModelPart> there = import_model(file);
@@ -273,7 +253,7 @@ TEST(ImportChild, PartsComeBackExactly) {
   const Material& mask = *there[0].material;
   ASSERT_TRUE(mask.albedo_pixels);
   EXPECT_EQ(mask.albedo_pixels, mask.opacity_pixels);
-  EXPECT_EQ(there[1].material->albedo_pixels, mask.albedo_pixels);
+  EXPECT_EQ(there[2].material->albedo_pixels, mask.albedo_pixels); // "opaque", the same texture
   EXPECT_EQ(mask.albedo_pixels->rgba.size(), 16u);
   const std::vector<ModelPart> cube = import_model(dir.write("cube.obj", kCube));
   expect_same(detail::import_model_in_process(dir.path() / "cube.obj"), cube);
@@ -282,8 +262,7 @@ TEST(ImportChild, PartsComeBackExactly) {
 // The child's bytes are not trusted: every truncation is refused; counts and indices set to any
 // value and random byte changes (fixed seed) are refused, or give parts that keep the invariants
 // (indices within the vertices, normals and uvs one per position, finite positions).
-TEST(ImportChild, CorruptResultIsRefused) {
-  TempDir dir("msm_import_child_test");
+TEST_F(ImportChild, CorruptResultIsRefused) {
   const fs::path file = write_textured(dir);
   const std::string bytes = detail::serialize_model(detail::import_model_in_process(file));
   expect_same(detail::deserialize_model(bytes, file), detail::import_model_in_process(file));

@@ -2,6 +2,8 @@
 
 #include "msm/vk/context.h"
 
+#include <type_traits>
+
 namespace msm::vk {
 
 void submit_and_wait(const Context& ctx, const std::function<void(VkCommandBuffer)>& record) {
@@ -39,28 +41,39 @@ void submit_and_wait(const Context& ctx, const std::function<void(VkCommandBuffe
   MSM_VK_CHECK(vkWaitForFences(device, 1, &raw_fence, VK_TRUE, UINT64_MAX));
 }
 
+namespace {
+
+// The stages and accesses on both sides, common to the three kinds of barrier; a buffer or image
+// barrier also transfers no ownership.
+template <class Barrier>
+Barrier barrier(VkStructureType type, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
+                VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
+  Barrier b{.sType = type};
+  b.srcStageMask = src_stage;
+  b.srcAccessMask = src_access;
+  b.dstStageMask = dst_stage;
+  b.dstAccessMask = dst_access;
+  if constexpr (!std::is_same_v<Barrier, VkMemoryBarrier2>)
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  return b;
+}
+
+} // namespace
+
 VkMemoryBarrier2 memory_barrier(VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                 VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access) {
-  return {.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER_2,
-          .srcStageMask = src_stage,
-          .srcAccessMask = src_access,
-          .dstStageMask = dst_stage,
-          .dstAccessMask = dst_access};
+  return barrier<VkMemoryBarrier2>(VK_STRUCTURE_TYPE_MEMORY_BARRIER_2, src_stage, src_access, dst_stage, dst_access);
 }
 
 VkBufferMemoryBarrier2 buffer_barrier(VkBuffer buffer, VkPipelineStageFlags2 src_stage, VkAccessFlags2 src_access,
                                       VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access, VkDeviceSize offset,
                                       VkDeviceSize size) {
-  return {.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2,
-          .srcStageMask = src_stage,
-          .srcAccessMask = src_access,
-          .dstStageMask = dst_stage,
-          .dstAccessMask = dst_access,
-          .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-          .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-          .buffer = buffer,
-          .offset = offset,
-          .size = size};
+  auto b = barrier<VkBufferMemoryBarrier2>(VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2, src_stage, src_access, dst_stage,
+                                           dst_access);
+  b.buffer = buffer;
+  b.offset = offset;
+  b.size = size;
+  return b;
 }
 
 VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, VkPipelineStageFlags2 src_stage,
@@ -68,17 +81,13 @@ VkImageMemoryBarrier2 image_barrier(VkImage image, VkImageAspectFlags aspect, Vk
                                     VkPipelineStageFlags2 dst_stage, VkAccessFlags2 dst_access,
                                     VkImageLayout new_layout, uint32_t base_mip, uint32_t mip_count,
                                     uint32_t base_layer, uint32_t layer_count) {
-  return {.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2,
-          .srcStageMask = src_stage,
-          .srcAccessMask = src_access,
-          .dstStageMask = dst_stage,
-          .dstAccessMask = dst_access,
-          .oldLayout = old_layout,
-          .newLayout = new_layout,
-          .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-          .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-          .image = image,
-          .subresourceRange = {aspect, base_mip, mip_count, base_layer, layer_count}};
+  auto b = barrier<VkImageMemoryBarrier2>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2, src_stage, src_access, dst_stage,
+                                          dst_access);
+  b.oldLayout = old_layout;
+  b.newLayout = new_layout;
+  b.image = image;
+  b.subresourceRange = {aspect, base_mip, mip_count, base_layer, layer_count};
+  return b;
 }
 
 void pipeline_barrier(VkCommandBuffer cmd, std::span<const VkMemoryBarrier2> memory,

@@ -53,20 +53,16 @@ Program create_graphics_program(const Context& ctx, const GraphicsDesc& desc) {
   SharedSpecialization specialization(ctx, desc.constants);
   std::vector<ShaderModule> modules;
   std::vector<VkPipelineShaderStageCreateInfo> stage_infos;
-  modules.push_back(make_module(desc.vertex_shader));
-  stage_infos.push_back({.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                         .stage = VK_SHADER_STAGE_VERTEX_BIT,
-                         .module = modules.back(),
-                         .pName = "main",
-                         .pSpecializationInfo = specialization.info()});
-  if (!desc.fragment_shader.empty()) {
-    modules.push_back(make_module(desc.fragment_shader));
+  auto add_stage = [&](const std::string& shader, VkShaderStageFlagBits stage) {
+    modules.push_back(make_module(shader));
     stage_infos.push_back({.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                           .stage = VK_SHADER_STAGE_FRAGMENT_BIT,
+                           .stage = stage,
                            .module = modules.back(),
                            .pName = "main",
                            .pSpecializationInfo = specialization.info()});
-  }
+  };
+  add_stage(desc.vertex_shader, VK_SHADER_STAGE_VERTEX_BIT);
+  if (!desc.fragment_shader.empty()) add_stage(desc.fragment_shader, VK_SHADER_STAGE_FRAGMENT_BIT);
 
   VkVertexInputBindingDescription vertex_binding{
       .binding = 0, .stride = desc.vertex_stride, .inputRate = VK_VERTEX_INPUT_RATE_VERTEX};

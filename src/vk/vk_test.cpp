@@ -1,5 +1,6 @@
 // Tests of the msm::vk layer on the device MSM_DEVICE picks (lavapipe here), validation on.
 #include "msm/shared.h"
+#include "msm/test/thrown.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
 
@@ -74,14 +75,9 @@ TEST(ShaderRegistryTest, FindsShadersByFileNameAndStem) {
 }
 
 TEST(ShaderRegistryTest, UnknownNameThrowsAndListsEmbeddedShaders) {
-  try {
-    embedded_shader("no_such_shader");
-    FAIL() << "no exception";
-  } catch (const std::runtime_error& e) {
-    std::string what = e.what();
-    EXPECT_NE(what.find("no_such_shader"), std::string::npos) << what;
-    EXPECT_NE(what.find("selftest"), std::string::npos) << what;
-  }
+  const std::string what = msm::test::thrown_message<std::runtime_error>([] { embedded_shader("no_such_shader"); });
+  EXPECT_NE(what.find("no_such_shader"), std::string::npos) << what;
+  EXPECT_NE(what.find("selftest"), std::string::npos) << what;
 }
 
 TEST(ContextTest, CreatesLavapipeDeviceWithValidation) {

@@ -79,6 +79,22 @@ GltfPrimitive quad(glm::vec3 origin, glm::vec3 u, glm::vec3 v, glm::vec3 normal,
   return p;
 }
 
+GltfModel alpha_modes_model(const GltfTexture& texture) {
+  GltfModel model;
+  model.textures = {texture};
+  model.materials = {{.name = "mask",
+                      .base_color = {1, 1, 1, 0.9f},
+                      .texture = 0,
+                      .alpha_mode = "MASK",
+                      .alpha_cutoff = 0.3f,
+                      .double_sided = true},
+                     {.name = "blend", .base_color = {1, 1, 1, 0.5f}, .alpha_mode = "BLEND"},
+                     {.name = "opaque", .base_color = {0.5f, 0.5f, 0.5f, 0.2f}, .texture = 0},
+                     {.name = "glass", .base_color = {1, 0.5f, 0.25f, 1}, .transmission = 0.8f}};
+  for (int i = 0; i < 4; ++i) model.primitives.push_back(quad({2.0f * i, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}, i));
+  return model;
+}
+
 void write_gltf(const std::filesystem::path& file, const GltfModel& model, bool external_pictures) {
   const bool glb = file.extension() == ".glb";
   Buffer buffer;

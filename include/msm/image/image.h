@@ -117,5 +117,7 @@ Image tone_map(const Image& image, const ToneMap& tone = {});
 // 8-bit interleaved sRGB of the image (colour channels encoded with linear_to_srgb8; a channel
 // named "A" is stored linearly: round(255 x)).
 std::vector<std::uint8_t> to_srgb8(const Image& image);
+// The same with channel `alpha` (-1: none) stored linearly, whatever its name.
+std::vector<std::uint8_t> to_srgb8(const Image& image, int alpha);
 
 } // namespace msm::image

@@ -142,26 +142,29 @@ class Context {
   void destroy() noexcept;
   bool probe_fused_fma() const;
 
+  // Validation, the instance and its debug messenger.
+  bool validation_ = false;
   std::shared_ptr<ValidationLog> log_ = std::make_shared<ValidationLog>();
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
-  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
-  VkDevice device_ = VK_NULL_HANDLE;
-  VkQueue queue_ = VK_NULL_HANDLE;
-  VkCommandPool command_pool_ = VK_NULL_HANDLE;
-  uint32_t queue_family_ = 0;
-  uint32_t timestamp_valid_bits_ = 0;
-  bool validation_ = false;
-  bool fused_fma_ = true;
-  bool use_native_fma_ = true;
+  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger_ = nullptr;
+  // The physical device, what it reports, the queue family chosen on it and its arithmetic.
   DeviceInfo info_;
-  DeviceFeatures features_;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
   VkPhysicalDeviceProperties properties_{};
   VkPhysicalDeviceMemoryProperties memory_{};
+  uint32_t queue_family_ = 0;
+  uint32_t timestamp_valid_bits_ = 0;
+  bool fused_fma_ = true;
+  bool use_native_fma_ = true;
+  // The device, the features it was created with, its queue, command pool and entry points.
+  VkDevice device_ = VK_NULL_HANDLE;
+  DeviceFeatures features_;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
   PFN_vkCmdPushDescriptorSetKHR push_descriptor_set_ = nullptr;
   PFN_vkCmdPushDescriptorSetWithTemplateKHR push_descriptor_set_with_template_ = nullptr;
   PFN_vkSetDebugUtilsObjectNameEXT set_object_name_ = nullptr;
-  PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger_ = nullptr;
 };
 
 } // namespace msm::vk

@@ -6,12 +6,5 @@
 layout(local_size_x = 64) in;
 layout(binding = 0, MSM_SAT_TABLE_FORMAT) uniform uimage2D table;
 
-void main() {
-  int x = int(gl_GlobalInvocationID.x);
-  if (x >= pc.size.x) return;
-  uvec4 sum = uvec4(0u);
-  for (int y = 0; y < pc.size.y; ++y) {
-    sum += imageLoad(table, ivec2(x, y));
-    imageStore(table, ivec2(x, y), sum);
-  }
-}
+uvec4 sat_scan_load(ivec2 p) { return imageLoad(table, p); }
+#include "sat_scan_lines.glsl"

@@ -7,12 +7,6 @@ layout(local_size_x = 64) in;
 layout(binding = 0) uniform sampler2D moments;
 layout(binding = 1, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
 
-void main() {
-  int y = int(gl_GlobalInvocationID.x);
-  if (y >= pc.size.y) return;
-  uvec4 sum = uvec4(0u);
-  for (int x = 0; x < pc.size.x; ++x) {
-    sum += sat_quantized_texel(moments, ivec2(x, y));
-    imageStore(table, ivec2(x, y), sum);
-  }
-}
+uvec4 sat_scan_load(ivec2 p) { return sat_quantized_texel(moments, p); }
+#define SAT_ALONG_ROWS
+#include "sat_scan_lines.glsl"

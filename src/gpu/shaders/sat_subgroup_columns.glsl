@@ -13,19 +13,6 @@
 layout(local_size_x = 64) in;
 layout(binding = 0, MSM_SAT_TABLE_FORMAT) uniform uimage2D table;
 
-void main() {
-  const int lanes = int(subgroupAdd(1u));
-  const int rank = int(subgroupExclusiveAdd(1u));
-  const uint last = subgroupMax(gl_SubgroupInvocationID);
-  const int subgroups = int(gl_NumWorkGroups.x * gl_NumSubgroups);
-  for (int x = int(gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID); x < pc.size.x; x += subgroups) {
-    uvec4 carry = uvec4(0u);
-    for (int y0 = 0; y0 < pc.size.y; y0 += lanes) {
-      int y = y0 + rank;
-      uvec4 v = y < pc.size.y ? imageLoad(table, ivec2(x, y)) : uvec4(0u);
-      v = carry + subgroupInclusiveAdd(v);
-      if (y < pc.size.y) imageStore(table, ivec2(x, y), v);
-      carry = subgroupShuffle(v, last);
-    }
-  }
-}
+uvec4 sat_scan_load(ivec2 p) { return imageLoad(table, p); }
+#define SAT_SUBGROUP
+#include "sat_scan_lines.glsl"

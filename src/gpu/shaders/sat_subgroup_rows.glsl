@@ -17,19 +17,7 @@ layout(local_size_x = 64) in;
 layout(binding = 0) uniform sampler2D moments;
 layout(binding = 1, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
 
-void main() {
-  const int lanes = int(subgroupAdd(1u));           // active lanes: the chunk width
-  const int rank = int(subgroupExclusiveAdd(1u));   // this lane's texel in the chunk
-  const uint last = subgroupMax(gl_SubgroupInvocationID); // the lane holding the chunk's total
-  const int subgroups = int(gl_NumWorkGroups.x * gl_NumSubgroups);
-  for (int y = int(gl_WorkGroupID.x * gl_NumSubgroups + gl_SubgroupID); y < pc.size.y; y += subgroups) {
-    uvec4 carry = uvec4(0u); // wraps modulo 2^32, as the CPU's sums
-    for (int x0 = 0; x0 < pc.size.x; x0 += lanes) {
-      int x = x0 + rank;
-      uvec4 v = x < pc.size.x ? sat_quantized_texel(moments, ivec2(x, y)) : uvec4(0u);
-      v = carry + subgroupInclusiveAdd(v);
-      if (x < pc.size.x) imageStore(table, ivec2(x, y), v);
-      carry = subgroupShuffle(v, last);
-    }
-  }
-}
+uvec4 sat_scan_load(ivec2 p) { return sat_quantized_texel(moments, p); }
+#define SAT_ALONG_ROWS
+#define SAT_SUBGROUP
+#include "sat_scan_lines.glsl"

@@ -113,24 +113,19 @@ void PrefixSumPass::reflect(PassBuilder& b) const {
   std::array<VkFormat, 2> formats = config_.prefix_sum_formats();
   // K transmittance layers per light (CSM: eight image layers each), light l's from K l.
   const uint32_t prefix_layers = uint32_t(config_.lights) * layers(config_);
-  b.read(kRectified, use::sampled(kCompute));
-  b.create(kPrefixSums,
-           {.format = formats[0],
-            .width = size(config_),
-            .height = size(config_),
-            .mips = config_.prefix_sum_mips,
-            .layers = (csm(config_) ? kCsmLayers : 1) * prefix_layers},
-           use::compute_general());
-  if (prefix_sums_have_two_images(config_)) {
-    b.read(kRectified1, use::sampled(kCompute));
-    b.create(kPrefixSums1,
-             {.format = formats[1],
+  // Per moment image: the rectified image read, its prefix sums created.
+  auto prefix_sums = [&](const char* rectified, const char* sums, VkFormat format, uint32_t image_layers) {
+    b.read(rectified, use::sampled(kCompute));
+    b.create(sums,
+             {.format = format,
               .width = size(config_),
               .height = size(config_),
               .mips = config_.prefix_sum_mips,
-              .layers = prefix_layers},
+              .layers = image_layers},
              use::compute_general());
-  }
+  };
+  prefix_sums(kRectified, kPrefixSums, formats[0], (csm(config_) ? kCsmLayers : 1) * prefix_layers);
+  if (prefix_sums_have_two_images(config_)) prefix_sums(kRectified1, kPrefixSums1, formats[1], prefix_layers);
 }
 
 void PrefixSumPass::execute(const PassContext& c) const {

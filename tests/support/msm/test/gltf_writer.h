@@ -51,6 +51,11 @@ struct GltfModel {
 // `normal` (wound counter-clockwise around it).
 GltfPrimitive quad(glm::vec3 origin, glm::vec3 u, glm::vec3 v, glm::vec3 normal, int material = -1);
 
+// Four quads side by side along x, one per material, one of each alpha mode of glTF: "mask"
+// (MASK with cutoff 0.3, alpha 0.9, the texture, double-sided), "blend" (BLEND, alpha 0.5),
+// "opaque" (OPAQUE, the texture, an alpha of 0.2 to be ignored) and "glass" (transmission 0.8).
+GltfModel alpha_modes_model(const GltfTexture& texture);
+
 // .glb: one binary chunk; .gltf: data URIs, or with external_pictures PNG files "<stem>_<i>.png".
 // Throws std::runtime_error if a file cannot be written.
 void write_gltf(const std::filesystem::path& file, const GltfModel& model, bool external_pictures = false);
