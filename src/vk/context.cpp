@@ -3,6 +3,7 @@
 #include "msm/vk/commands.h"
 #include "msm/vk/program.h"
 #include "msm/vk/resources.h"
+#include "shaders/vk_bindings.h"
 
 #include <fmt/format.h>
 
@@ -515,8 +516,10 @@ bool Context::probe_fused_fma() const {
   VkDeviceSize size = words.size() * sizeof(float);
   Buffer buffer = create_buffer(*this, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   std::memcpy(buffer.data(), words.data(), size);
-  Program probe = create_program(*this, "fma_probe", {Binding::storage_buffer});
-  submit_and_wait(*this, [&](VkCommandBuffer cmd) { dispatch(cmd, probe, group_count(n, 64), 1, 1, {buffer}); });
+  Program probe = create_program(*this, "fma_probe", {{MSM_BINDING_FMA_PROBE_CASES, Binding::storage_buffer}});
+  submit_and_wait(*this, [&](VkCommandBuffer cmd) {
+    dispatch(cmd, probe, group_count(n, 64), 1, 1, {{MSM_BINDING_FMA_PROBE_CASES, buffer}});
+  });
   std::memcpy(words.data(), buffer.data(), size);
   for (uint32_t i = 0; i < n; ++i) {
     float fused = std::fma(cases[i].a, cases[i].b, cases[i].c);
