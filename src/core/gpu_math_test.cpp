@@ -1013,7 +1013,8 @@ std::vector<KernelIO> run_kernels(vk::Context& ctx, const vk::Program& program, 
     uint32_t count;
   } push{id, uint32_t(in.size())};
   vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
-    vk::dispatch(cmd, program, vk::group_count(push.count, 64), 1, 1, {src, dst}, push);
+    vk::dispatch(cmd, program, vk::group_count(push.count, 64), 1, 1,
+                 {{MSM_BINDING_KERNELS_INPUTS, src}, {MSM_BINDING_KERNELS_OUTPUTS, dst}}, push);
   });
   std::vector<KernelIO> out(in.size());
   std::memcpy(static_cast<void*>(out.data()), dst.data(), size); // KernelIO: glm's operator=, plain bytes
@@ -1021,7 +1022,9 @@ std::vector<KernelIO> run_kernels(vk::Context& ctx, const vk::Program& program, 
 }
 
 vk::Program kernels_program(vk::Context& ctx) {
-  return vk::create_program(ctx, "kernels", {vk::Binding::storage_buffer, vk::Binding::storage_buffer},
+  return vk::create_program(ctx, "kernels",
+                            {{MSM_BINDING_KERNELS_INPUTS, vk::Binding::storage_buffer},
+                             {MSM_BINDING_KERNELS_OUTPUTS, vk::Binding::storage_buffer}},
                             2 * sizeof(uint32_t));
 }
 

@@ -2,7 +2,7 @@
 
 #include "msm/sat.h"
 #include "msm/vk/commands.h"
-#include "shaders/sat_push.h"
+#include "shaders/sat_interface.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -53,11 +53,22 @@ uint32_t subgroup_size_with_arithmetic(const vk::Context& ctx) {
   return v11.subgroupSize;
 }
 
-vk::Program subgroup_program(const vk::Context& ctx, bool supported, const char* name, bool sampled) {
+// A row pass: the moment image sampled, the table written.
+vk::Program rows_program(const vk::Context& ctx, const char* name) {
+  return vk::create_program(ctx, name,
+                            {{MSM_BINDING_SAT_ROWS_MOMENTS, vk::Binding::sampled_image},
+                             {MSM_BINDING_SAT_ROWS_TABLE, vk::Binding::storage_image}},
+                            sizeof(SatPush));
+}
+
+// A column pass: the table, in place.
+vk::Program columns_program(const vk::Context& ctx, const char* name) {
+  return vk::create_program(ctx, name, {{MSM_BINDING_SAT_COLUMNS_TABLE, vk::Binding::storage_image}}, sizeof(SatPush));
+}
+
+vk::Program subgroup_program(const vk::Context& ctx, bool supported, const char* name, bool rows) {
   if (!supported) return {};
-  if (sampled)
-    return vk::create_program(ctx, name, {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush));
-  return vk::create_program(ctx, name, {vk::Binding::storage_image}, sizeof(SatPush));
+  return rows ? rows_program(ctx, name) : columns_program(ctx, name);
 }
 
 } // namespace
@@ -74,23 +85,13 @@ SatImage::SatImage(const vk::Image& image, VkImageView layer_view, uint32_t laye
       usage(image.desc().usage), mips(image.desc().mip_levels), layer(layer_index) {}
 
 SatBuilder::SatBuilder(const vk::Context& ctx)
-    : rows_(vk::create_program(ctx, "sat_rows.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
-                               sizeof(SatPush))),
-      columns_(vk::create_program(ctx, "sat_columns.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
-      block_rows_(vk::create_program(ctx, "sat_block_rows.comp",
-                                     {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
-      block_columns_(vk::create_program(ctx, "sat_block_columns.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
-      rows_rg_(vk::create_program(ctx, "sat_rows_rg.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
-                                  sizeof(SatPush))),
-      columns_rg_(vk::create_program(ctx, "sat_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
-      block_rows_rg_(vk::create_program(ctx, "sat_block_rows_rg.comp",
-                                        {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
-      block_columns_rg_(
-          vk::create_program(ctx, "sat_block_columns_rg.comp", {vk::Binding::storage_image}, sizeof(SatPush))),
-      scan_rows_(vk::create_program(ctx, "sat_scan_rows.comp", {vk::Binding::sampled_image, vk::Binding::storage_image},
-                                    sizeof(SatPush))),
-      scan_rows_rg_(vk::create_program(ctx, "sat_scan_rows_rg.comp",
-                                       {vk::Binding::sampled_image, vk::Binding::storage_image}, sizeof(SatPush))),
+    : rows_(rows_program(ctx, "sat_rows.comp")), columns_(columns_program(ctx, "sat_columns.comp")),
+      block_rows_(rows_program(ctx, "sat_block_rows.comp")),
+      block_columns_(columns_program(ctx, "sat_block_columns.comp")), rows_rg_(rows_program(ctx, "sat_rows_rg.comp")),
+      columns_rg_(columns_program(ctx, "sat_columns_rg.comp")),
+      block_rows_rg_(rows_program(ctx, "sat_block_rows_rg.comp")),
+      block_columns_rg_(columns_program(ctx, "sat_block_columns_rg.comp")),
+      scan_rows_(rows_program(ctx, "sat_scan_rows.comp")), scan_rows_rg_(rows_program(ctx, "sat_scan_rows_rg.comp")),
       sampler_(vk::create_sampler(ctx, VK_FILTER_NEAREST)) {
   subgroup_size_ = subgroup_size_with_arithmetic(ctx);
   const bool sg = subgroup_size_ != 0;
@@ -161,7 +162,8 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, 
                         : scan        ? moments[i].height
                                       : vk::group_count(moments[i].height, 64);
       vk::dispatch(cmd, p, groups, 1, 1,
-                   {vk::Descriptor(moments[i].view, moments_layout, sampler_), vk::Descriptor(tables[i].view, general)},
+                   {{MSM_BINDING_SAT_ROWS_MOMENTS, vk::Descriptor(moments[i].view, moments_layout, sampler_)},
+                    {MSM_BINDING_SAT_ROWS_TABLE, vk::Descriptor(tables[i].view, general)}},
                    push(i));
     }
     if (timer) timer->end(cmd);
@@ -172,18 +174,19 @@ void SatBuilder::record(VkCommandBuffer cmd, std::span<const SatImage> moments, 
                    subgroup_columns ? program(i, subgroup_columns_, subgroup_columns_rg_)
                                     : program(i, columns_, columns_rg_),
                    subgroup_columns ? subgroup_groups(moments[i].width) : vk::group_count(moments[i].width, 64), 1, 1,
-                   {vk::Descriptor(tables[i].view, general)}, push(i));
+                   {{MSM_BINDING_SAT_COLUMNS_TABLE, vk::Descriptor(tables[i].view, general)}}, push(i));
     if (timer) timer->end(cmd);
   } else {
     if (timer) timer->begin(cmd, "sat_blocks");
     for (size_t i = 0; i < moments.size(); ++i)
       vk::dispatch(cmd, program(i, block_rows_, block_rows_rg_), vk::group_count(moments[i].height, 8), 1, 1,
-                   {vk::Descriptor(moments[i].view, moments_layout, sampler_), vk::Descriptor(tables[i].view, general)},
+                   {{MSM_BINDING_SAT_ROWS_MOMENTS, vk::Descriptor(moments[i].view, moments_layout, sampler_)},
+                    {MSM_BINDING_SAT_ROWS_TABLE, vk::Descriptor(tables[i].view, general)}},
                    push(i));
     vk::pipeline_barrier(cmd, between);
     for (size_t i = 0; i < moments.size(); ++i)
       vk::dispatch(cmd, program(i, block_columns_, block_columns_rg_), vk::group_count(moments[i].width, 8), 1, 1,
-                   {vk::Descriptor(tables[i].view, general)}, push(i));
+                   {{MSM_BINDING_SAT_COLUMNS_TABLE, vk::Descriptor(tables[i].view, general)}}, push(i));
     if (timer) timer->end(cmd);
   }
 }

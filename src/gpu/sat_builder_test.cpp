@@ -30,6 +30,8 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -425,13 +427,19 @@ TEST_P(SoftFlowOnTheDevice, AgreesWithTheCpu) {
   // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout, asserted above
   std::memcpy(query_buffer.data(), queries.data(), sizeof(SatQuery) * count);
   vk::Program program = vk::create_program(ctx(), "sat_queries.comp",
-                                           {vk::Binding::storage_image, vk::Binding::storage_image,
-                                            vk::Binding::storage_buffer, vk::Binding::storage_buffer},
+                                           {{MSM_BINDING_SAT_QUERIES_TABLE0, vk::Binding::storage_image},
+                                            {MSM_BINDING_SAT_QUERIES_TABLE1, vk::Binding::storage_image},
+                                            {MSM_BINDING_SAT_QUERIES_QUERIES, vk::Binding::storage_buffer},
+                                            {MSM_BINDING_SAT_QUERIES_RESULTS, vk::Binding::storage_buffer}},
                                            sizeof(SatQueryPush));
   const SatQueryPush push{ivec2(w, h), scale, width, vec2(30.0f), count, moments, params, ivec4(frequencies, 0, 0, 0)};
   vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
     vk::dispatch(cmd, program, vk::group_count(count, 64), 1, 1,
-                 {vk::Descriptor(table0), vk::Descriptor(table1), query_buffer, result_buffer}, push);
+                 {{MSM_BINDING_SAT_QUERIES_TABLE0, vk::Descriptor(table0)},
+                  {MSM_BINDING_SAT_QUERIES_TABLE1, vk::Descriptor(table1)},
+                  {MSM_BINDING_SAT_QUERIES_QUERIES, query_buffer},
+                  {MSM_BINDING_SAT_QUERIES_RESULTS, result_buffer}},
+                 push);
   });
   std::vector<SatQueryResult> gpu(count);
   std::memcpy(static_cast<void*>(gpu.data()), result_buffer.data(), sizeof(SatQueryResult) * count);
@@ -523,6 +531,95 @@ TEST(SharedDeclarations, SpecializationConstantIdsAreNamed) {
     }
   }
   EXPECT_GT(declared, 15);
+}
+
+// The text of every file under `dirs` of the source tree whose extension is in `extensions`.
+std::vector<std::pair<std::filesystem::path, std::string>> source_files(std::initializer_list<const char*> dirs,
+                                                                        std::initializer_list<const char*> extensions) {
+  const std::filesystem::path source(MSM_SOURCE_DIR);
+  std::vector<std::pair<std::filesystem::path, std::string>> files;
+  for (const char* dir : dirs)
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(source / dir)) {
+      if (!entry.is_regular_file()) continue;
+      const std::string ext = entry.path().extension().string();
+      if (std::find(extensions.begin(), extensions.end(), ext) == extensions.end()) continue;
+      std::ifstream in(entry.path());
+      std::stringstream text;
+      text << in.rdbuf();
+      files.emplace_back(std::filesystem::relative(entry.path(), source), text.str());
+    }
+  return files;
+}
+
+bool is_shader_side(const std::filesystem::path& file) {
+  const std::string ext = file.extension().string();
+  return ext == ".glsl" || ext == ".comp" || ext == ".frag" || ext == ".vert" ||
+         file.generic_string().find("/shaders/") != std::string::npos || file.filename() == "kernels.h";
+}
+
+// Descriptor bindings are numbered once, as MSM_BINDING_* in a header that the shader and its host
+// both include (include/msm/render/bindings.h, sat_interface.h, probe_interface.h, ...): no shader
+// gives a binding as a number, no host writes a positional binding list or indexes one by number,
+// and every name a shader declares a binding with is one the host pushes, and the other way round.
+TEST(SharedDeclarations, DescriptorBindingsAreNamed) {
+  const auto files = source_files({"src", "include", "tools"}, {".glsl", ".comp", ".frag", ".vert", ".h", ".cpp"});
+  const std::regex numbered_binding(R"(binding\s*=\s*[0-9])");
+  const std::regex numbered_parameter(R"(#define\s+MSM_\w*BINDING\s+[0-9])"); // frame.glsl's MSM_LIGHT_BINDING...
+  const std::regex declared(R"(#define\s+(MSM_BINDING_\w+)\s+[0-9]+)");
+  const std::regex shader_use(R"((?:binding\s*=\s*|#define\s+MSM_\w*BINDING\s+)(MSM_BINDING_\w+))");
+  const std::regex host_use(R"(MSM_BINDING_\w+)");
+  const std::regex binding_type(
+      R"((?:vk::)?(?:\bBinding|\bB)::(?:storage_buffer|uniform_buffer|storage_image|sampled_image))");
+  const std::regex named_before(R"((?:MSM_BINDING_\w+\s*,|[=?]|[^:]:)\s*$)");
+  const std::regex numbered_index(R"(\[\s*[0-9]+\s*\]\s*=\s*(?:vk::)?Descriptor\b)");
+  const std::regex positional_descriptors(R"(std::vector<(?:vk::)?Descriptor>\s*\w*\s*=?\s*\{)");
+  std::set<std::string> names, in_shaders, on_host;
+  int shader_files = 0, host_files = 0;
+  for (const auto& [file, text] : files) {
+    const std::string name = file.generic_string();
+    const bool header = file.extension() == ".h";
+    for (std::sregex_iterator m(text.begin(), text.end(), declared), end; m != end; ++m) {
+      EXPECT_TRUE(header) << name << " declares " << (*m)[1] << " outside a shared header";
+      EXPECT_TRUE(names.insert((*m)[1]).second) << (*m)[1] << " declared twice";
+    }
+    if (is_shader_side(file)) {
+      ++shader_files;
+      for (std::sregex_iterator m(text.begin(), text.end(), numbered_binding), end; m != end; ++m)
+        ADD_FAILURE() << name << ": a binding given as a number: " << text.substr(size_t(m->position()), 40);
+      for (std::sregex_iterator m(text.begin(), text.end(), numbered_parameter), end; m != end; ++m)
+        ADD_FAILURE() << name << ": a binding given as a number: " << m->str();
+      for (std::sregex_iterator m(text.begin(), text.end(), shader_use), end; m != end; ++m) in_shaders.insert((*m)[1]);
+      continue;
+    }
+    // msm::vk's own program code and its test of bindings_at's errors are the numbering's machinery.
+    if (name == "src/vk/program.cpp" || name == "include/msm/vk/program.h" || name == "src/vk/vk_test.cpp") {
+      for (std::sregex_iterator m(text.begin(), text.end(), host_use), end; m != end; ++m) on_host.insert(m->str());
+      continue;
+    }
+    ++host_files;
+    const std::string uses = std::regex_replace(text, declared, ""); // a declaration pushes nothing
+    for (std::sregex_iterator m(uses.begin(), uses.end(), host_use), end; m != end; ++m) on_host.insert(m->str());
+    for (std::sregex_iterator m(text.begin(), text.end(), binding_type), end; m != end; ++m) {
+      const std::string before = text.substr(size_t(std::max<std::ptrdiff_t>(0, m->position() - 80)),
+                                             size_t(std::min<std::ptrdiff_t>(80, m->position())));
+      EXPECT_TRUE(std::regex_search(before, named_before))
+          << name << ": " << m->str() << " in a positional list (give it as {MSM_BINDING_..., type}): ..." << before;
+    }
+    for (std::sregex_iterator m(text.begin(), text.end(), numbered_index), end; m != end; ++m)
+      ADD_FAILURE() << name << ": a descriptor set by binding number: " << m->str();
+    for (std::sregex_iterator m(text.begin(), text.end(), positional_descriptors), end; m != end; ++m)
+      ADD_FAILURE() << name << ": a positional descriptor list (use vk::descriptors_at): " << m->str();
+  }
+  for (const std::string& n : in_shaders) {
+    EXPECT_TRUE(names.count(n)) << n << ": used by a shader, declared nowhere";
+    EXPECT_TRUE(on_host.count(n)) << n << ": a shader's binding that no host code pushes by this name";
+  }
+  for (const std::string& n : on_host)
+    EXPECT_TRUE(in_shaders.count(n)) << n << ": pushed by the host, no shader declares it";
+  for (const std::string& n : names) EXPECT_TRUE(in_shaders.count(n)) << n << ": declared, used by no shader";
+  EXPECT_GT(shader_files, 100);
+  EXPECT_GT(host_files, 100);
+  EXPECT_GT(names.size(), 60u);
 }
 
 } // namespace

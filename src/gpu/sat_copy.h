@@ -5,7 +5,7 @@
 #pragma once
 
 #include "msm/vk/vk.h"
-#include "shaders/sat_push.h"
+#include "shaders/sat_interface.h"
 
 #include <cstdint>
 #include <initializer_list>
@@ -38,19 +38,20 @@ inline constexpr Shader shaders[] = {
 };
 inline constexpr int count = int(std::size(shaders));
 
-// The push constants of every sat_*.comp (shaders/sat_push.h); the copies read the size only.
+// The push constants of every sat_*.comp (shaders/sat_interface.h); the copies read the size only.
 using Push = SatPush;
 
 inline std::vector<vk::Program> create_programs(const vk::Context& ctx) {
   using B = vk::Binding;
   std::vector<vk::Program> programs;
   for (const Shader& s : shaders) {
-    if (s.kind == Kind::buffer)
-      programs.push_back(vk::create_program(ctx, s.file, {B::storage_buffer, B::storage_buffer}, sizeof(Push)));
-    else if (s.kind == Kind::fetch)
-      programs.push_back(vk::create_program(ctx, s.file, {B::sampled_image, B::storage_image}, sizeof(Push)));
-    else
-      programs.push_back(vk::create_program(ctx, s.file, {B::storage_image, B::storage_image}, sizeof(Push)));
+    const B source = s.kind == Kind::buffer  ? B::storage_buffer
+                     : s.kind == Kind::fetch ? B::sampled_image
+                                             : B::storage_image;
+    const B destination = s.kind == Kind::buffer ? B::storage_buffer : B::storage_image;
+    programs.push_back(vk::create_program(
+        ctx, s.file, {{MSM_BINDING_SAT_COPY_SOURCE, source}, {MSM_BINDING_SAT_COPY_DESTINATION, destination}},
+        sizeof(Push)));
   }
   return programs;
 }
@@ -66,7 +67,8 @@ inline void record(VkCommandBuffer cmd, const vk::Program& program, const Shader
   case Walk::row: gx = vk::group_count(height, 64); break;
   case Walk::column: gx = vk::group_count(width, 64); break;
   }
-  vk::dispatch(cmd, program, gx, gy, 1, {src, dst}, Push{glm::ivec2(int(width), int(height)), 0u, 0u});
+  vk::dispatch(cmd, program, gx, gy, 1, {{MSM_BINDING_SAT_COPY_SOURCE, src}, {MSM_BINDING_SAT_COPY_DESTINATION, dst}},
+               Push{glm::ivec2(int(width), int(height)), 0u, 0u});
 }
 
 } // namespace msm::gpu::sat_copy

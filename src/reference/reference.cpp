@@ -164,229 +164,300 @@ Result render(const scene::Scene& scene, const Settings& settings) {
 
 namespace {
 
-Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
-  const auto start = std::chrono::steady_clock::now();
-  Result result;
-  const int W = settings.width, H = settings.height;
-  const bool mc = is_monte_carlo(settings.effect);
+// The light as the soft effect traces it; std::invalid_argument for an extent outside [0, 90) degrees.
+TracedLight checked_light(const scene::Scene& scene, const Settings& settings) {
+  const TracedLight light = traced_light(scene.light(), settings);
+  if (!(std::isfinite(light.extent_deg) && light.extent_deg >= 0.0 && light.extent_deg < 90.0))
+    throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", light.extent_deg));
+  return light;
+}
 
-  const bool scattering = settings.effect == Effect::scattering;
-  if (scattering && !scene.medium)
-    throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
-  const bool environment = settings.effect == Effect::environment;
-  std::optional<EnvironmentLighting> lighting;
-  if (environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
-  const Tracer tracer(scene);
-  result.build_seconds = util::seconds_since(start);
-
+// The effects' context: the light frame, one shadow-map texel in world units, and the soft light's
+// shape, half-sizes and axes (the light-space axes, made exactly orthonormal to towards_light).
+EffectContext effect_context(const Tracer& tracer, const scene::Scene& scene, const Settings& settings,
+                             const TracedLight& light) {
   EffectContext ctx{
       tracer, settings, scene.light_frame(), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
   ctx.towards_light = ctx.frame.towards_light;
   ctx.texel_x = ctx.frame.x_axis * (ctx.frame.extent.x / settings.shadow_size);
   ctx.texel_y = ctx.frame.y_axis * (ctx.frame.extent.y / settings.shadow_size);
-  // The soft light's axes: the light-space axes, made exactly orthonormal to towards_light.
   ctx.light_x = glm::normalize(ctx.frame.x_axis - glm::dot(ctx.frame.x_axis, ctx.towards_light) * ctx.towards_light);
   ctx.light_y = glm::cross(ctx.towards_light, ctx.light_x);
   if (glm::dot(ctx.light_y, ctx.frame.y_axis) < 0.0) ctx.light_y = -ctx.light_y;
-  const TracedLight light = traced_light(scene.light(), settings);
-  if (!(std::isfinite(light.extent_deg) && light.extent_deg >= 0.0 && light.extent_deg < 90.0))
-    throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", light.extent_deg));
-  result.light_shape = light.shape;
-  result.light_extent_deg = light.extent_deg;
-  result.light_width_deg = light.width_deg;
-  result.light_height_deg = light.height_deg;
   const auto half_tan = [](double deg) { return std::tan(deg * std::numbers::pi / 360.0); };
   ctx.light_shape = light.shape;
-  ctx.half_x = half_tan(result.light_width_deg);
-  ctx.half_y = half_tan(result.light_height_deg);
-  const EffectFunction effect = effect_function(settings.effect);
+  ctx.half_x = half_tan(light.width_deg);
+  ctx.half_y = half_tan(light.height_deg);
+  return ctx;
+}
 
+// The result's images for the effect, every pixel at its starting value.
+void create_images(Result& result, const Settings& settings) {
+  const int W = settings.width, H = settings.height;
+  const bool mc = is_monte_carlo(settings.effect);
   std::vector<std::string> names{"visibility", "background"};
   if (mc) names.insert(names.end(), {"sample_count", "std_error"});
   result.visibility = image::Image(W, H, names);
   // translucent: the transmittance per RGB channel (coloured shadows; "visibility" is their
   // mean), in an image of its own (an image has at most 4 channels).
-  const bool coloured = settings.effect == Effect::translucent;
-  if (coloured) result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
+  if (settings.effect == Effect::translucent)
+    result.visibility_rgb = image::Image(W, H, {"visibility_r", "visibility_g", "visibility_b"}, 1.0f);
   result.radiance = image::Image(W, H, 3);
   result.surface = image::Image(W, H, {"n_dot_l", "object"});
-  if (scattering) result.scattering = image::Image(W, H, {"R", "G", "B", "length"});
-  if (environment) result.irradiance = image::Image(W, H, {"R", "G", "B", "std_error"});
+  if (settings.effect == Effect::scattering) result.scattering = image::Image(W, H, {"R", "G", "B", "length"});
+  if (settings.effect == Effect::environment) result.irradiance = image::Image(W, H, {"R", "G", "B", "std_error"});
   for (std::size_t i = 0; i < result.surface.pixel_count(); ++i) result.surface.pixels()[2 * i + 1] = -1.0f;
   result.samples = mc ? settings.samples : 1;
+}
+
+// A probe-lit scene's probe as the renderer loads it (GpuScene); an empty cube map without one.
+msm::probe::CubeMap background_probe(const scene::Scene& scene) {
+  if (!scene.probe) return {};
+  try {
+    return msm::probe::load_probe(scene.probe->file.string(), scene.probe->size, scene.probe->rotation_deg,
+                                  scene.probe->intensity);
+  } catch (const msm::probe::ProbeError& e) { throw std::invalid_argument(e.what()); }
+}
+
+// The per-pixel work of one render: the camera ray of a pixel to its visible surface, the effect
+// there, and what it writes into the result's images. Rows may be traced concurrently: each writes
+// only its own pixels and its own entries of row_sum and row_background.
+class PixelTracer {
+ public:
+  PixelTracer(const scene::Scene& scene, const Settings& settings, const EffectContext& ctx,
+              const EnvironmentLighting* lighting, Result& result)
+      : scene_(scene), settings_(settings), ctx_(ctx), tracer_(ctx.tracer), lighting_(lighting), result_(result),
+        W_(settings.width), H_(settings.height), mc_(is_monte_carlo(settings.effect)),
+        scattering_(settings.effect == Effect::scattering), effect_(effect_function(settings.effect)),
+        inv_vp_(glm::inverse(glm::dmat4(scene.camera_view_projection(float(W_) / float(H_))))),
+        irradiance_(scene.light().irradiance), camera_(scene.camera.position), probe_(background_probe(scene)),
+        row_sum(std::size_t(settings.height), 0.0), row_background(std::size_t(settings.height), 0) {
+    // scattering: every light of the scene (the first is ctx's), its direction and irradiance.
+    if (scattering_)
+      for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+        light_towards_.push_back(l == 0 ? ctx.towards_light : scene.light_frame(l).towards_light);
+        light_irradiance_.emplace_back(scene.lights[l].irradiance);
+      }
+  }
+
+  // Row y; returns the rays traced.
+  std::uint64_t trace_row(int y) {
+    std::uint64_t rays = 0;
+    for (int x = 0; x < W_; ++x) trace_pixel(x, y, rays);
+    return rays;
+  }
+
+ private:
+  std::size_t pixel(int x, int y) const { return std::size_t(y) * W_ + x; }
 
   // Camera: unproject NDC depth 0 and 1 with the inverse of the rasterizer's matrix.
-  const glm::dmat4 inv_vp = glm::inverse(glm::dmat4(scene.camera_view_projection(float(W) / float(H))));
-  const auto unproject = [&](double nx, double ny, double depth) {
-    const glm::dvec4 q = inv_vp * glm::dvec4(nx, ny, depth, 1.0);
+  glm::dvec3 unproject(double nx, double ny, double depth) const {
+    const glm::dvec4 q = inv_vp_ * glm::dvec4(nx, ny, depth, 1.0);
     return glm::dvec3(q) / q.w;
-  };
-  const glm::dvec3 irradiance(scene.light().irradiance);
-  const glm::dvec3 camera(scene.camera.position);
-  // A probe-lit scene's background: its probe as the renderer loads it (GpuScene), by texel.
-  msm::probe::CubeMap probe;
-  if (scene.probe) try {
-      probe = msm::probe::load_probe(scene.probe->file.string(), scene.probe->size, scene.probe->rotation_deg,
-                                     scene.probe->intensity);
-    } catch (const msm::probe::ProbeError& e) { throw std::invalid_argument(e.what()); }
-  result.probe_background = bool(scene.probe);
-  const auto background = [&](const glm::dvec3& dir) {
-    if (!probe.size) return glm::vec3(0.0f);
-    const glm::ivec3 t = msm_cube_texel(glm::vec3(dir), probe.size);
-    return probe.at(t.z, t.x, t.y);
-  };
-  // scattering: every light of the scene (the first is ctx's), its direction and irradiance.
-  std::vector<glm::dvec3> light_towards, light_irradiance;
-  if (scattering)
-    for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-      light_towards.push_back(l == 0 ? ctx.towards_light : scene.light_frame(l).towards_light);
-      light_irradiance.emplace_back(scene.lights[l].irradiance);
-    }
+  }
 
-  std::vector<double> row_sum(H, 0.0);
-  std::vector<std::size_t> row_background(H, 0);
-  std::atomic<std::uint64_t> rays{0};
-  std::atomic<std::size_t> rows_done{0};
-  std::mutex progress_mutex;
-  std::size_t progress_reported = 0;
-  const std::size_t progress_step = std::max<std::size_t>(1, std::size_t(H) / 200);
-  const int channels = result.visibility.channels();
-  float* vis = result.visibility.pixels().data();
-  float* rad = result.radiance.pixels().data();
-  float* surf = result.surface.pixels().data();
-  float* vis_rgb = coloured ? result.visibility_rgb.pixels().data() : nullptr;
+  glm::vec3 background(const glm::dvec3& dir) const {
+    if (!probe_.size) return glm::vec3(0.0f);
+    const glm::ivec3 t = msm_cube_texel(glm::vec3(dir), probe_.size);
+    return probe_.at(t.z, t.x, t.y);
+  }
+
+  // The closest surface along the ray that is not looked through: translucent surfaces (opacity
+  // < 1) are, as the renderer's shadow buffer does, and so are the back faces of single-sided
+  // materials, which the rasterizer culls.
+  bool visible_surface(const glm::dvec3& near, const glm::dvec3& dir, double length, SurfaceHit& hit,
+                       std::uint64_t& rays) const {
+    ++rays;
+    bool found = tracer_.closest(near, dir, length, hit);
+    const auto hidden = [&](const SurfaceHit& h) {
+      const scene::Material& m = tracer_.material(h);
+      return m.translucent() || (!m.double_sided && glm::dot(h.normal, dir) > 0.0);
+    };
+    for (int crossed = 0; found && hidden(hit) && crossed < kMaxCrossings; ++crossed) {
+      const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
+      found = tracer_.closest(beyond, dir, length - glm::length(beyond - near), hit);
+      ++rays;
+    }
+    return found;
+  }
+
+  void trace_pixel(int x, int y, std::uint64_t& rays) {
+    const double nx = (x + 0.5) / W_ * 2.0 - 1.0, ny = (y + 0.5) / H_ * 2.0 - 1.0;
+    const glm::dvec3 near = unproject(nx, ny, 0.0), far = unproject(nx, ny, 1.0);
+    const double length = glm::length(far - near);
+    const glm::dvec3 dir = (far - near) / length;
+    float* v = result_.visibility.pixels().data() + pixel(x, y) * result_.visibility.channels();
+    SurfaceHit hit;
+    if (!visible_surface(near, dir, length, hit, rays)) {
+      v[0] = 1.0f;
+      v[1] = 1.0f;
+      ++row_background[y];
+      const glm::vec3 sky = background(dir);
+      write_radiance(x, y, sky);
+      if (scattering_) add_scattering(x, y, dir, far, sky, rays);
+      return; // sample_count and std_error 0 (scattering: the ray's)
+    }
+    Rng rng = pixel_rng(settings_.seed, x, y, settings_.effect);
+    // Shading: interpolated normal turned towards the viewer.
+    glm::dvec3 n = tracer_.shading_normal(hit);
+    if (glm::dot(hit.normal, dir) > 0.0) n = -n;
+    if (lighting_)
+      shade_environment(x, y, hit, n, dir, rng, rays);
+    else
+      shade_effect(x, y, hit, n, dir, rng, rays);
+  }
+
+  void write_radiance(int x, int y, const glm::vec3& colour) {
+    float* c = result_.radiance.pixels().data() + pixel(x, y) * 3;
+    c[0] = colour.r, c[1] = colour.g, c[2] = colour.b;
+  }
+
+  void write_surface(int x, int y, float n_dot_l, const SurfaceHit& hit) {
+    float* q = result_.surface.pixels().data() + pixel(x, y) * 2;
+    q[0] = n_dot_l;
+    q[1] = float(hit.object);
+  }
+
+  // environment: the probe's irradiance through the scene's occluders against the unoccluded one.
+  void shade_environment(int x, int y, const SurfaceHit& hit, const glm::dvec3& n, const glm::dvec3& dir, Rng& rng,
+                         std::uint64_t& rays) {
+    const EnvironmentSample e = environment_irradiance(ctx_, *lighting_, hit, n, dir, rng);
+    rays += e.rays;
+    const double lum0 = msm_luminance(glm::vec3(e.unoccluded));
+    const double visible = lum0 > 0.0 ? msm_luminance(glm::vec3(e.irradiance)) / lum0 : 0.0;
+    float* v = result_.visibility.pixels().data() + pixel(x, y) * result_.visibility.channels();
+    v[0] = float(visible);
+    v[2] = float(e.samples);
+    v[3] = float(lum0 > 0.0 ? e.std_error / lum0 : 0.0);
+    row_sum[y] += visible;
+    const glm::vec3 direct = msm_direct_light(glm::vec3(e.irradiance), 1.0f, glm::vec3(1.0f));
+    write_surface(x, y, float(glm::dot(n, ctx_.towards_light)), hit);
+    write_radiance(x, y, msm_surface_radiance(tracer_.albedo(hit), direct, MSM_AMBIENT));
+    float* ir = result_.irradiance.pixels().data() + pixel(x, y) * 4;
+    ir[0] = float(e.irradiance.r), ir[1] = float(e.irradiance.g), ir[2] = float(e.irradiance.b);
+    ir[3] = float(e.std_error);
+  }
+
+  // Every other effect: the first light's visibility (per channel where the effect gives one), and
+  // the surface's radiance.
+  void shade_effect(int x, int y, const SurfaceHit& hit, const glm::dvec3& n, const glm::dvec3& dir, Rng& rng,
+                    std::uint64_t& rays) {
+    const EffectResult e = effect_(ctx_, hit, rng);
+    rays += e.rays;
+    float* v = result_.visibility.pixels().data() + pixel(x, y) * result_.visibility.channels();
+    v[0] = float(e.value);
+    if (mc_) {
+      v[2] = float(e.samples);
+      v[3] = float(e.std_error);
+    }
+    const glm::vec3 rgb = e.rgb ? glm::vec3(*e.rgb) : glm::vec3(float(e.value));
+    if (settings_.effect == Effect::translucent) {
+      float* t = result_.visibility_rgb.pixels().data() + pixel(x, y) * 3;
+      t[0] = rgb.r;
+      t[1] = rgb.g;
+      t[2] = rgb.b;
+    }
+    if (!scattering_) row_sum[y] += e.value;
+    const float n_dot_l = float(glm::dot(n, ctx_.towards_light));
+    glm::vec3 direct = e.lit ? msm_direct_light(glm::vec3(irradiance_), float(*e.lit), glm::vec3(1.0f))
+                             : msm_direct_light(glm::vec3(irradiance_), n_dot_l, rgb);
+    // scattering: the surface lit by every light, each with its exact (hard) shadow, as the
+    // renderer shades it (msm/shading.h's sum over the lights); the first light's is e.
+    for (std::size_t l = 1; scattering_ && l < light_towards_.size(); ++l) {
+      const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, light_towards_[l]);
+      const float lit = tracer_.occluded(origin, light_towards_[l]) ? 0.0f : 1.0f;
+      ++rays;
+      direct +=
+          msm_direct_light(glm::vec3(light_irradiance_[l]), float(glm::dot(n, light_towards_[l])), glm::vec3(lit));
+    }
+    const glm::vec3 colour = msm_surface_radiance(tracer_.albedo(hit), direct, MSM_AMBIENT);
+    write_surface(x, y, n_dot_l, hit);
+    write_radiance(x, y, colour);
+    if (scattering_) add_scattering(x, y, dir, hit.p, colour, rays);
+  }
+
   // scattering: the visible fraction of the ray from the camera to `end` over every light
   // (std_error, samples into the visibility image), the in-scattered radiance summed over the
   // lights, and the composite over surface_radiance (msm/scattering.h's sum over the lights).
-  const auto add_scattering = [&](int x, int y, const glm::dvec3& dir, const glm::dvec3& end,
-                                  const glm::vec3& surface_radiance, std::uint64_t& row_rays) {
-    const scene::Medium& m = *scene.medium;
-    const double s = glm::length(end - camera);
-    Rng rng = pixel_rng(settings.seed, x, y, Effect::scattering);
-    std::vector<float> phase(light_towards.size());
-    std::vector<ScatteringLight> lights(light_towards.size());
+  void add_scattering(int x, int y, const glm::dvec3& dir, const glm::dvec3& end, const glm::vec3& surface_radiance,
+                      std::uint64_t& rays) {
+    const scene::Medium& m = *scene_.medium;
+    const double s = glm::length(end - camera_);
+    Rng rng = pixel_rng(settings_.seed, x, y, Effect::scattering);
+    std::vector<float> phase(light_towards_.size());
+    std::vector<ScatteringLight> lights(light_towards_.size());
     for (std::size_t l = 0; l < lights.size(); ++l) {
-      phase[l] = msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, glm::vec3(light_towards[l]),
+      phase[l] = msm_scattering_phase_term(m.extinction, m.scattering_albedo, m.g, glm::vec3(light_towards_[l]),
                                            glm::vec3(dir));
-      lights[l] = {light_towards[l], double(msm_scattering_light_weight(glm::vec3(light_irradiance[l]), phase[l]))};
+      lights[l] = {light_towards_[l], double(msm_scattering_light_weight(glm::vec3(light_irradiance_[l]), phase[l]))};
     }
-    const ScatteringSample e = scattering_along_ray(ctx, m, camera, dir, s, lights, rng);
-    row_rays += e.rays;
+    const ScatteringSample e = scattering_along_ray(ctx_, m, camera_, dir, s, lights, rng);
+    rays += e.rays;
     row_sum[y] += e.visible;
-    float* v = result.visibility.pixels().data() + (std::size_t(y) * W + x) * result.visibility.channels();
+    float* v = result_.visibility.pixels().data() + pixel(x, y) * result_.visibility.channels();
     v[0] = float(e.visible);
     v[2] = float(e.samples);
     v[3] = float(e.std_error);
     ScatteringSum sum = msm_scattering_sum_none();
     for (std::size_t l = 0; l < lights.size(); ++l)
-      sum = msm_scattering_add_light(sum, glm::vec3(light_irradiance[l]), m.extinction, phase[l], float(s),
+      sum = msm_scattering_add_light(sum, glm::vec3(light_irradiance_[l]), m.extinction, phase[l], float(s),
                                      float(e.light_visible[l]));
     const glm::vec3 in = sum.inscattered;
-    const glm::vec3 all = msm_scattering_sum_radiance(surface_radiance, m.extinction, float(s), sum);
-    float* q = result.scattering.pixels().data() + (std::size_t(y) * W + x) * 4;
+    float* q = result_.scattering.pixels().data() + pixel(x, y) * 4;
     q[0] = in.r, q[1] = in.g, q[2] = in.b, q[3] = float(s);
-    float* c = result.radiance.pixels().data() + (std::size_t(y) * W + x) * 3;
-    c[0] = all.r, c[1] = all.g, c[2] = all.b;
-  };
-  const auto trace_start = std::chrono::steady_clock::now();
+    write_radiance(x, y, msm_scattering_sum_radiance(surface_radiance, m.extinction, float(s), sum));
+  }
 
+  const scene::Scene& scene_;
+  const Settings& settings_;
+  const EffectContext& ctx_;
+  const Tracer& tracer_;
+  const EnvironmentLighting* lighting_; // environment only
+  Result& result_;
+  const int W_, H_;
+  const bool mc_, scattering_;
+  const EffectFunction effect_;
+  const glm::dmat4 inv_vp_;
+  const glm::dvec3 irradiance_, camera_;
+  const msm::probe::CubeMap probe_;
+  std::vector<glm::dvec3> light_towards_, light_irradiance_; // scattering: every light's
+
+ public:
+  std::vector<double> row_sum;             // per row: the visibility summed over its pixels
+  std::vector<std::size_t> row_background; // per row: pixels without a surface
+};
+
+Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
+  const auto start = std::chrono::steady_clock::now();
+  Result result;
+  const int W = settings.width, H = settings.height;
+  const bool scattering = settings.effect == Effect::scattering;
+  if (scattering && !scene.medium)
+    throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
+  std::optional<EnvironmentLighting> lighting;
+  if (settings.effect == Effect::environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
+  const Tracer tracer(scene);
+  result.build_seconds = util::seconds_since(start);
+
+  const TracedLight light = checked_light(scene, settings);
+  result.light_shape = light.shape;
+  result.light_extent_deg = light.extent_deg;
+  result.light_width_deg = light.width_deg;
+  result.light_height_deg = light.height_deg;
+  const EffectContext ctx = effect_context(tracer, scene, settings, light);
+  create_images(result, settings);
+  PixelTracer pixels(scene, settings, ctx, lighting ? &*lighting : nullptr, result);
+  result.probe_background = bool(scene.probe);
+
+  std::atomic<std::uint64_t> rays{0};
+  std::atomic<std::size_t> rows_done{0};
+  std::mutex progress_mutex;
+  std::size_t progress_reported = 0;
+  const std::size_t progress_step = std::max<std::size_t>(1, std::size_t(H) / 200);
+  const auto trace_start = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& range) {
     for (int y = range.begin(); y != range.end(); ++y) {
-      std::uint64_t row_rays = 0;
-      for (int x = 0; x < W; ++x) {
-        const double nx = (x + 0.5) / W * 2.0 - 1.0, ny = (y + 0.5) / H * 2.0 - 1.0;
-        const glm::dvec3 near = unproject(nx, ny, 0.0), far = unproject(nx, ny, 1.0);
-        const double length = glm::length(far - near);
-        const glm::dvec3 dir = (far - near) / length;
-        float* v = vis + (std::size_t(y) * W + x) * channels;
-        float* c = rad + (std::size_t(y) * W + x) * 3;
-        SurfaceHit hit;
-        ++row_rays;
-        // The visible surface is the closest opaque one: translucent surfaces (opacity
-        // < 1) are looked through, as the renderer's shadow buffer does, and so are the back
-        // faces of single-sided materials, which the rasterizer culls.
-        bool found = tracer.closest(near, dir, length, hit);
-        const auto hidden = [&](const SurfaceHit& h) {
-          const scene::Material& m = tracer.material(h);
-          return m.translucent() || (!m.double_sided && glm::dot(h.normal, dir) > 0.0);
-        };
-        for (int crossed = 0; found && hidden(hit) && crossed < kMaxCrossings; ++crossed) {
-          const glm::dvec3 beyond = offset_origin(hit.p, hit.normal, hit.scale, dir);
-          found = tracer.closest(beyond, dir, length - glm::length(beyond - near), hit);
-          ++row_rays;
-        }
-        if (!found) {
-          v[0] = 1.0f;
-          v[1] = 1.0f;
-          ++row_background[y];
-          const glm::vec3 sky = background(dir);
-          float* c = rad + (std::size_t(y) * W + x) * 3;
-          c[0] = sky.r, c[1] = sky.g, c[2] = sky.b;
-          if (scattering) add_scattering(x, y, dir, far, sky, row_rays);
-          continue; // sample_count and std_error 0 (scattering: the ray's)
-        }
-        Rng rng = pixel_rng(settings.seed, x, y, settings.effect);
-        // Shading: interpolated normal turned towards the viewer.
-        glm::dvec3 n = tracer.shading_normal(hit);
-        if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-        if (environment) {
-          const EnvironmentSample e = environment_irradiance(ctx, *lighting, hit, n, dir, rng);
-          row_rays += e.rays;
-          const double lum0 = msm_luminance(glm::vec3(e.unoccluded));
-          const double visible = lum0 > 0.0 ? msm_luminance(glm::vec3(e.irradiance)) / lum0 : 0.0;
-          v[0] = float(visible);
-          v[2] = float(e.samples);
-          v[3] = float(lum0 > 0.0 ? e.std_error / lum0 : 0.0);
-          row_sum[y] += visible;
-          const glm::vec3 direct = msm_direct_light(glm::vec3(e.irradiance), 1.0f, glm::vec3(1.0f));
-          const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), direct, MSM_AMBIENT);
-          float* q = surf + (std::size_t(y) * W + x) * 2;
-          q[0] = float(glm::dot(n, ctx.towards_light));
-          q[1] = float(hit.object);
-          c[0] = colour.r, c[1] = colour.g, c[2] = colour.b;
-          float* ir = result.irradiance.pixels().data() + (std::size_t(y) * W + x) * 4;
-          ir[0] = float(e.irradiance.r), ir[1] = float(e.irradiance.g), ir[2] = float(e.irradiance.b);
-          ir[3] = float(e.std_error);
-          continue;
-        }
-        const EffectResult e = effect(ctx, hit, rng);
-        row_rays += e.rays;
-        v[0] = float(e.value);
-        if (mc) {
-          v[2] = float(e.samples);
-          v[3] = float(e.std_error);
-        }
-        const glm::vec3 rgb = e.rgb ? glm::vec3(*e.rgb) : glm::vec3(float(e.value));
-        if (vis_rgb) {
-          float* t = vis_rgb + (std::size_t(y) * W + x) * 3;
-          t[0] = rgb.r;
-          t[1] = rgb.g;
-          t[2] = rgb.b;
-        }
-        if (!scattering) row_sum[y] += e.value;
-        // Per channel where the effect gives a visibility per channel (translucent).
-        const float n_dot_l = float(glm::dot(n, ctx.towards_light));
-        glm::vec3 direct = e.lit ? msm_direct_light(glm::vec3(irradiance), float(*e.lit), glm::vec3(1.0f))
-                                 : msm_direct_light(glm::vec3(irradiance), n_dot_l, rgb);
-        // scattering: the surface lit by every light, each with its exact (hard) shadow, as the
-        // renderer shades it (msm/shading.h's sum over the lights); the first light's is e.
-        for (std::size_t l = 1; scattering && l < light_towards.size(); ++l) {
-          const glm::dvec3 origin = offset_origin(hit.p, hit.normal, hit.scale, light_towards[l]);
-          const float lit = tracer.occluded(origin, light_towards[l]) ? 0.0f : 1.0f;
-          ++row_rays;
-          direct +=
-              msm_direct_light(glm::vec3(light_irradiance[l]), float(glm::dot(n, light_towards[l])), glm::vec3(lit));
-        }
-        const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), direct, MSM_AMBIENT);
-        float* q = surf + (std::size_t(y) * W + x) * 2;
-        q[0] = n_dot_l;
-        q[1] = float(hit.object);
-        c[0] = colour.r;
-        c[1] = colour.g;
-        c[2] = colour.b;
-        if (scattering) add_scattering(x, y, dir, hit.p, colour, row_rays);
-      }
-      rays += row_rays;
+      rays += pixels.trace_row(y);
       const std::size_t done = ++rows_done;
       if (settings.progress && (done % progress_step == 0 || done == std::size_t(H))) {
         std::lock_guard lock(progress_mutex);
@@ -401,8 +472,8 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   result.rays = rays.load();
   double sum = 0.0;
   for (int y = 0; y < H; ++y) {
-    sum += row_sum[y];
-    result.background_pixels += row_background[y];
+    sum += pixels.row_sum[y];
+    result.background_pixels += pixels.row_background[y];
   }
   const std::size_t covered = scattering ? std::size_t(W) * H : std::size_t(W) * H - result.background_pixels;
   result.mean_visibility = covered ? sum / double(covered) : 1.0;

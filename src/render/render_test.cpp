@@ -313,8 +313,10 @@ TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
       for (bool mip1 : {false, true}) {
         SCOPED_TRACE(fmt::format("{} taps, sigma {}, {}{}", taps, sigma, bilinear ? "bilinear" : "point pairs",
                                  mip1 ? ", mip 1" : ""));
-        const std::vector<vk::Binding> bindings = {vk::Binding::sampled_image, vk::Binding::storage_image,
-                                                   vk::Binding::storage_image};
+        const std::vector<vk::Binding> bindings =
+            vk::bindings_at({{MSM_BINDING_BLUR_SOURCE, vk::Binding::sampled_image},
+                             {MSM_BINDING_BLUR_TARGET, vk::Binding::storage_image},
+                             {MSM_BINDING_BLUR_TARGET_MIP1, vk::Binding::storage_image}});
         vk::Program horizontal =
             vk::create_program(ctx(), vk::embedded_shader("blur.comp"), "blur.comp", bindings, sizeof(ImagePassPush),
                                blur_constants(taps, sigma, bilinear, false));
@@ -329,18 +331,20 @@ TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
                                           VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL);
           vk::pipeline_barrier(cmd, {}, {}, init);
           uint32_t groups = vk::group_count(n, 8);
-          vk::dispatch(
-              cmd, horizontal, groups, groups, 1,
-              {vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(temp), vk::Descriptor(temp)},
-              ImagePassPush{glm::ivec4(n, n, 0, 0)});
+          vk::dispatch(cmd, horizontal, groups, groups, 1,
+                       {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler)},
+                        {MSM_BINDING_BLUR_TARGET, vk::Descriptor(temp)},
+                        {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(temp)}},
+                       ImagePassPush{glm::ivec4(n, n, 0, 0)});
           vk::pipeline_barrier(
               cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
           uint32_t vertical_groups = mip1 ? vk::group_count(n / 2, 8) : groups;
-          vk::dispatch(
-              cmd, vertical, vertical_groups, vertical_groups, 1,
-              {vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler), vk::Descriptor(output), vk::Descriptor(half)},
-              ImagePassPush{glm::ivec4(n, n, 1, 0)});
+          vk::dispatch(cmd, vertical, vertical_groups, vertical_groups, 1,
+                       {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler)},
+                        {MSM_BINDING_BLUR_TARGET, vk::Descriptor(output)},
+                        {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(half)}},
+                       ImagePassPush{glm::ivec4(n, n, 1, 0)});
         });
         std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
         std::vector<float> out(texels.size());

@@ -493,7 +493,9 @@ struct Renderer::Impl {
     } else {
       if (!depth_copy)
         depth_copy = std::make_unique<vk::Program>(
-            vk::create_program(ctx, "depth_samples.comp", {vk::Binding::sampled_image, vk::Binding::storage_buffer},
+            vk::create_program(ctx, "depth_samples.comp",
+                               {{MSM_BINDING_DEPTH_SAMPLES_MAP, vk::Binding::sampled_image},
+                                {MSM_BINDING_DEPTH_SAMPLES_BUFFER, vk::Binding::storage_buffer}},
                                sizeof(ImagePassPush)));
       size_t count = texels * size_t(s.msaa);
       vk::Buffer buffer =
@@ -502,7 +504,8 @@ struct Renderer::Impl {
       vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
         uint32_t groups = vk::group_count(uint32_t(size), 8);
         vk::dispatch(cmd, *depth_copy, groups, groups, 1,
-                     {vk::Descriptor(depth.layer_views[0], layout, point_sampler), vk::Descriptor(buffer)},
+                     {{MSM_BINDING_DEPTH_SAMPLES_MAP, vk::Descriptor(depth.layer_views[0], layout, point_sampler)},
+                      {MSM_BINDING_DEPTH_SAMPLES_BUFFER, vk::Descriptor(buffer)}},
                      ImagePassPush{glm::ivec4(size, size, s.msaa, 0)});
       });
       std::span<const float> mapped = buffer.mapped<const float>();

@@ -3,6 +3,7 @@
 #include "msm/vk/commands.h"
 #include "msm/vk/program.h"
 #include "msm/vk/resources.h"
+#include "shaders/vk_bindings.h"
 
 #include <fmt/format.h>
 
@@ -263,6 +264,148 @@ std::vector<FmaCase> fma_cases() {
   };
 }
 
+// The instance's layers and extensions: the validation layer where asked for and installed (else a
+// warning and none), and the extensions the options name.
+struct InstanceSetup {
+  std::vector<const char*> layers, extensions;
+  bool validation = false, sync_validation = false;
+};
+
+InstanceSetup instance_setup(const ContextOptions& options) {
+  InstanceSetup setup;
+  if (options.validation || env_flag("MSM_VALIDATION")) {
+    std::vector<VkExtensionProperties> layer_extensions = instance_extensions(kValidationLayer);
+    bool debug_utils = contains(instance_extensions(nullptr), VK_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
+                       contains(layer_extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    if (!has_layer(kValidationLayer)) {
+      std::fprintf(stderr,
+                   "msm::vk: validation requested but %s is not installed (Debian: apt install "
+                   "vulkan-validationlayers); running WITHOUT validation\n",
+                   kValidationLayer);
+    } else if (!debug_utils) {
+      std::fprintf(stderr, "msm::vk: validation requested but " VK_EXT_DEBUG_UTILS_EXTENSION_NAME
+                           " is missing; running WITHOUT validation\n");
+    } else {
+      setup.validation = true;
+      setup.layers.push_back(kValidationLayer);
+      setup.extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+      setup.sync_validation =
+          options.synchronization_validation && contains(layer_extensions, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+      if (setup.sync_validation) setup.extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+    }
+  }
+  for (const std::string& name : options.instance_extensions) {
+    if (!contains(instance_extensions(nullptr), name.c_str()))
+      throw std::runtime_error(fmt::format("msm::vk: the Vulkan instance lacks extension {}", name));
+    setup.extensions.push_back(name.c_str());
+  }
+  return setup;
+}
+
+// Every warning and error, of every type, into `log`.
+VkDebugUtilsMessengerCreateInfoEXT messenger_create_info(ValidationLog* log) {
+  return {.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+          .messageSeverity =
+              VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+          .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                         VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+          .pfnUserCallback = on_message,
+          .pUserData = log};
+}
+
+// A Vulkan 1.3 instance with `setup`'s layers and extensions; with validation, `messenger` (and with
+// synchronization validation its feature) chained in.
+VkInstance create_instance(const ContextOptions& options, const InstanceSetup& setup,
+                           const VkDebugUtilsMessengerCreateInfoEXT& messenger) {
+  VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT validation_features{.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+                                              .pNext = &messenger,
+                                              .enabledValidationFeatureCount = 1,
+                                              .pEnabledValidationFeatures = enables};
+  VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
+                        .pApplicationName = options.application_name.c_str(),
+                        .pEngineName = "msm",
+                        .apiVersion = VK_API_VERSION_1_3};
+  VkInstanceCreateInfo instance_info{
+      .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
+      .pNext = setup.validation ? (setup.sync_validation ? static_cast<const void*>(&validation_features) : &messenger)
+                                : nullptr,
+      .pApplicationInfo = &app,
+      .enabledLayerCount = uint32_t(setup.layers.size()),
+      .ppEnabledLayerNames = setup.layers.data(),
+      .enabledExtensionCount = uint32_t(setup.extensions.size()),
+      .ppEnabledExtensionNames = setup.extensions.data()};
+  VkInstance instance = VK_NULL_HANDLE;
+  MSM_VK_CHECK(vkCreateInstance(&instance_info, nullptr, &instance));
+  return instance;
+}
+
+// The device that ContextOptions::device, else MSM_DEVICE, else the default policy selects.
+Candidate choose_device(VkInstance instance, const ContextOptions& options) {
+  uint32_t count = 0;
+  MSM_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+  std::vector<VkPhysicalDevice> devices(count);
+  MSM_VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, devices.data()));
+  std::vector<Candidate> candidates;
+  for (uint32_t i = 0; i < count; ++i) candidates.push_back(inspect(devices[i], i));
+
+  const char* source = "the default policy";
+  std::string selector = options.device;
+  if (!selector.empty())
+    source = "ContextOptions::device";
+  else if (const char* env = std::getenv("MSM_DEVICE"); env && *env) {
+    selector = env;
+    source = "MSM_DEVICE";
+  }
+  return candidates[select(candidates, selector, source)];
+}
+
+// The logical device: one queue of `queue_family`, `features` enabled, push descriptors and the
+// extensions the options name (std::runtime_error naming the device where one is missing).
+VkDevice create_device(VkPhysicalDevice physical_device, uint32_t queue_family, const DeviceFeatures& features,
+                       const ContextOptions& options, const std::string& device_name) {
+  DeviceFeatures chain = features;
+  chain.v11.pNext = &chain.v12;
+  chain.v12.pNext = &chain.v13;
+  VkPhysicalDeviceFeatures2 features2{
+      .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &chain.v11, .features = chain.core};
+  float priority = 1.0f;
+  VkDeviceQueueCreateInfo queue_info{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+                                     .queueFamilyIndex = queue_family,
+                                     .queueCount = 1,
+                                     .pQueuePriorities = &priority};
+  std::vector<const char*> device_extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
+  if (!options.device_extensions.empty()) {
+    uint32_t ext_count = 0;
+    vkEnumerateDeviceExtensionProperties(physical_device, nullptr, &ext_count, nullptr);
+    std::vector<VkExtensionProperties> available(ext_count);
+    vkEnumerateDeviceExtensionProperties(physical_device, nullptr, &ext_count, available.data());
+    available.resize(ext_count);
+    for (const std::string& name : options.device_extensions) {
+      if (!contains(available, name.c_str()))
+        throw std::runtime_error(fmt::format("msm::vk: {} lacks extension {}", device_name, name));
+      device_extensions.push_back(name.c_str());
+    }
+  }
+  VkDeviceCreateInfo device_info{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+                                 .pNext = &features2,
+                                 .queueCreateInfoCount = 1,
+                                 .pQueueCreateInfos = &queue_info,
+                                 .enabledExtensionCount = uint32_t(device_extensions.size()),
+                                 .ppEnabledExtensionNames = device_extensions.data()};
+  VkDevice device = VK_NULL_HANDLE;
+  MSM_VK_CHECK(vkCreateDevice(physical_device, &device_info, nullptr, &device));
+  return device;
+}
+
+// Whether msm_fma is the native fma(): as the probe found, unless the mode (or
+// MSM_FORCE_EMULATED_FMA with the probing mode) forces one.
+bool native_fma(ContextOptions::FmaMode mode, bool fused) {
+  if (mode == ContextOptions::FmaMode::probe && env_flag("MSM_FORCE_EMULATED_FMA"))
+    mode = ContextOptions::FmaMode::emulated;
+  return mode == ContextOptions::FmaMode::native || (mode == ContextOptions::FmaMode::probe && fused);
+}
+
 } // namespace
 
 void ValidationLog::add(ValidationMessage message) {
@@ -318,67 +461,12 @@ Context::Context(const ContextOptions& options) {
                                            VK_API_VERSION_MAJOR(loader_version), VK_API_VERSION_MINOR(loader_version)));
 
     log_->set_echo(options.echo_validation);
-    bool want_validation = options.validation || env_flag("MSM_VALIDATION");
-    std::vector<const char*> layers, extensions;
-    bool sync_validation = false;
-    if (want_validation) {
-      std::vector<VkExtensionProperties> layer_extensions = instance_extensions(kValidationLayer);
-      bool debug_utils = contains(instance_extensions(nullptr), VK_EXT_DEBUG_UTILS_EXTENSION_NAME) ||
-                         contains(layer_extensions, VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-      if (!has_layer(kValidationLayer)) {
-        std::fprintf(stderr,
-                     "msm::vk: validation requested but %s is not installed (Debian: apt install "
-                     "vulkan-validationlayers); running WITHOUT validation\n",
-                     kValidationLayer);
-      } else if (!debug_utils) {
-        std::fprintf(stderr, "msm::vk: validation requested but " VK_EXT_DEBUG_UTILS_EXTENSION_NAME
-                             " is missing; running WITHOUT validation\n");
-      } else {
-        validation_ = true;
-        layers.push_back(kValidationLayer);
-        extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
-        sync_validation =
-            options.synchronization_validation && contains(layer_extensions, VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
-        if (sync_validation) extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
-      }
-    }
-
-    for (const std::string& name : options.instance_extensions) {
-      if (!contains(instance_extensions(nullptr), name.c_str()))
-        throw std::runtime_error(fmt::format("msm::vk: the Vulkan instance lacks extension {}", name));
-      extensions.push_back(name.c_str());
-    }
-
+    const InstanceSetup setup = instance_setup(options);
+    validation_ = setup.validation;
     // The messenger is also chained into VkInstanceCreateInfo so that vkCreateInstance and
     // vkDestroyInstance are covered; it keeps a pointer to *log_, which outlives the instance.
-    VkDebugUtilsMessengerCreateInfoEXT messenger_info{
-        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
-        .messageSeverity =
-            VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
-        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
-        .pfnUserCallback = on_message,
-        .pUserData = log_.get()};
-    VkValidationFeatureEnableEXT enables[] = {VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
-    VkValidationFeaturesEXT validation_features{.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
-                                                .pNext = &messenger_info,
-                                                .enabledValidationFeatureCount = 1,
-                                                .pEnabledValidationFeatures = enables};
-    VkApplicationInfo app{.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
-                          .pApplicationName = options.application_name.c_str(),
-                          .pEngineName = "msm",
-                          .apiVersion = VK_API_VERSION_1_3};
-    VkInstanceCreateInfo instance_info{
-        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-        .pNext = validation_ ? (sync_validation ? static_cast<const void*>(&validation_features) : &messenger_info)
-                             : nullptr,
-        .pApplicationInfo = &app,
-        .enabledLayerCount = uint32_t(layers.size()),
-        .ppEnabledLayerNames = layers.data(),
-        .enabledExtensionCount = uint32_t(extensions.size()),
-        .ppEnabledExtensionNames = extensions.data()};
-    MSM_VK_CHECK(vkCreateInstance(&instance_info, nullptr, &instance_));
-
+    const VkDebugUtilsMessengerCreateInfoEXT messenger_info = messenger_create_info(log_.get());
+    instance_ = create_instance(options, setup, messenger_info);
     if (validation_) {
       auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
           vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
@@ -390,60 +478,15 @@ Context::Context(const ContextOptions& options) {
       MSM_VK_CHECK(create(instance_, &messenger_info, nullptr, &messenger_));
     }
 
-    uint32_t count = 0;
-    MSM_VK_CHECK(vkEnumeratePhysicalDevices(instance_, &count, nullptr));
-    std::vector<VkPhysicalDevice> devices(count);
-    MSM_VK_CHECK(vkEnumeratePhysicalDevices(instance_, &count, devices.data()));
-    std::vector<Candidate> candidates;
-    for (uint32_t i = 0; i < count; ++i) candidates.push_back(inspect(devices[i], i));
-
-    const char* source = "the default policy";
-    std::string selector = options.device;
-    if (!selector.empty())
-      source = "ContextOptions::device";
-    else if (const char* env = std::getenv("MSM_DEVICE"); env && *env) {
-      selector = env;
-      source = "MSM_DEVICE";
-    }
-    const Candidate& chosen = candidates[select(candidates, selector, source)];
+    const Candidate chosen = choose_device(instance_, options);
     physical_device_ = chosen.device;
     info_ = chosen.info;
     queue_family_ = chosen.queue_family;
     timestamp_valid_bits_ = chosen.timestamp_valid_bits;
     vkGetPhysicalDeviceProperties(physical_device_, &properties_);
     vkGetPhysicalDeviceMemoryProperties(physical_device_, &memory_);
-
     features_ = pick_features(physical_device_);
-    DeviceFeatures chain = features_;
-    chain.v11.pNext = &chain.v12;
-    chain.v12.pNext = &chain.v13;
-    VkPhysicalDeviceFeatures2 features2{
-        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &chain.v11, .features = chain.core};
-    float priority = 1.0f;
-    VkDeviceQueueCreateInfo queue_info{.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
-                                       .queueFamilyIndex = queue_family_,
-                                       .queueCount = 1,
-                                       .pQueuePriorities = &priority};
-    std::vector<const char*> device_extensions = {VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
-    if (!options.device_extensions.empty()) {
-      uint32_t ext_count = 0;
-      vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &ext_count, nullptr);
-      std::vector<VkExtensionProperties> available(ext_count);
-      vkEnumerateDeviceExtensionProperties(physical_device_, nullptr, &ext_count, available.data());
-      available.resize(ext_count);
-      for (const std::string& name : options.device_extensions) {
-        if (!contains(available, name.c_str()))
-          throw std::runtime_error(fmt::format("msm::vk: {} lacks extension {}", info_.name, name));
-        device_extensions.push_back(name.c_str());
-      }
-    }
-    VkDeviceCreateInfo device_info{.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
-                                   .pNext = &features2,
-                                   .queueCreateInfoCount = 1,
-                                   .pQueueCreateInfos = &queue_info,
-                                   .enabledExtensionCount = uint32_t(device_extensions.size()),
-                                   .ppEnabledExtensionNames = device_extensions.data()};
-    MSM_VK_CHECK(vkCreateDevice(physical_device_, &device_info, nullptr, &device_));
+    device_ = create_device(physical_device_, queue_family_, features_, options, info_.name);
     vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
 
     push_descriptor_set_ =
@@ -459,15 +502,11 @@ Context::Context(const ContextOptions& options) {
     MSM_VK_CHECK(vkCreateCommandPool(device_, &pool_info, nullptr, &command_pool_));
 
     fused_fma_ = probe_fused_fma();
-    ContextOptions::FmaMode fma_mode = options.fma_mode;
-    if (fma_mode == ContextOptions::FmaMode::probe && env_flag("MSM_FORCE_EMULATED_FMA"))
-      fma_mode = ContextOptions::FmaMode::emulated;
-    use_native_fma_ =
-        fma_mode == ContextOptions::FmaMode::native || (fma_mode == ContextOptions::FmaMode::probe && fused_fma_);
-
+    use_native_fma_ = native_fma(options.fma_mode, fused_fma_);
     if (options.verbose)
       std::fprintf(stderr, "msm::vk: device %u: %s; validation %s; fma() %s, msm_fma %s\n", info_.index,
-                   info_.describe().c_str(), validation_ ? (sync_validation ? "on (+synchronization)" : "on") : "off",
+                   info_.describe().c_str(),
+                   validation_ ? (setup.sync_validation ? "on (+synchronization)" : "on") : "off",
                    fused_fma_ ? "fused" : "NOT fused",
                    use_native_fma_ ? (fused_fma_ ? "native" : "native (forced, NOT exact)")
                                    : (fused_fma_ ? "emulated (forced)" : "emulated"));
@@ -515,8 +554,10 @@ bool Context::probe_fused_fma() const {
   VkDeviceSize size = words.size() * sizeof(float);
   Buffer buffer = create_buffer(*this, size, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   std::memcpy(buffer.data(), words.data(), size);
-  Program probe = create_program(*this, "fma_probe", {Binding::storage_buffer});
-  submit_and_wait(*this, [&](VkCommandBuffer cmd) { dispatch(cmd, probe, group_count(n, 64), 1, 1, {buffer}); });
+  Program probe = create_program(*this, "fma_probe", {{MSM_BINDING_FMA_PROBE_CASES, Binding::storage_buffer}});
+  submit_and_wait(*this, [&](VkCommandBuffer cmd) {
+    dispatch(cmd, probe, group_count(n, 64), 1, 1, {{MSM_BINDING_FMA_PROBE_CASES, buffer}});
+  });
   std::memcpy(words.data(), buffer.data(), size);
   for (uint32_t i = 0; i < n; ++i) {
     float fused = std::fma(cases[i].a, cases[i].b, cases[i].c);

@@ -19,7 +19,35 @@ VkDescriptorType descriptor_type(Binding binding) {
   throw std::invalid_argument("msm::vk: unknown Binding");
 }
 
+// The length of the positional list of `given`; std::invalid_argument unless the numbers are
+// 0 to given.size() - 1, each once.
+template <class At>
+std::size_t positional_count(std::span<const At> given, const char* what) {
+  std::vector<bool> seen(given.size(), false);
+  for (const At& at : given) {
+    if (at.binding >= given.size())
+      throw std::invalid_argument(fmt::format("msm::vk::{}: binding {} among {} bindings (numbers 0 to {} each once)",
+                                              what, at.binding, given.size(), given.size() - 1));
+    if (seen[at.binding])
+      throw std::invalid_argument(fmt::format("msm::vk::{}: binding {} given twice", what, at.binding));
+    seen[at.binding] = true;
+  }
+  return given.size();
+}
+
 } // namespace
+
+std::vector<Binding> bindings_at(std::span<const BindingAt> bindings) {
+  std::vector<Binding> list(positional_count(bindings, "bindings_at"));
+  for (const BindingAt& b : bindings) list[b.binding] = b.type;
+  return list;
+}
+
+std::vector<Descriptor> descriptors_at(std::span<const DescriptorAt> descriptors) {
+  std::vector<Descriptor> list(positional_count(descriptors, "descriptors_at"), Descriptor(VkBuffer(VK_NULL_HANDLE)));
+  for (const DescriptorAt& d : descriptors) list[d.binding] = d.descriptor;
+  return list;
+}
 
 SharedSpecialization::SharedSpecialization(const Context& ctx, std::span<const SpecConstant> extra) {
   values_.push_back(ctx.use_native_fma() ? VK_TRUE : VK_FALSE);
@@ -140,10 +168,9 @@ Program create_program(const Context& ctx, std::span<const uint32_t> spirv, std:
   return p;
 }
 
-Program create_program(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
+Program create_program(const Context& ctx, std::string_view shader, std::initializer_list<BindingAt> bindings,
                        uint32_t push_constant_size, std::initializer_list<SpecConstant> constants) {
-  return create_program(ctx, embedded_shader(shader), shader,
-                        std::span<const Binding>(bindings.begin(), bindings.size()), push_constant_size,
+  return create_program(ctx, embedded_shader(shader), shader, bindings_at(bindings), push_constant_size,
                         std::span<const SpecConstant>(constants.begin(), constants.size()));
 }
 

@@ -3,6 +3,7 @@
 #include "msm/test/thrown.h"
 #include "msm/test/vulkan_test.h"
 #include "msm/vk/vk.h"
+#include "shaders/vk_bindings.h"
 
 #include <gtest/gtest.h>
 
@@ -218,9 +219,14 @@ TEST_F(VkLayerTest, SaturateShaderMatchesCpu) {
   Buffer src = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::device);
   Buffer dst = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   upload_buffer(ctx(), src, std::as_bytes(std::span(input)));
-  Program program =
-      create_program(ctx(), "selftest", {Binding::storage_buffer, Binding::storage_buffer}, sizeof(uint32_t));
-  submit_and_wait(ctx(), [&](VkCommandBuffer cmd) { dispatch(cmd, program, group_count(n, 64), 1, 1, {src, dst}, n); });
+  Program program = create_program(ctx(), "selftest",
+                                   {{MSM_BINDING_SELFTEST_SOURCE, Binding::storage_buffer},
+                                    {MSM_BINDING_SELFTEST_DESTINATION, Binding::storage_buffer}},
+                                   sizeof(uint32_t));
+  submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
+    dispatch(cmd, program, group_count(n, 64), 1, 1,
+             {{MSM_BINDING_SELFTEST_SOURCE, src}, {MSM_BINDING_SELFTEST_DESTINATION, dst}}, n);
+  });
 
   std::span<const float> out = dst.mapped<const float>();
   ASSERT_EQ(out.size(), n);
@@ -276,9 +282,14 @@ int fma_mismatches(Context& ctx, const std::vector<float>& in, const char* setti
   Buffer src = create_buffer(ctx, in.size() * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   Buffer dst = create_buffer(ctx, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, Memory::host);
   std::memcpy(src.data(), in.data(), in.size() * sizeof(float));
-  Program program =
-      create_program(ctx, "selftest_fma", {Binding::storage_buffer, Binding::storage_buffer}, sizeof(uint32_t));
-  submit_and_wait(ctx, [&](VkCommandBuffer cmd) { dispatch(cmd, program, group_count(n, 64), 1, 1, {src, dst}, n); });
+  Program program = create_program(ctx, "selftest_fma",
+                                   {{MSM_BINDING_SELFTEST_SOURCE, Binding::storage_buffer},
+                                    {MSM_BINDING_SELFTEST_DESTINATION, Binding::storage_buffer}},
+                                   sizeof(uint32_t));
+  submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+    dispatch(cmd, program, group_count(n, 64), 1, 1,
+             {{MSM_BINDING_SELFTEST_SOURCE, src}, {MSM_BINDING_SELFTEST_DESTINATION, dst}}, n);
+  });
   std::span<const float> out = dst.mapped<const float>();
   int mismatches = 0;
   for (uint32_t i = 0; i < n; ++i) {
@@ -380,16 +391,23 @@ TEST_F(VkLayerTest, PushConstantsAndEveryBindingType) {
                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
   upload_buffer(ctx(), params, std::as_bytes(std::span(offset)));
 
-  Program program = create_program(
-      ctx(), "selftest_image",
-      {Binding::storage_image, Binding::storage_image, Binding::sampled_image, Binding::uniform_buffer}, sizeof(Push));
+  Program program = create_program(ctx(), "selftest_image",
+                                   {{MSM_BINDING_SELFTEST_IMAGE_SOURCE, Binding::storage_image},
+                                    {MSM_BINDING_SELFTEST_IMAGE_RESULT, Binding::storage_image},
+                                    {MSM_BINDING_SELFTEST_IMAGE_TABLE, Binding::sampled_image},
+                                    {MSM_BINDING_SELFTEST_IMAGE_PARAMS, Binding::uniform_buffer}},
+                                   sizeof(Push));
   submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
     pipeline_barrier(cmd, image_barrier(result.handle(), result.aspect(), VK_PIPELINE_STAGE_2_NONE, VK_ACCESS_2_NONE,
                                         VK_IMAGE_LAYOUT_UNDEFINED, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                                         VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, VK_IMAGE_LAYOUT_GENERAL));
-    dispatch(cmd, program, group_count(W, 8), group_count(H, 8), 1,
-             {source_image, result, Descriptor(table_image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler), params},
-             push);
+    dispatch(
+        cmd, program, group_count(W, 8), group_count(H, 8), 1,
+        {{MSM_BINDING_SELFTEST_IMAGE_SOURCE, source_image},
+         {MSM_BINDING_SELFTEST_IMAGE_RESULT, result},
+         {MSM_BINDING_SELFTEST_IMAGE_TABLE, Descriptor(table_image, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, sampler)},
+         {MSM_BINDING_SELFTEST_IMAGE_PARAMS, params}},
+        push);
   });
 
   std::vector<std::byte> bytes = readback_image(ctx(), result, VK_IMAGE_LAYOUT_GENERAL);
@@ -417,8 +435,10 @@ TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
   Buffer b = create_buffer(ctx(), n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   std::vector<float> zeros(n, 0.5f);
   upload_buffer(ctx(), a, std::as_bytes(std::span(zeros)));
-  Program program =
-      create_program(ctx(), "selftest", {Binding::storage_buffer, Binding::storage_buffer}, sizeof(uint32_t));
+  Program program = create_program(ctx(), "selftest",
+                                   {{MSM_BINDING_SELFTEST_SOURCE, Binding::storage_buffer},
+                                    {MSM_BINDING_SELFTEST_DESTINATION, Binding::storage_buffer}},
+                                   sizeof(uint32_t));
   auto compute_to_compute = memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                                            VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
                                            VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
@@ -429,15 +449,18 @@ TEST_F(VkLayerTest, TimerScopesAreNamedOrderedAndGrow) {
       timer.reset(cmd);
       timer.begin(cmd, "frame");
       timer.begin(cmd, "shadow_depth");
-      dispatch(cmd, program, group_count(n, 64), 1, 1, {a, b}, n);
+      dispatch(cmd, program, group_count(n, 64), 1, 1,
+               {{MSM_BINDING_SELFTEST_SOURCE, a}, {MSM_BINDING_SELFTEST_DESTINATION, b}}, n);
       timer.end(cmd);
       pipeline_barrier(cmd, compute_to_compute);
       timer.begin(cmd, "filter");
-      dispatch(cmd, program, group_count(n, 64), 1, 1, {b, a}, n);
+      dispatch(cmd, program, group_count(n, 64), 1, 1,
+               {{MSM_BINDING_SELFTEST_SOURCE, b}, {MSM_BINDING_SELFTEST_DESTINATION, a}}, n);
       timer.end(cmd);
       pipeline_barrier(cmd, compute_to_compute);
       timer.begin(cmd, "shadow_depth");
-      dispatch(cmd, program, group_count(n, 64), 1, 1, {a, b}, n);
+      dispatch(cmd, program, group_count(n, 64), 1, 1,
+               {{MSM_BINDING_SELFTEST_SOURCE, a}, {MSM_BINDING_SELFTEST_DESTINATION, b}}, n);
       timer.end(cmd);
       pipeline_barrier(cmd, compute_to_compute);
       timer.end(cmd);
@@ -521,15 +544,29 @@ TEST_F(VkLayerTest, AllocationLargerThanTheHeapIsAnError) {
 
 TEST_F(VkLayerTest, ArgumentErrorsThrowBeforeAnythingIsRecorded) {
   Buffer buffer = create_buffer(ctx(), 64, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  Program program = create_program(ctx(), "selftest", {Binding::storage_buffer, Binding::storage_buffer}, 4);
+  Program program = create_program(ctx(), "selftest",
+                                   {{MSM_BINDING_SELFTEST_SOURCE, Binding::storage_buffer},
+                                    {MSM_BINDING_SELFTEST_DESTINATION, Binding::storage_buffer}},
+                                   4);
   EXPECT_EQ(program.name(), "selftest");
   EXPECT_EQ(program.bindings().size(), 2u);
   submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
-    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer}, 1u), std::invalid_argument);
-    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer, buffer}), std::invalid_argument);
-    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {buffer, buffer}, uint64_t(1)), std::invalid_argument);
+    const std::initializer_list<DescriptorAt> both = {{MSM_BINDING_SELFTEST_SOURCE, buffer},
+                                                      {MSM_BINDING_SELFTEST_DESTINATION, buffer}};
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {{MSM_BINDING_SELFTEST_SOURCE, buffer}}, 1u), std::invalid_argument);
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, both), std::invalid_argument);
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, both, uint64_t(1)), std::invalid_argument);
+    // Binding numbers with a gap or given twice: no positional list to push.
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {{0, buffer}, {2, buffer}}, 1u), std::invalid_argument);
+    EXPECT_THROW(dispatch(cmd, program, 1, 1, 1, {{1, buffer}, {1, buffer}}, 1u), std::invalid_argument);
   });
-  EXPECT_THROW(create_program(ctx(), "selftest", {Binding::storage_buffer}, 6), std::invalid_argument);
+  EXPECT_THROW(create_program(ctx(), "selftest", {{MSM_BINDING_SELFTEST_SOURCE, Binding::storage_buffer}}, 6),
+               std::invalid_argument);
+  EXPECT_THROW(create_program(ctx(), "selftest", {{1, Binding::storage_buffer}}, 4), std::invalid_argument);
+  EXPECT_THROW(bindings_at({{0, Binding::storage_buffer}, {0, Binding::storage_image}}), std::invalid_argument);
+  // Given in any order, each lands at its number.
+  EXPECT_EQ(bindings_at({{1, Binding::storage_image}, {0, Binding::uniform_buffer}}),
+            (std::vector<Binding>{Binding::uniform_buffer, Binding::storage_image}));
   const uint32_t not_spirv[] = {1, 2, 3};
   EXPECT_THROW(create_program(ctx(), not_spirv, "junk", {}), std::invalid_argument);
   EXPECT_THROW(create_program(ctx(), "no_such_shader", {}), std::runtime_error);

@@ -5,6 +5,7 @@
 #ifndef MSM_RENDER_FRAME_H
 #define MSM_RENDER_FRAME_H
 #include "msm/filter.h"
+#include "msm/render/bindings.h"
 MSM_BEGIN
 
 // The largest number of shadow-casting lights in one frame (the layers of the shadow-map arrays;

@@ -1,8 +1,13 @@
 // Compute programs: a pipeline from embedded SPIR-V whose descriptors are pushed
 // (VK_KHR_push_descriptor, through a descriptor update template), and a one-call dispatch.
 //
-//   Program p = create_program(ctx, "selftest", {Binding::StorageBuffer, Binding::StorageBuffer}, sizeof(Push));
-//   dispatch(cmd, p, group_count(n, 64), 1, 1, {input, output}, Push{n});
+//   Program p = create_program(ctx, "selftest", {{MSM_BINDING_SELFTEST_SOURCE, Binding::storage_buffer},
+//                                                {MSM_BINDING_SELFTEST_DESTINATION, Binding::storage_buffer}}, sizeof(Push));
+//   dispatch(cmd, p, group_count(n, 64), 1, 1,
+//            {{MSM_BINDING_SELFTEST_SOURCE, input}, {MSM_BINDING_SELFTEST_DESTINATION, output}}, Push{n});
+//
+// Binding numbers are named once, in a header the shader and the host both include
+// (docs/architecture.md, "Shared declarations"); the host gives each binding with its name.
 #pragma once
 
 #include "msm/vk/common.h"
@@ -46,6 +51,32 @@ struct Descriptor {
   Descriptor(const Image& i, VkImageLayout layout = VK_IMAGE_LAYOUT_GENERAL, VkSampler sampler = VK_NULL_HANDLE)
       : image{sampler, i.view(), layout} {}
 };
+
+// A binding by its number: the name a shared header declares, as the shader's layout(binding = ...).
+struct BindingAt {
+  uint32_t binding = 0;
+  Binding type = Binding::storage_buffer;
+};
+
+// The positional list (entry i: binding i) of bindings given by number in any order. Precondition
+// (std::invalid_argument otherwise): every number from 0 to the largest given exactly once.
+std::vector<Binding> bindings_at(std::span<const BindingAt> bindings);
+inline std::vector<Binding> bindings_at(std::initializer_list<BindingAt> bindings) {
+  return bindings_at(std::span<const BindingAt>(bindings.begin(), bindings.size()));
+}
+
+// A descriptor for the binding of that number.
+struct DescriptorAt {
+  uint32_t binding = 0;
+  Descriptor descriptor;
+};
+
+// The positional list (entry i: binding i) of descriptors given by number in any order; the same
+// precondition as bindings_at.
+std::vector<Descriptor> descriptors_at(std::span<const DescriptorAt> descriptors);
+inline std::vector<Descriptor> descriptors_at(std::initializer_list<DescriptorAt> descriptors) {
+  return descriptors_at(std::span<const DescriptorAt>(descriptors.begin(), descriptors.size()));
+}
 
 // One 32-bit specialization constant (int, uint, float bits or a bool as VkBool32) of a pipeline.
 struct SpecConstant {
@@ -117,8 +148,8 @@ class SharedSpecialization {
 Program create_program(const Context& ctx, std::span<const uint32_t> spirv, std::string_view name,
                        std::span<const Binding> bindings, uint32_t push_constant_size = 0,
                        std::span<const SpecConstant> constants = {});
-// The same from an embedded shader (see shaders.h), looked up by name.
-Program create_program(const Context& ctx, std::string_view shader, std::initializer_list<Binding> bindings,
+// The same from an embedded shader (see shaders.h), looked up by name, with its bindings by number.
+Program create_program(const Context& ctx, std::string_view shader, std::initializer_list<BindingAt> bindings,
                        uint32_t push_constant_size = 0, std::initializer_list<SpecConstant> constants = {});
 
 // The layout of a program without its pipeline (for pipeline kinds built elsewhere, graphics.h):
@@ -130,19 +161,18 @@ Program create_program_layout(const Context& ctx, std::string_view name, std::sp
 // (preconditions as for dispatch); draws or dispatches follow.
 void bind_program(VkCommandBuffer cmd, const Program& program, std::span<const Descriptor> bindings,
                   std::span<const std::byte> push_constants = {});
-inline void bind_program(VkCommandBuffer cmd, const Program& program, std::initializer_list<Descriptor> bindings,
+inline void bind_program(VkCommandBuffer cmd, const Program& program, std::initializer_list<DescriptorAt> bindings,
                          std::span<const std::byte> push_constants = {}) {
-  bind_program(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()), push_constants);
+  bind_program(cmd, program, descriptors_at(bindings), push_constants);
 }
 template <class PushConstants>
 requires(
     std::is_standard_layout_v<PushConstants>&& std::is_trivially_destructible_v<PushConstants> &&
     !std::is_convertible_v<const PushConstants&,
                            std::span<const std::byte>>) void bind_program(VkCommandBuffer cmd, const Program& program,
-                                                                          std::initializer_list<Descriptor> bindings,
+                                                                          std::initializer_list<DescriptorAt> bindings,
                                                                           const PushConstants& push_constants) {
-  bind_program(cmd, program, std::span<const Descriptor>(bindings.begin(), bindings.size()),
-               std::as_bytes(std::span(&push_constants, 1)));
+  bind_program(cmd, program, descriptors_at(bindings), std::as_bytes(std::span(&push_constants, 1)));
 }
 
 // Binds the pipeline, pushes one descriptor per binding and the push constants, and dispatches
@@ -154,10 +184,9 @@ void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groups_x, ui
               std::span<const Descriptor> bindings, std::span<const std::byte> push_constants = {});
 
 inline void dispatch(VkCommandBuffer cmd, const Program& program, uint32_t groups_x, uint32_t groups_y,
-                     uint32_t groups_z, std::initializer_list<Descriptor> bindings = {},
+                     uint32_t groups_z, std::initializer_list<DescriptorAt> bindings = {},
                      std::span<const std::byte> push_constants = {}) {
-  dispatch(cmd, program, groups_x, groups_y, groups_z, std::span<const Descriptor>(bindings.begin(), bindings.size()),
-           push_constants);
+  dispatch(cmd, program, groups_x, groups_y, groups_z, descriptors_at(bindings), push_constants);
 }
 
 // Push constants given as one struct (its bytes, padding included, must match the shader's block).
@@ -169,9 +198,10 @@ requires(std::is_standard_layout_v<PushConstants>&& std::is_trivially_destructib
                                 std::span<const std::byte>>) void dispatch(VkCommandBuffer cmd, const Program& program,
                                                                            uint32_t groups_x, uint32_t groups_y,
                                                                            uint32_t groups_z,
-                                                                           std::initializer_list<Descriptor> bindings,
+                                                                           std::initializer_list<DescriptorAt> bindings,
                                                                            const PushConstants& push_constants) {
-  dispatch(cmd, program, groups_x, groups_y, groups_z, bindings, std::as_bytes(std::span(&push_constants, 1)));
+  dispatch(cmd, program, groups_x, groups_y, groups_z, descriptors_at(bindings),
+           std::as_bytes(std::span(&push_constants, 1)));
 }
 
 // Workgroups needed for `threads` invocations with `local_size` per group: ceil(threads / local_size).

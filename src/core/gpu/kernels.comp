@@ -14,8 +14,8 @@ layout(push_constant) uniform Push {
 // Context's probe of fma(), so this runs the emulation where fma() is not fused (lavapipe).
 #include "kernels.h"
 
-layout(std430, binding = 0) readonly buffer Inputs { KernelIO inputs[]; };
-layout(std430, binding = 1) writeonly buffer Outputs { KernelIO outputs[]; };
+layout(std430, binding = MSM_BINDING_KERNELS_INPUTS) readonly buffer Inputs { KernelIO inputs[]; };
+layout(std430, binding = MSM_BINDING_KERNELS_OUTPUTS) writeonly buffer Outputs { KernelIO outputs[]; };
 
 void main() {
   uint i = gl_GlobalInvocationID.x;

@@ -29,6 +29,10 @@
 #include "msm/three_moments.h"
 #include "msm/trigonometric.h"
 
+// kernels.comp's storage buffers: KernelIO[] in and out.
+#define MSM_BINDING_KERNELS_INPUTS 0
+#define MSM_BINDING_KERNELS_OUTPUTS 1
+
 MSM_BEGIN
 
 struct KernelIO {

@@ -7,7 +7,7 @@
 #include "sat_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0, MSM_SAT_TABLE_FORMAT) uniform uimage2D table;
+layout(binding = MSM_BINDING_SAT_COLUMNS_TABLE, MSM_SAT_TABLE_FORMAT) uniform uimage2D table;
 
 void main() {
   int x = int(gl_WorkGroupID.x) * 8 + int(gl_LocalInvocationID.x);

@@ -7,8 +7,8 @@
 #include "sat_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0) uniform sampler2D moments;
-layout(binding = 1, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
+layout(binding = MSM_BINDING_SAT_ROWS_MOMENTS) uniform sampler2D moments;
+layout(binding = MSM_BINDING_SAT_ROWS_TABLE, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
 
 void main() {
   int column = int(gl_LocalInvocationID.x); // within the block

@@ -4,7 +4,7 @@
 #include "sat_common.glsl"
 
 layout(local_size_x = 64) in;
-layout(binding = 0, MSM_SAT_TABLE_FORMAT) uniform uimage2D table;
+layout(binding = MSM_BINDING_SAT_COLUMNS_TABLE, MSM_SAT_TABLE_FORMAT) uniform uimage2D table;
 
 uvec4 sat_scan_load(ivec2 p) { return imageLoad(table, p); }
 #include "sat_scan_lines.glsl"

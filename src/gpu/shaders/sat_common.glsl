@@ -1,9 +1,9 @@
-// Shared by the summed-area table shaders (sat_*.comp): push constants (sat_push.h) and the moment fetch.
+// Shared by the summed-area table shaders (sat_*.comp): bindings and push constants (sat_interface.h) and the moment fetch.
 // The quantization itself is msm_sat_quantize (include/msm/sat.h), the same code as the CPU's.
 #ifndef SAT_COMMON_GLSL
 #define SAT_COMMON_GLSL
 #include "msm/sat.h"
-#include "sat_push.h"
+#include "sat_interface.h"
 
 layout(push_constant) uniform PushBlock { SatPush pc; };
 

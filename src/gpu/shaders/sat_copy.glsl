@@ -17,16 +17,16 @@
 
 layout(local_size_x = 64) in;
 #ifdef SAT_COPY_IMAGE
-layout(binding = 0, rgba32ui) uniform readonly uimage2D src;
-layout(binding = 1, rgba32ui) uniform writeonly uimage2D dst;
+layout(binding = MSM_BINDING_SAT_COPY_SOURCE, rgba32ui) uniform readonly uimage2D src;
+layout(binding = MSM_BINDING_SAT_COPY_DESTINATION, rgba32ui) uniform writeonly uimage2D dst;
 void copy_texel(int x, int y) { imageStore(dst, ivec2(x, y), imageLoad(src, ivec2(x, y))); }
 #elif defined(SAT_COPY_FETCH)
-layout(binding = 0) uniform sampler2D src;
-layout(binding = 1, rgba32ui) uniform writeonly uimage2D dst;
+layout(binding = MSM_BINDING_SAT_COPY_SOURCE) uniform sampler2D src;
+layout(binding = MSM_BINDING_SAT_COPY_DESTINATION, rgba32ui) uniform writeonly uimage2D dst;
 void copy_texel(int x, int y) { imageStore(dst, ivec2(x, y), floatBitsToUint(texelFetch(src, ivec2(x, y), 0))); }
 #else
-layout(binding = 0, std430) readonly buffer Src { uvec4 src[]; };
-layout(binding = 1, std430) writeonly buffer Dst { uvec4 dst[]; };
+layout(binding = MSM_BINDING_SAT_COPY_SOURCE, std430) readonly buffer Src { uvec4 src[]; };
+layout(binding = MSM_BINDING_SAT_COPY_DESTINATION, std430) writeonly buffer Dst { uvec4 dst[]; };
 void copy_texel(int x, int y) {
   int i = y * pc.size.x + x;
   dst[i] = src[i];

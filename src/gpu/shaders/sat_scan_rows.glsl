@@ -8,8 +8,8 @@
 #include "sat_common.glsl"
 
 layout(local_size_x = 64) in;
-layout(binding = 0) uniform sampler2D moments;
-layout(binding = 1, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
+layout(binding = MSM_BINDING_SAT_ROWS_MOMENTS) uniform sampler2D moments;
+layout(binding = MSM_BINDING_SAT_ROWS_TABLE, MSM_SAT_TABLE_FORMAT) uniform writeonly uimage2D table;
 
 shared uvec4 chunk[64];
 

@@ -8,30 +8,12 @@
 #include <fmt/format.h>
 
 #include "msm/vk/commands.h"
-#include "shaders/probe_push.h"
+#include "shaders/probe_interface.h"
 
 namespace msm::probe {
 namespace {
 
-// probe_cut.comp's output buffer (std430).
-struct RegionOut {
-  glm::ivec4 rect; // x0, y0, x1, y1
-  int face;
-  uint32_t lit;
-  uint64_t fixed_energy;
-  uint32_t faces; // Region::faces
-  uint32_t pad[3];
-};
-struct LightOut {
-  glm::vec4 direction_cone, x_axis_half_x, y_axis_half_y, irradiance;
-};
-struct ResultOut {
-  uint32_t region_count, pad[3];
-  RegionOut regions[kMaxDeviceLights];
-  LightOut lights[kMaxDeviceLights];
-};
-static_assert(sizeof(RegionOut) == 48 && sizeof(LightOut) == 64 && offsetof(ResultOut, lights) == 16 + 48 * 256,
-              "the output layout must match probe_cut.comp");
+static_assert(MSM_PROBE_MAX_REGIONS == kMaxDeviceLights, "probe_cut.comp's output holds every light of the cut");
 
 constexpr int kSupersampling = 4; // cube_from_equirect's default
 
@@ -65,16 +47,24 @@ DeviceProbe::DeviceProbe(const vk::Context& ctx, int size) : ctx_(&ctx), size_(s
     throw ProbeError(fmt::format("cube map size {} outside 1..{} on the device", size, kMaxDeviceCubeSize));
   if (!ctx.features().core.shaderInt64)
     throw ProbeError("the device has no shaderInt64: the light-probe tables are 64-bit integers");
-  using B = vk::Binding;
-  cube_ = vk::create_program(ctx, "probe_cube.comp", {B::storage_buffer, B::storage_buffer}, sizeof(ProbePush));
-  rows_ = vk::create_program(ctx, "probe_table_rows.comp", {B::storage_buffer, B::storage_buffer, B::storage_buffer},
+  constexpr vk::Binding buffer = vk::Binding::storage_buffer;
+  cube_ = vk::create_program(ctx, "probe_cube.comp",
+                             {{MSM_BINDING_PROBE_CUBE_PANORAMA, buffer}, {MSM_BINDING_PROBE_CUBE_FACES, buffer}},
                              sizeof(ProbePush));
-  columns_ = vk::create_program(ctx, "probe_table_columns.comp", {B::storage_buffer}, sizeof(ProbePush));
-  cut_ = vk::create_program(ctx, "probe_cut.comp", {B::storage_buffer, B::storage_buffer}, sizeof(ProbePush));
+  rows_ = vk::create_program(ctx, "probe_table_rows.comp",
+                             {{MSM_BINDING_PROBE_ROWS_CUBE, buffer},
+                              {MSM_BINDING_PROBE_ROWS_WEIGHTS, buffer},
+                              {MSM_BINDING_PROBE_ROWS_TABLES, buffer}},
+                             sizeof(ProbePush));
+  columns_ = vk::create_program(ctx, "probe_table_columns.comp", {{MSM_BINDING_PROBE_COLUMNS_TABLES, buffer}},
+                                sizeof(ProbePush));
+  cut_ = vk::create_program(ctx, "probe_cut.comp",
+                            {{MSM_BINDING_PROBE_CUT_TABLES, buffer}, {MSM_BINDING_PROBE_CUT_RESULT, buffer}},
+                            sizeof(ProbePush));
   const VkDeviceSize texels = VkDeviceSize(size) * VkDeviceSize(size);
   cube_buffer_ = vk::create_buffer(ctx, 6 * texels * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   tables_ = vk::create_buffer(ctx, 6 * 7 * texels * sizeof(uint64_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-  result_ = vk::create_buffer(ctx, sizeof(ResultOut), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+  result_ = vk::create_buffer(ctx, sizeof(ProbeCutResult), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
   // The weights of one face's texels, then the coordinates of the texel centres (host-computed:
   // light_probe.h explains why).
   std::vector<float> weights = texel_weights(size);
@@ -137,18 +127,24 @@ void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk:
                                           VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT));
   if (resample_) {
     if (timer) timer->begin(cmd, "probe_cube");
-    vk::dispatch(cmd, cube_, vk::group_count(m, 8), vk::group_count(m, 8), 6, {panorama_, cube_buffer_}, push);
+    vk::dispatch(cmd, cube_, vk::group_count(m, 8), vk::group_count(m, 8), 6,
+                 {{MSM_BINDING_PROBE_CUBE_PANORAMA, panorama_}, {MSM_BINDING_PROBE_CUBE_FACES, cube_buffer_}}, push);
     if (timer) timer->end(cmd);
     vk::pipeline_barrier(cmd, kComputeToCompute);
   }
   if (timer) timer->begin(cmd, "probe_tables");
-  vk::dispatch(cmd, rows_, vk::group_count(m, 64), 6, 1, {cube_buffer_, weights_, tables_}, push);
+  vk::dispatch(cmd, rows_, vk::group_count(m, 64), 6, 1,
+               {{MSM_BINDING_PROBE_ROWS_CUBE, cube_buffer_},
+                {MSM_BINDING_PROBE_ROWS_WEIGHTS, weights_},
+                {MSM_BINDING_PROBE_ROWS_TABLES, tables_}},
+               push);
   vk::pipeline_barrier(cmd, kComputeToCompute);
-  vk::dispatch(cmd, columns_, vk::group_count(m, 64), 7, 6, {tables_}, push);
+  vk::dispatch(cmd, columns_, vk::group_count(m, 64), 7, 6, {{MSM_BINDING_PROBE_COLUMNS_TABLES, tables_}}, push);
   if (timer) timer->end(cmd);
   vk::pipeline_barrier(cmd, kComputeToCompute);
   if (timer) timer->begin(cmd, "probe_cut");
-  vk::dispatch(cmd, cut_, 1, 1, 1, {tables_, result_}, push);
+  vk::dispatch(cmd, cut_, 1, 1, 1, {{MSM_BINDING_PROBE_CUT_TABLES, tables_}, {MSM_BINDING_PROBE_CUT_RESULT, result_}},
+               push);
   if (timer) timer->end(cmd);
   vk::pipeline_barrier(cmd,
                        vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
@@ -156,12 +152,12 @@ void DeviceProbe::record(VkCommandBuffer cmd, int count, float rotation_deg, vk:
 }
 
 DeviceCut DeviceProbe::read() const {
-  ResultOut out;
+  ProbeCutResult out;
   std::memcpy(static_cast<void*>(&out), result_.data(), sizeof(out)); // glm members: no trivial assignment, same bytes
   DeviceCut cut;
   const int n = std::min(int(out.region_count), kMaxDeviceLights);
   for (int k = 0; k < n; ++k) {
-    const RegionOut& r = out.regions[k];
+    const ProbeCutRegion& r = out.regions[k];
     Region region{r.face, r.rect.x, r.rect.y, r.rect.z, r.rect.w};
     region.fixed_energy = r.fixed_energy;
     region.faces = r.faces;
@@ -169,7 +165,7 @@ DeviceCut DeviceProbe::read() const {
     cut.regions.push_back(region);
     cut.light_of_region.push_back(r.lit ? int(cut.lights.size()) : -1);
     if (!r.lit) continue;
-    const LightOut& l = out.lights[k];
+    const ProbeCutLight& l = out.lights[k];
     cut.lights.push_back(MsmAreaLight(glm::vec3(l.direction_cone), glm::vec3(l.x_axis_half_x),
                                       glm::vec3(l.y_axis_half_y), glm::vec2(l.x_axis_half_x.w, l.y_axis_half_y.w),
                                       l.direction_cone.w, glm::vec3(l.irradiance)));

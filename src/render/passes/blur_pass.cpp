@@ -49,8 +49,10 @@ void BlurPass::prepare(const PassResources& r) {
     throw RenderError(fmt::format("the blur needs linear filtering of RGBA32F images; {} has none (use "
                                   "--filter-mode one-pass or --filter 1)",
                                   ctx.info().name));
-  const std::vector<vk::Binding> bindings = {vk::Binding::sampled_image, vk::Binding::storage_image,
-                                             vk::Binding::storage_image};
+  const std::vector<vk::Binding> bindings =
+      vk::bindings_at({{MSM_BINDING_BLUR_SOURCE, vk::Binding::sampled_image},
+                       {MSM_BINDING_BLUR_TARGET, vk::Binding::storage_image},
+                       {MSM_BINDING_BLUR_TARGET_MIP1, vk::Binding::storage_image}});
   bool bilinear = bilinear_blur(config_);
   program_ = &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush),
                                  blur_constants(config_.taps, config_.sigma, bilinear, false));
@@ -88,7 +90,9 @@ void BlurPass::execute(const PassContext& c) const {
                                                     compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT, general));
       vk::Descriptor temp_storage(temp.layer_views[0], general);
       vk::dispatch(c.cmd, *program_, groups, groups, 1,
-                   {vk::Descriptor(moments, general, sampler), temp_storage, temp_storage},
+                   {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(moments, general, sampler)},
+                    {MSM_BINDING_BLUR_TARGET, temp_storage},
+                    {MSM_BINDING_BLUR_TARGET_MIP1, temp_storage}},
                    ImagePassPush{glm::ivec4(size, size, 0, 0)});
       vk::pipeline_barrier(
           c.cmd,
@@ -99,8 +103,10 @@ void BlurPass::execute(const PassContext& c) const {
       const GraphImage& target = c.image(moment_image(channel_, i));
       uint32_t vertical_groups = mip1 ? vk::group_count(uint32_t(size / 2), 8) : groups;
       vk::dispatch(c.cmd, *vertical_program_, vertical_groups, vertical_groups, 1,
-                   {vk::Descriptor(temp.layer_views[0], general, sampler), vk::Descriptor(moments, general),
-                    vk::Descriptor(mip1 ? target.layer_mip1_views[size_t(l)] : moments, general)},
+                   {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(temp.layer_views[0], general, sampler)},
+                    {MSM_BINDING_BLUR_TARGET, vk::Descriptor(moments, general)},
+                    {MSM_BINDING_BLUR_TARGET_MIP1,
+                     vk::Descriptor(mip1 ? target.layer_mip1_views[size_t(l)] : moments, general)}},
                    ImagePassPush{glm::ivec4(size, size, 1, 0)});
     }
     c.end_light();

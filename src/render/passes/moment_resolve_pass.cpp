@@ -18,8 +18,11 @@ ImageSpec moment_image_spec(const FrameConfig& config, int i) {
 void MomentResolvePass::prepare(const PassResources& r) {
   const FrameConfig& config = config_;
   program_ = &r.programs.compute(config.msaa == 1 ? "moment_resolve_1x.comp" : "moment_resolve.comp",
-                                 {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image,
-                                  vk::Binding::storage_image, vk::Binding::sampled_image},
+                                 vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                                  {MSM_BINDING_RESOLVE_DEPTH, vk::Binding::sampled_image},
+                                                  {MSM_BINDING_RESOLVE_MOMENTS0, vk::Binding::storage_image},
+                                                  {MSM_BINDING_RESOLVE_MOMENTS1, vk::Binding::storage_image},
+                                                  {MSM_BINDING_RESOLVE_BACK_DEPTH, vk::Binding::sampled_image}}),
                                  sizeof(ImagePassPush),
                                  {{MSM_SPEC_TECHNIQUE, uint32_t(config.technique->id)},
                                   {MSM_SPEC_SPLIT_RG, config.split_rg() ? 1u : 0u},
@@ -47,10 +50,14 @@ void MomentResolvePass::execute(const PassContext& c) const {
     VkImageView second = images > 1 ? VkImageView(c.image(moment_image(0, 1)).layer_mip0_views[size_t(l)]) : first;
     vk::dispatch(
         c.cmd, *program_, groups, groups, 1,
-        {vk::Descriptor(c.frame.uniforms),
-         vk::Descriptor(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler),
-         vk::Descriptor(first, VK_IMAGE_LAYOUT_GENERAL), vk::Descriptor(second, VK_IMAGE_LAYOUT_GENERAL),
-         vk::Descriptor(back.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler)},
+        {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+         {MSM_BINDING_RESOLVE_DEPTH, vk::Descriptor(depth.layer_views[size_t(l)],
+                                                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler)},
+         {MSM_BINDING_RESOLVE_MOMENTS0, vk::Descriptor(first, VK_IMAGE_LAYOUT_GENERAL)},
+         {MSM_BINDING_RESOLVE_MOMENTS1, vk::Descriptor(second, VK_IMAGE_LAYOUT_GENERAL)},
+         {MSM_BINDING_RESOLVE_BACK_DEPTH,
+          vk::Descriptor(back.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                         c.frame.point_sampler)}},
         push);
     c.end_light();
   }

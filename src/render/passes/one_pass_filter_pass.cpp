@@ -25,7 +25,10 @@ const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& c
   bool nl32 = config.technique->formats[0] == TexelFormat::r32_uint;
   std::string shader =
       std::string(nl32 ? "one_pass_filter_nl32" : "one_pass_filter") + (config.msaa == 1 ? "_1x.comp" : ".comp");
-  return programs.compute(shader, {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_image},
+  return programs.compute(shader,
+                          vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                           {MSM_BINDING_ONE_PASS_DEPTH, vk::Binding::sampled_image},
+                                           {MSM_BINDING_ONE_PASS_TARGET, vk::Binding::storage_image}}),
                           sizeof(ImagePassPush),
                           {{MSM_SPEC_TECHNIQUE, uint32_t(config.technique->id)},
                            {MSM_SPEC_FILTER_RADIUS, uint32_t(radius)},
@@ -50,9 +53,10 @@ void OnePassFilterPass::execute(const PassContext& c) const {
     c.begin_light(name(), l);
     vk::dispatch(
         c.cmd, *program_, vk::group_count(size, 32 * kOnePassColumns), vk::group_count(size, kOnePassStripH), 1,
-        {vk::Descriptor(c.frame.uniforms),
-         vk::Descriptor(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler),
-         vk::Descriptor(moments.layer_mip0_views[size_t(l)], VK_IMAGE_LAYOUT_GENERAL)},
+        {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+         {MSM_BINDING_ONE_PASS_DEPTH, vk::Descriptor(depth.layer_views[size_t(l)],
+                                                     VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler)},
+         {MSM_BINDING_ONE_PASS_TARGET, vk::Descriptor(moments.layer_mip0_views[size_t(l)], VK_IMAGE_LAYOUT_GENERAL)}},
         ImagePassPush{glm::ivec4(int(size), int(size), 0, 0)});
     c.end_light();
   }

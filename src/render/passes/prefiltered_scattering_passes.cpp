@@ -42,11 +42,13 @@ void RectifyPass::prepare(const PassResources& r) {
                        (config_.filtered_resampling ? "_filtered.comp"
                         : config_.msaa == 1         ? "_1x.comp"
                                                     : ".comp");
-  std::vector<vk::Binding> bindings = {vk::Binding::uniform_buffer, vk::Binding::storage_buffer,
-                                       vk::Binding::storage_buffer, vk::Binding::sampled_image,
-                                       vk::Binding::storage_image};
-  if (six) bindings.push_back(vk::Binding::storage_image);
-  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush),
+  std::vector<vk::BindingAt> bindings = {{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                         {MSM_BINDING_RECTIFY_RECTS, vk::Binding::storage_buffer},
+                                         {MSM_BINDING_RECTIFY_LIGHTS, vk::Binding::storage_buffer},
+                                         {MSM_BINDING_RECTIFY_SOURCE, vk::Binding::sampled_image},
+                                         {MSM_BINDING_RECTIFY_TARGET, vk::Binding::storage_image}};
+  if (six) bindings.push_back({MSM_BINDING_RECTIFY_TARGET1, vk::Binding::storage_image});
+  program_ = &r.programs.compute(shader, vk::bindings_at(bindings), sizeof(ImagePassPush),
                                  {{MSM_RECTIFY_ON_THE_FLY_SPEC_ID, config_.on_the_fly_resampling ? 1u : 0u}});
 }
 
@@ -75,17 +77,22 @@ void RectifyPass::execute(const PassContext& c) const {
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     const size_t layer = size_t(l);
-    std::vector<vk::Descriptor> d = {
-        vk::Descriptor(c.frame.uniforms), vk::Descriptor(*c.frame.rectification), vk::Descriptor(c.frame.lights),
-        config_.filtered_resampling // every mip, trilinear
-            ? vk::Descriptor(c.image(moment_image(0, 0)).layer_views[layer], kReadOnly, c.frame.linear_sampler)
-            : vk::Descriptor(c.image(kShadowDepth).layer_views[layer], kReadOnly, c.frame.point_sampler),
-        csm(config_) ? vk::Descriptor(c.image(kRectified).array_view, VK_IMAGE_LAYOUT_GENERAL) // layers 8 l + t
-                     : vk::Descriptor(c.image(kRectified).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)};
+    std::vector<vk::DescriptorAt> d = {
+        {MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+        {MSM_BINDING_RECTIFY_RECTS, vk::Descriptor(*c.frame.rectification)},
+        {MSM_BINDING_RECTIFY_LIGHTS, vk::Descriptor(c.frame.lights)},
+        {MSM_BINDING_RECTIFY_SOURCE,
+         config_.filtered_resampling // every mip, trilinear
+             ? vk::Descriptor(c.image(moment_image(0, 0)).layer_views[layer], kReadOnly, c.frame.linear_sampler)
+             : vk::Descriptor(c.image(kShadowDepth).layer_views[layer], kReadOnly, c.frame.point_sampler)},
+        {MSM_BINDING_RECTIFY_TARGET,
+         csm(config_) ? vk::Descriptor(c.image(kRectified).array_view, VK_IMAGE_LAYOUT_GENERAL) // layers 8 l + t
+                      : vk::Descriptor(c.image(kRectified).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)}};
     if (prefix_sums_have_two_images(config_))
-      d.emplace_back(c.image(kRectified1).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL);
+      d.push_back({MSM_BINDING_RECTIFY_TARGET1,
+                   vk::Descriptor(c.image(kRectified1).layer_views[layer], VK_IMAGE_LAYOUT_GENERAL)});
     const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, 0)};
-    vk::dispatch(c.cmd, *program_, groups, groups, 1, d, std::as_bytes(std::span(&push, 1)));
+    vk::dispatch(c.cmd, *program_, groups, groups, 1, vk::descriptors_at(d), std::as_bytes(std::span(&push, 1)));
     c.end_light();
   }
 }
@@ -97,15 +104,15 @@ void PrefixSumPass::prepare(const PassResources& r) {
                        : rep == MSM_REP6_FLOAT   ? "prefix_sums6_32.comp"
                        : csm(config_)            ? "prefix_sums_csm.comp"
                                                  : "prefix_sums.comp";
-  // Six moments read and write a second image pair. Two lists rather than an insert into one: GCC 12
-  // reports a false -Warray-bounds on vector<enum>::insert of an initializer list.
-  const std::vector<vk::Binding> bindings =
-      rep >= 0
-          ? std::vector<vk::Binding>{vk::Binding::storage_buffer, vk::Binding::sampled_image,
-                                     vk::Binding::storage_image, vk::Binding::sampled_image, vk::Binding::storage_image}
-          : std::vector<vk::Binding>{vk::Binding::storage_buffer, vk::Binding::sampled_image,
-                                     vk::Binding::storage_image};
-  program_ = &r.programs.compute(shader, bindings, sizeof(ImagePassPush),
+  // Six moments read and write a second image pair.
+  std::vector<vk::BindingAt> bindings = {{MSM_BINDING_PREFIX_RECTS, vk::Binding::storage_buffer},
+                                         {MSM_BINDING_PREFIX_SOURCE, vk::Binding::sampled_image},
+                                         {MSM_BINDING_PREFIX_TARGET, vk::Binding::storage_image}};
+  if (rep >= 0) {
+    bindings.push_back({MSM_BINDING_PREFIX_SOURCE1, vk::Binding::sampled_image});
+    bindings.push_back({MSM_BINDING_PREFIX_TARGET1, vk::Binding::storage_image});
+  }
+  program_ = &r.programs.compute(shader, vk::bindings_at(bindings), sizeof(ImagePassPush),
                                  {{MSM_PREFIX_ROWS_SPEC_ID, config_.prefix_sums_appendix_c ? 0u : 1u}});
 }
 
@@ -138,17 +145,19 @@ void PrefixSumPass::execute(const PassContext& c) const {
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     const size_t layer = size_t(l);
-    std::vector<vk::Descriptor> d = {
-        vk::Descriptor(*c.frame.rectification),
-        vk::Descriptor(array ? rectified.array_view : rectified.layer_views[layer], kReadOnly, c.frame.point_sampler),
-        vk::Descriptor(mip0(prefix_sums), VK_IMAGE_LAYOUT_GENERAL)};
+    std::vector<vk::DescriptorAt> d = {
+        {MSM_BINDING_PREFIX_RECTS, vk::Descriptor(*c.frame.rectification)},
+        {MSM_BINDING_PREFIX_SOURCE,
+         vk::Descriptor(array ? rectified.array_view : rectified.layer_views[layer], kReadOnly, c.frame.point_sampler)},
+        {MSM_BINDING_PREFIX_TARGET, vk::Descriptor(mip0(prefix_sums), VK_IMAGE_LAYOUT_GENERAL)}};
     if (prefix_sums_have_two_images(config_)) {
-      d.emplace_back(c.image(kRectified1).layer_views[layer], kReadOnly, c.frame.point_sampler);
-      d.emplace_back(mip0(c.image(kPrefixSums1)), VK_IMAGE_LAYOUT_GENERAL);
+      d.push_back({MSM_BINDING_PREFIX_SOURCE1,
+                   vk::Descriptor(c.image(kRectified1).layer_views[layer], kReadOnly, c.frame.point_sampler)});
+      d.push_back({MSM_BINDING_PREFIX_TARGET1, vk::Descriptor(mip0(c.image(kPrefixSums1)), VK_IMAGE_LAYOUT_GENERAL)});
     }
     const ImagePassPush push{glm::ivec4(config_.shadow_size, config_.shadow_size, l, int(layers(config_)))};
     vk::dispatch(c.cmd, *program_, vk::group_count(size(config_), rows_per_group), 1,
-                 (array ? kCsmLayers : 1) * layers(config_), d, std::as_bytes(std::span(&push, 1)));
+                 (array ? kCsmLayers : 1) * layers(config_), vk::descriptors_at(d), std::as_bytes(std::span(&push, 1)));
     c.end_light();
   }
 }

@@ -16,9 +16,14 @@ void ScatteringPass::prepare(const PassResources& r) {
                                         : prefiltered()     ? "scatter_prefiltered.frag"
                                         : config_.msaa == 1 ? "scatter_march_1x.frag"
                                                             : "scatter_march.frag",
-                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
-                                  vk::Binding::sampled_image, vk::Binding::sampled_image, vk::Binding::storage_buffer,
-                                  vk::Binding::storage_buffer, vk::Binding::sampled_image},
+                     .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                                  {MSM_BINDING_SCATTER_SURFACE_RADIANCE, vk::Binding::sampled_image},
+                                                  {MSM_BINDING_SCATTER_CAMERA_DEPTH, vk::Binding::sampled_image},
+                                                  {MSM_BINDING_SCATTER_SHADOW_MAP, vk::Binding::sampled_image},
+                                                  {MSM_BINDING_SCATTER_BLUE_NOISE, vk::Binding::sampled_image},
+                                                  {MSM_BINDING_SCATTER_LIGHTS, vk::Binding::storage_buffer},
+                                                  {MSM_BINDING_SCATTER_RECTS, vk::Binding::storage_buffer},
+                                                  {MSM_BINDING_SCATTER_PREFIX_SUMS1, vk::Binding::sampled_image}}),
                      .push_constant_size = sizeof(ScatteringPush),
                      .color_formats = {VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R32G32B32A32_SFLOAT},
                      .depth_write = false,
@@ -54,16 +59,21 @@ void ScatteringPass::execute(const PassContext& c) const {
   VkSampler point = c.frame.point_sampler;
   vk::bind_program(
       c.cmd, *program_,
-      {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, point),
-       vk::Descriptor(c.image(kCameraDepth).layer_views[0], read_only, point),
+      {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+       {MSM_BINDING_SCATTER_SURFACE_RADIANCE,
+        vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, point)},
+       {MSM_BINDING_SCATTER_CAMERA_DEPTH, vk::Descriptor(c.image(kCameraDepth).layer_views[0], read_only, point)},
        // Every light's layers as one array (CSM: eight per light).
-       prefiltered() ? vk::Descriptor(c.image(kPrefixSums).array_view, read_only, *c.frame.repeat_sampler)
-                     : vk::Descriptor(c.image(kShadowDepth).array_view, read_only, point),
-       vk::Descriptor(c.frame.blue_noise.view(), read_only, point), vk::Descriptor(c.frame.lights),
-       vk::Descriptor(*c.frame.rectification),
+       {MSM_BINDING_SCATTER_SHADOW_MAP,
+        prefiltered() ? vk::Descriptor(c.image(kPrefixSums).array_view, read_only, *c.frame.repeat_sampler)
+                      : vk::Descriptor(c.image(kShadowDepth).array_view, read_only, point)},
+       {MSM_BINDING_SCATTER_BLUE_NOISE, vk::Descriptor(c.frame.blue_noise.view(), read_only, point)},
+       {MSM_BINDING_SCATTER_LIGHTS, vk::Descriptor(c.frame.lights)},
+       {MSM_BINDING_SCATTER_RECTS, vk::Descriptor(*c.frame.rectification)},
        // The second image of six moments (the others: any 2D image, unused).
-       six_moments() ? vk::Descriptor(c.image(kPrefixSums1).array_view, read_only, *c.frame.repeat_sampler)
-                     : vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, *c.frame.repeat_sampler)},
+       {MSM_BINDING_SCATTER_PREFIX_SUMS1,
+        six_moments() ? vk::Descriptor(c.image(kPrefixSums1).array_view, read_only, *c.frame.repeat_sampler)
+                      : vk::Descriptor(c.image(kSurfaceRadiance).layer_views[0], read_only, *c.frame.repeat_sampler)}},
       c.frame.scattering);
   vkCmdDraw(c.cmd, 3, 1, 0, 0);
   vkCmdEndRendering(c.cmd);

@@ -38,13 +38,33 @@ std::string fragment_shader(const FrameConfig& config, Stage stage) {
   }
 }
 
+// The shading's layout, the same for every technique and stage (msm/render/bindings.h).
+std::vector<vk::Binding> shading_bindings() {
+  using B = vk::Binding;
+  return vk::bindings_at({{MSM_BINDING_FRAME, B::uniform_buffer},
+                          {MSM_BINDING_SHADING_ALBEDO_TEXTURE, B::sampled_image},
+                          {MSM_BINDING_SHADING_SHADOW_MAP, B::sampled_image},
+                          {MSM_BINDING_SHADING_SHADOW_MAP1, B::sampled_image},
+                          {MSM_BINDING_SHADING_BLUE_NOISE, B::sampled_image},
+                          {MSM_BINDING_SHADING_OPACITY_TEXTURE, B::sampled_image},
+                          {MSM_BINDING_SHADING_GREEN_MOMENTS, B::sampled_image},
+                          {MSM_BINDING_SHADING_GREEN_MOMENTS1, B::sampled_image},
+                          {MSM_BINDING_SHADING_BLUE_MOMENTS, B::sampled_image},
+                          {MSM_BINDING_SHADING_BLUE_MOMENTS1, B::sampled_image},
+                          {MSM_BINDING_SHADING_LIGHTS, B::storage_buffer},
+                          {MSM_BINDING_SHADING_SURFACE_POSITION, B::sampled_image},
+                          {MSM_BINDING_SHADING_SURFACE_NORMAL, B::sampled_image},
+                          {MSM_BINDING_SHADING_SURFACE_ALBEDO, B::sampled_image},
+                          {MSM_BINDING_SHADING_SOFT_CLAMPS, B::storage_buffer}});
+}
+
 vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
   const Technique& technique = *config.technique;
   vk::GraphicsDesc d{.name =
                          std::string(stage == Stage::surfaces ? "surfaces " : "shading ") + std::string(technique.name),
                      .vertex_shader = "shading.vert",
                      .fragment_shader = fragment_shader(config, stage),
-                     .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image},
+                     .bindings = shading_bindings(),
                      .push_constant_size = sizeof(ObjectPush),
                      .vertex_stride = sizeof(Vertex),
                      .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
@@ -68,27 +88,19 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;
     d.constants.push_back({MSM_SPEC_LINEAR_RADIANCE, 1u});
   }
-  // Second moment image, blue noise, opacity texture, the green and blue channels' moment images
-  // (coloured translucency), then the lights (binding 10); the same layout for every technique.
-  for (int i = 0; i < 7; ++i) d.bindings.push_back(vk::Binding::sampled_image);
-  d.bindings.push_back(vk::Binding::storage_buffer);
   if (stage == Stage::translucent) { // over the opaque image; the shadow buffer keeps the opaque surface's
     d.name += " (translucent)";
     d.alpha_blend = true;
     d.color_write_masks = {VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT, 0};
   } else if (stage == Stage::surfaces) { // position, normal, albedo: exact, as the forward pass has them
     d.color_formats.assign(3, VK_FORMAT_R32G32B32A32_SFLOAT);
-  } else if (stage == Stage::deferred) { // the surfaces (bindings 11-13), a full-screen triangle
+  } else if (stage == Stage::deferred) { // the surfaces (the surface bindings), a full-screen triangle
     d.name += " (deferred)";
     d.vertex_shader = "fullscreen.vert";
     d.vertex_stride = 0;
     d.attributes.clear();
     d.depth_compare = VK_COMPARE_OP_ALWAYS; // the translucent draws after it test against the surfaces
   }
-  // The surfaces (deferred; white images in the forward passes), then the soft techniques' count of
-  // lookups clamped by the kernel (binding 14, soft_clamps.glsl).
-  for (int i = 0; i < 3; ++i) d.bindings.push_back(vk::Binding::sampled_image);
-  d.bindings.push_back(vk::Binding::storage_buffer);
   return d;
 }
 
@@ -101,7 +113,8 @@ vk::GraphicsDesc background_desc(const FrameConfig& config) {
   return {.name = "background (probe)",
           .vertex_shader = "background.vert",
           .fragment_shader = "background.frag",
-          .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image},
+          .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                       {MSM_BINDING_BACKGROUND_PROBE, vk::Binding::sampled_image}}),
           .push_constant_size = sizeof(ScatteringPush),
           .color_formats = {linear ? VK_FORMAT_R16G16B16A16_SFLOAT : VK_FORMAT_R8G8B8A8_SRGB,
                             VK_FORMAT_R32G32B32A32_SFLOAT},
@@ -111,10 +124,10 @@ vk::GraphicsDesc background_desc(const FrameConfig& config) {
           .color_write_masks = {VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT |
                                     VK_COLOR_COMPONENT_A_BIT,
                                 0},
-          .constants = {{5, linear ? 1u : 0u}}};
+          .constants = {{MSM_SPEC_LINEAR_RADIANCE, linear ? 1u : 0u}}};
 }
 
-// The shading's bindings 0-14 but the per-draw textures (1 and 5): the uniforms, the shadow maps of
+// The shading's bindings but the per-draw textures (albedo, opacity): the uniforms, the shadow maps of
 // the technique (a white image of the declared kind in the bindings it does not read: every
 // declared binding needs a valid descriptor), the blue noise, the lights, white images in place of
 // the deferred pass's surfaces and the soft techniques' clamp counts.
@@ -147,24 +160,24 @@ std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameC
       for (int i = 0; i < 2; ++i)
         colour[size_t(2 * (channel - 1) + i)] =
             array_of(moment_image(channel, std::min(i, config.moment_images() - 1)), moment_sampler);
-  return {vk::Descriptor(c.frame.uniforms),
-          white,
-          first,
-          second,
-          noise,
-          white,
-          colour[0],
-          colour[1],
-          colour[2],
-          colour[3],
-          vk::Descriptor(c.frame.lights),
-          white,
-          white,
-          white,
-          vk::Descriptor(*c.frame.soft_clamps)};
+  return vk::descriptors_at({{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+                             {MSM_BINDING_SHADING_ALBEDO_TEXTURE, white},
+                             {MSM_BINDING_SHADING_SHADOW_MAP, first},
+                             {MSM_BINDING_SHADING_SHADOW_MAP1, second},
+                             {MSM_BINDING_SHADING_BLUE_NOISE, noise},
+                             {MSM_BINDING_SHADING_OPACITY_TEXTURE, white},
+                             {MSM_BINDING_SHADING_GREEN_MOMENTS, colour[0]},
+                             {MSM_BINDING_SHADING_GREEN_MOMENTS1, colour[1]},
+                             {MSM_BINDING_SHADING_BLUE_MOMENTS, colour[2]},
+                             {MSM_BINDING_SHADING_BLUE_MOMENTS1, colour[3]},
+                             {MSM_BINDING_SHADING_LIGHTS, vk::Descriptor(c.frame.lights)},
+                             {MSM_BINDING_SHADING_SURFACE_POSITION, white},
+                             {MSM_BINDING_SHADING_SURFACE_NORMAL, white},
+                             {MSM_BINDING_SHADING_SURFACE_ALBEDO, white},
+                             {MSM_BINDING_SHADING_SOFT_CLAMPS, vk::Descriptor(*c.frame.soft_clamps)}});
 }
 
-// Draws the scene's `draws` (in that order) with `program`, each with its textures (bindings 1, 5).
+// Draws the scene's `draws` (in that order) with `program`, each with its albedo and opacity textures.
 void draw_scene(const PassContext& c, const vk::Program& program, std::vector<vk::Descriptor> descriptors,
                 std::span<const Draw* const> draws) {
   const GpuScene& scene = c.frame.scene;
@@ -172,8 +185,8 @@ void draw_scene(const PassContext& c, const vk::Program& program, std::vector<vk
     const vk::Image& texture = d->texture >= 0 ? scene.textures[size_t(d->texture)] : scene.white;
     const vk::Image& opacity =
         d->opacity_texture >= 0 ? scene.opacity_textures[size_t(d->opacity_texture)] : scene.white;
-    descriptors[1] = vk::Descriptor(texture.view(), kReadOnly, scene.texture_sampler);
-    descriptors[5] = vk::Descriptor(opacity.view(), kReadOnly, scene.texture_sampler);
+    descriptors[MSM_BINDING_SHADING_ALBEDO_TEXTURE] = vk::Descriptor(texture.view(), kReadOnly, scene.texture_sampler);
+    descriptors[MSM_BINDING_SHADING_OPACITY_TEXTURE] = vk::Descriptor(opacity.view(), kReadOnly, scene.texture_sampler);
     vkCmdSetCullMode(c.cmd, d->double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_BACK_BIT);
     vk::bind_program(c.cmd, program, descriptors, std::as_bytes(std::span(&d->push, 1)));
     vkCmdDrawIndexed(c.cmd, d->index_count, 1, d->first_index, 0, 0);
@@ -262,9 +275,12 @@ void ShadingPass::execute(const PassContext& c) const {
   std::vector<vk::Descriptor> descriptors = frame_descriptors(c, config_, true);
   if (config_.deferred) { // one full-screen triangle over the surfaces
     std::vector<vk::Descriptor> deferred = descriptors;
-    size_t binding = 11;
-    for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo})
-      deferred[binding++] = vk::Descriptor(c.image(name).layer_views[0], kReadOnly, c.frame.point_sampler);
+    auto surface = [&](const char* name) {
+      return vk::Descriptor(c.image(name).layer_views[0], kReadOnly, c.frame.point_sampler);
+    };
+    deferred[MSM_BINDING_SHADING_SURFACE_POSITION] = surface(kSurfacePosition);
+    deferred[MSM_BINDING_SHADING_SURFACE_NORMAL] = surface(kSurfaceNormal);
+    deferred[MSM_BINDING_SHADING_SURFACE_ALBEDO] = surface(kSurfaceAlbedo);
     vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
     ObjectPush none{};
     vk::bind_program(c.cmd, *program_, deferred, std::as_bytes(std::span(&none, 1)));
@@ -276,7 +292,8 @@ void ShadingPass::execute(const PassContext& c) const {
     vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
     vk::bind_program(
         c.cmd, *background_program_,
-        {vk::Descriptor(c.frame.uniforms), vk::Descriptor(scene.probe.view(), kReadOnly, c.frame.point_sampler)},
+        {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+         {MSM_BINDING_BACKGROUND_PROBE, vk::Descriptor(scene.probe.view(), kReadOnly, c.frame.point_sampler)}},
         std::as_bytes(std::span(&c.frame.scattering, 1)));
     vkCmdDraw(c.cmd, 3, 1, 0, 0);
   }

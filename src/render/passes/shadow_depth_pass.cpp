@@ -11,21 +11,25 @@ void bind_scene(VkCommandBuffer cmd, const GpuScene& scene) {
 
 void ShadowDepthPass::prepare(const PassResources& r) {
   const FrameConfig& config = config_;
-  program_ = &r.programs.graphics({.name = "shadow_depth",
-                                   .vertex_shader = "shadow_depth.vert",
-                                   .bindings = {vk::Binding::uniform_buffer, vk::Binding::storage_buffer},
-                                   .push_constant_size = sizeof(ObjectPush),
-                                   .vertex_stride = sizeof(Vertex),
-                                   .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}},
-                                   .depth_format = VK_FORMAT_D16_UNORM,
-                                   .samples = VkSampleCountFlagBits(config.msaa),
-                                   // casters in front of the fitted near plane still cast
-                                   .depth_clamp = true});
+  program_ = &r.programs.graphics(
+      {.name = "shadow_depth",
+       .vertex_shader = "shadow_depth.vert",
+       .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                    {MSM_BINDING_SHADOW_DEPTH_LIGHTS, vk::Binding::storage_buffer}}),
+       .push_constant_size = sizeof(ObjectPush),
+       .vertex_stride = sizeof(Vertex),
+       .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, 0}},
+       .depth_format = VK_FORMAT_D16_UNORM,
+       .samples = VkSampleCountFlagBits(config.msaa),
+       // casters in front of the fitted near plane still cast
+       .depth_clamp = true});
   masked_program_ = &r.programs.graphics(
       {.name = "shadow_depth (alpha-tested)",
        .vertex_shader = "shadow_depth_masked.vert",
        .fragment_shader = "shadow_depth_masked.frag",
-       .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::storage_buffer},
+       .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                    {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY, vk::Binding::sampled_image},
+                                    {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Binding::storage_buffer}}),
        .push_constant_size = sizeof(ObjectPush),
        .vertex_stride = sizeof(Vertex),
        .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
@@ -74,15 +78,19 @@ void ShadowDepthPass::execute(const PassContext& c) const {
         push.light.x = l;
         vk::bind_program(
             c.cmd, *masked_program_,
-            {vk::Descriptor(c.frame.uniforms),
-             vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler),
-             vk::Descriptor(c.frame.lights)},
+            {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+             {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY,
+              vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler)},
+             {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Descriptor(c.frame.lights)}},
             push);
         bound = masked_program_;
       } else if (bound != program_) {
         ObjectPush push{};
         push.light.x = l;
-        vk::bind_program(c.cmd, *program_, {vk::Descriptor(c.frame.uniforms), vk::Descriptor(c.frame.lights)}, push);
+        vk::bind_program(c.cmd, *program_,
+                         {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+                          {MSM_BINDING_SHADOW_DEPTH_LIGHTS, vk::Descriptor(c.frame.lights)}},
+                         push);
         bound = program_;
       }
       vkCmdDrawIndexed(c.cmd, d.index_count, 1, d.first_index, 0, 0);

@@ -15,8 +15,10 @@ vk::GraphicsDesc translucent_desc(const FrameConfig& config) {
       .name = std::string("translucent ") + std::string(config.technique->name),
       .vertex_shader = "translucent.vert",
       .fragment_shader = fragment,
-      .bindings = {vk::Binding::uniform_buffer, vk::Binding::sampled_image, vk::Binding::sampled_image,
-                   vk::Binding::storage_buffer},
+      .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                   {MSM_BINDING_TRANSLUCENT_OPACITY, vk::Binding::sampled_image},
+                                   {MSM_BINDING_TRANSLUCENT_DEPTH, vk::Binding::sampled_image},
+                                   {MSM_BINDING_TRANSLUCENT_LIGHTS, vk::Binding::storage_buffer}}),
       .push_constant_size = sizeof(ObjectPush),
       .vertex_stride = sizeof(Vertex),
       .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
@@ -73,11 +75,14 @@ void TranslucentPass::execute(const PassContext& c) const {
       push.light.x = l;
       const vk::Image& opacity =
           d->opacity_texture >= 0 ? scene.opacity_textures[size_t(d->opacity_texture)] : scene.white;
-      vk::bind_program(c.cmd, *program_,
-                       {vk::Descriptor(c.frame.uniforms),
-                        vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler),
-                        depth_samples, vk::Descriptor(c.frame.lights)},
-                       push);
+      vk::bind_program(
+          c.cmd, *program_,
+          {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
+           {MSM_BINDING_TRANSLUCENT_OPACITY,
+            vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler)},
+           {MSM_BINDING_TRANSLUCENT_DEPTH, depth_samples},
+           {MSM_BINDING_TRANSLUCENT_LIGHTS, vk::Descriptor(c.frame.lights)}},
+          push);
       vkCmdDrawIndexed(c.cmd, d->index_count, 1, d->first_index, 0, 0);
     }
     vkCmdEndRendering(c.cmd);

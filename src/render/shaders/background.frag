@@ -8,7 +8,7 @@
 
 layout(constant_id = MSM_SPEC_LINEAR_RADIANCE) const bool kLinearRadiance = false;
 
-layout(binding = 1) uniform sampler2DArray probe; // six faces of linear RGB radiance
+layout(binding = MSM_BINDING_BACKGROUND_PROBE) uniform sampler2DArray probe; // six faces of linear RGB radiance
 layout(push_constant) uniform Push { ScatteringPush scatter; };
 
 layout(location = 0) out vec4 out_color;

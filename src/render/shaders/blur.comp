@@ -14,9 +14,9 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0) uniform sampler2D source;
-layout(binding = 1) writeonly uniform image2D target;
-layout(binding = 2) writeonly uniform image2D target_mip1; // kMip1
+layout(binding = MSM_BINDING_BLUR_SOURCE) uniform sampler2D source;
+layout(binding = MSM_BINDING_BLUR_TARGET) writeonly uniform image2D target;
+layout(binding = MSM_BINDING_BLUR_TARGET_MIP1) writeonly uniform image2D target_mip1; // kMip1
 
 layout(push_constant) uniform Push { ImagePassPush pc; };
 

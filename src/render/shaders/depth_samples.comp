@@ -5,8 +5,8 @@
 #include "msm/render/frame.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0) uniform sampler2DMS depth_map;
-layout(std430, binding = 1) writeonly buffer Samples { float samples[]; };
+layout(binding = MSM_BINDING_DEPTH_SAMPLES_MAP) uniform sampler2DMS depth_map;
+layout(std430, binding = MSM_BINDING_DEPTH_SAMPLES_BUFFER) writeonly buffer Samples { float samples[]; };
 layout(push_constant) uniform Push { ImagePassPush pc; }; // size.xy, size.z = samples
 
 void main() {

@@ -1,10 +1,10 @@
 // Shared by the renderer's shaders: the frame's uniform block, the lights and the shading helpers.
 #include "msm/render/frame.h"
 
-layout(std140, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+layout(std140, binding = MSM_BINDING_FRAME) uniform FrameBlock { FrameUniforms frame; };
 
 // The frame's lights (FrameUniforms::lights.x of them), at the binding the including shader
-// names with MSM_LIGHT_BINDING (every pipeline's bindings are positional).
+// defines as MSM_LIGHT_BINDING (one of msm/render/bindings.h's names).
 #ifdef MSM_LIGHT_BINDING
 layout(std430, binding = MSM_LIGHT_BINDING) readonly buffer LightBlock { LightUniforms lights[]; };
 #endif

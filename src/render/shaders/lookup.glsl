@@ -1,6 +1,7 @@
 // Shadow-map lookups of the filtered techniques (MSM_LOOKUP_*): where to read, and the
 // bilinear weights. The blue-noise textures (64 layers, RG8) dither the nearest lookup.
-layout(binding = 4) uniform sampler2DArray blue_noise;
+#include "msm/render/bindings.h"
+layout(binding = MSM_BINDING_SHADING_BLUE_NOISE) uniform sampler2DArray blue_noise;
 
 // Texel-centre coordinate t (texel i covers [i - 0.5, i + 0.5)) -> the texel a nearest or
 // dithered lookup reads, clamped to the map.

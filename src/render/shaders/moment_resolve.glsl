@@ -9,11 +9,11 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 // The mean of the front- and back-face depth (Kneiphof §4.2.3; FrameConfig::front_back).
 layout(constant_id = MSM_SPEC_FRONT_BACK) const bool kFrontBack = false;
-#define MSM_DEPTH_BINDING 1
-#define MSM_BACK_DEPTH_BINDING 4
+#define MSM_DEPTH_BINDING MSM_BINDING_RESOLVE_DEPTH
+#define MSM_BACK_DEPTH_BINDING MSM_BINDING_RESOLVE_BACK_DEPTH
 #include "depth_map.glsl"
-layout(binding = 2) writeonly uniform image2D moments0;
-layout(binding = 3) writeonly uniform image2D moments1; // second half of 6MSM; else moments0 again
+layout(binding = MSM_BINDING_RESOLVE_MOMENTS0) writeonly uniform image2D moments0;
+layout(binding = MSM_BINDING_RESOLVE_MOMENTS1) writeonly uniform image2D moments1; // second half of 6MSM; else moments0 again
 
 layout(push_constant) uniform Push { ImagePassPush pc; };
 

@@ -36,12 +36,12 @@ const int kTileW = kStripW + 2 * kRadius; // with the horizontal apron
 const int kApron = kStep * 2 * kRadius;   // apron texels per step
 const int kApronRounds = (kApron + kThreads - 1) / kThreads;
 
-#define MSM_DEPTH_BINDING 1
+#define MSM_DEPTH_BINDING MSM_BINDING_ONE_PASS_DEPTH
 #include "depth_map.glsl"
 #ifdef MSM_NL32
-layout(binding = 2) writeonly uniform uimage2D target;
+layout(binding = MSM_BINDING_ONE_PASS_TARGET) writeonly uniform uimage2D target;
 #else
-layout(binding = 2) writeonly uniform image2D target;
+layout(binding = MSM_BINDING_ONE_PASS_TARGET) writeonly uniform image2D target;
 #endif
 
 layout(push_constant) uniform Push { ImagePassPush pc; };

@@ -20,24 +20,24 @@
 #include "msm/render/rectification_uniforms.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std430, binding = 0) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+layout(std430, binding = MSM_BINDING_PREFIX_RECTS) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 layout(push_constant) uniform Push { ImagePassPush pass; }; // size.z: the light
-layout(binding = 2, MSM_PREFIX_FORMAT0) uniform writeonly image2DArray prefix_sums; // every light's layers
+layout(binding = MSM_BINDING_PREFIX_TARGET, MSM_PREFIX_FORMAT0) uniform writeonly image2DArray prefix_sums; // every light's layers
 #ifdef MSM_CSM
-layout(binding = 1) uniform sampler2DArray rectified; // float coefficients, texelFetch only
+layout(binding = MSM_BINDING_PREFIX_SOURCE) uniform sampler2DArray rectified; // float coefficients, texelFetch only
 #define kTerm (int(gl_WorkGroupID.z) % MSM_CSM_MAX_TEXELS)
 #define kLayer (int(gl_WorkGroupID.z) / MSM_CSM_MAX_TEXELS)
 #define MSM_TEXEL(x, y) ivec3(x, y, MSM_CSM_MAX_TEXELS * pass.size.z + kTerm)
 #define MSM_OUT(x, y) ivec3(x, y, MSM_CSM_MAX_TEXELS * (pass.size.w * pass.size.z + kLayer) + kTerm)
 #else
-layout(binding = 1) uniform sampler2D rectified; // float moments, texelFetch only
+layout(binding = MSM_BINDING_PREFIX_SOURCE) uniform sampler2D rectified; // float moments, texelFetch only
 #define kLayer int(gl_WorkGroupID.z)
 #define MSM_TEXEL(x, y) ivec2(x, y)
 #define MSM_OUT(x, y) ivec3(x, y, pass.size.w * pass.size.z + kLayer)
 #endif
 #ifdef MSM_SIX_MOMENTS
-layout(binding = 3) uniform sampler2D rectified1;
-layout(binding = 4, MSM_PREFIX_FORMAT1) uniform writeonly image2DArray prefix_sums1;
+layout(binding = MSM_BINDING_PREFIX_SOURCE1) uniform sampler2D rectified1;
+layout(binding = MSM_BINDING_PREFIX_TARGET1, MSM_PREFIX_FORMAT1) uniform writeonly image2DArray prefix_sums1;
 #endif
 
 layout(constant_id = MSM_PREFIX_ROWS_SPEC_ID) const bool kRowSweep = true;

@@ -19,26 +19,26 @@
 // a caster, gets the farthest rectified depth: nothing on it shadows any view ray.
 #include "msm/render/rectification_uniforms.h"
 #include "msm/quantize.h"
-#define MSM_LIGHT_BINDING 2
+#define MSM_LIGHT_BINDING MSM_BINDING_RECTIFY_LIGHTS
 #include "frame.glsl"
 #ifdef MSM_FILTERED_MAP
-layout(binding = 3) uniform sampler2D resampling_moments; // the light's layer, every mip, trilinear
+layout(binding = MSM_BINDING_RECTIFY_SOURCE) uniform sampler2D resampling_moments; // the light's layer, every mip, trilinear
 #else
-#define MSM_DEPTH_BINDING 3
+#define MSM_DEPTH_BINDING MSM_BINDING_RECTIFY_SOURCE
 #include "depth_map.glsl"
 layout(constant_id = MSM_RECTIFY_ON_THE_FLY_SPEC_ID) const bool kOnTheFlyFilter = false; // parameter x = 2
 #endif
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(std430, binding = 1) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+layout(std430, binding = MSM_BINDING_RECTIFY_RECTS) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 layout(push_constant) uniform Push { ImagePassPush pass; }; // size.z: the light
 #ifdef MSM_CSM
-layout(binding = 4, rgba16f) uniform writeonly image2DArray rectified;
+layout(binding = MSM_BINDING_RECTIFY_TARGET, rgba16f) uniform writeonly image2DArray rectified;
 #else
-layout(binding = 4, rgba32f) uniform writeonly image2D rectified;
+layout(binding = MSM_BINDING_RECTIFY_TARGET, rgba32f) uniform writeonly image2D rectified;
 #endif
 #ifdef MSM_SIX_MOMENTS
-layout(binding = 5, rgba32f) uniform writeonly image2D rectified1;
+layout(binding = MSM_BINDING_RECTIFY_TARGET1, rgba32f) uniform writeonly image2D rectified1;
 #endif
 
 void main() {

@@ -15,7 +15,7 @@
 #include "msm/ray_march.h"
 #include "msm/render/rectification_uniforms.h"
 #include "msm/shading.h"
-#define MSM_LIGHT_BINDING 5
+#define MSM_LIGHT_BINDING MSM_BINDING_SCATTER_LIGHTS
 #include "frame.glsl"
 #include "light_loop.glsl"
 #ifdef MSM_SCATTER_PREFILTERED
@@ -24,20 +24,20 @@
 layout(constant_id = MSM_SPEC_SCATTER_LAYERS) const int kLayers = 1;
 layout(constant_id = MSM_SPEC_PREFIX_SUM_MIPS) const bool kPrefixSumMips = false; // FrameConfig::prefix_sum_mips > 1
 layout(constant_id = MSM_SPEC_SCATTER_BETA_MODE) const int kBetaMode = 0; // FrameConfig::scattering_beta: MSM_SCATTERING_BETA_*
-layout(binding = 3) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
-layout(std430, binding = 6) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+layout(binding = MSM_BINDING_SCATTER_SHADOW_MAP) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
+layout(std430, binding = MSM_BINDING_SCATTER_RECTS) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 #ifdef MSM_SIX_MOMENTS
-layout(binding = 7) uniform sampler2DArray prefix_sums1; // Θ6* image 1
+layout(binding = MSM_BINDING_SCATTER_PREFIX_SUMS1) uniform sampler2DArray prefix_sums1; // Θ6* image 1
 #endif
 #else
-#define MSM_DEPTH_BINDING 3
+#define MSM_DEPTH_BINDING MSM_BINDING_SCATTER_SHADOW_MAP
 #define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
 #endif
 
-layout(binding = 1) uniform sampler2D surface_radiance; // linear, before exposure
-layout(binding = 2) uniform sampler2D camera_depth;
-layout(binding = 4) uniform sampler2DArray blue_noise;
+layout(binding = MSM_BINDING_SCATTER_SURFACE_RADIANCE) uniform sampler2D surface_radiance; // linear, before exposure
+layout(binding = MSM_BINDING_SCATTER_CAMERA_DEPTH) uniform sampler2D camera_depth;
+layout(binding = MSM_BINDING_SCATTER_BLUE_NOISE) uniform sampler2DArray blue_noise;
 layout(push_constant) uniform Push { ScatteringPush scatter; };
 
 layout(location = 0) out vec4 out_color;      // tone mapped; the attachment is sRGB

@@ -6,7 +6,7 @@
 #include "msm/footprint.h"
 #include "msm/shading.h"
 #include "msm/techniques.h"
-#define MSM_LIGHT_BINDING 10
+#define MSM_LIGHT_BINDING MSM_BINDING_SHADING_LIGHTS
 #include "frame.glsl"
 #include "light_loop.glsl"
 // Scattering techniques: the colour attachment takes linear radiance (before exposure and tone
@@ -20,17 +20,17 @@ layout(constant_id = MSM_SPEC_TEXTURED_DRAWS) const bool kTexturedDraws = true;
 // a constant, so that frames without them compile none of their loop.
 layout(constant_id = MSM_SPEC_SUB_LIGHTS) const bool kSubLights = false;
 
-layout(binding = 1) uniform sampler2D albedo_texture;
-layout(binding = 5) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
+layout(binding = MSM_BINDING_SHADING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
+layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
 layout(push_constant) uniform Push { ObjectPush object; };
 
 #ifdef MSM_DEFERRED_SHADOWS
 // Deferred shading (a full-screen pass): the visible surface of each pixel from the surfaces pass
 // (MSM_SURFACES below), bit for bit what the forward pass interpolates, so one shadow evaluation per
 // pixel gives the forward pass's result.
-layout(binding = 11) uniform sampler2D surface_position; // xyz; w: 1 where a surface, 0 background
-layout(binding = 12) uniform sampler2D surface_normal;   // xyz: towards the viewer
-layout(binding = 13) uniform sampler2D surface_albedo;   // rgb, a: opacity
+layout(binding = MSM_BINDING_SHADING_SURFACE_POSITION) uniform sampler2D surface_position; // xyz; w: 1 where a surface, 0 background
+layout(binding = MSM_BINDING_SHADING_SURFACE_NORMAL) uniform sampler2D surface_normal;   // xyz: towards the viewer
+layout(binding = MSM_BINDING_SHADING_SURFACE_ALBEDO) uniform sampler2D surface_albedo;   // rgb, a: opacity
 vec3 world_position;
 #else
 layout(location = 0) in vec3 world_position;

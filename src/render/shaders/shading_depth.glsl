@@ -5,7 +5,7 @@
 #include "msm/soft.h"
 #include "shading.glsl"
 #include "soft_clamps.glsl"
-#define MSM_DEPTH_BINDING 2
+#define MSM_DEPTH_BINDING MSM_BINDING_SHADING_SHADOW_MAP
 #define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
 

@@ -5,14 +5,15 @@
 // defines MSM_COLOURED_SHADOWS) once per colour channel. A separate shader, not a specialization
 // constant: lavapipe compiled the three reconstructions even where the constant disabled them,
 // tripling the pipeline build time of every linear technique.
-layout(binding = 2) uniform sampler2DArray moments0;
-layout(binding = 3) uniform sampler2DArray moments1; // second half of 6MSM; else moments0 again
+#include "msm/render/bindings.h"
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP) uniform sampler2DArray moments0;
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP1) uniform sampler2DArray moments1; // second half of 6MSM; else moments0 again
 // Coloured translucency: the green and blue channels' moment images (bound to moments0/1 where the
 // frame has none; only shading_moments_rgb.frag reads them).
-layout(binding = 6) uniform sampler2DArray moments0_g;
-layout(binding = 7) uniform sampler2DArray moments1_g;
-layout(binding = 8) uniform sampler2DArray moments0_b;
-layout(binding = 9) uniform sampler2DArray moments1_b;
+layout(binding = MSM_BINDING_SHADING_GREEN_MOMENTS) uniform sampler2DArray moments0_g;
+layout(binding = MSM_BINDING_SHADING_GREEN_MOMENTS1) uniform sampler2DArray moments1_g;
+layout(binding = MSM_BINDING_SHADING_BLUE_MOMENTS) uniform sampler2DArray moments0_b;
+layout(binding = MSM_BINDING_SHADING_BLUE_MOMENTS1) uniform sampler2DArray moments1_b;
 #include "shading.glsl"
 #include "lookup.glsl"
 

@@ -2,12 +2,13 @@
 // texels cannot be interpolated as stored: nearest and dithered lookups decode one texel; the
 // true bilinear lookup decodes four, converts each back to moments (Eq. 4), interpolates those
 // and applies Φ again.
+#include "msm/render/bindings.h"
 #ifdef MSM_NL32
-layout(binding = 2) uniform usampler2DArray moments0;
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP) uniform usampler2DArray moments0;
 #else
-layout(binding = 2) uniform sampler2DArray moments0;
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP) uniform sampler2DArray moments0;
 #endif
-layout(binding = 3) uniform sampler2DArray unused_second_image; // the shading layout of every filtered technique
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP1) uniform sampler2DArray unused_second_image; // the shading layout of every filtered technique
 #include "shading.glsl"
 #include "lookup.glsl"
 

@@ -4,8 +4,9 @@
 // specialization each: mssm4 (Θ4*, one table), mssm6 (Θ6*, two tables, Kneiphof §4.2) and vssm (two
 // moments, naive variance soft shadows: the baseline), and the convolution soft shadows cssm8 /
 // cssm16 (cssm.h: CSM tiles stacked in one table).
-layout(binding = 2) uniform usampler2DArray sat_table;
-layout(binding = 3) uniform usampler2DArray sat_table1; // six moments: b4, b6; else the first again
+#include "msm/render/bindings.h"
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP) uniform usampler2DArray sat_table;
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP1) uniform usampler2DArray sat_table1; // six moments: b4, b6; else the first again
 #include "shading.glsl"
 #include "soft_clamps.glsl"
 

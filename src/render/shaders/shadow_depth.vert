@@ -2,7 +2,8 @@
 // draw per light, into its layer of the depth array (ObjectPush::light).
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#define MSM_LIGHT_BINDING 1
+#include "msm/render/bindings.h"
+#define MSM_LIGHT_BINDING MSM_BINDING_SHADOW_DEPTH_LIGHTS
 #include "frame.glsl"
 
 layout(location = 0) in vec3 position;

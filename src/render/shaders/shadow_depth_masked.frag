@@ -4,7 +4,7 @@
 #include "frame.glsl"
 #include "alpha_test.glsl"
 
-layout(binding = 1) uniform sampler2D opacity_texture;
+layout(binding = MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY) uniform sampler2D opacity_texture;
 layout(push_constant) uniform Push { ObjectPush object; };
 
 layout(location = 0) in vec2 texcoord;

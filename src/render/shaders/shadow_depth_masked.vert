@@ -2,7 +2,8 @@
 // clip space and the texture coordinate of the opacity texture.
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#define MSM_LIGHT_BINDING 2
+#include "msm/render/bindings.h"
+#define MSM_LIGHT_BINDING MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS
 #include "frame.glsl"
 
 layout(location = 0) in vec3 position;

@@ -2,7 +2,8 @@
 // of the opacity texture. One draw per light and object, into the light's layer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#define MSM_LIGHT_BINDING 3
+#include "msm/render/bindings.h"
+#define MSM_LIGHT_BINDING MSM_BINDING_TRANSLUCENT_LIGHTS
 #include "frame.glsl"
 
 layout(location = 0) in vec3 position;

@@ -7,8 +7,8 @@
 #include "msm/techniques.h"
 #include "frame.glsl"
 
-layout(binding = 1) uniform sampler2D opacity_texture;
-#define MSM_DEPTH_BINDING 2
+layout(binding = MSM_BINDING_TRANSLUCENT_OPACITY) uniform sampler2D opacity_texture;
+#define MSM_DEPTH_BINDING MSM_BINDING_TRANSLUCENT_DEPTH
 #include "depth_map.glsl"
 layout(push_constant) uniform Push { ObjectPush object; };
 

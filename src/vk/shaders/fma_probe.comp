@@ -5,13 +5,15 @@
 // consumed by a `precise` variable (SPIR-V NoContraction), which a driver may lower differently.
 // The inputs come from the buffer, so neither glslc nor the driver can fold them.
 #version 460
+#extension GL_GOOGLE_include_directive : require
+#include "vk_bindings.h"
 
 layout(local_size_x = 64) in;
 
 // Per case i of count = v.length() / 3: v[i] = (a, b, c, unused) and a copy of it in v[count + i]
 // (separate loads, so that the optimizer cannot merge the two fma()), results (fma, precise fma,
 // 0, 0) in v[2 count + i].
-layout(std430, binding = 0) buffer Cases { vec4 v[]; };
+layout(std430, binding = MSM_BINDING_FMA_PROBE_CASES) buffer Cases { vec4 v[]; };
 
 void main() {
   uint count = uint(v.length()) / 3u;

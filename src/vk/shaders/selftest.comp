@@ -3,11 +3,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "msm/shared.h"
+#include "vk_bindings.h"
 
 layout(local_size_x = 64) in;
 
-layout(binding = 0) readonly buffer Source { float src[]; };
-layout(binding = 1) writeonly buffer Destination { float dst[]; };
+layout(binding = MSM_BINDING_SELFTEST_SOURCE) readonly buffer Source { float src[]; };
+layout(binding = MSM_BINDING_SELFTEST_DESTINATION) writeonly buffer Destination { float dst[]; };
 layout(push_constant) uniform Push { uint count; } pc;
 
 void main() {

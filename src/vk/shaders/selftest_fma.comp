@@ -4,11 +4,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "msm/shared.h"
+#include "vk_bindings.h"
 
 layout(local_size_x = 64) in;
 
-layout(std430, binding = 0) readonly buffer Source { vec4 src[]; };
-layout(std430, binding = 1) writeonly buffer Destination { float dst[]; };
+layout(std430, binding = MSM_BINDING_SELFTEST_SOURCE) readonly buffer Source { vec4 src[]; };
+layout(std430, binding = MSM_BINDING_SELFTEST_DESTINATION) writeonly buffer Destination { float dst[]; };
 layout(push_constant) uniform Push { uint count; } pc;
 
 void main() {

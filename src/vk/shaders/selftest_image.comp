@@ -2,13 +2,15 @@
 //   result(p) = source(p) * scale + texelFetch(table, p) + offset + vec4(p, layer, 0)
 // (values chosen by the test so that every step is exact, whatever the rounding or fusing).
 #version 460
+#extension GL_GOOGLE_include_directive : require
+#include "vk_bindings.h"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-layout(binding = 0, rgba32f) uniform readonly image2D source;
-layout(binding = 1, rgba32f) uniform writeonly image2D result;
-layout(binding = 2) uniform sampler2D table;
-layout(binding = 3) uniform Params { vec4 offset; } params;
+layout(binding = MSM_BINDING_SELFTEST_IMAGE_SOURCE, rgba32f) uniform readonly image2D source;
+layout(binding = MSM_BINDING_SELFTEST_IMAGE_RESULT, rgba32f) uniform writeonly image2D result;
+layout(binding = MSM_BINDING_SELFTEST_IMAGE_TABLE) uniform sampler2D table;
+layout(binding = MSM_BINDING_SELFTEST_IMAGE_PARAMS) uniform Params { vec4 offset; } params;
 layout(push_constant) uniform Push {
   ivec2 size;
   float scale;

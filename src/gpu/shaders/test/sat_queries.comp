@@ -5,16 +5,16 @@
 #include "msm/shared.h"
 
 layout(local_size_x = 64) in;
-// Moment techniques: the first and the second table (six moments); CSSM: the stacked tiles in the first.
-layout(binding = 0, rgba32ui) uniform readonly uimage2D table0;
-layout(binding = 1, rgba32ui) uniform readonly uimage2D table1;
 
-uvec4 sat_fetch(int x, int y, int table); // below the push constants, which it reads
+uvec4 sat_fetch(int x, int y, int table); // below the bindings and push constants, which it reads
 #define MSM_SOFT_FETCH sat_fetch
 #include "sat_queries.h"
 
-layout(binding = 2, std430) readonly buffer Queries { SatQuery queries[]; };
-layout(binding = 3, std430) writeonly buffer Results { SatQueryResult results[]; };
+// Moment techniques: the first and the second table (six moments); CSSM: the stacked tiles in the first.
+layout(binding = MSM_BINDING_SAT_QUERIES_TABLE0, rgba32ui) uniform readonly uimage2D table0;
+layout(binding = MSM_BINDING_SAT_QUERIES_TABLE1, rgba32ui) uniform readonly uimage2D table1;
+layout(binding = MSM_BINDING_SAT_QUERIES_QUERIES, std430) readonly buffer Queries { SatQuery queries[]; };
+layout(binding = MSM_BINDING_SAT_QUERIES_RESULTS, std430) writeonly buffer Results { SatQueryResult results[]; };
 layout(push_constant) uniform PushBlock { SatQueryPush pc; };
 
 uvec4 sat_fetch(int x, int y, int table) {

@@ -1,11 +1,16 @@
 // The device test of the shared table queries and of soft.h's per-pixel flow: the layout of its
-// buffers and push constants, and one query, the same code in sat_queries.comp (the device) and
+// bindings, buffers and push constants, and one query, the same code in sat_queries.comp (the device) and
 // sat_builder_test.cpp (the CPU). It composes nothing: it calls the flow the renderer's shading
 // calls (msm_soft_moment_flow, msm_soft_cssm_flow). Shared-header rules (include/msm/shared.h);
 // include it after soft.h's flow (GLSL: after defining MSM_SOFT_FETCH).
 #ifndef MSM_GPU_TEST_SAT_QUERIES_H
 #define MSM_GPU_TEST_SAT_QUERIES_H
 #include "msm/soft.h"
+
+#define MSM_BINDING_SAT_QUERIES_TABLE0 0 // storage images: the tables
+#define MSM_BINDING_SAT_QUERIES_TABLE1 1
+#define MSM_BINDING_SAT_QUERIES_QUERIES 2 // storage buffers: SatQuery[] in, SatQueryResult[] out
+#define MSM_BINDING_SAT_QUERIES_RESULTS 3
 
 MSM_BEGIN
 

@@ -1,10 +1,10 @@
 // Shared by the light-probe shaders (probe_*.comp): the push constants of msm::probe::DeviceProbe
-// (probe_push.h) and the layout of the fixed-point tables.
+// (probe_interface.h, with the bindings) and the layout of the fixed-point tables.
 #ifndef PROBE_COMMON_GLSL
 #define PROBE_COMMON_GLSL
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "msm/light_probe.h"
-#include "probe_push.h"
+#include "probe_interface.h"
 
 layout(push_constant) uniform PushBlock { ProbePush pc; };
 

@@ -6,8 +6,8 @@
 #include "probe_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 0, std430) readonly buffer Panorama { vec4 panorama[]; };
-layout(binding = 1, std430) writeonly buffer Cube { vec4 cube[]; };
+layout(binding = MSM_BINDING_PROBE_CUBE_PANORAMA, std430) readonly buffer Panorama { vec4 panorama[]; };
+layout(binding = MSM_BINDING_PROBE_CUBE_FACES, std430) writeonly buffer Cube { vec4 cube[]; };
 
 vec3 fetch(ivec2 p) {
   ivec2 q = msm_equirect_texel(p, pc.panorama);

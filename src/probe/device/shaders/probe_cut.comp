@@ -12,31 +12,11 @@
 #include "probe_common.glsl"
 #include "msm/median_cut.h"
 
-const int MAX_REGIONS = 256; // msm::probe::kMaxDeviceLights
+const int MAX_REGIONS = MSM_PROBE_MAX_REGIONS;
 layout(local_size_x = 256) in;
-layout(binding = 0, std430) readonly buffer Tables { uint64_t tables[]; };
+layout(binding = MSM_BINDING_PROBE_CUT_TABLES, std430) readonly buffer Tables { uint64_t tables[]; };
 
-struct RegionOut {
-  ivec4 rect; // x0, y0, x1, y1: texels [x0, x1) x [y0, y1)
-  int face;
-  uint lit; // 1: the region has energy and lights[t] is its light
-  uint64_t fixed_energy;
-  uint faces; // a group of whole faces: bit f per face f (face: the lowest); 0: the rectangle of face
-  uint pad0, pad1, pad2;
-};
-struct LightOut {
-  vec4 direction_cone; // direction, cone_half_angle
-  vec4 x_axis_half_x;
-  vec4 y_axis_half_y;
-  vec4 irradiance;
-};
-layout(binding = 1, std430) writeonly buffer Result {
-  uint region_count;
-  uint pad0, pad1, pad2;
-  RegionOut regions[MAX_REGIONS];
-  LightOut lights[MAX_REGIONS];
-}
-result;
+layout(binding = MSM_BINDING_PROBE_CUT_RESULT, std430) writeonly buffer Result { ProbeCutResult result; };
 
 shared ivec4 s_rect[MAX_REGIONS];
 shared int s_face[MAX_REGIONS];
@@ -204,9 +184,9 @@ void main() {
       lit = sums.xyz.y > 0.0f;
       if (lit) l = msm_area_light_from_region(face, sums);
     }
-    result.regions[t] = RegionOut(r, face, lit ? 1u : 0u, s_energy[t], faces, 0u, 0u, 0u);
+    result.regions[t] = ProbeCutRegion(r, face, lit ? 1u : 0u, s_energy[t], faces, 0u, 0u, 0u);
     if (lit)
-      result.lights[t] = LightOut(vec4(l.direction, l.cone_half_angle), vec4(l.x_axis, l.half_extent.x),
+      result.lights[t] = ProbeCutLight(vec4(l.direction, l.cone_half_angle), vec4(l.x_axis, l.half_extent.x),
                                   vec4(l.y_axis, l.half_extent.y), vec4(l.irradiance, 0.0f));
   }
   if (t == 0u) result.region_count = uint(n);

@@ -5,7 +5,7 @@
 #include "probe_common.glsl"
 
 layout(local_size_x = 64) in;
-layout(binding = 0, std430) buffer Tables { uint64_t tables[]; };
+layout(binding = MSM_BINDING_PROBE_COLUMNS_TABLES, std430) buffer Tables { uint64_t tables[]; };
 
 void main() {
   int x = int(gl_GlobalInvocationID.x), k = int(gl_GlobalInvocationID.y), face = int(gl_GlobalInvocationID.z);

@@ -5,10 +5,10 @@
 #include "probe_common.glsl"
 
 layout(local_size_x = 64) in;
-layout(binding = 0, std430) readonly buffer Cube { vec4 cube[]; };
+layout(binding = MSM_BINDING_PROBE_ROWS_CUBE, std430) readonly buffer Cube { vec4 cube[]; };
 // m² texel weights (msm_cube_texel_weight), then m texel-centre coordinates, from the host.
-layout(binding = 1, std430) readonly buffer Weights { float weights[]; };
-layout(binding = 2, std430) writeonly buffer Tables { uint64_t tables[]; };
+layout(binding = MSM_BINDING_PROBE_ROWS_WEIGHTS, std430) readonly buffer Weights { float weights[]; };
+layout(binding = MSM_BINDING_PROBE_ROWS_TABLES, std430) writeonly buffer Tables { uint64_t tables[]; };
 
 void main() {
   int y = int(gl_GlobalInvocationID.x), face = int(gl_GlobalInvocationID.y), m = pc.size;
