@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "internal.h"
+#include "msm/local_light.h"
 #include "msm/probe/probe.h"
 #include "msm/util/limits.h"
 
@@ -23,6 +24,26 @@ namespace {
 // finite for kMaxLights lights of at most FLT_MAX / kMaxLights ≈ 1.3e36 each (above, the weights'
 // sum overflowed to inf and the shadow buffer's visibility became inf / inf = NaN).
 constexpr float kMaxIrradiance = 1e36f;
+// The largest radiant intensity of a spot or point light: at the shortest distance the shading
+// takes (MSM_LOCAL_LIGHT_MIN_DISTANCE2) its irradiance stays below kMaxIrradiance.
+constexpr float kMaxIntensity = 1e27f;
+
+constexpr std::string_view kDirectionalKeys[] = {"towards_light", "irradiance", "angular_extent_deg",
+                                                 "angular_height_deg", "x_axis"};
+constexpr std::string_view kSpotKeys[] = {"position", "direction", "inner_cone_deg", "outer_cone_deg",
+                                          "range",    "intensity", "radius"};
+constexpr std::string_view kPointKeys[] = {"position", "range", "intensity", "radius"};
+
+constexpr LightKindInfo kLightKinds[] = {
+    {LightKind::directional, "directional", kDirectionalKeys,
+     "orthographic, fitted to what the camera sees (ShadowFraming)", 1,
+     "distance along the light's travel, affine: 0 at the box's near side, 1 at its far side",
+     "parallel rays towards towards_light, unbounded; a disc or rectangle of directions when soft", true},
+    {LightKind::spot, "spot", kSpotKeys, "perspective, the outer cone's field of view", 1, "radial distance / range",
+     "a shadow ray to the light's position (bounded by the distance)", false},
+    {LightKind::point, "point", kPointKeys, "six perspective faces of a cube, 90 degrees each", 6,
+     "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", false},
+};
 
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -107,13 +128,22 @@ class Parser {
     if (!light_json && !lights_json) {
       s.lights.clear();
     } else if (light_json) {
+      if (light_type(*light_json, "/light") != LightKind::directional)
+        fail("/light/type", "\"light\" is one directional light: give spot and point lights in \"lights\"");
       s.lights = {light(*light_json, "/light")};
     } else {
       if (!lights_json->is_array() || lights_json->empty() || lights_json->size() > size_t(kMaxLights))
         fail("/lights", fmt::format("must be a list of 1 to {} lights", kMaxLights));
       s.lights.clear();
-      for (size_t i = 0; i < lights_json->size(); ++i)
-        s.lights.push_back(light((*lights_json)[i], fmt::format("/lights/{}", i)));
+      for (size_t i = 0; i < lights_json->size(); ++i) {
+        const json& entry = (*lights_json)[i];
+        const std::string ptr = fmt::format("/lights/{}", i);
+        const LightKind kind = light_type(entry, ptr);
+        if (kind == LightKind::directional)
+          s.lights.push_back(light(entry, ptr));
+        else
+          s.local_lights.push_back(local_light(entry, ptr, kind));
+      }
     }
     if (const json* v = find(root, "shadow_map")) s.shadow = framing(*v, "/shadow_map");
     if (const json* v = find(root, "medium")) s.medium = medium(*v, "/medium");
@@ -269,8 +299,63 @@ class Parser {
     return c;
   }
 
+  // A "lights" entry's "type" (default: directional); then only that kind's keys are allowed.
+  LightKind light_type(const json& j, const std::string& ptr) const {
+    if (!j.is_object()) fail(ptr, fmt::format("must be a JSON object (got {})", j.type_name()));
+    const json* t = find(j, "type");
+    if (!t) return LightKind::directional;
+    const std::string name = string(*t, ptr + "/type");
+    if (const std::optional<LightKind> kind = parse_light_kind(name)) return *kind;
+    std::vector<std::string_view> names;
+    for (const LightKindInfo& k : light_kinds()) names.push_back(k.name);
+    fail(ptr + "/type", fmt::format("unknown light type '{}' (allowed: {})", shortened(name), fmt::join(names, ", ")));
+  }
+
+  // The keys of a light of `kind` (its declaration's) and "type".
+  void light_keys(const json& j, const std::string& ptr, LightKind kind) const {
+    std::vector<std::string_view> allowed(light_kind(kind).keys.begin(), light_kind(kind).keys.end());
+    allowed.push_back("type");
+    for (const auto& [key, value] : j.items())
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        fail(ptr + "/" + escape(key),
+             fmt::format("unknown key of a {} light (allowed: {})", light_kind(kind).name, fmt::join(allowed, ", ")));
+  }
+
+  LocalLight local_light(const json& j, const std::string& ptr, LightKind kind) const {
+    light_keys(j, ptr, kind);
+    LocalLight l;
+    l.kind = kind;
+    const json* position = find(j, "position");
+    if (!position) fail(ptr + "/position", "required key missing (where the light is)");
+    l.position = vec<3>(*position, ptr + "/position");
+    if (glm::any(glm::greaterThan(glm::abs(l.position), glm::vec3(kMaxSize))))
+      fail(ptr + "/position", fmt::format("|component| must be at most {:g}", kMaxSize));
+    if (l.spot()) {
+      const json* d = find(j, "direction");
+      if (!d) fail(ptr + "/direction", "required key missing (the direction the spot light shines in)");
+      l.direction = direction(*d, ptr + "/direction");
+      if (const json* v = find(j, "outer_cone_deg"))
+        l.outer_cone_deg = number_in(*v, ptr + "/outer_cone_deg", 0.0f, 90.0f, true, true);
+      if (const json* v = find(j, "inner_cone_deg"))
+        l.inner_cone_deg = number_in(*v, ptr + "/inner_cone_deg", 0.0f, 90.0f, false, true);
+      if (l.inner_cone_deg > l.outer_cone_deg)
+        fail(ptr + "/inner_cone_deg", fmt::format("{:g} degrees is wider than outer_cone_deg {:g}: the inner cone "
+                                                  "(full intensity) lies within the outer one",
+                                                  l.inner_cone_deg, l.outer_cone_deg));
+    }
+    if (const json* v = find(j, "range")) l.range = number_in(*v, ptr + "/range", 0.0f, kMaxCameraFar, true, false);
+    if (const json* v = find(j, "intensity")) {
+      l.intensity = vec<3>(*v, ptr + "/intensity");
+      if (glm::any(glm::lessThan(l.intensity, glm::vec3(0.0f)))) fail(ptr + "/intensity", "must be >= 0");
+      if (glm::any(glm::greaterThan(l.intensity, glm::vec3(kMaxIntensity))))
+        fail(ptr + "/intensity", fmt::format("must be at most {:g} W/sr", kMaxIntensity));
+    }
+    if (const json* v = find(j, "radius")) l.radius = number_in(*v, ptr + "/radius", 0.0f, kMaxSize, false, false);
+    return l;
+  }
+
   DirectionalLight light(const json& j, const std::string& ptr) const {
-    keys(j, ptr, {"towards_light", "irradiance", "angular_extent_deg", "angular_height_deg", "x_axis"});
+    light_keys(j, ptr, LightKind::directional);
     DirectionalLight l;
     const json* d = find(j, "towards_light");
     if (!d) fail(ptr + "/towards_light", "required key missing (direction from the scene towards the light)");
@@ -309,9 +394,10 @@ class Parser {
     p.file = name == "sky" ? fs::path("sky") : probe_file(name, ptr + "/file");
     if (const json* v = find(j, "lights")) p.lights = integer(*v, ptr + "/lights");
     if (p.lights < 1 || p.lights > 256) fail(ptr + "/lights", "must be in [1, 256]");
-    if (s.lights.size() + std::size_t(p.lights) > std::size_t(kMaxLights))
-      fail(ptr + "/lights", fmt::format("{} directional lights and {} of the probe exceed {} lights", s.lights.size(),
-                                        p.lights, kMaxLights));
+    const std::size_t declared = s.lights.size() + s.local_lights.size();
+    if (declared + std::size_t(p.lights) > std::size_t(kMaxLights))
+      fail(ptr + "/lights",
+           fmt::format("{} declared lights and {} of the probe exceed {} lights", declared, p.lights, kMaxLights));
     if (const json* v = find(j, "intensity")) p.intensity = number_in(*v, ptr + "/intensity", 0.0f, 1e6f, false, false);
     if (const json* v = find(j, "rotation_deg"))
       p.rotation_deg = number_in(*v, ptr + "/rotation_deg", -360.0f, 360.0f, false, false);
@@ -653,6 +739,36 @@ class Parser {
 
 } // namespace
 
+std::span<const LightKindInfo> light_kinds() { return kLightKinds; }
+
+const LightKindInfo& light_kind(LightKind kind) {
+  for (const LightKindInfo& k : kLightKinds)
+    if (k.kind == kind) return k;
+  throw std::invalid_argument("undeclared light kind");
+}
+
+std::optional<LightKind> parse_light_kind(std::string_view name) {
+  for (const LightKindInfo& k : kLightKinds)
+    if (k.name == name) return k.kind;
+  return std::nullopt;
+}
+
+float LocalLight::cos_outer() const { return spot() ? std::cos(glm::radians(outer_cone_deg)) : -1.0f; }
+float LocalLight::cos_inner() const { return spot() ? std::cos(glm::radians(inner_cone_deg)) : -1.0f; }
+
+glm::vec3 LocalLight::irradiance_at(const glm::vec3& p) const {
+  const glm::vec3 from_light = p - position;
+  const float distance = glm::length(from_light);
+  const float cos_angle = distance > 0.0f ? glm::dot(from_light, direction) / distance : 1.0f;
+  return msm::msm_local_light_irradiance(intensity, distance, range, cos_angle, cos_outer(), cos_inner());
+}
+
+std::size_t Scene::light_count(LightKind kind) const {
+  if (kind == LightKind::directional) return lights.size();
+  return std::size_t(
+      std::count_if(local_lights.begin(), local_lights.end(), [&](const LocalLight& l) { return l.kind == kind; }));
+}
+
 DirectionalLight light_of_probe_light(const msm::probe::ProbeLight& light) {
   DirectionalLight l = light_of_area_light(light.light);
   for (const msm::MsmAreaLight& a : light.sub_lights) l.sub_lights.push_back(light_of_area_light(a));
@@ -853,11 +969,10 @@ void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_light
   if (count < 1 || count > 256)
     throw SceneError(file, "/probe/lights", fmt::format("{} lights: must be in [1, 256]", count));
   const std::size_t old_end = std::min(scene.lights.size(), p.first_light + std::size_t(p.lights));
-  const std::size_t others = scene.lights.size() - (old_end - p.first_light);
+  const std::size_t others = scene.lights.size() - (old_end - p.first_light) + scene.local_lights.size();
   if (others + std::size_t(count) > std::size_t(kMaxLights))
-    throw SceneError(
-        file, "/probe/lights",
-        fmt::format("{} directional lights and {} of the probe exceed {} lights", others, count, kMaxLights));
+    throw SceneError(file, "/probe/lights",
+                     fmt::format("{} declared lights and {} of the probe exceed {} lights", others, count, kMaxLights));
   p.lights = count;
   try {
     msm::probe::check_cut(count, p.size, p.horizon_split);
@@ -902,6 +1017,7 @@ void set_probe(Scene& scene, const std::filesystem::path& file) {
   }
   if (lights.empty()) throw SceneError(file.string(), "", "the probe has no light (every texel is black)");
   scene.lights = std::move(lights);
+  scene.local_lights.clear();
   scene.probe = p;
 }
 
