@@ -146,6 +146,8 @@ class Tracer {
   bool closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const;
   // True if anything lies on origin + t dir, t in [0, inf).
   bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
+  // True if anything lies on origin + t dir, t in [0, tfar]: a ray to a light at distance tfar.
+  bool occluded(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) const;
   // occluded() of n rays, as packets of 8 (a pixel's sample rays are nearly coherent).
   void occluded(const glm::dvec3* origins, const glm::dvec3* dirs, int n, bool* blocked) const;
   // occluded() of n rays from one origin, their directions in single precision (what Embree
@@ -276,6 +278,18 @@ struct ScatteringSample {
 ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Medium& medium, const glm::dvec3& camera,
                                       const glm::dvec3& dir, double s, std::span<const ScatteringLight> lights,
                                       Rng& rng);
+
+// Every light of a scene with spot or point lights (effect_lights.cpp): the `hard` effect over all
+// of them. A directional light's shadow ray runs to infinity, a spot or point light's to the
+// light's position (a light inside a closed mesh reaches nothing outside it).
+struct LightsSample {
+  glm::dvec3 direct{0.0}; // Σ_l msm_direct_light(E_l, n·l_l, V_l)
+  double visible = 0.0;   // Σ_l w_l V_l / Σ_l w_l, w_l the luminance of E_l max(n·l_l, 0); 0 where Σ w_l = 0
+  double n_dot_l = 0.0;   // of the first light (directional ones first, then spot and point lights)
+  std::uint64_t rays = 0;
+};
+// n: the shading normal turned towards the viewer.
+LightsSample hard_lights(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n);
 
 // environment (effect_environment.cpp): the lights of a scene's image-based lighting, built once
 // per render. Throws std::invalid_argument for a scene without a "probe".

@@ -174,13 +174,24 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   if (scattering && !scene.medium)
     throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
   const bool environment = settings.effect == Effect::environment;
+  // Spot and point lights: the hard effect shades every light of the scene (hard_lights).
+  const bool local_lights = !scene.local_lights.empty();
+  if (local_lights && settings.effect != Effect::hard)
+    throw std::invalid_argument(fmt::format("the {} effect traces directional lights only; a scene with spot or point "
+                                            "lights is traced by the hard effect",
+                                            to_string(settings.effect)));
   std::optional<EnvironmentLighting> lighting;
   if (environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
   const Tracer tracer(scene);
   result.build_seconds = util::seconds_since(start);
 
-  EffectContext ctx{
-      tracer, settings, scene.light_frame(), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
+  // A scene of spot and point lights only has no directional light to frame.
+  const scene::DirectionalLight first_light = scene.lights.empty() ? scene::DirectionalLight{} : scene.light();
+  EffectContext ctx{tracer,
+                    settings,
+                    scene.lights.empty() ? LightFrame{} : scene.light_frame(),
+                    {},
+                    FilterKernel(settings.filter_size, settings.filter_sigma)};
   ctx.towards_light = ctx.frame.towards_light;
   ctx.texel_x = ctx.frame.x_axis * (ctx.frame.extent.x / settings.shadow_size);
   ctx.texel_y = ctx.frame.y_axis * (ctx.frame.extent.y / settings.shadow_size);
@@ -188,7 +199,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   ctx.light_x = glm::normalize(ctx.frame.x_axis - glm::dot(ctx.frame.x_axis, ctx.towards_light) * ctx.towards_light);
   ctx.light_y = glm::cross(ctx.towards_light, ctx.light_x);
   if (glm::dot(ctx.light_y, ctx.frame.y_axis) < 0.0) ctx.light_y = -ctx.light_y;
-  const TracedLight light = traced_light(scene.light(), settings);
+  const TracedLight light = traced_light(first_light, settings);
   if (!(std::isfinite(light.extent_deg) && light.extent_deg >= 0.0 && light.extent_deg < 90.0))
     throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", light.extent_deg));
   result.light_shape = light.shape;
@@ -221,7 +232,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
     const glm::dvec4 q = inv_vp * glm::dvec4(nx, ny, depth, 1.0);
     return glm::dvec3(q) / q.w;
   };
-  const glm::dvec3 irradiance(scene.light().irradiance);
+  const glm::dvec3 irradiance(first_light.irradiance);
   const glm::dvec3 camera(scene.camera.position);
   // A probe-lit scene's background: its probe as the renderer loads it (GpuScene), by texel.
   msm::probe::CubeMap probe;
@@ -329,6 +340,18 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         // Shading: interpolated normal turned towards the viewer.
         glm::dvec3 n = tracer.shading_normal(hit);
         if (glm::dot(hit.normal, dir) > 0.0) n = -n;
+        if (local_lights) {
+          const LightsSample e = hard_lights(ctx, hit, n);
+          row_rays += e.rays;
+          v[0] = float(e.visible);
+          row_sum[y] += e.visible;
+          const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), glm::vec3(e.direct), MSM_AMBIENT);
+          float* q = surf + (std::size_t(y) * W + x) * 2;
+          q[0] = float(e.n_dot_l);
+          q[1] = float(hit.object);
+          c[0] = colour.r, c[1] = colour.g, c[2] = colour.b;
+          continue;
+        }
         if (environment) {
           const EnvironmentSample e = environment_irradiance(ctx, *lighting, hit, n, dir, rng);
           row_rays += e.rays;

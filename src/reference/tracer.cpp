@@ -188,7 +188,11 @@ bool Tracer::closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfa
 }
 
 bool Tracer::occluded(const glm::dvec3& origin, const glm::dvec3& dir) const {
-  RTCRay ray = make_ray(origin, dir, std::numeric_limits<double>::infinity());
+  return occluded(origin, dir, std::numeric_limits<double>::infinity());
+}
+
+bool Tracer::occluded(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) const {
+  RTCRay ray = make_ray(origin, dir, tfar);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   rtcOccluded1(impl_->scene, &context, &ray);
