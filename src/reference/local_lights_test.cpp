@@ -133,4 +133,42 @@ TEST(LocalLightsReference, EffectsBeyondHardAreRefusedForLocalLights) {
   }
 }
 
+// scenes/street.json: a street at night (two point lights among columns, a spot light through a
+// fence, faint moonlight). Taking an occluder away never darkens a pixel and brightens some: the
+// fence's bars shadow the spot's light, the columns the lamps'.
+TEST(LocalLightsReference, StreetOccludersOnlyEverTakeLightAway) {
+  const Scene street = msm::scene::load_scene_file(std::filesystem::path(MSM_SCENES_DIR) / "street.json");
+  ASSERT_EQ(street.light_count(msm::scene::LightKind::point), 2u);
+  ASSERT_EQ(street.light_count(msm::scene::LightKind::spot), 1u);
+  Settings s;
+  s.effect = Effect::hard;
+  s.width = 192;
+  s.height = 108;
+  const Result all = render(street, s);
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(all.radiance.at(x, y, c))) << x << ", " << y;
+  EXPECT_GT(all.mean_visibility, 0.2);
+  EXPECT_LT(all.mean_visibility, 0.98);
+  for (const std::string& occluder : {std::string("fence"), std::string("column")}) {
+    SCOPED_TRACE(occluder);
+    Scene without = street;
+    std::erase_if(without.objects, [&](const msm::scene::Object& o) { return o.name.starts_with(occluder); });
+    ASSERT_LT(without.objects.size(), street.objects.size());
+    const Result open = render(without, s);
+    std::size_t brighter = 0, compared = 0;
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        // Only pixels that see the same object in both (not the occluder itself, nor behind it).
+        const int seen = int(all.surface.at(x, y, 1)), seen_open = int(open.surface.at(x, y, 1));
+        if (seen < 0 || seen_open < 0 || street.objects[seen].name != without.objects[seen_open].name) continue;
+        ++compared;
+        const float before = all.radiance.at(x, y, 1), after = open.radiance.at(x, y, 1);
+        EXPECT_GE(after, before - 1e-6f * std::max(1.0f, before)) << x << ", " << y;
+        brighter += after > before * 1.01f + 1e-6f;
+      }
+    EXPECT_GT(brighter, compared / 100) << brighter << " of " << compared << " pixels brighter";
+  }
+}
+
 } // namespace
