@@ -279,17 +279,24 @@ ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Med
                                       const glm::dvec3& dir, double s, std::span<const ScatteringLight> lights,
                                       Rng& rng);
 
-// Every light of a scene with spot or point lights (effect_lights.cpp): the `hard` effect over all
-// of them. A directional light's shadow ray runs to infinity, a spot or point light's to the
-// light's position (a light inside a closed mesh reaches nothing outside it).
+// Every light of a scene with spot or point lights (effect_lights.cpp), for the hard and soft
+// effects. A directional light's shadow rays run to infinity, a spot or point light's to the light
+// (a light inside a closed mesh reaches nothing outside it). hard: one ray per light towards its
+// centre. soft: `samples` directions per light of some extent, uniform in the cone it fills (a
+// directional light's angular_extent_deg as a disc; a spot or point light's sphere of `radius`,
+// sin α = r / d), each ray ending on the sphere; lights without extent get one ray.
+// lit_l = ∫ max(n·ω, 0) V dω / (π sin² α) over the cone (max(n·l, 0) V for a point), the
+// light's unoccluded lit0_l from the same samples.
 struct LightsSample {
-  glm::dvec3 direct{0.0}; // Σ_l msm_direct_light(E_l, n·l_l, V_l)
-  double visible = 0.0;   // Σ_l w_l V_l / Σ_l w_l, w_l the luminance of E_l max(n·l_l, 0); 0 where Σ w_l = 0
-  double n_dot_l = 0.0;   // of the first light (directional ones first, then spot and point lights)
+  glm::dvec3 direct{0.0}; // Σ_l msm_direct_light(E_l, lit_l, 1)
+  double visible = 0.0;   // Σ_l lum(E_l) lit_l / Σ_l lum(E_l) lit0_l; 0 where no light arrives
+  double std_error = 0.0; // of visible, from the per-sample values (soft)
+  double n_dot_l = 0.0;   // with the first light's centre (directional lights first, then spot and point)
+  int samples = 1;
   std::uint64_t rays = 0;
 };
 // n: the shading normal turned towards the viewer.
-LightsSample hard_lights(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n);
+LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n, Rng& rng);
 
 // environment (effect_environment.cpp): the lights of a scene's image-based lighting, built once
 // per render. Throws std::invalid_argument for a scene without a "probe".

@@ -23,20 +23,21 @@ constexpr int kSide = 21;
 
 // 21² pixels, fov 90°, 5.25 m above the plane: pixel centre i of the middle row is at NDC
 // (2i − 20) / 21, i.e. x = 5.25 (2i − 20) / 21 = (i − 10) / 2 m on the plane.
-Scene scene_with(const std::string& light, const std::string& extra_objects = "") {
+Scene scene_with(const std::string& light, const std::string& extra_objects = "",
+                 const std::string& camera_position = "[0, 5.25, 0]") {
   return msm::scene::load_scene_json(
-      R"({"msm_scene": 1,
-        "camera": {"position": [0, 5.25, 0], "target": [0, 0, 0], "up": [0, 0, -1], "fov_y_deg": 90,
-                   "near": 0.1, "far": 100},
+      R"({"msm_scene": 1, "camera": {"position": )" + camera_position +
+          R"(, "target": [0, 0, 0], "up": [0, 0, -1], "fov_y_deg": 90, "near": 0.1, "far": 100},
         "lights": [)" +
           light + R"(], "objects": [{"primitive": {"type": "plane", "size": [40, 40]}})" + extra_objects + "]}",
       std::filesystem::current_path(), "test.json");
 }
 
-Result trace(const Scene& scene) {
+Result trace(const Scene& scene, Effect effect = Effect::hard, int samples = 256) {
   Settings s;
-  s.effect = Effect::hard;
+  s.effect = effect;
   s.width = s.height = kSide;
+  s.samples = samples;
   return render(scene, s);
 }
 
@@ -122,9 +123,48 @@ TEST(LocalLightsReference, ALightOnTheSurfaceOrInsideAMeshGivesNoNaN) {
   EXPECT_NEAR(inside.radiance.at(pixel(2.0), kSide / 2, 0), radiance_of(0.0), 1e-7);
 }
 
-TEST(LocalLightsReference, EffectsBeyondHardAreRefusedForLocalLights) {
+// soft: a sphere light of radius 0.5 fills a cone of sin α = r / d; wholly above the horizon its
+// cosine-weighted integral is π sin² α cos θ, so the irradiance is the point light's I cos θ / d².
+TEST(LocalLightsReference, ASphereLightUnoccludedGivesThePointLightsIrradiance) {
+  const Result r =
+      trace(scene_with(R"({"type": "point", "position": [0, 2, 0], "radius": 0.5, "intensity": [8, 8, 8]})"),
+            Effect::soft, 64);
+  const int row = kSide / 2;
+  for (const auto& [x, e_cos] : {std::pair{0.0, 2.0}, {1.0, 1.4310835}, {3.0, 0.3413644}}) {
+    EXPECT_NEAR(r.radiance.at(pixel(x), row, 0), radiance_of(e_cos), 5e-3 * radiance_of(e_cos)) << "x = " << x;
+    EXPECT_EQ(r.visibility.at(pixel(x), row, 0), 1.0f) << "x = " << x;
+    EXPECT_EQ(r.visibility.at(pixel(x), row, 2), 64.0f); // sample_count
+  }
+  // Radius 0: the soft effect traces the hard shadow, exactly.
+  const Scene hard_light = scene_with(R"({"type": "point", "position": [0, 2, 0], "intensity": [8, 8, 8]})");
+  const Result soft = trace(hard_light, Effect::soft, 16), hard = trace(hard_light);
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x) ASSERT_EQ(soft.radiance.at(x, y, 0), hard.radiance.at(x, y, 0)) << x << ", " << y;
+}
+
+// A half-plane occluder (x < 0, 1 m up) whose edge lies in the vertical plane through the point
+// below the light and the light's centre: that plane halves the light's cone and mirrors its
+// cosine weights, so exactly half the light is seen, 0.5 up to the sampling error.
+TEST(LocalLightsReference, AHalfPlaneThroughTheSphereLightsCentreHidesHalfOfIt) {
+  const std::string light = R"({"type": "point", "position": [0, 2, 0], "radius": 0.5, "intensity": [8, 8, 8]})";
+  const auto half_plane = [](double edge) {
+    return R"(, {"primitive": {"type": "box", "size": [10, 0.02, 10]}, "transform": {"translate": [)" +
+           std::to_string(edge - 5.0) + ", 1, 0]}}";
+  };
+  // The camera looks past the occluder's edge at the origin (the middle pixel).
+  const Result r = trace(scene_with(light, half_plane(0.0), "[2, 5.25, 0]"), Effect::soft, 1024);
+  const int mid = kSide / 2;
+  EXPECT_NEAR(r.visibility.at(mid, mid, 0), 0.5, 0.01);
+  EXPECT_GT(r.visibility.at(mid, mid, 3), 0.0f); // std_error
+  EXPECT_LT(r.visibility.at(mid, mid, 3), 0.02f);
+  // The edge 0.3 m further into the shadowed side: more than half seen; 0.3 m the other way, less.
+  EXPECT_GT(trace(scene_with(light, half_plane(-0.3), "[2, 5.25, 0]"), Effect::soft).visibility.at(mid, mid, 0), 0.6f);
+  EXPECT_LT(trace(scene_with(light, half_plane(0.3), "[2, 5.25, 0]"), Effect::soft).visibility.at(mid, mid, 0), 0.4f);
+}
+
+TEST(LocalLightsReference, EffectsBeyondHardAndSoftAreRefusedForLocalLights) {
   const Scene scene = scene_with(kSpot);
-  for (Effect effect : {Effect::filtered, Effect::soft, Effect::translucent}) {
+  for (Effect effect : {Effect::filtered, Effect::translucent}) {
     Settings s;
     s.effect = effect;
     s.width = s.height = 8;

@@ -174,12 +174,21 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   if (scattering && !scene.medium)
     throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
   const bool environment = settings.effect == Effect::environment;
-  // Spot and point lights: the hard effect shades every light of the scene (hard_lights).
+  // Spot and point lights: the hard and soft effects shade every light of the scene (trace_lights).
   const bool local_lights = !scene.local_lights.empty();
-  if (local_lights && settings.effect != Effect::hard)
+  if (local_lights && settings.effect != Effect::hard && settings.effect != Effect::soft)
     throw std::invalid_argument(fmt::format("the {} effect traces directional lights only; a scene with spot or point "
-                                            "lights is traced by the hard effect",
+                                            "lights is traced by the hard and soft effects",
                                             to_string(settings.effect)));
+  if (local_lights &&
+      (settings.light_extent_deg || settings.light_shape || settings.light_width_deg || settings.light_height_deg))
+    throw std::invalid_argument("the light overrides (extent, shape, width, height) change a scene's one directional "
+                                "light; a scene with spot or point lights is traced as it declares its lights");
+  if (local_lights && settings.effect == Effect::soft)
+    for (const scene::DirectionalLight& l : scene.lights)
+      if (l.rectangular() || !l.sub_lights.empty())
+        throw std::invalid_argument("the soft effect traces a scene with spot or point lights with disc-shaped "
+                                    "directional lights only (no rectangles, no probe lights)");
   std::optional<EnvironmentLighting> lighting;
   if (environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
   const Tracer tracer(scene);
@@ -341,9 +350,13 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
         glm::dvec3 n = tracer.shading_normal(hit);
         if (glm::dot(hit.normal, dir) > 0.0) n = -n;
         if (local_lights) {
-          const LightsSample e = hard_lights(ctx, hit, n);
+          const LightsSample e = trace_lights(ctx, hit, n, rng);
           row_rays += e.rays;
           v[0] = float(e.visible);
+          if (mc) {
+            v[2] = float(e.samples);
+            v[3] = float(e.std_error);
+          }
           row_sum[y] += e.visible;
           const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), glm::vec3(e.direct), MSM_AMBIENT);
           float* q = surf + (std::size_t(y) * W + x) * 2;

@@ -34,8 +34,14 @@
 //               is msm/shading.h's sum over the lights; "visibility" is their mean
 //               Σ w_l V_l / Σ w_l weighted by w_l = luminance of E_l max(n·l_l, 0) (the
 //               renderer's shadow buffer of several lights), 0 where no light arrives; n_dot_l
-//               is the first light's (directional lights first). The other effects refuse
-//               such scenes (std::invalid_argument).
+//               is the first light's (directional lights first). The soft effect does the same
+//               with every light of some extent sampled over it (`samples` directions uniform in
+//               the cone it fills, a spot or point light's sphere of `radius`: sin α = r / d, each
+//               ray ending on the sphere; a directional light's disc of angular_extent_deg): each
+//               light's lit = ∫ max(n·ω, 0) V dω / (π sin² α) replaces max(n·l, 0) V, visibility
+//               = Σ lum(E_l) lit_l / Σ lum(E_l) lit0_l (lit0 unoccluded, the same samples). The
+//               other effects, the light overrides and rectangular or probe lights with soft
+//               refuse such scenes (std::invalid_argument).
 //
 //   filtered    What a filtered shadow map means, on any geometry (the renderer's PCF with
 //               perfect depth): with n_s the interpolated normal turned towards the viewer (the
