@@ -45,6 +45,38 @@ constexpr LightKindInfo kLightKinds[] = {
      "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", false},
 };
 
+// What is wrong with a spot or point light (the key and the problem), or nothing: the one set of
+// rules for the scene's "lights" and the lights imported from glTF files.
+struct LightProblem {
+  std::string key, problem;
+};
+std::string range_text(float lo, float hi, bool open_lo, bool open_hi, float x) {
+  return fmt::format("must be in {}{:g}, {:g}{} (got {:g})", open_lo ? '(' : '[', lo, hi, open_hi ? ')' : ']', x);
+}
+std::optional<LightProblem> local_light_problem(const LocalLight& l) {
+  if (glm::any(glm::greaterThan(glm::abs(l.position), glm::vec3(kMaxSize))))
+    return LightProblem{"position", fmt::format("|component| must be at most {:g}", kMaxSize)};
+  if (l.spot()) {
+    if (!(l.outer_cone_deg > 0.0f && l.outer_cone_deg < 90.0f))
+      return LightProblem{"outer_cone_deg", range_text(0.0f, 90.0f, true, true, l.outer_cone_deg)};
+    if (!(l.inner_cone_deg >= 0.0f && l.inner_cone_deg < 90.0f))
+      return LightProblem{"inner_cone_deg", range_text(0.0f, 90.0f, false, true, l.inner_cone_deg)};
+    if (l.inner_cone_deg > l.outer_cone_deg)
+      return LightProblem{"inner_cone_deg",
+                          fmt::format("{:g} degrees is wider than outer_cone_deg {:g}: the inner cone "
+                                      "(full intensity) lies within the outer one",
+                                      l.inner_cone_deg, l.outer_cone_deg)};
+  }
+  if (l.range != LocalLight::kInfiniteRange && !(l.range > 0.0f && l.range <= kMaxCameraFar))
+    return LightProblem{"range", range_text(0.0f, kMaxCameraFar, true, false, l.range)};
+  if (glm::any(glm::lessThan(l.intensity, glm::vec3(0.0f)))) return LightProblem{"intensity", "must be >= 0"};
+  if (glm::any(glm::greaterThan(l.intensity, glm::vec3(kMaxIntensity))))
+    return LightProblem{"intensity", fmt::format("must be at most {:g} W/sr", kMaxIntensity)};
+  if (!(l.radius >= 0.0f && l.radius <= kMaxSize))
+    return LightProblem{"radius", range_text(0.0f, kMaxSize, false, false, l.radius)};
+  return std::nullopt;
+}
+
 using nlohmann::json;
 namespace fs = std::filesystem;
 
@@ -122,8 +154,13 @@ class Parser {
     const json* light_json = find(root, "light");
     const json* lights_json = find(root, "lights");
     const json* probe_json = find(root, "probe");
-    if (!light_json && !lights_json && !probe_json)
-      fail("/light", "required key missing (or \"lights\": a list of them, or a \"probe\")");
+    const json* objects_json = find(root, "objects");
+    const bool imports_lights = objects_json && objects_json->is_array() &&
+                                std::any_of(objects_json->begin(), objects_json->end(),
+                                            [](const json& o) { return o.is_object() && o.contains("import_lights"); });
+    if (!light_json && !lights_json && !probe_json && !imports_lights)
+      fail("/light", "required key missing (or \"lights\": a list of them, a \"probe\", or an object's "
+                     "\"import_lights\")");
     if (light_json && lights_json) fail("/lights", "give either \"light\" or \"lights\", not both");
     if (!light_json && !lights_json) {
       s.lights.clear();
@@ -166,6 +203,8 @@ class Parser {
     if (!objs) fail("/objects", "required key missing");
     if (!objs->is_array() || objs->empty()) fail("/objects", "must be a non-empty array");
     for (std::size_t i = 0; i < objs->size(); ++i) object((*objs)[i], fmt::format("/objects/{}", i), i, s);
+    if (s.lights.empty() && s.local_lights.empty())
+      fail("/objects", "no light: the objects' \"import_lights\" files hold none, and the scene declares none");
     return s;
   }
 
@@ -328,30 +367,59 @@ class Parser {
     const json* position = find(j, "position");
     if (!position) fail(ptr + "/position", "required key missing (where the light is)");
     l.position = vec<3>(*position, ptr + "/position");
-    if (glm::any(glm::greaterThan(glm::abs(l.position), glm::vec3(kMaxSize))))
-      fail(ptr + "/position", fmt::format("|component| must be at most {:g}", kMaxSize));
     if (l.spot()) {
       const json* d = find(j, "direction");
       if (!d) fail(ptr + "/direction", "required key missing (the direction the spot light shines in)");
       l.direction = direction(*d, ptr + "/direction");
-      if (const json* v = find(j, "outer_cone_deg"))
-        l.outer_cone_deg = number_in(*v, ptr + "/outer_cone_deg", 0.0f, 90.0f, true, true);
-      if (const json* v = find(j, "inner_cone_deg"))
-        l.inner_cone_deg = number_in(*v, ptr + "/inner_cone_deg", 0.0f, 90.0f, false, true);
-      if (l.inner_cone_deg > l.outer_cone_deg)
-        fail(ptr + "/inner_cone_deg", fmt::format("{:g} degrees is wider than outer_cone_deg {:g}: the inner cone "
-                                                  "(full intensity) lies within the outer one",
-                                                  l.inner_cone_deg, l.outer_cone_deg));
+      if (const json* v = find(j, "outer_cone_deg")) l.outer_cone_deg = number(*v, ptr + "/outer_cone_deg");
+      if (const json* v = find(j, "inner_cone_deg")) l.inner_cone_deg = number(*v, ptr + "/inner_cone_deg");
     }
-    if (const json* v = find(j, "range")) l.range = number_in(*v, ptr + "/range", 0.0f, kMaxCameraFar, true, false);
-    if (const json* v = find(j, "intensity")) {
-      l.intensity = vec<3>(*v, ptr + "/intensity");
-      if (glm::any(glm::lessThan(l.intensity, glm::vec3(0.0f)))) fail(ptr + "/intensity", "must be >= 0");
-      if (glm::any(glm::greaterThan(l.intensity, glm::vec3(kMaxIntensity))))
-        fail(ptr + "/intensity", fmt::format("must be at most {:g} W/sr", kMaxIntensity));
-    }
-    if (const json* v = find(j, "radius")) l.radius = number_in(*v, ptr + "/radius", 0.0f, kMaxSize, false, false);
+    if (const json* v = find(j, "range")) l.range = number(*v, ptr + "/range");
+    if (const json* v = find(j, "intensity")) l.intensity = vec<3>(*v, ptr + "/intensity");
+    if (const json* v = find(j, "radius")) l.radius = number(*v, ptr + "/radius");
+    if (const auto problem = local_light_problem(l)) fail(ptr + "/" + problem->key, problem->problem);
     return l;
+  }
+
+  // A glTF file's KHR_lights_punctual lights (detail::gltf_lights), moved by the object's transform,
+  // appended to the scene's lights; checked as the scene's own ("import_lights").
+  void import_lights(const fs::path& file, const Transform& transform, const std::string& ptr, Scene& s) const {
+    std::vector<detail::FileLight> lights;
+    try {
+      lights = detail::gltf_lights(file);
+    } catch (const SceneError& e) { fail(ptr, fmt::format("{} ({})", e.problem(), file.string())); }
+    const glm::mat4 m = transform.matrix();
+    for (const detail::FileLight& f : lights) {
+      const std::string what =
+          fmt::format("{}'s KHR_lights_punctual light {} ('{}')", file.filename().string(), f.index, shortened(f.name));
+      const glm::vec3 direction = transform.rotate * (f.direction / transform.scale);
+      if (!(glm::length(direction) > 0.0f)) fail(ptr, what + ": its node's transform has no direction left");
+      if (f.kind == LightKind::directional) {
+        DirectionalLight l;
+        l.towards_light = -glm::normalize(direction);
+        l.irradiance = f.intensity;
+        if (glm::any(glm::lessThan(l.irradiance, glm::vec3(0.0f))) ||
+            glm::any(glm::greaterThan(l.irradiance, glm::vec3(kMaxIrradiance))))
+          fail(ptr, fmt::format("{}: irradiance must be in [0, {:g}]", what, kMaxIrradiance));
+        s.lights.push_back(l);
+        continue;
+      }
+      LocalLight l;
+      l.kind = f.kind;
+      l.position = glm::vec3(m * glm::vec4(f.position, 1.0f));
+      l.direction = glm::normalize(direction);
+      l.inner_cone_deg = f.inner_cone_deg;
+      l.outer_cone_deg = f.outer_cone_deg;
+      // A range scales with the object (the largest of its scales: the light reaches at least as far).
+      if (f.range) l.range = *f.range * std::max({transform.scale.x, transform.scale.y, transform.scale.z});
+      l.intensity = f.intensity;
+      if (const auto problem = local_light_problem(l))
+        fail(ptr, fmt::format("{}: {}: {}", what, problem->key, problem->problem));
+      s.local_lights.push_back(l);
+    }
+    if (s.lights.size() + s.local_lights.size() > std::size_t(kMaxLights))
+      fail(ptr,
+           fmt::format("{} lights with the file's: at most {}", s.lights.size() + s.local_lights.size(), kMaxLights));
   }
 
   DirectionalLight light(const json& j, const std::string& ptr) const {
@@ -659,7 +727,7 @@ class Parser {
     if (j.is_object())
       if (const json* v = find(j, "name")) name = this->name(*v, ptr + "/name");
     try {
-      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material", "motion"});
+      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material", "motion", "import_lights"});
       const json* mesh = find(j, "mesh");
       const json* prim = find(j, "primitive");
       if (!mesh == !prim) fail(ptr, "needs exactly one of \"mesh\" (a file) and \"primitive\"");
@@ -680,11 +748,17 @@ class Parser {
         }
       }
       if (!mesh) {
+        if (find(j, "import_lights")) fail(ptr + "/import_lights", "imports a glTF \"mesh\" file's lights");
         Mesh m = primitive(*prim, ptr + "/primitive", o.primitive);
         add_object(std::move(o), std::move(m), ptr, s);
         return;
       }
       o.mesh_file = existing_file(string(*mesh, ptr + "/mesh"), ptr + "/mesh", "mesh");
+      if (const json* v = find(j, "import_lights"); v && boolean(*v, ptr + "/import_lights")) {
+        if (o.motion)
+          fail(ptr + "/import_lights", "an animated object's lights are not imported (they would stay put)");
+        import_lights(o.mesh_file, o.transform, ptr + "/import_lights", s);
+      }
       std::vector<ModelPart> parts;
       try {
         if (material_json) {

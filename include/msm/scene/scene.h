@@ -112,6 +112,14 @@
 //     "scale": s | [sx,sy,sz]              > 0 (no mirroring)
 //   },                                     world = translate * rotate * scale * local
 //   "material": <material> | "name"        default: the default material
+//   "import_lights": false                 a glTF "mesh" (.gltf, .glb): its KHR_lights_punctual lights
+//                                          join the scene's, placed by the file's nodes (the light
+//                                          shines along its node's -Z) and then "transform" (a range
+//                                          scaled by the largest scale); colour × intensity taken as
+//                                          W/sr (spot, point) or irradiance (directional); checked as
+//                                          "lights" (an outer cone of 90°, which glTF allows, is
+//                                          refused). With it the scene needs no "light" of its own.
+//                                          Not with "motion".
 //   "motion": {                            an animated object (`msm render --frames`, `msm reference
 //                                          --frame`; at_frame): per frame, a turn about an axis
 //                                          through the object's origin (its "translate"), then a move
