@@ -56,6 +56,7 @@ void basis(const glm::dvec3& n, glm::dvec3& x, glm::dvec3& y) {
 LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n, Rng& rng) {
   const scene::Scene& scene = ctx.tracer.scene();
   const bool soft = ctx.settings.effect == Effect::soft;
+  const bool translucent = ctx.settings.effect == Effect::translucent;
   const int samples = soft ? ctx.settings.samples : 1;
   const SampleSet set(ctx.settings.sampler, samples);
   // The geometric normal on the viewer's side: light from below it is blocked by the surface.
@@ -63,7 +64,8 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
   LightsSample out;
   out.samples = samples;
   std::vector<double> per_sample(std::size_t(samples), 0.0); // Σ_l lum(E_l) (its lit in this sample)
-  double lit_sum = 0.0, unoccluded_sum = 0.0;                // Σ_l lum(E_l) lit_l, Σ_l lum(E_l) lit0_l
+  glm::dvec3 lit_sum{0.0};                                   // Σ_l lum(E_l) lit_l (per channel)
+  double unoccluded_sum = 0.0;                               // Σ_l lum(E_l) lit0_l
   bool first = true;
   const auto add = [&](const LightAtPoint& l) {
     const double n_dot_l = glm::dot(n, l.towards);
@@ -78,7 +80,8 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
     const double weight = (point ? 1.0 : 2.0 / (1.0 + l.cos_alpha)) / count;
     glm::dvec3 x, y;
     basis(l.towards, x, y);
-    double lit = 0.0, unoccluded = 0.0;
+    glm::dvec3 lit{0.0}; // per channel: translucent occluders pass some of each
+    double unoccluded = 0.0;
     for (int i = 0; i < count; ++i) {
       glm::dvec3 d = l.towards;
       if (!point) {
@@ -98,20 +101,29 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
         const double b = glm::dot(d, to), far2 = glm::dot(to, to) - l.radius * l.radius;
         tfar = far2 > 0.0 ? b - std::sqrt(std::max(0.0, b * b - far2)) : 0.0;
       }
+      if (translucent) {
+        const Tracer::Transmission t = ctx.tracer.transmission(origin, d, ctx.settings.max_crossings, tfar);
+        out.rays += t.rays;
+        lit += weight * c * t.channels;
+        continue;
+      }
       ++out.rays;
       if (tfar > 0.0 && ctx.tracer.occluded(origin, d, tfar)) continue;
       lit += weight * c;
       if (!point) per_sample[std::size_t(i)] += luminance * count * weight * c; // its mean: luminance × lit
     }
     if (point) // the same in every sample
-      for (double& v : per_sample) v += luminance * lit;
-    out.direct += glm::dvec3(msm_direct_light(glm::vec3(l.irradiance), float(lit), glm::vec3(1.0f)));
+      for (double& v : per_sample) v += luminance * lit.r;
+    out.direct += glm::dvec3(msm_direct_light(glm::vec3(l.irradiance), 1.0f, glm::vec3(lit)));
     lit_sum += luminance * lit;
     unoccluded_sum += luminance * unoccluded;
   };
   for (const scene::DirectionalLight& l : scene.lights) add(at_point(l, soft));
   for (const scene::LocalLight& l : scene.local_lights) add(at_point(l, hit.p, soft));
-  out.visible = unoccluded_sum > 0.0 ? lit_sum / unoccluded_sum : 0.0;
+  out.visible_rgb = unoccluded_sum > 0.0 ? lit_sum / unoccluded_sum : glm::dvec3(0.0);
+  // The mean, written so that three equal channels give exactly that value.
+  const glm::dvec3& v = out.visible_rgb;
+  out.visible = v.r + ((v.g - v.r) + (v.b - v.r)) / 3.0;
   if (unoccluded_sum > 0.0 && samples > 1) {
     RunningStats stats;
     for (double v : per_sample) stats.add(v / unoccluded_sum);

@@ -162,9 +162,29 @@ TEST(LocalLightsReference, AHalfPlaneThroughTheSphereLightsCentreHidesHalfOfIt) 
   EXPECT_LT(trace(scene_with(light, half_plane(0.3), "[2, 5.25, 0]"), Effect::soft).visibility.at(mid, mid, 0), 0.4f);
 }
 
-TEST(LocalLightsReference, EffectsBeyondHardAndSoftAreRefusedForLocalLights) {
+// translucent: a red pane (opacity 0.5, transmission colour [1, 0, 0]) 1 m up between the point
+// light and the ground passes [1, 0.5, 0.5]; a second one 3 m up, beyond the light, passes
+// nothing that arrives: the transmittance runs to the light only.
+TEST(LocalLightsReference, TranslucentPanesBetweenTheLightAndTheGroundColourItsLight) {
+  const std::string pane =
+      R"(, {"primitive": {"type": "plane", "size": [40, 40]}, "transform": {"translate": [0, Y, 0]},
+      "material": {"opacity": 0.5, "transmission_color": [1, 0, 0], "double_sided": true}})";
+  const auto at = [&](const char* y) { return std::string(pane).replace(pane.find('Y'), 1, y); };
+  const Result r =
+      trace(scene_with(R"({"type": "point", "position": [0, 2, 0], "intensity": [8, 8, 8]})", at("1") + at("3")),
+            Effect::translucent);
+  const int x = pixel(1.0), y = kSide / 2;
+  const glm::dvec3 t(1.0, 0.5, 0.5);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(r.visibility_rgb.at(x, y, c), t[c], 1e-6) << c;
+    EXPECT_NEAR(r.radiance.at(x, y, c), kAlbedo * (1.4310835 * t[c] / kPi + kAmbient), 2e-5) << c;
+  }
+  EXPECT_NEAR(r.visibility.at(x, y, 0), 2.0 / 3.0, 1e-6);
+}
+
+TEST(LocalLightsReference, EffectsBeyondHardSoftAndTranslucentAreRefusedForLocalLights) {
   const Scene scene = scene_with(kSpot);
-  for (Effect effect : {Effect::filtered, Effect::translucent}) {
+  for (Effect effect : {Effect::filtered, Effect::scattering}) {
     Settings s;
     s.effect = effect;
     s.width = s.height = 8;

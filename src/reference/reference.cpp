@@ -176,9 +176,10 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const bool environment = settings.effect == Effect::environment;
   // Spot and point lights: the hard and soft effects shade every light of the scene (trace_lights).
   const bool local_lights = !scene.local_lights.empty();
-  if (local_lights && settings.effect != Effect::hard && settings.effect != Effect::soft)
+  if (local_lights && settings.effect != Effect::hard && settings.effect != Effect::soft &&
+      settings.effect != Effect::translucent)
     throw std::invalid_argument(fmt::format("the {} effect traces directional lights only; a scene with spot or point "
-                                            "lights is traced by the hard and soft effects",
+                                            "lights is traced by the hard, soft and translucent effects",
                                             to_string(settings.effect)));
   if (local_lights &&
       (settings.light_extent_deg || settings.light_shape || settings.light_width_deg || settings.light_height_deg))
@@ -358,6 +359,10 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
             v[3] = float(e.std_error);
           }
           row_sum[y] += e.visible;
+          if (vis_rgb) {
+            float* t = vis_rgb + (std::size_t(y) * W + x) * 3;
+            t[0] = float(e.visible_rgb.r), t[1] = float(e.visible_rgb.g), t[2] = float(e.visible_rgb.b);
+          }
           const glm::vec3 colour = msm_surface_radiance(tracer.albedo(hit), glm::vec3(e.direct), MSM_AMBIENT);
           float* q = surf + (std::size_t(y) * W + x) * 2;
           q[0] = float(e.n_dot_l);

@@ -40,8 +40,11 @@
 //               ray ending on the sphere; a directional light's disc of angular_extent_deg): each
 //               light's lit = ∫ max(n·ω, 0) V dω / (π sin² α) replaces max(n·l, 0) V, visibility
 //               = Σ lum(E_l) lit_l / Σ lum(E_l) lit0_l (lit0 unoccluded, the same samples). The
-//               other effects, the light overrides and rectangular or probe lights with soft
-//               refuse such scenes (std::invalid_argument).
+//               translucent effect: one ray per light, V_l the transmittance per channel of the
+//               surfaces between p and the light (none beyond it), "visibility_rgb" the weighted
+//               mean per channel and "visibility" their mean. The filtered, scattering and
+//               environment effects, the light overrides and rectangular or probe lights with
+//               soft refuse such scenes (std::invalid_argument).
 //
 //   filtered    What a filtered shadow map means, on any geometry (the renderer's PCF with
 //               perfect depth): with n_s the interpolated normal turned towards the viewer (the
