@@ -492,8 +492,9 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Object> objects;
   Camera camera;
-  // Shadow-casting directional lights, at least one (the JSON's "light", or 1..kMaxLights of
-  // "lights"). The ray tracer's effects use the first: light().
+  // Shadow-casting directional lights (the JSON's "light", the directional ones of "lights", a
+  // glTF object's imported ones, then the probe's); this and local_lights together hold at least
+  // one light. The ray tracer's effects for directional lights use the first: light().
   std::vector<DirectionalLight> lights{DirectionalLight{}};
   // The spot and point lights of "lights", in their order there (directional ones + these <=
   // kMaxLights). A scene may have these only: then `lights` is empty and light() must not be called.
