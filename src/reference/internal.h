@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -146,6 +147,8 @@ class Tracer {
   bool closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfar, SurfaceHit& hit) const;
   // True if anything lies on origin + t dir, t in [0, inf).
   bool occluded(const glm::dvec3& origin, const glm::dvec3& dir) const;
+  // True if anything lies on origin + t dir, t in [0, tfar]: a ray to a light at distance tfar.
+  bool occluded(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) const;
   // occluded() of n rays, as packets of 8 (a pixel's sample rays are nearly coherent).
   void occluded(const glm::dvec3* origins, const glm::dvec3* dirs, int n, bool* blocked) const;
   // occluded() of n rays from one origin, their directions in single precision (what Embree
@@ -164,7 +167,9 @@ class Tracer {
   // counting at most max_crossings of them; stops early when every channel is 0. alpha = the
   // material's constant times its opacity texture or noise (scene::opacity_image) at the hit's
   // uv. Without transmission colours every channel is the product of (1 - alpha).
-  Transmission transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const;
+  // Surfaces at t > tfar (beyond a light) do not count.
+  Transmission transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings,
+                            double tfar = std::numeric_limits<double>::infinity()) const;
 
   // Interpolated vertex normal at a hit (unit).
   glm::dvec3 shading_normal(const SurfaceHit& hit) const;
@@ -276,6 +281,27 @@ struct ScatteringSample {
 ScatteringSample scattering_along_ray(const EffectContext& ctx, const scene::Medium& medium, const glm::dvec3& camera,
                                       const glm::dvec3& dir, double s, std::span<const ScatteringLight> lights,
                                       Rng& rng);
+
+// Every light of a scene with spot or point lights (effect_lights.cpp), for the hard and soft
+// effects. A directional light's shadow rays run to infinity, a spot or point light's to the light
+// (a light inside a closed mesh reaches nothing outside it). hard: one ray per light towards its
+// centre. soft: `samples` directions per light of some extent, uniform in the cone it fills (a
+// directional light's angular_extent_deg as a disc; a spot or point light's sphere of `radius`,
+// sin α = r / d), each ray ending on the sphere; lights without extent get one ray. translucent:
+// one ray per light, V the transmittance per channel (Tracer::transmission up to the light).
+// lit_l = ∫ max(n·ω, 0) V dω / (π sin² α) over the cone (max(n·l, 0) V for a point), the
+// light's unoccluded lit0_l from the same samples.
+struct LightsSample {
+  glm::dvec3 direct{0.0};      // Σ_l msm_direct_light(E_l, lit_l, 1)
+  double visible = 0.0;        // Σ_l lum(E_l) lit_l / Σ_l lum(E_l) lit0_l; 0 where no light arrives
+  glm::dvec3 visible_rgb{0.0}; // the same per channel (translucent; else all equal to visible)
+  double std_error = 0.0;      // of visible, from the per-sample values (soft)
+  double n_dot_l = 0.0;        // with the first light's centre (directional lights first, then spot and point)
+  int samples = 1;
+  std::uint64_t rays = 0;
+};
+// n: the shading normal turned towards the viewer.
+LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n, Rng& rng);
 
 // environment (effect_environment.cpp): the lights of a scene's image-based lighting, built once
 // per render. Throws std::invalid_argument for a scene without a "probe".

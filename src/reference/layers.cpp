@@ -101,6 +101,9 @@ ShadowLayers trace_layers(const scene::Scene& scene, const LayerSettings& settin
     throw std::invalid_argument(fmt::format("max layers {} is out of range [1, {}]", settings.max_layers, kMaxLayers));
   if (settings.threads < 0 || settings.threads > kMaxThreads)
     throw std::invalid_argument(fmt::format("threads {} is out of range [0, {}]", settings.threads, kMaxThreads));
+  if (scene.lights.empty())
+    throw std::invalid_argument("shadow layers are traced along the scene's first directional light; the scene has "
+                                "none (spot and point lights only)");
   if (settings.threads == 0) return trace(scene, settings);
   tbb::task_arena arena(settings.threads);
   return arena.execute([&] { return trace(scene, settings); });

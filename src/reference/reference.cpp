@@ -164,9 +164,33 @@ Result render(const scene::Scene& scene, const Settings& settings) {
 
 namespace {
 
+// The scene's first directional light; a default one where it has only spot and point lights.
+scene::DirectionalLight first_light(const scene::Scene& scene) {
+  return scene.lights.empty() ? scene::DirectionalLight{} : scene.light();
+}
+
+// Spot and point lights are traced by the hard, soft and translucent effects (trace_lights), as
+// the scene declares them; std::invalid_argument for what else a scene with them asks.
+void check_local_lights(const scene::Scene& scene, const Settings& settings) {
+  if (scene.local_lights.empty()) return;
+  if (settings.effect != Effect::hard && settings.effect != Effect::soft && settings.effect != Effect::translucent)
+    throw std::invalid_argument(fmt::format("the {} effect traces directional lights only; a scene with spot or point "
+                                            "lights is traced by the hard, soft and translucent effects",
+                                            to_string(settings.effect)));
+  if (settings.light_extent_deg || settings.light_shape || settings.light_width_deg || settings.light_height_deg)
+    throw std::invalid_argument("the light overrides (extent, shape, width, height) change a scene's one directional "
+                                "light; a scene with spot or point lights is traced as it declares its lights");
+  if (settings.effect == Effect::soft)
+    for (const scene::DirectionalLight& l : scene.lights)
+      if (l.rectangular() || !l.sub_lights.empty())
+        throw std::invalid_argument("the soft effect traces a scene with spot or point lights with disc-shaped "
+                                    "directional lights only (no rectangles, no probe lights)");
+}
+
 // The light as the soft effect traces it; std::invalid_argument for an extent outside [0, 90) degrees.
+// A scene of spot and point lights only has no directional light: a default one stands for it.
 TracedLight checked_light(const scene::Scene& scene, const Settings& settings) {
-  const TracedLight light = traced_light(scene.light(), settings);
+  const TracedLight light = traced_light(first_light(scene), settings);
   if (!(std::isfinite(light.extent_deg) && light.extent_deg >= 0.0 && light.extent_deg < 90.0))
     throw std::invalid_argument(fmt::format("light extent {} degrees is out of range [0, 90)", light.extent_deg));
   return light;
@@ -176,8 +200,11 @@ TracedLight checked_light(const scene::Scene& scene, const Settings& settings) {
 // shape, half-sizes and axes (the light-space axes, made exactly orthonormal to towards_light).
 EffectContext effect_context(const Tracer& tracer, const scene::Scene& scene, const Settings& settings,
                              const TracedLight& light) {
-  EffectContext ctx{
-      tracer, settings, scene.light_frame(), {}, FilterKernel(settings.filter_size, settings.filter_sigma)};
+  EffectContext ctx{tracer,
+                    settings,
+                    scene.lights.empty() ? LightFrame{} : scene.light_frame(),
+                    {},
+                    FilterKernel(settings.filter_size, settings.filter_sigma)};
   ctx.towards_light = ctx.frame.towards_light;
   ctx.texel_x = ctx.frame.x_axis * (ctx.frame.extent.x / settings.shadow_size);
   ctx.texel_y = ctx.frame.y_axis * (ctx.frame.extent.y / settings.shadow_size);
@@ -230,7 +257,7 @@ class PixelTracer {
         W_(settings.width), H_(settings.height), mc_(is_monte_carlo(settings.effect)),
         scattering_(settings.effect == Effect::scattering), effect_(effect_function(settings.effect)),
         inv_vp_(glm::inverse(glm::dmat4(scene.camera_view_projection(float(W_) / float(H_))))),
-        irradiance_(scene.light().irradiance), camera_(scene.camera.position), probe_(background_probe(scene)),
+        irradiance_(first_light(scene).irradiance), camera_(scene.camera.position), probe_(background_probe(scene)),
         row_sum(std::size_t(settings.height), 0.0), row_background(std::size_t(settings.height), 0) {
     // scattering: every light of the scene (the first is ctx's), its direction and irradiance.
     if (scattering_)
@@ -301,10 +328,31 @@ class PixelTracer {
     // Shading: interpolated normal turned towards the viewer.
     glm::dvec3 n = tracer_.shading_normal(hit);
     if (glm::dot(hit.normal, dir) > 0.0) n = -n;
-    if (lighting_)
+    if (!scene_.local_lights.empty())
+      shade_lights(x, y, hit, n, rng, rays);
+    else if (lighting_)
       shade_environment(x, y, hit, n, dir, rng, rays);
     else
       shade_effect(x, y, hit, n, dir, rng, rays);
+  }
+
+  // Spot and point lights (with the directional ones): every light of the scene (trace_lights).
+  void shade_lights(int x, int y, const SurfaceHit& hit, const glm::dvec3& n, Rng& rng, std::uint64_t& rays) {
+    const LightsSample e = trace_lights(ctx_, hit, n, rng);
+    rays += e.rays;
+    float* v = result_.visibility.pixels().data() + pixel(x, y) * result_.visibility.channels();
+    v[0] = float(e.visible);
+    if (mc_) {
+      v[2] = float(e.samples);
+      v[3] = float(e.std_error);
+    }
+    row_sum[y] += e.visible;
+    if (!result_.visibility_rgb.empty()) {
+      float* t = result_.visibility_rgb.pixels().data() + pixel(x, y) * 3;
+      t[0] = float(e.visible_rgb.r), t[1] = float(e.visible_rgb.g), t[2] = float(e.visible_rgb.b);
+    }
+    write_surface(x, y, float(e.n_dot_l), hit);
+    write_radiance(x, y, msm_surface_radiance(tracer_.albedo(hit), glm::vec3(e.direct), MSM_AMBIENT));
   }
 
   void write_radiance(int x, int y, const glm::vec3& colour) {
@@ -434,6 +482,7 @@ Result render_in_arena(const scene::Scene& scene, const Settings& settings) {
   const bool scattering = settings.effect == Effect::scattering;
   if (scattering && !scene.medium)
     throw std::invalid_argument("the scattering effect needs a scene with a \"medium\" (extinction, albedo, phase)");
+  check_local_lights(scene, settings);
   std::optional<EnvironmentLighting> lighting;
   if (settings.effect == Effect::environment) lighting.emplace(scene, settings.probe_lights); // throws without a probe
   const Tracer tracer(scene);

@@ -188,7 +188,11 @@ bool Tracer::closest(const glm::dvec3& origin, const glm::dvec3& dir, double tfa
 }
 
 bool Tracer::occluded(const glm::dvec3& origin, const glm::dvec3& dir) const {
-  RTCRay ray = make_ray(origin, dir, std::numeric_limits<double>::infinity());
+  return occluded(origin, dir, std::numeric_limits<double>::infinity());
+}
+
+bool Tracer::occluded(const glm::dvec3& origin, const glm::dvec3& dir, double tfar) const {
+  RTCRay ray = make_ray(origin, dir, tfar);
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   rtcOccluded1(impl_->scene, &context, &ray);
@@ -256,13 +260,15 @@ void Tracer::occluded(const glm::dvec3& origin, const float* dir_x, const float*
   }
 }
 
-Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings) const {
+Tracer::Transmission Tracer::transmission(const glm::dvec3& origin, const glm::dvec3& dir, int max_crossings,
+                                          double tfar) const {
   Transmission result;
   glm::dvec3 o = origin;
   SurfaceHit hit;
   while (result.crossings < max_crossings) {
     ++result.rays;
-    if (!closest(o, dir, std::numeric_limits<double>::infinity(), hit)) break;
+    const double left = std::isfinite(tfar) ? tfar - glm::dot(o - origin, dir) : tfar;
+    if (!(left > 0.0) || !closest(o, dir, left, hit)) break;
     const double alpha = opacity(hit);
     const glm::vec3 colour = material(hit).transmission_color;
     for (int c = 0; c < 3; ++c) {

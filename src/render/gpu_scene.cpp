@@ -4,6 +4,11 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
 
 namespace msm::render {
 namespace {
@@ -26,6 +31,14 @@ struct Geometry {
   std::vector<Vertex> vertices;
   std::vector<uint32_t> indices, first_index;
 };
+
+// "directional and ..." lights: the kinds the renderer draws.
+std::string rendered_light_kinds() {
+  std::vector<std::string_view> names;
+  for (const scene::LightKindInfo& kind : scene::light_kinds())
+    if (kind.rendered) names.push_back(kind.name);
+  return fmt::format("{} lights only", fmt::join(names, " and "));
+}
 
 Geometry geometry(const scene::Scene& scene) {
   Geometry g;
@@ -81,6 +94,12 @@ vk::Image upload_probe(const vk::Context& ctx, const scene::ProbeLighting& p) {
 } // namespace
 
 GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
+  // The kinds of light whose shadows the renderer does not draw are refused, not left dark.
+  for (const scene::LightKindInfo& kind : scene::light_kinds())
+    if (!kind.rendered && scene.light_count(kind.kind) > 0)
+      throw RenderError(fmt::format("the scene has {} {} light(s): the renderer draws {}; the ray tracer (msm "
+                                    "reference) traces them",
+                                    scene.light_count(kind.kind), kind.name, rendered_light_kinds()));
   const Geometry g = geometry(scene);
   std::map<std::filesystem::path, int> texture_index;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {

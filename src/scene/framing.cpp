@@ -186,7 +186,8 @@ void clip_to_box(std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch
 
 TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size) {
   TexelCoverage c;
-  if (width <= 0 || height <= 0 || shadow_size <= 0) return c;
+  // The orthographic map of the first directional light; spot and point lights alone have none.
+  if (width <= 0 || height <= 0 || shadow_size <= 0 || scene.lights.empty()) return c;
   const glm::dmat4 camera_vp =
       glm::dmat4(scene.camera.projection(float(width) / float(height))) * glm::dmat4(scene.camera.view());
   const glm::dmat4 light_vp(scene.light_view_projection());

@@ -1,14 +1,18 @@
 // glTF as engines use it: per-primitive materials, texture coordinates right side up, alpha
 // modes, textures in files, data URIs and GLB, KHR_materials_transmission; and real models from
 // Debian packages (assimp-testmodels, glmark2-data), found through CMake-configured paths.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "msm/scene/scene.h"
 #include "msm/test/gltf_writer.h"
@@ -366,4 +370,129 @@ TEST(GltfImport, BunnyHasNoMaterial) {
   const std::vector<ModelPart> parts = import_model(bunny);
   ASSERT_EQ(parts.size(), 1u);
   EXPECT_FALSE(parts[0].material.has_value());
+}
+
+// ---------------------------------------------------------------------------------------------
+// KHR_lights_punctual: an object's "import_lights" adds its glTF file's lights, placed by the
+// file's nodes and then the object's transform.
+
+namespace {
+
+// Adds the extension's `lights` to a written .gltf and each of `nodes` as a root of its scene.
+void add_lights(const fs::path& file, const nlohmann::json& lights, const std::vector<nlohmann::json>& nodes) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(file));
+  j["extensionsUsed"].push_back("KHR_lights_punctual");
+  j["extensions"]["KHR_lights_punctual"]["lights"] = lights;
+  for (const nlohmann::json& node : nodes) {
+    j["nodes"].push_back(node);
+    j["scenes"][0]["nodes"].push_back(j["nodes"].size() - 1);
+  }
+  std::ofstream(file) << j.dump();
+}
+
+void write_quad(const fs::path& file) {
+  GltfModel model;
+  model.primitives.push_back(quad({0, 0, 0}, {1, 0, 0}, {0, 0, -1}, {0, 1, 0}));
+  write_gltf(file, model);
+}
+
+std::string lights_scene(const std::string& object_extra, const std::string& lights = "") {
+  return R"({"msm_scene": 1, )" + lights +
+         R"("objects": [{"name": "lamp", "mesh": "lamp.gltf", "import_lights": true)" + object_extra + "}]}";
+}
+
+const double kSqrtHalf = std::sqrt(0.5);
+
+// Expects a SceneError whose message contains every one of the given fragments.
+template <class F>
+void expect_error(F&& f, std::initializer_list<std::string> fragments) {
+  try {
+    f();
+    ADD_FAILURE() << "no SceneError thrown (expected one mentioning '" << *fragments.begin() << "')";
+  } catch (const SceneError& e) {
+    const std::string what = e.what();
+    for (const std::string& frag : fragments)
+      EXPECT_NE(what.find(frag), std::string::npos) << "'" << frag << "' not in: " << what;
+  }
+}
+
+} // namespace
+
+TEST(GltfLights, ImportedWithTheNodeHierarchyAndTheObjectTransform) {
+  TempDir dir("msm_gltf_test");
+  write_quad(dir.path() / "lamp.gltf");
+  const nlohmann::json lights = {{{"type", "spot"},
+                                  {"name", "desk"},
+                                  {"color", {1.0, 0.5, 0.25}},
+                                  {"intensity", 8.0},
+                                  {"range", 10.0},
+                                  {"spot", {{"innerConeAngle", 0.2}, {"outerConeAngle", 0.5}}}},
+                                 {{"type", "point"}, {"intensity", 3.0}},
+                                 {{"type", "directional"}, {"color", {0.5, 0.5, 0.5}}, {"intensity", 2.0}}};
+  // The spot on a child (0, 1, 0) of a node at (1, 2, 3) turned 90° about +Y: at (1, 3, 3),
+  // shining along -Z turned, -X. The point light at (-1, 0, 0); the sun turned -90° about +X:
+  // shining down.
+  add_lights(dir.path() / "lamp.gltf", lights,
+             {{{"translation", {1, 2, 3}}, {"rotation", {0, kSqrtHalf, 0, kSqrtHalf}}, {"children", {4}}},
+              {{"translation", {-1, 0, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}},
+              {{"rotation", {-kSqrtHalf, 0, 0, kSqrtHalf}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}},
+              {{"translation", {0, 1, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}});
+  // The last node (index 4) is the first one's child, not a root of the scene: drop it from the roots.
+  {
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(dir.path() / "lamp.gltf"));
+    j["scenes"][0]["nodes"].erase(j["scenes"][0]["nodes"].size() - 1);
+    std::ofstream(dir.path() / "lamp.gltf") << j.dump();
+  }
+  const Scene s = load(dir, lights_scene(R"(, "transform": {"translate": [0, 0, 10], "scale": 2})"));
+  ASSERT_EQ(s.lights.size(), 1u);
+  ASSERT_EQ(s.local_lights.size(), 2u);
+  EXPECT_NEAR(glm::distance(s.lights[0].towards_light, glm::vec3(0, 1, 0)), 0.0f, 1e-6f);
+  EXPECT_EQ(s.lights[0].irradiance, glm::vec3(1.0f));
+  const msm::scene::LocalLight* spot = &s.local_lights[0];
+  const msm::scene::LocalLight* point = &s.local_lights[1];
+  if (spot->kind != msm::scene::LightKind::spot) std::swap(spot, point);
+  ASSERT_EQ(spot->kind, msm::scene::LightKind::spot);
+  EXPECT_NEAR(glm::distance(spot->position, glm::vec3(2, 6, 16)), 0.0f, 1e-5f); // (1, 3, 3) × 2 + (0, 0, 10)
+  EXPECT_NEAR(glm::distance(spot->direction, glm::vec3(-1, 0, 0)), 0.0f, 1e-6f);
+  EXPECT_NEAR(spot->inner_cone_deg, 0.2 * 180.0 / std::numbers::pi, 1e-4);
+  EXPECT_NEAR(spot->outer_cone_deg, 0.5 * 180.0 / std::numbers::pi, 1e-4);
+  EXPECT_EQ(spot->intensity, glm::vec3(8, 4, 2));
+  EXPECT_EQ(spot->range, 20.0f); // scaled with the object
+  EXPECT_EQ(point->kind, msm::scene::LightKind::point);
+  EXPECT_NEAR(glm::distance(point->position, glm::vec3(-2, 0, 10)), 0.0f, 1e-5f);
+  EXPECT_EQ(point->range, msm::scene::LocalLight::kInfiniteRange);
+  EXPECT_EQ(point->intensity, glm::vec3(3.0f));
+}
+
+TEST(GltfLights, BadLightsAndMisuseAreClearErrors) {
+  TempDir dir("msm_gltf_test");
+  const auto with_light = [&](const nlohmann::json& light) {
+    write_quad(dir.path() / "lamp.gltf");
+    add_lights(dir.path() / "lamp.gltf", nlohmann::json::array({light}),
+               {{{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}}});
+  };
+  // glTF allows an outer cone of π/2; a perspective shadow map does not.
+  with_light({{"type", "spot"}, {"name", "wide"}, {"spot", {{"outerConeAngle", std::numbers::pi / 2.0}}}});
+  expect_error([&] { load(dir, lights_scene("")); },
+               {"/objects/0/import_lights", "lamp.gltf", "light 0 ('wide')", "outer_cone_deg", "(0, 90)"});
+  with_light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.6}, {"outerConeAngle", 0.5}}}});
+  expect_error([&] { load(dir, lights_scene("")); }, {"inner_cone_deg", "wider"});
+  with_light({{"type", "point"}, {"range", -1.0}});
+  expect_error([&] { load(dir, lights_scene("")); }, {"range"});
+  with_light({{"type", "area"}});
+  expect_error([&] { load(dir, lights_scene("")); }, {"/objects/0/import_lights", "type 'area'"});
+  // A file without lights, and no light in the scene either.
+  write_quad(dir.path() / "lamp.gltf");
+  expect_error([&] { load(dir, lights_scene("")); }, {"/objects", "no light"});
+  EXPECT_EQ(load(dir, lights_scene("", R"("light": {"towards_light": [0, 1, 0]}, )")).lights.size(), 1u);
+  // Not a glTF file; a primitive.
+  std::ofstream(dir.path() / "lamp.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  expect_error([&] { load(dir, R"({"msm_scene": 1, "objects": [{"mesh": "lamp.obj", "import_lights": true}]})"); },
+               {"/objects/0/import_lights", "glTF"});
+  expect_error(
+      [&] {
+        load(dir, R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]},
+                  "objects": [{"primitive": {"type": "box", "size": [1, 1, 1]}, "import_lights": true}]})");
+      },
+      {"/objects/0/import_lights"});
 }

@@ -1,6 +1,7 @@
 // Internal helpers of msm_scene (not installed).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,5 +44,21 @@ double import_timeout_seconds();
 // Test hook (tests only, null otherwise): called in the child before Assimp, to make it crash,
 // hang or allocate without end.
 extern void (*import_child_hook)();
+
+// A light of a glTF 2.0 file (KHR_lights_punctual) in the file's frame: its node's world position
+// and -Z axis (not normalized: the node's scale is in it), its colour times intensity, its cone
+// half-angles in degrees (glTF's radians converted) and range where given.
+struct FileLight {
+  std::size_t index = 0; // in the file's "lights"
+  std::string name;
+  LightKind kind = LightKind::point;
+  glm::vec3 position{0.0f}, direction{0.0f, 0.0f, -1.0f}, intensity{1.0f};
+  float inner_cone_deg = 0.0f, outer_cone_deg = 45.0f;
+  std::optional<float> range;
+};
+// The lights of the nodes of a .gltf or .glb file's scene (its "scene", else its first; without
+// scenes every root node), read from its JSON; none without KHR_lights_punctual. SceneError("", "",
+// problem) for another format, malformed JSON or a hierarchy that is not a tree.
+std::vector<FileLight> gltf_lights(const std::filesystem::path& file);
 
 } // namespace msm::scene::detail

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "internal.h"
+#include "msm/local_light.h"
 #include "msm/probe/probe.h"
 #include "msm/util/limits.h"
 
@@ -23,6 +24,58 @@ namespace {
 // finite for kMaxLights lights of at most FLT_MAX / kMaxLights ≈ 1.3e36 each (above, the weights'
 // sum overflowed to inf and the shadow buffer's visibility became inf / inf = NaN).
 constexpr float kMaxIrradiance = 1e36f;
+// The largest radiant intensity of a spot or point light: at the shortest distance the shading
+// takes (MSM_LOCAL_LIGHT_MIN_DISTANCE2) its irradiance stays below kMaxIrradiance.
+constexpr float kMaxIntensity = 1e27f;
+
+constexpr std::string_view kDirectionalKeys[] = {"towards_light", "irradiance", "angular_extent_deg",
+                                                 "angular_height_deg", "x_axis"};
+constexpr std::string_view kSpotKeys[] = {"position", "direction", "inner_cone_deg", "outer_cone_deg",
+                                          "range",    "intensity", "radius"};
+constexpr std::string_view kPointKeys[] = {"position", "range", "intensity", "radius"};
+
+constexpr LightKindInfo kLightKinds[] = {
+    {LightKind::directional, "directional", kDirectionalKeys,
+     "orthographic, fitted to what the camera sees (ShadowFraming)", 1,
+     "distance along the light's travel, affine: 0 at the box's near side, 1 at its far side",
+     "parallel rays towards towards_light, unbounded; a disc or rectangle of directions when soft", true},
+    {LightKind::spot, "spot", kSpotKeys, "perspective, the outer cone's field of view", 1, "radial distance / range",
+     "a shadow ray to the light's position (bounded by the distance)", false},
+    {LightKind::point, "point", kPointKeys, "six perspective faces of a cube, 90 degrees each", 6,
+     "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", false},
+};
+
+// What is wrong with a spot or point light (the key and the problem), or nothing: the one set of
+// rules for the scene's "lights" and the lights imported from glTF files.
+struct LightProblem {
+  std::string key, problem;
+};
+std::string range_text(float lo, float hi, bool open_lo, bool open_hi, float x) {
+  return fmt::format("must be in {}{:g}, {:g}{} (got {:g})", open_lo ? '(' : '[', lo, hi, open_hi ? ')' : ']', x);
+}
+std::optional<LightProblem> local_light_problem(const LocalLight& l) {
+  if (glm::any(glm::greaterThan(glm::abs(l.position), glm::vec3(kMaxSize))))
+    return LightProblem{"position", fmt::format("|component| must be at most {:g}", kMaxSize)};
+  if (l.spot()) {
+    if (!(l.outer_cone_deg > 0.0f && l.outer_cone_deg < 90.0f))
+      return LightProblem{"outer_cone_deg", range_text(0.0f, 90.0f, true, true, l.outer_cone_deg)};
+    if (!(l.inner_cone_deg >= 0.0f && l.inner_cone_deg < 90.0f))
+      return LightProblem{"inner_cone_deg", range_text(0.0f, 90.0f, false, true, l.inner_cone_deg)};
+    if (l.inner_cone_deg > l.outer_cone_deg)
+      return LightProblem{"inner_cone_deg",
+                          fmt::format("{:g} degrees is wider than outer_cone_deg {:g}: the inner cone "
+                                      "(full intensity) lies within the outer one",
+                                      l.inner_cone_deg, l.outer_cone_deg)};
+  }
+  if (l.range != LocalLight::kInfiniteRange && !(l.range > 0.0f && l.range <= kMaxCameraFar))
+    return LightProblem{"range", range_text(0.0f, kMaxCameraFar, true, false, l.range)};
+  if (glm::any(glm::lessThan(l.intensity, glm::vec3(0.0f)))) return LightProblem{"intensity", "must be >= 0"};
+  if (glm::any(glm::greaterThan(l.intensity, glm::vec3(kMaxIntensity))))
+    return LightProblem{"intensity", fmt::format("must be at most {:g} W/sr", kMaxIntensity)};
+  if (!(l.radius >= 0.0f && l.radius <= kMaxSize))
+    return LightProblem{"radius", range_text(0.0f, kMaxSize, false, false, l.radius)};
+  return std::nullopt;
+}
 
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -101,19 +154,33 @@ class Parser {
     const json* light_json = find(root, "light");
     const json* lights_json = find(root, "lights");
     const json* probe_json = find(root, "probe");
-    if (!light_json && !lights_json && !probe_json)
-      fail("/light", "required key missing (or \"lights\": a list of them, or a \"probe\")");
+    const json* objects_json = find(root, "objects");
+    const bool imports_lights = objects_json && objects_json->is_array() &&
+                                std::any_of(objects_json->begin(), objects_json->end(),
+                                            [](const json& o) { return o.is_object() && o.contains("import_lights"); });
+    if (!light_json && !lights_json && !probe_json && !imports_lights)
+      fail("/light", "required key missing (or \"lights\": a list of them, a \"probe\", or an object's "
+                     "\"import_lights\")");
     if (light_json && lights_json) fail("/lights", "give either \"light\" or \"lights\", not both");
     if (!light_json && !lights_json) {
       s.lights.clear();
     } else if (light_json) {
+      if (light_type(*light_json, "/light") != LightKind::directional)
+        fail("/light/type", "\"light\" is one directional light: give spot and point lights in \"lights\"");
       s.lights = {light(*light_json, "/light")};
     } else {
       if (!lights_json->is_array() || lights_json->empty() || lights_json->size() > size_t(kMaxLights))
         fail("/lights", fmt::format("must be a list of 1 to {} lights", kMaxLights));
       s.lights.clear();
-      for (size_t i = 0; i < lights_json->size(); ++i)
-        s.lights.push_back(light((*lights_json)[i], fmt::format("/lights/{}", i)));
+      for (size_t i = 0; i < lights_json->size(); ++i) {
+        const json& entry = (*lights_json)[i];
+        const std::string ptr = fmt::format("/lights/{}", i);
+        const LightKind kind = light_type(entry, ptr);
+        if (kind == LightKind::directional)
+          s.lights.push_back(light(entry, ptr));
+        else
+          s.local_lights.push_back(local_light(entry, ptr, kind));
+      }
     }
     if (const json* v = find(root, "shadow_map")) s.shadow = framing(*v, "/shadow_map");
     if (const json* v = find(root, "medium")) s.medium = medium(*v, "/medium");
@@ -136,6 +203,8 @@ class Parser {
     if (!objs) fail("/objects", "required key missing");
     if (!objs->is_array() || objs->empty()) fail("/objects", "must be a non-empty array");
     for (std::size_t i = 0; i < objs->size(); ++i) object((*objs)[i], fmt::format("/objects/{}", i), i, s);
+    if (s.lights.empty() && s.local_lights.empty())
+      fail("/objects", "no light: the objects' \"import_lights\" files hold none, and the scene declares none");
     return s;
   }
 
@@ -269,8 +338,92 @@ class Parser {
     return c;
   }
 
+  // A "lights" entry's "type" (default: directional); then only that kind's keys are allowed.
+  LightKind light_type(const json& j, const std::string& ptr) const {
+    if (!j.is_object()) fail(ptr, fmt::format("must be a JSON object (got {})", j.type_name()));
+    const json* t = find(j, "type");
+    if (!t) return LightKind::directional;
+    const std::string name = string(*t, ptr + "/type");
+    if (const std::optional<LightKind> kind = parse_light_kind(name)) return *kind;
+    std::vector<std::string_view> names;
+    for (const LightKindInfo& k : light_kinds()) names.push_back(k.name);
+    fail(ptr + "/type", fmt::format("unknown light type '{}' (allowed: {})", shortened(name), fmt::join(names, ", ")));
+  }
+
+  // The keys of a light of `kind` (its declaration's) and "type".
+  void light_keys(const json& j, const std::string& ptr, LightKind kind) const {
+    std::vector<std::string_view> allowed(light_kind(kind).keys.begin(), light_kind(kind).keys.end());
+    allowed.push_back("type");
+    for (const auto& [key, value] : j.items())
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        fail(ptr + "/" + escape(key),
+             fmt::format("unknown key of a {} light (allowed: {})", light_kind(kind).name, fmt::join(allowed, ", ")));
+  }
+
+  LocalLight local_light(const json& j, const std::string& ptr, LightKind kind) const {
+    light_keys(j, ptr, kind);
+    LocalLight l;
+    l.kind = kind;
+    const json* position = find(j, "position");
+    if (!position) fail(ptr + "/position", "required key missing (where the light is)");
+    l.position = vec<3>(*position, ptr + "/position");
+    if (l.spot()) {
+      const json* d = find(j, "direction");
+      if (!d) fail(ptr + "/direction", "required key missing (the direction the spot light shines in)");
+      l.direction = direction(*d, ptr + "/direction");
+      if (const json* v = find(j, "outer_cone_deg")) l.outer_cone_deg = number(*v, ptr + "/outer_cone_deg");
+      if (const json* v = find(j, "inner_cone_deg")) l.inner_cone_deg = number(*v, ptr + "/inner_cone_deg");
+    }
+    if (const json* v = find(j, "range")) l.range = number(*v, ptr + "/range");
+    if (const json* v = find(j, "intensity")) l.intensity = vec<3>(*v, ptr + "/intensity");
+    if (const json* v = find(j, "radius")) l.radius = number(*v, ptr + "/radius");
+    if (const auto problem = local_light_problem(l)) fail(ptr + "/" + problem->key, problem->problem);
+    return l;
+  }
+
+  // A glTF file's KHR_lights_punctual lights (detail::gltf_lights), moved by the object's transform,
+  // appended to the scene's lights; checked as the scene's own ("import_lights").
+  void import_lights(const fs::path& file, const Transform& transform, const std::string& ptr, Scene& s) const {
+    std::vector<detail::FileLight> lights;
+    try {
+      lights = detail::gltf_lights(file);
+    } catch (const SceneError& e) { fail(ptr, fmt::format("{} ({})", e.problem(), file.string())); }
+    const glm::mat4 m = transform.matrix();
+    for (const detail::FileLight& f : lights) {
+      const std::string what =
+          fmt::format("{}'s KHR_lights_punctual light {} ('{}')", file.filename().string(), f.index, shortened(f.name));
+      const glm::vec3 direction = transform.rotate * (f.direction / transform.scale);
+      if (!(glm::length(direction) > 0.0f)) fail(ptr, what + ": its node's transform has no direction left");
+      if (f.kind == LightKind::directional) {
+        DirectionalLight l;
+        l.towards_light = -glm::normalize(direction);
+        l.irradiance = f.intensity;
+        if (glm::any(glm::lessThan(l.irradiance, glm::vec3(0.0f))) ||
+            glm::any(glm::greaterThan(l.irradiance, glm::vec3(kMaxIrradiance))))
+          fail(ptr, fmt::format("{}: irradiance must be in [0, {:g}]", what, kMaxIrradiance));
+        s.lights.push_back(l);
+        continue;
+      }
+      LocalLight l;
+      l.kind = f.kind;
+      l.position = glm::vec3(m * glm::vec4(f.position, 1.0f));
+      l.direction = glm::normalize(direction);
+      l.inner_cone_deg = f.inner_cone_deg;
+      l.outer_cone_deg = f.outer_cone_deg;
+      // A range scales with the object (the largest of its scales: the light reaches at least as far).
+      if (f.range) l.range = *f.range * std::max({transform.scale.x, transform.scale.y, transform.scale.z});
+      l.intensity = f.intensity;
+      if (const auto problem = local_light_problem(l))
+        fail(ptr, fmt::format("{}: {}: {}", what, problem->key, problem->problem));
+      s.local_lights.push_back(l);
+    }
+    if (s.lights.size() + s.local_lights.size() > std::size_t(kMaxLights))
+      fail(ptr,
+           fmt::format("{} lights with the file's: at most {}", s.lights.size() + s.local_lights.size(), kMaxLights));
+  }
+
   DirectionalLight light(const json& j, const std::string& ptr) const {
-    keys(j, ptr, {"towards_light", "irradiance", "angular_extent_deg", "angular_height_deg", "x_axis"});
+    light_keys(j, ptr, LightKind::directional);
     DirectionalLight l;
     const json* d = find(j, "towards_light");
     if (!d) fail(ptr + "/towards_light", "required key missing (direction from the scene towards the light)");
@@ -309,9 +462,10 @@ class Parser {
     p.file = name == "sky" ? fs::path("sky") : probe_file(name, ptr + "/file");
     if (const json* v = find(j, "lights")) p.lights = integer(*v, ptr + "/lights");
     if (p.lights < 1 || p.lights > 256) fail(ptr + "/lights", "must be in [1, 256]");
-    if (s.lights.size() + std::size_t(p.lights) > std::size_t(kMaxLights))
-      fail(ptr + "/lights", fmt::format("{} directional lights and {} of the probe exceed {} lights", s.lights.size(),
-                                        p.lights, kMaxLights));
+    const std::size_t declared = s.lights.size() + s.local_lights.size();
+    if (declared + std::size_t(p.lights) > std::size_t(kMaxLights))
+      fail(ptr + "/lights",
+           fmt::format("{} declared lights and {} of the probe exceed {} lights", declared, p.lights, kMaxLights));
     if (const json* v = find(j, "intensity")) p.intensity = number_in(*v, ptr + "/intensity", 0.0f, 1e6f, false, false);
     if (const json* v = find(j, "rotation_deg"))
       p.rotation_deg = number_in(*v, ptr + "/rotation_deg", -360.0f, 360.0f, false, false);
@@ -573,7 +727,7 @@ class Parser {
     if (j.is_object())
       if (const json* v = find(j, "name")) name = this->name(*v, ptr + "/name");
     try {
-      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material", "motion"});
+      keys(j, ptr, {"name", "mesh", "primitive", "transform", "material", "motion", "import_lights"});
       const json* mesh = find(j, "mesh");
       const json* prim = find(j, "primitive");
       if (!mesh == !prim) fail(ptr, "needs exactly one of \"mesh\" (a file) and \"primitive\"");
@@ -594,11 +748,17 @@ class Parser {
         }
       }
       if (!mesh) {
+        if (find(j, "import_lights")) fail(ptr + "/import_lights", "imports a glTF \"mesh\" file's lights");
         Mesh m = primitive(*prim, ptr + "/primitive", o.primitive);
         add_object(std::move(o), std::move(m), ptr, s);
         return;
       }
       o.mesh_file = existing_file(string(*mesh, ptr + "/mesh"), ptr + "/mesh", "mesh");
+      if (const json* v = find(j, "import_lights"); v && boolean(*v, ptr + "/import_lights")) {
+        if (o.motion)
+          fail(ptr + "/import_lights", "an animated object's lights are not imported (they would stay put)");
+        import_lights(o.mesh_file, o.transform, ptr + "/import_lights", s);
+      }
       std::vector<ModelPart> parts;
       try {
         if (material_json) {
@@ -652,6 +812,36 @@ class Parser {
 };
 
 } // namespace
+
+std::span<const LightKindInfo> light_kinds() { return kLightKinds; }
+
+const LightKindInfo& light_kind(LightKind kind) {
+  for (const LightKindInfo& k : kLightKinds)
+    if (k.kind == kind) return k;
+  throw std::invalid_argument("undeclared light kind");
+}
+
+std::optional<LightKind> parse_light_kind(std::string_view name) {
+  for (const LightKindInfo& k : kLightKinds)
+    if (k.name == name) return k.kind;
+  return std::nullopt;
+}
+
+float LocalLight::cos_outer() const { return spot() ? std::cos(glm::radians(outer_cone_deg)) : -1.0f; }
+float LocalLight::cos_inner() const { return spot() ? std::cos(glm::radians(inner_cone_deg)) : -1.0f; }
+
+glm::vec3 LocalLight::irradiance_at(const glm::vec3& p) const {
+  const glm::vec3 from_light = p - position;
+  const float distance = glm::length(from_light);
+  const float cos_angle = distance > 0.0f ? glm::dot(from_light, direction) / distance : 1.0f;
+  return msm::msm_local_light_irradiance(intensity, distance, range, cos_angle, cos_outer(), cos_inner());
+}
+
+std::size_t Scene::light_count(LightKind kind) const {
+  if (kind == LightKind::directional) return lights.size();
+  return std::size_t(
+      std::count_if(local_lights.begin(), local_lights.end(), [&](const LocalLight& l) { return l.kind == kind; }));
+}
 
 DirectionalLight light_of_probe_light(const msm::probe::ProbeLight& light) {
   DirectionalLight l = light_of_area_light(light.light);
@@ -853,11 +1043,10 @@ void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_light
   if (count < 1 || count > 256)
     throw SceneError(file, "/probe/lights", fmt::format("{} lights: must be in [1, 256]", count));
   const std::size_t old_end = std::min(scene.lights.size(), p.first_light + std::size_t(p.lights));
-  const std::size_t others = scene.lights.size() - (old_end - p.first_light);
+  const std::size_t others = scene.lights.size() - (old_end - p.first_light) + scene.local_lights.size();
   if (others + std::size_t(count) > std::size_t(kMaxLights))
-    throw SceneError(
-        file, "/probe/lights",
-        fmt::format("{} directional lights and {} of the probe exceed {} lights", others, count, kMaxLights));
+    throw SceneError(file, "/probe/lights",
+                     fmt::format("{} declared lights and {} of the probe exceed {} lights", others, count, kMaxLights));
   p.lights = count;
   try {
     msm::probe::check_cut(count, p.size, p.horizon_split);
@@ -902,6 +1091,7 @@ void set_probe(Scene& scene, const std::filesystem::path& file) {
   }
   if (lights.empty()) throw SceneError(file.string(), "", "the probe has no light (every texel is black)");
   scene.lights = std::move(lights);
+  scene.local_lights.clear();
   scene.probe = p;
 }
 

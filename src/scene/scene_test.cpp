@@ -1389,3 +1389,153 @@ TEST(Probe, SixFaceFilesAreAProbe) {
   expect_error([&] { set_probe(turned, pattern); },
                {"cannot be rotated", "the scene's probe has \"rotation_deg\": 10"});
 }
+
+// ---------------------------------------------------------------------------------------------
+// Spot and point lights: "lights" entries of every kind, their declaration and their validation
+
+namespace {
+
+std::string scene_with_lights(const std::string& lights) {
+  return R"({"msm_scene": 1, "lights": [)" + lights +
+         R"(], "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})";
+}
+
+Scene load_lights(const std::string& lights) {
+  return load_scene_json(scene_with_lights(lights), fs::current_path(), "test.json");
+}
+
+} // namespace
+
+TEST(LocalLights, KindsMixInOneListInTheirOrder) {
+  const Scene s = load_lights(R"({"type": "spot", "position": [0, 3, 0], "direction": [0, -2, 0],
+      "inner_cone_deg": 20, "outer_cone_deg": 30, "range": 10, "intensity": [5, 6, 7], "radius": 0.1},
+    {"towards_light": [0, 1, 0]},
+    {"type": "point", "position": [1, 2, 3]},
+    {"type": "directional", "towards_light": [1, 1, 0], "irradiance": [2, 2, 2]})");
+  ASSERT_EQ(s.lights.size(), 2u);
+  ASSERT_EQ(s.local_lights.size(), 2u);
+  EXPECT_EQ(s.light_count(msm::scene::LightKind::directional), 2u);
+  EXPECT_EQ(s.light_count(msm::scene::LightKind::spot), 1u);
+  EXPECT_EQ(s.light_count(msm::scene::LightKind::point), 1u);
+  EXPECT_EQ(s.lights[1].irradiance, glm::vec3(2.0f));
+  const msm::scene::LocalLight& spot = s.local_lights[0];
+  EXPECT_EQ(spot.kind, msm::scene::LightKind::spot);
+  EXPECT_EQ(spot.position, glm::vec3(0, 3, 0));
+  EXPECT_EQ(spot.direction, glm::vec3(0, -1, 0)); // normalized
+  EXPECT_EQ(spot.inner_cone_deg, 20.0f);
+  EXPECT_EQ(spot.outer_cone_deg, 30.0f);
+  EXPECT_EQ(spot.range, 10.0f);
+  EXPECT_EQ(spot.intensity, glm::vec3(5, 6, 7));
+  EXPECT_EQ(spot.radius, 0.1f);
+  const msm::scene::LocalLight& point = s.local_lights[1];
+  EXPECT_EQ(point.kind, msm::scene::LightKind::point);
+  EXPECT_EQ(point.position, glm::vec3(1, 2, 3));
+  EXPECT_EQ(point.range, msm::scene::LocalLight::kInfiniteRange); // glTF: unbounded when absent
+  EXPECT_EQ(point.intensity, glm::vec3(1.0f));
+  EXPECT_EQ(point.radius, 0.0f);
+}
+
+TEST(LocalLights, OnlyLocalLightsLeaveNoDirectionalOne) {
+  const Scene s = load_lights(R"({"type": "point", "position": [0, 1, 0]})");
+  EXPECT_TRUE(s.lights.empty());
+  ASSERT_EQ(s.local_lights.size(), 1u);
+}
+
+// The declaration is what the loader reads: every declared key of a kind is accepted for it.
+TEST(LocalLights, TheDeclarationNamesEachKindAndItsKeys) {
+  for (const msm::scene::LightKindInfo& k : msm::scene::light_kinds()) {
+    EXPECT_EQ(msm::scene::parse_light_kind(k.name), k.kind);
+    EXPECT_EQ(&msm::scene::light_kind(k.kind), &k);
+    EXPECT_FALSE(k.keys.empty());
+    EXPECT_GE(k.shadow_views, 1);
+  }
+  EXPECT_FALSE(msm::scene::parse_light_kind("area").has_value());
+  EXPECT_EQ(msm::scene::light_kind(msm::scene::LightKind::point).shadow_views, 6);
+}
+
+TEST(LocalLights, BadInputNamesThePointerAndTheProblem) {
+  expect_json_error(scene_with_lights(R"({"type": "area", "position": [0, 1, 0]})"),
+                    {"/lights/0/type", "unknown light type 'area'", "spot"});
+  expect_json_error(scene_with_lights(R"({"type": "spot", "direction": [0, -1, 0]})"),
+                    {"/lights/0/position", "required"});
+  expect_json_error(scene_with_lights(R"({"type": "spot", "position": [0, 1, 0]})"),
+                    {"/lights/0/direction", "required"});
+  expect_json_error(scene_with_lights(R"({"type": "spot", "position": [0, 1, 0], "direction": [0, 0, 0]})"),
+                    {"/lights/0/direction", "non-zero"});
+  // Cone angles: outer in (0, 90), inner in [0, 90) and not wider than outer.
+  const std::string spot = R"({"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], )";
+  expect_json_error(scene_with_lights(spot + R"("outer_cone_deg": 90})"), {"/lights/0/outer_cone_deg", "(0, 90)"});
+  expect_json_error(scene_with_lights(spot + R"("outer_cone_deg": 0})"), {"/lights/0/outer_cone_deg", "(0, 90)"});
+  expect_json_error(scene_with_lights(spot + R"("outer_cone_deg": -5})"), {"/lights/0/outer_cone_deg"});
+  expect_json_error(scene_with_lights(spot + R"("inner_cone_deg": -1})"), {"/lights/0/inner_cone_deg", "[0, 90)"});
+  expect_json_error(scene_with_lights(spot + R"("inner_cone_deg": 40, "outer_cone_deg": 30})"),
+                    {"/lights/0/inner_cone_deg", "wider than outer_cone_deg"});
+  // The default outer cone (45°) bounds a given inner one too.
+  expect_json_error(scene_with_lights(spot + R"("inner_cone_deg": 50})"), {"/lights/0/inner_cone_deg", "wider"});
+  // Range > 0; radius >= 0 (0: a hard point); intensity >= 0.
+  const std::string point = R"({"towards_light": [0, 1, 0]}, {"type": "point", "position": [0, 1, 0], )";
+  expect_json_error(scene_with_lights(point + R"("range": 0})"), {"/lights/1/range", "(0, "});
+  expect_json_error(scene_with_lights(point + R"("range": -3})"), {"/lights/1/range"});
+  expect_json_error(scene_with_lights(point + R"("radius": -0.1})"), {"/lights/1/radius", "[0, "});
+  expect_json_error(scene_with_lights(point + R"("intensity": [1, -1, 1]})"), {"/lights/1/intensity", ">= 0"});
+  expect_json_error(scene_with_lights(point + R"("intensity": [1, 1e30, 1]})"), {"/lights/1/intensity", "at most"});
+  expect_json_error(scene_with_lights(point + R"("position": [0, 1e7, 0]})"), {"/lights/1/position"});
+  // A key of another kind is a typo here: a point light has no direction or cone.
+  expect_json_error(scene_with_lights(point + R"("direction": [0, -1, 0]})"),
+                    {"/lights/1/direction", "unknown key of a point light"});
+  expect_json_error(scene_with_lights(spot + R"("towards_light": [0, 1, 0]})"),
+                    {"/lights/0/towards_light", "unknown key of a spot light"});
+  expect_json_error(scene_with_lights(R"({"type": "directional", "position": [0, 1, 0], "towards_light": [0, 1, 0]})"),
+                    {"/lights/0/position", "unknown key of a directional light"});
+  expect_json_error(scene_with_lights(R"({"type": 3, "position": [0, 1, 0]})"), {"/lights/0/type", "string"});
+  expect_json_error(scene_with_lights(R"(7)"), {"/lights/0", "JSON object"});
+  // "light" stays one directional light.
+  expect_json_error(
+      R"({"msm_scene": 1, "light": {"type": "point", "position": [0, 1, 0]}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})",
+      {"/light/type", "\"lights\""});
+}
+
+TEST(LocalLights, AnEqualInnerAndOuterConeIsAHardEdge) {
+  const Scene s = load_lights(R"({"type": "spot", "position": [0, 0, 0], "direction": [0, -1, 0],
+      "inner_cone_deg": 30, "outer_cone_deg": 30})");
+  const msm::scene::LocalLight& l = s.local_lights[0];
+  const auto at_angle = [](float deg) {
+    return glm::vec3(std::sin(glm::radians(deg)), -std::cos(glm::radians(deg)), 0);
+  };
+  EXPECT_EQ(l.irradiance_at(at_angle(29.9f)), glm::vec3(1.0f));
+  EXPECT_EQ(l.irradiance_at(at_angle(30.1f)), glm::vec3(0.0f));
+}
+
+// E = I cone(θ) / d², hand-computed: a spot 2 m above the origin pointing down, I = 8 W/sr, inner
+// 30°, outer 45°. glTF's cone: t = (cos θ − cos 45°) / (cos 30° − cos 45°), cone = t².
+TEST(LocalLights, IrradianceIsInverseSquareTimesTheGltfCone) {
+  const Scene s = load_lights(R"({"type": "spot", "position": [0, 2, 0], "direction": [0, -1, 0],
+      "inner_cone_deg": 30, "outer_cone_deg": 45, "range": 5, "intensity": [8, 8, 8]})");
+  const msm::scene::LocalLight& l = s.local_lights[0];
+  // Straight below at d = 2: 8 / 4 = 2.
+  EXPECT_NEAR(l.irradiance_at({0, 0, 0}).x, 2.0f, 1e-6f);
+  // 1 m to the side: d² = 5, θ = atan(1/2) = 26.57° inside the inner cone: 8 / 5 = 1.6.
+  EXPECT_NEAR(l.irradiance_at({1, 0, 0}).x, 1.6f, 1e-6f);
+  // 1.5 m to the side: d² = 6.25, cos θ = 2 / 2.5 = 0.8 (36.87°, in the ramp):
+  // t = (0.8 − 0.70710678) / (0.86602540 − 0.70710678) = 0.58454, cone = 0.34169, E = 8 × 0.34169 / 6.25.
+  EXPECT_NEAR(l.irradiance_at({0, 0, 1.5f}).x, 0.437363f, 2e-5f);
+  // 2.5 m to the side: θ = 51.3° beyond the outer cone: 0.
+  EXPECT_EQ(l.irradiance_at({2.5f, 0, 0}), glm::vec3(0.0f));
+  // Beyond the range (5 m): 0; a point light lights every direction.
+  EXPECT_EQ(l.irradiance_at({0, -3.5f, 0}), glm::vec3(0.0f));
+  const Scene p = load_lights(R"({"type": "point", "position": [0, 2, 0], "intensity": [8, 8, 8]})");
+  EXPECT_NEAR(p.local_lights[0].irradiance_at({0, 6, 0}).x, 0.5f, 1e-6f);
+  // At the light's own position: finite, never inf or NaN.
+  const glm::vec3 at = p.local_lights[0].irradiance_at({0, 2, 0});
+  EXPECT_TRUE(std::isfinite(at.x));
+}
+
+// The probe's area lights count together with the declared lights of every kind.
+TEST(LocalLights, CountTowardsTheLightLimitWithAProbe) {
+  std::string lights = R"({"type": "point", "position": [0, 1, 0]})";
+  for (int i = 1; i < 250; ++i) lights += R"(, {"type": "point", "position": [0, 1, 0]})";
+  expect_json_error(
+      R"({"msm_scene": 1, "lights": [)" + lights +
+          R"(], "probe": {"file": "sky", "lights": 8, "size": 8}, "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})",
+      {"/probe/lights", "250 declared lights", "exceed"});
+}

@@ -267,7 +267,9 @@ void add_reference(CLI::App& app) {
     j["seed"] = settings.seed;
     j["filter"] = {
         {"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
-    j["light"] = light_json(scene.light(), settings, result);
+    if (!scene.lights.empty()) j["light"] = light_json(scene.light(), settings, result);
+    for (const msm::scene::LightKindInfo& kind : msm::scene::light_kinds())
+      j["light_counts"][std::string(kind.name)] = scene.light_count(kind.kind);
     j["max_crossings"] = settings.max_crossings;
     j["warnings"] = warnings;
     j["threads"] = result.threads;

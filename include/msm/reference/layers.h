@@ -60,7 +60,8 @@ struct ShadowLayers {
   }
 };
 
-// Throws std::invalid_argument for bad settings or a scene with non-finite vertices.
+// Throws std::invalid_argument for bad settings, a scene with non-finite vertices or without a
+// directional light.
 ShadowLayers trace_layers(const scene::Scene& scene, const LayerSettings& settings);
 
 } // namespace msm::reference

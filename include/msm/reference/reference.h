@@ -26,6 +26,26 @@
 //   hard        V(p) = 1 if the ray p -> L reaches infinity, else 0. One primary ray per pixel
 //               centre, no bias beyond eps, no antialiasing: the renderer's shadow buffer.
 //
+//               With spot or point lights (scene.local_lights) the scene's every light is
+//               shaded, each with its exact visibility V_l: a directional light's shadow ray runs
+//               to infinity, a spot or point light's from p to the light's position (a light
+//               inside a closed mesh lights nothing outside it), and E_l = the light's
+//               LocalLight::irradiance_at(p) (I cone(θ) / d², 0 beyond its range). The radiance
+//               is msm/shading.h's sum over the lights; "visibility" is their mean
+//               Σ w_l V_l / Σ w_l weighted by w_l = luminance of E_l max(n·l_l, 0) (the
+//               renderer's shadow buffer of several lights), 0 where no light arrives; n_dot_l
+//               is the first light's (directional lights first). The soft effect does the same
+//               with every light of some extent sampled over it (`samples` directions uniform in
+//               the cone it fills, a spot or point light's sphere of `radius`: sin α = r / d, each
+//               ray ending on the sphere; a directional light's disc of angular_extent_deg): each
+//               light's lit = ∫ max(n·ω, 0) V dω / (π sin² α) replaces max(n·l, 0) V, visibility
+//               = Σ lum(E_l) lit_l / Σ lum(E_l) lit0_l (lit0 unoccluded, the same samples). The
+//               translucent effect: one ray per light, V_l the transmittance per channel of the
+//               surfaces between p and the light (none beyond it), "visibility_rgb" the weighted
+//               mean per channel and "visibility" their mean. The filtered, scattering and
+//               environment effects, the light overrides and rectangular or probe lights with
+//               soft refuse such scenes (std::invalid_argument).
+//
 //   filtered    What a filtered shadow map means, on any geometry (the renderer's PCF with
 //               perfect depth): with n_s the interpolated normal turned towards the viewer (the
 //               normal the renderer shades with), V(p) = 0 where n_s . L <= 0 (a surface turned

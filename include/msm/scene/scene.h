@@ -45,6 +45,19 @@
 //                                          to towards_light (not parallel to it); default: the light
 //                                          frame's horizontal axis (Scene::light_view)
 //   },
+//   "lights": [ <light>, ... ]             instead of "light": 1..kMaxLights lights of any kinds
+//                                          (LightKindInfo, glTF KHR_lights_punctual's vocabulary):
+//     {"type": "directional", ...}         "type" optional (the default); the keys of "light"
+//     {"type": "spot",
+//      "position": [x,y,z],                REQUIRED
+//      "direction": [x,y,z],               REQUIRED where the light shines (normalized on load)
+//      "inner_cone_deg": 0,                half-angles: 0 <= inner <= outer, outer in (0, 90); full
+//      "outer_cone_deg": 45,               intensity within inner, glTF's smooth falloff to 0 at outer
+//      "range": r,                         > 0 metres, the light ends there (default: unbounded)
+//      "intensity": [1,1,1],               radiant intensity W/sr, >= 0; irradiance I / d² (LocalLight)
+//      "radius": 0}                        >= 0 metres, the emitter's size for soft shadows (0: a point)
+//     {"type": "point", "position", "range", "intensity", "radius"}   as for "spot"; every direction
+//                                          A light inside a closed mesh lights nothing outside it.
 //   "shadow_map": {
 //     "framing": "fit"                     default: orthographic light frustum fitted to what the
 //                                          camera sees (fit_light_frustum)
@@ -99,6 +112,14 @@
 //     "scale": s | [sx,sy,sz]              > 0 (no mirroring)
 //   },                                     world = translate * rotate * scale * local
 //   "material": <material> | "name"        default: the default material
+//   "import_lights": false                 a glTF "mesh" (.gltf, .glb): its KHR_lights_punctual lights
+//                                          join the scene's, placed by the file's nodes (the light
+//                                          shines along its node's -Z) and then "transform" (a range
+//                                          scaled by the largest scale); colour × intensity taken as
+//                                          W/sr (spot, point) or irradiance (directional); checked as
+//                                          "lights" (an outer cone of 90°, which glTF allows, is
+//                                          refused). With it the scene needs no "light" of its own.
+//                                          Not with "motion".
 //   "motion": {                            an animated object (`msm render --frames`, `msm reference
 //                                          --frame`; at_frame): per frame, a turn about an axis
 //                                          through the object's origin (its "translate"), then a move
@@ -148,6 +169,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -341,6 +363,53 @@ struct DirectionalLight {
   glm::vec2 rectangle_extents() const { return rectangular() ? tan_half_extents() : glm::vec2(0.0f); }
 };
 
+// ---- Light kinds ------------------------------------------------------------------------------
+//
+// The kinds of light a scene declares (each entry of "lights" names one by its "type", glTF
+// KHR_lights_punctual's vocabulary). LightKindInfo is their one declaration: the loader reads its
+// keys, the renderer whether it draws the kind, the ray tracer how it samples it, the docs
+// (docs/techniques.md, "Light kinds") its projection and depth convention.
+enum class LightKind { directional, spot, point };
+
+struct LightKindInfo {
+  LightKind kind = LightKind::directional;
+  std::string_view name;                  // the scene's "type"
+  std::span<const std::string_view> keys; // its JSON keys besides "type"
+  std::string_view projection;            // of its shadow map
+  int shadow_views = 1;                   // shadow-map views per light (a point light's cube: 6)
+  std::string_view depth;                 // what its shadow map stores
+  std::string_view traced;                // how the ray tracer (msm reference) samples it
+  bool rendered = false;                  // the renderer (msm render, msm view) draws its shadows
+};
+std::span<const LightKindInfo> light_kinds();
+const LightKindInfo& light_kind(LightKind kind);
+std::optional<LightKind> parse_light_kind(std::string_view name);
+
+// A spot or point light (glTF KHR_lights_punctual): a point source of radiant intensity
+// `intensity` (W/sr) at `position`, whose irradiance on a surface facing it at distance d is
+// intensity / d² (msm/local_light.h), none beyond `range`; a spot light's times glTF's smooth cone
+// falloff about `direction` between inner_cone_deg and outer_cone_deg.
+struct LocalLight {
+  LightKind kind = LightKind::point; // spot or point
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f}; // spot: unit, where the light shines
+  // Spot: half-angles from `direction`, 0 <= inner <= outer < 90 (a perspective shadow map's field
+  // of view is below 180°); full intensity within inner, none beyond outer.
+  float inner_cone_deg = 0.0f, outer_cone_deg = 45.0f;
+  float range = kInfiniteRange; // metres, > 0: the light ends there (glTF: infinite when absent)
+  glm::vec3 intensity{1.0f};    // W/sr, >= 0
+  float radius = 0.0f;          // the emitter's radius for soft shadows, >= 0 (0: a hard point)
+
+  static constexpr float kInfiniteRange = 3.0e38f;
+  bool spot() const { return kind == LightKind::spot; }
+  // Cosines of the cone's half-angles (a point light: -1, -1, every direction in full).
+  float cos_outer() const;
+  float cos_inner() const;
+  // The irradiance on a surface at p facing the light (msm_local_light_irradiance): intensity / d²
+  // times the cone's falloff, 0 beyond range; and the unit direction from p towards the light.
+  glm::vec3 irradiance_at(const glm::vec3& p) const;
+};
+
 // The light that the renderer, the ray tracer and the viewer draw for `light` under a command
 // line's (or a viewer's) overrides, the one rule for all three: an extent alone replaces the light
 // by a disc of that angular diameter; a height makes it a rectangle of that height, its width the
@@ -423,14 +492,20 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Object> objects;
   Camera camera;
-  // Shadow-casting directional lights, at least one (the JSON's "light", or 1..kMaxLights of
-  // "lights"). The ray tracer's effects use the first: light().
+  // Shadow-casting directional lights (the JSON's "light", the directional ones of "lights", a
+  // glTF object's imported ones, then the probe's); this and local_lights together hold at least
+  // one light. The ray tracer's effects for directional lights use the first: light().
   std::vector<DirectionalLight> lights{DirectionalLight{}};
+  // The spot and point lights of "lights", in their order there (directional ones + these <=
+  // kMaxLights). A scene may have these only: then `lights` is empty and light() must not be called.
+  std::vector<LocalLight> local_lights;
   ShadowFraming shadow;
   std::optional<Medium> medium;       // the JSON's "medium"; none: clear air
   std::optional<ProbeLighting> probe; // the JSON's "probe"; its lights follow the directional ones
 
-  const DirectionalLight& light() const { return lights.front(); }
+  const DirectionalLight& light() const { return lights.front(); } // precondition: !lights.empty()
+  // The number of lights of a kind (the probe's area lights are directional).
+  std::size_t light_count(LightKind kind) const;
   // Some object has a "motion": its frames differ (at_frame).
   bool animated() const;
 
@@ -533,8 +608,8 @@ void set_probe_light_count(Scene& scene, int count, std::optional<int> sub_light
 
 // Lights the scene by the light probe `file` (an equirectangular EXR, a cube-map cross, six faces
 // named by a "{face}" path, or "sky")
-// instead of its own lighting (`msm render --probe`, `msm reference --probe`): its directional
-// lights and its probe's lights are replaced by the new probe's area lights. The scene's probe
+// instead of its own lighting (`msm render --probe`, `msm reference --probe`): its lights (every
+// kind) and its probe's lights are replaced by the new probe's area lights. The scene's probe
 // settings (lights, size, intensity, rotation, horizon split, sub-lights) are kept where it has a
 // probe, else ProbeLighting's defaults (32 lights, 128² per face). SceneError naming the file for a
 // missing or unreadable probe, or one without light.

@@ -1,0 +1,35 @@
+// Spot and point lights (glTF KHR_lights_punctual): the irradiance a point source of radiant
+// intensity I (W/sr) gives a surface facing it, the one formula the shading and the ray tracer
+// (msm::scene::LocalLight::irradiance_at) share.
+#ifndef MSM_LOCAL_LIGHT_H
+#define MSM_LOCAL_LIGHT_H
+#include "msm/shared.h"
+
+MSM_BEGIN
+
+// The smallest squared distance the inverse-square law is evaluated at (0.1 mm, squared): a
+// surface through the light's position gets a large but finite irradiance, never inf or NaN
+// (intensities up to 1e27 W/sr give at most 1e35).
+const float MSM_LOCAL_LIGHT_MIN_DISTANCE2 = 1e-8f;
+
+// glTF KHR_lights_punctual's spot cone: 1 within the inner half-angle, 0 beyond the outer, between
+// them the square of the linear ramp in the cosine of the angle off the spot's axis. Equal cones:
+// a hard edge. A point light: cos_outer = cos_inner = -1, 1 everywhere.
+MSM_FN float msm_spot_cone(float cos_angle, float cos_outer, float cos_inner) {
+  if (cos_inner <= cos_outer) return cos_angle >= cos_outer ? 1.0f : 0.0f;
+  float t = clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0f, 1.0f);
+  return t * t;
+}
+
+// Irradiance on a surface facing the light at `distance` from it, `cos_angle` off the spot's axis:
+// intensity / distance² times the cone's falloff, 0 beyond `range` (the light ends there).
+MSM_FN vec3 msm_local_light_irradiance(vec3 intensity, float distance, float range, float cos_angle, float cos_outer,
+                                       float cos_inner) {
+  if (distance > range) return vec3(0.0f);
+  float cone = msm_spot_cone(cos_angle, cos_outer, cos_inner);
+  return intensity * (cone / max(distance * distance, MSM_LOCAL_LIGHT_MIN_DISTANCE2));
+}
+
+MSM_END
+
+#endif
