@@ -18,7 +18,13 @@ packages=(
   libglfw3-dev libimgui-dev xvfb xauth  # msm view (GLFW, Dear ImGui) and its tests in a virtual X server
   fonts-dejavu-core  # the font of msm view's panel (Greek letters of the parameter help)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
+  nodejs chromium  # the three.js package in web/ and its browser tests (headless chromium)
 )
+command -v npm >/dev/null || packages+=(npm) # Debian's npm, unless the installed nodejs brings its own
+
+# The web package's npm dependencies, as its lockfile pins them (once node and npm are there).
+web_dir="$(dirname "$0")/../web"
+npm_ci_web() { [[ -d "$web_dir/node_modules" ]] || (cd "$web_dir" && npm ci --no-audit --no-fund); }
 
 missing=()
 for p in "${packages[@]}"; do
@@ -28,6 +34,7 @@ done
 
 if ((${#missing[@]} == 0)); then
   echo "bootstrap: all ${#packages[@]} packages present"
+  npm_ci_web
   exit 0
 fi
 
@@ -38,3 +45,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${sudo[@]}" apt-get update -qq
 "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+npm_ci_web
