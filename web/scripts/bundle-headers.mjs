@@ -1,8 +1,9 @@
 // Bundles the shared headers of include/msm/ (valid GLSL ES 3.00 through shared.h's GL_ES mode)
 // into JavaScript strings, for WebGL 2, which has no #include: each bundle is one entry header with
 // the headers it includes resolved depth first, each header once (where its first #include stands;
-// the include guards stay), comments and blank lines removed. Nothing else changes: every code
-// line of the bundle is a line of a header.
+// the include guards stay), comments, blank lines and the C++ standard and GLM #include <...> lines
+// of shared.h's C++ branch removed (three.js would try to resolve them as its shader chunks).
+// Nothing else changes: every code line of the bundle is a line of a header.
 //
 //   node scripts/bundle-headers.mjs          writes the bundles
 //   node scripts/bundle-headers.mjs --check  fails, naming the first difference, where a written
@@ -29,6 +30,7 @@ export const BUNDLES = {
 };
 
 const includeLine = /^\s*#\s*include\s+"([^"]+)"\s*$/;
+const systemIncludeLine = /^\s*#\s*include\s+<[^>]+>\s*$/;
 
 function findHeader(name) {
   for (const dir of includeDirs) {
@@ -58,7 +60,7 @@ export function bundle(entry) {
       const line = raw.trimEnd();
       const m = includeLine.exec(line);
       if (m) visit(m[1]);
-      else if (line.length > 0) out.push(line);
+      else if (line.length > 0 && !systemIncludeLine.test(line)) out.push(line);
     }
   };
   visit(entry);
