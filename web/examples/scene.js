@@ -53,7 +53,7 @@ export function buildScene({ pointLight = true, spotLight = false } = {}) {
   if (spotLight) {
     const spot = new THREE.SpotLight(0xffffff, 60, 30, Math.PI / 6, 0.3);
     spot.name = 'spot';
-    spot.position.set(0, 8, 4);
+    spot.position.set(6, 6, -7);
     spot.target.position.set(0, 0, -2);
     spot.castShadow = true;
     spot.shadow.mapSize.set(1024, 1024);
