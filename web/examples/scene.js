@@ -2,7 +2,7 @@
 // directional sun and a spot light; shared by the example page and the browser tests.
 import * as THREE from 'three';
 
-export function buildScene({ pointLight = true, spotLight = false } = {}) {
+export function buildScene({ pointLight = true, spotLight = false, sunLight = true } = {}) {
   const scene = new THREE.Scene();
   scene.background = new THREE.Color(0x9fb4c8);
   const stone = new THREE.MeshStandardMaterial({ color: 0xd8d2c4, roughness: 0.8 });
@@ -37,6 +37,7 @@ export function buildScene({ pointLight = true, spotLight = false } = {}) {
   sun.name = 'sun';
   sun.position.set(-6, 10, -10);
   sun.castShadow = true;
+  sun.visible = sunLight;
   sun.shadow.mapSize.set(1024, 1024);
   Object.assign(sun.shadow.camera, { left: -12, right: 12, top: 12, bottom: -12, near: 1, far: 40 });
   scene.add(sun);
