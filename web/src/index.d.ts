@@ -1,7 +1,7 @@
 // Moment shadow maps for three.js's WebGLRenderer (see README.md).
 
-/** The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM. */
-export declare const TECHNIQUES: Readonly<{ 'msm-hamburger-64': 0; 'msm-hamburger-128': 1 }>;
+/** The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM, 64-bit non-linear moments. */
+export declare const TECHNIQUES: Readonly<{ 'msm-hamburger-64': 0; 'msm-hamburger-128': 1; 'msm-nl-64': 2 }>;
 export type Technique = keyof typeof TECHNIQUES;
 
 /** The Gaussian blur of the moment maps: taps x taps texels (odd, 1..63), σ in texels. */

@@ -18,6 +18,7 @@ import { MSM_THREE_GLSL } from './generated/msm-glsl.js';
 export const TECHNIQUES = Object.freeze({
   'msm-hamburger-64': 0, // 4 x 16 bits after Θ4* (JCGT), Hamburger 4MSM
   'msm-hamburger-128': 1, // 4 x float (JCGT), Hamburger 4MSM
+  'msm-nl-64': 2, // Φ of the float moments in 4 x 16 bits (HPG 2017), Algorithm 3
 });
 
 // The Gaussian blur: taps x taps texels, σ in texels (filter.h's defaults: the 2015 paper's kernel).
@@ -72,10 +73,25 @@ const GET_SHADOW = `
 		float getShadow( sampler2D shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord ) {
 			float shadow = 1.0;
 			shadowCoord.xyz /= shadowCoord.w;
-			shadowCoord.z += shadowBias - MSM_DEPTH_BIAS_FILTERED;
+			shadowCoord.z += shadowBias - msm_three_depth_bias( MSM_THREE_TECHNIQUE );
 			bool inFrustum = shadowCoord.x >= 0.0 && shadowCoord.x <= 1.0 && shadowCoord.y >= 0.0 && shadowCoord.y <= 1.0;
 			if ( inFrustum && shadowCoord.z <= 1.0 ) {
-				shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
+				#if MSM_THREE_TECHNIQUE == 2
+					// Non-linear texels are not interpolated as stored: four decoded to moments, those interpolated.
+					ivec2 last = textureSize( shadowMap, 0 ) - 1;
+					vec2 t = shadowCoord.xy * vec2( last + 1 ) - 0.5;
+					ivec2 i0 = ivec2( floor( t ) );
+					vec2 f = t - floor( t );
+					ivec2 i1 = min( i0 + 1, last );
+					i0 = max( i0, ivec2( 0 ) );
+					vec4 m00 = msm_three_nl64_moments( texelFetch( shadowMap, i0, 0 ) );
+					vec4 m10 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i1.x, i0.y ), 0 ) );
+					vec4 m01 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i0.x, i1.y ), 0 ) );
+					vec4 m11 = msm_three_nl64_moments( texelFetch( shadowMap, i1, 0 ) );
+					shadow = 1.0 - msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), shadowCoord.z );
+				#else
+					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
+				#endif
 			}
 			return mix( 1.0, shadow, shadowIntensity );
 		}

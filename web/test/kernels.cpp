@@ -26,10 +26,10 @@ using namespace msm;
 constexpr int kInputs = 4096; // per function
 
 const char* const kNames[] = {
-    "fma",         "moments4",          "theta4_star",     "theta4_star_inverse", "pack_unorm16x4", "unpack_unorm16x4",
-    "apply_bias",  "hamburger4_bounds", "nl_from_moments", "nl_moments_from",     "nl_psi4",        "nl_psi4_inverse",
-    "nl_pack64",   "nl_unpack64",       "nl_pack32",       "nl_unpack32",         "nl_shadow",      "three_generate",
-    "three_shadow"};
+    "fma",          "moments4",          "theta4_star",     "theta4_star_inverse", "pack_unorm16x4", "unpack_unorm16x4",
+    "apply_bias",   "hamburger4_bounds", "nl_from_moments", "nl_moments_from",     "nl_psi4",        "nl_psi4_inverse",
+    "nl_pack64",    "nl_unpack64",       "nl_pack32",       "nl_unpack32",         "nl_shadow",      "three_generate",
+    "three_shadow", "three_store"};
 static_assert(sizeof(kNames) / sizeof(kNames[0]) == MSM_WK_COUNT);
 
 class Inputs {
@@ -130,12 +130,21 @@ KernelIO make_input(int id, Inputs& g) {
     break;
   case MSM_WK_THREE_GENERATE:
     x.a[0] = g.chance(0.05) ? float(g.integer(0, 4)) * 0.25f : g.uni(0.0f, 1.0f);
-    x.u[0] = uint32_t(g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_HAMBURGER_128));
+    x.u[0] = uint32_t(g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64));
     break;
-  case MSM_WK_THREE_SHADOW: { // a texel as the package stores it, a receiver near its depths
-    int t = g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_HAMBURGER_128);
+  case MSM_WK_THREE_STORE: { // blurred channels in each technique's basis
+    int t = g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64);
     vec4 b = test::moments4f(d);
-    x.a = t == MSM_THREE_HAMBURGER_64 ? msm_quantize_unorm16(msm_theta4_star(b)) : b;
+    x.a = t == MSM_THREE_HAMBURGER_64 ? msm_theta4_star(b) : b;
+    x.u[0] = uint32_t(t);
+    break;
+  }
+  case MSM_WK_THREE_SHADOW: { // a texel as the package stores it, a receiver near its depths
+    int t = g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64);
+    vec4 b = test::moments4f(d);
+    x.a = t == MSM_THREE_HAMBURGER_64 ? msm_quantize_unorm16(msm_theta4_star(b))
+          : t == MSM_THREE_NL64       ? msm_three_store(t, b)
+                                      : b;
     x.b[0] = msm_unit_depth(g.receiver(d));
     x.u[0] = uint32_t(t);
     break;
@@ -147,7 +156,8 @@ KernelIO make_input(int id, Inputs& g) {
 
 // The renderer's technique (techniques.h) that each of the package's techniques is.
 int renderer_technique(uint32_t t) {
-  return t == uint32_t(MSM_THREE_HAMBURGER_64) ? MSM_TECH_HAMBURGER_64 : MSM_TECH_HAMBURGER_128;
+  if (t == uint32_t(MSM_THREE_HAMBURGER_64)) return MSM_TECH_HAMBURGER_64;
+  return t == uint32_t(MSM_THREE_NL64) ? MSM_TECH_NL64 : MSM_TECH_HAMBURGER_128;
 }
 
 // The package's per-texel steps (msm_three.h) are the renderer's: identical results in C++, so
@@ -160,7 +170,15 @@ bool same_as_renderer(int id, const KernelIO& x, const KernelIO& r) {
     // The renderer's 64-bit map rounds to UNORM16 on the write; msm_three_store does that in the shader.
     return r.a == want && (t != MSM_TECH_HAMBURGER_64 || stored == msm_quantize_unorm16(want));
   }
-  if (id == MSM_WK_THREE_SHADOW) {
+  if (id == MSM_WK_THREE_STORE) {
+    vec4 want = t == MSM_TECH_HAMBURGER_64 ? msm_quantize_unorm16(x.a)
+                : t == MSM_TECH_NL64       ? msm_nl64_encode(x.a)
+                                           : x.a;
+    return r.a == want;
+  }
+  // The non-linear shading is the renderer's bilinear lookup in shading_nonlinear.glsl (decode,
+  // moments, Φ, Algorithm 3), which has no C++ twin: compared with the C++ build alone.
+  if (id == MSM_WK_THREE_SHADOW && t != MSM_TECH_NL64) {
     float want = msm_technique_shadow(t, MsmTexel(x.a, vec4(0.0f)), x.b[0], msm_technique_default_params(t));
     return std::bit_cast<uint32_t>(r.a[0]) == std::bit_cast<uint32_t>(want);
   }

@@ -42,7 +42,8 @@ const int MSM_WK_NL_UNPACK32 = 15;        // u.x -> a = nl
 const int MSM_WK_NL_SHADOW = 16;          // a = nl, b.x = zf -> a.x (HPG Algorithm 3)
 const int MSM_WK_THREE_GENERATE = 17;     // a.x = unit depth, u.x = package technique -> a
 const int MSM_WK_THREE_SHADOW = 18;       // a = stored texel, b.x = unit zf, u.x = package technique -> a.x
-const int MSM_WK_COUNT = 19;
+const int MSM_WK_THREE_STORE = 19;        // a = filtered, u.x = package technique -> a
+const int MSM_WK_COUNT = 20;
 
 MSM_FN KernelIO msm_web_kernel_nl(NonLinearMoments m) {
   return KernelIO(vec4(m.y1, m.y2, m.v2, m.xi4), vec4(0.0f), uvec4(0u));
@@ -71,6 +72,7 @@ MSM_FN KernelIO msm_web_kernel(int function, KernelIO x) {
   case MSM_WK_NL_SHADOW: r.a[0] = msm_nl_shadow(nl, x.b[0]); break;
   case MSM_WK_THREE_GENERATE: r.a = msm_three_generate(int(x.u[0]), x.a[0]); break;
   case MSM_WK_THREE_SHADOW: r.a[0] = msm_three_shadow(int(x.u[0]), x.a, x.b[0]); break;
+  case MSM_WK_THREE_STORE: r.a = msm_three_store(int(x.u[0]), x.a); break;
   default: break;
   }
   return r;

@@ -31,7 +31,7 @@ try {
 const module = await import(resolve(webDir, 'src/index.js'));
 for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR'])
   if (!(name in module)) fail(`src/index.js does not export ${name}`);
-if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128']))
+if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64']))
   fail(`TECHNIQUES is ${JSON.stringify(module.TECHNIQUES)}, not what index.d.ts declares`);
 if (failed) process.exit(1);
 console.log('web-package: ok');

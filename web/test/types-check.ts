@@ -5,6 +5,6 @@ declare const renderer: RendererLike;
 const technique: Technique = 'msm-hamburger-64';
 const moments = new MomentShadowMaps(renderer, { technique, blur: { taps: 9, sigma: DEFAULT_BLUR.sigma } });
 moments.technique = 'msm-hamburger-128';
-const id: 0 | 1 = TECHNIQUES[moments.technique];
+const id: 0 | 1 | 2 = TECHNIQUES[moments.technique];
 const ok: boolean = MomentShadowMaps.isSupported(renderer, true) && moments.supported && id >= 0;
 if (ok) moments.dispose();
