@@ -289,22 +289,28 @@ export class MomentShadowMaps {
     }
     for (const light of lights) {
       const state = this._lights.get(light);
-      if (!state || !state.generated) continue;
-      state.generated = false;
-      const blur = this._blurPass.uniforms;
-      blur.taps.value = taps;
-      blur.technique.value = this._technique;
-      blur.source.value = state.moments.texture;
-      blur.direction.value.set(1, 0);
-      blur.store.value = false;
-      this._draw(this._blurPass, state.scratch);
-      blur.source.value = state.scratch.texture;
-      blur.direction.value.set(0, 1);
-      blur.store.value = true;
-      this._draw(this._blurPass, state.moments);
+      if (!state || state.threeMap !== light.shadow.map) continue;
+      // A light that three.js did not update this frame (shadow.autoUpdate off) keeps its moments.
+      if (state.generated) this._blur(state, taps);
       light.shadow.map = state.moments;
     }
     renderer.setRenderTarget(previousTarget);
+  }
+
+  // The separable Gaussian of the generated moments, then their storage.
+  _blur(state, taps) {
+    state.generated = false;
+    const blur = this._blurPass.uniforms;
+    blur.taps.value = taps;
+    blur.technique.value = this._technique;
+    blur.source.value = state.moments.texture;
+    blur.direction.value.set(1, 0);
+    blur.store.value = false;
+    this._draw(this._blurPass, state.scratch);
+    blur.source.value = state.scratch.texture;
+    blur.direction.value.set(0, 1);
+    blur.store.value = true;
+    this._draw(this._blurPass, state.moments);
   }
 
   // The receivers' programs read the technique as a define (part of three.js's program key).
