@@ -18,15 +18,16 @@ packages=(
   libglfw3-dev libimgui-dev xvfb xauth  # msm view (GLFW, Dear ImGui) and its tests in a virtual X server
   fonts-dejavu-core  # the font of msm view's panel (Greek letters of the parameter help)
   assimp-testmodels  # Khronos glTF samples (2CylinderEngine, BoxTextured, ...) for the real-model tests (74 MB)
-  python3-matplotlib chromium nodejs  # msm report's charts, and its page's test in headless Chromium
+  python3-matplotlib  # msm report's charts
+  nodejs chromium  # the three.js package in web/, and the browser tests of it and of msm report's page (headless)
 )
 command -v npm >/dev/null || packages+=(npm) # a nodejs from elsewhere (NodeSource) brings its own npm
 
-# web/'s npm packages (playwright-core drives Chromium in tests/browser), from its lockfile.
+# web/'s npm packages as its lockfile pins them (three, playwright-core, ...), again when the lockfile changes.
 web_packages() {
   local web
   web="$(dirname "$0")/../web"
-  [[ -d "$web/node_modules" ]] || (cd "$web" && npm ci --no-audit --no-fund)
+  [[ "$web/node_modules/.package-lock.json" -nt "$web/package-lock.json" ]] || (cd "$web" && npm ci --no-audit --no-fund)
 }
 
 missing=()

@@ -84,7 +84,14 @@ MSM_FN float msm_receiver_depth_sigma(vec2 depth_per_texel, float kernel_varianc
 // The bias a negative exponential warp −e^{−c z} needs (see above), for σ in [-1,1] depth.
 MSM_FN float msm_receiver_plane_bias_negative_warp(float sigma, float c) { return 0.5f * c * sigma * sigma; }
 
-MSM_FN vec4 msm_apply_bias(vec4 b, float alpha, vec4 bstar) { return mix(b, bstar, alpha); }
+// mix(b, b*, α) written out as GLM computes it, b (1 - α) + b* α, and `precise`: GLSL's mix() may
+// round otherwise (WebGL 2 on SwiftShader differs from GLM in the last bit for 61% of moment
+// vectors), and one ulp of the float-biased moments of a single depth (α = 3e-7) moved Hamburger
+// 4MSM by up to 0.15 for receivers just behind it (web/test/math.test.mjs).
+MSM_FN vec4 msm_apply_bias(vec4 b, float alpha, vec4 bstar) {
+  MSM_PRECISE vec4 biased = b * (1.0f - alpha) + bstar * alpha;
+  return biased;
+}
 
 // b with b4 raised so that the last LDLᵀ pivot D2 = b4 - b2² - L21² D1 (hamburger4.h) is at least
 // min_d2: adding to b4 adds the same to D2 and leaves b0..b3 alone, and a larger D2 only lowers
@@ -94,7 +101,7 @@ MSM_FN vec4 msm_apply_bias(vec4 b, float alpha, vec4 bstar) { return mix(b, bsta
 MSM_FN vec4 msm_raise_d2(vec4 b, float min_d2) {
   return vec4(b[0], b[1], b[2], b[3] + msm_at_least(min_d2 - msm_hankel3_ldl(b).D2, 0.0f));
 }
-MSM_FN vec4 msm_apply_bias(vec4 b, MomentBias4 bias) { return mix(b, bias.bstar, bias.alpha); }
+MSM_FN vec4 msm_apply_bias(vec4 b, MomentBias4 bias) { return msm_apply_bias(b, bias.alpha, bias.bstar); }
 MSM_FN Moments6 msm_apply_bias6(Moments6 b, MomentBias6 bias) { return msm_moments6_mix(b, bias.bstar, bias.alpha); }
 
 MSM_END

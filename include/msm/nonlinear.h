@@ -72,7 +72,8 @@ MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
   float xi4 = msm_hankel3_ldl(b).D2;
   NonLinearMoments m =
       NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, msm_at_least(xi4, 0.0f));
-  return msm_nl_is_finite(m) ? m : MSM_NL_FAR; // finite but overflowing garbage
+  if (!msm_nl_is_finite(m)) return MSM_NL_FAR; // finite but overflowing garbage
+  return m;
 }
 
 // Φ of filtered, unbiased float moments: applies the float bias of [-1,1] depth first.
@@ -109,7 +110,7 @@ MSM_FN float msm_nl_psi4_inverse(float psi4) {
 
 // ---- 64 bits: four 16-bit UNORM (HPG §3.3) ----
 MSM_FN uvec2 msm_nl_pack64(NonLinearMoments m) {
-  m = msm_nl_is_finite(m) ? m : MSM_NL_FAR;
+  if (!msm_nl_is_finite(m)) m = MSM_NL_FAR;
   return msm_pack_unorm16x4(vec4(0.5f * m.y1 + 0.5f, 0.5f * m.y2 + 0.5f, m.v2, msm_nl_psi4(m.xi4)));
 }
 MSM_FN NonLinearMoments msm_nl_unpack64(uvec2 p) {
@@ -160,7 +161,7 @@ MSM_FN uint msm_nl_psi4_encode6(float psi4) {
 }
 
 MSM_FN uint msm_nl_pack32(NonLinearMoments m) {
-  m = msm_nl_is_finite(m) ? m : MSM_NL_FAR;
+  if (!msm_nl_is_finite(m)) m = MSM_NL_FAR;
   uint t1 = msm_nl_depth10_encode(m.y1);
   uint t2 = msm_nl_depth10_encode(m.y2);
   uint pair = msm_nl_fold_depths(uvec2(min(t1, t2), max(t1, t2)));

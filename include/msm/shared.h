@@ -1,7 +1,9 @@
 // The bridge between GLSL 4.60 and C++20: every header in include/msm/ is valid in both
 // languages once this file has been included. Shaders include it through glslc -I<include>;
 // C++ includes it normally and gets the same functions in namespace msm, in single precision,
-// on top of GLM.
+// on top of GLM. A third mode, GLSL ES 3.00 (WebGL 2; the preprocessor defines GL_ES), serves the
+// three.js package in web/, whose build bundles the headers a shader needs into JavaScript strings
+// (web/scripts/bundle-headers.mjs resolves the #include lines that WebGL lacks).
 //
 // Rules for the shared headers (each keeps the two builds identical):
 //  - functions are declared `MSM_FN type name(...)`; no references, pointers, out/inout
@@ -9,6 +11,7 @@
 //  - structs are constructed with their type name, `Bounds(lo, hi)` (C++20 aggregates);
 //  - float literals carry the f suffix (`0.5f`): GLM's operators take no double scalar;
 //  - no swizzles (`v.xy`): write `vec2(v.x, v.y)` or index with `v[i]`;
+//  - no `?:` choosing between structs (WebGL rejects it): an `if` instead;
 //  - no names that GLSL reserves (`filter`, `sample`, `input`, `output`, `common`, `active`);
 //  - constants are `const float NAME = ...;` at file scope, inside MSM_BEGIN/MSM_END;
 //  - include guards, not #pragma once.
@@ -40,11 +43,23 @@ using uint = std::uint32_t;
 #endif
 
 // `precise` (SPIR-V NoContraction): no contraction into fma and no reassociation of the operation
-// whose result it qualifies. Nothing in C++, whose build has -ffp-contract=off instead.
+// whose result it qualifies. Nothing in C++, whose build has -ffp-contract=off instead. GLSL ES
+// 3.00 has no `precise` (ES 3.20 and EXT_gpu_shader5 do, WebGL 2 has neither): there the error-free
+// transformations are exact only where the compiler neither contracts nor reassociates, which the
+// web package's browser test measures (web/test/math.html, on ANGLE's SwiftShader).
 #if MSM_CPP
+#define MSM_PRECISE
+#elif defined(GL_ES)
 #define MSM_PRECISE
 #else
 #define MSM_PRECISE precise
+#endif
+
+// GLSL ES: every float and integer at full precision; the shared math assumes IEEE single
+// precision and 32-bit integers (floatBitsToInt, packUnorm2x16, the 32-bit packings).
+#if !MSM_CPP && defined(GL_ES)
+precision highp float;
+precision highp int;
 #endif
 
 // The error-free transformations (TwoSum, TwoProduct, double-float) that msm_fma's emulation and
@@ -100,6 +115,10 @@ MSM_FN float msm_fma_emulated(float a, float b, float c) {
 
 #if MSM_CPP
 MSM_FN float msm_fma(float a, float b, float c) { return std::fma(a, b, c); }
+#elif defined(GL_ES)
+// GLSL ES 3.00 has no fma(): always the emulation (exact where the compiler keeps the operations
+// apart, see MSM_PRECISE).
+MSM_FN float msm_fma(float a, float b, float c) { return msm_fma_emulated(a, b, c); }
 #else
 #ifdef VULKAN
 layout(constant_id = MSM_SPEC_FUSED_FMA_ID) const bool msm_fused_fma = true;

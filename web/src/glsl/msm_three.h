@@ -1,0 +1,76 @@
+// The per-texel steps of the three.js package's techniques, from the shared headers: what a
+// shadow-map texel holds for one depth (generate), what its blurred value is stored as (store), and
+// the shadow intensity at a receiver from the stored, bilinearly fetched texel (shadow). These
+// are the steps of the renderer's techniques (techniques.h) of the same name, which this header
+// cannot include (techniques.h reaches headers that GLSL ES 3.00 does not compile); the browser
+// test compares them with msm_technique_generate and msm_technique_shadow of the C++ library
+// (web/test/kernels.cpp). A SHARED header: shared.h's rules apply.
+// Depths: unit_depth and unit_zf are shadow-map depths in [0,1] (three.js's shadow coordinates).
+#ifndef MSM_THREE_H
+#define MSM_THREE_H
+#include "msm/bias.h"
+#include "msm/filter.h"
+#include "msm/hamburger4.h"
+#include "msm/moments.h"
+#include "msm/nonlinear.h"
+#include "msm/quantize.h"
+#include "msm/shared.h"
+
+MSM_BEGIN
+
+// The package's techniques (web/src/index.js names them).
+const int MSM_THREE_HAMBURGER_64 = 0;  // 4 x 16 bits after Θ4*, [-1,1] depth (JCGT): msm-hamburger-64
+const int MSM_THREE_HAMBURGER_128 = 1; // 4 x float, [-1,1] depth (JCGT): msm-hamburger-128
+const int MSM_THREE_NL64 = 2;          // Φ of the float moments in 4 x 16 bits (HPG 2017): msm-nl-64
+
+MSM_FN bool msm_three_is_nonlinear(int t) { return t == MSM_THREE_NL64; }
+
+// The filterable channels of one depth, already in the storage basis (Θ4* commutes with the blur).
+MSM_FN vec4 msm_three_generate(int t, float unit_depth) {
+  vec4 b = msm_moments4(msm_signed_depth(unit_depth));
+  if (t == MSM_THREE_HAMBURGER_64) return msm_theta4_star(b);
+  return b;
+}
+
+// What the shadow map stores of the blurred channels: 16-bit rounding (UNORM16 storage; the
+// package keeps the rounded values in a float texture, which filters them as UNORM16 would).
+// The non-linear map stores Φ's four UNORM16 values as floats k / 65535 (techniques.h's
+// msm_nl64_encode).
+MSM_FN vec4 msm_three_store(int t, vec4 filtered) {
+  if (t == MSM_THREE_HAMBURGER_64) return msm_quantize_unorm16(filtered);
+  if (t == MSM_THREE_NL64) {
+    uvec2 p = msm_nl_pack64(msm_nl_from_filtered(filtered));
+    return vec4(unpackUnorm2x16(p.x), unpackUnorm2x16(p.y));
+  }
+  return filtered;
+}
+
+// The depth bias of the technique's maps (config.h), in the shadow map's [0,1] depth.
+MSM_FN float msm_three_depth_bias(int t) {
+  return msm_three_is_nonlinear(t) ? MSM_DEPTH_BIAS_NONLINEAR : MSM_DEPTH_BIAS_FILTERED;
+}
+
+// A non-linear texel back to moments (HPG Eq. (4)): what the bilinear lookup interpolates, as the
+// renderer's shading_nonlinear.glsl does, before Φ and Algorithm 3 (msm_three_nl_shadow).
+MSM_FN vec4 msm_three_nl64_moments(vec4 texel) {
+  uvec2 p = uvec2(packUnorm2x16(vec2(texel.x, texel.y)), packUnorm2x16(vec2(texel.z, texel.w)));
+  return msm_nl_moments_from(msm_nl_unpack64(p));
+}
+MSM_FN float msm_three_nl_shadow(vec4 moments, float unit_zf) {
+  return msm_nl_shadow(msm_nl_from_moments(moments), msm_signed_depth(unit_zf));
+}
+
+// Shadow intensity in [0,1] (1 = fully shadowed) at receiver depth unit_zf: Hamburger 4MSM on the
+// biased moments (the representation's α and b*).
+MSM_FN float msm_three_shadow(int t, vec4 stored, float unit_zf) {
+  if (t == MSM_THREE_NL64) return msm_three_nl_shadow(msm_three_nl64_moments(stored), unit_zf); // one texel
+  float zf = msm_signed_depth(unit_zf);
+  if (t == MSM_THREE_HAMBURGER_64)
+    return msm_hamburger4_lower(msm_apply_bias(msm_theta4_star_inverse(stored), msm_moment_bias(MSM_REP_SIGNED_THETA4)),
+                                zf);
+  return msm_hamburger4_lower(msm_apply_bias(stored, msm_moment_bias(MSM_REP_SIGNED_FLOAT)), zf);
+}
+
+MSM_END
+
+#endif // MSM_THREE_H

@@ -1,0 +1,36 @@
+// Moment shadow maps for three.js's WebGLRenderer (see README.md).
+
+/** The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM, 64-bit non-linear moments. */
+export declare const TECHNIQUES: Readonly<{ 'msm-hamburger-64': 0; 'msm-hamburger-128': 1; 'msm-nl-64': 2 }>;
+export type Technique = keyof typeof TECHNIQUES;
+
+/** The Gaussian blur of the moment maps: taps x taps texels (odd, 1..63), σ in texels. */
+export interface Blur {
+  taps: number;
+  sigma: number;
+}
+export declare const DEFAULT_BLUR: Readonly<Blur>;
+
+export interface MomentShadowMapsOptions {
+  technique?: Technique;
+  blur?: Blur;
+}
+
+/** The part of three's WebGLRenderer this package uses (three's own types need not be installed). */
+export interface RendererLike {
+  shadowMap: { enabled: boolean; type: number; render: (...args: unknown[]) => void };
+  extensions: { has(name: string): boolean };
+}
+
+export declare class MomentShadowMaps {
+  /** Switches the renderer's directional and spot light shadows to moment shadow maps. */
+  constructor(renderer: RendererLike, options?: MomentShadowMapsOptions);
+  /** False where WebGL 2 lacks float render targets (a console warning said so): three's shadows stay. */
+  readonly supported: boolean;
+  technique: Technique;
+  blur: Blur;
+  /** WebGL 2 with EXT_color_buffer_float and OES_texture_float_linear; report: warn on the console if not. */
+  static isSupported(renderer: RendererLike, report?: boolean): boolean;
+  /** Back to three's own shadows, of the type the renderer had before. */
+  dispose(): void;
+}

@@ -1,0 +1,234 @@
+// msm_web_kernels OUT.json OUT.bin: the inputs of the browser test of the shared math
+// (test/math.test.mjs) and the C++ library's results on them, computed by the same dispatcher
+// (kernels.h) that the WebGL 2 fragment shader runs. For each function id: 'count' inputs that are
+// meaningful for it (biased moments of random depth distributions in every storage path the
+// package uses, receivers on, just in front of and behind a surface, storage words, rounding
+// ties). OUT.bin holds, per function in the order of OUT.json, the inputs then the results, each a
+// KernelIO as 12 little-endian uint32 words (a and b as float bits, then u).
+#include "kernels.h"
+#include "test_distributions.h"
+
+#include "msm/techniques.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace msm;
+
+constexpr int kInputs = 4096; // per function
+
+const char* const kNames[] = {
+    "fma",          "moments4",          "theta4_star",     "theta4_star_inverse", "pack_unorm16x4", "unpack_unorm16x4",
+    "apply_bias",   "hamburger4_bounds", "nl_from_moments", "nl_moments_from",     "nl_psi4",        "nl_psi4_inverse",
+    "nl_pack64",    "nl_unpack64",       "nl_pack32",       "nl_unpack32",         "nl_shadow",      "three_generate",
+    "three_shadow", "three_store"};
+static_assert(sizeof(kNames) / sizeof(kNames[0]) == MSM_WK_COUNT);
+
+class Inputs {
+ public:
+  explicit Inputs(uint64_t seed) : rng_(seed) {}
+  float uni(float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng_); }
+  float log_uniform(float lo, float hi) { return std::exp(uni(std::log(lo), std::log(hi))); }
+  bool chance(double p) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng_) < p; }
+  int integer(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
+  uint32_t word() { return uint32_t(rng_()); }
+
+  // A random depth distribution on [-1,1] (flat receivers, i.e. single depths, in a quarter).
+  test::Distribution distribution() {
+    if (chance(0.25)) return test::Distribution{{double(uni(-1.0f, 1.0f))}, {1.0}};
+    return test::random_distribution(rng_, -1.0, 1.0);
+  }
+  // A receiver near one of d's depths: on it, just in front or behind, or anywhere.
+  float receiver(const test::Distribution& d) {
+    float surface = float(d.z[size_t(integer(0, int(d.z.size()) - 1))]);
+    int k = integer(0, 3);
+    if (k == 0) return surface;
+    if (k == 3) return uni(-1.0f, 1.0f);
+    return surface + (k == 1 ? -1.0f : 1.0f) * log_uniform(1e-5f, 0.1f);
+  }
+  // What the package's 64-bit MSM reads: Θ4*, 16-bit storage, inverse, bias; or float moments
+  // with the float bias.
+  vec4 stored_moments(const test::Distribution& d) {
+    vec4 b = test::moments4f(d);
+    if (chance(0.5)) return msm_apply_bias(b, msm_moment_bias(MSM_REP_SIGNED_FLOAT));
+    vec4 q = msm_quantize_unorm16(msm_theta4_star(b));
+    return msm_apply_bias(msm_theta4_star_inverse(q), msm_moment_bias(MSM_REP_SIGNED_THETA4));
+  }
+  NonLinearMoments nonlinear(const test::Distribution& d) {
+    NonLinearMoments m = msm_nl_from_filtered(test::moments4f(d));
+    int k = integer(0, 2);
+    return k == 0 ? m : k == 1 ? msm_nl_quantize64(m) : msm_nl_quantize32(m);
+  }
+  // A value to be stored in UNORM16: mostly in [0,1], some outside, some on a tie k + 1/2.
+  float unorm_value() {
+    int k = integer(0, 9);
+    if (k == 0) return uni(-0.2f, 1.2f);
+    float q = float(integer(0, 65534));
+    if (k == 1) return (q + 0.5f) / 65535.0f;
+    if (k == 2) return q / 65535.0f;
+    return uni(0.0f, 1.0f);
+  }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+KernelIO make_input(int id, Inputs& g) {
+  KernelIO x{vec4(0.0f), vec4(0.0f), uvec4(0u)};
+  test::Distribution d = g.distribution();
+  switch (id) {
+  case MSM_WK_FMA: { // the cancelling differences of the Hankel pivots, and random triples
+    vec4 b = test::moments4f(d);
+    int k = g.integer(0, 2);
+    x.a = k == 0   ? vec4(-b[0], b[0], b[1], 0.0f)
+          : k == 1 ? vec4(-b[0], b[1], b[2], 0.0f)
+                   : vec4(g.uni(-2, 2), g.uni(-2, 2), g.uni(-2, 2), 0.0f);
+    break;
+  }
+  case MSM_WK_MOMENTS4: x.a[0] = g.chance(0.05) ? float(g.integer(0, 4)) * 0.25f : g.uni(0.0f, 1.0f); break;
+  case MSM_WK_THETA4_STAR: x.a = test::moments4f(d); break;
+  case MSM_WK_THETA4_STAR_INVERSE:
+    x.a = g.chance(0.5) ? msm_quantize_unorm16(msm_theta4_star(test::moments4f(d)))
+                        : vec4(g.uni(0, 1), g.uni(0, 1), g.uni(0, 1), g.uni(0, 1));
+    break;
+  case MSM_WK_PACK_UNORM16: x.a = vec4(g.unorm_value(), g.unorm_value(), g.unorm_value(), g.unorm_value()); break;
+  case MSM_WK_UNPACK_UNORM16:
+  case MSM_WK_NL_UNPACK64:
+  case MSM_WK_NL_UNPACK32: x.u = uvec4(g.word(), g.word(), 0u, 0u); break;
+  case MSM_WK_APPLY_BIAS:
+    x.a = test::moments4f(d);
+    x.u[0] = uint32_t(g.chance(0.5) ? MSM_REP_SIGNED_FLOAT : MSM_REP_SIGNED_THETA4);
+    break;
+  case MSM_WK_HAMBURGER4_BOUNDS:
+    x.a = g.stored_moments(d);
+    x.b[0] = g.receiver(d);
+    break;
+  case MSM_WK_NL_FROM_MOMENTS: // Φ's precondition, the float bias, in most; unbiased ones too
+    x.a = test::moments4f(d);
+    if (g.chance(0.9)) x.a = msm_apply_bias(x.a, msm_moment_bias(MSM_REP_SIGNED_FLOAT));
+    break;
+  case MSM_WK_NL_MOMENTS_FROM:
+  case MSM_WK_NL_PACK64:
+  case MSM_WK_NL_PACK32:
+  case MSM_WK_NL_SHADOW: {
+    NonLinearMoments m = g.nonlinear(d);
+    x.a = vec4(m.y1, m.y2, m.v2, m.xi4);
+    x.b[0] = g.receiver(d);
+    break;
+  }
+  case MSM_WK_NL_PSI4: x.a[0] = g.chance(0.05) ? 0.0f : g.log_uniform(1e-8f, 0.5f); break;
+  case MSM_WK_NL_PSI4_INVERSE:
+    x.a[0] = g.chance(0.2) ? msm_nl_psi4_decode6(uint32_t(g.integer(0, 63))) : g.uni(0.0f, 1.0f);
+    break;
+  case MSM_WK_THREE_GENERATE:
+    x.a[0] = g.chance(0.05) ? float(g.integer(0, 4)) * 0.25f : g.uni(0.0f, 1.0f);
+    x.u[0] = uint32_t(g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64));
+    break;
+  case MSM_WK_THREE_STORE: { // blurred channels in each technique's basis
+    int t = g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64);
+    vec4 b = test::moments4f(d);
+    x.a = t == MSM_THREE_HAMBURGER_64 ? msm_theta4_star(b) : b;
+    x.u[0] = uint32_t(t);
+    break;
+  }
+  case MSM_WK_THREE_SHADOW: { // a texel as the package stores it, a receiver near its depths
+    int t = g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64);
+    vec4 b = test::moments4f(d);
+    x.a = t == MSM_THREE_HAMBURGER_64 ? msm_quantize_unorm16(msm_theta4_star(b))
+          : t == MSM_THREE_NL64       ? msm_three_store(t, b)
+                                      : b;
+    x.b[0] = msm_unit_depth(g.receiver(d));
+    x.u[0] = uint32_t(t);
+    break;
+  }
+  default: break;
+  }
+  return x;
+}
+
+// The renderer's technique (techniques.h) that each of the package's techniques is.
+int renderer_technique(uint32_t t) {
+  if (t == uint32_t(MSM_THREE_HAMBURGER_64)) return MSM_TECH_HAMBURGER_64;
+  return t == uint32_t(MSM_THREE_NL64) ? MSM_TECH_NL64 : MSM_TECH_HAMBURGER_128;
+}
+
+// The package's per-texel steps (msm_three.h) are the renderer's: identical results in C++, so
+// that the browser's comparison with msm_web_kernel is one with the renderer's technique too.
+bool same_as_renderer(int id, const KernelIO& x, const KernelIO& r) {
+  int t = renderer_technique(x.u[0]);
+  if (id == MSM_WK_THREE_GENERATE) {
+    vec4 want = msm_technique_generate(t, x.a[0], msm_technique_default_params(t)).a;
+    vec4 stored = msm_three_store(int(x.u[0]), r.a);
+    // The renderer's 64-bit map rounds to UNORM16 on the write; msm_three_store does that in the shader.
+    return r.a == want && (t != MSM_TECH_HAMBURGER_64 || stored == msm_quantize_unorm16(want));
+  }
+  if (id == MSM_WK_THREE_STORE) {
+    vec4 want = t == MSM_TECH_HAMBURGER_64 ? msm_quantize_unorm16(x.a)
+                : t == MSM_TECH_NL64       ? msm_nl64_encode(x.a)
+                                           : x.a;
+    return r.a == want;
+  }
+  // The non-linear shading is the renderer's bilinear lookup in shading_nonlinear.glsl (decode,
+  // moments, Φ, Algorithm 3), which has no C++ twin: compared with the C++ build alone.
+  if (id == MSM_WK_THREE_SHADOW && t != MSM_TECH_NL64) {
+    float want = msm_technique_shadow(t, MsmTexel(x.a, vec4(0.0f)), x.b[0], msm_technique_default_params(t));
+    return std::bit_cast<uint32_t>(r.a[0]) == std::bit_cast<uint32_t>(want);
+  }
+  return true;
+}
+
+void put(std::vector<uint32_t>& words, const KernelIO& x) {
+  for (int i = 0; i < 4; ++i) words.push_back(std::bit_cast<uint32_t>(x.a[i]));
+  for (int i = 0; i < 4; ++i) words.push_back(std::bit_cast<uint32_t>(x.b[i]));
+  for (int i = 0; i < 4; ++i) words.push_back(x.u[i]);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: msm_web_kernels OUT.json OUT.bin\n");
+    return 2;
+  }
+  std::vector<uint32_t> words;
+  std::string json = "{\"words_per_io\": 12, \"functions\": [";
+  for (int id = 0; id < MSM_WK_COUNT; ++id) {
+    Inputs g(0x5eed0000u + uint64_t(id));
+    std::vector<KernelIO> in;
+    for (int n = 0; n < kInputs; ++n) in.push_back(make_input(id, g));
+    for (const KernelIO& x : in) put(words, x);
+    for (const KernelIO& x : in) {
+      KernelIO r = msm_web_kernel(id, x);
+      if (!same_as_renderer(id, x, r)) {
+        std::fprintf(stderr,
+                     "msm_web_kernels: %s differs from the renderer's technique at a = (%.9g, %.9g, %.9g, %.9g), "
+                     "b.x = %.9g, technique %u\n",
+                     kNames[id], x.a[0], x.a[1], x.a[2], x.a[3], x.b[0], x.u[0]);
+        return 1;
+      }
+      put(words, r);
+    }
+    json += std::string(id ? ", " : "") + "{\"id\": " + std::to_string(id) + ", \"name\": \"" + kNames[id] +
+            "\", \"count\": " + std::to_string(kInputs) + "}";
+  }
+  json += "]}\n";
+  std::FILE* j = std::fopen(argv[1], "wb");
+  std::FILE* b = std::fopen(argv[2], "wb");
+  bool ok = j && b && std::fwrite(json.data(), 1, json.size(), j) == json.size() &&
+            std::fwrite(words.data(), sizeof(uint32_t), words.size(), b) == words.size();
+  ok = (j && std::fclose(j) == 0) && ok;
+  ok = (b && std::fclose(b) == 0) && ok;
+  if (!ok) {
+    std::fprintf(stderr, "msm_web_kernels: cannot write %s and %s\n", argv[1], argv[2]);
+    return 1;
+  }
+  return 0;
+}

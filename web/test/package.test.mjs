@@ -1,0 +1,37 @@
+// The npm package as a user receives it: `npm pack` holds the ES module, its TypeScript
+// declarations, the bundled GLSL and the README (and nothing of the tests), the declarations
+// compile against a use of the API (test/types-check.ts, strict), and the packed module's exports
+// are what the declarations promise.
+import { execFileSync } from 'node:child_process';
+import { dirname, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
+const REQUIRED = ['package.json', 'README.md', 'src/index.js', 'src/index.d.ts', 'src/generated/msm-glsl.js'];
+let failed = false;
+const fail = (what) => {
+  console.error(`web-package: FAILED: ${what}`);
+  failed = true;
+};
+
+const [pack] = JSON.parse(execFileSync('npm', ['pack', '--dry-run', '--json', '--ignore-scripts'], { cwd: webDir, encoding: 'utf8' }));
+const files = pack.files.map((f) => f.path).sort();
+console.log(`[web-package] ${pack.filename}: ${files.join(', ')} (${pack.size} bytes packed)`);
+for (const f of REQUIRED) if (!files.includes(f)) fail(`the package lacks ${f}`);
+for (const f of files) if (f.startsWith('test/') || f.includes('node_modules')) fail(`the package holds ${f}`);
+
+try {
+  execFileSync(resolve(webDir, 'node_modules/.bin/tsc'), ['-p', 'test/tsconfig.json'], { cwd: webDir, stdio: 'inherit' });
+  console.log('[web-package] declarations: test/types-check.ts compiles (strict)');
+} catch {
+  fail('test/types-check.ts does not compile against src/index.d.ts');
+}
+
+// The module's exports (it imports three, which node resolves from node_modules).
+const module = await import(resolve(webDir, 'src/index.js'));
+for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR'])
+  if (!(name in module)) fail(`src/index.js does not export ${name}`);
+if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64']))
+  fail(`TECHNIQUES is ${JSON.stringify(module.TECHNIQUES)}, not what index.d.ts declares`);
+if (failed) process.exit(1);
+console.log('web-package: ok');
