@@ -1,7 +1,7 @@
 # msm evaluate: the command and its CLI tests, kept apart from the other commands' file.
 # Every test goes through msm_cli_test (tests/cli/expect: exit status and output together).
-target_sources(msm PRIVATE ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp)
-target_link_libraries(msm PRIVATE msm::evaluate_mpi)
+target_sources(msm_cli PRIVATE ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp)
+target_link_libraries(msm_cli PUBLIC msm::evaluate_mpi)
 
 if(MSM_BUILD_TESTS)
   set(MSM_EVALUATE_OUT ${CMAKE_CURRENT_BINARY_DIR}/evaluate-tests)
