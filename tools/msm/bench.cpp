@@ -6,6 +6,7 @@
 // host clock on a CPU device, whose compute timestamps are not the passes' time (results.md).
 #include "probe_bench.h"
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/image/io.h"
 #include "msm/render/renderer_internals.h"
@@ -340,7 +341,7 @@ struct BenchOptions {
 };
 
 void add_bench_options(CLI::App* cmd, BenchOptions& o) {
-  cmd->add_option("-t,--techniques", o.techniques, "Techniques or aliases (default: all)")->delimiter(',');
+  add_term(cmd, "--techniques", o.techniques, " (default: all)")->delimiter(',');
   cmd->add_option("--resolutions", o.resolutions, "Image sizes for the shading cost")
       ->delimiter(',')
       ->capture_default_str();
@@ -361,18 +362,19 @@ void add_bench_options(CLI::App* cmd, BenchOptions& o) {
   cmd->add_flag("--quick", o.quick,
                 "A short run, to check that it works (not for recorded numbers): unless given, resolution 320x180, "
                 "shadow size and sizes 256, 1 frame after 1 warm-up, 2 repeats");
-  cmd->add_option("--json", o.json, "Write the results as JSON here");
+  cmd->add_option("--json-file", o.json, "Write the results as JSON here");
+  add_deprecated_option(cmd, "--json", "--json-file", o.json);
   cmd->add_option("--markdown", o.markdown, "Write the results as a markdown table here");
   cmd->add_flag("--callgrind", o.callgrind,
                 "Under valgrind --tool=callgrind --instr-atstart=no: one callgrind dump per prefix of each frame "
                 "(first resolution, each shadow size) instead of times; scripts/callgrind-passes.sh turns them into "
                 "instructions per pass");
-  cmd->add_option("--probe", o.probe.probe,
-                  "Time the light-probe pipeline instead (an equirectangular EXR, or 'sky'): cube map, tables and "
-                  "median cut on the device against face size and light count");
+  add_term(cmd, "--probe", o.probe.probe,
+           ": time the light-probe pipeline instead: cube map, tables and median cut on the device against face "
+           "size and light count");
   cmd->add_option("--probe-sizes", o.probe.sizes, "Face sizes for --probe")->delimiter(',')->capture_default_str();
   add_deprecated_option(cmd, "--probe-lights", "--lights", o.probe.lights)->delimiter(',');
-  cmd->add_option("--lights", o.probe.lights, "Light counts for --probe")->delimiter(',')->capture_default_str();
+  add_term(cmd, "--lights", o.probe.lights, ": the counts timed with --probe")->delimiter(',')->capture_default_str();
   add_frame_options(cmd, o.frame);
 }
 

@@ -30,6 +30,8 @@
 #include "msm/util/output_dir.h"
 #include "msm/util/progress.h"
 #include "reference_look.h"
+#include "usage.h"
+#include "vocabulary.h"
 
 namespace msm::tool {
 namespace {
@@ -75,52 +77,45 @@ struct ReferenceOptions {
 };
 
 void add_reference_options(CLI::App* cmd, ReferenceOptions& o) {
-  cmd->add_option("--scene", o.scene, "Built-in scene name or scene file (default fence)");
+  add_term(cmd, "--scene", o.scene, " (default fence)");
   cmd->add_option("--effect", o.effect, "hard | filtered | soft | translucent | scattering | environment")->required();
-  cmd->add_option("--width", o.width, "Image width (default 640)");
-  cmd->add_option("--height", o.height, "Image height (default 360)");
+  add_term(cmd, "--width", o.width, " (default 640)");
+  add_term(cmd, "--height", o.height, " (default 360)");
   cmd->add_option("--samples", o.samples, "Samples per pixel of filtered, soft and scattering (default 256)");
   cmd->add_option("--seed", o.seed, "Seed of the per-pixel generators (default 1)");
   cmd->add_option("--sampler", o.sampler, "stratified (default) | independent");
-  cmd->add_option("--shadow-size", o.shadow_size, "filtered: shadow map size in texels (default 1024)");
-  cmd->add_option("--filter-size", o.filter_size, "filtered: Gaussian taps per axis, odd")->capture_default_str();
-  cmd->add_option("--filter-sigma", o.filter_sigma, "filtered: Gaussian sigma in texels")->capture_default_str();
-  cmd->add_option("--light-extent", o.light_extent,
-                  "soft: override the light by a disc of this angular diameter in degrees, as msm render "
-                  "--light-extent (default: the scene's light as it declares it)");
+  add_term(cmd, "--shadow-size", o.shadow_size, ", filtered (default 1024)");
+  add_term(cmd, "--filter-size", o.filter_size, ", filtered")->capture_default_str();
+  add_term(cmd, "--filter-sigma", o.filter_sigma, ", filtered")->capture_default_str();
+  add_term(cmd, "--light-extent-deg", o.light_extent,
+           ", soft: the light becomes a disc of this diameter, as msm render --light-extent-deg makes it (default: "
+           "the scene's light as it declares it)");
   cmd->add_option("--light-shape", o.light_shape,
                   "soft: override the light's shape: disc | rectangle (default: the scene light's own)");
-  cmd->add_option("--light-width", o.light_width,
-                  "soft: a rectangle of this angular width in degrees (default: the light's extent)");
-  cmd->add_option("--light-height", o.light_height,
-                  "soft: a rectangle of this angular height in degrees, as msm render --light-height (default: the "
-                  "light's own, else its extent)");
+  add_term(cmd, "--light-width-deg", o.light_width, ", soft (default: the light's extent)");
+  add_term(cmd, "--light-height-deg", o.light_height,
+           ", soft, as msm render --light-height-deg (default: the light's own, else its extent)");
+  // The spellings of older versions.
+  add_deprecated_option(cmd, "--light-extent", "--light-extent-deg", o.light_extent);
+  add_deprecated_option(cmd, "--light-width", "--light-width-deg", o.light_width);
+  add_deprecated_option(cmd, "--light-height", "--light-height-deg", o.light_height);
+  add_deprecated_flag(cmd, "--probe-lights", "--extracted-lights", o.probe_lights);
   cmd->add_option("--max-crossings", o.max_crossings, "translucent: surfaces counted per light ray (default 64)");
-  cmd->add_option("--probe", o.probe,
-                  "Image-based lighting: light the scene by this light probe instead of its own lights (an "
-                  "equirectangular EXR, a cube-map cross, six faces named by a path with \"{face}\", or 'sky'; the "
-                  "scene's probe settings are kept, else 32 "
-                  "lights, 128² per face), as msm render --probe");
-  cmd->add_option("--lights", o.lights,
-                  "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
-                  "the scene's)");
-  cmd->add_option("--sub-lights", o.sub_lights,
-                  "Image-based lighting: the probe lights' sub-lights, a finer cut into this many regions (0: none; "
-                  "default: the scene's); --probe-lights traces them");
-  cmd->add_flag("--probe-lights", o.probe_lights,
+  add_term(cmd, "--probe", o.probe,
+           ": lights the scene instead of its own lights (image-based lighting; the scene's probe settings are "
+           "kept, else 32 lights, 128² per face), as msm render --probe");
+  add_term(cmd, "--lights", o.lights, " (default: the scene's)");
+  add_term(cmd, "--sub-lights", o.sub_lights, " (default: the scene's); --extracted-lights traces them");
+  cmd->add_flag("--extracted-lights", o.probe_lights,
                 "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
-  cmd->add_option("--frame", o.frame,
-                  "Trace frame K of a dynamic scene, as msm render --frames draws it: its animated objects moved K "
-                  "times (an object's \"motion\"), its probe turned K times --probe-rotation-speed")
+  add_term(cmd, "--frame", o.frame,
+           ", traced as msm render --frames draws it, its probe turned K times --probe-rotation-speed")
       ->check(CLI::Range(0, 9999));
-  cmd->add_option("--probe-rotation-speed", o.probe_rotation_speed,
-                  "Degrees the scene's light probe turns about +Y per frame (with --frame)");
-  cmd->add_option("--threads", o.threads, "Worker threads (default 0: all cores)");
-  cmd->add_option("-o,--out", o.out, "Output directory (default out/reference)");
-  cmd->add_flag("--json", o.json, "Print reference.json to stdout");
-  cmd->add_flag("--progress", o.progress,
-                "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth of the "
-                "rows once the run has taken 2 s)");
+  add_term(cmd, "--probe-rotation-speed", o.probe_rotation_speed, " (with --frame)");
+  add_term(cmd, "--threads", o.threads, " (default 0: all cores)");
+  add_term(cmd, "--out", o.out, " (default out/reference)");
+  add_term_flag(cmd, "--json", o.json, ": reference.json");
+  add_term_flag(cmd, "--progress", o.progress);
 }
 
 // The ray tracer's settings of the options; UsageError for a bad value.
@@ -131,7 +126,7 @@ Settings reference_settings(const ReferenceOptions& o, const CLI::App& cmd) {
     throw UsageError(
         fmt::format("--effect {}: expected hard, filtered, soft, translucent, scattering or environment", o.effect));
   if (o.probe_lights && *effect != msm::reference::Effect::environment)
-    throw UsageError("--probe-lights applies to --effect environment only");
+    throw UsageError("--extracted-lights applies to --effect environment only");
   settings.probe_lights = o.probe_lights;
   settings.effect = *effect;
   if (cmd.count("--light-shape") > 0) {
@@ -155,7 +150,7 @@ Settings reference_settings(const ReferenceOptions& o, const CLI::App& cmd) {
   settings.max_crossings = o.max_crossings;
   settings.threads = o.threads;
   if (settings.light_shape == msm::reference::LightShape::disc && (o.light_width || o.light_height))
-    throw UsageError("--light-width / --light-height make a rectangle: they cannot go with --light-shape disc");
+    throw UsageError("--light-width-deg / --light-height-deg make a rectangle: they cannot go with --light-shape disc");
   try {
     msm::reference::validate(settings);
   } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }

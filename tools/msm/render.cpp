@@ -1,6 +1,7 @@
 // `msm render`: one or more techniques on one scene; `msm scenes`: the built-in scenes.
 #include "frames.h"
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/util/text.h"
 #include "msm/viewer/view_file.h"
@@ -59,10 +60,8 @@ void add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
                                            "EXR and JSON per technique)");
   add_deprecated_option(cmd, "--technique", "-t/--techniques", opt->techniques)->delimiter(',');
-  cmd->add_option("-t,--techniques", opt->techniques,
-                  "Technique or alias, comma-separated list, or 'all' (msm techniques lists them)")
-      ->capture_default_str();
-  cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
+  add_term(cmd, "--techniques", opt->techniques, ", or 'all'")->capture_default_str();
+  add_term(cmd, "--out", opt->out)->capture_default_str();
   cmd->add_option("--view", opt->view,
                   "A view file of msm view (scene, camera, lights, every setting), or a render's JSON output: "
                   "renders exactly that view; only -t, -o and --device go with it");
@@ -72,19 +71,13 @@ void add_render(CLI::App& app) {
                   "light probe into its area lights again on the device, and moves its animated objects (an "
                   "object's \"motion\"; frames.h)")
       ->check(CLI::Range(1, 10000));
-  cmd->add_option("--probe-rotation-speed", opt->frames.rotation_speed_deg,
-                  "Degrees the scene's light probe turns about +Y per frame (with --frames)");
-  cmd->add_option("--probe", opt->probe,
-                  "Image-based lighting: light the scene by this light probe instead of its own lights (an "
-                  "equirectangular EXR, a cube-map cross, six faces named by a path with \"{face}\", or 'sky'; the "
-                  "scene's probe settings are kept, else 32 "
-                  "lights, 128² per face)");
-  cmd->add_option("--lights", opt->lights,
-                  "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
-                  "the scene's)");
-  cmd->add_option("--sub-lights", opt->sub_lights,
-                  "Image-based lighting: each area light's unshadowed light from the lights of a finer cut into this "
-                  "many regions inside its own (0: none; default: the scene's \"sub_lights\")");
+  add_term(cmd, "--probe-rotation-speed", opt->frames.rotation_speed_deg, " (with --frames)");
+  add_term(cmd, "--probe", opt->probe,
+           ": lights the scene instead of its own lights (image-based lighting; the scene's probe settings are "
+           "kept, else 32 lights, 128² per face)");
+  add_term(cmd, "--lights", opt->lights, " (default: the scene's)");
+  add_term(cmd, "--sub-lights", opt->sub_lights,
+           ", whose unshadowed light each area light sums (default: the scene's \"sub_lights\")");
   cmd->callback([opt, cmd] {
     const bool frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
     ViewGiven view;

@@ -1,4 +1,5 @@
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/image/io.h"
 #include "msm/render/settings_schema.h"
@@ -84,7 +85,7 @@ std::string setting_problem(const SettingDeclaration& setting, const std::string
 } // namespace
 
 void add_frame_options(CLI::App* cmd, FrameOptions& o) {
-  cmd->add_option("--scene", o.scene, "Built-in scene (msm scenes) or scene file")->capture_default_str();
+  add_term(cmd, "--scene", o.scene)->capture_default_str();
   for (const SettingDeclaration& setting : render::setting_declarations())
     if (setting.type != SettingType::technique && setting.type != SettingType::parameters)
       add_setting_option(cmd, o, setting);
@@ -103,12 +104,9 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
       ->take_all();
   // The positional vector of older versions: still read for one version, with a warning.
   cmd->add_option("--param", o.params, "")->delimiter(',')->group("");
-  cmd->add_option("--frame", o.animation_frame,
-                  "Frame K of a dynamic scene: its animated objects moved K times (an object's \"motion\"), as msm "
-                  "reference --frame K traces it (default 0)")
+  add_term(cmd, "--frame", o.animation_frame, ", as msm reference --frame K traces it (default 0)")
       ->check(CLI::Range(0, 9999));
-  cmd->add_option("--device", o.device,
-                  "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
+  add_term(cmd, "--device", o.device);
 }
 
 void finish_frame_options(FrameOptions& o) {
