@@ -527,6 +527,14 @@ std::string bench_markdown(const BenchOptions& o, const vk::Context& ctx, const 
   return md;
 }
 
+// A progress line: rewritten in place on a terminal, one line per step in a log.
+void print_progress(bool tty, const std::string& line) {
+  if (tty)
+    fmt::print(stderr, "\r{:<70}", line);
+  else
+    fmt::print(stderr, "{}\n", line);
+}
+
 // The techniques to time, canonical names (default: all; --scattering: only scattering ones), PCF
 // first unless under callgrind or --scattering (the ratios' reference).
 std::vector<std::string> bench_techniques(const BenchOptions& o) {
@@ -610,14 +618,8 @@ void add_bench(CLI::App& app) {
     // are not the time they take (results.md), so there the host clock times them.
     const bool host_clock = ctx->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
 
-    // A progress line: rewritten in place on a terminal, one line per step in a log.
-    bool tty = isatty(fileno(stderr));
-    auto progress = [&](const std::string& line) {
-      if (tty)
-        fmt::print(stderr, "\r{:<70}", line);
-      else
-        fmt::print(stderr, "{}\n", line);
-    };
+    const bool tty = isatty(fileno(stderr));
+    auto progress = [tty](const std::string& line) { print_progress(tty, line); };
     auto run = [&](render::RenderSettings s) {
       if (opt->warmup) renderer.time_frames(s, opt->warmup);
       return renderer.time_frames(s, opt->frames);
