@@ -251,8 +251,10 @@ nlohmann::ordered_json reference_json(const msm::scene::Scene& scene, const Sett
   j["samples"] = result.samples;
   j["sampler"] = std::string(msm::reference::to_string(settings.sampler));
   j["seed"] = settings.seed;
-  j["filter"] = {
-      {"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
+  // Under the render settings' keys (msm/render/settings_schema.h), as render.json has them.
+  j["shadow_size"] = settings.shadow_size;
+  j["filter_size"] = settings.filter_size;
+  j["filter_sigma"] = settings.filter_sigma;
   j["light"] = light_json(scene.light(), settings, result);
   j["max_crossings"] = settings.max_crossings;
   j["warnings"] = warnings;
