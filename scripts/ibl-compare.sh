@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Image-based lighting against the ground truth (issue 15; docs/results.md, "Image-based lighting
 # against the ground truth"): for one scene with a "probe", the full-probe truth and the area-light
-# truth per light count (msm reference --effect environment [--probe-lights] --lights N), the
+# truth per light count (msm reference --effect environment [--extracted-lights] --lights N), the
 # renders (msm render --lights N -t T), and the MAE of the tone-mapped images (msm compare of
 # radiance.png with the render's PNG, background masked):
 #   total   = render vs the full-probe truth
@@ -48,7 +48,7 @@ if [ "${NOISE:-0}" = 1 ]; then
 fi
 printf '%-18s %6s %8s %8s %8s\n' technique lights total lights shadows
 for n in $counts; do
-  "$msm" reference --scene "$scene" "${probe[@]}" --effect environment --probe-lights --lights "$n" "${sub[@]}" \
+  "$msm" reference --scene "$scene" "${probe[@]}" --effect environment --extracted-lights --lights "$n" "${sub[@]}" \
     "${size[@]}" \
     --seed "$seed" \
     --samples "$([ "$n" = 256 ] && echo $((samples / 16 > 4 ? samples / 16 : 4)) || echo $((samples / 4 > 4 ? samples / 4 : 4)))" \

@@ -542,7 +542,7 @@ const Technique kTechniques[] = {
     {.name = "mssm4",
      .description = "Moment soft shadow mapping (JCGT §4): Θ4* moments in a 32-bit integer summed-area table, "
                     "blocker search, nine-region filter over the penumbra of a directional area light "
-                    "(--light-extent)",
+                    "(--light-extent-deg)",
      .id = MSM_TECH_MSSM4,
      .bits_per_texel = 128,
      .channels = 4,

@@ -1,7 +1,7 @@
 // environment: image-based lighting with exact visibility (reference.h, "environment"). The full
 // probe is sampled in proportion to its luminance above its mean x solid angle and the
 // cosine-weighted hemisphere, combined by the balance heuristic; the extracted area lights
-// (--probe-lights) and the scene's other directional lights are uniform cones (discs) or
+// (--extracted-lights) and the scene's other directional lights are uniform cones (discs) or
 // rectangles (Kneiphof §4.1.2). The texel geometry is msm/light_probe.h's.
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 // Tests of the environment effect (image-based lighting with exact visibility) against answers
 // that do not use its sampler: a plane under the procedural sky-and-sun probe against quadrature
 // over the cube's texels (full probe) and against quadrature over the extracted rectangles
-// (--probe-lights), and a box's shadow that takes the sun's share away.
+// (--extracted-lights), and a box's shadow that takes the sun's share away.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -105,7 +105,7 @@ TEST(Environment, UnoccludedPlaneReceivesTheProbesIrradiance) {
 }
 
 // ∫ max(n·d, 0) dω / F over a rectangular light (its frame's axes, Scene::light_frame) by the
-// midpoint rule on its plane at unit distance (dω = dA / r³): what --probe-lights integrates for
+// midpoint rule on its plane at unit distance (dω = dA / r³): what --extracted-lights integrates for
 // it, without its sampler; the same as msm_cone_cosine where the whole light is above the horizon.
 double rectangle_cosine(const Scene& scene, const msm::scene::DirectionalLight& l, const glm::dvec3& n) {
   const msm::scene::LightFrame f = scene.light_frame(l);

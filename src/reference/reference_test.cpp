@@ -545,8 +545,8 @@ TEST(reference_soft, RectangleLightOverHalfPlaneIsALinearRamp) {
 
 // A scene light declared as a rectangle (angular_height_deg) is traced as that rectangle without any
 // override: the same image, sample for sample, as the explicit --light-shape rectangle with its
-// extents; --light-shape disc and --light-extent alone (which makes it a disc, as in the renderer:
-// scene::overridden_light) trace the disc; --light-height keeps the scene's width.
+// extents; --light-shape disc and --light-extent-deg alone (which makes it a disc, as in the renderer:
+// scene::overridden_light) trace the disc; --light-height-deg keeps the scene's width.
 TEST(reference_soft, SceneRectangleLightIsTracedAsDeclared) {
   const CameraSpec camera{{0.0, 0.06, 0.0}, {0.0, 0.0, 0.0}, {0, 0, -1}};
   const std::string light =

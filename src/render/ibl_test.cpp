@@ -1,6 +1,6 @@
 // Image-based lighting in the renderer against the ray-traced ground truth (Kneiphof
 // 2017 §6): the full probe (msm::reference, effect environment) and its extracted area lights
-// (--probe-lights). The orderings of the paper that hold on the built-in probe scenes, asserted
+// (--extracted-lights). The orderings of the paper that hold on the built-in probe scenes, asserted
 // with margins from the measurements of docs/results.md ("Image-based lighting against the ground
 // truth", scripts/ibl-compare.sh): on sky_probe, 32 soft-shadowed area lights are closer to the
 // full probe than 256 point lights with hard shadows (on city_probe with its plain cut they are

@@ -598,7 +598,7 @@ TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
              wide, t.across_height, narrow);
   EXPECT_NEAR(t.across_width, wide, 0.03 * wide);
   EXPECT_NEAR(t.across_height, narrow, 0.03 * narrow);
-  // The environment effect's rectangles (--probe-lights: how the probe's lights are ray traced):
+  // The environment effect's rectangles (--extracted-lights: how the probe's lights are ray traced):
   // "visibility" is the irradiance over the unoccluded one, so a direction (a, b) of the light
   // weighs (n·d) dω / dA = (1 + a² + b²)^−2 on a surface facing it: the ramp is that weight's
   // distribution along the axis across the edge (cosine_weighted_ramp: 0.5209 m and 0.2093 m).
@@ -634,7 +634,7 @@ TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
   }
 }
 
-// RenderSettings::light_height_deg (msm render --light-height, the viewer's height slider): with
+// RenderSettings::light_height_deg (msm render --light-height-deg, the viewer's height slider): with
 // light_extent_deg 20 and height 8 the scene's own 20° x 8° rectangle renders bit-identically; with
 // the extent alone the light is a disc (both ramps the wide one); 8 by 20 swaps the two ramps. mssm4,
 // the setting of RectangularLightsPenumbraeFollowTheirTwoExtents, its ramp fraction within 5%.
@@ -660,7 +660,8 @@ TEST_F(SoftShadowTest, LightHeightSettingMakesEveryLightARectangle) {
   EXPECT_EQ(different, 0);
   const RampWidths disc = rectangle_ramps(scene, render(20.0f, {}));
   const RampWidths swapped = rectangle_ramps(scene, render(8.0f, 20.0f));
-  fmt::print("--light-extent 20: ramps {:.4f} m, {:.4f} m; --light-extent 8 --light-height 20: {:.4f} m, {:.4f} m\n",
+  fmt::print("--light-extent-deg 20: ramps {:.4f} m, {:.4f} m; --light-extent-deg 8 --light-height-deg 20: {:.4f} m, "
+             "{:.4f} m\n",
              disc.across_width, disc.across_height, swapped.across_width, swapped.across_height);
   EXPECT_NEAR(disc.across_width, fraction * wide, 0.05 * fraction * wide);
   EXPECT_NEAR(disc.across_height, fraction * wide, 0.05 * fraction * wide);

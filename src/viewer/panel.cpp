@@ -2,6 +2,7 @@
 // setter, so a script exercises what the panel does.
 #include "viewer_state.h"
 
+#include "msm/render/settings_schema.h"
 #include "msm/vk/context.h"
 #include "msm/vk/swapchain.h"
 
@@ -50,6 +51,14 @@ std::vector<std::string> technique_names() {
 
 // A setting through the view file's setter (the one `set KEY VALUE` uses).
 void set(render::RenderSettings& s, const char* key, const nlohmann::json& value) { apply_setting(s, key, value); }
+
+// A choice setting's combo over its declared choices (msm/render/settings_schema.h).
+void choose_setting(render::RenderSettings& s, const char* label, const char* key) {
+  const render::SettingDeclaration& setting = render::find_setting(key);
+  std::string value = setting.get(s).get<std::string>();
+  if (choose(label, value, std::vector<std::string>(setting.choices.begin(), setting.choices.end())))
+    set(s, key, value);
+}
 
 // One widget per declared parameter of the technique (msm/cpu/techniques.h), its meaning as the
 // tooltip; a value outside the declared range is not set.
@@ -307,10 +316,8 @@ void Viewer::panel() {
     std::string msaa = std::to_string(s.msaa);
     if (choose("MSAA", msaa, {"1", "4", "8"})) s.msaa = std::stoi(msaa);
     ImGui::Checkbox("mipmaps", &s.mipmaps);
-    std::string mode = setting_json(s, "filter_mode").get<std::string>();
-    if (choose("filter", mode, {"auto", "one-pass", "three-pass"})) set(s, "filter_mode", mode);
-    std::string lookup = setting_json(s, "lookup").get<std::string>();
-    if (choose("lookup", lookup, {"auto", "bilinear", "nearest", "dither"})) set(s, "lookup", lookup);
+    choose_setting(s, "filter", "filter_mode");
+    choose_setting(s, "lookup", "lookup");
     if (t.area_light) {
       ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.max_soft_kernel);
       // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along

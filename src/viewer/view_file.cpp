@@ -1,5 +1,6 @@
 #include "msm/viewer/view_file.h"
 
+#include "msm/render/settings_schema.h"
 #include "msm/techniques.h"
 #include "msm/util/spelling.h"
 
@@ -16,7 +17,6 @@ namespace msm::viewer {
 namespace {
 
 using json = nlohmann::json;
-using Lookup = render::RenderSettings::Lookup;
 
 [[noreturn]] void fail(std::string_view key, std::string_view problem) {
   throw ViewError(fmt::format("{}: {}", key, problem));
@@ -31,11 +31,6 @@ int integer(std::string_view key, const json& v) {
   if (!v.is_number_integer() || v.get<long long>() < -(1ll << 30) || v.get<long long>() > (1ll << 30))
     fail(key, fmt::format("expected an integer, got {}", v.dump()));
   return v.get<int>();
-}
-
-bool boolean(std::string_view key, const json& v) {
-  if (!v.is_boolean()) fail(key, fmt::format("expected true or false, got {}", v.dump()));
-  return v.get<bool>();
 }
 
 std::string word(std::string_view key, const json& v) {
@@ -58,195 +53,22 @@ void check_keys(const json& object, std::string_view where, std::initializer_lis
       fail(fmt::format("{}/{}", where, key), "unknown key");
 }
 
-const char* lookup_name(Lookup l) {
-  switch (l) {
-  case Lookup::bilinear: return "bilinear";
-  case Lookup::nearest: return "nearest";
-  case Lookup::dither: return "dither";
-  default: return "auto";
-  }
-}
-
-// The technique's parameters by name (msm techniques NAME): numbers, integers, true/false, a
-// choice by its name.
-json parameters_json(const render::RenderSettings& s) {
-  json out = json::object();
-  for (const Parameter* p : render::find_rendered_technique(s.technique).parameter_list()) {
-    const float v = s.parameter(p->name);
-    json& value = out[std::string(p->name)];
-    if (p->type == ParameterType::number)
-      value = v;
-    else if (p->type == ParameterType::integer)
-      value = int(v);
-    else if (p->type == ParameterType::flag)
-      value = v != 0.0f;
-    else
-      value = p->value_text(v);
-  }
-  return out;
-}
-
-// The inverse, validated against the technique's declarations (the technique comes first in
-// setting_keys(), so that a file's names are its parameters'). Null: every default.
-void set_parameters(render::RenderSettings& s, const json& v) {
-  if (v.is_null()) return s.reset_parameters();
-  if (!v.is_object()) fail("parameters", fmt::format("expected {{\"NAME\": value, ...}} or null, got {}", v.dump()));
-  const Technique& t = render::find_rendered_technique(s.technique);
-  ParameterValues values;
-  for (const auto& [name, value] : v.items()) {
-    const std::string where = "parameters/" + name;
-    if (!value.is_string() && !value.is_boolean() && !value.is_number())
-      fail(where, fmt::format("expected a number, true/false or a name, got {}", value.dump()));
-    const std::string text = value.is_string()    ? value.get<std::string>()
-                             : value.is_boolean() ? (value.get<bool>() ? "on" : "off")
-                                                  : value.dump();
-    try {
-      set_parameter(t, values, name + "=" + text);
-    } catch (const std::invalid_argument& e) { fail(where, e.what()); }
-  }
-  s.parameters = values;
-}
-
 } // namespace
 
-std::vector<std::string> setting_keys() {
-  return {"technique",
-          "width",
-          "height",
-          "shadow_size",
-          "msaa",
-          "filter_size",
-          "filter_sigma",
-          "mipmaps",
-          "parameters",
-          "overdarken",
-          "normal_offset",
-          "depth_bias",
-          "receiver_plane_bias",
-          "exposure",
-          "lookup",
-          "filter_mode",
-          "noise_frame",
-          "translucent_occluders",
-          "coloured_translucency",
-          "alpha_threshold",
-          "light_extent_deg",
-          "light_height_deg",
-          "soft_kernel",
-          "front_back_depth"};
-}
+std::vector<std::string> setting_keys() { return render::setting_keys(); }
 
 void apply_setting(render::RenderSettings& s, std::string_view key, const json& v) {
-  if (key == "technique") {
-    std::string name = word(key, v);
-    try {
-      s.technique = std::string(render::find_rendered_technique(canonical_technique_name(name)).name);
-    } catch (const render::RenderError& e) { fail(key, e.what()); }
-  } else if (key == "width")
-    s.width = integer(key, v);
-  else if (key == "height")
-    s.height = integer(key, v);
-  else if (key == "shadow_size")
-    s.shadow_size = integer(key, v);
-  else if (key == "msaa")
-    s.msaa = integer(key, v);
-  else if (key == "filter_size")
-    s.filter_size = integer(key, v);
-  else if (key == "filter_sigma")
-    s.filter_sigma = number(key, v);
-  else if (key == "mipmaps")
-    s.mipmaps = boolean(key, v);
-  else if (key == "parameters")
-    set_parameters(s, v);
-  else if (key == "params") // the positional vector of older versions
+  if (key == "params") // the positional vector of older versions
     fail(key, "replaced by \"parameters\", each by name (msm techniques NAME lists them)");
-  else if (key == "overdarken")
-    s.overdarken = number(key, v);
-  else if (key == "normal_offset")
-    s.normal_offset = number(key, v);
-  else if (key == "depth_bias") {
-    if (v.is_null())
-      s.depth_bias.reset();
-    else
-      s.depth_bias = number(key, v);
-  } else if (key == "receiver_plane_bias")
-    s.receiver_plane_bias = number(key, v);
-  else if (key == "exposure")
-    s.exposure = number(key, v);
-  else if (key == "lookup") {
-    std::string l = word(key, v);
-    if (l == "auto")
-      s.lookup = Lookup::automatic;
-    else if (l == "bilinear")
-      s.lookup = Lookup::bilinear;
-    else if (l == "nearest")
-      s.lookup = Lookup::nearest;
-    else if (l == "dither")
-      s.lookup = Lookup::dither;
-    else
-      fail(key, fmt::format("'{}': expected auto, bilinear, nearest or dither", l));
-  } else if (key == "filter_mode") {
-    std::string m = word(key, v);
-    if (m == "auto")
-      s.one_pass.reset();
-    else if (m == "one-pass")
-      s.one_pass = true;
-    else if (m == "three-pass")
-      s.one_pass = false;
-    else
-      fail(key, fmt::format("'{}': expected auto, one-pass or three-pass", m));
-  } else if (key == "noise_frame")
-    s.frame = integer(key, v);
-  else if (key == "translucent_occluders")
-    s.translucent_occluders = boolean(key, v);
-  else if (key == "coloured_translucency")
-    s.coloured_translucency = boolean(key, v);
-  else if (key == "alpha_threshold")
-    s.translucent_alpha_threshold = number(key, v);
-  else if (key == "light_extent_deg") {
-    if (v.is_null())
-      s.light_extent_deg.reset();
-    else
-      s.light_extent_deg = number(key, v);
-  } else if (key == "light_height_deg") {
-    if (v.is_null())
-      s.light_height_deg.reset();
-    else
-      s.light_height_deg = number(key, v);
-  } else if (key == "soft_kernel")
-    s.soft_kernel = integer(key, v);
-  else if (key == "front_back_depth")
-    s.front_back_depth = boolean(key, v);
-  else
-    fail(key, fmt::format("unknown setting{}", util::did_you_mean(key, setting_keys())));
+  try {
+    render::apply_setting(s, render::find_setting(key), v);
+  } catch (const render::SettingError& e) { fail(fmt::format("{}{}", key, e.pointer), e.what()); }
 }
 
 json setting_json(const render::RenderSettings& s, std::string_view key) {
-  if (key == "technique") return s.technique;
-  if (key == "width") return s.width;
-  if (key == "height") return s.height;
-  if (key == "shadow_size") return s.shadow_size;
-  if (key == "msaa") return s.msaa;
-  if (key == "filter_size") return s.filter_size;
-  if (key == "filter_sigma") return s.filter_sigma;
-  if (key == "mipmaps") return s.mipmaps;
-  if (key == "parameters") return parameters_json(s);
-  if (key == "overdarken") return s.overdarken;
-  if (key == "normal_offset") return s.normal_offset;
-  if (key == "depth_bias") return s.depth_bias ? json(*s.depth_bias) : json();
-  if (key == "receiver_plane_bias") return s.receiver_plane_bias;
-  if (key == "exposure") return s.exposure;
-  if (key == "lookup") return lookup_name(s.lookup);
-  if (key == "filter_mode") return !s.one_pass ? "auto" : *s.one_pass ? "one-pass" : "three-pass";
-  if (key == "noise_frame") return s.frame;
-  if (key == "translucent_occluders") return s.translucent_occluders;
-  if (key == "coloured_translucency") return s.coloured_translucency;
-  if (key == "alpha_threshold") return s.translucent_alpha_threshold;
-  if (key == "light_extent_deg") return s.light_extent_deg ? json(*s.light_extent_deg) : json();
-  if (key == "light_height_deg") return s.light_height_deg ? json(*s.light_height_deg) : json();
-  if (key == "soft_kernel") return s.soft_kernel;
-  if (key == "front_back_depth") return s.front_back_depth;
-  fail(key, "unknown setting");
+  try {
+    return render::find_setting(key).get(s);
+  } catch (const render::SettingError& e) { fail(key, e.what()); }
 }
 
 View default_view(const std::string& scene_name, const scene::Scene& scene) {
@@ -257,8 +79,7 @@ View default_view(const std::string& scene_name, const scene::Scene& scene) {
 }
 
 json view_json(const View& v) {
-  json settings = json::object();
-  for (const std::string& key : setting_keys()) settings[key] = setting_json(v.settings, key);
+  const json settings = render::settings_json(v.settings);
   json lights = json::array();
   for (const scene::DirectionalLight& l : v.settings.lights) {
     json light = {{"towards_light", to_json(l.towards_light)},

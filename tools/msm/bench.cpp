@@ -6,6 +6,7 @@
 // host clock on a CPU device, whose compute timestamps are not the passes' time (results.md).
 #include "probe_bench.h"
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/image/io.h"
 #include "msm/render/renderer_internals.h"
@@ -328,72 +329,265 @@ std::string scattering_markdown(nlohmann::json& results, const std::vector<std::
 
 } // namespace
 
-void add_bench(CLI::App& app) {
-  struct Options {
-    FrameOptions frame;
-    std::vector<std::string> techniques;
-    std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
-    std::vector<int> shadow_sizes = {1024, 2048};
-    int frames = 20, warmup = 2, repeats = 5;
-    std::string json, markdown;
-    bool callgrind = false, scattering = false, quick = false;
-    ProbeBench probe;
-  };
-  auto opt = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
-                                          "pixel, shadow map per texel)");
-  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases (default: all)")->delimiter(',');
-  cmd->add_option("--resolutions", opt->resolutions, "Image sizes for the shading cost")
+struct BenchOptions {
+  FrameOptions frame;
+  std::vector<std::string> techniques;
+  std::vector<std::string> resolutions = {"1920x1080", "3840x2160"};
+  std::vector<int> shadow_sizes = {1024, 2048};
+  int frames = 20, warmup = 2, repeats = 5;
+  std::string json, markdown;
+  bool callgrind = false, scattering = false, quick = false;
+  ProbeBench probe;
+};
+
+void add_bench_options(CLI::App* cmd, BenchOptions& o) {
+  add_term(cmd, "--techniques", o.techniques, " (default: all)")->delimiter(',');
+  cmd->add_option("--resolutions", o.resolutions, "Image sizes for the shading cost")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--shadow-sizes", opt->shadow_sizes, "Shadow map sizes for the shadow-map cost")
+  cmd->add_option("--shadow-sizes", o.shadow_sizes, "Shadow map sizes for the shadow-map cost")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--frames", opt->frames, "Timed frames per configuration")->capture_default_str();
-  cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str();
-  cmd->add_option("--repeats", opt->repeats,
+  cmd->add_option("--frames", o.frames, "Timed frames per configuration")->capture_default_str();
+  cmd->add_option("--warmup", o.warmup, "Untimed frames first")->capture_default_str();
+  cmd->add_option("--repeats", o.repeats,
                   "Host-clock repeats (median) of the frame prefixes and of the copy that time the rectified map's "
                   "passes")
       ->capture_default_str();
-  cmd->add_flag("--scattering", opt->scattering,
+  cmd->add_flag("--scattering", o.scattering,
                 "Single scattering (JCGT §5): the scattering pass per pixel against ray marching, the rectified "
                 "map's passes per texel against a copy of the same bytes; unless given: techniques "
                 "scatter-march-32,scatter-march-128,scatter-msm4-64,scatter-msm6-96,scatter-csm-32, scene tower, "
                 "shadow sizes 512,1024,2048; no PCF table");
-  cmd->add_flag("--quick", opt->quick,
+  cmd->add_flag("--quick", o.quick,
                 "A short run, to check that it works (not for recorded numbers): unless given, resolution 320x180, "
                 "shadow size and sizes 256, 1 frame after 1 warm-up, 2 repeats");
-  cmd->add_option("--json", opt->json, "Write the results as JSON here");
-  cmd->add_option("--markdown", opt->markdown, "Write the results as a markdown table here");
-  cmd->add_flag("--callgrind", opt->callgrind,
+  cmd->add_option("--json-file", o.json, "Write the results as JSON here");
+  add_deprecated_option(cmd, "--json", "--json-file", o.json);
+  cmd->add_option("--markdown", o.markdown, "Write the results as a markdown table here");
+  cmd->add_flag("--callgrind", o.callgrind,
                 "Under valgrind --tool=callgrind --instr-atstart=no: one callgrind dump per prefix of each frame "
                 "(first resolution, each shadow size) instead of times; scripts/callgrind-passes.sh turns them into "
                 "instructions per pass");
-  cmd->add_option("--probe", opt->probe.probe,
-                  "Time the light-probe pipeline instead (an equirectangular EXR, or 'sky'): cube map, tables and "
-                  "median cut on the device against face size and light count");
-  cmd->add_option("--probe-sizes", opt->probe.sizes, "Face sizes for --probe")->delimiter(',')->capture_default_str();
-  add_deprecated_option(cmd, "--probe-lights", "--lights", opt->probe.lights)->delimiter(',');
-  cmd->add_option("--lights", opt->probe.lights, "Light counts for --probe")->delimiter(',')->capture_default_str();
-  add_frame_options(cmd, opt->frame);
+  add_term(cmd, "--probe", o.probe.probe,
+           ": time the light-probe pipeline instead: cube map, tables and median cut on the device against face "
+           "size and light count");
+  cmd->add_option("--probe-sizes", o.probe.sizes, "Face sizes for --probe")->delimiter(',')->capture_default_str();
+  add_deprecated_option(cmd, "--probe-lights", "--lights", o.probe.lights)->delimiter(',');
+  add_term(cmd, "--lights", o.probe.lights, ": the counts timed with --probe")->delimiter(',')->capture_default_str();
+  add_frame_options(cmd, o.frame);
+}
+
+// --quick and --scattering: their defaults of what is not given.
+void apply_bench_defaults(BenchOptions& o, const CLI::App& cmd) {
+  auto given = [&cmd](const char* option) { return cmd.get_option(option)->count() > 0; };
+  if (o.quick) {
+    if (!given("--resolutions")) o.resolutions = {"320x180"};
+    if (!given("--shadow-sizes")) o.shadow_sizes = {256};
+    if (!given("--shadow-size")) o.frame.settings.shadow_size = 256;
+    if (!given("--frames")) o.frames = 1;
+    if (!given("--warmup")) o.warmup = 1; // lavapipe compiles shader variants in a configuration's first frame
+    if (!given("--repeats")) o.repeats = 2;
+  }
+  if (o.scattering) {
+    if (!o.probe.probe.empty()) throw UsageError("--scattering and --probe: one at a time");
+    if (!given("--scene")) o.frame.scene = "tower";
+    if (!given("--shadow-sizes") && !o.quick) o.shadow_sizes = {512, 1024, 2048};
+    if (o.techniques.empty())
+      o.techniques = {"scatter-march-32", "scatter-march-128", "scatter-msm4-64", "scatter-msm6-96", "scatter-csm-32"};
+  }
+}
+
+// The rectified map and its prefix sums of a prefiltered scattering technique at one shadow-map
+// size: per texel, against a copy of the bytes they read and write, both schemes of the sums.
+nlohmann::json rectified_json(render::Renderer& renderer, const vk::Context& ctx, const BenchOptions& o,
+                              const render::RenderSettings& s, const std::vector<std::vector<render::PassTime>>& frames,
+                              const Technique& technique, int size, bool host_clock) {
+  auto run = [&](const render::RenderSettings& settings) {
+    if (o.warmup) renderer.time_frames(settings, o.warmup);
+    return renderer.time_frames(settings, o.frames);
+  };
+  // The rectified map and its prefix sums per texel, and the prefix sums against a copy of
+  // the bytes they read and write, both by the host clock on a CPU device. The scattering
+  // pass (320x180) both ways too: a check of the timestamps the per-pixel table uses.
+  Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"}),
+        scatter = pass_sum(frames, {"scattering"});
+  std::map<std::string, double> host = host_pass_ms(renderer, s, {"rectify", "prefix_sums", "scattering"}, o.repeats);
+  const glm::ivec2 bytes = msm_technique_scatter_map_bytes(technique.id);
+  const double texels = double(size) * size;
+  // The prefix sums read the rectified map and write their layer once per transmittance layer.
+  const auto copy_bytes = VkDeviceSize(texels * (bytes.x + bytes.y) / 2 * render::transmittance_layers(s));
+  CopyTimes copy = copy_times(ctx, copy_bytes, o.repeats);
+  const double rect_ms = host_clock ? host["rectify"] : rect.median,
+               prefix_ms = host_clock ? host["prefix_sums"] : prefix.median,
+               copy_ms = host_clock ? copy.host_ms : copy.timestamp_ms;
+  // The other scheme of the prefix sums (RenderSettings::prefix_sums), by the same clock.
+  render::RenderSettings other = s;
+  other.prefix_sums = s.prefix_sums == render::RenderSettings::PrefixSums::rows
+                          ? render::RenderSettings::PrefixSums::appendix_c
+                          : render::RenderSettings::PrefixSums::rows;
+  const double other_ms = host_clock ? host_pass_ms(renderer, other, {"prefix_sums"}, o.repeats)["prefix_sums"]
+                                     : pass_sum(run(other), {"prefix_sums"}).median;
+  const bool rows = s.prefix_sums == render::RenderSettings::PrefixSums::rows;
+  const double rows_ms = rows ? prefix_ms : other_ms, appendix_c_ms = rows ? other_ms : prefix_ms;
+  return {{"clock", host_clock ? "host" : "timestamps"},
+          {"rectify_ms", rect_ms},
+          {"prefix_sums_ms", prefix_ms},
+          {"rectify_ns_per_texel", rect_ms * 1e6 / texels},
+          {"prefix_sums_ns_per_texel", prefix_ms * 1e6 / texels},
+          {"bytes_read_per_texel", bytes.x},
+          {"bytes_written_per_texel", bytes.y},
+          {"copy_ms", copy_ms},
+          {"copy_gb_s", 2.0 * double(copy_bytes) / (copy_ms * 1e6)},
+          {"fraction_of_bound", copy_ms / prefix_ms},
+          {"schemes",
+           {{"rows_ms", rows_ms},
+            {"appendix_c_ms", appendix_c_ms},
+            {"rows_fraction_of_bound", copy_ms / rows_ms},
+            {"appendix_c_fraction_of_bound", copy_ms / appendix_c_ms}}},
+          {"host_clock",
+           {{"rectify_ms", host["rectify"]},
+            {"prefix_sums_ms", host["prefix_sums"]},
+            {"scattering_320x180_ms", host["scattering"]},
+            {"copy_ms", copy.host_ms}}},
+          {"timestamps",
+           {{"rectify_ms", rect.median},
+            {"prefix_sums_ms", prefix.median},
+            {"scattering_320x180_ms", scatter.median},
+            {"copy_ms", copy.timestamp_ms},
+            {"copy_after_barrier_ms", copy.timestamp_flushed_ms}}}};
+}
+
+// Each technique's cost relative to PCF where it ran, the soft techniques' shading also to PCSS
+// where it ran (JCGT §4: two table queries against hundreds of taps).
+void add_ratios(nlohmann::json& results, std::map<std::string, std::map<std::string, double>>& per_unit) {
+  bool with_pcf = per_unit.count("pcf") > 0, with_pcss = per_unit.count("pcss") > 0;
+  for (nlohmann::json& entry : results) {
+    const std::string name = entry["technique"];
+    for (auto& [key, value] : entry["shading"].items()) {
+      if (with_pcf) value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
+      if (with_pcss && render::find_rendered_technique(name).area_light)
+        value["ratio_to_pcss"] = per_unit[name]["shading " + key] / per_unit["pcss"]["shading " + key];
+    }
+    if (with_pcf)
+      for (auto& [key, value] : entry["shadow_map"].items())
+        value["ratio_to_pcf"] = per_unit[name]["shadow " + key] / per_unit["pcf"]["shadow " + key];
+  }
+}
+
+// The markdown table of the results (and the scattering part where they have one, which adds its
+// ratios to the results).
+std::string bench_markdown(const BenchOptions& o, const vk::Context& ctx, const scene::Scene& scene,
+                           nlohmann::json& results, const std::vector<std::pair<int, int>>& resolutions,
+                           bool host_clock) {
+  bool with_pcf = false, with_pcss = false; // where they ran
+  for (const nlohmann::json& entry : results) {
+    with_pcf = with_pcf || entry["technique"] == "pcf";
+    with_pcss = with_pcss || entry["technique"] == "pcss";
+  }
+  std::string md =
+      fmt::format("Device: {}. Scene '{}', {} frames per configuration (median; p10–p90 in JSON), "
+                  "{}x MSAA, {}² Gaussian.\n",
+                  ctx.info().describe(), scene.name, o.frames, o.frame.settings.msaa, o.frame.settings.filter_size);
+  if (with_pcf) {
+    md += "\n| technique |";
+    for (auto [w, h] : resolutions) md += fmt::format(" shading {}x{} ms (× PCF) |", w, h);
+    for (int size : o.shadow_sizes) md += fmt::format(" shadow map {}² ms (× PCF) |", size);
+    md += "\n|---|";
+    for (size_t i = 0; i < resolutions.size() + o.shadow_sizes.size(); ++i) md += "---:|";
+    md += "\n";
+    for (const nlohmann::json& entry : results) {
+      md += fmt::format("| {} |", entry["technique"].get<std::string>());
+      for (auto [w, h] : resolutions) {
+        const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
+        md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
+      }
+      for (int size : o.shadow_sizes) {
+        const auto& v = entry["shadow_map"][std::to_string(size)];
+        md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
+      }
+      md += "\n";
+    }
+  }
+  if (with_pcss) {
+    md += fmt::format("\nSoft shadows, shading time relative to pcss ({}² search):",
+                      o.frame.settings.soft_kernel ? o.frame.settings.soft_kernel : render::kDefaultPcssKernel);
+    for (const nlohmann::json& entry : results)
+      for (auto [w, h] : resolutions) {
+        const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
+        if (v.contains("ratio_to_pcss") && entry["technique"] != "pcss")
+          md += fmt::format(" {} {}x{}: {:.3f};", entry["technique"].get<std::string>(), w, h,
+                            v["ratio_to_pcss"].get<double>());
+      }
+    md += "\n";
+  }
+  md += scattering_markdown(results, resolutions, o.frame.settings.shadow_size,
+                            host_clock ? fmt::format("host clock, median of {} repeats", o.repeats)
+                                       : fmt::format("timestamps, median of {} frames", o.frames));
+  return md;
+}
+
+// A progress line: rewritten in place on a terminal, one line per step in a log.
+void print_progress(bool tty, const std::string& line) {
+  if (tty)
+    fmt::print(stderr, "\r{:<70}", line);
+  else
+    fmt::print(stderr, "{}\n", line);
+}
+
+// The techniques to time, canonical names (default: all; --scattering: only scattering ones), PCF
+// first unless under callgrind or --scattering (the ratios' reference).
+std::vector<std::string> bench_techniques(const BenchOptions& o) {
+  std::vector<std::string> names = canonical_technique_names(o.techniques);
+  if (names.empty())
+    for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
+  if (o.scattering)
+    for (const std::string& name : names)
+      if (!render::find_rendered_technique(name).scatters())
+        throw UsageError(fmt::format("--scattering: '{}' is not a scattering technique (msm techniques)", name));
+  if (!o.callgrind && !o.scattering && std::find(names.begin(), names.end(), "pcf") == names.end())
+    names.insert(names.begin(), "pcf");
+  return names;
+}
+
+// Every configuration is valid before the first frame: UsageError naming the first problem.
+void validate_configurations(const BenchOptions& o, const std::vector<std::string>& names,
+                             const std::vector<std::pair<int, int>>& resolutions) {
+  // Validate every configuration before the first frame.
+  for (const std::string& name : names) {
+    render::RenderSettings s = settings_for(o.frame, name);
+    try {
+      for (auto [w, h] : resolutions) {
+        s.width = w;
+        s.height = h;
+        s.validate();
+      }
+      for (int size : o.shadow_sizes) {
+        s.shadow_size = size;
+        s.validate();
+      }
+    } catch (const render::RenderError& e) { throw UsageError(e.what()); }
+  }
+}
+
+// --json and --markdown, each written whole or not at all.
+void write_results(const BenchOptions& o, const nlohmann::json& doc, const std::string& md) {
+  auto write = [](const std::string& path, const std::string& text) {
+    try {
+      image::write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+  };
+  if (!o.json.empty()) write(o.json, doc.dump(2) + "\n");
+  if (!o.markdown.empty()) write(o.markdown, md);
+}
+
+void add_bench(CLI::App& app) {
+  auto opt = std::make_shared<BenchOptions>();
+  auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
+                                          "pixel, shadow map per texel)");
+  add_bench_options(cmd, *opt);
   cmd->callback([opt, cmd] {
-    auto given = [cmd](const char* option) { return cmd->get_option(option)->count() > 0; };
-    if (opt->quick) {
-      if (!given("--resolutions")) opt->resolutions = {"320x180"};
-      if (!given("--shadow-sizes")) opt->shadow_sizes = {256};
-      if (!given("--shadow-size")) opt->frame.settings.shadow_size = 256;
-      if (!given("--frames")) opt->frames = 1;
-      if (!given("--warmup")) opt->warmup = 1; // lavapipe compiles shader variants in a configuration's first frame
-      if (!given("--repeats")) opt->repeats = 2;
-    }
-    if (opt->scattering) {
-      if (!opt->probe.probe.empty()) throw UsageError("--scattering and --probe: one at a time");
-      if (!given("--scene")) opt->frame.scene = "tower";
-      if (!given("--shadow-sizes") && !opt->quick) opt->shadow_sizes = {512, 1024, 2048};
-      if (opt->techniques.empty())
-        opt->techniques = {"scatter-march-32", "scatter-march-128", "scatter-msm4-64", "scatter-msm6-96",
-                           "scatter-csm-32"};
-    }
+    apply_bench_defaults(*opt, *cmd);
     finish_frame_options(opt->frame);
     if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
     if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
@@ -403,32 +597,10 @@ void add_bench(CLI::App& app) {
       return;
     }
     if (opt->callgrind) check_callgrind();
-    std::vector<std::string> names = canonical_technique_names(opt->techniques);
-    if (names.empty())
-      for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
-    if (opt->scattering)
-      for (const std::string& name : names)
-        if (!render::find_rendered_technique(name).scatters())
-          throw UsageError(fmt::format("--scattering: '{}' is not a scattering technique (msm techniques)", name));
-    if (!opt->callgrind && !opt->scattering && std::find(names.begin(), names.end(), "pcf") == names.end())
-      names.insert(names.begin(), "pcf");
+    const std::vector<std::string> names = bench_techniques(*opt);
     std::vector<std::pair<int, int>> resolutions;
     for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
-    // Validate every configuration before the first frame.
-    for (const std::string& name : names) {
-      render::RenderSettings s = settings_for(opt->frame, name);
-      try {
-        for (auto [w, h] : resolutions) {
-          s.width = w;
-          s.height = h;
-          s.validate();
-        }
-        for (int size : opt->shadow_sizes) {
-          s.shadow_size = size;
-          s.validate();
-        }
-      } catch (const render::RenderError& e) { throw UsageError(e.what()); }
-    }
+    validate_configurations(*opt, names, resolutions);
     scene::Scene scene = scene_at_frame(opt->frame, load_scene_or_fail(opt->frame.scene));
     if (opt->scattering && !scene.medium)
       throw UsageError(
@@ -446,14 +618,8 @@ void add_bench(CLI::App& app) {
     // are not the time they take (results.md), so there the host clock times them.
     const bool host_clock = ctx->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
 
-    // A progress line: rewritten in place on a terminal, one line per step in a log.
-    bool tty = isatty(fileno(stderr));
-    auto progress = [&](const std::string& line) {
-      if (tty)
-        fmt::print(stderr, "\r{:<70}", line);
-      else
-        fmt::print(stderr, "{}\n", line);
-    };
+    const bool tty = isatty(fileno(stderr));
+    auto progress = [tty](const std::string& line) { print_progress(tty, line); };
     auto run = [&](render::RenderSettings s) {
       if (opt->warmup) renderer.time_frames(s, opt->warmup);
       return renderer.time_frames(s, opt->frames);
@@ -509,57 +675,8 @@ void add_bench(CLI::App& app) {
         auto frames = run(s);
         Stats st = pass_sum(frames, shadow_passes);
         if (prefiltered) {
-          // The rectified map and its prefix sums per texel, and the prefix sums against a copy of
-          // the bytes they read and write, both by the host clock on a CPU device. The scattering
-          // pass (320x180) both ways too: a check of the timestamps the per-pixel table uses.
-          Stats rect = pass_sum(frames, {"rectify"}), prefix = pass_sum(frames, {"prefix_sums"}),
-                scatter = pass_sum(frames, {"scattering"});
-          std::map<std::string, double> host =
-              host_pass_ms(renderer, s, {"rectify", "prefix_sums", "scattering"}, opt->repeats);
-          const glm::ivec2 bytes = msm_technique_scatter_map_bytes(technique.id);
-          const double texels = double(size) * size;
-          // The prefix sums read the rectified map and write their layer once per transmittance layer.
-          const auto copy_bytes = VkDeviceSize(texels * (bytes.x + bytes.y) / 2 * render::transmittance_layers(s));
-          CopyTimes copy = copy_times(*ctx, copy_bytes, opt->repeats);
-          const double rect_ms = host_clock ? host["rectify"] : rect.median,
-                       prefix_ms = host_clock ? host["prefix_sums"] : prefix.median,
-                       copy_ms = host_clock ? copy.host_ms : copy.timestamp_ms;
-          // The other scheme of the prefix sums (RenderSettings::prefix_sums), by the same clock.
-          render::RenderSettings other = s;
-          other.prefix_sums = s.prefix_sums == render::RenderSettings::PrefixSums::rows
-                                  ? render::RenderSettings::PrefixSums::appendix_c
-                                  : render::RenderSettings::PrefixSums::rows;
-          const double other_ms = host_clock
-                                      ? host_pass_ms(renderer, other, {"prefix_sums"}, opt->repeats)["prefix_sums"]
-                                      : pass_sum(run(other), {"prefix_sums"}).median;
-          const bool rows = s.prefix_sums == render::RenderSettings::PrefixSums::rows;
-          const double rows_ms = rows ? prefix_ms : other_ms, appendix_c_ms = rows ? other_ms : prefix_ms;
-          entry["rectified"][std::to_string(size)] = {{"clock", host_clock ? "host" : "timestamps"},
-                                                      {"rectify_ms", rect_ms},
-                                                      {"prefix_sums_ms", prefix_ms},
-                                                      {"rectify_ns_per_texel", rect_ms * 1e6 / texels},
-                                                      {"prefix_sums_ns_per_texel", prefix_ms * 1e6 / texels},
-                                                      {"bytes_read_per_texel", bytes.x},
-                                                      {"bytes_written_per_texel", bytes.y},
-                                                      {"copy_ms", copy_ms},
-                                                      {"copy_gb_s", 2.0 * double(copy_bytes) / (copy_ms * 1e6)},
-                                                      {"fraction_of_bound", copy_ms / prefix_ms},
-                                                      {"schemes",
-                                                       {{"rows_ms", rows_ms},
-                                                        {"appendix_c_ms", appendix_c_ms},
-                                                        {"rows_fraction_of_bound", copy_ms / rows_ms},
-                                                        {"appendix_c_fraction_of_bound", copy_ms / appendix_c_ms}}},
-                                                      {"host_clock",
-                                                       {{"rectify_ms", host["rectify"]},
-                                                        {"prefix_sums_ms", host["prefix_sums"]},
-                                                        {"scattering_320x180_ms", host["scattering"]},
-                                                        {"copy_ms", copy.host_ms}}},
-                                                      {"timestamps",
-                                                       {{"rectify_ms", rect.median},
-                                                        {"prefix_sums_ms", prefix.median},
-                                                        {"scattering_320x180_ms", scatter.median},
-                                                        {"copy_ms", copy.timestamp_ms},
-                                                        {"copy_after_barrier_ms", copy.timestamp_flushed_ms}}}};
+          entry["rectified"][std::to_string(size)] =
+              rectified_json(renderer, *ctx, *opt, s, frames, technique, size, host_clock);
         }
         std::string key = std::to_string(size);
         double ns = st.median * 1e6 / (double(size) * size);
@@ -570,60 +687,8 @@ void add_bench(CLI::App& app) {
       results.push_back(entry);
     }
     if (tty) fmt::print(stderr, "\r{:<70}\r", "");
-    // Ratios to PCF where it ran; the soft techniques' shading also to PCSS where it ran (JCGT §4:
-    // two table queries against hundreds of taps).
-    bool with_pcf = per_unit.count("pcf") > 0, with_pcss = per_unit.count("pcss") > 0;
-    for (nlohmann::json& entry : results) {
-      const std::string name = entry["technique"];
-      for (auto& [key, value] : entry["shading"].items()) {
-        if (with_pcf) value["ratio_to_pcf"] = per_unit[name]["shading " + key] / per_unit["pcf"]["shading " + key];
-        if (with_pcss && render::find_rendered_technique(name).area_light)
-          value["ratio_to_pcss"] = per_unit[name]["shading " + key] / per_unit["pcss"]["shading " + key];
-      }
-      if (with_pcf)
-        for (auto& [key, value] : entry["shadow_map"].items())
-          value["ratio_to_pcf"] = per_unit[name]["shadow " + key] / per_unit["pcf"]["shadow " + key];
-    }
-
-    std::string md = fmt::format("Device: {}. Scene '{}', {} frames per configuration (median; p10–p90 in JSON), "
-                                 "{}x MSAA, {}² Gaussian.\n",
-                                 ctx->info().describe(), scene.name, opt->frames, opt->frame.settings.msaa,
-                                 opt->frame.settings.filter_size);
-    if (with_pcf) {
-      md += "\n| technique |";
-      for (auto [w, h] : resolutions) md += fmt::format(" shading {}x{} ms (× PCF) |", w, h);
-      for (int size : opt->shadow_sizes) md += fmt::format(" shadow map {}² ms (× PCF) |", size);
-      md += "\n|---|";
-      for (size_t i = 0; i < resolutions.size() + opt->shadow_sizes.size(); ++i) md += "---:|";
-      md += "\n";
-      for (const nlohmann::json& entry : results) {
-        md += fmt::format("| {} |", entry["technique"].get<std::string>());
-        for (auto [w, h] : resolutions) {
-          const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
-          md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
-        }
-        for (int size : opt->shadow_sizes) {
-          const auto& v = entry["shadow_map"][std::to_string(size)];
-          md += fmt::format(" {:.3f} ({:.2f}) |", v["median_ms"].get<double>(), v["ratio_to_pcf"].get<double>());
-        }
-        md += "\n";
-      }
-    }
-    if (with_pcss) {
-      md += fmt::format("\nSoft shadows, shading time relative to pcss ({}² search):",
-                        opt->frame.settings.soft_kernel ? opt->frame.settings.soft_kernel : render::kDefaultPcssKernel);
-      for (const nlohmann::json& entry : results)
-        for (auto [w, h] : resolutions) {
-          const auto& v = entry["shading"][fmt::format("{}x{}", w, h)];
-          if (v.contains("ratio_to_pcss") && entry["technique"] != "pcss")
-            md += fmt::format(" {} {}x{}: {:.3f};", entry["technique"].get<std::string>(), w, h,
-                              v["ratio_to_pcss"].get<double>());
-        }
-      md += "\n";
-    }
-    md += scattering_markdown(results, resolutions, opt->frame.settings.shadow_size,
-                              host_clock ? fmt::format("host clock, median of {} repeats", opt->repeats)
-                                         : fmt::format("timestamps, median of {} frames", opt->frames));
+    add_ratios(results, per_unit);
+    const std::string md = bench_markdown(*opt, *ctx, scene, results, resolutions, host_clock);
     fmt::print("{}", md);
     nlohmann::json doc = {{"device", ctx->info().describe()},
                           {"scene", scene.name},
@@ -634,13 +699,7 @@ void add_bench(CLI::App& app) {
                           {"filter_size", opt->frame.settings.filter_size},
                           {"shadow_size", opt->frame.settings.shadow_size},
                           {"results", results}};
-    auto write = [](const std::string& path, const std::string& text) {
-      try {
-        image::write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-      } catch (const image::ImageError& e) { throw UsageError(e.what()); }
-    };
-    if (!opt->json.empty()) write(opt->json, doc.dump(2) + "\n");
-    if (!opt->markdown.empty()) write(opt->markdown, md);
+    write_results(*opt, doc, md);
   });
 }
 

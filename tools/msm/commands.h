@@ -4,6 +4,10 @@
 
 namespace msm::tool {
 
+// The whole msm command line: every subcommand below and `help`, each with its options; every
+// floating-point option refuses non-finite numbers.
+void build_app(CLI::App& app);
+
 void add_demo(CLI::App& app);
 void add_evaluate(CLI::App& app);
 void add_kernels(CLI::App& app);

@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "msm/image/io.h"
 #include "msm/image/metrics.h"
+#include "vocabulary.h"
 
 #include <fmt/core.h>
 
@@ -90,7 +91,7 @@ void add_compare(CLI::App& app) {
   auto* cmd = app.add_subcommand("compare", "Error metrics of a test image against a reference (EXR or PNG)");
   cmd->add_option("REFERENCE", opt->reference, "Reference image")->required();
   cmd->add_option("TEST", opt->test, "Test image")->required();
-  cmd->add_flag("--json", opt->json, "Print JSON");
+  add_term_flag(cmd, "--json", opt->json);
   cmd->add_option("--error-image", opt->error_image, "Write the false-colour error image (PNG) here");
   cmd->add_option("--range", opt->range, "Difference shown at full colour in the error image (default 0.1)");
   cmd->add_option("--mask", opt->mask,

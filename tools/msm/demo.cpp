@@ -14,6 +14,7 @@
 // prints a table of the errors and the GPU time per pass.
 #include "reference_look.h"
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/image/compose.h"
 #include "msm/image/io.h"
@@ -252,9 +253,8 @@ void add_demo(CLI::App& app) {
               "the time per pass; single scattering (ray marching, CSM, four and six moments) against the ray-traced "
               "scattering, and image-based lighting (a probe cut into 16-256 area lights) against the whole "
               "probe, in between");
-  cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
-  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases to compare (the first is the reference)")
-      ->delimiter(',');
+  add_term(cmd, "--out", opt->out)->capture_default_str();
+  add_term(cmd, "--techniques", opt->techniques, ", to compare (the first is the reference)")->delimiter(',');
   cmd->add_option("--soft-scene", opt->soft_scene, "Scene of the soft-shadow part")->capture_default_str();
   cmd->add_option("--soft-techniques", opt->soft_techniques, "Soft techniques or aliases (\"\": skip the soft part)")
       ->delimiter(',');

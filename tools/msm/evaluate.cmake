@@ -1,14 +1,14 @@
 # msm evaluate: the command and its CLI tests, kept apart from the other commands' file.
 # Every test goes through msm_cli_test (tests/cli/expect: exit status and output together).
-target_sources(msm PRIVATE ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp)
-target_link_libraries(msm PRIVATE msm::evaluate_mpi)
+target_sources(msm_cli PRIVATE ${CMAKE_CURRENT_LIST_DIR}/evaluate.cpp)
+target_link_libraries(msm_cli PUBLIC msm::evaluate_mpi)
 
 if(MSM_BUILD_TESTS)
   set(MSM_EVALUATE_OUT ${CMAKE_CURRENT_BINARY_DIR}/evaluate-tests)
   set(MSM_EVALUATE_DATA ${PROJECT_SOURCE_DIR}/tests/data)
   # A small run: two built-in scenes at 32 x 32 texels, a 257-point grid, the named candidates and
   # 12 drawn sets of four functions (28 candidates).
-  set(evaluate_small --scene fence,stair --size 32 --grid 257 --candidates named,sample:4:12 --fresh)
+  set(evaluate_small --scene fence,stair --shadow-size 32 --grid 257 --candidates named,sample:4:12 --fresh)
 
   msm_cli_test(msm_cli_evaluate_functions ARGS evaluate --functions
     OUTPUT "^z +z +power" "bump +exp\\(-8 \\(z - 1/2\\)\\^2\\) +other$")
@@ -27,7 +27,7 @@ if(MSM_BUILD_TESTS)
   msm_cli_test(msm_cli_evaluate_killed STATUS 3 SETUP msm_evaluate_killed
     ARGS evaluate ${evaluate_small} --threads 2 --stop-after 5 --out ${MSM_EVALUATE_OUT}/resumed)
   msm_cli_test(msm_cli_evaluate_resumed REQUIRES msm_evaluate_killed SETUP msm_evaluate_resumed
-    ARGS evaluate --scene fence,stair --size 32 --grid 257 --candidates named,sample:4:12 --threads 1
+    ARGS evaluate --scene fence,stair --shadow-size 32 --grid 257 --candidates named,sample:4:12 --threads 1
       --out ${MSM_EVALUATE_OUT}/resumed
     OUTPUT "28 candidates \\(5 from the checkpoint\\)")
   add_test(NAME msm_cli_evaluate_resumed_equals_single
@@ -48,14 +48,14 @@ if(MSM_BUILD_TESTS)
       FIXTURES_REQUIRED "msm_evaluate_single;msm_evaluate_mpi")
     # An error on the ranks (here: a bad candidate) ends them all with the message, no hang.
     msm_cli_test(msm_cli_evaluate_mpi_bad_candidate STATUS 2 LAUNCHER ${mpi_two} ENVIRONMENT ${mpi_root}
-      ARGS evaluate --scene fence --size 16 --candidates z+nope --out ${MSM_EVALUATE_OUT}/bad
+      ARGS evaluate --scene fence --shadow-size 16 --candidates z+nope --out ${MSM_EVALUATE_OUT}/bad
       OUTPUT "unknown function 'nope'" EMPTY ${MSM_EVALUATE_OUT}/bad)
     set_tests_properties(msm_cli_evaluate_mpi_bad_candidate PROPERTIES TIMEOUT 60)
   endif()
 
   # A checkpoint of another run is refused (unless --fresh).
   msm_cli_test(msm_cli_evaluate_other_checkpoint STATUS 2 REQUIRES msm_evaluate_single
-    ARGS evaluate --scene fence --size 32 --grid 257 --candidates power4 --out ${MSM_EVALUATE_OUT}/single
+    ARGS evaluate --scene fence --shadow-size 32 --grid 257 --candidates power4 --out ${MSM_EVALUATE_OUT}/single
     OUTPUT "the checkpoint belongs to a different run.*--fresh")
 
   # Bad input: a clear message and exit status 2.
@@ -86,7 +86,7 @@ if(MSM_BUILD_TESTS)
     if(NOT args MATCHES "--candidates")
       string(APPEND args " --candidates power2")
     endif()
-    separate_arguments(args UNIX_COMMAND "${args} --size 16 --fresh")
+    separate_arguments(args UNIX_COMMAND "${args} --shadow-size 16 --fresh")
     msm_cli_test(msm_cli_evaluate_${name} STATUS 2 ARGS evaluate ${args} OUTPUT "${message}" EMPTY ${empty})
   endforeach()
 
@@ -94,7 +94,7 @@ if(MSM_BUILD_TESTS)
   # configured MSM_GLMARK2_MODELS_DIR): the scene is written with that path at configure time.
   configure_file(${MSM_EVALUATE_DATA}/evaluate_bunny.json.in ${MSM_EVALUATE_OUT}/evaluate_bunny.json @ONLY)
   msm_cli_test(msm_cli_evaluate_imported_mesh
-    ARGS evaluate --scene ${MSM_EVALUATE_OUT}/evaluate_bunny.json --size 48 --grid 257
+    ARGS evaluate --scene ${MSM_EVALUATE_OUT}/evaluate_bunny.json --shadow-size 48 --grid 257
       --candidates power4,trig4,hamburger4 --fresh --out ${MSM_EVALUATE_OUT}/bunny
     OUTPUT "3 candidates \\(0 from the checkpoint\\) on 1 scene.*evaluate_bunny.json: [0-9]+ fragments \\([0-9]+ receive light")
 endif()

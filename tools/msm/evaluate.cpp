@@ -22,6 +22,7 @@
 #include "msm/util/progress.h"
 #include "msm/util/text.h"
 #include "usage.h"
+#include "vocabulary.h"
 
 namespace msm::tool {
 namespace {
@@ -100,27 +101,25 @@ void add_evaluate(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "evaluate", "The 2015 evaluation of shadow-map data: every fragment of depth-peeled shadow-map stacks through "
                   "the sharp LP bound of each candidate basis, against PCF (threads, or MPI ranks under mpirun)");
-  cmd->add_option("--scene", opt->scenes,
-                  "Built-in scene names or scene files, comma-separated or repeated (default "
-                  "fence,railing,stair,column,models,pillar_wall)");
+  add_term(cmd, "--scene", opt->scenes,
+           "; several, comma-separated or repeated (default fence,railing,stair,column,models,pillar_wall)");
   cmd->add_option("--candidates", opt->candidates,
                   "Candidate list: named | all:K | sample:K:N[:SEED] | f1+f2+.. | power4, trig4, vsm, esm, .. "
                   "(comma-separated; default named; --functions lists the 37 functions)");
-  cmd->add_option("-o,--out", opt->out, "Output directory (default out/evaluate)");
-  cmd->add_option("--size", opt->stack.size, "Shadow map texels per side (default 128)");
+  add_term(cmd, "--out", opt->out, " (default out/evaluate)");
+  add_term(cmd, "--shadow-size", opt->stack.size, " (default 128)");
+  add_deprecated_option(cmd, "--size", "--shadow-size", opt->stack.size);
   cmd->add_option("--grid", opt->stack.grid, "Depth grid points on [0,1] (default 1025)");
-  cmd->add_option("--filter-size", opt->stack.filter_taps, "Gaussian taps per axis, odd (default 9)");
-  cmd->add_option("--filter-sigma", opt->stack.filter_sigma, "Gaussian sigma in texels (default 2.4)");
+  add_term(cmd, "--filter-size", opt->stack.filter_taps, " (default 9)");
+  add_term(cmd, "--filter-sigma", opt->stack.filter_sigma, " (default 2.4)");
   cmd->add_option("--max-layers", opt->stack.max_layers, "Surfaces kept per texel (default 64)");
   cmd->add_option("--max-bias", opt->stack.max_bias,
                   "Cap of the receiver-plane depth bias in depth units (default 1: none)");
-  cmd->add_option("--threads", opt->threads, "Threads per rank (default: the cores divided among the ranks)");
+  add_term(cmd, "--threads", opt->threads, " per rank (default: the cores divided among the ranks)");
   cmd->add_flag("--solve-lit", opt->solve_lit, "Also send fully lit fragments through the LP (their bound is 0)");
   cmd->add_flag("--fresh", opt->fresh, "Discard an existing checkpoint in --out instead of resuming from it");
-  cmd->add_flag("--progress", opt->progress,
-                "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth once the "
-                "run has taken 2 s)");
-  cmd->add_flag("--json", opt->json, "Print summary.json to stdout instead of the text summary");
+  add_term_flag(cmd, "--progress", opt->progress);
+  add_term_flag(cmd, "--json", opt->json, ": summary.json instead of the text summary");
   cmd->add_flag("--functions", opt->list_functions, "List the 37 candidate functions and exit");
   cmd->add_option("--stop-after", opt->stop_after, "Testing: end abruptly after N candidates of this rank")->group("");
   cmd->callback([opt] {

@@ -18,6 +18,7 @@
 #include "msm/probe/probe.h"
 #include "msm/scene/scene.h"
 #include "usage.h"
+#include "vocabulary.h"
 
 namespace msm::tool {
 namespace {
@@ -254,6 +255,8 @@ void add_lights(CLI::App& app) {
       "An equirectangular or cube-map cross (4:3, 3:4) EXR (e.g. /usr/share/blender/datafiles/studiolights/world/"
       "studio.exr), six face EXRs named by a path with \"{face}\" (px nx py ny pz nz), or 'sky' for the procedural "
       "sky with a sun";
+  const std::string probe_detail = " (e.g. /usr/share/blender/datafiles/studiolights/world/studio.exr; the six faces "
+                                   "px nx py ny pz nz; 'sky': the procedural sky with a sun)";
   const std::string scene_lights_help = "Write the lights as a scene's \"lights\" list (JSON: direction, irradiance "
                                         "on a facing surface, angular diameter)";
   const std::string picture_help = "Write the cube map as a cross with the regions outlined (.png or .exr)";
@@ -262,10 +265,10 @@ void add_lights(CLI::App& app) {
     auto* cmd = app.add_subcommand(
         "lights", "A light probe's area lights by the median cut (Kneiphof 2017): direction, extents, solid angle, "
                   "irradiance; a picture of the regions");
-    cmd->add_option("--probe", o->probe, probe_help)->required();
-    cmd->add_option("--lights", o->count, "Number of area lights (median-cut regions), 1 to 256 (default 32)");
+    add_term(cmd, "--probe", o->probe, probe_detail)->required();
+    add_term(cmd, "--lights", o->count, " (default 32)");
     add_deprecated_option(cmd, "--count", "--lights", o->count);
-    cmd->add_flag("--json", o->json, "Print the lights as JSON");
+    add_term_flag(cmd, "--json", o->json, ": the lights");
     cmd->add_option("--size", o->size, "Cube-map face size in texels (default 128)");
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
     cmd->add_option("--intensity", o->intensity, "Radiance scale (default 1)");
@@ -277,9 +280,8 @@ void add_lights(CLI::App& app) {
                   "Start the cut from the side faces halved at the horizon (10 regions: --lights 10 to 256, even "
                   "--size), so that no light straddles the horizon");
     cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
-    cmd->add_option("--sub-lights", o->sub_lights,
-                    "Each light's sub-lights: the lights of the cut into this many regions inside its region, as a "
-                    "scene's \"sub_lights\" shades them (listed by --json; 0, or no more than --lights: none)");
+    add_term(cmd, "--sub-lights", o->sub_lights,
+             ", as a scene's \"sub_lights\" shades them (listed by --json; no more than --lights: none)");
     cmd->callback([o] { run(*o); });
   }
   {
@@ -287,12 +289,12 @@ void add_lights(CLI::App& app) {
     auto* cmd = app.add_subcommand("probe", "The first name of msm lights: msm probe PROBE --lights N [--cross F]");
     cmd->add_option("probe", o->probe, probe_help)->required();
     cmd->add_option("--size", o->size, "Cube-map face size in texels");
-    cmd->add_option("--lights", o->count, "Number of area lights (median-cut regions), 1 to 256");
+    add_term(cmd, "--lights", o->count);
     cmd->add_option("--rotation", o->rotation_deg, "Probe rotation about +Y in degrees");
     cmd->add_option("--intensity", o->intensity, "Radiance scale");
     cmd->add_option("--scene-lights", o->scene_lights, scene_lights_help);
     cmd->add_option("--cross", o->picture, picture_help);
-    cmd->add_flag("--json", o->json, "Print the lights as JSON");
+    add_term_flag(cmd, "--json", o->json, ": the lights");
     cmd->callback([o] { run(*o); });
   }
 }

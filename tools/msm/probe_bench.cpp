@@ -23,13 +23,13 @@ void write_text(const std::string& path, const std::string& text) {
 
 void bench_probe(const ProbeBench& o, const std::string& device_name, int frames, int warmup, const std::string& json,
                  const std::string& markdown) {
-  if (o.sizes.empty() || o.lights.empty()) throw UsageError("--probe-sizes and --probe-lights need a value each");
+  if (o.sizes.empty() || o.lights.empty()) throw UsageError("--probe-sizes and --lights need a value each");
   for (int size : o.sizes)
     if (size < 1 || size > probe::kMaxDeviceCubeSize)
       throw UsageError(fmt::format("--probe-sizes: {} outside 1..{}", size, probe::kMaxDeviceCubeSize));
   for (int n : o.lights)
     if (n < 1 || n > probe::kMaxDeviceLights)
-      throw UsageError(fmt::format("--probe-lights: {} outside 1..{}", n, probe::kMaxDeviceLights));
+      throw UsageError(fmt::format("--lights: {} outside 1..{}", n, probe::kMaxDeviceLights));
   const bool sky = o.probe == "sky";
   probe::Panorama panorama;
   if (!sky) {

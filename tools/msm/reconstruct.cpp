@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "msm/cpu/techniques.h"
 #include "usage.h"
+#include "vocabulary.h"
 #if MSM_TOOL_RENDER
 #include "msm/render/renderer.h"
 #endif
@@ -84,7 +85,7 @@ void add_techniques(CLI::App& app) {
   cmd->add_flag("--passes", opt->passes,
                 "Print the passes of each rendered technique's frame in execution order (default settings; "
                 "translucent and coloured variants where the technique blends translucent occluders)");
-  cmd->add_flag("--json", opt->json, "Print JSON: every technique (or the one named) with its parameters");
+  add_term_flag(cmd, "--json", opt->json, ": every technique (or the one named) with its parameters");
   cmd->callback([opt] {
 #if !MSM_TOOL_RENDER
     if (opt->passes) throw UsageError("--passes: this msm was built without the renderer (MSM_BUILD_VULKAN=OFF)");
@@ -146,9 +147,9 @@ void add_reconstruct(CLI::App& app) {
   cmd->add_option("--depths", opt->depths, "Occluder depths in the kernel, in [0,1]")->required()->delimiter(',');
   cmd->add_option("--weights", opt->weights, "Filter weights (default: equal)")->delimiter(',');
   cmd->add_option("--zf", opt->zf, "Fragment depth in [0,1]")->required();
-  cmd->add_option("-t,--techniques", opt->techniques, "Techniques or aliases to run (default: all)")->delimiter(',');
+  add_term(cmd, "--techniques", opt->techniques, ", to run (default: all)")->delimiter(',');
   add_deprecated_option(cmd, "--technique", "-t/--techniques", opt->techniques)->delimiter(',');
-  cmd->add_flag("--json", opt->json, "Print JSON");
+  add_term_flag(cmd, "--json", opt->json);
   cmd->callback([opt] {
     auto finite_unit = [](float x) { return std::isfinite(x) && x >= 0.0f && x <= 1.0f; };
     for (float d : opt->depths)

@@ -30,6 +30,8 @@
 #include "msm/util/output_dir.h"
 #include "msm/util/progress.h"
 #include "reference_look.h"
+#include "usage.h"
+#include "vocabulary.h"
 
 namespace msm::tool {
 namespace {
@@ -57,141 +59,254 @@ nlohmann::ordered_json light_json(const msm::scene::DirectionalLight& declared, 
           {"overrides", overrides}};
 }
 
+// The options of msm reference, as given.
+struct ReferenceOptions {
+  std::string scene{msm::scene::default_scene_name()};
+  std::string effect, out = "out/reference", light_shape, sampler = "stratified";
+  int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = MSM_FILTER_DEFAULT_TAPS,
+      max_crossings = 64, threads = 0;
+  std::uint64_t seed = 1;
+  double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
+  std::optional<double> light_extent, light_width, light_height;
+  std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
+  std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
+  std::optional<int> sub_lights; // and their sub-lights
+  int frame = 0;                 // of a dynamic scene (msm render --frames)
+  float probe_rotation_speed = 0.0f;
+  bool json = false, progress = false, probe_lights = false;
+};
+
+void add_reference_options(CLI::App* cmd, ReferenceOptions& o) {
+  add_term(cmd, "--scene", o.scene, " (default fence)");
+  cmd->add_option("--effect", o.effect, "hard | filtered | soft | translucent | scattering | environment")->required();
+  add_term(cmd, "--width", o.width, " (default 640)");
+  add_term(cmd, "--height", o.height, " (default 360)");
+  cmd->add_option("--samples", o.samples, "Samples per pixel of filtered, soft and scattering (default 256)");
+  cmd->add_option("--seed", o.seed, "Seed of the per-pixel generators (default 1)");
+  cmd->add_option("--sampler", o.sampler, "stratified (default) | independent");
+  add_term(cmd, "--shadow-size", o.shadow_size, ", filtered (default 1024)");
+  add_term(cmd, "--filter-size", o.filter_size, ", filtered")->capture_default_str();
+  add_term(cmd, "--filter-sigma", o.filter_sigma, ", filtered")->capture_default_str();
+  add_term(cmd, "--light-extent-deg", o.light_extent,
+           ", soft: the light becomes a disc of this diameter, as msm render --light-extent-deg makes it (default: "
+           "the scene's light as it declares it)");
+  cmd->add_option("--light-shape", o.light_shape,
+                  "soft: override the light's shape: disc | rectangle (default: the scene light's own)");
+  add_term(cmd, "--light-width-deg", o.light_width, ", soft (default: the light's extent)");
+  add_term(cmd, "--light-height-deg", o.light_height,
+           ", soft, as msm render --light-height-deg (default: the light's own, else its extent)");
+  // The spellings of older versions.
+  add_deprecated_option(cmd, "--light-extent", "--light-extent-deg", o.light_extent);
+  add_deprecated_option(cmd, "--light-width", "--light-width-deg", o.light_width);
+  add_deprecated_option(cmd, "--light-height", "--light-height-deg", o.light_height);
+  add_deprecated_flag(cmd, "--probe-lights", "--extracted-lights", o.probe_lights);
+  cmd->add_option("--max-crossings", o.max_crossings, "translucent: surfaces counted per light ray (default 64)");
+  add_term(cmd, "--probe", o.probe,
+           ": lights the scene instead of its own lights (image-based lighting; the scene's probe settings are "
+           "kept, else 32 lights, 128² per face), as msm render --probe");
+  add_term(cmd, "--lights", o.lights, " (default: the scene's)");
+  add_term(cmd, "--sub-lights", o.sub_lights, " (default: the scene's); --extracted-lights traces them");
+  cmd->add_flag("--extracted-lights", o.probe_lights,
+                "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
+  add_term(cmd, "--frame", o.frame,
+           ", traced as msm render --frames draws it, its probe turned K times --probe-rotation-speed")
+      ->check(CLI::Range(0, 9999));
+  add_term(cmd, "--probe-rotation-speed", o.probe_rotation_speed, " (with --frame)");
+  add_term(cmd, "--threads", o.threads, " (default 0: all cores)");
+  add_term(cmd, "--out", o.out, " (default out/reference)");
+  add_term_flag(cmd, "--json", o.json, ": reference.json");
+  add_term_flag(cmd, "--progress", o.progress);
+}
+
+// The ray tracer's settings of the options; UsageError for a bad value.
+Settings reference_settings(const ReferenceOptions& o, const CLI::App& cmd) {
+  Settings settings;
+  const auto effect = msm::reference::parse_effect(o.effect);
+  if (!effect)
+    throw UsageError(
+        fmt::format("--effect {}: expected hard, filtered, soft, translucent, scattering or environment", o.effect));
+  if (o.probe_lights && *effect != msm::reference::Effect::environment)
+    throw UsageError("--extracted-lights applies to --effect environment only");
+  settings.probe_lights = o.probe_lights;
+  settings.effect = *effect;
+  if (cmd.count("--light-shape") > 0) {
+    const auto shape = msm::reference::parse_light_shape(o.light_shape);
+    if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", o.light_shape));
+    settings.light_shape = *shape;
+  }
+  const auto sampler = msm::reference::parse_sampler(o.sampler);
+  if (!sampler) throw UsageError(fmt::format("--sampler {}: expected stratified or independent", o.sampler));
+  settings.sampler = *sampler;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.samples = o.samples;
+  settings.seed = o.seed;
+  settings.shadow_size = o.shadow_size;
+  settings.filter_size = o.filter_size;
+  settings.filter_sigma = o.filter_sigma;
+  settings.light_extent_deg = o.light_extent;
+  settings.light_width_deg = o.light_width;
+  settings.light_height_deg = o.light_height;
+  settings.max_crossings = o.max_crossings;
+  settings.threads = o.threads;
+  if (settings.light_shape == msm::reference::LightShape::disc && (o.light_width || o.light_height))
+    throw UsageError("--light-width-deg / --light-height-deg make a rectangle: they cannot go with --light-shape disc");
+  try {
+    msm::reference::validate(settings);
+  } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
+  return settings;
+}
+
+// The scene as traced: its probe (--probe, turned to --frame), its animated objects at --frame, its
+// probe's light count; UsageError where the effect needs what the scene lacks.
+msm::scene::Scene reference_scene(const ReferenceOptions& o, const CLI::App& cmd, const Settings& settings) {
+  msm::scene::Scene scene = msm::scene::load_scene(o.scene); // SceneError: printed by main
+  if (!o.probe.empty()) try {
+      msm::scene::set_probe(scene, o.probe);
+    } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
+  if (o.probe_rotation_speed != 0.0f) {
+    if (!scene.probe)
+      throw UsageError(
+          fmt::format("--probe-rotation-speed: scene '{}' has no light probe (its \"probe\" key)", scene.name));
+    if (cmd.count("--frame") == 0) throw UsageError("--probe-rotation-speed turns the probe per --frame: give one");
+    // The probe's lights are cut again at the turned probe (below), as msm render's device does.
+    scene.probe->rotation_deg += float(o.frame) * o.probe_rotation_speed;
+  }
+  if (o.frame > 0) {
+    if (!scene.animated() && o.probe_rotation_speed == 0.0f)
+      throw UsageError(fmt::format("--frame {}: scene '{}' is the same at every frame (no object has a "
+                                   "\"motion\", no --probe-rotation-speed)",
+                                   o.frame, scene.name));
+    scene = msm::scene::at_frame(scene, o.frame);
+  }
+  if (o.lights || o.sub_lights || o.probe_rotation_speed != 0.0f) try {
+      msm::scene::set_probe_light_count(scene, o.lights.value_or(scene.probe ? scene.probe->lights : 1), o.sub_lights);
+    } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
+  if (settings.effect == msm::reference::Effect::scattering && !scene.medium)
+    throw UsageError(fmt::format("{}: --effect scattering needs a scene with a \"medium\" (extinction, "
+                                 "scattering_albedo, phase; scenes/README.md)",
+                                 scene.source.string()));
+  if (settings.effect == msm::reference::Effect::environment && !scene.probe)
+    throw UsageError(fmt::format("{}: --effect environment needs a scene with a \"probe\" (file, lights, intensity, "
+                                 "rotation_deg, size; scenes/README.md)",
+                                 scene.source.string()));
+  return scene;
+}
+
+// A progress bar on a terminal (or with --progress), else a line per tenth once the run takes long.
+void report_progress(Settings& settings, bool bar_wanted) {
+  auto bar = [](const msm::reference::Progress& p) {
+    fmt::print(stderr, "\r{}", util::progress_bar("msm reference", p.rows_done, p.rows_total, p.seconds, 40));
+    if (p.rows_done == p.rows_total) fmt::print(stderr, "\n");
+    std::fflush(stderr);
+  };
+  if (bar_wanted || ::isatty(::fileno(stderr))) {
+    settings.progress = bar;
+  } else {
+    // A log (stderr redirected): a line per tenth once the run has taken a few seconds.
+    settings.progress = [lines = std::make_shared<msm::util::ProgressLines>("msm reference: ", " rows")](
+                            const msm::reference::Progress& p) {
+      if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
+    };
+  }
+}
+
+// The images of a result; no stale copy of an earlier run's other effects.
+void add_reference_images(msm::image::FileSet& files, const fs::path& out, const msm::reference::Result& result) {
+  try {
+    files.add_exr(out / "visibility.exr", result.visibility);
+    files.add_exr(out / "radiance.exr", result.radiance);
+    files.add_exr(out / "surface.exr", result.surface);
+    // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
+    // from an earlier run into the same folder for the other effects.
+    if (!result.visibility_rgb.empty())
+      files.add_exr(out / "visibility_rgb.exr", result.visibility_rgb);
+    else
+      files.remove(out / "visibility_rgb.exr");
+    if (!result.scattering.empty())
+      files.add_exr(out / "scattering.exr", result.scattering);
+    else
+      files.remove(out / "scattering.exr");
+    if (!result.irradiance.empty()) {
+      files.add_exr(out / "irradiance.exr", result.irradiance);
+      // environment: the renderer's look (ACES at exposure 1, the probe where no surface is), to
+      // compare with msm render's PNG (msm compare radiance.png TECHNIQUE.png).
+      files.add_png(out / "radiance.png", reference_look(result, 1.0f));
+    } else {
+      files.remove(out / "irradiance.exr");
+      files.remove(out / "radiance.png");
+    }
+  } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
+}
+
+// reference.json but its timings: the settings as traced, the light, the files and their channels.
+nlohmann::ordered_json reference_json(const msm::scene::Scene& scene, const Settings& settings, int frame,
+                                      const std::vector<std::string>& warnings, const msm::reference::Result& result) {
+  nlohmann::ordered_json j;
+  j["scene"] = {{"name", scene.name}, {"source", scene.source.string()}, {"triangles", scene.triangle_count()}};
+  j["effect"] = std::string(msm::reference::to_string(settings.effect));
+  j["frame"] = frame;
+  j["width"] = settings.width;
+  j["height"] = settings.height;
+  j["samples"] = result.samples;
+  j["sampler"] = std::string(msm::reference::to_string(settings.sampler));
+  j["seed"] = settings.seed;
+  // Under the render settings' keys (msm/render/settings_schema.h), as render.json has them.
+  j["shadow_size"] = settings.shadow_size;
+  j["filter_size"] = settings.filter_size;
+  j["filter_sigma"] = settings.filter_sigma;
+  if (!scene.lights.empty()) j["light"] = light_json(scene.light(), settings, result);
+  for (const msm::scene::LightKindInfo& kind : msm::scene::light_kinds())
+    j["light_counts"][std::string(kind.name)] = scene.light_count(kind.kind);
+  j["max_crossings"] = settings.max_crossings;
+  j["warnings"] = warnings;
+  j["threads"] = result.threads;
+  j["rays"] = result.rays;
+  j["background_pixels"] = result.background_pixels;
+  j["mean_visibility"] = result.mean_visibility;
+  j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}, {"surface", "surface.exr"}};
+  j["channels"] = {{"visibility", result.visibility.channel_names()},
+                   {"radiance", result.radiance.channel_names()},
+                   {"surface", result.surface.channel_names()}};
+  if (!result.scattering.empty()) {
+    j["files"]["scattering"] = "scattering.exr";
+    j["channels"]["scattering"] = result.scattering.channel_names();
+    j["medium"] = {{"extinction", scene.medium->extinction},
+                   {"scattering_albedo", scene.medium->scattering_albedo},
+                   {"g", scene.medium->g}};
+  }
+  if (!result.irradiance.empty()) {
+    j["files"]["irradiance"] = "irradiance.exr";
+    j["files"]["radiance_png"] = "radiance.png";
+    j["channels"]["irradiance"] = result.irradiance.channel_names();
+    const msm::scene::ProbeLighting& p = *scene.probe;
+    j["probe"] = {{"file", p.file.string()},
+                  {"lights", p.lights},
+                  {"intensity", p.intensity},
+                  {"rotation_deg", p.rotation_deg},
+                  {"size", p.size},
+                  {"probe_lights", settings.probe_lights},
+                  {"horizon_split", p.horizon_split},
+                  {"sub_lights", p.sub_lights}};
+  }
+  if (!result.visibility_rgb.empty()) {
+    j["files"]["visibility_rgb"] = "visibility_rgb.exr";
+    j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();
+  }
+  return j;
+}
+
 } // namespace
 
 void add_reference(CLI::App& app) {
-  struct Options {
-    std::string scene{msm::scene::default_scene_name()};
-    std::string effect, out = "out/reference", light_shape, sampler = "stratified";
-    int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = MSM_FILTER_DEFAULT_TAPS,
-        max_crossings = 64, threads = 0;
-    std::uint64_t seed = 1;
-    double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
-    std::optional<double> light_extent, light_width, light_height;
-    std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
-    std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
-    std::optional<int> sub_lights; // and their sub-lights
-    int frame = 0;                 // of a dynamic scene (msm render --frames)
-    float probe_rotation_speed = 0.0f;
-    bool json = false, progress = false, probe_lights = false;
-  };
-  auto opt = std::make_shared<Options>();
+  auto opt = std::make_shared<ReferenceOptions>();
   auto* cmd = app.add_subcommand("reference", "Ground-truth shadows of a scene by CPU ray tracing (Embree): "
                                               "visibility.exr, radiance.exr, reference.json");
-  cmd->add_option("--scene", opt->scene, "Built-in scene name or scene file (default fence)");
-  cmd->add_option("--effect", opt->effect, "hard | filtered | soft | translucent | scattering | environment")
-      ->required();
-  cmd->add_option("--width", opt->width, "Image width (default 640)");
-  cmd->add_option("--height", opt->height, "Image height (default 360)");
-  cmd->add_option("--samples", opt->samples, "Samples per pixel of filtered, soft and scattering (default 256)");
-  cmd->add_option("--seed", opt->seed, "Seed of the per-pixel generators (default 1)");
-  cmd->add_option("--sampler", opt->sampler, "stratified (default) | independent");
-  cmd->add_option("--shadow-size", opt->shadow_size, "filtered: shadow map size in texels (default 1024)");
-  cmd->add_option("--filter-size", opt->filter_size, "filtered: Gaussian taps per axis, odd")->capture_default_str();
-  cmd->add_option("--filter-sigma", opt->filter_sigma, "filtered: Gaussian sigma in texels")->capture_default_str();
-  cmd->add_option("--light-extent", opt->light_extent,
-                  "soft: override the light by a disc of this angular diameter in degrees, as msm render "
-                  "--light-extent (default: the scene's light as it declares it)");
-  cmd->add_option("--light-shape", opt->light_shape,
-                  "soft: override the light's shape: disc | rectangle (default: the scene light's own)");
-  cmd->add_option("--light-width", opt->light_width,
-                  "soft: a rectangle of this angular width in degrees (default: the light's extent)");
-  cmd->add_option("--light-height", opt->light_height,
-                  "soft: a rectangle of this angular height in degrees, as msm render --light-height (default: the "
-                  "light's own, else its extent)");
-  cmd->add_option("--max-crossings", opt->max_crossings, "translucent: surfaces counted per light ray (default 64)");
-  cmd->add_option("--probe", opt->probe,
-                  "Image-based lighting: light the scene by this light probe instead of its own lights (an "
-                  "equirectangular EXR, a cube-map cross, six faces named by a path with \"{face}\", or 'sky'; the "
-                  "scene's probe settings are kept, else 32 "
-                  "lights, 128² per face), as msm render --probe");
-  cmd->add_option("--lights", opt->lights,
-                  "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
-                  "the scene's)");
-  cmd->add_option("--sub-lights", opt->sub_lights,
-                  "Image-based lighting: the probe lights' sub-lights, a finer cut into this many regions (0: none; "
-                  "default: the scene's); --probe-lights traces them");
-  cmd->add_flag("--probe-lights", opt->probe_lights,
-                "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
-  cmd->add_option("--frame", opt->frame,
-                  "Trace frame K of a dynamic scene, as msm render --frames draws it: its animated objects moved K "
-                  "times (an object's \"motion\"), its probe turned K times --probe-rotation-speed")
-      ->check(CLI::Range(0, 9999));
-  cmd->add_option("--probe-rotation-speed", opt->probe_rotation_speed,
-                  "Degrees the scene's light probe turns about +Y per frame (with --frame)");
-  cmd->add_option("--threads", opt->threads, "Worker threads (default 0: all cores)");
-  cmd->add_option("-o,--out", opt->out, "Output directory (default out/reference)");
-  cmd->add_flag("--json", opt->json, "Print reference.json to stdout");
-  cmd->add_flag("--progress", opt->progress,
-                "Progress bar on stderr (default: when stderr is a terminal; otherwise a line per tenth of the "
-                "rows once the run has taken 2 s)");
+  add_reference_options(cmd, *opt);
   cmd->callback([opt, cmd] {
     const auto start = std::chrono::steady_clock::now();
-    Settings settings;
-    const auto effect = msm::reference::parse_effect(opt->effect);
-    if (!effect)
-      throw UsageError(fmt::format("--effect {}: expected hard, filtered, soft, translucent, scattering or environment",
-                                   opt->effect));
-    if (opt->probe_lights && *effect != msm::reference::Effect::environment)
-      throw UsageError("--probe-lights applies to --effect environment only");
-    settings.probe_lights = opt->probe_lights;
-    settings.effect = *effect;
-    if (cmd->count("--light-shape") > 0) {
-      const auto shape = msm::reference::parse_light_shape(opt->light_shape);
-      if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", opt->light_shape));
-      settings.light_shape = *shape;
-    }
-    const auto sampler = msm::reference::parse_sampler(opt->sampler);
-    if (!sampler) throw UsageError(fmt::format("--sampler {}: expected stratified or independent", opt->sampler));
-    settings.sampler = *sampler;
-    settings.width = opt->width;
-    settings.height = opt->height;
-    settings.samples = opt->samples;
-    settings.seed = opt->seed;
-    settings.shadow_size = opt->shadow_size;
-    settings.filter_size = opt->filter_size;
-    settings.filter_sigma = opt->filter_sigma;
-    settings.light_extent_deg = opt->light_extent;
-    settings.light_width_deg = opt->light_width;
-    settings.light_height_deg = opt->light_height;
-    settings.max_crossings = opt->max_crossings;
-    settings.threads = opt->threads;
-    if (settings.light_shape == msm::reference::LightShape::disc && (opt->light_width || opt->light_height))
-      throw UsageError("--light-width / --light-height make a rectangle: they cannot go with --light-shape disc");
-    try {
-      msm::reference::validate(settings);
-    } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
-    msm::scene::Scene scene = msm::scene::load_scene(opt->scene); // SceneError: printed by main
-    if (!opt->probe.empty()) try {
-        msm::scene::set_probe(scene, opt->probe);
-      } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
-    if (opt->probe_rotation_speed != 0.0f) {
-      if (!scene.probe)
-        throw UsageError(
-            fmt::format("--probe-rotation-speed: scene '{}' has no light probe (its \"probe\" key)", scene.name));
-      if (cmd->count("--frame") == 0) throw UsageError("--probe-rotation-speed turns the probe per --frame: give one");
-      // The probe's lights are cut again at the turned probe (below), as msm render's device does.
-      scene.probe->rotation_deg += float(opt->frame) * opt->probe_rotation_speed;
-    }
-    if (opt->frame > 0) {
-      if (!scene.animated() && opt->probe_rotation_speed == 0.0f)
-        throw UsageError(fmt::format("--frame {}: scene '{}' is the same at every frame (no object has a "
-                                     "\"motion\", no --probe-rotation-speed)",
-                                     opt->frame, scene.name));
-      scene = msm::scene::at_frame(scene, opt->frame);
-    }
-    if (opt->lights || opt->sub_lights || opt->probe_rotation_speed != 0.0f) try {
-        msm::scene::set_probe_light_count(scene, opt->lights.value_or(scene.probe ? scene.probe->lights : 1),
-                                          opt->sub_lights);
-      } catch (const msm::scene::SceneError& e) { throw UsageError(e.what()); }
-    if (settings.effect == msm::reference::Effect::scattering && !scene.medium)
-      throw UsageError(fmt::format("{}: --effect scattering needs a scene with a \"medium\" (extinction, "
-                                   "scattering_albedo, phase; scenes/README.md)",
-                                   scene.source.string()));
-    if (settings.effect == msm::reference::Effect::environment && !scene.probe)
-      throw UsageError(fmt::format("{}: --effect environment needs a scene with a \"probe\" (file, lights, intensity, "
-                                   "rotation_deg, size; scenes/README.md)",
-                                   scene.source.string()));
+    Settings settings = reference_settings(*opt, *cmd);
+    msm::scene::Scene scene = reference_scene(*opt, *cmd, settings);
     // The filtered effect traces the renderer's shadow map: the warnings of its framing.
     std::vector<std::string> warnings;
     if (settings.effect == msm::reference::Effect::filtered)
@@ -207,20 +322,7 @@ void add_reference(CLI::App& app) {
     const fs::path out = opt->out;
     if (const auto problem = util::prepare_output_dir(out, "msm-reference-probe"))
       throw UsageError(fmt::format("--out {}: {}", out.string(), *problem));
-    auto bar = [](const msm::reference::Progress& p) {
-      fmt::print(stderr, "\r{}", util::progress_bar("msm reference", p.rows_done, p.rows_total, p.seconds, 40));
-      if (p.rows_done == p.rows_total) fmt::print(stderr, "\n");
-      std::fflush(stderr);
-    };
-    if (opt->progress || ::isatty(::fileno(stderr))) {
-      settings.progress = bar;
-    } else {
-      // A log (stderr redirected): a line per tenth once the run has taken a few seconds.
-      settings.progress = [lines = std::make_shared<msm::util::ProgressLines>("msm reference: ", " rows")](
-                              const msm::reference::Progress& p) {
-        if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
-      };
-    }
+    report_progress(settings, opt->progress);
 
     msm::reference::Result result;
     try {
@@ -231,80 +333,8 @@ void add_reference(CLI::App& app) {
     const auto write_start = std::chrono::steady_clock::now();
     // All the files or none (a full disk, a failed rename): temporaries first, renamed together.
     msm::image::FileSet files;
-    try {
-      files.add_exr(out / "visibility.exr", result.visibility);
-      files.add_exr(out / "radiance.exr", result.radiance);
-      files.add_exr(out / "surface.exr", result.surface);
-      // translucent: the transmittance per RGB channel (coloured shadows); no stale copy
-      // from an earlier run into the same folder for the other effects.
-      if (!result.visibility_rgb.empty())
-        files.add_exr(out / "visibility_rgb.exr", result.visibility_rgb);
-      else
-        files.remove(out / "visibility_rgb.exr");
-      if (!result.scattering.empty())
-        files.add_exr(out / "scattering.exr", result.scattering);
-      else
-        files.remove(out / "scattering.exr");
-      if (!result.irradiance.empty()) {
-        files.add_exr(out / "irradiance.exr", result.irradiance);
-        // environment: the renderer's look (ACES at exposure 1, the probe where no surface is), to
-        // compare with msm render's PNG (msm compare radiance.png TECHNIQUE.png).
-        files.add_png(out / "radiance.png", reference_look(result, 1.0f));
-      } else {
-        files.remove(out / "irradiance.exr");
-        files.remove(out / "radiance.png");
-      }
-    } catch (const msm::image::ImageError& e) { throw UsageError(e.what()); }
-
-    nlohmann::ordered_json j;
-    j["scene"] = {{"name", scene.name}, {"source", scene.source.string()}, {"triangles", scene.triangle_count()}};
-    j["effect"] = std::string(msm::reference::to_string(settings.effect));
-    j["frame"] = opt->frame;
-    j["width"] = settings.width;
-    j["height"] = settings.height;
-    j["samples"] = result.samples;
-    j["sampler"] = std::string(msm::reference::to_string(settings.sampler));
-    j["seed"] = settings.seed;
-    j["filter"] = {
-        {"shadow_size", settings.shadow_size}, {"size", settings.filter_size}, {"sigma", settings.filter_sigma}};
-    if (!scene.lights.empty()) j["light"] = light_json(scene.light(), settings, result);
-    for (const msm::scene::LightKindInfo& kind : msm::scene::light_kinds())
-      j["light_counts"][std::string(kind.name)] = scene.light_count(kind.kind);
-    j["max_crossings"] = settings.max_crossings;
-    j["warnings"] = warnings;
-    j["threads"] = result.threads;
-    j["rays"] = result.rays;
-    j["background_pixels"] = result.background_pixels;
-    j["mean_visibility"] = result.mean_visibility;
-    j["files"] = {{"visibility", "visibility.exr"}, {"radiance", "radiance.exr"}, {"surface", "surface.exr"}};
-    j["channels"] = {{"visibility", result.visibility.channel_names()},
-                     {"radiance", result.radiance.channel_names()},
-                     {"surface", result.surface.channel_names()}};
-    if (!result.scattering.empty()) {
-      j["files"]["scattering"] = "scattering.exr";
-      j["channels"]["scattering"] = result.scattering.channel_names();
-      j["medium"] = {{"extinction", scene.medium->extinction},
-                     {"scattering_albedo", scene.medium->scattering_albedo},
-                     {"g", scene.medium->g}};
-    }
-    if (!result.irradiance.empty()) {
-      j["files"]["irradiance"] = "irradiance.exr";
-      j["files"]["radiance_png"] = "radiance.png";
-      j["channels"]["irradiance"] = result.irradiance.channel_names();
-      const msm::scene::ProbeLighting& p = *scene.probe;
-      j["probe"] = {{"file", p.file.string()},
-                    {"lights", p.lights},
-                    {"intensity", p.intensity},
-                    {"rotation_deg", p.rotation_deg},
-                    {"size", p.size},
-                    {"probe_lights", settings.probe_lights},
-                    {"horizon_split", p.horizon_split},
-                    {"sub_lights", p.sub_lights}};
-    }
-    if (!result.visibility_rgb.empty()) {
-      j["files"]["visibility_rgb"] = "visibility_rgb.exr";
-      j["channels"]["visibility_rgb"] = result.visibility_rgb.channel_names();
-    }
+    add_reference_images(files, out, result);
+    nlohmann::ordered_json j = reference_json(scene, settings, opt->frame, warnings, result);
     j["seconds"] = {{"load", load_seconds},
                     {"build", result.build_seconds},
                     {"render", result.render_seconds},

@@ -1,6 +1,7 @@
 // `msm render`: one or more techniques on one scene; `msm scenes`: the built-in scenes.
 #include "frames.h"
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/util/text.h"
 #include "msm/viewer/view_file.h"
@@ -12,27 +13,55 @@
 #include <optional>
 
 namespace msm::tool {
-namespace {} // namespace
+namespace {
+
+// The options of msm render, as given.
+struct RenderOptions {
+  FrameOptions frame;
+  std::string techniques = "msm-hamburger-64";
+  std::string out = "msm-render";
+  std::string view; // a view file (msm view)
+  Frames frames;
+  std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
+  std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
+  std::optional<int> sub_lights; // and their sub-lights
+};
+
+// --view: the view file's scene, camera, animated objects' frame and settings (its technique unless
+// -t is given); only -t, -o and --device go with it (UsageError otherwise).
+struct ViewGiven {
+  std::optional<scene::Camera> camera;
+  int object_frame = 0;
+};
+ViewGiven apply_view(RenderOptions& o, const CLI::App& cmd) {
+  ViewGiven given;
+  for (const CLI::Option* option : cmd.get_options()) {
+    const std::vector<std::string>& long_names = option->get_lnames();
+    std::string name = long_names.empty() ? option->get_name() : long_names.front();
+    if (option->count() > 0 && name != "view" && name != "out" && name != "techniques" && name != "technique" &&
+        name != "device")
+      throw UsageError(fmt::format("--view sets the scene and every setting; --{} cannot go with it", name));
+  }
+  try {
+    viewer::View view = viewer::load_view(o.view);
+    o.frame.settings = view.settings;
+    o.frame.scene = view.scene;
+    given.camera = view.camera;
+    given.object_frame = view.object_frame;
+    if (cmd.count("--techniques") + cmd.count("--technique") == 0) o.techniques = view.settings.technique;
+  } catch (const viewer::ViewError& e) { throw UsageError(e.what()); }
+  return given;
+}
+
+} // namespace
 
 void add_render(CLI::App& app) {
-  struct Options {
-    FrameOptions frame;
-    std::string techniques = "msm-hamburger-64";
-    std::string out = "msm-render";
-    std::string view; // a view file (msm view)
-    Frames frames;
-    std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
-    std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
-    std::optional<int> sub_lights; // and their sub-lights
-  };
-  auto opt = std::make_shared<Options>();
+  auto opt = std::make_shared<RenderOptions>();
   auto* cmd = app.add_subcommand("render", "Render a scene with one or more shadow techniques (PNG, shadow-buffer "
                                            "EXR and JSON per technique)");
   add_deprecated_option(cmd, "--technique", "-t/--techniques", opt->techniques)->delimiter(',');
-  cmd->add_option("-t,--techniques", opt->techniques,
-                  "Technique or alias, comma-separated list, or 'all' (msm techniques lists them)")
-      ->capture_default_str();
-  cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
+  add_term(cmd, "--techniques", opt->techniques, ", or 'all'")->capture_default_str();
+  add_term(cmd, "--out", opt->out)->capture_default_str();
   cmd->add_option("--view", opt->view,
                   "A view file of msm view (scene, camera, lights, every setting), or a render's JSON output: "
                   "renders exactly that view; only -t, -o and --device go with it");
@@ -42,42 +71,20 @@ void add_render(CLI::App& app) {
                   "light probe into its area lights again on the device, and moves its animated objects (an "
                   "object's \"motion\"; frames.h)")
       ->check(CLI::Range(1, 10000));
-  cmd->add_option("--probe-rotation-speed", opt->frames.rotation_speed_deg,
-                  "Degrees the scene's light probe turns about +Y per frame (with --frames)");
-  cmd->add_option("--probe", opt->probe,
-                  "Image-based lighting: light the scene by this light probe instead of its own lights (an "
-                  "equirectangular EXR, a cube-map cross, six faces named by a path with \"{face}\", or 'sky'; the "
-                  "scene's probe settings are kept, else 32 "
-                  "lights, 128² per face)");
-  cmd->add_option("--lights", opt->lights,
-                  "Image-based lighting: the number of area lights the scene's probe is cut into, 1 to 256 (default: "
-                  "the scene's)");
-  cmd->add_option("--sub-lights", opt->sub_lights,
-                  "Image-based lighting: each area light's unshadowed light from the lights of a finer cut into this "
-                  "many regions inside its own (0: none; default: the scene's \"sub_lights\")");
+  add_term(cmd, "--probe-rotation-speed", opt->frames.rotation_speed_deg, " (with --frames)");
+  add_term(cmd, "--probe", opt->probe,
+           ": lights the scene instead of its own lights (image-based lighting; the scene's probe settings are "
+           "kept, else 32 lights, 128² per face)");
+  add_term(cmd, "--lights", opt->lights, " (default: the scene's)");
+  add_term(cmd, "--sub-lights", opt->sub_lights,
+           ", whose unshadowed light each area light sums (default: the scene's \"sub_lights\")");
   cmd->callback([opt, cmd] {
     const bool frames = cmd->count("--frames") > 0 || cmd->count("--probe-rotation-speed") > 0;
-    std::optional<scene::Camera> view_camera;
-    int view_object_frame = 0;
-    if (!opt->view.empty()) {
-      for (const CLI::Option* o : cmd->get_options()) {
-        const std::vector<std::string>& long_names = o->get_lnames();
-        std::string name = long_names.empty() ? o->get_name() : long_names.front();
-        if (o->count() > 0 && name != "view" && name != "out" && name != "techniques" && name != "technique" &&
-            name != "device")
-          throw UsageError(fmt::format("--view sets the scene and every setting; --{} cannot go with it", name));
-      }
-      try {
-        viewer::View view = viewer::load_view(opt->view);
-        opt->frame.settings = view.settings;
-        opt->frame.scene = view.scene;
-        view_camera = view.camera;
-        view_object_frame = view.object_frame;
-        if (cmd->count("--techniques") + cmd->count("--technique") == 0) opt->techniques = view.settings.technique;
-      } catch (const viewer::ViewError& e) { throw UsageError(e.what()); }
-    } else {
+    ViewGiven view;
+    if (!opt->view.empty())
+      view = apply_view(*opt, *cmd);
+    else
       finish_frame_options(opt->frame);
-    }
     std::vector<std::string> names;
     if (opt->techniques == "all")
       for (const Technique* t : render::rendered_techniques()) names.emplace_back(t->name);
@@ -86,14 +93,14 @@ void add_render(CLI::App& app) {
     if (names.empty()) throw UsageError("--techniques: no technique given");
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
-    if (view_camera) scene.camera = *view_camera;
-    if (view_object_frame > 0) scene = scene::at_frame(scene, view_object_frame); // the view's animated objects
+    if (view.camera) scene.camera = *view.camera;
+    if (view.object_frame > 0) scene = scene::at_frame(scene, view.object_frame); // the view's animated objects
     if (frames && opt->frame.animation_frame > 0)
       throw UsageError(fmt::format("--frame {} renders one frame of the scene, --frames a sequence from frame 0: give "
                                    "one of them",
                                    opt->frame.animation_frame));
     scene = scene_at_frame(opt->frame, std::move(scene));
-    const int frame = view_object_frame > 0 ? view_object_frame : opt->frame.animation_frame;
+    const int frame = view.object_frame > 0 ? view.object_frame : opt->frame.animation_frame;
     if (!opt->probe.empty()) try {
         scene::set_probe(scene, opt->probe);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }

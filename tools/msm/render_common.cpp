@@ -1,12 +1,16 @@
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/image/io.h"
+#include "msm/render/settings_schema.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
+#include "msm/util/spelling.h"
 #include "msm/viewer/view_file.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <fstream>
@@ -16,121 +20,113 @@
 
 namespace msm::tool {
 
+namespace {
+
+using render::SettingDeclaration;
+using render::SettingType;
+
+// The help line of a setting's option: its meaning and range.
+std::string setting_help(const SettingDeclaration& setting, bool negated) {
+  if (negated) return fmt::format("Turn off (on by default): {}", setting.help);
+  if (setting.type == SettingType::number || setting.type == SettingType::integer)
+    return fmt::format("{}; in {}", setting.help, render::setting_range_text(setting));
+  return std::string(setting.help);
+}
+
+std::string default_text(const nlohmann::json& value) {
+  if (value.is_null()) return "";
+  if (value.is_string()) return value.get<std::string>();
+  if (value.is_number_float()) return fmt::format("{}", value.get<float>());
+  return value.dump();
+}
+
+// One setting's option: its text is kept in options.given and applied by finish_frame_options;
+// a value that is not of the setting's type is a parse error naming the option.
+void add_setting_option(CLI::App* cmd, FrameOptions& o, const SettingDeclaration& setting) {
+  const std::string name = render::setting_option_name(setting, o.settings);
+  const std::string key(setting.key);
+  std::optional<std::string>& text = o.given[key];
+  if (setting.type == SettingType::flag) {
+    const bool value = !setting.get(o.settings).get<bool>();
+    cmd->add_flag_callback(
+        name, [&text, value] { text = value ? "true" : "false"; }, setting_help(setting, !value));
+    return;
+  }
+  CLI::Option* option = cmd->add_option(name, text, setting_help(setting, false));
+  option->type_name(setting.type == SettingType::number    ? "FLOAT"
+                    : setting.type == SettingType::integer ? "INT"
+                                                           : "TEXT");
+  option->default_str(setting.nullable ? "" : default_text(setting.get(o.settings)));
+  option->check([&setting](const std::string& value) -> std::string {
+    try {
+      render::setting_from_text(setting, value);
+    } catch (const render::SettingError& e) { return e.what(); }
+    return {};
+  });
+}
+
+// Why a setting's value from the command line is refused, in the words the renderer's own checks
+// use ("width = 0 is outside [1, 16384]").
+std::string setting_problem(const SettingDeclaration& setting, const std::string& option, const std::string& text,
+                            const render::SettingError& error) {
+  if (setting.type == SettingType::choice) {
+    const std::vector<std::string> choices(setting.choices.begin(), setting.choices.end());
+    return fmt::format("{} {}: use {}{}", option, text, render::setting_range_text(setting),
+                       util::did_you_mean(text, choices));
+  }
+  if (setting.type == SettingType::number || setting.type == SettingType::integer) {
+    std::string label(setting.key);
+    std::replace(label.begin(), label.end(), '_', ' ');
+    return fmt::format("{} = {} is outside {} ({})", label, text, render::setting_range_text(setting), option);
+  }
+  return fmt::format("{} {}: {}", option, text, error.what());
+}
+
+} // namespace
+
 void add_frame_options(CLI::App* cmd, FrameOptions& o) {
-  render::RenderSettings& s = o.settings;
-  cmd->add_option("--scene", o.scene, "Built-in scene (msm scenes) or scene file")->capture_default_str();
-  cmd->add_option("--width", s.width, "Image width in pixels")->capture_default_str();
-  cmd->add_option("--height", s.height, "Image height in pixels")->capture_default_str();
-  cmd->add_option("--shadow-size", s.shadow_size, "Shadow map texels per side")->capture_default_str();
-  cmd->add_option("--msaa", s.msaa, "Shadow depth samples: 1, 4 or 8")->capture_default_str();
-  cmd->add_option("--filter-size", s.filter_size, "Gaussian taps per axis (odd; 1 = no blur)")->capture_default_str();
-  cmd->add_option("--filter-sigma", s.filter_sigma, "Gaussian standard deviation in texels")->capture_default_str();
-  add_deprecated_option(cmd, "--filter", "--filter-size", s.filter_size);
-  add_deprecated_option(cmd, "--sigma", "--filter-sigma", s.filter_sigma);
-  cmd->add_flag("--no-mipmaps", o.no_mipmaps, "No mip chain for the moment images");
+  add_term(cmd, "--scene", o.scene)->capture_default_str();
+  for (const SettingDeclaration& setting : render::setting_declarations())
+    if (setting.type != SettingType::technique && setting.type != SettingType::parameters)
+      add_setting_option(cmd, o, setting);
+  cmd->get_option("--noise-frame")
+      ->description(fmt::format("{} (default: the --frame)", render::find_setting("noise_frame").help))
+      ->default_str("");
+  // The spellings of older versions.
+  for (const auto& [old_name, key] : {std::pair{"--filter", "filter_size"},
+                                      {"--sigma", "filter_sigma"},
+                                      {"--light-extent", "light_extent_deg"},
+                                      {"--light-height", "light_height_deg"}})
+    add_deprecated_option(cmd, old_name, render::setting_option_name(render::find_setting(key)), o.given[key]);
   cmd->add_option("--set", o.parameters,
                   "A technique parameter NAME=VALUE, repeatable (msm techniques NAME lists them: type, range, "
                   "default, meaning)")
       ->take_all();
   // The positional vector of older versions: still read for one version, with a warning.
   cmd->add_option("--param", o.params, "")->delimiter(',')->group("");
-  cmd->add_option("--overdarken", s.overdarken, "Over-darkening factor in [0.5,1] (1 = off)")->capture_default_str();
-  cmd->add_option("--normal-offset", s.normal_offset, "Normal offset in shadow-map texels")->capture_default_str();
-  cmd->add_option("--depth-bias", s.depth_bias, "Depth bias in [0,1] depth (default per technique)");
-  cmd->add_flag_callback(
-      "--no-translucent-occluders", [&s] { s.translucent_occluders = false; },
-      "Translucent objects cast no shadow (not blended into the moment map)");
-  cmd->add_option("--alpha-threshold", s.translucent_alpha_threshold,
-                  "Translucent fragments below this opacity are not blended (JCGT: 1%)")
-      ->capture_default_str();
-  cmd->add_flag("--coloured-translucency", s.coloured_translucency,
-                "Coloured translucent shadows: one moment map per colour channel (materials' transmission_color)");
-  cmd->add_option("--receiver-plane-bias", s.receiver_plane_bias,
-                  "Receiver-plane (slope-scaled) bias of the filtered techniques, as a fraction of what "
-                  "their bound needs on a plane (0 = off)")
-      ->check(CLI::Range(0.0f, 4.0f))
-      ->capture_default_str();
-  cmd->add_option("--exposure", s.exposure, "Exposure before tone mapping")->capture_default_str();
-  cmd->add_option("--lookup", o.lookup,
-                  "Shadow-map lookup: auto (dither for msm-nl*, else bilinear), bilinear, "
-                  "nearest, dither")
-      ->capture_default_str();
-  cmd->add_option("--filter-mode", o.filter_mode,
-                  "auto (one-pass for msm-nl*), one-pass (resolve + blur in shared "
-                  "memory), three-pass (resolve, blur H, blur V)")
-      ->capture_default_str();
-  cmd->add_option(
-         "--shading", o.shading,
-         "auto (deferred for pcf, pcss and the soft techniques), forward (shadows per shaded fragment), "
-         "deferred (a surfaces pass, then shadows once per visible pixel; depth-based and soft techniques only)")
-      ->capture_default_str();
-  cmd->add_option("--prefix-sums", o.prefix_sums,
-                  "prefiltered scattering's prefix sums: rows (a thread per row, each texel once) or appendix-c "
-                  "(JCGT's 8 x 8 scheme; the same sums)")
-      ->capture_default_str();
-  cmd->add_flag("--prefix-sum-mips", s.prefix_sum_mips,
-                "prefiltered scattering: a mip chain of the prefix sums, read at the pixel's footprint across the rows "
-                "(JCGT App. D.5)");
-  cmd->add_option("--light-extent", s.light_extent_deg,
-                  "Angular diameter of the light in degrees, for soft "
-                  "shadows (default: the scene's)");
-  cmd->add_option("--light-height", s.light_height_deg,
-                  "Angular height in degrees of a rectangular light, for soft shadows: every light becomes a "
-                  "rectangle of this height and --light-extent's width (default: each light's own)");
-  cmd->add_flag("--front-back-depth", s.front_back_depth,
-                "Moment soft shadows: the map stores the mean of the nearest front- and back-face depth "
-                "(Kneiphof §4.2.3; for closed occluders)");
-  cmd->add_option("--soft-kernel", s.soft_kernel,
-                  "Largest soft-shadow kernel width W in texels (tables: n_t = W²); default 27, pcss 15; at most "
-                  "127 for mssm4 and 111 for mssm6 (the tables' precision), 63 for pcss, 255 otherwise");
-  cmd->add_option("--frame", o.animation_frame,
-                  "Frame K of a dynamic scene: its animated objects moved K times (an object's \"motion\"), as msm "
-                  "reference --frame K traces it (default 0)")
+  add_term(cmd, "--frame", o.animation_frame, ", as msm reference --frame K traces it (default 0)")
       ->check(CLI::Range(0, 9999));
-  cmd->add_option("--noise-frame", o.noise_frame,
-                  "Blue-noise layer and offset of the dithered lookups (default: the --frame)")
-      ->check(CLI::Range(0, 1 << 30));
-  cmd->add_option("--device", o.device,
-                  "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
+  add_term(cmd, "--device", o.device);
 }
 
 void finish_frame_options(FrameOptions& o) {
-  o.settings.frame = o.noise_frame.value_or(o.animation_frame);
   if (!o.params.empty()) {
     if (o.params.size() != 4) throw UsageError("--param takes four comma-separated values");
     fmt::print(stderr, "msm: warning: --param is deprecated and goes in the next version: set each parameter by "
                        "name with --set NAME=VALUE (msm techniques NAME lists them)\n");
   }
-  o.settings.mipmaps = !o.no_mipmaps;
-  using Lookup = render::RenderSettings::Lookup;
-  if (o.lookup == "auto")
-    o.settings.lookup = Lookup::automatic;
-  else if (o.lookup == "bilinear")
-    o.settings.lookup = Lookup::bilinear;
-  else if (o.lookup == "nearest")
-    o.settings.lookup = Lookup::nearest;
-  else if (o.lookup == "dither")
-    o.settings.lookup = Lookup::dither;
+  for (const auto& [key, text] : o.given) {
+    if (!text) continue;
+    const SettingDeclaration& setting = render::find_setting(key);
+    const std::string option = render::setting_option_name(setting, render::RenderSettings{});
+    try {
+      render::apply_setting(o.settings, setting, render::setting_from_text(setting, *text));
+    } catch (const render::SettingError& e) { throw UsageError(setting_problem(setting, option, *text, e)); }
+  }
+  if (o.given["noise_frame"])
+    o.noise_frame = o.settings.frame;
   else
-    throw UsageError(fmt::format("--lookup {}: use auto, bilinear, nearest or dither", o.lookup));
-  if (o.filter_mode == "one-pass")
-    o.settings.one_pass = true;
-  else if (o.filter_mode == "three-pass")
-    o.settings.one_pass = false;
-  else if (o.filter_mode != "auto")
-    throw UsageError(fmt::format("--filter-mode {}: use auto, one-pass or three-pass", o.filter_mode));
-  if (o.shading == "forward")
-    o.settings.deferred_shading = false;
-  else if (o.shading == "deferred")
-    o.settings.deferred_shading = true;
-  else if (o.shading != "auto")
-    throw UsageError(fmt::format("--shading {}: use auto, forward or deferred", o.shading));
-  if (o.prefix_sums == "rows")
-    o.settings.prefix_sums = render::RenderSettings::PrefixSums::rows;
-  else if (o.prefix_sums == "appendix-c")
-    o.settings.prefix_sums = render::RenderSettings::PrefixSums::appendix_c;
-  else
-    throw UsageError(fmt::format("--prefix-sums {}: use rows or appendix-c", o.prefix_sums));
+    o.settings.frame = o.animation_frame;
 }
 
 scene::Scene scene_at_frame(const FrameOptions& o, scene::Scene scene) {
@@ -246,9 +242,9 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                         {"scene_source", scene.source.string()},
                         {"description", t.description},
                         {"bits_per_texel", t.bits_per_texel}};
-  // Every setting under its view-file key (msm/viewer/view_file.h: the one schema of the settings),
-  // then what the technique's defaults resolved to.
-  for (const std::string& key : viewer::setting_keys()) out[key] = viewer::setting_json(s, key);
+  // Every setting under its key (msm/render/settings_schema.h), then what the technique's
+  // defaults resolved to.
+  out.update(render::settings_json(s));
   const bool one_pass = s.one_pass.value_or(t.one_pass_default());
   out["resolved"] = {{"depth_bias", s.resolved_depth_bias()},
                      {"soft_kernel", s.resolved_soft_kernel()},

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,20 +25,19 @@ struct FrameOptions {
   std::string device;                  // see ContextOptions::device; empty: MSM_DEVICE or the first GPU
   std::vector<std::string> parameters; // --set NAME=VALUE, for each technique
   std::vector<float> params;           // the deprecated --param x,y,z,w
-  bool no_mipmaps = false;
-  std::string lookup = "auto";      // auto, bilinear, nearest, dither
-  std::string filter_mode = "auto"; // auto, one-pass, three-pass
-  std::string shading = "auto";     // auto, forward, deferred
-  std::string prefix_sums = "rows"; // rows, appendix-c
   // --frame: the frame of a dynamic scene (scene::at_frame: its animated objects moved), as msm
   // reference --frame traces it. --noise-frame: the blue-noise layer and offset
   // (RenderSettings::frame); unset, the animation frame's, so that a sequence varies.
   int animation_frame = 0;
   std::optional<int> noise_frame;
+  // The text of each declared setting given on the command line (msm/render/settings_schema.h), by
+  // key; finish_frame_options applies them to `settings`.
+  std::map<std::string, std::optional<std::string>, std::less<>> given;
 };
 
-// --scene, --width, --height, --shadow-size, --msaa, --filter, --sigma, --no-mipmaps, --set,
-// --overdarken, --normal-offset, --depth-bias, --exposure, --device.
+// --scene, an option for each declared setting of msm/render/settings_schema.h (--width, --msaa,
+// --filter-size, --no-mipmaps, --lookup, ...: --KEY-WITH-DASHES, a flag that is on by default as
+// --no-KEY), --set, --frame, --device; the help shows each one's default from options.settings.
 void add_frame_options(CLI::App* cmd, FrameOptions& options);
 // Applies the parsed options to options.settings; UsageError for bad values.
 void finish_frame_options(FrameOptions& options);

@@ -5,6 +5,7 @@
 #include "reference_look.h"
 #include "render_common.h"
 #include "report_suite.h"
+#include "vocabulary.h"
 
 #include "msm/image/compose.h"
 #include "msm/image/metrics.h"
@@ -408,8 +409,8 @@ void add_report(CLI::App& app) {
                                            "DIR/index.html (images, error maps, insets, sortable tables, charts)");
   cmd->add_option("--suite", opt->suite, fmt::format("The suite: {}", fmt::join(suite_names(), ", ")))
       ->capture_default_str();
-  cmd->add_option("--out,-o", opt->out, "Output directory")->capture_default_str();
-  cmd->add_option("--device", opt->device, "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE)");
+  add_term(cmd, "--out", opt->out)->capture_default_str();
+  add_term(cmd, "--device", opt->device);
   cmd->add_option("--set", opt->overrides,
                   "A technique's parameter for every row that measures it, TECHNIQUE:NAME=VALUE (repeatable)")
       ->take_all();

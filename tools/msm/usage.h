@@ -36,4 +36,13 @@ CLI::Option* add_deprecated_option(CLI::App* cmd, const std::string& old_name, c
   });
 }
 
+// The same for a flag.
+inline CLI::Option* add_deprecated_flag(CLI::App* cmd, const std::string& old_name, const std::string& current,
+                                        bool& target) {
+  return cmd->add_flag(old_name, target, "")->group("")->each([old_name, current](const std::string&) {
+    std::fprintf(stderr, "msm: warning: %s is deprecated and goes in the next version: use %s\n", old_name.c_str(),
+                 current.c_str());
+  });
+}
+
 } // namespace msm::tool

@@ -1,5 +1,6 @@
 // `msm view`: the interactive viewer (src/viewer), where the build has it (MSM_BUILD_VIEWER).
 #include "render_common.h"
+#include "vocabulary.h"
 
 #include "msm/viewer/script.h"
 #include "msm/viewer/view_file.h"
@@ -19,20 +20,16 @@ void add_view(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   auto* cmd = app.add_subcommand("view", "Interactive viewer: every technique live, split screen, GPU time per pass "
                                          "(a window; on a headless machine use xvfb-run)");
-  auto* scene =
-      cmd->add_option("--scene", opt->scene, "Built-in scene (msm scenes) or scene file")->capture_default_str();
-  cmd->add_option("--technique,-t", opt->technique, "Technique or alias to start with (msm techniques)");
+  auto* scene = add_term(cmd, "--scene", opt->scene)->capture_default_str();
+  add_term(cmd, "--technique", opt->technique, ": the one to start with");
   cmd->add_option("--view", opt->view_file, "Start from this view file (scene, camera, lights, settings)")
       ->excludes(scene);
   cmd->add_option("--script", opt->script_file,
                   "Run these actions, one per frame (technique, set, camera, light, split, screenshot, resize, "
                   "quit, ...: docs/viewer.md)");
-  cmd->add_option("--width", opt->width, "Window width in pixels")->capture_default_str()->check(CLI::Range(64, 8192));
-  cmd->add_option("--height", opt->height, "Window height in pixels")
-      ->capture_default_str()
-      ->check(CLI::Range(64, 8192));
-  cmd->add_option("--device", opt->device,
-                  "Vulkan device: cpu, gpu, an index or a name (default: MSM_DEVICE, else a GPU)");
+  add_term(cmd, "--width", opt->width, ": the window's")->capture_default_str()->check(CLI::Range(64, 8192));
+  add_term(cmd, "--height", opt->height, ": the window's")->capture_default_str()->check(CLI::Range(64, 8192));
+  add_term(cmd, "--device", opt->device);
   cmd->callback([opt, cmd] {
 #if !MSM_TOOL_VIEWER
     (void)opt;

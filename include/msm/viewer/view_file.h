@@ -42,10 +42,11 @@ struct View {
 };
 inline constexpr int kMaxObjectFrame = 100000;
 
-// The keys of "settings", in the order view_json writes them.
+// The keys of "settings": the declared settings (msm/render/settings_schema.h).
 std::vector<std::string> setting_keys();
 // Sets one setting from JSON (a bare word where a string is expected also comes as a string).
-// ViewError "KEY: expected ..." for an unknown key or a value of the wrong type or range.
+// ViewError "KEY: expected ..." for a value of the wrong type or range, "KEY: unknown setting (did
+// you mean ...?)" for an unknown key.
 void apply_setting(render::RenderSettings& settings, std::string_view key, const nlohmann::json& value);
 nlohmann::json setting_json(const render::RenderSettings& settings, std::string_view key);
 
