@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Facts about the tree that a grep can check: a README a newcomer reads in two minutes, and code and
 # docs that speak of what is rather than of how it came to be (no issue numbers, sessions or branch
-# names; "branch" as a conditional in code or a tree's branch is fine). Exit 1 naming each breach.
+# names; "branch" as a conditional in code or a tree's branch is fine), and functions short enough to
+# read whole or saying why not. Exit 1 naming each breach.
 set -uo pipefail
 root=${1:-$(dirname "$0")/..}
 cd "$root" || exit 2
@@ -46,6 +47,15 @@ for top in ["src", "include", "tools", "scripts", "tests", "bench", "docs", "REA
 EOF
 ) || [[ -n $hits ]]; then
   fail "citations of docs/results.md whose title is none of its headings:"
+  echo "$hits" >&2
+fi
+# Functions over 120 lines say why above them ("// long: ..."); tests/long_functions.py says how it
+# finds a function and what it misses.
+if ! python3 tests/long_functions.py --self-test >&2; then
+  fail "tests/long_functions.py does not find the functions of its own example"
+fi
+if ! hits=$(python3 tests/long_functions.py src tools include); then
+  fail "functions over 120 lines without a \"long:\" comment above them that says why:"
   echo "$hits" >&2
 fi
 exit $failed

@@ -283,6 +283,8 @@ std::vector<double> merge_grids(std::span<const double> a, std::span<const doubl
   return grid;
 }
 
+// long: one GLPK problem from its columns to its checked minimum and maximum; the parts share the
+// problem, its scaling and the state of the solver attempts.
 LpBounds lp_bounds(std::span<const double> grid_in, const Basis& basis, std::span<const double> b, double zf,
                    const LpOptions& options) {
   require(!grid_in.empty() && basis.size >= 1 && bool(basis.eval) && b.size() == basis.size,

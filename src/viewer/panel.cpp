@@ -244,6 +244,185 @@ void Viewer::fly(float dt) {
   }
 }
 
+// The scene, the technique and the split screen's second technique.
+void Viewer::choices_section() {
+  std::string scene_name = view.scene;
+  std::vector<std::string> scenes = scene::builtin_scene_names();
+  if (std::find(scenes.begin(), scenes.end(), scene_name) == scenes.end()) scenes.push_back(scene_name);
+  if (choose("scene", scene_name, scenes)) try {
+      set_scene(scene_name, false);
+    } catch (const scene::SceneError& e) { error = e.what(); }
+  ImGui::SameLine();
+  if (ImGui::Button("reload")) try {
+      set_scene(view.scene, true);
+    } catch (const scene::SceneError& e) { error = e.what(); }
+  std::string technique = view.settings.technique;
+  if (choose("technique", technique, technique_names())) {
+    set_technique(technique);
+    error.clear();
+  }
+  bool split = !split_technique.empty();
+  if (ImGui::Checkbox("split screen", &split)) set_split(split ? "pcf" : "");
+  if (split) {
+    std::string other = split_technique;
+    if (choose("right side", other, technique_names())) set_split(other);
+    ImGui::SliderFloat("divider", &divider, 0.02f, 0.98f);
+  }
+}
+
+// The technique's parameters, its shadow map, filter and bias, its light and the shading's settings.
+void Viewer::technique_settings_section() {
+  render::RenderSettings& s = view.settings;
+  const Technique& t = render::find_rendered_technique(s.technique);
+  technique_parameters(s, t);
+  bool own_bias = s.depth_bias.has_value();
+  if (ImGui::Checkbox("depth bias", &own_bias)) {
+    if (own_bias)
+      s.depth_bias = s.resolved_depth_bias();
+    else
+      s.depth_bias.reset();
+  }
+  if (s.depth_bias) {
+    ImGui::SameLine();
+    ImGui::DragFloat("##depth_bias", &*s.depth_bias, 1e-6f, 0.0f, 0.05f, "%.2e");
+  }
+  int taps = s.filter_size;
+  if (ImGui::SliderInt("kernel taps", &taps, 1, 63)) s.filter_size = taps | 1;
+  ImGui::SliderFloat("sigma", &s.filter_sigma, 0.1f, 16.0f);
+  std::string size = std::to_string(s.shadow_size);
+  if (choose("shadow map", size, {"256", "512", "1024", "2048", "4096"})) s.shadow_size = std::stoi(size);
+  std::string msaa = std::to_string(s.msaa);
+  if (choose("MSAA", msaa, {"1", "4", "8"})) s.msaa = std::stoi(msaa);
+  ImGui::Checkbox("mipmaps", &s.mipmaps);
+  choose_setting(s, "filter", "filter_mode");
+  choose_setting(s, "lookup", "lookup");
+  if (t.area_light) {
+    ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.max_soft_kernel);
+    // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
+    // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
+    const scene::DirectionalLight drawn =
+        scene::overridden_light(scene.light(), s.light_extent_deg, s.light_height_deg);
+    float extent = drawn.angular_extent_deg;
+    bool rectangle = drawn.rectangular();
+    float height = drawn.angular_height_deg.value_or(extent);
+    if (ImGui::Checkbox("rectangular light", &rectangle)) {
+      s.light_extent_deg = extent;
+      if (rectangle)
+        s.light_height_deg = height;
+      else
+        s.light_height_deg.reset();
+    }
+    if (ImGui::SliderFloat(rectangle ? "light width (deg)" : "light extent (deg)", &extent, 0.0f, 20.0f)) {
+      s.light_extent_deg = extent;
+      if (rectangle) s.light_height_deg = height;
+    }
+    if (rectangle && ImGui::SliderFloat("light height (deg)", &height, 0.0f, 20.0f)) {
+      s.light_extent_deg = extent;
+      s.light_height_deg = height;
+    }
+  }
+  // Kneiphof §4.2.3: the moments of the mean of the nearest front- and back-face depth (a second
+  // depth pass); the soft techniques only, greyed out for the others.
+  ImGui::BeginDisabled(!t.soft());
+  ImGui::Checkbox("front+back face depth", &s.front_back_depth);
+  ImGui::EndDisabled();
+  ImGui::Checkbox("translucent occluders", &s.translucent_occluders);
+  ImGui::Checkbox("coloured translucency", &s.coloured_translucency);
+  ImGui::SliderFloat("alpha threshold", &s.translucent_alpha_threshold, 0.0f, 0.5f);
+  ImGui::SliderFloat("over-darkening", &s.overdarken, 0.5f, 1.0f);
+  ImGui::SliderFloat("normal offset", &s.normal_offset, 0.0f, 4.0f);
+  ImGui::SliderFloat("receiver-plane bias", &s.receiver_plane_bias, 0.0f, 4.0f);
+  ImGui::SliderFloat("exposure", &s.exposure, 0.1f, 4.0f);
+}
+
+// The light's direction and animation, the objects' animation and the camera's fly speed.
+void Viewer::light_and_camera_section() {
+  glm::vec3 t = light_direction();
+  float azimuth = glm::degrees(std::atan2(t.z, t.x)), elevation = glm::degrees(std::asin(std::clamp(t.y, -1.f, 1.f)));
+  bool a = ImGui::SliderFloat("light azimuth", &azimuth, -180.0f, 180.0f);
+  bool e = ImGui::SliderFloat("light elevation", &elevation, 1.0f, 90.0f);
+  if (a || e) {
+    float az = glm::radians(azimuth), el = glm::radians(elevation);
+    set_light_direction({std::cos(el) * std::cos(az), std::sin(el), std::cos(el) * std::sin(az)});
+  }
+  ImGui::Checkbox("animate light", &animate_light);
+  ImGui::SameLine();
+  ImGui::SliderFloat("deg/s", &light_speed_deg, -90.0f, 90.0f);
+  if (scene.animated()) { // the scene's objects with a "motion"
+    if (ImGui::Checkbox("animate objects", &animate_objects)) object_clock = view.object_frame;
+    ImGui::SameLine();
+    ImGui::SliderFloat("frames/s", &object_rate, 1.0f, 60.0f);
+    int frame = view.object_frame;
+    if (ImGui::InputInt("object frame", &frame)) {
+      show_object_frame(frame);
+      object_clock = view.object_frame;
+    }
+  }
+  ImGui::SliderFloat("fly speed", &fly_speed, 0.05f, 50.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
+  ImGui::TextDisabled("WASD/QE move, right drag looks, wheel: speed;");
+  ImGui::TextDisabled("middle drag turns the light");
+  if (ImGui::Button("reset camera and light")) {
+    view.camera = scene.camera;
+    view.settings.lights.clear();
+  }
+}
+
+// The time of each pass of the last frame and the history of the total.
+void Viewer::gpu_time_section() {
+  double total = 0;
+  for (const render::PassTime& p : passes) {
+    ImGui::Text("%-16s %8.3f ms", p.name.c_str(), p.ms);
+    total += p.ms;
+  }
+  ImGui::Text("%-16s %8.3f ms", "total", total);
+  float top = *std::max_element(gpu_history.begin(), gpu_history.end());
+  ImGui::PlotLines("##history", gpu_history.data(), int(gpu_history.size()), int(history_next), nullptr, 0.0f,
+                   top * 1.1f + 1e-3f, ImVec2(0, 50));
+  if (!frame_ms.empty()) ImGui::Text("frame %.1f ms (wall)", frame_ms.back());
+}
+
+// The ray-traced view and the errors of the technique against it.
+void Viewer::ground_truth_section() {
+  ImGui::SliderInt("samples", &truth_samples, 1, 256, "%d", ImGuiSliderFlags_Logarithmic);
+  if (truth.running()) {
+    ImGui::ProgressBar(truth.progress(), ImVec2(-1, 0));
+  } else if (ImGui::Button("ray trace this view")) {
+    start_truth(truth_samples);
+  }
+  if (!truth.error().empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", truth.error().c_str());
+  if (truth_metrics) {
+    const scene::Camera& c = *view.camera;
+    if (c.position != truth_camera.position || c.target != truth_camera.target)
+      ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "of an earlier view (the camera moved)");
+    ImGui::Text("%s: MAE %.4f", truth_technique.c_str(), truth_metrics->mae);
+    ImGui::Text("leaking %.4f, over-darkening %.4f", truth_metrics->light_leaking, truth_metrics->over_darkening);
+    ImGui::Checkbox("error image right of the divider", &show_truth);
+    if (show_truth) ImGui::TextDisabled("red: too bright (leaking), blue: too dark");
+  }
+}
+
+// Screenshots, view files and the command that renders the view.
+void Viewer::files_section() {
+  if (ImGui::Button("screenshot")) screenshot_path = fmt::format("msm-view-{}.png", ++screenshot_count);
+  char path[512];
+  std::snprintf(path, sizeof path, "%s", view_path.c_str());
+  if (ImGui::InputText("view file", path, sizeof path)) view_path = path;
+  if (ImGui::Button("save view")) try {
+      save_view_file(view_path);
+    } catch (const ViewError& e) { error = e.what(); }
+  ImGui::SameLine();
+  if (ImGui::Button("load view")) try {
+      View loaded = load_view(view_path);
+      if (loaded.camera) view.camera = loaded.camera;
+      view.settings = loaded.settings;
+      show_object_frame(loaded.object_frame);
+    } catch (const ViewError& e) { error = e.what(); }
+  ImGui::SameLine();
+  if (ImGui::Button("copy the command")) try {
+      copy_command();
+    } catch (const ViewError& e) { error = e.what(); }
+}
+
 void Viewer::panel() {
   ImGuiIO& io = ImGui::GetIO();
   PanelLayout layout = panel_layout(io.DisplaySize.x, io.DisplaySize.y);
@@ -271,177 +450,13 @@ void Viewer::panel() {
   ImGui::Text("%s, %d triangles, %dx%d", scene.name.c_str(), int(scene.triangle_count()), s.width, s.height);
   if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", error.c_str());
 
-  std::string scene_name = view.scene;
-  std::vector<std::string> scenes = scene::builtin_scene_names();
-  if (std::find(scenes.begin(), scenes.end(), scene_name) == scenes.end()) scenes.push_back(scene_name);
-  if (choose("scene", scene_name, scenes)) try {
-      set_scene(scene_name, false);
-    } catch (const scene::SceneError& e) { error = e.what(); }
-  ImGui::SameLine();
-  if (ImGui::Button("reload")) try {
-      set_scene(view.scene, true);
-    } catch (const scene::SceneError& e) { error = e.what(); }
-  std::string technique = s.technique;
-  if (choose("technique", technique, technique_names())) {
-    set_technique(technique);
-    error.clear();
-  }
-  bool split = !split_technique.empty();
-  if (ImGui::Checkbox("split screen", &split)) set_split(split ? "pcf" : "");
-  if (split) {
-    std::string other = split_technique;
-    if (choose("right side", other, technique_names())) set_split(other);
-    ImGui::SliderFloat("divider", &divider, 0.02f, 0.98f);
-  }
-
-  if (ImGui::CollapsingHeader("Technique settings", ImGuiTreeNodeFlags_DefaultOpen)) {
-    const Technique& t = render::find_rendered_technique(s.technique);
-    technique_parameters(s, t);
-    bool own_bias = s.depth_bias.has_value();
-    if (ImGui::Checkbox("depth bias", &own_bias)) {
-      if (own_bias)
-        s.depth_bias = s.resolved_depth_bias();
-      else
-        s.depth_bias.reset();
-    }
-    if (s.depth_bias) {
-      ImGui::SameLine();
-      ImGui::DragFloat("##depth_bias", &*s.depth_bias, 1e-6f, 0.0f, 0.05f, "%.2e");
-    }
-    int taps = s.filter_size;
-    if (ImGui::SliderInt("kernel taps", &taps, 1, 63)) s.filter_size = taps | 1;
-    ImGui::SliderFloat("sigma", &s.filter_sigma, 0.1f, 16.0f);
-    std::string size = std::to_string(s.shadow_size);
-    if (choose("shadow map", size, {"256", "512", "1024", "2048", "4096"})) s.shadow_size = std::stoi(size);
-    std::string msaa = std::to_string(s.msaa);
-    if (choose("MSAA", msaa, {"1", "4", "8"})) s.msaa = std::stoi(msaa);
-    ImGui::Checkbox("mipmaps", &s.mipmaps);
-    choose_setting(s, "filter", "filter_mode");
-    choose_setting(s, "lookup", "lookup");
-    if (t.area_light) {
-      ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.max_soft_kernel);
-      // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
-      // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
-      const scene::DirectionalLight drawn =
-          scene::overridden_light(scene.light(), s.light_extent_deg, s.light_height_deg);
-      float extent = drawn.angular_extent_deg;
-      bool rectangle = drawn.rectangular();
-      float height = drawn.angular_height_deg.value_or(extent);
-      if (ImGui::Checkbox("rectangular light", &rectangle)) {
-        s.light_extent_deg = extent;
-        if (rectangle)
-          s.light_height_deg = height;
-        else
-          s.light_height_deg.reset();
-      }
-      if (ImGui::SliderFloat(rectangle ? "light width (deg)" : "light extent (deg)", &extent, 0.0f, 20.0f)) {
-        s.light_extent_deg = extent;
-        if (rectangle) s.light_height_deg = height;
-      }
-      if (rectangle && ImGui::SliderFloat("light height (deg)", &height, 0.0f, 20.0f)) {
-        s.light_extent_deg = extent;
-        s.light_height_deg = height;
-      }
-    }
-    // Kneiphof §4.2.3: the moments of the mean of the nearest front- and back-face depth (a second
-    // depth pass); the soft techniques only, greyed out for the others.
-    ImGui::BeginDisabled(!t.soft());
-    ImGui::Checkbox("front+back face depth", &s.front_back_depth);
-    ImGui::EndDisabled();
-    ImGui::Checkbox("translucent occluders", &s.translucent_occluders);
-    ImGui::Checkbox("coloured translucency", &s.coloured_translucency);
-    ImGui::SliderFloat("alpha threshold", &s.translucent_alpha_threshold, 0.0f, 0.5f);
-    ImGui::SliderFloat("over-darkening", &s.overdarken, 0.5f, 1.0f);
-    ImGui::SliderFloat("normal offset", &s.normal_offset, 0.0f, 4.0f);
-    ImGui::SliderFloat("receiver-plane bias", &s.receiver_plane_bias, 0.0f, 4.0f);
-    ImGui::SliderFloat("exposure", &s.exposure, 0.1f, 4.0f);
-  }
-
-  if (ImGui::CollapsingHeader("Light and camera")) {
-    glm::vec3 t = light_direction();
-    float azimuth = glm::degrees(std::atan2(t.z, t.x)), elevation = glm::degrees(std::asin(std::clamp(t.y, -1.f, 1.f)));
-    bool a = ImGui::SliderFloat("light azimuth", &azimuth, -180.0f, 180.0f);
-    bool e = ImGui::SliderFloat("light elevation", &elevation, 1.0f, 90.0f);
-    if (a || e) {
-      float az = glm::radians(azimuth), el = glm::radians(elevation);
-      set_light_direction({std::cos(el) * std::cos(az), std::sin(el), std::cos(el) * std::sin(az)});
-    }
-    ImGui::Checkbox("animate light", &animate_light);
-    ImGui::SameLine();
-    ImGui::SliderFloat("deg/s", &light_speed_deg, -90.0f, 90.0f);
-    if (scene.animated()) { // the scene's objects with a "motion"
-      if (ImGui::Checkbox("animate objects", &animate_objects)) object_clock = view.object_frame;
-      ImGui::SameLine();
-      ImGui::SliderFloat("frames/s", &object_rate, 1.0f, 60.0f);
-      int frame = view.object_frame;
-      if (ImGui::InputInt("object frame", &frame)) {
-        show_object_frame(frame);
-        object_clock = view.object_frame;
-      }
-    }
-    ImGui::SliderFloat("fly speed", &fly_speed, 0.05f, 50.0f, "%.2f", ImGuiSliderFlags_Logarithmic);
-    ImGui::TextDisabled("WASD/QE move, right drag looks, wheel: speed;");
-    ImGui::TextDisabled("middle drag turns the light");
-    if (ImGui::Button("reset camera and light")) {
-      view.camera = scene.camera;
-      view.settings.lights.clear();
-    }
-  }
-
+  choices_section();
+  if (ImGui::CollapsingHeader("Technique settings", ImGuiTreeNodeFlags_DefaultOpen)) technique_settings_section();
+  if (ImGui::CollapsingHeader("Light and camera")) light_and_camera_section();
   ImGui::Checkbox("moment map in the corner", &show_map);
-
-  if (ImGui::CollapsingHeader("GPU time", ImGuiTreeNodeFlags_DefaultOpen)) {
-    double total = 0;
-    for (const render::PassTime& p : passes) {
-      ImGui::Text("%-16s %8.3f ms", p.name.c_str(), p.ms);
-      total += p.ms;
-    }
-    ImGui::Text("%-16s %8.3f ms", "total", total);
-    float top = *std::max_element(gpu_history.begin(), gpu_history.end());
-    ImGui::PlotLines("##history", gpu_history.data(), int(gpu_history.size()), int(history_next), nullptr, 0.0f,
-                     top * 1.1f + 1e-3f, ImVec2(0, 50));
-    if (!frame_ms.empty()) ImGui::Text("frame %.1f ms (wall)", frame_ms.back());
-  }
-
-  if (ImGui::CollapsingHeader("Ground truth", ImGuiTreeNodeFlags_DefaultOpen)) {
-    ImGui::SliderInt("samples", &truth_samples, 1, 256, "%d", ImGuiSliderFlags_Logarithmic);
-    if (truth.running()) {
-      ImGui::ProgressBar(truth.progress(), ImVec2(-1, 0));
-    } else if (ImGui::Button("ray trace this view")) {
-      start_truth(truth_samples);
-    }
-    if (!truth.error().empty()) ImGui::TextColored(ImVec4(1, 0.3f, 0.3f, 1), "%s", truth.error().c_str());
-    if (truth_metrics) {
-      const scene::Camera& c = *view.camera;
-      if (c.position != truth_camera.position || c.target != truth_camera.target)
-        ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "of an earlier view (the camera moved)");
-      ImGui::Text("%s: MAE %.4f", truth_technique.c_str(), truth_metrics->mae);
-      ImGui::Text("leaking %.4f, over-darkening %.4f", truth_metrics->light_leaking, truth_metrics->over_darkening);
-      ImGui::Checkbox("error image right of the divider", &show_truth);
-      if (show_truth) ImGui::TextDisabled("red: too bright (leaking), blue: too dark");
-    }
-  }
-
-  if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) {
-    if (ImGui::Button("screenshot")) screenshot_path = fmt::format("msm-view-{}.png", ++screenshot_count);
-    char path[512];
-    std::snprintf(path, sizeof path, "%s", view_path.c_str());
-    if (ImGui::InputText("view file", path, sizeof path)) view_path = path;
-    if (ImGui::Button("save view")) try {
-        save_view_file(view_path);
-      } catch (const ViewError& e) { error = e.what(); }
-    ImGui::SameLine();
-    if (ImGui::Button("load view")) try {
-        View loaded = load_view(view_path);
-        if (loaded.camera) view.camera = loaded.camera;
-        view.settings = loaded.settings;
-        show_object_frame(loaded.object_frame);
-      } catch (const ViewError& e) { error = e.what(); }
-    ImGui::SameLine();
-    if (ImGui::Button("copy the command")) try {
-        copy_command();
-      } catch (const ViewError& e) { error = e.what(); }
-  }
+  if (ImGui::CollapsingHeader("GPU time", ImGuiTreeNodeFlags_DefaultOpen)) gpu_time_section();
+  if (ImGui::CollapsingHeader("Ground truth", ImGuiTreeNodeFlags_DefaultOpen)) ground_truth_section();
+  if (ImGui::CollapsingHeader("Files", ImGuiTreeNodeFlags_DefaultOpen)) files_section();
   if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
   ImGui::PopItemWidth();
   ImGui::End();

@@ -61,6 +61,13 @@ struct Viewer {
 
   // panel.cpp
   void panel();
+  // The panel's parts, each drawn by panel() under its header.
+  void choices_section();
+  void technique_settings_section();
+  void light_and_camera_section();
+  void gpu_time_section();
+  void ground_truth_section();
+  void files_section();
   void fly(float dt);
   void step_script();
   // The actions of the panel and the script.

@@ -224,25 +224,167 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
              file.string(), figure.width(), figure.height());
 }
 
+struct DemoOptions {
+  FrameOptions frame;
+  std::string out = "msm-demo";
+  std::vector<std::string> techniques = {"pcf",      "vsm-32",  "evsm4-64", "msm-hamburger-64", "msm-hamburger-128",
+                                         "msm-nl64", "msm-nl32"};
+  std::string soft_scene = "models";
+  std::vector<std::string> soft_techniques = {"mssm4", "mssm6", "vssm", "pcss"};
+  int soft_samples = 64;
+  std::string scatter_scene = "trees";
+  std::vector<std::string> scatter_techniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
+                                                 "scatter-msm4-64", "scatter-msm6-96"};
+  int scatter_samples = 32;
+  std::string ibl_scene = "sky_probe";
+  int ibl_samples = 256;
+};
+
+// Each part's frame and scene, checked and loaded before the device is opened; a part without its
+// scene is skipped.
+struct DemoParts {
+  scene::Scene scene; // the hard part's
+  FrameOptions soft, scatter, ibl;
+  std::optional<scene::Scene> soft_scene, scatter_scene, ibl_scene;
+};
+
+// The options' own checks: the technique lists made canonical, the sample counts in range.
+void check_demo_options(DemoOptions& o) {
+  finish_frame_options(o.frame);
+  if (o.frame.animation_frame != 0)
+    throw UsageError("msm demo draws its scenes as they are (frame 0); --frame is msm render's");
+  // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
+  for (auto* list : {&o.techniques, &o.soft_techniques, &o.scatter_techniques}) {
+    std::erase(*list, std::string());
+    *list = canonical_technique_names(*list);
+  }
+  if (o.techniques.empty()) throw UsageError("--techniques: none given");
+  if (o.soft_samples < 1 || o.soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
+  if (o.scatter_samples < 1 || o.scatter_samples > 4096) throw UsageError("--scatter-samples must be in [1, 4096]");
+  if (o.ibl_samples < 1 || o.ibl_samples > 4096) throw UsageError("--ibl-samples must be in [1, 4096]");
+  validate_techniques(o.frame, o.techniques);
+}
+
+// The scattering part's frame (a third of the width and height) with its techniques checked.
+FrameOptions scatter_frame(const DemoOptions& o) {
+  FrameOptions scatter = o.frame;
+  scatter.scene = o.scatter_scene;
+  scatter.settings.width = std::max(16, o.frame.settings.width / 3);
+  scatter.settings.height = std::max(16, o.frame.settings.height / 3);
+  if (o.scatter_techniques.empty()) return scatter;
+  validate_techniques(scatter, o.scatter_techniques);
+  for (const std::string& t : o.scatter_techniques)
+    if (!msm_technique_is_scattering(render::find_rendered_technique(t).id))
+      throw UsageError(fmt::format("--scatter-techniques: {} is not a scattering technique (msm techniques: "
+                                   "scatter-*)",
+                                   t));
+  return scatter;
+}
+
+// The image-based-lighting part's scene, checked with every case's light count.
+std::optional<scene::Scene> load_ibl_scene(const FrameOptions& ibl) {
+  if (ibl.scene.empty()) return std::nullopt;
+  scene::Scene ibl_scene = load_scene_or_fail(ibl.scene);
+  if (!ibl_scene.probe)
+    throw UsageError(fmt::format("--ibl-scene {}: the scene has no \"probe\" (scenes/README.md)", ibl.scene));
+  for (const IblCase& c : kIblCases) {
+    validate_techniques(ibl, {c.technique});
+    scene::Scene lit = ibl_scene;
+    try {
+      scene::set_probe_light_count(lit, c.lights);
+    } catch (const scene::SceneError& e) { throw UsageError(fmt::format("--ibl-scene {}: {}", ibl.scene, e.what())); }
+  }
+  return ibl_scene;
+}
+
+DemoParts demo_parts(const DemoOptions& o) {
+  DemoParts p;
+  p.soft = o.frame;
+  p.soft.scene = o.soft_scene;
+  if (!o.soft_techniques.empty()) validate_techniques(p.soft, o.soft_techniques);
+  p.scatter = scatter_frame(o);
+  p.scene = load_scene_or_fail(o.frame.scene);
+  if (!o.soft_techniques.empty()) p.soft_scene = load_scene_or_fail(p.soft.scene);
+  if (!o.scatter_techniques.empty()) {
+    p.scatter_scene = load_scene_or_fail(p.scatter.scene);
+    if (!p.scatter_scene->medium)
+      throw UsageError(
+          fmt::format("--scatter-scene {}: the scene has no \"medium\" (scenes/README.md)", p.scatter.scene));
+  }
+  p.ibl = p.scatter;
+  p.ibl.scene = o.ibl_scene;
+  // One shadow map per light, up to 256 of them: the paper's 256² (Kneiphof §6), not the hard part's size.
+  p.ibl.settings.shadow_size = std::min(p.ibl.settings.shadow_size, 256);
+  p.ibl_scene = load_ibl_scene(p.ibl);
+  return p;
+}
+
+// The soft part: the soft techniques against the ray-traced area light.
+void soft_part(render::Renderer& renderer, const vk::Context& ctx, const DemoOptions& o, const DemoParts& p) {
+  const render::RenderSettings& fs = o.frame.settings;
+  float extent = fs.light_extent_deg ? *fs.light_extent_deg : p.soft_scene->light().angular_extent_deg;
+  fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
+             "samples per pixel\n",
+             p.soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, o.soft_samples);
+  reference::Settings rs = reference_settings(reference::Effect::soft, fs, o.soft_samples);
+  // The light the renderer draws: the scene's, or the command line's overrides of it.
+  if (fs.light_extent_deg) rs.light_extent_deg = *fs.light_extent_deg;
+  if (fs.light_height_deg) rs.light_height_deg = *fs.light_height_deg;
+  rs.progress = [lines = std::make_shared<util::ProgressLines>("msm demo: ray tracing ", " rows")](
+                    const reference::Progress& progress) {
+    if (auto line = lines->next(progress.rows_done, progress.rows_total, progress.seconds))
+      fmt::print(stderr, "{}\n", *line);
+  };
+  reference::Result truth = reference::render(*p.soft_scene, rs);
+  image::Image truth_rgb = reference_look(truth, fs.exposure);
+  compare_techniques(renderer, ctx, p.soft, o.soft_techniques, &truth.visibility, &truth_rgb, o.out,
+                     "soft-comparison.png");
+}
+
+void run_demo(DemoOptions& o) {
+  check_demo_options(o);
+  const DemoParts p = demo_parts(o);
+  std::unique_ptr<vk::Context> ctx = open_device(o.frame.device);
+  // Both parts' renderers first: what the device cannot do is refused before the output
+  // directory exists (the first renderer is released before the soft part).
+  std::optional<render::Renderer> hard, soft_renderer, scatter_renderer;
+  hard.emplace(*ctx, p.scene);
+  check_on_device(*hard, o.frame, o.techniques);
+  if (p.soft_scene) {
+    soft_renderer.emplace(*ctx, *p.soft_scene);
+    check_on_device(*soft_renderer, p.soft, o.soft_techniques);
+  }
+  if (p.scatter_scene) {
+    scatter_renderer.emplace(*ctx, *p.scatter_scene);
+    check_on_device(*scatter_renderer, p.scatter, o.scatter_techniques);
+  }
+  ensure_output_dir(o.out);
+  const render::RenderSettings& fs = o.frame.settings;
+  fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
+             p.scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
+             ctx->info().name);
+  compare_techniques(*hard, *ctx, o.frame, o.techniques, nullptr, nullptr, o.out, "comparison.png");
+  hard.reset();
+  if (p.scatter_scene)
+    scatter_part(*scatter_renderer, *ctx, p.scatter, *p.scatter_scene, o.scatter_techniques, o.scatter_samples,
+                 sheet_magnification(fs.width, p.scatter.settings.width), o.out);
+  else
+    fmt::print("\nmsm demo: scattering part skipped (no --scatter-techniques)\n");
+  scatter_renderer.reset();
+  if (p.ibl_scene)
+    ibl_part(*ctx, p.ibl, *p.ibl_scene, o.ibl_samples, sheet_magnification(fs.width, p.ibl.settings.width), o.out);
+  else
+    fmt::print("\nmsm demo: image-based-lighting part skipped (--ibl-scene \"\")\n");
+  if (p.soft_scene)
+    soft_part(*soft_renderer, *ctx, o, p);
+  else
+    fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
+}
+
 } // namespace
 
 void add_demo(CLI::App& app) {
-  struct Options {
-    FrameOptions frame;
-    std::string out = "msm-demo";
-    std::vector<std::string> techniques = {"pcf",      "vsm-32",  "evsm4-64", "msm-hamburger-64", "msm-hamburger-128",
-                                           "msm-nl64", "msm-nl32"};
-    std::string soft_scene = "models";
-    std::vector<std::string> soft_techniques = {"mssm4", "mssm6", "vssm", "pcss"};
-    int soft_samples = 64;
-    std::string scatter_scene = "trees";
-    std::vector<std::string> scatter_techniques = {"scatter-march-32", "scatter-march-128", "scatter-csm-32",
-                                                   "scatter-msm4-64", "scatter-msm6-96"};
-    int scatter_samples = 32;
-    std::string ibl_scene = "sky_probe";
-    int ibl_samples = 256;
-  };
-  auto opt = std::make_shared<Options>();
+  auto opt = std::make_shared<DemoOptions>();
   opt->frame.settings.width = 960;
   opt->frame.settings.height = 540;
   opt->frame.scene = std::string(scene::default_scene_name());
@@ -275,117 +417,7 @@ void add_demo(CLI::App& app) {
   cmd->add_option("--ibl-samples", opt->ibl_samples, "Ray-traced samples per pixel of the whole probe's ground truth")
       ->capture_default_str();
   add_frame_options(cmd, opt->frame);
-  cmd->callback([opt] {
-    finish_frame_options(opt->frame);
-    if (opt->frame.animation_frame != 0)
-      throw UsageError("msm demo draws its scenes as they are (frame 0); --frame is msm render's");
-    // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
-    for (auto* list : {&opt->techniques, &opt->soft_techniques, &opt->scatter_techniques}) {
-      std::erase(*list, std::string());
-      *list = canonical_technique_names(*list);
-    }
-    if (opt->techniques.empty()) throw UsageError("--techniques: none given");
-    if (opt->soft_samples < 1 || opt->soft_samples > 4096) throw UsageError("--soft-samples must be in [1, 4096]");
-    if (opt->scatter_samples < 1 || opt->scatter_samples > 4096)
-      throw UsageError("--scatter-samples must be in [1, 4096]");
-    if (opt->ibl_samples < 1 || opt->ibl_samples > 4096) throw UsageError("--ibl-samples must be in [1, 4096]");
-    validate_techniques(opt->frame, opt->techniques);
-    FrameOptions soft = opt->frame;
-    soft.scene = opt->soft_scene;
-    if (!opt->soft_techniques.empty()) validate_techniques(soft, opt->soft_techniques);
-    FrameOptions scatter = opt->frame;
-    scatter.scene = opt->scatter_scene;
-    scatter.settings.width = std::max(16, opt->frame.settings.width / 3);
-    scatter.settings.height = std::max(16, opt->frame.settings.height / 3);
-    if (!opt->scatter_techniques.empty()) {
-      validate_techniques(scatter, opt->scatter_techniques);
-      for (const std::string& t : opt->scatter_techniques)
-        if (!msm_technique_is_scattering(render::find_rendered_technique(t).id))
-          throw UsageError(fmt::format("--scatter-techniques: {} is not a scattering technique (msm techniques: "
-                                       "scatter-*)",
-                                       t));
-    }
-    scene::Scene scene = load_scene_or_fail(opt->frame.scene);
-    std::optional<scene::Scene> soft_scene;
-    if (!opt->soft_techniques.empty()) soft_scene = load_scene_or_fail(soft.scene);
-    std::optional<scene::Scene> scatter_scene;
-    if (!opt->scatter_techniques.empty()) {
-      scatter_scene = load_scene_or_fail(scatter.scene);
-      if (!scatter_scene->medium)
-        throw UsageError(
-            fmt::format("--scatter-scene {}: the scene has no \"medium\" (scenes/README.md)", scatter.scene));
-    }
-    FrameOptions ibl = scatter;
-    ibl.scene = opt->ibl_scene;
-    // One shadow map per light, up to 256 of them: the paper's 256² (Kneiphof §6), not the hard part's size.
-    ibl.settings.shadow_size = std::min(ibl.settings.shadow_size, 256);
-    std::optional<scene::Scene> ibl_scene;
-    if (!opt->ibl_scene.empty()) {
-      ibl_scene = load_scene_or_fail(ibl.scene);
-      if (!ibl_scene->probe)
-        throw UsageError(fmt::format("--ibl-scene {}: the scene has no \"probe\" (scenes/README.md)", ibl.scene));
-      for (const IblCase& c : kIblCases) {
-        validate_techniques(ibl, {c.technique});
-        scene::Scene lit = *ibl_scene;
-        try {
-          scene::set_probe_light_count(lit, c.lights);
-        } catch (const scene::SceneError& e) {
-          throw UsageError(fmt::format("--ibl-scene {}: {}", ibl.scene, e.what()));
-        }
-      }
-    }
-    std::unique_ptr<vk::Context> ctx = open_device(opt->frame.device);
-    // Both parts' renderers first: what the device cannot do is refused before the output
-    // directory exists (the first renderer is released before the soft part).
-    std::optional<render::Renderer> hard, soft_renderer, scatter_renderer;
-    hard.emplace(*ctx, scene);
-    check_on_device(*hard, opt->frame, opt->techniques);
-    if (soft_scene) {
-      soft_renderer.emplace(*ctx, *soft_scene);
-      check_on_device(*soft_renderer, soft, opt->soft_techniques);
-    }
-    if (scatter_scene) {
-      scatter_renderer.emplace(*ctx, *scatter_scene);
-      check_on_device(*scatter_renderer, scatter, opt->scatter_techniques);
-    }
-    ensure_output_dir(opt->out);
-    const render::RenderSettings& fs = opt->frame.settings;
-    fmt::print("msm demo: scene '{}' at {}x{}, shadow map {}² with {}x MSAA, {}² Gaussian (sigma {}), on {}\n",
-               scene.name, fs.width, fs.height, fs.shadow_size, fs.msaa, fs.filter_size, fs.filter_sigma,
-               ctx->info().name);
-    compare_techniques(*hard, *ctx, opt->frame, opt->techniques, nullptr, nullptr, opt->out, "comparison.png");
-    hard.reset();
-    if (scatter_scene)
-      scatter_part(*scatter_renderer, *ctx, scatter, *scatter_scene, opt->scatter_techniques, opt->scatter_samples,
-                   sheet_magnification(fs.width, scatter.settings.width), opt->out);
-    else
-      fmt::print("\nmsm demo: scattering part skipped (no --scatter-techniques)\n");
-    scatter_renderer.reset();
-    if (ibl_scene)
-      ibl_part(*ctx, ibl, *ibl_scene, opt->ibl_samples, sheet_magnification(fs.width, ibl.settings.width), opt->out);
-    else
-      fmt::print("\nmsm demo: image-based-lighting part skipped (--ibl-scene \"\")\n");
-    if (!soft_scene) {
-      fmt::print("\nmsm demo: soft part skipped (no --soft-techniques)\n");
-      return;
-    }
-    float extent = fs.light_extent_deg ? *fs.light_extent_deg : soft_scene->light().angular_extent_deg;
-    fmt::print("\nmsm demo: soft shadows, scene '{}' at {}x{}, light {}° across, shadow map {}², ray traced with {} "
-               "samples per pixel\n",
-               soft_scene->name, fs.width, fs.height, extent, fs.shadow_size, opt->soft_samples);
-    reference::Settings rs = reference_settings(reference::Effect::soft, fs, opt->soft_samples);
-    // The light the renderer draws: the scene's, or the command line's overrides of it.
-    if (fs.light_extent_deg) rs.light_extent_deg = *fs.light_extent_deg;
-    if (fs.light_height_deg) rs.light_height_deg = *fs.light_height_deg;
-    rs.progress = [lines = std::make_shared<util::ProgressLines>("msm demo: ray tracing ", " rows")](
-                      const reference::Progress& p) {
-      if (auto line = lines->next(p.rows_done, p.rows_total, p.seconds)) fmt::print(stderr, "{}\n", *line);
-    };
-    reference::Result truth = reference::render(*soft_scene, rs);
-    image::Image truth_rgb = reference_look(truth, fs.exposure);
-    compare_techniques(*soft_renderer, *ctx, soft, opt->soft_techniques, &truth.visibility, &truth_rgb, opt->out,
-                       "soft-comparison.png");
-  });
+  cmd->callback([opt] { run_demo(*opt); });
 }
 
 } // namespace msm::tool

@@ -99,8 +99,8 @@ void make_parent(const std::string& path) {
 
 nlohmann::json vec(glm::vec3 v) { return {v.x, v.y, v.z}; }
 
-void run(const LightsOptions& o) {
-  // Checked here, not by CLI11, so that a bad value is a failed command (exit 2) naming the range.
+// Checked here, not by CLI11, so that a bad value is a failed command (exit 2) naming the range.
+void check_options(const LightsOptions& o) {
   if (o.count < 1 || o.count > 256)
     throw UsageError(fmt::format("--lights {}: the median cut makes 1 to 256 lights", o.count));
   if (o.sub_lights < 0 || o.sub_lights > 256)
@@ -125,99 +125,112 @@ void run(const LightsOptions& o) {
     probe::check_cut(o.count, o.size, o.horizon_split); // --horizon-split: count >= 10, size even
     if (probe::sub_lights_refine(o.count, o.sub_lights)) probe::check_cut(o.sub_lights, o.size, o.horizon_split);
   } catch (const probe::ProbeError& e) { throw UsageError(fmt::format("--horizon-split: {}", e.what())); }
+}
+
+// The probe's cube map cut into lights with their regions (cut_lights skips regions without energy,
+// Σ w Y = 0 in the tables: a black probe has none), and each light's sub-lights: the lights of the cut
+// into --sub-lights regions inside its region, as a scene's "sub_lights" gives them to the renderer.
+struct ProbeCut {
   probe::CubeMap cube;
-  try {
-    cube = probe::load_probe(o.probe, o.size, o.rotation_deg, o.intensity);
-  } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-  const probe::ProbeTables tables(cube);
-  // The lights with their regions (cut_lights skips regions without energy, Σ w Y = 0 in the
-  // tables: a black probe has none), and each light's sub-lights: the lights of the cut into
-  // --sub-lights regions inside its region, as a scene's "sub_lights" gives them to the renderer.
   probe::CutLights cut;
-  std::vector<probe::ProbeLight> grouped;
+  std::vector<probe::ProbeLight> grouped; // empty without sub-lights
+  std::vector<probe::Region> lit;         // the region of each light
+};
+
+ProbeCut cut_probe(const LightsOptions& o) {
+  ProbeCut c;
   try {
-    cut = probe::cut_lights(tables, o.count, o.horizon_split);
-    if (probe::sub_lights_refine(o.count, o.sub_lights))
-      grouped = probe::with_sub_lights(cut, probe::cut_lights(tables, o.sub_lights, o.horizon_split));
+    c.cube = probe::load_probe(o.probe, o.size, o.rotation_deg, o.intensity);
   } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
-  const std::vector<probe::Region>& regions = cut.regions;
-  const std::vector<MsmAreaLight>& lights = cut.lights;
-  std::vector<probe::Region> lit(lights.size());
-  for (std::size_t r = 0; r < regions.size(); ++r)
-    if (cut.light_of_region[r] >= 0) lit[std::size_t(cut.light_of_region[r])] = regions[r];
-  const glm::dvec3 total = probe::integrate(cube);
-  nlohmann::ordered_json doc;
-  doc["probe"] = o.probe;
-  doc["size"] = cube.size;
-  doc["rotation_deg"] = o.rotation_deg;
-  doc["intensity"] = o.intensity;
-  doc["horizon_split"] = o.horizon_split;
-  doc["regions"] = regions.size();
-  doc["sub_lights"] = grouped.empty() ? 0 : o.sub_lights;
-  doc["integral"] = {total.x, total.y, total.z};
-  if (!o.json)
-    fmt::print("probe {}: {}² texels per face, {} regions, {} lights{}; ∫L dω = ({:.4g}, {:.4g}, {:.4g})\n", o.probe,
-               cube.size, regions.size(), lights.size(), lights.empty() ? " (the probe is black)" : "", total.x,
-               total.y, total.z);
-  if (!o.json && !lights.empty())
+  const probe::ProbeTables tables(c.cube);
+  try {
+    c.cut = probe::cut_lights(tables, o.count, o.horizon_split);
+    if (probe::sub_lights_refine(o.count, o.sub_lights))
+      c.grouped = probe::with_sub_lights(c.cut, probe::cut_lights(tables, o.sub_lights, o.horizon_split));
+  } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
+  c.lit.resize(c.cut.lights.size());
+  for (std::size_t r = 0; r < c.cut.regions.size(); ++r)
+    if (c.cut.light_of_region[r] >= 0) c.lit[std::size_t(c.cut.light_of_region[r])] = c.cut.regions[r];
+  return c;
+}
+
+// A light as a scene's "lights" entry: a rectangle of angular width and height below 90°
+// (light_of_area_light).
+nlohmann::json scene_light(const MsmAreaLight& l) {
+  const scene::DirectionalLight drawn = scene::light_of_area_light(l);
+  return {{"towards_light", vec(drawn.towards_light)},
+          {"irradiance", vec(drawn.irradiance)},
+          {"angular_extent_deg", drawn.angular_extent_deg},
+          {"angular_height_deg", *drawn.angular_height_deg},
+          {"x_axis", vec(*drawn.x_axis)}};
+}
+
+nlohmann::json region_json(const probe::Region& r, int cube_size) {
+  nlohmann::json region = {{"face", r.face}, {"x", {r.x0, r.x1}}, {"y", {r.y0, r.y1}}};
+  if (r.faces != 0) { // a group of whole faces (N < 6)
+    nlohmann::json faces = nlohmann::json::array();
+    for (const probe::Region& part : probe::region_parts(r, cube_size)) faces.push_back(part.face);
+    region["faces"] = faces;
+  }
+  return region;
+}
+
+// Light k's row of the JSON table, with its sub-lights when the cut has them.
+nlohmann::json light_entry(const ProbeCut& c, std::size_t k) {
+  const MsmAreaLight& l = c.cut.lights[k];
+  const glm::vec2 half_deg = half_extent_deg(l);
+  nlohmann::json entry = {{"direction", vec(l.direction)},
+                          {"x_axis", vec(l.x_axis)},
+                          {"y_axis", vec(l.y_axis)},
+                          {"half_extent_deg", {half_deg.x, half_deg.y}},
+                          {"cone_half_angle_deg", glm::degrees(l.cone_half_angle)},
+                          {"solid_angle_sr", solid_angle(c.lit[k], c.cube.size)},
+                          {"irradiance", vec(l.irradiance)},
+                          {"facing_irradiance", vec(msm_area_light_facing_irradiance(l))},
+                          {"region", region_json(c.lit[k], c.cube.size)}};
+  if (!c.grouped.empty()) {
+    nlohmann::json subs = nlohmann::json::array();
+    for (const MsmAreaLight& sub : c.grouped[k].sub_lights)
+      subs.push_back({{"direction", vec(sub.direction)},
+                      {"x_axis", vec(sub.x_axis)},
+                      {"half_extent_deg", {half_extent_deg(sub).x, half_extent_deg(sub).y}},
+                      {"irradiance", vec(sub.irradiance)}});
+    entry["sub_lights"] = subs;
+  }
+  return entry;
+}
+
+// The text form: a line about the probe, then the table of lights and a line about their sub-lights.
+void print_table(const LightsOptions& o, const ProbeCut& c, const glm::dvec3& total) {
+  const std::vector<MsmAreaLight>& lights = c.cut.lights;
+  fmt::print("probe {}: {}² texels per face, {} regions, {} lights{}; ∫L dω = ({:.4g}, {:.4g}, {:.4g})\n", o.probe,
+             c.cube.size, c.cut.regions.size(), lights.size(), lights.empty() ? " (the probe is black)" : "", total.x,
+             total.y, total.z);
+  if (!lights.empty())
     fmt::print("{:>3}  {:>24}  {:>15}  {:>7}  {:>8}  {:>30}\n", "#", "towards light", "half-extents °", "Ω sr",
                "cone °", "irradiance M_e (RGB)");
-  nlohmann::json list = nlohmann::json::array(), table = nlohmann::json::array();
   for (std::size_t k = 0; k < lights.size(); ++k) {
     const MsmAreaLight& l = lights[k];
     const glm::vec2 half_deg = half_extent_deg(l);
-    const double omega = solid_angle(lit[k], cube.size);
-    if (!o.json)
-      fmt::print("{:>3}  ({:>6.3f}, {:>6.3f}, {:>6.3f})  {:>6.2f} x {:>6.2f}  {:>7.4f}  {:>8.3f}  ({:>8.4g}, {:>8.4g}, "
-                 "{:>8.4g})\n",
-                 k, l.direction.x, l.direction.y, l.direction.z, half_deg.x, half_deg.y, omega,
-                 glm::degrees(l.cone_half_angle), l.irradiance.x, l.irradiance.y, l.irradiance.z);
-    const glm::vec3 facing = msm_area_light_facing_irradiance(l);
-    // The scene's lights are rectangles of angular width and height below 90° (light_of_area_light).
-    const scene::DirectionalLight drawn = scene::light_of_area_light(l);
-    list.push_back({{"towards_light", vec(drawn.towards_light)},
-                    {"irradiance", vec(drawn.irradiance)},
-                    {"angular_extent_deg", drawn.angular_extent_deg},
-                    {"angular_height_deg", *drawn.angular_height_deg},
-                    {"x_axis", vec(*drawn.x_axis)}});
-    const probe::Region& r = lit[k];
-    nlohmann::json region = {{"face", r.face}, {"x", {r.x0, r.x1}}, {"y", {r.y0, r.y1}}};
-    if (r.faces != 0) { // a group of whole faces (N < 6)
-      nlohmann::json faces = nlohmann::json::array();
-      for (const probe::Region& part : probe::region_parts(r, cube.size)) faces.push_back(part.face);
-      region["faces"] = faces;
-    }
-    table.push_back({{"direction", vec(l.direction)},
-                     {"x_axis", vec(l.x_axis)},
-                     {"y_axis", vec(l.y_axis)},
-                     {"half_extent_deg", {half_deg.x, half_deg.y}},
-                     {"cone_half_angle_deg", glm::degrees(l.cone_half_angle)},
-                     {"solid_angle_sr", omega},
-                     {"irradiance", vec(l.irradiance)},
-                     {"facing_irradiance", vec(facing)},
-                     {"region", region}});
-    if (!grouped.empty()) {
-      nlohmann::json subs = nlohmann::json::array();
-      for (const MsmAreaLight& sub : grouped[k].sub_lights)
-        subs.push_back({{"direction", vec(sub.direction)},
-                        {"x_axis", vec(sub.x_axis)},
-                        {"half_extent_deg", {half_extent_deg(sub).x, half_extent_deg(sub).y}},
-                        {"irradiance", vec(sub.irradiance)}});
-      table.back()["sub_lights"] = subs;
-    }
+    fmt::print("{:>3}  ({:>6.3f}, {:>6.3f}, {:>6.3f})  {:>6.2f} x {:>6.2f}  {:>7.4f}  {:>8.3f}  ({:>8.4g}, {:>8.4g}, "
+               "{:>8.4g})\n",
+               k, l.direction.x, l.direction.y, l.direction.z, half_deg.x, half_deg.y,
+               solid_angle(c.lit[k], c.cube.size), glm::degrees(l.cone_half_angle), l.irradiance.x, l.irradiance.y,
+               l.irradiance.z);
   }
-  if (!o.json && !grouped.empty()) {
-    std::size_t fewest = grouped.front().sub_lights.size(), most = fewest, total_subs = 0;
-    for (const probe::ProbeLight& g : grouped) {
-      fewest = std::min(fewest, g.sub_lights.size());
-      most = std::max(most, g.sub_lights.size());
-      total_subs += g.sub_lights.size();
-    }
-    fmt::print("sub-lights: {} lights of the cut into {} regions, {} to {} per light (--json lists them)\n", total_subs,
-               o.sub_lights, fewest, most);
+  if (c.grouped.empty()) return;
+  std::size_t fewest = c.grouped.front().sub_lights.size(), most = fewest, total_subs = 0;
+  for (const probe::ProbeLight& g : c.grouped) {
+    fewest = std::min(fewest, g.sub_lights.size());
+    most = std::max(most, g.sub_lights.size());
+    total_subs += g.sub_lights.size();
   }
-  doc["lights"] = table;
-  // Files first (each written whole under a temporary name, then renamed), then the JSON.
+  fmt::print("sub-lights: {} lights of the cut into {} regions, {} to {} per light (--json lists them)\n", total_subs,
+             o.sub_lights, fewest, most);
+}
+
+// The files asked for, each written whole under a temporary name, then renamed.
+void write_files(const LightsOptions& o, const ProbeCut& c) {
   const auto wrote = [&](const std::string& path) {
     if (o.json)
       fmt::print(stderr, "wrote {}\n", path);
@@ -226,6 +239,8 @@ void run(const LightsOptions& o) {
   };
   if (!o.scene_lights.empty()) {
     make_parent(o.scene_lights);
+    nlohmann::json list = nlohmann::json::array();
+    for (const MsmAreaLight& l : c.cut.lights) list.push_back(scene_light(l));
     const std::string text = nlohmann::json{{"lights", list}}.dump(2) + "\n";
     image::write_file_atomic(o.scene_lights,
                              std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
@@ -234,18 +249,39 @@ void run(const LightsOptions& o) {
   if (!o.picture.empty()) {
     make_parent(o.picture);
     try {
-      image::write_image(o.picture, cross_picture(cube, regions));
+      image::write_image(o.picture, cross_picture(c.cube, c.cut.regions));
     } catch (const image::ImageError& e) { throw UsageError(e.what()); }
     wrote(o.picture);
   }
   if (!o.faces.empty()) {
     make_parent(o.faces);
     try {
-      probe::write_cube_faces(o.faces, cube);
+      probe::write_cube_faces(o.faces, c.cube);
     } catch (const probe::ProbeError& e) { throw UsageError(e.what()); }
     for (const std::filesystem::path& face : probe::cube_face_files(o.faces)) wrote(face.string());
   }
-  if (o.json) fmt::print("{}\n", doc.dump(2));
+}
+
+void run(const LightsOptions& o) {
+  check_options(o);
+  const ProbeCut c = cut_probe(o);
+  const glm::dvec3 total = probe::integrate(c.cube);
+  if (!o.json) print_table(o, c, total);
+  write_files(o, c);
+  if (!o.json) return;
+  nlohmann::ordered_json doc;
+  doc["probe"] = o.probe;
+  doc["size"] = c.cube.size;
+  doc["rotation_deg"] = o.rotation_deg;
+  doc["intensity"] = o.intensity;
+  doc["horizon_split"] = o.horizon_split;
+  doc["regions"] = c.cut.regions.size();
+  doc["sub_lights"] = c.grouped.empty() ? 0 : o.sub_lights;
+  doc["integral"] = {total.x, total.y, total.z};
+  nlohmann::json table = nlohmann::json::array();
+  for (std::size_t k = 0; k < c.cut.lights.size(); ++k) table.push_back(light_entry(c, k));
+  doc["lights"] = table;
+  fmt::print("{}\n", doc.dump(2));
 }
 
 } // namespace
