@@ -6,6 +6,7 @@
 #include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
 #include "msm/shading.h"
+#include "msm/techniques.h"
 
 #include "msm/image/metrics.h"
 #include "msm/test/image_compare.h"
@@ -84,11 +85,31 @@ RenderSettings spot_settings(std::string technique) {
   return s;
 }
 
-// MAE of each technique's visibility against the ray tracer's hard shadow of spot_scene (the
-// tracer's exact edges; the renderer's filtered ones are wider: most of the error is the
-// penumbra's), measured on lavapipe; the bound is 1.25x that, at least 0.002 more.
-const std::map<std::string, double> kSpotMeasuredMae = {
-    {"plain", 0.0011}, {"pcf", 0.0037}, {"vsm-32", 0.0066}, {"msm-hamburger-64", 0.0075}};
+// MAE of each hard and filtered technique's visibility against the ray tracer's hard shadow of
+// spot_scene (the tracer's exact edges; the renderer's filtered ones are wider: most of the error is
+// the penumbra's), measured on lavapipe; the bound is 1.25x that, at least 0.002 more.
+const std::map<std::string, double> kSpotMeasuredMae = {{"plain", 0.0011},
+                                                        {"pcf", 0.0037},
+                                                        {"vsm-32", 0.0066},
+                                                        {"msm-hamburger-64", 0.0075},
+                                                        {"vsm-64", 0.0068},
+                                                        {"esm-32", 0.0062},
+                                                        {"evsm2-32", 0.0066},
+                                                        {"evsm2-64", 0.0063},
+                                                        {"evsm4-64", 0.0066},
+                                                        {"evsm4-128", 0.0066},
+                                                        {"msm-hamburger-128-unit", 0.0091},
+                                                        {"msm-hamburger-128", 0.0095},
+                                                        {"msm-hamburger-64-theta4", 0.0078},
+                                                        {"msm-hausdorff-128-unit", 0.0096},
+                                                        {"msm-hausdorff-128", 0.0095},
+                                                        {"msm-hausdorff-64-theta4", 0.0092},
+                                                        {"msm-hausdorff-64", 0.0081},
+                                                        {"tmsm-128", 0.0091},
+                                                        {"msm6-192", 0.0092},
+                                                        {"msm6-96", 0.0075},
+                                                        {"msm-nl64", 0.0039},
+                                                        {"msm-nl32", 0.0140}};
 
 TEST_F(LocalLightsRenderTest, SpotLightShadowsAgreeWithTheRayTracer) {
   const scene::Scene scene = spot_scene();
@@ -99,14 +120,19 @@ TEST_F(LocalLightsRenderTest, SpotLightShadowsAgreeWithTheRayTracer) {
   const reference::Result truth = reference::render(scene, r);
   const image::Image mask = truth.visibility.channel("background");
   Renderer renderer(ctx(), scene);
-  for (const auto& [technique, measured] : kSpotMeasuredMae) {
+  for (const Technique* tp : rendered_techniques()) {
+    const std::string technique(tp->name);
+    if (tp->soft() || msm_technique_is_area_light(tp->id) || tp->scatters()) continue; // refused above
+    ASSERT_TRUE(kSpotMeasuredMae.count(technique)) << technique << " has no measured error";
+    const double measured = kSpotMeasuredMae.at(technique);
     RenderResult result = renderer.render(spot_settings(technique));
     image::Tolerances tolerances;
     tolerances.max_mae = std::max(1.25 * measured, measured + 0.002);
-    // The filtered edges against the tracer's hard ones: up to 4.3% of the pixels (MSM 64) differ
-    // by more than 3%, 1.8% by more than 10% (measured); the MAE bounds the error.
-    tolerances.max_share_above_3pct = 0.06;
-    tolerances.max_share_above_10pct = 0.025;
+    // The filtered edges against the tracer's hard ones: up to 7.6% of the pixels (MSM 32 non-linear,
+    // its scattered over-darkening; the others up to 4.3%) differ by more than 3%, 3.3% by more
+    // than 10% (measured); the MAE, per technique, bounds the error.
+    tolerances.max_share_above_3pct = 0.09;
+    tolerances.max_share_above_10pct = 0.04;
     image::CompareResult c =
         image::compare(result.shadow.channel("visibility"), truth.visibility.channel("visibility"), tolerances,
                        {.metrics = {.mask = &mask}, .failure_dir = "test-failures/local-lights/spot-" + technique});
