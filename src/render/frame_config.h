@@ -67,6 +67,9 @@ struct FrameConfig {
   // Kneiphof §4.2.3 (RenderSettings::front_back_depth): a second depth pass keeps the nearest back
   // face, and the moment resolve stores the mean of the front- and back-face depth.
   bool front_back = false;
+  // Spot lights in the frame (after its directional lights): the shadow pass writes their radial
+  // depth and the shading's kSpotLights (shading.glsl) projects, biases and lights by each light's kind.
+  int spot_lights = 0;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                   // translucent and four channels in one image

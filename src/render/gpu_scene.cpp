@@ -40,9 +40,15 @@ std::string rendered_light_kinds() {
   return fmt::format("{} lights only", fmt::join(names, " and "));
 }
 
+// The direction translucent surfaces are sorted along: the first directional light's travel (a
+// scene of spot lights only has no translucent pass, RenderError in the renderer's check).
+glm::vec3 translucent_travel(const scene::Scene& scene) {
+  return scene.lights.empty() ? glm::vec3(0.0f, -1.0f, 0.0f) : scene.light().travel();
+}
+
 Geometry geometry(const scene::Scene& scene) {
   Geometry g;
-  const glm::vec3 travel = scene.light().travel();
+  const glm::vec3 travel = translucent_travel(scene);
   for (const scene::Object& object : scene.objects) {
     const scene::Mesh& mesh = object.mesh;
     const uint32_t base = uint32_t(g.vertices.size());
@@ -135,7 +141,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
     if (!draw.index_count) continue;
     (material.translucent() ? translucent : draws).push_back(draw);
   }
-  sort_translucent(translucent, scene.light().travel());
+  sort_translucent(translucent, translucent_travel(scene));
   vertices = vk::create_buffer(ctx, g.vertices.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
   vk::upload_buffer(ctx, vertices, std::as_bytes(std::span(g.vertices)));
   indices = vk::create_buffer(ctx, g.indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
@@ -156,7 +162,7 @@ void GpuScene::move_objects(const vk::Context& ctx, const scene::Scene& scene) {
   vk::upload_buffer(ctx, indices, std::as_bytes(std::span(g.indices)));
   for (std::vector<Draw>* list : {&draws, &translucent})
     for (Draw& d : *list) d.center = scene.objects.at(d.object).bounds.center();
-  sort_translucent(translucent, scene.light().travel());
+  sort_translucent(translucent, translucent_travel(scene));
 }
 
 } // namespace msm::render

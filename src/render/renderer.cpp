@@ -24,6 +24,7 @@
 #include "msm/util/limits.h"
 
 #include <fmt/format.h>
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
 #include <algorithm>
@@ -192,6 +193,13 @@ struct Renderer::Impl {
     return s.lights.empty() ? scene.lights : s.lights;
   }
 
+  // The scene's spot lights, whose shadow-map layers follow the directional lights'.
+  std::vector<scene::LocalLight> spot_lights() const {
+    std::vector<scene::LocalLight> spots;
+    std::ranges::copy_if(scene.local_lights, std::back_inserter(spots), &scene::LocalLight::spot);
+    return spots;
+  }
+
   FrameUniforms frame_uniforms(const RenderSettings& s, const Technique& technique) const {
     FrameUniforms u{};
     u.camera_view_projection = scene.camera_view_projection(float(s.width) / float(s.height));
@@ -231,7 +239,7 @@ struct Renderer::Impl {
     double kernel_variance = msm_gaussian_variance(s.filter_size, s.filter_sigma);
     for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
     u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
-    u.lights = glm::ivec4(int(lights_of(s).size()), 0, 0, 0);
+    u.lights = glm::ivec4(int(lights_of(s).size() + spot_lights().size()), 0, 0, 0);
     u.camera_viewport = glm::vec4(float(s.width), float(s.height), 0.0f, 0.0f);
     return u;
   }
@@ -259,6 +267,25 @@ struct Renderer::Impl {
       u.rect_x_axis = glm::vec4(glm::vec3(f.x_axis), 0.0f);
       u.rect_extent = glm::vec4(drawn.rectangle_extents(), 0.0f, 0.0f);
     }
+    return u;
+  }
+
+  // A spot light as the shadow pass and the shading read it (docs/techniques.md, "Light kinds"): a
+  // perspective map over the outer cone, radial distance / range its depth; the normal offset of
+  // RenderSettings::normal_offset texels of the map's width where the receiver is.
+  static LightUniforms spot_light_uniforms(const RenderSettings& s, const scene::LocalLight& spot) {
+    const glm::vec3 up = std::abs(spot.direction.y) > 0.99f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
+    const float outer = glm::radians(spot.outer_cone_deg);
+    // The near plane clips nothing (depth clamp, gl_FragDepth): it only has to be positive.
+    const glm::mat4 projection = glm::perspective(2.0f * outer, 1.0f, 1e-3f * spot.range, spot.range);
+    LightUniforms u{};
+    u.view_projection = projection * glm::lookAt(spot.position, spot.position + spot.direction, up);
+    u.normal_matrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(u.view_projection))));
+    u.irradiance = glm::vec4(spot.intensity, 0.0f);
+    u.spot_position = glm::vec4(spot.position, spot.range);
+    u.spot_axis = glm::vec4(spot.direction, std::tan(outer));
+    const float texel_angle = 2.0f * std::tan(outer) / float(s.shadow_size);
+    u.spot_cone = glm::vec4(spot.cos_outer(), spot.cos_inner(), s.normal_offset * texel_angle, 0.0f);
     return u;
   }
 
@@ -307,9 +334,30 @@ struct Renderer::Impl {
     if (slots > kLightSlots)
       throw RenderError(
           fmt::format("{} lights, sub-lights and their summaries: the renderer holds {}", slots, kLightSlots));
-    if (frame_lights.size() > ctx.properties().limits.maxImageArrayLayers)
+    const std::vector<scene::LocalLight> spots = spot_lights();
+    slots += spots.size();
+    if (!spots.empty()) check_spot_lights(s, spots);
+    if (frame_lights.size() + spots.size() > ctx.properties().limits.maxImageArrayLayers)
       throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
                                     ctx.properties().limits.maxImageArrayLayers));
+  }
+
+  // What the renderer draws with spot lights: the hard and filtered techniques of one depth per
+  // texel, opaque occluders, a finite range (the stored depth is distance / range).
+  void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots) const {
+    const Technique& technique = find_rendered_technique(s.technique);
+    const char* unsupported = technique.soft() || msm_technique_is_area_light(technique.id) ? "soft shadows"
+                              : technique.scatters()                                        ? "scattering"
+                              : s.translucent_occluders && !gpu.translucent.empty()         ? "translucent occluders"
+                                                                                            : nullptr;
+    if (unsupported)
+      throw RenderError(fmt::format("{} with spot lights: the renderer draws spot lights' hard and filtered shadows "
+                                    "of opaque occluders only; the ray tracer (msm reference) traces them",
+                                    unsupported));
+    for (const scene::LocalLight& spot : spots)
+      if (!(spot.range < scene::LocalLight::kInfiniteRange))
+        throw RenderError("a spot light without \"range\": the renderer's spot shadow maps store distance / range, "
+                          "so a spot light it draws needs a finite range");
   }
 
   // Validates, (re)builds the frame graph where the configuration changed, writes the uniforms.
@@ -327,7 +375,7 @@ struct Renderer::Impl {
                   .msaa = s.msaa,
                   .taps = s.filter_size,
                   .sigma = s.filter_sigma,
-                  .lights = int(frame_lights.size()),
+                  .lights = int(frame_lights.size() + spot_lights().size()),
                   .one_pass = one_pass,
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
@@ -339,7 +387,8 @@ struct Renderer::Impl {
                   .textured_draws = has_textured_draws(gpu),
                   .sub_lights = std::ranges::any_of(
                       lights_of(s), [](const scene::DirectionalLight& l) { return !l.sub_lights.empty(); }),
-                  .front_back = s.front_back_depth};
+                  .front_back = s.front_back_depth,
+                  .spot_lights = int(spot_lights().size())};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     c.mip_levels =
@@ -383,6 +432,7 @@ struct Renderer::Impl {
     std::ranges::fill(soft_clamps.mapped<std::uint32_t>(), 0u);
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
+    for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, spot));
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {

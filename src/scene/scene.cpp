@@ -40,7 +40,7 @@ constexpr LightKindInfo kLightKinds[] = {
      "distance along the light's travel, affine: 0 at the box's near side, 1 at its far side",
      "parallel rays towards towards_light, unbounded; a disc or rectangle of directions when soft", true},
     {LightKind::spot, "spot", kSpotKeys, "perspective, the outer cone's field of view", 1, "radial distance / range",
-     "a shadow ray to the light's position (bounded by the distance)", false},
+     "a shadow ray to the light's position (bounded by the distance)", true},
     {LightKind::point, "point", kPointKeys, "six perspective faces of a cube, 90 degrees each", 6,
      "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", false},
 };

@@ -39,14 +39,16 @@ struct FrameUniforms {
   vec4 camera_viewport;    // xy: the camera image's size in pixels (msm_surface_footprint), zw: unused
 };
 
-// One shadow-casting directional light of the frame: its shadow map is layer `index` of every
-// shadow-map array of the frame (a storage buffer of these, binding named by each pipeline).
+// One shadow-casting light of the frame, directional or spot: its shadow map is layer `index` of
+// every shadow-map array of the frame (a storage buffer of these, binding named by each pipeline).
 struct LightUniforms {
-  mat4 view_projection; // world -> its shadow-map clip space (orthographic, depth in [0,1])
+  mat4 view_projection; // world -> its shadow-map clip space (directional: orthographic, depth in
+                        // [0,1]; spot: perspective, its map storing radial distance / range)
   mat4 normal_matrix;   // inverse transpose of the 3x3 part (normals -> clip space)
   vec4 towards_light;   // xyz: unit direction from the scene towards the light,
                         // w: normal offset in world units (RenderSettings::normal_offset texels)
-  vec4 irradiance;      // rgb: irradiance on a surface facing the light, a: unused
+  vec4 irradiance;      // rgb: irradiance on a surface facing the light (a spot: its radiant
+                        // intensity, W/sr, msm_local_light_irradiance), a: unused
   vec4 soft;            // soft shadows: xy: texels of reach per unit of [-1,1] depth
                         // (msm_soft_spread), z: the light's cone half-angle in radians for the
                         // shading's msm_cone_cosine (0: a point light, max(n·l, 0)), w: unused
@@ -55,6 +57,10 @@ struct LightUniforms {
                         // shaded by soft.z); the shading's msm_light_cosine takes both. zw: its
                         // sub-lights (w of them, 0: none): entry z of the same array their summary
                         // (SubLightsSummary below), [z + 1, z + 1 + w) the sub-lights
+  vec4 spot_position;   // a spot light: xyz its position, w its range (> 0); w = 0: a directional light
+  vec4 spot_axis;       // xyz: the unit direction the spot shines in, w: tan of its outer half-angle
+  vec4 spot_cone;       // x: cos of the outer half-angle, y: of the inner, z: normal offset in world
+                        // units per metre of distance from the light, w: unused
 };
 
 // The entry before a light's sub-lights in the lights' array: their linear part and the rectangle
@@ -73,7 +79,7 @@ MSM_FN LightUniforms msm_sub_lights_summary_entry(SubLightsSummary s) {
   packed[3] = vec4(s.bounds, 0.0f, 1.0f);
   mat4 axes = mat4(vec4(s.x_axis, 0.0f), vec4(s.y_axis, 0.0f), vec4(0.0f), vec4(0.0f));
   vec4 zero = vec4(0.0f);
-  return LightUniforms(packed, axes, zero, zero, zero, zero, zero);
+  return LightUniforms(packed, axes, zero, zero, zero, zero, zero, zero, zero, zero);
 }
 MSM_FN SubLightsSummary msm_sub_lights_summary(mat4 view_projection, mat4 normal_matrix) {
   return SubLightsSummary(mat3(view_projection), vec2(view_projection[3][0], view_projection[3][1]),
@@ -117,6 +123,7 @@ struct ObjectPush {
 #define MSM_SPEC_FRONT_BACK 13        // bool: the mean of front- and back-face depth (moment_resolve.glsl)
 #define MSM_SPEC_SCATTER_LAYERS 14    // int: transmittance layers per light (scatter.glsl)
 #define MSM_SPEC_SCATTER_BETA_MODE 15 // int: MSM_SCATTERING_BETA_* (scatter.glsl)
+#define MSM_SPEC_SPOT_LIGHTS 16       // bool: some light of the frame is a spot light (shading.glsl)
 // The blur's specialization constants (blur.comp, passes/blur_pass.cpp): id MSM_BLUR_SPEC_ID holds
 // the fetches per side, + 1 the centre weight, + 2 + i the offset and + 2 + MSM_BLUR_MAX_PAIRS + i
 // the weight of fetch i + 1 (msm_filter_pairs of the largest kernel: 16); + 2 + 2 MSM_BLUR_MAX_PAIRS
@@ -158,8 +165,9 @@ static_assert(sizeof(msm::FrameUniforms) == 544 && offsetof(msm::FrameUniforms, 
               offsetof(msm::FrameUniforms, filter_weights) == 128 && offsetof(msm::FrameUniforms, lookup) == 384 &&
               offsetof(msm::FrameUniforms, sample_offsets) == 432 && offsetof(msm::FrameUniforms, lights) == 512 &&
               offsetof(msm::FrameUniforms, camera_viewport) == 528);
-static_assert(sizeof(msm::LightUniforms) == 208 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
-              offsetof(msm::LightUniforms, towards_light) == 128 && offsetof(msm::LightUniforms, rect_extent) == 192);
+static_assert(sizeof(msm::LightUniforms) == 256 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
+              offsetof(msm::LightUniforms, towards_light) == 128 && offsetof(msm::LightUniforms, rect_extent) == 192 &&
+              offsetof(msm::LightUniforms, spot_cone) == 240);
 static_assert(sizeof(msm::ObjectPush) == 64 && offsetof(msm::ObjectPush, light) == 48);
 static_assert(sizeof(msm::ImagePassPush) == 16);
 static_assert(sizeof(msm::ScatteringPush) == 128 && offsetof(msm::ScatteringPush, sky) == 112);

@@ -31,6 +31,7 @@ class ShadowDepthPass : public Pass {
  private:
   const vk::Program* program_ = nullptr;
   const vk::Program* masked_program_ = nullptr; // alpha-tested draws: a fragment stage discards cut-outs
+  const vk::Program* spot_program_ = nullptr;   // spot lights' layers: radial depth, alpha-tested
   FrameConfig config_;
   bool back_ = false;
 };

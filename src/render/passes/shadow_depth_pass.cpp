@@ -37,6 +37,22 @@ void ShadowDepthPass::prepare(const PassResources& r) {
        .depth_format = VK_FORMAT_D16_UNORM,
        .samples = VkSampleCountFlagBits(config.msaa),
        .depth_clamp = true});
+  if (config.spot_lights > 0)
+    spot_program_ = &r.programs.graphics(
+        {.name = "shadow_depth (spot)",
+         .vertex_shader = "shadow_depth_spot.vert",
+         .fragment_shader = "shadow_depth_spot.frag",
+         // the alpha-tested variant's bindings: the same opacity texture and lights
+         .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                      {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY, vk::Binding::sampled_image},
+                                      {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Binding::storage_buffer}}),
+         .push_constant_size = sizeof(ObjectPush),
+         .vertex_stride = sizeof(Vertex),
+         .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                        {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+         .depth_format = VK_FORMAT_D16_UNORM,
+         .samples = VkSampleCountFlagBits(config.msaa),
+         .depth_clamp = true});
 }
 
 void ShadowDepthPass::reflect(PassBuilder& b) const {
@@ -65,25 +81,28 @@ void ShadowDepthPass::execute(const PassContext& c) const {
     bind_scene(c.cmd, c.frame.scene);
     const GpuScene& scene = c.frame.scene;
     const vk::Program* bound = nullptr;
+    // The spot lights' layers follow the directional lights' (FrameConfig::spot_lights).
+    const bool spot = l >= config_.lights - config_.spot_lights;
     for (const Draw& d : scene.draws) {
       if (back_) {
         VkCullModeFlags want = d.double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_FRONT_BIT;
         if (want != cull) vkCmdSetCullMode(c.cmd, want);
         cull = want;
       }
-      if (d.masked) { // its own opacity texture and cutoff
+      if (d.masked || spot) { // its own opacity texture and cutoff
         const vk::Image& opacity =
             d.opacity_texture >= 0 ? scene.opacity_textures[size_t(d.opacity_texture)] : scene.white;
         ObjectPush push = d.push;
         push.light.x = l;
+        const vk::Program* program = spot ? spot_program_ : masked_program_;
         vk::bind_program(
-            c.cmd, *masked_program_,
+            c.cmd, *program,
             {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
              {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY,
               vk::Descriptor(opacity.view(), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, scene.texture_sampler)},
              {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Descriptor(c.frame.lights)}},
             push);
-        bound = masked_program_;
+        bound = program;
       } else if (bound != program_) {
         ObjectPush push{};
         push.light.x = l;

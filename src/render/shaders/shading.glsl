@@ -4,6 +4,7 @@
 // family of techniques; it reads layer `shadow_layer` of the shadow-map arrays (the light being
 // evaluated).
 #include "msm/footprint.h"
+#include "msm/local_light.h"
 #include "msm/shading.h"
 #include "msm/techniques.h"
 #define MSM_LIGHT_BINDING MSM_BINDING_SHADING_LIGHTS
@@ -19,6 +20,10 @@ layout(constant_id = MSM_SPEC_TEXTURED_DRAWS) const bool kTexturedDraws = true;
 // Whether some light of the frame has sub-lights (FrameConfig::sub_lights, a probe's "sub_lights"):
 // a constant, so that frames without them compile none of their loop.
 layout(constant_id = MSM_SPEC_SUB_LIGHTS) const bool kSubLights = false;
+// Whether some light of the frame is a spot light (FrameConfig::spot_lights): a constant, so that
+// frames of directional lights compile none of the spot lights' projection and irradiance.
+layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
+bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
 
 layout(binding = MSM_BINDING_SHADING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
 layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
@@ -68,30 +73,72 @@ float shadow_intensity(ShadowLookup s);
 vec3 shadow_intensity_rgb(ShadowLookup s);
 #endif
 
+// The change of the map coordinate t (texels) along the world vector v at a point of clip
+// coordinates clip in spot light l's perspective map.
+vec2 spot_texels_along(int l, vec4 clip, vec3 v) {
+  vec4 dv = lights[l].view_projection * vec4(v, 0.0f);
+  return (vec2(dv) - vec2(clip) * (dv.w / clip.w)) * (0.5f * frame.shadow_map.x / clip.w);
+}
+
+// Spot light l's lookup of the receiver at world_position with normal n (docs/techniques.md, "Light
+// kinds"): projected as the shadow pass projects the casters, its depth in the map's convention
+// (radial distance / range) less the depth bias, which like the normal offset grows with the
+// texel's world size (distance × texel angle): frame.shadow_map.w is the bias relative to the map's
+// width where the receiver is. Returns whether the receiver is inside the map's frustum.
+bool spot_lookup(int l, vec3 n, float n_dot_l, MsmFootprint pixel, out ShadowLookup s) {
+  vec3 light_position = lights[l].spot_position.xyz;
+  float range = lights[l].spot_position.w;
+  float width_per_distance = 2.0f * lights[l].spot_axis.w;
+  vec3 p = world_position + n * (lights[l].spot_cone.z * distance(world_position, light_position) * (1.0f - n_dot_l));
+  vec4 clip = lights[l].view_projection * vec4(p, 1.0f);
+  vec2 ndc = vec2(clip) / clip.w;
+  s.t = (ndc * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
+  s.dt_dx = spot_texels_along(l, clip, pixel.dp_dx);
+  s.dt_dy = spot_texels_along(l, clip, pixel.dp_dy);
+  float r = distance(p, light_position);
+  s.z = (r - frame.shadow_map.w * width_per_distance * r) / range;
+  // The receiver plane's radial depth per texel: d(r)/d(tangent) times d(tangent)/d(t).
+  vec3 tangent_x = normalize(abs(n.x) > 0.5f ? cross(n, vec3(0.0f, 1.0f, 0.0f)) : cross(n, vec3(1.0f, 0.0f, 0.0f)));
+  vec3 tangent_y = cross(n, tangent_x);
+  mat2 texels_per_tangent = mat2(spot_texels_along(l, clip, tangent_x), spot_texels_along(l, clip, tangent_y));
+  vec3 away = (p - light_position) / max(r, 1e-20f);
+  vec2 depth_per_tangent = vec2(dot(away, tangent_x), dot(away, tangent_y)) / range;
+  float det = determinant(texels_per_tangent);
+  float slope_limit = MSM_MAX_RECEIVER_DEPTH_SLOPE;
+  s.depth_per_texel = abs(det) > 1e-12f
+                          ? clamp(depth_per_tangent * inverse(texels_per_tangent), -slope_limit, slope_limit)
+                          : vec2(0.0f);
+  return clip.w > 0.0f && all(lessThanEqual(abs(ndc), vec2(1.0f))) && s.z <= 1.0f;
+}
 
 // Visibility of light l at the surface, per colour channel: 0 where none of its light reaches the
 // surface (lit <= 0: its cosine factor, or with sub-lights their unshadowed irradiance's largest
 // channel; the surface's own shadow).
 vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixel) {
   current_layer = l;
-  // Normal offset: more at grazing light, where depth varies fastest across a texel.
-  vec3 p = world_position + n * (lights[l].towards_light.w * (1.0f - n_dot_l));
-  vec4 clip = lights[l].view_projection * vec4(p, 1.0f);
   ShadowLookup s;
-  s.t = (clip.xy * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
-  float texels_per_clip_unit = 0.5f * frame.shadow_map.x;
-  s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
-  s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
-  if (lit <= 0.0f) return vec3(0.0f);
-  vec3 nc = mat3(lights[l].normal_matrix) * n;
-  s.z = clip.z - frame.shadow_map.w;
-  // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
-  float slope_limit = MSM_MAX_RECEIVER_DEPTH_SLOPE; // per texel (frame.h)
-  s.depth_per_texel = abs(nc.z) > 1e-6f
-                          ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
-                          : vec2(0.0f);
-  bool inside = all(greaterThanEqual(clip.xy, vec2(-1.0f))) && all(lessThanEqual(clip.xy, vec2(1.0f))) &&
-                clip.z <= 1.0f;
+  bool inside;
+  if (is_spot(l)) {
+    if (lit <= 0.0f) return vec3(0.0f);
+    inside = spot_lookup(l, n, n_dot_l, pixel, s);
+  } else {
+    // Normal offset: more at grazing light, where depth varies fastest across a texel.
+    vec3 p = world_position + n * (lights[l].towards_light.w * (1.0f - n_dot_l));
+    vec4 clip = lights[l].view_projection * vec4(p, 1.0f);
+    s.t = (clip.xy * 0.5f + 0.5f) * frame.shadow_map.x - 0.5f;
+    float texels_per_clip_unit = 0.5f * frame.shadow_map.x;
+    s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
+    s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
+    if (lit <= 0.0f) return vec3(0.0f);
+    vec3 nc = mat3(lights[l].normal_matrix) * n;
+    s.z = clip.z - frame.shadow_map.w;
+    // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
+    float slope_limit = MSM_MAX_RECEIVER_DEPTH_SLOPE; // per texel (frame.h)
+    s.depth_per_texel = abs(nc.z) > 1e-6f
+                            ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
+                            : vec2(0.0f);
+    inside = all(greaterThanEqual(clip.xy, vec2(-1.0f))) && all(lessThanEqual(clip.xy, vec2(1.0f))) && clip.z <= 1.0f;
+  }
 #ifdef MSM_COLOURED_SHADOWS
   vec3 shadow = inside ? shadow_intensity_rgb(s) : vec3(0.0f);
 #else
@@ -125,8 +172,21 @@ vec3 sub_lights_irradiance(int l, vec3 n, int count) {
 // Light l's direct light at the surface with normal n (towards the viewer), added to direct, and
 // its visibility, returned and added to weighted with the irradiance it brings (luminance of
 // E max(n·l, 0), for area lights msm_light_cosine: the same factor as the shading) as its weight.
-vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inout vec3 weighted, inout float weight_sum) {
-  float n_dot_l = dot(n, lights[l].towards_light.xyz);
+vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inout vec3 weighted,
+                      inout float weight_sum) {
+  // A spot light: its direction and irradiance at the surface (msm_local_light_irradiance, the ray
+  // tracer's formula); a directional light's are the same everywhere.
+  vec3 towards_light = lights[l].towards_light.xyz;
+  vec3 irradiance = lights[l].irradiance.rgb;
+  if (is_spot(l)) {
+    vec3 to_light = lights[l].spot_position.xyz - world_position;
+    float d = length(to_light);
+    towards_light = to_light / max(d, 1e-20f);
+    irradiance = msm_local_light_irradiance(irradiance, d, lights[l].spot_position.w,
+                                            dot(-towards_light, lights[l].spot_axis.xyz), lights[l].spot_cone.x,
+                                            lights[l].spot_cone.y);
+  }
+  float n_dot_l = dot(n, towards_light);
   // Area lights: the cosine integrated over the part of the light above the surface's horizon
   // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
   // the rectangle clipped by the horizon plane (msm_rect_light_cosine) or the disc's cone
@@ -149,14 +209,17 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
                                  lights[l].soft.z)
               : msm_cone_cosine(n_dot_l, 0.0f);
   }
+  // Where a spot light brings nothing (outside its cone, beyond its range) its visibility is 0, as
+  // where a surface faces away from a light.
+  if (is_spot(l) && max(irradiance.r, max(irradiance.g, irradiance.b)) <= 0.0f) lit = 0.0f;
   vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
   float w;
   if (sub_count > 0) {
     direct += msm_direct_light(unshadowed, 1.0f, v);
     w = msm_luminance(unshadowed);
   } else {
-    direct += msm_direct_light(lights[l].irradiance.rgb, lit, v);
-    w = msm_luminance(lights[l].irradiance.rgb) * lit;
+    direct += msm_direct_light(irradiance, lit, v);
+    w = msm_luminance(irradiance) * lit;
   }
   weighted += w * v;
   weight_sum += w;
