@@ -581,6 +581,15 @@ void write_results(const BenchOptions& o, const nlohmann::json& doc, const std::
   if (!o.markdown.empty()) write(o.markdown, md);
 }
 
+namespace {
+// --frames, --warmup and --repeats within their ranges; UsageError otherwise.
+void check_frame_counts(const BenchOptions& o) {
+  if (o.frames < 1 || o.frames > 10000) throw UsageError("--frames must be in [1, 10000]");
+  if (o.warmup < 0 || o.warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
+  if (o.repeats < 1 || o.repeats > 1000) throw UsageError("--repeats must be in [1, 1000]");
+}
+} // namespace
+
 void add_bench(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
@@ -589,9 +598,7 @@ void add_bench(CLI::App& app) {
   cmd->callback([opt, cmd] {
     apply_bench_defaults(*opt, *cmd);
     finish_frame_options(opt->frame);
-    if (opt->frames < 1 || opt->frames > 10000) throw UsageError("--frames must be in [1, 10000]");
-    if (opt->warmup < 0 || opt->warmup > 1000) throw UsageError("--warmup must be in [0, 1000]");
-    if (opt->repeats < 1 || opt->repeats > 1000) throw UsageError("--repeats must be in [1, 1000]");
+    check_frame_counts(*opt);
     if (!opt->probe.probe.empty()) {
       bench_probe(opt->probe, opt->frame.device, opt->frames, opt->warmup, opt->json, opt->markdown);
       return;
