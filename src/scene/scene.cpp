@@ -1013,6 +1013,7 @@ Scene load_scene_file(const std::filesystem::path& file) {
   text << in.rdbuf();
   Scene s = load_scene_json(text.str(), file.parent_path(), file.string());
   s.source = file;
+  if (s.name.empty()) s.name = file.stem().string(); // outputs and messages name every scene
   return s;
 }
 

@@ -533,6 +533,7 @@ TEST(Import, ObjPlyOffGltf) {
       dir.write("scenes/s.json",
                 scene_with_object(R"({"name": "m", "mesh": "../m.obj", "transform": {"translate": [0, 0, 7]}})"));
   const Scene s = load_scene_file(scene);
+  EXPECT_EQ(s.name, "s"); // no "name": the file's stem
   EXPECT_EQ(s.triangle_count(), 3u);
   EXPECT_NEAR(s.bounds().min.z, 7.0f, 1e-6f);
   EXPECT_EQ(s.objects[0].mesh_file, (dir.path() / "m.obj").lexically_normal());

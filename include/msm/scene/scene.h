@@ -487,7 +487,7 @@ struct LightFrame {
 };
 
 struct Scene {
-  std::string name;
+  std::string name;             // "name", else a scene file's stem
   std::filesystem::path source; // the scene file, or "builtin:<name>"
   std::vector<Material> materials;
   std::vector<Object> objects;
