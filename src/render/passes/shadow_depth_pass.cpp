@@ -23,36 +23,29 @@ void ShadowDepthPass::prepare(const PassResources& r) {
        .samples = VkSampleCountFlagBits(config.msaa),
        // casters in front of the fitted near plane still cast
        .depth_clamp = true});
-  masked_program_ = &r.programs.graphics(
-      {.name = "shadow_depth (alpha-tested)",
-       .vertex_shader = "shadow_depth_masked.vert",
-       .fragment_shader = "shadow_depth_masked.frag",
-       .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
-                                    {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY, vk::Binding::sampled_image},
-                                    {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Binding::storage_buffer}}),
-       .push_constant_size = sizeof(ObjectPush),
-       .vertex_stride = sizeof(Vertex),
-       .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
-                      {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
-       .depth_format = VK_FORMAT_D16_UNORM,
-       .samples = VkSampleCountFlagBits(config.msaa),
-       .depth_clamp = true});
-  if (config.spot_lights > 0)
-    spot_program_ = &r.programs.graphics(
-        {.name = "shadow_depth (spot)",
-         .vertex_shader = "shadow_depth_spot.vert",
-         .fragment_shader = "shadow_depth_spot.frag",
-         // the alpha-tested variant's bindings: the same opacity texture and lights
-         .bindings = vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
-                                      {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY, vk::Binding::sampled_image},
-                                      {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Binding::storage_buffer}}),
-         .push_constant_size = sizeof(ObjectPush),
-         .vertex_stride = sizeof(Vertex),
-         .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
-                        {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
-         .depth_format = VK_FORMAT_D16_UNORM,
-         .samples = VkSampleCountFlagBits(config.msaa),
-         .depth_clamp = true});
+  // The alpha-tested variant; the spot lights' pass has its bindings and state, and its own shaders.
+  vk::GraphicsDesc masked{.name = "shadow_depth (alpha-tested)",
+                          .vertex_shader = "shadow_depth_masked.vert",
+                          .fragment_shader = "shadow_depth_masked.frag",
+                          .bindings =
+                              vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
+                                               {MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY, vk::Binding::sampled_image},
+                                               {MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS, vk::Binding::storage_buffer}}),
+                          .push_constant_size = sizeof(ObjectPush),
+                          .vertex_stride = sizeof(Vertex),
+                          .attributes = {{0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
+                                         {2, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}},
+                          .depth_format = VK_FORMAT_D16_UNORM,
+                          .samples = VkSampleCountFlagBits(config.msaa),
+                          .depth_clamp = true};
+  masked_program_ = &r.programs.graphics(masked);
+  if (config.spot_lights > 0) {
+    vk::GraphicsDesc spot = masked;
+    spot.name = "shadow_depth (spot)";
+    spot.vertex_shader = "shadow_depth_spot.vert";
+    spot.fragment_shader = "shadow_depth_spot.frag";
+    spot_program_ = &r.programs.graphics(spot);
+  }
 }
 
 void ShadowDepthPass::reflect(PassBuilder& b) const {
