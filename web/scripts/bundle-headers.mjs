@@ -2,7 +2,7 @@
 // into JavaScript strings, for WebGL 2, which has no #include: each bundle is one entry header with
 // the headers it includes resolved depth first, each header once (where its first #include stands;
 // the include guards stay), comments, blank lines and the C++ standard and GLM #include <...> lines
-// of shared.h's C++ branch removed (three.js would try to resolve them as its shader chunks).
+// of shared.h's C++ part removed (three.js would try to resolve them as its shader chunks).
 // Nothing else changes: every code line of the bundle is a line of a header.
 //
 //   node scripts/bundle-headers.mjs          writes the bundles
