@@ -4,6 +4,7 @@
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
+#include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
 #include "msm/test/image_compare.h"
@@ -59,11 +60,7 @@ double mae_bound(double measured) { return std::max(1.5 * measured, measured + 0
 constexpr int kWidth = 200, kHeight = 112, kShadowSize = 512;
 
 RenderSettings settings(std::string technique) {
-  RenderSettings s;
-  s.technique = std::move(technique);
-  s.width = kWidth;
-  s.height = kHeight;
-  s.shadow_size = kShadowSize;
+  RenderSettings s = test::render_settings(std::move(technique), kWidth, kHeight, kShadowSize);
   s.msaa = 4;
   s.mipmaps = false;
   return s;

@@ -7,6 +7,7 @@
 #include "msm/scene/scene.h"
 #include "msm/shading.h"
 #include "msm/techniques.h"
+#include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
 #include "msm/test/image_compare.h"
@@ -76,11 +77,7 @@ scene::Scene spot_scene() {
 constexpr int kWidth = 200, kHeight = 150, kShadowSize = 512;
 
 RenderSettings spot_settings(std::string technique) {
-  RenderSettings s;
-  s.technique = std::move(technique);
-  s.width = kWidth;
-  s.height = kHeight;
-  s.shadow_size = kShadowSize;
+  RenderSettings s = test::render_settings(std::move(technique), kWidth, kHeight, kShadowSize);
   s.msaa = 4;
   return s;
 }

@@ -16,6 +16,7 @@
 
 #include "msm/scene/scene.h"
 #include "msm/test/gltf_writer.h"
+#include "msm/test/scene_error.h"
 #include "msm/test/temp_dir.h"
 
 namespace fs = std::filesystem;
@@ -403,19 +404,6 @@ std::string lights_scene(const std::string& object_extra, const std::string& lig
 
 const double kSqrtHalf = std::sqrt(0.5);
 
-// Expects a SceneError whose message contains every one of the given fragments.
-template <class F>
-void expect_error(F&& f, std::initializer_list<std::string> fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "no SceneError thrown (expected one mentioning '" << *fragments.begin() << "')";
-  } catch (const SceneError& e) {
-    const std::string what = e.what();
-    for (const std::string& frag : fragments)
-      EXPECT_NE(what.find(frag), std::string::npos) << "'" << frag << "' not in: " << what;
-  }
-}
-
 } // namespace
 
 TEST(GltfLights, ImportedWithTheNodeHierarchyAndTheObjectTransform) {
@@ -473,23 +461,25 @@ TEST(GltfLights, BadLightsAndMisuseAreClearErrors) {
   };
   // glTF allows an outer cone of π/2; a perspective shadow map does not.
   with_light({{"type", "spot"}, {"name", "wide"}, {"spot", {{"outerConeAngle", std::numbers::pi / 2.0}}}});
-  expect_error([&] { load(dir, lights_scene("")); },
-               {"/objects/0/import_lights", "lamp.gltf", "light 0 ('wide')", "outer_cone_deg", "(0, 90)"});
+  msm::test::expect_scene_error(
+      [&] { load(dir, lights_scene("")); },
+      {"/objects/0/import_lights", "lamp.gltf", "light 0 ('wide')", "outer_cone_deg", "(0, 90)"});
   with_light({{"type", "spot"}, {"spot", {{"innerConeAngle", 0.6}, {"outerConeAngle", 0.5}}}});
-  expect_error([&] { load(dir, lights_scene("")); }, {"inner_cone_deg", "wider"});
+  msm::test::expect_scene_error([&] { load(dir, lights_scene("")); }, {"inner_cone_deg", "wider"});
   with_light({{"type", "point"}, {"range", -1.0}});
-  expect_error([&] { load(dir, lights_scene("")); }, {"range"});
+  msm::test::expect_scene_error([&] { load(dir, lights_scene("")); }, {"range"});
   with_light({{"type", "area"}});
-  expect_error([&] { load(dir, lights_scene("")); }, {"/objects/0/import_lights", "type 'area'"});
+  msm::test::expect_scene_error([&] { load(dir, lights_scene("")); }, {"/objects/0/import_lights", "type 'area'"});
   // A file without lights, and no light in the scene either.
   write_quad(dir.path() / "lamp.gltf");
-  expect_error([&] { load(dir, lights_scene("")); }, {"/objects", "no light"});
+  msm::test::expect_scene_error([&] { load(dir, lights_scene("")); }, {"/objects", "no light"});
   EXPECT_EQ(load(dir, lights_scene("", R"("light": {"towards_light": [0, 1, 0]}, )")).lights.size(), 1u);
   // Not a glTF file; a primitive.
   std::ofstream(dir.path() / "lamp.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-  expect_error([&] { load(dir, R"({"msm_scene": 1, "objects": [{"mesh": "lamp.obj", "import_lights": true}]})"); },
-               {"/objects/0/import_lights", "glTF"});
-  expect_error(
+  msm::test::expect_scene_error(
+      [&] { load(dir, R"({"msm_scene": 1, "objects": [{"mesh": "lamp.obj", "import_lights": true}]})"); },
+      {"/objects/0/import_lights", "glTF"});
+  msm::test::expect_scene_error(
       [&] {
         load(dir, R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]},
                   "objects": [{"primitive": {"type": "box", "size": [1, 1, 1]}, "import_lights": true}]})");

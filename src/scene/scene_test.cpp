@@ -15,6 +15,7 @@
 #include "msm/light_probe.h"
 #include "msm/probe/probe.h"
 #include "msm/scene/scene.h"
+#include "msm/test/scene_error.h"
 #include "msm/test/temp_dir.h"
 #include "msm/util/random.h"
 
@@ -56,21 +57,8 @@ std::string scene_with_object(const std::string& object_json, const std::string&
   return R"({"msm_scene": 1, "light": {"towards_light": [0, 1, 0]}, )" + extra + R"("objects": [)" + object_json + "]}";
 }
 
-// Expects a SceneError whose message contains every one of the given fragments.
-template <class F>
-void expect_error(F&& f, std::initializer_list<std::string> fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "no SceneError thrown (expected one mentioning '" << *fragments.begin() << "')";
-  } catch (const SceneError& e) {
-    const std::string what = e.what();
-    for (const std::string& frag : fragments)
-      EXPECT_NE(what.find(frag), std::string::npos) << "'" << frag << "' not in: " << what;
-  } catch (const std::exception& e) { ADD_FAILURE() << "not a SceneError: " << e.what(); }
-}
-
 void expect_json_error(const std::string& json, std::initializer_list<std::string> fragments) {
-  expect_error([&] { load_scene_json(json, fs::current_path(), "test.json"); }, fragments);
+  msm::test::expect_scene_error([&] { load_scene_json(json, fs::current_path(), "test.json"); }, fragments);
 }
 
 } // namespace
@@ -353,7 +341,7 @@ TEST(Matrices, CameraUsesVulkanClipConventions) {
   glm::vec4 f = m * glm::vec4(s.camera.position + s.camera.far * dir, 1.0f);
   EXPECT_NEAR(n.z / n.w, 0.0f, 1e-5f);
   EXPECT_NEAR(f.z / f.w, 1.0f, 1e-5f);
-  expect_error([&] { (void)s.camera.projection(0.0f); }, {"aspect"});
+  msm::test::expect_scene_error([&] { (void)s.camera.projection(0.0f); }, {"aspect"});
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -577,10 +565,12 @@ TEST(Import, TruncatedPlyIsAnErrorNotAnAbort) {
   TempDir dir("msm_scene_test");
   const fs::path truncated = dir.write("truncated.ply", head);
   // Caught by the check of the ASCII body (mesh_header.cpp) before Assimp reads it.
-  expect_error([&] { (void)import_mesh(truncated); },
-               {"truncated.ply", "the PLY body ends in element 'vertex' (5314 of 11184 read; truncated?)"});
+  msm::test::expect_scene_error(
+      [&] { (void)import_mesh(truncated); },
+      {"truncated.ply", "the PLY body ends in element 'vertex' (5314 of 11184 read; truncated?)"});
   const fs::path short_file = dir.write("short.ply", head.substr(0, 40000));
-  expect_error([&] { (void)import_mesh(short_file); }, {"short.ply", "at least 186,408 bytes", "truncated or corrupt"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(short_file); },
+                                {"short.ply", "at least 186,408 bytes", "truncated or corrupt"});
   // The importer still works afterwards.
   EXPECT_GT(import_mesh(wuson).triangle_count(), 0u);
 }
@@ -624,8 +614,8 @@ TEST(Import, TriangleLimitCheckedFromTheFileBeforeImport) {
                                        dir.write("fan.off", fan_off(n))};
   ::setenv("MSM_MAX_TRIANGLES", "1000", 1);
   for (const fs::path& file : files)
-    expect_error([&] { (void)import_mesh(file); },
-                 {file.filename().string(), "declares 1,001", "the limit is 1,000", "MSM_MAX_TRIANGLES"});
+    msm::test::expect_scene_error([&] { (void)import_mesh(file); }, {file.filename().string(), "declares 1,001",
+                                                                     "the limit is 1,000", "MSM_MAX_TRIANGLES"});
   // glTF: a one-triangle mesh shown by 1001 nodes is 1001 triangles after PreTransformVertices.
   std::string nodes;
   for (int i = 0; i < n; ++i) nodes += std::string(i ? "," : "") + R"({"mesh":0})";
@@ -633,7 +623,8 @@ TEST(Import, TriangleLimitCheckedFromTheFileBeforeImport) {
       dir.write("instanced.gltf", R"({"asset":{"version":"2.0"},"nodes":[)" + nodes +
                                       R"(],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
                                       R"("accessors":[{"count":3},{"count":3}]})");
-  expect_error([&] { (void)import_mesh(gltf); }, {"instanced.gltf", "declares 1,001 triangles", "the limit is 1,000"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(gltf); },
+                                {"instanced.gltf", "declares 1,001 triangles", "the limit is 1,000"});
   ::setenv("MSM_MAX_TRIANGLES", "1001", 1);
   for (const fs::path& file : files) EXPECT_EQ(import_mesh(file).triangle_count(), std::size_t(n)) << file;
   ::unsetenv("MSM_MAX_TRIANGLES");
@@ -661,35 +652,40 @@ TEST(Import, ImpossiblePlyAndOffHeadersAreErrorsNotHangs) {
   const fs::path no_end =
       dir.write("no_end.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
                               "property float y\nproperty float z\nend_headlr\n0 0 0\n1 0 0\n0 1 0\n");
-  expect_error([&] { (void)import_mesh(no_end); }, {"no_end.ply", "no end_header", "truncated or corrupt"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(no_end); },
+                                {"no_end.ply", "no end_header", "truncated or corrupt"});
   const fs::path glued =
       dir.write("glued.ply", std::string("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
                                          "property float y\nproperty float z\nend_header\x08") +
                                  "0 0 0\n1 0 0\n0 1 0\n");
-  expect_error([&] { (void)import_mesh(glued); }, {"glued.ply", "no end_header"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(glued); }, {"glued.ply", "no end_header"});
   const fs::path binary_line =
       dir.write("binary_line.ply", std::string("ply\nformat ascii 1.0\nproperty list ucha\0\0\"a\"\n"
                                                "end_header\n0 0 0\n",
                                                62));
-  expect_error([&] { (void)import_mesh(binary_line); }, {"binary_line.ply", "line 3 of the PLY header is not text"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(binary_line); },
+                                {"binary_line.ply", "line 3 of the PLY header is not text"});
   const fs::path many = dir.write("many.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
                                               "property float x\nproperty float y\nproperty float z\nend_header\n");
-  expect_error([&] { (void)import_mesh(many); }, {"many.ply", "48,000,000,000 bytes", "truncated or corrupt"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(many); },
+                                {"many.ply", "48,000,000,000 bytes", "truncated or corrupt"});
   // An ASCII body that breaks the format (Assimp read past its buffers on one: a bus error, the
   // fuzzer's find in tests/fuzz/crashes/mesh_import): a vertex line of five values for three
   // properties, a face index beyond the vertices, a word that is not a number.
   const std::string ply_head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
                                "property float z\nelement face 1\nproperty list uchar int vertex_index\nend_header\n";
   const fs::path extra = dir.write("extra.ply", ply_head + "0 0 0\n4 0 1 3 2\n0 1 0\n3 0 1 2\n");
-  expect_error([&] { (void)import_mesh(extra); },
-               {"extra.ply", "line 2 of the PLY body has 5 values; element 'vertex' declares 3"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(extra); },
+                                {"extra.ply", "line 2 of the PLY body has 5 values; element 'vertex' declares 3"});
   const fs::path index = dir.write("index.ply", ply_head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 51\n");
-  expect_error([&] { (void)import_mesh(index); }, {"index.ply", "vertex index 51 of 3 vertices"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(index); }, {"index.ply", "vertex index 51 of 3 vertices"});
   const fs::path word = dir.write("word.ply", ply_head + "0 0 0\n1 0 0\n0 1 zero\n3 0 1 2\n");
-  expect_error([&] { (void)import_mesh(word); }, {"word.ply", "line 3 of the PLY body: 'zero' is not a number"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(word); },
+                                {"word.ply", "line 3 of the PLY body: 'zero' is not a number"});
   EXPECT_GT(import_mesh(dir.write("good.ply", ply_head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")).triangle_count(), 0u);
   const fs::path off = dir.write("many.off", "OFF\n1000000 3 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  expect_error([&] { (void)import_mesh(off); }, {"many.off", "1,000,000 vertices", "truncated or corrupt"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(off); },
+                                {"many.off", "1,000,000 vertices", "truncated or corrupt"});
   // A GLB whose JSON chunk, or the binary chunk after it, claims more than the file holds: Assimp
   // would allocate the claim first (4.1 GB from a file of a few hundred bytes: the fuzzer's find,
   // tests/fuzz/crashes/mesh_import). The same file with honest lengths still loads.
@@ -703,11 +699,12 @@ TEST(Import, ImpossiblePlyAndOffHeadersAreErrorsNotHangs) {
            std::string("BIN\0", 4) + std::string(4, '\0');
   };
   const fs::path json_claim = dir.write("json_claim.glb", glb(0xf4620100u, 4));
-  expect_error([&] { (void)import_mesh(json_claim); },
-               {"json_claim.glb", "truncated GLB: its JSON chunk claims 4,100,063,488 bytes"});
+  msm::test::expect_scene_error([&] { (void)import_mesh(json_claim); },
+                                {"json_claim.glb", "truncated GLB: its JSON chunk claims 4,100,063,488 bytes"});
   const fs::path bin_claim = dir.write("bin_claim.glb", glb(28, 0x7fffffffu));
-  expect_error([&] { (void)import_mesh(bin_claim); },
-               {"bin_claim.glb", "truncated GLB: its binary chunk claims 2,147,483,647 bytes, the file has 4"});
+  msm::test::expect_scene_error(
+      [&] { (void)import_mesh(bin_claim); },
+      {"bin_claim.glb", "truncated GLB: its binary chunk claims 2,147,483,647 bytes, the file has 4"});
   // Honest lengths: past the header check (Assimp then finds no mesh in it, a different error).
   const fs::path honest = dir.write("honest.glb", glb(28, 4));
   try {
@@ -735,9 +732,9 @@ TEST(Textures, PathRecordedAndLoadedLazily) {
   ASSERT_EQ(img.width, 2);
   ASSERT_EQ(img.height, 1);
   EXPECT_EQ(img.rgba, (std::vector<std::uint8_t>{255, 0, 0, 255, 0, 128, 255, 255}));
-  expect_error([&] { load_texture(dir.path() / "none.png"); }, {"none.png", "does not exist"});
+  msm::test::expect_scene_error([&] { load_texture(dir.path() / "none.png"); }, {"none.png", "does not exist"});
   dir.write("bad.png", "not an image");
-  expect_error([&] { load_texture(dir.path() / "bad.png"); }, {"bad.png", "cannot decode"});
+  msm::test::expect_scene_error([&] { load_texture(dir.path() / "bad.png"); }, {"bad.png", "cannot decode"});
 }
 
 TEST(Materials, TransmissionColor) {
@@ -797,12 +794,13 @@ TEST(Materials, TransmissionColor) {
 
 TEST(Errors, Files) {
   TempDir dir("msm_scene_test");
-  expect_error([&] { load_scene_file(dir.path() / "missing.json"); }, {"missing.json", "does not exist"});
-  expect_error([&] { load_scene_file(dir.path()); }, {"not a regular file"});
+  msm::test::expect_scene_error([&] { load_scene_file(dir.path() / "missing.json"); },
+                                {"missing.json", "does not exist"});
+  msm::test::expect_scene_error([&] { load_scene_file(dir.path()); }, {"not a regular file"});
   const fs::path bad = dir.write("bad.json", R"({"msm_scene": 1, "objects": [ )");
-  expect_error([&] { load_scene_file(bad); }, {"bad.json", "malformed JSON"});
-  expect_error([&] { builtin_scene("nosuch"); }, {"unknown built-in scene 'nosuch'", "fence"});
-  expect_error([&] { load_scene("nosuch"); }, {"nosuch", "neither a built-in scene"});
+  msm::test::expect_scene_error([&] { load_scene_file(bad); }, {"bad.json", "malformed JSON"});
+  msm::test::expect_scene_error([&] { builtin_scene("nosuch"); }, {"unknown built-in scene 'nosuch'", "fence"});
+  msm::test::expect_scene_error([&] { load_scene("nosuch"); }, {"nosuch", "neither a built-in scene"});
 }
 
 // A scene saved as UTF-16 (Windows editors' "Unicode"), with or without a byte-order mark, or as
@@ -923,20 +921,23 @@ TEST(Errors, Meshes) {
   auto load = [&](const std::string& object_json) {
     load_scene_file(dir.write("s.json", scene_with_object(object_json)));
   };
-  expect_error([&] { load(R"({"name": "m", "mesh": "missing.obj"})"); },
-               {"s.json", "/objects/0/mesh", "object 'm'", "missing.obj", "does not exist"});
+  msm::test::expect_scene_error([&] { load(R"({"name": "m", "mesh": "missing.obj"})"); },
+                                {"s.json", "/objects/0/mesh", "object 'm'", "missing.obj", "does not exist"});
   dir.write("garbage.ply", "ply\nthis is not a ply file\n\x01\x02\x03");
-  expect_error([&] { load(R"({"mesh": "garbage.ply"})"); }, {"/objects/0/mesh", "garbage.ply", "truncated or corrupt"});
+  msm::test::expect_scene_error([&] { load(R"({"mesh": "garbage.ply"})"); },
+                                {"/objects/0/mesh", "garbage.ply", "truncated or corrupt"});
   dir.write("empty.obj", "# nothing\n");
-  expect_error([&] { load(R"({"mesh": "empty.obj"})"); }, {"/objects/0/mesh", "empty.obj"});
+  msm::test::expect_scene_error([&] { load(R"({"mesh": "empty.obj"})"); }, {"/objects/0/mesh", "empty.obj"});
   dir.write("degenerate.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 1 4\n");
-  expect_error([&] { load(R"({"mesh": "degenerate.obj"})"); }, {"/objects/0/mesh", "non-zero area"});
+  msm::test::expect_scene_error([&] { load(R"({"mesh": "degenerate.obj"})"); }, {"/objects/0/mesh", "non-zero area"});
   dir.write("nan.ply",
             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
             "element face 1\nproperty list uchar int vertex_indices\nend_header\nnan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  expect_error([&] { load(R"({"mesh": "nan.ply"})"); }, {"/objects/0/mesh", "nan.ply", "NaN or infinite"});
+  msm::test::expect_scene_error([&] { load(R"({"mesh": "nan.ply"})"); },
+                                {"/objects/0/mesh", "nan.ply", "NaN or infinite"});
   dir.write("inf.obj", "v 1e39 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
-  expect_error([&] { load(R"({"mesh": "inf.obj"})"); }, {"/objects/0/mesh", "inf.obj", "NaN or infinite"});
+  msm::test::expect_scene_error([&] { load(R"({"mesh": "inf.obj"})"); },
+                                {"/objects/0/mesh", "inf.obj", "NaN or infinite"});
   // Degenerate triangles next to good ones are dropped.
   dir.write("mixed.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 4\n");
   load_scene_file(dir.write("ok.json", scene_with_object(R"({"mesh": "mixed.obj"})")));
@@ -1297,7 +1298,7 @@ TEST(Motion, AtFrameTurnsAboutTheOriginThenMoves) {
   EXPECT_EQ(moved.objects[1].mesh.positions, s.objects[1].mesh.positions);
   EXPECT_EQ(at_frame(s, 0).objects[0].mesh.positions, s.objects[0].mesh.positions);
   EXPECT_FALSE(load_scene_json(scene_with_object(still), ".", "t.json").animated());
-  expect_error([&] { (void)at_frame(s, -1); }, {"frame -1", ">= 0"});
+  msm::test::expect_scene_error([&] { (void)at_frame(s, -1); }, {"frame -1", ">= 0"});
 }
 
 TEST(Motion, BadValuesNameTheirPointer) {
@@ -1347,9 +1348,10 @@ TEST(Probe, SetProbeReplacesTheScenesLighting) {
   EXPECT_EQ(sky.probe->size, 64);
   EXPECT_EQ(sky.probe->lights, 12);
   EXPECT_EQ(sky.lights.size(), 12u);
-  expect_error([&] { set_probe(models, "/no/such/probe.exr"); }, {"/no/such/probe.exr", "no such light probe"});
-  expect_error([&] { set_probe(models, std::string(MSM_TEST_DATA_DIR) + "/probes/black.exr"); },
-               {"black.exr", "no light"});
+  msm::test::expect_scene_error([&] { set_probe(models, "/no/such/probe.exr"); },
+                                {"/no/such/probe.exr", "no such light probe"});
+  msm::test::expect_scene_error([&] { set_probe(models, std::string(MSM_TEST_DATA_DIR) + "/probes/black.exr"); },
+                                {"black.exr", "no light"});
   EXPECT_EQ(models.lights.size(), 32u) << "a refused probe leaves the scene as it was";
 }
 
@@ -1383,12 +1385,12 @@ TEST(Probe, SixFaceFilesAreAProbe) {
   fs::remove(files[3]);
   expect_json_error(scene_with_object(box, R"("probe": {"file": ")" + pattern.string() + R"("},)"),
                     {"/probe/file", "sky_ny.exr", "does not exist"});
-  expect_error([&] { set_probe(set, pattern); }, {"sky_ny.exr", "no such light probe"});
+  msm::test::expect_scene_error([&] { set_probe(set, pattern); }, {"sky_ny.exr", "no such light probe"});
   msm::probe::write_cube_faces(pattern, sky);
   Scene turned = own;
   turned.probe->rotation_deg = 10.0f;
-  expect_error([&] { set_probe(turned, pattern); },
-               {"cannot be rotated", "the scene's probe has \"rotation_deg\": 10"});
+  msm::test::expect_scene_error([&] { set_probe(turned, pattern); },
+                                {"cannot be rotated", "the scene's probe has \"rotation_deg\": 10"});
 }
 
 // ---------------------------------------------------------------------------------------------
