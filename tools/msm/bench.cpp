@@ -4,6 +4,9 @@
 // `--scattering`: the scattering techniques alone (JCGT §5): the scattering pass per pixel against
 // ray marching, the rectified map's passes per texel against a copy of the same bytes, timed by the
 // host clock on a CPU device, whose compute timestamps are not the passes' time (results.md).
+// `--light-kinds`: the scene under one light of each kind (light_kinds.h), each kind's shadow map
+// and shading against the directional light's at the same texel count.
+#include "light_kinds.h"
 #include "probe_bench.h"
 #include "render_common.h"
 #include "vocabulary.h"
@@ -22,6 +25,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <unistd.h>
 
 // Optional: without valgrind's header --callgrind says so (the client requests are inline asm, no-ops when
@@ -55,6 +59,10 @@ Stats pass_sum(const std::vector<std::vector<render::PassTime>>& frames, const s
 }
 
 using Clock = std::chrono::steady_clock;
+
+// The passes that make a shadow map (the cost per texel).
+const std::vector<std::string> kShadowMapPasses = {"shadow_depth", "moment_resolve",  "translucent", "blur",
+                                                   "mipmaps",      "one_pass_filter", "sat"};
 
 // The copy-bandwidth bound of the prefix sums (JCGT App. C): a vkCmdCopyBuffer of `bytes`, half of
 // what the prefix sums read and write per frame, so that the copy reads and writes as many bytes
@@ -336,7 +344,7 @@ struct BenchOptions {
   std::vector<int> shadow_sizes = {1024, 2048};
   int frames = 20, warmup = 2, repeats = 5;
   std::string json, markdown;
-  bool callgrind = false, scattering = false, quick = false;
+  bool callgrind = false, scattering = false, quick = false, light_kinds = false;
   ProbeBench probe;
 };
 
@@ -359,6 +367,12 @@ void add_bench_options(CLI::App* cmd, BenchOptions& o) {
                 "map's passes per texel against a copy of the same bytes; unless given: techniques "
                 "scatter-march-32,scatter-march-128,scatter-msm4-64,scatter-msm6-96,scatter-csm-32, scene tower, "
                 "shadow sizes 512,1024,2048; no PCF table");
+  cmd->add_flag("--light-kinds", o.light_kinds,
+                "Per-light shadow cost of each light kind: the scene under one directional, spot and point light in "
+                "turn (placed on the scene's light direction; kinds the renderer does not draw are skipped with its "
+                "message), each kind's shadow map and shading against the directional light's at the same texel "
+                "count (a point light's six faces against six maps); unless given: techniques "
+                "pcf,vsm-32,msm-hamburger-64");
   cmd->add_flag("--quick", o.quick,
                 "A short run, to check that it works (not for recorded numbers): unless given, resolution 320x180, "
                 "shadow size and sizes 256, 1 frame after 1 warm-up, 2 repeats");
@@ -388,6 +402,11 @@ void apply_bench_defaults(BenchOptions& o, const CLI::App& cmd) {
     if (!given("--frames")) o.frames = 1;
     if (!given("--warmup")) o.warmup = 1; // lavapipe compiles shader variants in a configuration's first frame
     if (!given("--repeats")) o.repeats = 2;
+  }
+  if (o.light_kinds) {
+    if (o.scattering || !o.probe.probe.empty())
+      throw UsageError("--light-kinds, --scattering and --probe: one at a time");
+    if (o.techniques.empty()) o.techniques = {"pcf", "vsm-32", "msm-hamburger-64"};
   }
   if (o.scattering) {
     if (!o.probe.probe.empty()) throw UsageError("--scattering and --probe: one at a time");
@@ -590,6 +609,100 @@ void check_frame_counts(const BenchOptions& o) {
 }
 } // namespace
 
+// --light-kinds: each technique's shadow map (per size) and shading (per resolution) with the scene
+// under one light of each kind the renderer draws, and its ratio to the directional light's at the
+// same texel count: a kind's shadow_views maps against as many directional maps. Kinds and
+// techniques the renderer refuses are listed with its message.
+void bench_light_kinds(const BenchOptions& o, const std::vector<std::string>& names,
+                       const std::vector<std::pair<int, int>>& resolutions) {
+  const scene::Scene base = scene_at_frame(o.frame, load_scene_or_fail(o.frame.scene));
+  std::vector<std::pair<const scene::LightKindInfo*, scene::Scene>> kinds;
+  for (const scene::LightKindInfo& kind : scene::light_kinds())
+    kinds.emplace_back(&kind, scene_under_light_kind(base, kind.kind));
+  std::unique_ptr<vk::Context> ctx = open_device(o.frame.device);
+  auto run = [&](render::Renderer& renderer, const render::RenderSettings& s) {
+    if (o.warmup) renderer.time_frames(s, o.warmup);
+    return renderer.time_frames(s, o.frames);
+  };
+  nlohmann::json results = nlohmann::json::array(), skipped = nlohmann::json::array();
+  std::map<std::string, double> directional_ms; // "technique shadow SIZE" / "technique shading WxH"
+  std::string md = fmt::format("Device: {}. Scene '{}' under one light of each kind, {} frames per configuration "
+                               "(median), {}x MSAA; × directional: against the directional light's time for as many "
+                               "texels (a kind's maps per light × one directional map) or pixels.\n\n| kind | "
+                               "technique |",
+                               ctx->info().describe(), base.name, o.frames, o.frame.settings.msaa);
+  for (int size : o.shadow_sizes) md += fmt::format(" shadow map {}² ms (× directional) |", size);
+  for (auto [w, h] : resolutions) md += fmt::format(" shading {}x{} ms (× directional) |", w, h);
+  md += "\n|---|---|";
+  for (size_t i = 0; i < o.shadow_sizes.size() + resolutions.size(); ++i) md += "---:|";
+  md += "\n";
+  for (auto& [kind, scene] : kinds) {
+    std::optional<render::Renderer> renderer;
+    try {
+      renderer.emplace(*ctx, scene);
+    } catch (const render::RenderError& e) {
+      fmt::print(stderr, "msm bench: {} light skipped: {}\n", kind->name, e.what());
+      skipped.push_back({{"kind", kind->name}, {"reason", e.what()}});
+      continue;
+    }
+    for (const std::string& name : names) {
+      nlohmann::json entry = {{"kind", kind->name},
+                              {"shadow_views", kind->shadow_views},
+                              {"technique", name},
+                              {"shadow_map", nlohmann::json::object()},
+                              {"shading", nlohmann::json::object()}};
+      std::string row = fmt::format("| {} | {} |", kind->name, name);
+      auto add = [&](const std::string& part, const std::string& key, const Stats& st, double units) {
+        const std::string id = name + " " + part + " " + key;
+        if (kind->kind == scene::LightKind::directional) directional_ms[id] = st.median;
+        nlohmann::json v = {{"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}};
+        v[part == "shadow_map" ? "ns_per_texel" : "ns_per_pixel"] = st.median * 1e6 / units;
+        row += fmt::format(" {:.3f}", st.median);
+        if (directional_ms.count(id)) {
+          const double views = part == "shadow_map" ? kind->shadow_views : 1;
+          v["ratio_to_directional"] = st.median / (views * directional_ms[id]);
+          row += fmt::format(" ({:.2f})", v["ratio_to_directional"].get<double>());
+        }
+        row += " |";
+        entry[part][key] = v;
+      };
+      try {
+        for (int size : o.shadow_sizes) {
+          render::RenderSettings s = settings_for(o.frame, name);
+          s.width = 320; // the shadow-map passes do not depend on the image size
+          s.height = 180;
+          s.shadow_size = size;
+          add("shadow_map", std::to_string(size), pass_sum(run(*renderer, s), kShadowMapPasses),
+              double(kind->shadow_views) * size * size);
+        }
+        for (auto [w, h] : resolutions) {
+          render::RenderSettings s = settings_for(o.frame, name);
+          s.width = w;
+          s.height = h;
+          add("shading", fmt::format("{}x{}", w, h), pass_sum(run(*renderer, s), {"surfaces", "shading"}),
+              double(w) * h);
+        }
+      } catch (const render::RenderError& e) {
+        fmt::print(stderr, "msm bench: {} with a {} light skipped: {}\n", name, kind->name, e.what());
+        skipped.push_back({{"kind", kind->name}, {"technique", name}, {"reason", e.what()}});
+        continue;
+      }
+      results.push_back(entry);
+      md += row + "\n";
+    }
+  }
+  fmt::print("{}", md);
+  const nlohmann::json doc = {{"device", ctx->info().describe()},
+                              {"scene", base.name},
+                              {"frames", o.frames},
+                              {"warmup", o.warmup},
+                              {"msaa", o.frame.settings.msaa},
+                              {"filter_size", o.frame.settings.filter_size},
+                              {"light_kinds", results},
+                              {"skipped", skipped}};
+  write_results(o, doc, md);
+}
+
 void add_bench(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
@@ -608,6 +721,11 @@ void add_bench(CLI::App& app) {
     std::vector<std::pair<int, int>> resolutions;
     for (const std::string& r : opt->resolutions) resolutions.push_back(parse_resolution(r));
     validate_configurations(*opt, names, resolutions);
+    if (opt->light_kinds) {
+      if (opt->callgrind) throw UsageError("--light-kinds and --callgrind: one at a time");
+      bench_light_kinds(*opt, names, resolutions);
+      return;
+    }
     scene::Scene scene = scene_at_frame(opt->frame, load_scene_or_fail(opt->frame.scene));
     if (opt->scattering && !scene.medium)
       throw UsageError(
@@ -619,8 +737,7 @@ void add_bench(CLI::App& app) {
       callgrind_prefixes(renderer, opt->frame, names, resolutions[0], opt->shadow_sizes, opt->warmup);
       return;
     }
-    const std::vector<std::string> shadow_passes = {"shadow_depth", "moment_resolve",  "translucent", "blur",
-                                                    "mipmaps",      "one_pass_filter", "sat"};
+    const std::vector<std::string>& shadow_passes = kShadowMapPasses;
     // The rectified map's compute passes and the copy: on a CPU device (lavapipe) their timestamps
     // are not the time they take (results.md), so there the host clock times them.
     const bool host_clock = ctx->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
