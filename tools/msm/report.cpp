@@ -2,6 +2,7 @@
 // the device, driver, build, settings and command that produced it; docs/results.schema.json), the
 // images it shows and, by the page generator (report_page.py: matplotlib charts and the HTML),
 // DIR/index.html. `msm report --compare A/results.json B/results.json` writes the page of two runs.
+#include "light_kinds.h"
 #include "reference_look.h"
 #include "render_common.h"
 #include "report_suite.h"
@@ -156,10 +157,19 @@ reference::Settings truth_settings(const SuiteRow& row, const render::RenderSett
   return rs;
 }
 
+// The row's scene, under the row's light kind where it names one.
+scene::Scene row_scene(const SuiteRow& row) {
+  scene::Scene scene = load_scene_or_fail(row.scene);
+  if (!row.light_kind) return scene;
+  scene::Scene lit = scene_under_light_kind(scene, *row.light_kind);
+  lit.name = fmt::format("{} ({} light)", scene.name, scene::light_kind(*row.light_kind).name);
+  return lit;
+}
+
 // Every technique's settings are valid, and the row's renders and truth within the limits shared
 // with msm render and msm reference (msm/util/limits.h): UsageError naming the row otherwise.
 void check_row(const SuiteRow& row, const ReportOptions& options) {
-  const scene::Scene scene = load_scene_or_fail(row.scene);
+  const scene::Scene scene = row_scene(row);
   try {
     for (const SuiteTechnique& t : row.techniques) {
       const render::RenderSettings s = technique_settings(row, t, options);
@@ -241,7 +251,7 @@ ordered_json run_row(const vk::Context& ctx, const Suite& suite, const SuiteRow&
   const auto start = std::chrono::steady_clock::now();
   std::vector<render::RenderSettings> settings;
   for (const SuiteTechnique& t : row.techniques) settings.push_back(technique_settings(row, t, options));
-  scene::Scene scene = load_scene_or_fail(row.scene);
+  scene::Scene scene = row_scene(row);
   if (row.probe_lights) try {
       scene::set_probe_light_count(scene, *row.probe_lights);
     } catch (const scene::SceneError& e) { throw UsageError(fmt::format("suite row {}: {}", row.id, e.what())); }

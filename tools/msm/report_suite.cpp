@@ -61,6 +61,13 @@ std::vector<Suite> declared_suites() {
                std::nullopt, 32},
               {"sky_probe-256-lights", "sky_probe", Effect::environment, 320, 180, 256, 256, point_light_techniques(),
                std::nullopt, 256}}};
+  // The fence under one light of each kind the renderer draws, against the traced hard shadow (the
+  // filtered penumbra is part of the error): the same texels per map, so the pass times compare
+  // the kinds' per-light cost.
+  for (const scene::LightKindInfo& kind : scene::light_kinds())
+    if (kind.rendered)
+      full.rows.push_back({fmt::format("fence-{}-hard", kind.name), "fence", Effect::hard, 640, 360, 1024, 1,
+                           filtered_techniques(), std::nullopt, std::nullopt, kind.kind});
   // The papers' ratios at 1080p and 4K on a GPU (about 8 minutes with the truths): MSM's shading
   // against PCF's (JCGT Fig. 20's shape), the one-pass filter of the non-linear maps against the
   // three-pass of the others, prefiltered scattering against ray marching, soft shadows against PCSS.

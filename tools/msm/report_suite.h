@@ -4,6 +4,7 @@
 #pragma once
 
 #include "msm/reference/reference.h"
+#include "msm/scene/scene.h"
 
 #include <optional>
 #include <string>
@@ -35,6 +36,9 @@ struct SuiteRow {
   std::optional<float> light_extent_deg;
   // Image-based lighting: the scene's probe cut into this many area lights (default: the scene's).
   std::optional<int> probe_lights;
+  // The scene under one light of this kind instead of its own lights (light_kinds.h: on its first
+  // light's direction), in the renders and the truth alike; its name says which.
+  std::optional<scene::LightKind> light_kind;
 };
 
 struct Suite {
