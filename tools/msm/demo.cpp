@@ -10,8 +10,13 @@
 //  4. image-based lighting (Kneiphof): the `sky_probe` scene rendered at a third of the width and
 //     height (shown magnified to the full width), its probe cut into 16, 32 and 64 area lights with mssm6, 32 with pcss and 256 point lights
 //     with hard shadows, errors against the full probe's Monte Carlo ground truth.
+//  5. light kinds: the default scene under a directional, a spot and a point light in turn (the
+//     kinds of scene::light_kinds() the renderer draws; the others are skipped with its message),
+//     at a third of the width and height, with MSM 64 and PCF beside the ray-traced hard shadow and
+//     their error heat maps (light_kinds.h places the lights).
 // Each part writes one labelled image with magnified insets where the techniques differ, and
 // prints a table of the errors and the GPU time per pass.
+#include "light_kinds.h"
 #include "reference_look.h"
 #include "render_common.h"
 #include "vocabulary.h"
@@ -26,6 +31,7 @@
 #include "msm/util/statistics.h"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <array>
@@ -224,6 +230,65 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
              file.string(), figure.width(), figure.height());
 }
 
+// Part 5: the scene under one light of each kind (light_kinds.h), each technique beside the
+// ray-traced hard shadow and its error heat map (visibility, red where the technique is brighter
+// than the truth, blue where darker; full colour at 0.1), one row per kind. A kind the renderer does
+// not draw, or draws with none of the techniques, is skipped with its message.
+void light_kinds_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Scene& scene,
+                      const std::vector<std::string>& techniques, const std::string& out) {
+  const render::RenderSettings& fs = frame.settings;
+  fmt::print("\nmsm demo: light kinds, scene '{}' at {}x{} under one light of each kind, shadow map {}², against the "
+             "traced hard shadow\n\n{:<12} {:<20} {:>8} {:>8} {:>9}\n",
+             scene.name, fs.width, fs.height, fs.shadow_size, "light", "technique", "MAE", "leaking", "GPU ms");
+  std::vector<image::Panel> panels;
+  for (const scene::LightKindInfo& kind : scene::light_kinds()) {
+    const scene::Scene lit = scene_under_light_kind(scene, kind.kind);
+    std::optional<render::Renderer> renderer;
+    try {
+      renderer.emplace(ctx, lit);
+    } catch (const render::RenderError& e) {
+      fmt::print("{:<12} skipped: {}\n", kind.name, e.what());
+      continue;
+    }
+    reference::Result truth = reference::render(lit, reference_settings(reference::Effect::hard, fs, 1));
+    const image::Image mask = truth.visibility.channel("background"),
+                       reference = truth.visibility.channel("visibility");
+    std::vector<image::Panel> row = {
+        {fmt::format("{} light, ray traced", kind.name), reference_look(truth, fs.exposure), "reference"}};
+    for (const std::string& technique : techniques) {
+      render::RenderResult r;
+      try {
+        r = renderer->render(settings_for(frame, technique));
+      } catch (const render::RenderError& e) {
+        fmt::print("{:<12} {:<20} skipped: {}\n", kind.name, technique, e.what());
+        continue;
+      }
+      const image::Image signal = r.shadow.channel("visibility");
+      const image::Metrics m = image::compute_metrics(signal, reference, {.mask = &mask});
+      fmt::print("{:<12} {:<20} {:>8.5f} {:>8.5f} {:>9.3f}\n", kind.name, technique, m.mae, m.light_leaking,
+                 r.total_ms);
+      row.push_back({technique, r.color, fmt::format("MAE {:.4f}  leak {:.4f}", m.mae, m.light_leaking)});
+      row.push_back({technique + " error", image::error_image(signal, reference, 0.1, {.mask = &mask}), ""});
+    }
+    if (row.size() > 1) panels.insert(panels.end(), row.begin(), row.end());
+  }
+  if (panels.empty()) {
+    fmt::print("msm demo: no light kind drawn with {}: no light-kinds image\n", fmt::join(techniques, ", "));
+    return;
+  }
+  image::ComposeOptions options;
+  options.columns = int(1 + 2 * techniques.size());
+  image::Image figure = image::compose_comparison(panels, options);
+  std::filesystem::path file = std::filesystem::path(out) / "light-kinds-comparison.png";
+  try {
+    image::write_png(file, figure);
+  } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+  fmt::print("\nErrors are in visibility against the traced hard shadow, background excluded (heat maps: red "
+             "brighter, blue darker than the truth, full colour at 0.1); times are GPU timestamps of one frame.\n"
+             "Wrote {} ({}x{})\n",
+             file.string(), figure.width(), figure.height());
+}
+
 struct DemoOptions {
   FrameOptions frame;
   std::string out = "msm-demo";
@@ -238,6 +303,7 @@ struct DemoOptions {
   int scatter_samples = 32;
   std::string ibl_scene = "sky_probe";
   int ibl_samples = 256;
+  std::vector<std::string> light_kinds_techniques = {"msm-hamburger-64", "pcf"};
 };
 
 // Each part's frame and scene, checked and loaded before the device is opened; a part without its
@@ -248,13 +314,21 @@ struct DemoParts {
   std::optional<scene::Scene> soft_scene, scatter_scene, ibl_scene;
 };
 
+// The light-kinds part's frame: a third of the width and height (its panels are not magnified).
+FrameOptions light_kinds_frame(const DemoOptions& o) {
+  FrameOptions f = o.frame;
+  f.settings.width = std::max(16, o.frame.settings.width / 3);
+  f.settings.height = std::max(16, o.frame.settings.height / 3);
+  return f;
+}
+
 // The options' own checks: the technique lists made canonical, the sample counts in range.
 void check_demo_options(DemoOptions& o) {
   finish_frame_options(o.frame);
   if (o.frame.animation_frame != 0)
     throw UsageError("msm demo draws its scenes as they are (frame 0); --frame is msm render's");
   // `--soft-techniques ""` reaches here as one empty name: it means none (skip the soft part).
-  for (auto* list : {&o.techniques, &o.soft_techniques, &o.scatter_techniques}) {
+  for (auto* list : {&o.techniques, &o.soft_techniques, &o.scatter_techniques, &o.light_kinds_techniques}) {
     std::erase(*list, std::string());
     *list = canonical_technique_names(*list);
   }
@@ -263,6 +337,7 @@ void check_demo_options(DemoOptions& o) {
   if (o.scatter_samples < 1 || o.scatter_samples > 4096) throw UsageError("--scatter-samples must be in [1, 4096]");
   if (o.ibl_samples < 1 || o.ibl_samples > 4096) throw UsageError("--ibl-samples must be in [1, 4096]");
   validate_techniques(o.frame, o.techniques);
+  validate_techniques(light_kinds_frame(o), o.light_kinds_techniques);
 }
 
 // The scattering part's frame (a third of the width and height) with its techniques checked.
@@ -304,6 +379,9 @@ DemoParts demo_parts(const DemoOptions& o) {
   if (!o.soft_techniques.empty()) validate_techniques(p.soft, o.soft_techniques);
   p.scatter = scatter_frame(o);
   p.scene = load_scene_or_fail(o.frame.scene);
+  // The light-kinds part places its lights by the scene's directional light: refused here, before
+  // the output directory exists, where it has none.
+  if (!o.light_kinds_techniques.empty()) (void)scene_under_light_kind(p.scene, scene::LightKind::directional);
   if (!o.soft_techniques.empty()) p.soft_scene = load_scene_or_fail(p.soft.scene);
   if (!o.scatter_techniques.empty()) {
     p.scatter_scene = load_scene_or_fail(p.scatter.scene);
@@ -365,6 +443,10 @@ void run_demo(DemoOptions& o) {
              ctx->info().name);
   compare_techniques(*hard, *ctx, o.frame, o.techniques, nullptr, nullptr, o.out, "comparison.png");
   hard.reset();
+  if (!o.light_kinds_techniques.empty())
+    light_kinds_part(*ctx, light_kinds_frame(o), p.scene, o.light_kinds_techniques, o.out);
+  else
+    fmt::print("\nmsm demo: light-kinds part skipped (no --light-kinds-techniques)\n");
   if (p.scatter_scene)
     scatter_part(*scatter_renderer, *ctx, p.scatter, *p.scatter_scene, o.scatter_techniques, o.scatter_samples,
                  sheet_magnification(fs.width, p.scatter.settings.width), o.out);
@@ -416,6 +498,10 @@ void add_demo(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--ibl-samples", opt->ibl_samples, "Ray-traced samples per pixel of the whole probe's ground truth")
       ->capture_default_str();
+  cmd->add_option("--light-kinds-techniques", opt->light_kinds_techniques,
+                  "Techniques of the light-kinds part: the scene under a directional, a spot and a point light, at a "
+                  "third of the width and height, against the traced hard shadow (\"\": skip the part)")
+      ->delimiter(',');
   add_frame_options(cmd, opt->frame);
   cmd->callback([opt] { run_demo(*opt); });
 }
