@@ -7,6 +7,7 @@
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/figures.h"
 #include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
 
@@ -162,6 +163,10 @@ TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
           renderer.render(settings(std::string(t.name))).shadow.channel("visibility"), reference, {.mask = &mask});
       ASSERT_TRUE(kMeasuredMae.count(std::string(t.name))) << t.name << " has no measured error";
       EXPECT_LE(m.mae, mae_bound(kMeasuredMae.at(std::string(t.name))[i])) << name << ", " << t.name;
+      msm::test::record_figure(
+          fmt::format("ground_truth.filtered.{}.{}.mae", name, t.name), m.mae,
+          {.below = mae_bound(kMeasuredMae.at(std::string(t.name))[i]),
+           .meaning = fmt::format("{}, {}: MAE of visibility against the filtered truth", name, t.name)});
       EXPECT_EQ(m.non_finite, 0u);
       table[std::string(t.name)][name] = m;
     }
