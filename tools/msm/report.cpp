@@ -446,6 +446,7 @@ void run_suite(const ReportOptions& options) {
   image::FileSet files;
   ordered_json rows = ordered_json::array();
   for (const SuiteRow& row : suite.rows) rows.push_back(run_row(*ctx, suite, row, options, files));
+  const ordered_json device = device_json(*ctx);
   ctx.reset(); // the tests open the device themselves
   int failed_runs = 0;
   const ordered_json tests =
@@ -456,7 +457,7 @@ void run_suite(const ReportOptions& options) {
       {"command", command_line(options)},
       {"started_utc", started},
       {"seconds", seconds_since(start)},
-      {"device", device_json(*ctx)},
+      {"device", device},
       {"host", host_json()},
       {"build", build},
       {"timing", fmt::format("GPU timestamps per pass, median of {} frames after the first", suite.timed_frames)},
