@@ -8,6 +8,10 @@
 #include "msm/oracle/moment_oracle.h"
 #include "test_distributions.h"
 
+#include "msm/test/figures.h"
+
+#include <fmt/core.h>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -206,6 +210,10 @@ TEST(Vsm, EqualsTheMomentOracleWithTwoMoments) {
   EXPECT_LT(err_oracle.quantile(0.99), 1e-4);
   EXPECT_LT(err_oracle.max(), 2e-2);
   EXPECT_LT(err_hand.max(), 2e-2);
+  test::record_figure("math.vsm_vs_alg1.error_p99", err_oracle.quantile(0.99),
+                      {.below = 1e-4, .meaning = "VSM (Cantelli), float, vs JCGT Alg. 1 (m = 2): error, p99"});
+  test::record_figure("math.vsm_vs_alg1.error_max", err_oracle.max(),
+                      {.below = 2e-2, .meaning = "VSM (Cantelli), float, vs JCGT Alg. 1 (m = 2): error, max"});
 }
 
 // And against the LP on a wide grid (the stand-in for I = R): the same bound from the general
@@ -426,6 +434,11 @@ TEST(Esm, EqualsTheLinearProgramForTheExponentialBasis) {
     }
     std::printf("[esm vs LP, c = %g, grid [%g,1]] n %zu (shadow > 0: %d) p90 %.2e max %.2e\n", c, lo, err.errors.size(),
                 positive, err.quantile(0.9), err.max());
+    test::record_figure(fmt::format("math.esm_c{:g}_vs_lp.error_max", c), err.max(),
+                        {.below = tolerance,
+                         .meaning = fmt::format("ESM, c = {:g}, vs the 2015 LP, exponential basis: error, max "
+                                                "(each case within the bound)",
+                                                c)});
     EXPECT_GT(positive, 50);
   }
 }

@@ -8,6 +8,8 @@
 #include "msm/oracle/moment_oracle.h"
 #include "test_distributions.h"
 
+#include "msm/test/figures.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -238,6 +240,17 @@ void check_against_oracle(int m) {
   EXPECT_LT(numerator_err.max(), 0.02);
   EXPECT_LT(depth_err.quantile(0.99), 2e-4);
   EXPECT_LT(depth_err.max(), 0.02);
+  const std::string key = "math.blocker" + std::to_string(m) + "_vs_equation4.";
+  const std::string what =
+      "blocker search, " + std::to_string(m) + " moments, vs Eq. (4) on the oracle's distribution: ";
+  test::record_figure(key + "shadow_error_p99", shadow_err.quantile(0.99),
+                      {.below = 2e-4, .meaning = what + "shadow's error, p99"});
+  test::record_figure(key + "shadow_error_max", shadow_err.max(),
+                      {.below = 0.02, .meaning = what + "shadow's error, max"});
+  test::record_figure(key + "depth_error_p99", depth_err.quantile(0.99),
+                      {.below = 2e-4, .meaning = what + "blocker depth's error, p99"});
+  test::record_figure(key + "depth_error_max", depth_err.max(),
+                      {.below = 0.02, .meaning = what + "blocker depth's error, max"});
 }
 
 TEST(Blocker, FourMomentsEqualEquation4OnTheOraclesDistribution) { check_against_oracle(4); }

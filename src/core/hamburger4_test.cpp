@@ -6,6 +6,8 @@
 #include "oracle_range.h"
 #include "test_distributions.h"
 
+#include "msm/test/figures.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -72,6 +74,15 @@ void check_against_moment_oracle(bool signed_depth, int representation) {
   EXPECT_LT(lower_err.max(), 1e-5);
   EXPECT_LT(upper_err.max(), 5e-4);
   EXPECT_LT(lower_plain.quantile(0.99), 2e-4);
+  const std::string key = signed_depth ? "math.hamburger4_signed_vs_alg1." : "math.hamburger4_unit_vs_alg1.";
+  const std::string what =
+      signed_depth ? "Hamburger 4MSM, [-1,1] depth, vs JCGT Alg. 1: " : "Hamburger 4MSM, [0,1] depth, vs JCGT Alg. 1: ";
+  test::record_figure(key + "lower_range_distance_max", lower_err.max(),
+                      {.below = 1e-5, .meaning = what + "lower bound's distance to the range over 4 ulps, max"});
+  test::record_figure(key + "upper_range_distance_max", upper_err.max(),
+                      {.below = 5e-4, .meaning = what + "upper bound's distance to the range over 4 ulps, max"});
+  test::record_figure(key + "lower_error_p99", lower_plain.quantile(0.99),
+                      {.below = 2e-4, .meaning = what + "lower bound's error, p99"});
 }
 
 TEST(Hamburger4, EqualsJcgtAlgorithm1UnitDepth) { check_against_moment_oracle(false, MSM_REP_UNIT_FLOAT); }
@@ -115,6 +126,11 @@ TEST(Hamburger4, ExactForUpToTwoDepths) {
     err.add(msm_hamburger4_lower(b, zf) - test::cdf_less(d, zf));
   }
   err.expect_below("hamburger4 exactness, <= 2 depths", 8001, 0.99, 5e-4, 1e-2);
+  const char* what = "Hamburger 4MSM lower vs the true CDF, 1-2 depths >= 0.2 apart, 0.05 away from them: ";
+  test::record_figure("math.hamburger4_two_depths_exact.error_p99", err.quantile(0.99),
+                      {.below = 5e-4, .meaning = std::string(what) + "error, p99"});
+  test::record_figure("math.hamburger4_two_depths_exact.error_max", err.max(),
+                      {.below = 1e-2, .meaning = std::string(what) + "error, max"});
 }
 
 // The canonical distribution reproduces b0..b4 (it is what the blocker search averages).
@@ -169,6 +185,11 @@ void check_against_lp(const std::vector<double>& grid, bool hausdorff, int cases
   EXPECT_GT(err.errors.size(), size_t(cases * 8 / 10));
   EXPECT_LT(err.quantile(0.9), 1e-4);
   EXPECT_LT(err.max(), 5e-3);
+  const std::string key = hausdorff ? "math.hausdorff4_vs_lp." : "math.hamburger4_vs_lp.";
+  const std::string what = hausdorff ? "Hausdorff 4MSM on [0,1] vs the 2015 LP on [0,1], exact: "
+                                     : "Hamburger 4MSM vs the 2015 LP on a wide grid, exact: ";
+  test::record_figure(key + "error_p90", err.quantile(0.9), {.below = 1e-4, .meaning = what + "error, p90"});
+  test::record_figure(key + "error_max", err.max(), {.below = 5e-3, .meaning = what + "error, max"});
   if (hausdorff) {
     EXPECT_GT(four_atom_cases, 4); // the branch that differs from Hamburger is exercised
   }

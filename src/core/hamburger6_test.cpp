@@ -8,6 +8,8 @@
 #include "msm/oracle/moment_oracle.h"
 #include "test_distributions.h"
 
+#include "msm/test/figures.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,8 +61,8 @@ float uniform_float(std::mt19937_64& rng, float lo, float hi) {
 // random distributions, zf drawn by draw_zf(rng, d): the p99 and the maximum error of either
 // bound within the tolerances, and almost every case checked (some have no reference).
 template <class DrawZf>
-void expect_agreement_with_algorithm1(const char* label, std::uint64_t seed, DrawZf draw_zf, double p99_tolerance,
-                                      double max_tolerance) {
+void expect_agreement_with_algorithm1(const char* label, const std::string& key, std::uint64_t seed, DrawZf draw_zf,
+                                      double p99_tolerance, double max_tolerance) {
   std::mt19937_64 rng(seed);
   ErrorStats lower_err, upper_err;
   int checked = 0, total = 20000;
@@ -87,6 +89,15 @@ void expect_agreement_with_algorithm1(const char* label, std::uint64_t seed, Dra
   EXPECT_LT(upper_err.quantile(0.99), p99_tolerance);
   EXPECT_LT(lower_err.max(), max_tolerance);
   EXPECT_LT(upper_err.max(), max_tolerance);
+  const std::string what = std::string("Hamburger 6MSM vs JCGT Alg. 1 (m = 6)") + label + ": ";
+  test::record_figure(key + "lower_error_p99", lower_err.quantile(0.99),
+                      {.below = p99_tolerance, .meaning = what + "lower bound's error, p99"});
+  test::record_figure(key + "upper_error_p99", upper_err.quantile(0.99),
+                      {.below = p99_tolerance, .meaning = what + "upper bound's error, p99"});
+  test::record_figure(key + "lower_error_max", lower_err.max(),
+                      {.below = max_tolerance, .meaning = what + "lower bound's error, max"});
+  test::record_figure(key + "upper_error_max", upper_err.max(),
+                      {.below = max_tolerance, .meaning = what + "upper bound's error, max"});
 }
 
 // Agreement with JCGT Algorithm 1 (m = 6, long double) on the same biased float moments: what is
@@ -100,8 +111,8 @@ void expect_agreement_with_algorithm1(const char* label, std::uint64_t seed, Dra
 // solve gives errors of order 0.1-1).
 TEST(Hamburger6, EqualsJcgtAlgorithm1) {
   expect_agreement_with_algorithm1(
-      "", 61, [](std::mt19937_64& rng, const test::Distribution&) { return uniform_float(rng, -1.2f, 1.2f); }, 1e-4,
-      0.02);
+      "", "math.hamburger6_vs_alg1.", 61,
+      [](std::mt19937_64& rng, const test::Distribution&) { return uniform_float(rng, -1.2f, 1.2f); }, 1e-4, 0.02);
 }
 
 // The same with zf close to one of the depths of the distribution (within 1% of the depth
@@ -113,7 +124,7 @@ TEST(Hamburger6, EqualsJcgtAlgorithm1) {
 // max < 0.03.
 TEST(Hamburger6, EqualsJcgtAlgorithm1NearTheDepths) {
   expect_agreement_with_algorithm1(
-      ", zf near a depth", 62,
+      ", zf near a depth", "math.hamburger6_near_depths_vs_alg1.", 62,
       [](std::mt19937_64& rng, const test::Distribution& d) {
         size_t atom = std::uniform_int_distribution<size_t>(0, d.z.size() - 1)(rng);
         return float(d.z[atom]) + uniform_float(rng, -0.02f, 0.02f);
@@ -146,6 +157,12 @@ TEST(Hamburger6, EqualsTheLinearProgramOnAWideGrid) {
     err.add(lower - lp.lower);
   }
   err.expect_below("hamburger6 vs exact LP on a wide grid", 12, 0.9, 1e-4, 1e-3);
+  test::record_figure(
+      "math.hamburger6_vs_lp.error_p90", err.quantile(0.9),
+      {.below = 1e-4, .meaning = "Hamburger 6MSM lower vs the 2015 LP (m = 6) on a wide grid, exact: error, p90"});
+  test::record_figure(
+      "math.hamburger6_vs_lp.error_max", err.max(),
+      {.below = 1e-3, .meaning = "Hamburger 6MSM lower vs the 2015 LP (m = 6) on a wide grid, exact: error, max"});
 }
 
 // lower <= Z(z < zf) and Z(z <= zf) <= upper for the distribution the moments came from. The

@@ -7,6 +7,8 @@
 #include "msm/oracle/moment_oracle.h"
 #include "test_distributions.h"
 
+#include "msm/test/figures.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -390,6 +392,16 @@ TEST(NonLinear, Algorithm3EqualsHamburger4) {
   EXPECT_GT(printed.quantile(0.99), 0.1);
   EXPECT_LT(nl_float.quantile(0.99), 1e-5);
   EXPECT_LT(nl_float.max(), 2e-3);
+  test::record_figure(
+      "math.nl_algorithm3_float_vs_alg1.error_p99", nl_float.quantile(0.99),
+      {.below = 1e-5, .meaning = "non-linear Algorithm 3 (erratum), float, vs JCGT Alg. 1: error, p99"});
+  test::record_figure(
+      "math.nl_algorithm3_float_vs_alg1.error_max", nl_float.max(),
+      {.below = 2e-3, .meaning = "non-linear Algorithm 3 (erratum), float, vs JCGT Alg. 1: error, max"});
+  test::record_figure("math.nl_algorithm3_as_printed_vs_alg1.error_max", printed.max(),
+                      {.above = 0.5,
+                       .meaning = "non-linear Algorithm 3 as printed (ξ'4 multiplied), double, vs JCGT "
+                                  "Alg. 1: error, max (the erratum is needed)"});
   EXPECT_GT(hb_float_conditioned.errors.size(), 5000u);
   EXPECT_LT(hb_float_conditioned.quantile(0.99), 1e-4);
   EXPECT_LT(hb_float_conditioned.max(), 0.02);

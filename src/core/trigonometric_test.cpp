@@ -4,6 +4,8 @@
 #include "msm/trigonometric.h"
 #include "test_distributions.h"
 
+#include "msm/test/figures.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -113,6 +115,15 @@ TEST(Trigonometric, EqualsLinearProgram) {
   EXPECT_LT(lower_err.max(), 3e-3);
   EXPECT_LT(upper_err.quantile(0.99), 1e-4);
   EXPECT_LT(upper_err.max(), 3e-3);
+  const char* what = "TMSM vs the 2015 LP, trigonometric basis, 4001 points refined near the atoms: ";
+  test::record_figure("math.tmsm_vs_lp.lower_error_p99", lower_err.quantile(0.99),
+                      {.below = 1e-4, .meaning = std::string(what) + "lower bound's error, p99"});
+  test::record_figure("math.tmsm_vs_lp.lower_error_max", lower_err.max(),
+                      {.below = 3e-3, .meaning = std::string(what) + "lower bound's error, max"});
+  test::record_figure("math.tmsm_vs_lp.upper_error_p99", upper_err.quantile(0.99),
+                      {.below = 1e-4, .meaning = std::string(what) + "upper bound's error (mirrored), p99"});
+  test::record_figure("math.tmsm_vs_lp.upper_error_max", upper_err.max(),
+                      {.below = 3e-3, .meaning = std::string(what) + "upper bound's error (mirrored), max"});
 }
 
 // Lower <= true CDF <= upper. Biasing replaces Z by (1-α) Z + α U (U uniform on [0,1]), which

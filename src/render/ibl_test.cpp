@@ -16,6 +16,7 @@
 #include "msm/shading.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/figures.h"
 #include "msm/test/reference_settings.h"
 #include "msm/test/vulkan_test.h"
 
@@ -105,17 +106,28 @@ struct Expected {
 
 void check_orderings(const vk::Context& ctx, const std::string& name, const Expected& e,
                      const std::string& probe_file = "", bool horizon_split = false) {
+  const std::string under = probe_file.empty() ? "" : "_under_" + std::filesystem::path(probe_file).stem().string();
+  const std::string key = "ordering.ibl." + name + under + (horizon_split ? "_horizon_split" : "") + ".";
+  const std::string what =
+      name + (probe_file.empty() ? "" : " under " + std::filesystem::path(probe_file).filename().string()) +
+      (horizon_split ? ", horizon split" : "") + ": ";
   if (e.area_over_points > 0.0 || e.pcss_over_points > 0.0) {
     const Truth probe = truth(with_lights(name, 32, probe_file), false, 256);
     const scene::Scene area_lights = with_lights(name, 32, probe_file, horizon_split);
     const double points = mae(ctx, with_lights(name, 256, probe_file, horizon_split), "msm-hamburger-64", probe);
     if (e.area_over_points > 0.0) {
-      EXPECT_GT(points - mae(ctx, area_lights, "mssm6", probe), 0.5 * e.area_over_points)
-          << name << ": 32 area lights against 256 point lights";
+      const double margin = points - mae(ctx, area_lights, "mssm6", probe);
+      EXPECT_GT(margin, 0.5 * e.area_over_points) << name << ": 32 area lights against 256 point lights";
+      msm::test::record_figure(key + "hard256_minus_mssm6_32", margin,
+                               {.above = 0.5 * e.area_over_points,
+                                .meaning = what + "MAE of 256 hard point lights minus 32 area lights' (mssm6)"});
     }
     if (e.pcss_over_points > 0.0) {
-      EXPECT_GT(points - mae(ctx, area_lights, "pcss", probe), 0.5 * e.pcss_over_points)
-          << name << ": 32 area lights (PCSS) against 256 point lights";
+      const double margin = points - mae(ctx, area_lights, "pcss", probe);
+      EXPECT_GT(margin, 0.5 * e.pcss_over_points) << name << ": 32 area lights (PCSS) against 256 point lights";
+      msm::test::record_figure(key + "hard256_minus_pcss_32", margin,
+                               {.above = 0.5 * e.pcss_over_points,
+                                .meaning = what + "MAE of 256 hard point lights minus 32 area lights' (pcss)"});
     }
   }
   if (e.six_over_four <= 0.0) return;
@@ -123,6 +135,10 @@ void check_orderings(const vk::Context& ctx, const std::string& name, const Expe
   const Truth lights = truth(sixteen, true, 64);
   const double six = mae(ctx, sixteen, "mssm6", lights), four = mae(ctx, sixteen, "mssm4", lights);
   EXPECT_GT(four - six, 0.5 * e.six_over_four) << name << ": MSSM6 against MSSM4 under 16 large lights";
+  msm::test::record_figure(
+      key + "mssm4_minus_mssm6_16", four - six,
+      {.above = 0.5 * e.six_over_four,
+       .meaning = what + "MAE of mssm4 minus mssm6's under 16 lights (against the lights' truth)"});
 }
 
 TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0048, 0.0003, 0.0050}); }

@@ -10,6 +10,7 @@
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/figures.h"
 #include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
 
@@ -134,6 +135,10 @@ TEST_F(LocalLightsRenderTest, SpotLightShadowsAgreeWithTheRayTracer) {
         image::compare(result.shadow.channel("visibility"), truth.visibility.channel("visibility"), tolerances,
                        {.metrics = {.mask = &mask}, .failure_dir = "test-failures/local-lights/spot-" + technique});
     EXPECT_TRUE(c.passed) << technique << ": " << c.report;
+    msm::test::record_figure(
+        "light.spot." + technique + ".mae", c.metrics.mae,
+        {.below = tolerances.max_mae,
+         .meaning = "spot light, " + technique + ": MAE of visibility against the traced hard shadow"});
     EXPECT_EQ(c.metrics.non_finite_in_test, 0u) << technique;
     EXPECT_EQ(image::compute_metrics(result.color, truth.radiance).non_finite_in_test, 0u) << technique;
     fmt::print("spot, {:<18} vs ray traced: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}\n", technique,

@@ -9,6 +9,7 @@
 #include "msm/render/frame.h"
 #include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
+#include "msm/test/figures.h"
 #include "msm/test/image_compare.h"
 #include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
@@ -156,6 +157,9 @@ TEST_F(RenderTest, LeakingOrderingsOfThePapersHold) {
   auto less = [&](const std::string& scene, const std::string& a, const std::string& b) {
     double la = leak(scene, a), lb = leak(scene, b);
     EXPECT_LT(la, 0.99 * lb) << scene << ": " << a << " leaks " << la << ", " << b << " " << lb;
+    msm::test::record_figure(
+        fmt::format("ordering.leaking.{}.{}_over_{}", scene, a, b), la / lb,
+        {.below = 0.99, .meaning = fmt::format("{}: light leaking (against PCF) of {} over {}'s", scene, a, b)});
   };
   for (const char* scene : {"fence", "stair"}) {
     less(scene, "msm-hamburger-64", "vsm-32");

@@ -10,6 +10,7 @@
 #include "msm/techniques.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/figures.h"
 #include "msm/test/image_compare.h"
 #include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
@@ -92,6 +93,9 @@ void expect_near_measured(const std::string& scene, const std::string& technique
   const double measured = kMeasuredSoftMae.at(scene).at(technique);
   EXPECT_LE(mae, std::max(1.5 * measured, measured + 0.002))
       << scene << ", " << technique << " (measured " << measured << ")";
+  msm::test::record_figure("ground_truth.soft." + scene + "." + technique + ".mae", mae,
+                           {.below = std::max(1.5 * measured, measured + 0.002),
+                            .meaning = scene + ", " + technique + ": MAE of visibility against the traced area light"});
 }
 
 // On the column (JCGT Fig. 11: a long shadow, so its penumbra grows from contact to wide) and the

@@ -6,6 +6,7 @@
 #include "reference_look.h"
 #include "render_common.h"
 #include "report_suite.h"
+#include "report_tests.h"
 #include "vocabulary.h"
 
 #include "msm/image/compose.h"
@@ -29,6 +30,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <fstream>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -50,6 +52,9 @@ struct ReportOptions {
   std::vector<std::string> overrides; // --set TECHNIQUE:NAME=VALUE
   std::vector<std::string> compare;   // two results.json
   bool no_page = false;
+  std::string tests_from;   // the build directory of the suite's test executables ("": msm's own)
+  bool no_tests = false;    // run no test executables: results.json without "tests"
+  std::string update_tests; // a results.json whose "tests" are gathered again, nothing else run
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -105,7 +110,43 @@ std::string command_line(const ReportOptions& o) {
   std::string line = fmt::format("msm report --suite {} --out {}", o.suite, o.out);
   if (!o.device.empty()) line += " --device " + o.device;
   for (const std::string& s : o.overrides) line += " --set " + s;
+  if (!o.tests_from.empty()) line += " --tests-from " + o.tests_from;
+  if (o.no_tests) line += " --no-tests";
+  if (!o.update_tests.empty()) line += " --update-tests " + o.update_tests;
   return line;
+}
+
+fs::path tests_dir(const ReportOptions& o) {
+  return o.tests_from.empty() ? default_tests_dir() : fs::path(o.tests_from);
+}
+
+// results.json's "tests": the figures the suite's test executables record, with the command, the
+// source and the device they came from. A run that failed is counted in `failed_runs`.
+ordered_json test_figures_json(const Suite& suite, const ReportOptions& options, const ordered_json& build,
+                               int& failed_runs) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::string started = utc_now();
+  const GatheredTests gathered =
+      gather_test_figures(suite, tests_dir(options), options.device, fs::path(options.out) / "tests");
+  failed_runs = gathered.failed_runs;
+  return {{"command", command_line(options)}, {"started_utc", started},
+          {"seconds", seconds_since(start)},  {"build", build},
+          {"msm_device", options.device},     {"runs", gathered.runs}};
+}
+
+void write_text_file(const fs::path& path, const std::string& text) {
+  try {
+    image::FileSet files;
+    files.add(path, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    files.commit();
+  } catch (const image::ImageError& e) { throw UsageError(e.what()); }
+}
+
+void throw_if_tests_failed(int failed_runs, const ReportOptions& options) {
+  if (failed_runs > 0)
+    throw std::runtime_error(fmt::format("{} test run(s) failed: their figures are in \"tests\" with \"holds\": false "
+                                         "where an assertion failed; the output of each run is in {}/tests/",
+                                         failed_runs, options.out));
 }
 
 // The settings of one technique of a row: the row's size, its named parameters, then the
@@ -375,10 +416,36 @@ void write_page(const std::vector<std::string>& results, const std::string& out)
                                  MSM_REPORT_PAGE_SCRIPT, status, out));
 }
 
+// --update-tests FILE: the suite's test figures gathered again into FILE (a results.json of the same
+// suite), its other figures kept as they are.
+void update_tests(const ReportOptions& options) {
+  const Suite& suite = find_suite(options.suite);
+  check_test_executables(suite, tests_dir(options));
+  ordered_json results;
+  try {
+    std::ifstream in(options.update_tests);
+    if (!in) throw UsageError(fmt::format("--update-tests {}: no such file", options.update_tests));
+    results = ordered_json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw UsageError(fmt::format("--update-tests {}: not JSON: {}", options.update_tests, e.what()));
+  }
+  if (!results.is_object() || !results.contains("suite") || results["suite"].value("name", "") != suite.name)
+    throw UsageError(
+        fmt::format("--update-tests {}: not the results.json of suite '{}'", options.update_tests, suite.name));
+  if (const auto problem = util::prepare_output_dir(options.out, "msm-report-probe"))
+    throw UsageError(fmt::format("--out {}: {}", options.out, *problem));
+  int failed_runs = 0;
+  results["tests"] = test_figures_json(suite, options, build_json(), failed_runs);
+  write_text_file(options.update_tests, results.dump(2) + "\n");
+  fmt::print(stderr, "msm report: wrote the test figures into {}\n", options.update_tests);
+  throw_if_tests_failed(failed_runs, options);
+}
+
 void run_suite(const ReportOptions& options) {
   const Suite& suite = find_suite(options.suite);
   check_overrides(suite, options);
   for (const SuiteRow& row : suite.rows) check_row(row, options); // refused before any work
+  if (!options.no_tests) check_test_executables(suite, tests_dir(options));
   const auto start = std::chrono::steady_clock::now();
   const std::string started = utc_now();
   const ordered_json build = build_json();                        // the source as the run starts
@@ -389,17 +456,23 @@ void run_suite(const ReportOptions& options) {
   image::FileSet files;
   ordered_json rows = ordered_json::array();
   for (const SuiteRow& row : suite.rows) rows.push_back(run_row(*ctx, suite, row, options, files));
+  const ordered_json device = device_json(*ctx);
+  ctx.reset(); // the tests open the device themselves
+  int failed_runs = 0;
+  const ordered_json tests =
+      options.no_tests || suite.tests.empty() ? ordered_json() : test_figures_json(suite, options, build, failed_runs);
   ordered_json results = {
       {"schema_version", 1},
       {"suite", {{"name", suite.name}, {"description", suite.description}}},
       {"command", command_line(options)},
       {"started_utc", started},
       {"seconds", seconds_since(start)},
-      {"device", device_json(*ctx)},
+      {"device", device},
       {"host", host_json()},
       {"build", build},
       {"timing", fmt::format("GPU timestamps per pass, median of {} frames after the first", suite.timed_frames)},
       {"rows", rows}};
+  if (!tests.is_null()) results["tests"] = tests;
   const std::string text = results.dump(2) + "\n";
   try {
     files.add(fs::path(options.out) / "results.json",
@@ -408,6 +481,7 @@ void run_suite(const ReportOptions& options) {
   } catch (const image::ImageError& e) { throw UsageError(e.what()); }
   fmt::print(stderr, "msm report: {:.1f} s; wrote {}/results.json\n", seconds_since(start), options.out);
   if (!options.no_page) write_page({(fs::path(options.out) / "results.json").string()}, options.out);
+  throw_if_tests_failed(failed_runs, options);
 }
 
 } // namespace
@@ -429,15 +503,30 @@ void add_report(CLI::App& app) {
                   "nothing")
       ->expected(2);
   cmd->add_flag("--no-page", opt->no_page, "Write results.json and the images only");
+  cmd->add_option("--tests-from", opt->tests_from,
+                  fmt::format("The build directory whose test executables record the suite's test figures "
+                              "(default: the one msm was built in, {})",
+                              default_tests_dir().string()));
+  cmd->add_flag("--no-tests", opt->no_tests, "Run no test executables: results.json without the test figures");
+  cmd->add_option("--update-tests", opt->update_tests,
+                  "A results.json of the suite: gather its test figures again (logs under --out) and replace them "
+                  "there, its other figures kept; renders nothing");
   cmd->callback([opt, cmd] {
     if (!opt->compare.empty()) {
-      for (const char* o : {"--suite", "--device", "--set", "--no-page"})
+      for (const char* o :
+           {"--suite", "--device", "--set", "--no-page", "--tests-from", "--no-tests", "--update-tests"})
         if (cmd->count(o) > 0) throw UsageError(fmt::format("--compare runs nothing: {} cannot go with it", o));
       for (const std::string& f : opt->compare)
         if (!fs::is_regular_file(f)) throw UsageError(fmt::format("--compare {}: no such file", f));
       if (const auto problem = util::prepare_output_dir(opt->out, "msm-report-probe"))
         throw UsageError(fmt::format("--out {}: {}", opt->out, *problem));
       write_page(opt->compare, opt->out);
+      return;
+    }
+    if (!opt->update_tests.empty()) {
+      for (const char* o : {"--set", "--no-page", "--no-tests"})
+        if (cmd->count(o) > 0) throw UsageError(fmt::format("--update-tests renders nothing: {} cannot go with it", o));
+      update_tests(*opt);
       return;
     }
     run_suite(*opt);

@@ -310,6 +310,25 @@ def metrics_table(row):
     return "\n".join(lines) + "</tbody></table>" + notes
 
 
+def test_figures_table(run):
+    """The figures the test suite recorded (results.json's "tests"), one sortable table."""
+    tests = run.get("tests")
+    if not tests:
+        return ""
+    lines = ["<h2>Figures the tests assert</h2>",
+             f"<p class=meta>Each figure is the value an assertion of a test checks, beside its bound; gathered by "
+             f"<code>{esc(tests['command'])}</code> ({tests['seconds']:.0f} s).</p>",
+             "<table class=sortable><thead><tr><th>figure</th><th>value</th><th>asserted</th><th>holds</th>"
+             "<th>key</th><th>test</th></tr></thead><tbody>"]
+    for r in tests["runs"]:
+        for f in r["figures"]:
+            value, bound = ("not finite" if v is None else f"{v:.3g}" for v in (f["value"], f["bound"]))
+            lines.append(f"<tr><td>{esc(f['meaning'])}</td><td data-value={f['value'] or 0!r}>{value}</td>"
+                         f"<td>{esc(f['relation'])} {bound}</td><td>{'yes' if f['holds'] else 'no'}</td>"
+                         f"<td><code>{esc(f['key'])}</code></td><td>{esc(f['test'])}</td></tr>")
+    return "\n".join(lines) + "</tbody></table>"
+
+
 def row_title(row):
     truth = row["truth"]
     lights = f", the probe cut into {truth['probe_lights']} lights" if truth["effect"] == "environment" else ""
@@ -341,6 +360,7 @@ def single_page(run, out, prefix):
                      "".join(f"<img src='{c}' alt='time against resolution'>" for c in charts) + "</p>")
     parts.append(f"<h2>Error against bits per texel</h2><p class=charts><img src='{error_bits_chart(run, out)}' "
                  "alt='error against bits per texel'></p>")
+    parts.append(test_figures_table(run))
     return page(f"msm report: suite {run['suite']['name']} on {device_name(run)}", "\n".join(parts))
 
 

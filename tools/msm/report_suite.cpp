@@ -84,6 +84,30 @@ std::vector<Suite> declared_suites() {
              {"trees-scattering-1080p", "trees", Effect::scattering, 1920, 1080, 1024, 8, gpu_scattering},
              {"trees-scattering-4k", "trees", Effect::scattering, 3840, 2160, 1024, 8, gpu_scattering}},
             10};
+  // The math against the oracles: seconds on a CPU (the LP cases are the slow ones).
+  const SuiteTests oracles{"The single-source math against the oracles", "src/core/msm_hamburger4_test",
+                           "Hamburger4.EqualsJcgtAlgorithm1*"};
+  quick.tests = {oracles};
+  full.tests = {
+      {"The single-source math against the oracles", "src/core/msm_hamburger4_test",
+       "Hamburger4.Equals*:Hamburger4.ExactForUpToTwoDepths:Hausdorff4.Equals*"},
+      {"The single-source math against the oracles", "src/core/msm_hamburger6_test", "Hamburger6.Equals*"},
+      {"The single-source math against the oracles", "src/core/msm_trigonometric_test",
+       "Trigonometric.EqualsLinearProgram"},
+      {"The single-source math against the oracles", "src/core/msm_blocker_test", "Blocker.*EqualEquation4*"},
+      {"The single-source math against the oracles", "src/core/msm_nonlinear_test",
+       "NonLinear.Algorithm3EqualsHamburger4"},
+      {"The single-source math against the oracles", "src/core/msm_baselines_test",
+       "Vsm.EqualsTheMomentOracleWithTwoMoments:Esm.EqualsTheLinearProgramForTheExponentialBasis"},
+      {"The papers' leaking orderings (against PCF)", "src/render/msm_render_test",
+       "RenderTest.LeakingOrderingsOfThePapersHold"},
+      {"Every technique against the filtered ground truth", "src/render/msm_render_ground_truth_test",
+       "GroundTruthTest.EveryTechniqueAgainstTheGroundTruth"},
+      {"Soft shadows against the traced area light", "src/render/msm_render_soft_shadow_test",
+       "SoftShadowTest.CloserToTheAreaLightThanHardShadows:SoftShadowTest.ModelsAndPillarBeforeBrickWall"},
+      {"Spot lights against the ray tracer", "src/render/msm_render_local_lights_test",
+       "LocalLightsRenderTest.SpotLightShadowsAgreeWithTheRayTracer"},
+      {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"}};
   return {quick, full, gpu};
 }
 

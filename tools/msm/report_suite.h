@@ -41,11 +41,21 @@ struct SuiteRow {
   std::optional<scene::LightKind> light_kind;
 };
 
+// Figures of the test suite itself: a test executable of the build run with a GoogleTest filter
+// and MSM_TEST_FIGURES set, so that its tests write the figures their assertions check, with the
+// bounds (tests/support/msm/test/figures.h). They join results.json under "tests".
+struct SuiteTests {
+  std::string title;      // what the figures are: the heading of their table
+  std::string executable; // relative to the build directory (the CMake target's path)
+  std::string filter;     // --gtest_filter
+};
+
 struct Suite {
   std::string name;
   std::string description;
   std::vector<SuiteRow> rows;
   int timed_frames = 3; // GPU time per pass: the median of this many frames after the first
+  std::vector<SuiteTests> tests = {};
 };
 
 // The names of the declared suites, and one by name (UsageError naming the suites otherwise).
