@@ -11,6 +11,7 @@
 #include "msm/bias.h"
 #include "msm/filter.h"
 #include "msm/hamburger4.h"
+#include "msm/local_light.h"
 #include "msm/moments.h"
 #include "msm/nonlinear.h"
 #include "msm/quantize.h"
