@@ -16,16 +16,19 @@
 // across the faces' seams (a cube texture samples seamlessly in WebGL 2) and bound where three.js
 // binds a point light's cube map; the chunks gain a VSM getPointShadow.
 import { ShaderChunk, VSMShadowMap, RawShaderMaterial, GLSL3, WebGLRenderTarget, WebGLCubeRenderTarget, BufferGeometry,
-  BufferAttribute, Mesh, OrthographicCamera, FloatType, RGBAFormat, LinearFilter, NearestFilter, ClampToEdgeWrapping,
-  Vector2 } from 'three';
+  BufferAttribute, Mesh, OrthographicCamera, FloatType, UnsignedByteType, RGBAFormat, RGFormat, LinearFilter, NearestFilter,
+  ClampToEdgeWrapping, Vector2, DataTexture } from 'three';
 import { MSM_THREE_GLSL } from './generated/msm-glsl.js';
+import { MSM_BLUE_NOISE } from './generated/blue-noise.js';
 
 // The techniques: name -> the id of src/glsl/msm_three.h (MSM_THREE_*).
 export const TECHNIQUES = Object.freeze({
   'msm-hamburger-64': 0, // 4 x 16 bits after Θ4* (JCGT), Hamburger 4MSM
   'msm-hamburger-128': 1, // 4 x float (JCGT), Hamburger 4MSM
   'msm-nl-64': 2, // Φ of the float moments in 4 x 16 bits (HPG 2017), Algorithm 3
+  'msm-nl-32': 3, // Φ in 32 bits (HPG 2017 §3.5) in an RGBA8 texture, a blue-noise dithered texel, Algorithm 3
 });
+const NL32 = TECHNIQUES['msm-nl-32'];
 
 // The Gaussian blur: taps x taps texels, σ in texels (filter.h's defaults: the 2015 paper's kernel).
 export const DEFAULT_BLUR = Object.freeze({ taps: 9, sigma: 2.4 });
@@ -124,6 +127,9 @@ const GET_SHADOW = `
 		#ifndef MSM_THREE_TECHNIQUE
 		#define MSM_THREE_TECHNIQUE 0
 		#endif
+		#if MSM_THREE_TECHNIQUE == 3
+		uniform highp sampler2D msmThreeBlueNoise;
+		#endif
 		float getShadow( sampler2D shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord ) {
 			float shadow = 1.0;
 			shadowCoord.xyz /= shadowCoord.w;
@@ -143,6 +149,14 @@ const GET_SHADOW = `
 					vec4 m01 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i0.x, i1.y ), 0 ) );
 					vec4 m11 = msm_three_nl64_moments( texelFetch( shadowMap, i1, 0 ) );
 					shadow = 1.0 - msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), shadowCoord.z );
+				#elif MSM_THREE_TECHNIQUE == 3
+					// The 32-bit texels decode alone: the texel nearest to the lookup moved by blue noise
+					// in [-0.5, 0.5) texels (the renderer's dithered lookup, lookup.glsl).
+					ivec2 last = textureSize( shadowMap, 0 ) - 1;
+					vec2 t = shadowCoord.xy * vec2( last + 1 ) - 0.5;
+					vec2 noise = texelFetch( msmThreeBlueNoise, ivec2( gl_FragCoord.xy ) & ( textureSize( msmThreeBlueNoise, 0 ) - 1 ), 0 ).xy;
+					ivec2 i = clamp( ivec2( floor( t + noise ) ), ivec2( 0 ), last );
+					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texelFetch( shadowMap, i, 0 ), shadowCoord.z );
 				#else
 					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
 				#endif
@@ -153,11 +167,11 @@ const GET_SHADOW = `
 
 // A point light's lookup under VSM (three.js has none): the receiver's radial depth in msm's
 // convention for local lights, the depth bias relative to the texel's size (a cube face spans
-// 2 x distance); the non-linear technique's point lights keep float moments (technique 1).
+// 2 x distance); the non-linear techniques' point lights keep float moments (technique 1).
 const GET_POINT_SHADOW = `
 	#elif defined( SHADOWMAP_TYPE_VSM )
 	float getPointShadow( samplerCube shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord, float shadowCameraNear, float shadowCameraFar ) {
-		const int technique = MSM_THREE_TECHNIQUE == 2 ? 1 : MSM_THREE_TECHNIQUE;
+		const int technique = MSM_THREE_TECHNIQUE >= 2 ? 1 : MSM_THREE_TECHNIQUE;
 		float shadow = 1.0;
 		vec3 lightToPosition = shadowCoord.xyz;
 		float depth = msm_local_light_receiver_depth( length( lightToPosition ), shadowCameraFar, msm_three_depth_bias( technique ), 2.0 ) + shadowBias;
@@ -193,9 +207,9 @@ function pointCallChunk(original) {
   return POINT_CALL.test(original) ? original.replace(POINT_CALL, '$1( defined( SHADOWMAP_TYPE_PCF ) || defined( SHADOWMAP_TYPE_BASIC ) || defined( SHADOWMAP_TYPE_VSM ) )') : null;
 }
 
-function floatTarget(width, height, filter, format = RGBAFormat) {
+function mapTarget(width, height, filter, type = FloatType) {
   const target = new WebGLRenderTarget(width, height, {
-    type: FloatType, format, minFilter: filter, magFilter: filter, wrapS: ClampToEdgeWrapping, wrapT: ClampToEdgeWrapping,
+    type, format: RGBAFormat, minFilter: filter, magFilter: filter, wrapS: ClampToEdgeWrapping, wrapT: ClampToEdgeWrapping,
     depthBuffer: false, generateMipmaps: false,
   });
   target.texture.name = 'msm-three';
@@ -236,7 +250,7 @@ export class MomentShadowMaps {
     renderer.shadowMap.type = VSMShadowMap;
     this._triangle = new Mesh(new BufferGeometry().setAttribute('position', new BufferAttribute(new Float32Array(9), 3)));
     this._camera = new OrthographicCamera();
-    this._weights = floatTarget(63, 1, NearestFilter);
+    this._weights = mapTarget(63, 1, NearestFilter);
     this._weightsPass = pass(WEIGHTS, { taps: { value: 9 }, sigma: { value: 2.4 } });
     this._generatePass = pass(GENERATE, { depthMap: { value: null }, technique: { value: 0 } });
     this._generateCubePass = pass(GENERATE_CUBE, {
@@ -251,6 +265,10 @@ export class MomentShadowMaps {
       technique: { value: 0 }, store: { value: false },
     });
     this._weightsKey = '';
+    // The dithered lookup's blue noise, bound in every marked material (_markMaterials).
+    const noise = Uint8Array.from(atob(MSM_BLUE_NOISE.base64), (c) => c.charCodeAt(0));
+    this._blueNoise = { value: new DataTexture(noise, MSM_BLUE_NOISE.size, MSM_BLUE_NOISE.size, RGFormat, UnsignedByteType) };
+    this._blueNoise.value.needsUpdate = true;
     const shadowMap = renderer.shadowMap;
     this._render = shadowMap.render;
     const self = this;
@@ -302,9 +320,10 @@ export class MomentShadowMaps {
   dispose() {
     if (!this.supported) return;
     this._restore([...this._lights.keys()]);
-    for (const { moments, scratch } of this._lights.values()) {
+    for (const { moments, scratch, packed } of this._lights.values()) {
       moments.dispose();
       scratch.dispose();
+      packed?.dispose();
     }
     this._lights.clear();
     for (const [light, { distance, moments, scratch }] of this._points) {
@@ -317,9 +336,11 @@ export class MomentShadowMaps {
     if (--activeInstances === 0) Object.assign(ShaderChunk, originalChunks);
     for (const m of [this._weightsPass, this._generatePass, this._blurPass, this._generateCubePass, this._blurCubePass]) m.dispose();
     this._weights.dispose();
+    this._blueNoise.value.dispose();
     this._triangle.geometry.dispose();
     this._marked?.forEach((material) => {
       delete material.defines.MSM_THREE_TECHNIQUE;
+      material.onBeforeCompile = this._onBeforeCompile.get(material);
       material.needsUpdate = true;
     });
     this.supported = false;
@@ -329,7 +350,7 @@ export class MomentShadowMaps {
   _restore(lights) {
     for (const light of lights) {
       const state = this._lights.get(light);
-      if (state && light.shadow.map === state.moments) light.shadow.map = state.threeMap;
+      if (state && (light.shadow.map === state.moments || light.shadow.map === state.packed)) light.shadow.map = state.threeMap;
     }
   }
 
@@ -381,14 +402,16 @@ export class MomentShadowMaps {
     if (!state || state.moments.width !== threeMap.width || state.moments.height !== threeMap.height) {
       state?.moments.dispose();
       state?.scratch.dispose();
+      state?.packed?.dispose();
       state = {
-        moments: floatTarget(threeMap.width, threeMap.height, LinearFilter),
-        scratch: floatTarget(threeMap.width, threeMap.height, NearestFilter),
+        moments: mapTarget(threeMap.width, threeMap.height, LinearFilter),
+        scratch: mapTarget(threeMap.width, threeMap.height, NearestFilter),
       };
       this._lights.set(light, state);
     }
     state.threeMap = threeMap;
     state.generated = true;
+    if (this._technique === NL32 && !state.packed) state.packed = mapTarget(threeMap.width, threeMap.height, NearestFilter, UnsignedByteType);
     const previousTarget = renderer.getRenderTarget();
     this._generatePass.uniforms.depthMap.value = depth;
     this._generatePass.uniforms.technique.value = this._technique;
@@ -418,7 +441,7 @@ export class MomentShadowMaps {
       if (!state || state.threeMap !== light.shadow.map) continue;
       // A light that three.js did not update this frame (shadow.autoUpdate off) keeps its moments.
       if (state.generated) this._blur(state, taps);
-      light.shadow.map = state.moments;
+      light.shadow.map = this._technique === NL32 ? state.packed : state.moments;
     }
     for (const light of lights) {
       const state = this._points.get(light);
@@ -433,8 +456,8 @@ export class MomentShadowMaps {
   _pointMoments(light, state, taps) {
     state.rendered = false;
     let technique = this._technique;
-    if (technique === TECHNIQUES['msm-nl-64']) {
-      this._warnOnce(light, 'msm-nl-64 has no cube maps: this point light\'s moments are msm-hamburger-128\'s');
+    if (technique === TECHNIQUES['msm-nl-64'] || technique === NL32) {
+      this._warnOnce(light, `${this.technique} has no cube maps: this point light's moments are msm-hamburger-128's`);
       technique = TECHNIQUES['msm-hamburger-128'];
     }
     const generate = this._generateCubePass.uniforms, blur = this._blurCubePass.uniforms;
@@ -475,13 +498,15 @@ export class MomentShadowMaps {
     blur.source.value = state.scratch.texture;
     blur.direction.value.set(0, 1);
     blur.store.value = true;
-    this._draw(this._blurPass, state.moments);
+    this._draw(this._blurPass, this._technique === NL32 ? state.packed : state.moments); // 32 bits: RGBA8
   }
 
   // The receivers' programs read the technique as a define (part of three.js's program key).
   _markMaterials(scene) {
     this._marked ??= new Set();
+    this._onBeforeCompile ??= new Map(); // a material's own hook, put back by dispose()
     const technique = this._technique;
+    const blueNoise = this._blueNoise;
     scene.traverse((object) => {
       if (!object.material) return;
       for (const material of Array.isArray(object.material) ? object.material : [object.material]) {
@@ -489,6 +514,14 @@ export class MomentShadowMaps {
         if (material.defines.MSM_THREE_TECHNIQUE === technique) continue;
         material.defines.MSM_THREE_TECHNIQUE = technique;
         material.needsUpdate = true;
+        if (!this._onBeforeCompile.has(material)) {
+          const own = material.onBeforeCompile;
+          this._onBeforeCompile.set(material, own);
+          material.onBeforeCompile = function (shader, renderer) {
+            own.call(this, shader, renderer);
+            shader.uniforms.msmThreeBlueNoise = blueNoise;
+          };
+        }
         this._marked.add(material);
       }
     });
