@@ -17,7 +17,7 @@
 // binds a point light's cube map; the chunks gain a VSM getPointShadow.
 import { ShaderChunk, VSMShadowMap, RawShaderMaterial, GLSL3, WebGLRenderTarget, WebGLCubeRenderTarget, BufferGeometry,
   BufferAttribute, Mesh, OrthographicCamera, FloatType, UnsignedByteType, RGBAFormat, RGFormat, LinearFilter, NearestFilter,
-  ClampToEdgeWrapping, Vector2, DataTexture } from 'three';
+  ClampToEdgeWrapping, Vector2, DataTexture, DoubleSide } from 'three';
 import { MSM_THREE_GLSL } from './generated/msm-glsl.js';
 import { MSM_BLUE_NOISE } from './generated/blue-noise.js';
 
@@ -220,6 +220,24 @@ function pass(fragmentShader, uniforms) {
   return new RawShaderMaterial({ glslVersion: GLSL3, vertexShader: VERTEX, fragmentShader, uniforms, depthTest: false, depthWrite: false });
 }
 
+// Every surface casts from both sides into the point lights' maps, as into msm's (its depth pass
+// culls nothing): three.js's VSM renders the materials' front faces only (its PCF the back
+// faces), and a caster cut open by the light's near plane (shadow.camera.near, 0.5 by default)
+// would cast no shadow through the cut. Materials with their own shadowSide keep it. Returns
+// what puts the materials back.
+function castFromBothSides(scene) {
+  const changed = [];
+  scene.traverse((object) => {
+    if (!object.material) return;
+    for (const material of Array.isArray(object.material) ? object.material : [object.material])
+      if (material.shadowSide === null) {
+        material.shadowSide = DoubleSide;
+        changed.push(material);
+      }
+  });
+  return () => changed.forEach((material) => (material.shadowSide = null));
+}
+
 // The chunks the package replaces, as three.js has them, and what replaces them.
 const CHUNKS = { shadowmap_pars_fragment: momentChunk, lights_fragment_begin: pointCallChunk, shadowmask_pars_fragment: pointCallChunk };
 const originalChunks = Object.fromEntries(Object.keys(CHUNKS).map((name) => [name, ShaderChunk[name]]));
@@ -291,7 +309,12 @@ export class MomentShadowMaps {
         if (points.length > 0) {
           this.needsUpdate = needsUpdate;
           self._preparePoints(points);
-          self._render.call(this, points, scene, camera);
+          const restoreSides = castFromBothSides(scene);
+          try {
+            self._render.call(this, points, scene, camera);
+          } finally {
+            restoreSides();
+          }
         }
       } finally {
         renderer.renderBufferDirect = draw;
