@@ -30,6 +30,17 @@ MSM_FN vec3 msm_local_light_irradiance(vec3 intensity, float distance, float ran
   return intensity * (cone / max(distance * distance, MSM_LOCAL_LIGHT_MIN_DISTANCE2));
 }
 
+// A local light's shadow-map depth: the radial distance over the range (docs/techniques.md, "Light
+// kinds"), not a perspective z / w, whose precision crowds at the near plane.
+MSM_FN float msm_local_light_depth(float distance, float range) { return distance / range; }
+
+// A receiver's depth in that convention less the depth bias, which grows with the texel's world
+// size: `bias` is relative to the map's width where the receiver is, width_per_distance × distance
+// (2 tan of the map's half-angle: 2 for a cube map's face).
+MSM_FN float msm_local_light_receiver_depth(float distance, float range, float bias, float width_per_distance) {
+  return msm_local_light_depth(distance - bias * width_per_distance * distance, range);
+}
+
 MSM_END
 
 #endif

@@ -1,7 +1,7 @@
 // Moment shadow maps for three.js's WebGLRenderer (see README.md).
 
-/** The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM, 64-bit non-linear moments. */
-export declare const TECHNIQUES: Readonly<{ 'msm-hamburger-64': 0; 'msm-hamburger-128': 1; 'msm-nl-64': 2 }>;
+/** The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM, 64- and 32-bit non-linear moments. */
+export declare const TECHNIQUES: Readonly<{ 'msm-hamburger-64': 0; 'msm-hamburger-128': 1; 'msm-nl-64': 2; 'msm-nl-32': 3 }>;
 export type Technique = keyof typeof TECHNIQUES;
 
 /** The Gaussian blur of the moment maps: taps x taps texels (odd, 1..63), σ in texels. */
@@ -23,7 +23,7 @@ export interface RendererLike {
 }
 
 export declare class MomentShadowMaps {
-  /** Switches the renderer's directional and spot light shadows to moment shadow maps. */
+  /** Switches the renderer's directional, spot and point light shadows to moment shadow maps. */
   constructor(renderer: RendererLike, options?: MomentShadowMapsOptions);
   /** False where WebGL 2 lacks float render targets (a console warning said so): three's shadows stay. */
   readonly supported: boolean;

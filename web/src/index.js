@@ -10,16 +10,25 @@
 //    that the lights bind it where they bound VSM's mean and deviation;
 //  - ShaderChunk.shadowmap_pars_fragment's VSM getShadow() is replaced by the moment
 //    reconstruction, so every standard material (and ShadowMaterial) reads it unchanged.
-import { ShaderChunk, VSMShadowMap, RawShaderMaterial, GLSL3, WebGLRenderTarget, BufferGeometry, BufferAttribute, Mesh,
-  OrthographicCamera, FloatType, RGBAFormat, RedFormat, LinearFilter, NearestFilter, ClampToEdgeWrapping, Vector2 } from 'three';
+// Point lights, which three.js's VSM leaves without a shadow: the package gives each a cube render
+// target, into which three.js renders its six faces of radial distance (MeshDistanceMaterial, as
+// for its own point shadows); the moments are made from it face by face, blurred over directions
+// across the faces' seams (a cube texture samples seamlessly in WebGL 2) and bound where three.js
+// binds a point light's cube map; the chunks gain a VSM getPointShadow.
+import { ShaderChunk, VSMShadowMap, RawShaderMaterial, GLSL3, WebGLRenderTarget, WebGLCubeRenderTarget, BufferGeometry,
+  BufferAttribute, Mesh, OrthographicCamera, FloatType, UnsignedByteType, RGBAFormat, RGFormat, LinearFilter, NearestFilter,
+  ClampToEdgeWrapping, Vector2, DataTexture, DoubleSide } from 'three';
 import { MSM_THREE_GLSL } from './generated/msm-glsl.js';
+import { MSM_BLUE_NOISE } from './generated/blue-noise.js';
 
 // The techniques: name -> the id of src/glsl/msm_three.h (MSM_THREE_*).
 export const TECHNIQUES = Object.freeze({
   'msm-hamburger-64': 0, // 4 x 16 bits after Θ4* (JCGT), Hamburger 4MSM
   'msm-hamburger-128': 1, // 4 x float (JCGT), Hamburger 4MSM
   'msm-nl-64': 2, // Φ of the float moments in 4 x 16 bits (HPG 2017), Algorithm 3
+  'msm-nl-32': 3, // Φ in 32 bits (HPG 2017 §3.5) in an RGBA8 texture, a blue-noise dithered texel, Algorithm 3
 });
+const NL32 = TECHNIQUES['msm-nl-32'];
 
 // The Gaussian blur: taps x taps texels, σ in texels (filter.h's defaults: the 2015 paper's kernel).
 export const DEFAULT_BLUR = Object.freeze({ taps: 9, sigma: 2.4 });
@@ -63,12 +72,63 @@ void main() {
   result = store ? msm_three_store(technique, sum) : sum;
 }`;
 
+// A cube face's texel (its gl_FragCoord, face coordinates st in [-1, 1]) as the direction WebGL's
+// cube sampling maps to it (the major-axis table of the OpenGL ES 3.0 specification, 3.8.10).
+const CUBE_DIRECTION = `
+uniform int face;
+vec3 cubeDirection(vec2 st) {
+  if (face == 0) return vec3(1.0, -st.y, -st.x);
+  if (face == 1) return vec3(-1.0, -st.y, st.x);
+  if (face == 2) return vec3(st.x, 1.0, st.y);
+  if (face == 3) return vec3(st.x, -1.0, -st.y);
+  if (face == 4) return vec3(st.x, -st.y, 1.0);
+  return vec3(-st.x, -st.y, -1.0);
+}
+vec2 faceCoordinates(vec2 texel, float size) { return 2.0 * texel / size - 1.0; }`;
+
+// The filterable channels of a point light's cube face, from three.js's distance map:
+// (distance - near) / (far - near), far the light's range; msm's depth is distance / range.
+const GENERATE_CUBE = `${MSM_THREE_GLSL}${CUBE_DIRECTION}
+uniform highp samplerCube distanceMap;
+uniform float near;
+uniform float range;
+uniform int technique;
+layout(location = 0) out vec4 channels;
+void main() {
+  float size = float(textureSize(distanceMap, 0).x);
+  float stored = texture(distanceMap, cubeDirection(faceCoordinates(gl_FragCoord.xy, size))).x;
+  channels = msm_three_generate(technique, msm_local_light_depth(mix(near, range, stored), range));
+}`;
+
+// One direction of the separable blur on a cube face: the taps step one texel along the face's
+// own axis and continue onto the neighbouring face where they leave it.
+const BLUR_CUBE = `${MSM_THREE_GLSL}${CUBE_DIRECTION}
+uniform highp samplerCube source;
+uniform highp sampler2D weights;
+uniform int taps;
+uniform vec2 direction;
+uniform int technique;
+uniform bool store;
+layout(location = 0) out vec4 result;
+void main() {
+  float size = float(textureSize(source, 0).x);
+  vec2 st = faceCoordinates(gl_FragCoord.xy, size);
+  int r = taps / 2;
+  vec4 sum = vec4(0.0);
+  for (int k = 0; k < taps; ++k)
+    sum += texelFetch(weights, ivec2(k, 0), 0).x * texture(source, cubeDirection(st + float(2 * (k - r)) / size * direction));
+  result = store ? msm_three_store(technique, sum) : sum;
+}`;
+
 // three.js's VSM getShadow, with the moments in place of mean and deviation: same signature,
 // same shadow coordinates, bias and frustum test.
 const GET_SHADOW = `
 		${MSM_THREE_GLSL}
 		#ifndef MSM_THREE_TECHNIQUE
 		#define MSM_THREE_TECHNIQUE 0
+		#endif
+		#if MSM_THREE_TECHNIQUE == 3
+		uniform highp sampler2D msmThreeBlueNoise;
 		#endif
 		float getShadow( sampler2D shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord ) {
 			float shadow = 1.0;
@@ -89,6 +149,14 @@ const GET_SHADOW = `
 					vec4 m01 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i0.x, i1.y ), 0 ) );
 					vec4 m11 = msm_three_nl64_moments( texelFetch( shadowMap, i1, 0 ) );
 					shadow = 1.0 - msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), shadowCoord.z );
+				#elif MSM_THREE_TECHNIQUE == 3
+					// The 32-bit texels decode alone: the texel nearest to the lookup moved by blue noise
+					// in [-0.5, 0.5) texels (the renderer's dithered lookup, lookup.glsl).
+					ivec2 last = textureSize( shadowMap, 0 ) - 1;
+					vec2 t = shadowCoord.xy * vec2( last + 1 ) - 0.5;
+					vec2 noise = texelFetch( msmThreeBlueNoise, ivec2( gl_FragCoord.xy ) & ( textureSize( msmThreeBlueNoise, 0 ) - 1 ), 0 ).xy;
+					ivec2 i = clamp( ivec2( floor( t + noise ) ), ivec2( 0 ), last );
+					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texelFetch( shadowMap, i, 0 ), shadowCoord.z );
 				#else
 					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
 				#endif
@@ -97,24 +165,51 @@ const GET_SHADOW = `
 		}
 `;
 
+// A point light's lookup under VSM (three.js has none): the receiver's radial depth in msm's
+// convention for local lights, the depth bias relative to the texel's size (a cube face spans
+// 2 x distance); the non-linear techniques' point lights keep float moments (technique 1).
+const GET_POINT_SHADOW = `
+	#elif defined( SHADOWMAP_TYPE_VSM )
+	float getPointShadow( samplerCube shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord, float shadowCameraNear, float shadowCameraFar ) {
+		const int technique = MSM_THREE_TECHNIQUE >= 2 ? 1 : MSM_THREE_TECHNIQUE;
+		float shadow = 1.0;
+		vec3 lightToPosition = shadowCoord.xyz;
+		float depth = msm_local_light_receiver_depth( length( lightToPosition ), shadowCameraFar, msm_three_depth_bias( technique ), 2.0 ) + shadowBias;
+		if ( depth <= 1.0 ) shadow = 1.0 - msm_three_shadow( technique, texture( shadowMap, lightToPosition ), depth );
+		return mix( 1.0, shadow, shadowIntensity );
+	}
+`;
+
 const VSM_BEGIN = '#elif defined( SHADOWMAP_TYPE_VSM )';
 // The #else after it at the chunk's outer level (one tab: the ones inside getShadow are deeper).
 const VSM_END = /\n\t#else\b/g;
 
-// shadowmap_pars_fragment with the VSM getShadow replaced; null where the chunk is not the one
-// this package knows (another three.js release).
+// The point lights' sampler, declared for Basic shadows, and their lookup, called for PCF and Basic.
+const POINT_SAMPLER = /#elif defined\( SHADOWMAP_TYPE_BASIC \)(\s*uniform samplerCube pointShadowMap)/;
+const POINT_LOOKUP = /\n\t#elif defined\( SHADOWMAP_TYPE_BASIC \)\s*float getPointShadow\(/;
+const POINT_CALL = /(NUM_POINT_LIGHT_SHADOWS[^\n]*)\( defined\( SHADOWMAP_TYPE_PCF \) \|\| defined\( SHADOWMAP_TYPE_BASIC \) \)/;
+
+// shadowmap_pars_fragment with the VSM getShadow replaced and a VSM getPointShadow added;
+// null where the chunk is not the one this package knows (another three.js release).
 function momentChunk(original) {
   const begin = original.indexOf(VSM_BEGIN);
-  if (begin < 0) return null;
+  if (begin < 0 || !POINT_SAMPLER.test(original) || !POINT_LOOKUP.test(original)) return null;
   VSM_END.lastIndex = begin;
   const end = VSM_END.exec(original);
   if (end === null) return null;
-  return `${original.slice(0, begin + VSM_BEGIN.length)}\n${GET_SHADOW}${original.slice(end.index)}`;
+  const chunk = `${original.slice(0, begin + VSM_BEGIN.length)}\n${GET_SHADOW}${original.slice(end.index)}`;
+  return chunk.replace(POINT_SAMPLER, '#elif defined( SHADOWMAP_TYPE_BASIC ) || defined( SHADOWMAP_TYPE_VSM )$1')
+    .replace(POINT_LOOKUP, (m) => `\n${GET_POINT_SHADOW}${m}`);
 }
 
-function floatTarget(width, height, filter, format = RGBAFormat) {
+// A chunk that calls getPointShadow for PCF and Basic shadows, calling it for VSM too.
+function pointCallChunk(original) {
+  return POINT_CALL.test(original) ? original.replace(POINT_CALL, '$1( defined( SHADOWMAP_TYPE_PCF ) || defined( SHADOWMAP_TYPE_BASIC ) || defined( SHADOWMAP_TYPE_VSM ) )') : null;
+}
+
+function mapTarget(width, height, filter, type = FloatType) {
   const target = new WebGLRenderTarget(width, height, {
-    type: FloatType, format, minFilter: filter, magFilter: filter, wrapS: ClampToEdgeWrapping, wrapT: ClampToEdgeWrapping,
+    type, format: RGBAFormat, minFilter: filter, magFilter: filter, wrapS: ClampToEdgeWrapping, wrapT: ClampToEdgeWrapping,
     depthBuffer: false, generateMipmaps: false,
   });
   target.texture.name = 'msm-three';
@@ -125,7 +220,27 @@ function pass(fragmentShader, uniforms) {
   return new RawShaderMaterial({ glslVersion: GLSL3, vertexShader: VERTEX, fragmentShader, uniforms, depthTest: false, depthWrite: false });
 }
 
-const originalChunk = ShaderChunk.shadowmap_pars_fragment;
+// Every surface casts from both sides into the point lights' maps, as into msm's (its depth pass
+// culls nothing): three.js's VSM renders the materials' front faces only (its PCF the back
+// faces), and a caster cut open by the light's near plane (shadow.camera.near, 0.5 by default)
+// would cast no shadow through the cut. Materials with their own shadowSide keep it. Returns
+// what puts the materials back.
+function castFromBothSides(scene) {
+  const changed = [];
+  scene.traverse((object) => {
+    if (!object.material) return;
+    for (const material of Array.isArray(object.material) ? object.material : [object.material])
+      if (material.shadowSide === null) {
+        material.shadowSide = DoubleSide;
+        changed.push(material);
+      }
+  });
+  return () => changed.forEach((material) => (material.shadowSide = null));
+}
+
+// The chunks the package replaces, as three.js has them, and what replaces them.
+const CHUNKS = { shadowmap_pars_fragment: momentChunk, lights_fragment_begin: pointCallChunk, shadowmask_pars_fragment: pointCallChunk };
+const originalChunks = Object.fromEntries(Object.keys(CHUNKS).map((name) => [name, ShaderChunk[name]]));
 let activeInstances = 0;
 
 export class MomentShadowMaps {
@@ -137,28 +252,41 @@ export class MomentShadowMaps {
     this._technique = TECHNIQUES['msm-hamburger-64'];
     this.technique = technique;
     this._lights = new Map(); // light -> { threeMap, moments, scratch }
+    this._points = new Map(); // point light -> { distance, moments, scratch } (cube render targets)
     this._warned = new Set();
     if (!this.supported) return;
-    const chunk = momentChunk(originalChunk);
-    if (chunk === null) {
-      console.warn('msm-three: this three.js release has no VSM getShadow in shadowmap_pars_fragment; three.js\'s own shadows stay');
+    const chunks = Object.fromEntries(Object.entries(CHUNKS).map(([name, make]) => [name, make(originalChunks[name])]));
+    const unknown = Object.keys(chunks).filter((name) => chunks[name] === null);
+    if (unknown.length > 0) {
+      console.warn(`msm-three: this three.js release's ${unknown.join(' and ')} are not the ones the package knows (VSM getShadow, point-light shadows); three.js's own shadows stay`);
       this.supported = false;
       return;
     }
-    ShaderChunk.shadowmap_pars_fragment = chunk;
+    Object.assign(ShaderChunk, chunks);
     ++activeInstances;
     this._previousType = renderer.shadowMap.type;
     renderer.shadowMap.type = VSMShadowMap;
     this._triangle = new Mesh(new BufferGeometry().setAttribute('position', new BufferAttribute(new Float32Array(9), 3)));
     this._camera = new OrthographicCamera();
-    this._weights = floatTarget(63, 1, NearestFilter);
+    this._weights = mapTarget(63, 1, NearestFilter);
     this._weightsPass = pass(WEIGHTS, { taps: { value: 9 }, sigma: { value: 2.4 } });
     this._generatePass = pass(GENERATE, { depthMap: { value: null }, technique: { value: 0 } });
+    this._generateCubePass = pass(GENERATE_CUBE, {
+      distanceMap: { value: null }, face: { value: 0 }, near: { value: 0 }, range: { value: 1 }, technique: { value: 0 },
+    });
+    this._blurCubePass = pass(BLUR_CUBE, {
+      source: { value: null }, weights: { value: this._weights.texture }, taps: { value: 9 }, direction: { value: new Vector2() },
+      face: { value: 0 }, technique: { value: 0 }, store: { value: false },
+    });
     this._blurPass = pass(BLUR, {
       source: { value: null }, weights: { value: this._weights.texture }, taps: { value: 9 }, direction: { value: new Vector2() },
       technique: { value: 0 }, store: { value: false },
     });
     this._weightsKey = '';
+    // The dithered lookup's blue noise, bound in every marked material (_markMaterials).
+    const noise = Uint8Array.from(atob(MSM_BLUE_NOISE.base64), (c) => c.charCodeAt(0));
+    this._blueNoise = { value: new DataTexture(noise, MSM_BLUE_NOISE.size, MSM_BLUE_NOISE.size, RGFormat, UnsignedByteType) };
+    this._blueNoise.value.needsUpdate = true;
     const shadowMap = renderer.shadowMap;
     this._render = shadowMap.render;
     const self = this;
@@ -173,7 +301,21 @@ export class MomentShadowMaps {
         return draw.call(this, camera_, scene_, geometry, material, ...rest);
       };
       try {
-        self._render.call(this, lights, scene, camera);
+        // The point lights after the others: three.js rebuilds every map in the first render after
+        // the shadow type changed, and leaves a point light under VSM without one (and a warning).
+        const points = lights.filter((l) => l.isPointLight);
+        const needsUpdate = this.needsUpdate;
+        self._render.call(this, lights.filter((l) => !l.isPointLight), scene, camera);
+        if (points.length > 0) {
+          this.needsUpdate = needsUpdate;
+          self._preparePoints(points);
+          const restoreSides = castFromBothSides(scene);
+          try {
+            self._render.call(this, points, scene, camera);
+          } finally {
+            restoreSides();
+          }
+        }
       } finally {
         renderer.renderBufferDirect = draw;
       }
@@ -201,19 +343,27 @@ export class MomentShadowMaps {
   dispose() {
     if (!this.supported) return;
     this._restore([...this._lights.keys()]);
-    for (const { moments, scratch } of this._lights.values()) {
+    for (const { moments, scratch, packed } of this._lights.values()) {
       moments.dispose();
       scratch.dispose();
+      packed?.dispose();
     }
     this._lights.clear();
+    for (const [light, { distance, moments, scratch }] of this._points) {
+      if (light.shadow.map === distance || light.shadow.map === moments) light.shadow.map = null; // three.js makes its own
+      for (const target of [distance, moments, scratch]) target.dispose();
+    }
+    this._points.clear();
     this.renderer.shadowMap.render = this._render;
     this.renderer.shadowMap.type = this._previousType;
-    if (--activeInstances === 0) ShaderChunk.shadowmap_pars_fragment = originalChunk;
-    for (const m of [this._weightsPass, this._generatePass, this._blurPass]) m.dispose();
+    if (--activeInstances === 0) Object.assign(ShaderChunk, originalChunks);
+    for (const m of [this._weightsPass, this._generatePass, this._blurPass, this._generateCubePass, this._blurCubePass]) m.dispose();
     this._weights.dispose();
+    this._blueNoise.value.dispose();
     this._triangle.geometry.dispose();
     this._marked?.forEach((material) => {
       delete material.defines.MSM_THREE_TECHNIQUE;
+      material.onBeforeCompile = this._onBeforeCompile.get(material);
       material.needsUpdate = true;
     });
     this.supported = false;
@@ -223,7 +373,30 @@ export class MomentShadowMaps {
   _restore(lights) {
     for (const light of lights) {
       const state = this._lights.get(light);
-      if (state && light.shadow.map === state.moments) light.shadow.map = state.threeMap;
+      if (state && (light.shadow.map === state.moments || light.shadow.map === state.packed)) light.shadow.map = state.threeMap;
+    }
+  }
+
+  // Each shadow-casting point light renders its distances into the package's cube target.
+  _preparePoints(points) {
+    for (const light of points) {
+      if (!light.castShadow) continue;
+      const size = light.shadow.mapSize.x;
+      let state = this._points.get(light);
+      if (!state || state.distance.width !== size) {
+        if (state) for (const target of [state.distance, state.moments, state.scratch]) target.dispose();
+        else if (light.shadow.map !== null) light.shadow.map.dispose(); // three.js's own, from another shadow type
+        const cube = (filter, depthBuffer) => new WebGLCubeRenderTarget(size, {
+          type: FloatType, format: RGBAFormat, minFilter: filter, magFilter: filter, generateMipmaps: false, depthBuffer,
+        });
+        state = { distance: cube(NearestFilter, true), moments: cube(LinearFilter, false), scratch: cube(LinearFilter, false) };
+        state.moments.texture.name = 'msm-three';
+        // three.js disposes it instead of rendering where the shadow type changed in this render.
+        state.distance.addEventListener('dispose', () => (state.rendered = false));
+        this._points.set(light, state);
+      }
+      light.shadow.map = state.distance;
+      state.rendered = light.shadow.autoUpdate || light.shadow.needsUpdate; // what three.js renders
     }
   }
 
@@ -252,14 +425,16 @@ export class MomentShadowMaps {
     if (!state || state.moments.width !== threeMap.width || state.moments.height !== threeMap.height) {
       state?.moments.dispose();
       state?.scratch.dispose();
+      state?.packed?.dispose();
       state = {
-        moments: floatTarget(threeMap.width, threeMap.height, LinearFilter),
-        scratch: floatTarget(threeMap.width, threeMap.height, NearestFilter),
+        moments: mapTarget(threeMap.width, threeMap.height, LinearFilter),
+        scratch: mapTarget(threeMap.width, threeMap.height, NearestFilter),
       };
       this._lights.set(light, state);
     }
     state.threeMap = threeMap;
     state.generated = true;
+    if (this._technique === NL32 && !state.packed) state.packed = mapTarget(threeMap.width, threeMap.height, NearestFilter, UnsignedByteType);
     const previousTarget = renderer.getRenderTarget();
     this._generatePass.uniforms.depthMap.value = depth;
     this._generatePass.uniforms.technique.value = this._technique;
@@ -273,9 +448,6 @@ export class MomentShadowMaps {
     const renderer = this.renderer;
     if (renderer.shadowMap.enabled !== true) return;
     this._markMaterials(scene);
-    for (const light of lights)
-      if (light.isPointLight && light.castShadow)
-        this._warnOnce(light, 'point lights have no moment shadow map (three.js has no VSM for them either): no shadow');
     const previousTarget = renderer.getRenderTarget();
     const { taps, sigma } = this.blur;
     const key = `${taps}/${sigma}`;
@@ -292,9 +464,48 @@ export class MomentShadowMaps {
       if (!state || state.threeMap !== light.shadow.map) continue;
       // A light that three.js did not update this frame (shadow.autoUpdate off) keeps its moments.
       if (state.generated) this._blur(state, taps);
+      light.shadow.map = this._technique === NL32 ? state.packed : state.moments;
+    }
+    for (const light of lights) {
+      const state = this._points.get(light);
+      if (!state || light.shadow.map !== state.distance) continue;
+      if (state.rendered) this._pointMoments(light, state, taps);
       light.shadow.map = state.moments;
     }
     renderer.setRenderTarget(previousTarget);
+  }
+
+  // A point light's moments, face by face from its distances, then blurred across the faces.
+  _pointMoments(light, state, taps) {
+    state.rendered = false;
+    let technique = this._technique;
+    if (technique === TECHNIQUES['msm-nl-64'] || technique === NL32) {
+      this._warnOnce(light, `${this.technique} has no cube maps: this point light's moments are msm-hamburger-128's`);
+      technique = TECHNIQUES['msm-hamburger-128'];
+    }
+    const generate = this._generateCubePass.uniforms, blur = this._blurCubePass.uniforms;
+    generate.distanceMap.value = state.distance.texture;
+    generate.near.value = light.shadow.camera.near;
+    generate.range.value = light.shadow.camera.far; // three.js's: the light's distance, else the camera's far
+    generate.technique.value = technique;
+    blur.taps.value = taps;
+    blur.technique.value = technique;
+    const faces = (material, target) => {
+      for (let face = 0; face < 6; ++face) {
+        material.uniforms.face.value = face;
+        this.renderer.setRenderTarget(target, face);
+        this.renderer.renderBufferDirect(this._camera, null, this._triangle.geometry, material, this._triangle, null);
+      }
+    };
+    faces(this._generateCubePass, state.moments);
+    blur.source.value = state.moments.texture;
+    blur.direction.value.set(1, 0);
+    blur.store.value = false;
+    faces(this._blurCubePass, state.scratch);
+    blur.source.value = state.scratch.texture;
+    blur.direction.value.set(0, 1);
+    blur.store.value = true;
+    faces(this._blurCubePass, state.moments);
   }
 
   // The separable Gaussian of the generated moments, then their storage.
@@ -310,13 +521,15 @@ export class MomentShadowMaps {
     blur.source.value = state.scratch.texture;
     blur.direction.value.set(0, 1);
     blur.store.value = true;
-    this._draw(this._blurPass, state.moments);
+    this._draw(this._blurPass, this._technique === NL32 ? state.packed : state.moments); // 32 bits: RGBA8
   }
 
   // The receivers' programs read the technique as a define (part of three.js's program key).
   _markMaterials(scene) {
     this._marked ??= new Set();
+    this._onBeforeCompile ??= new Map(); // a material's own hook, put back by dispose()
     const technique = this._technique;
+    const blueNoise = this._blueNoise;
     scene.traverse((object) => {
       if (!object.material) return;
       for (const material of Array.isArray(object.material) ? object.material : [object.material]) {
@@ -324,6 +537,14 @@ export class MomentShadowMaps {
         if (material.defines.MSM_THREE_TECHNIQUE === technique) continue;
         material.defines.MSM_THREE_TECHNIQUE = technique;
         material.needsUpdate = true;
+        if (!this._onBeforeCompile.has(material)) {
+          const own = material.onBeforeCompile;
+          this._onBeforeCompile.set(material, own);
+          material.onBeforeCompile = function (shader, renderer) {
+            own.call(this, shader, renderer);
+            shader.uniforms.msmThreeBlueNoise = blueNoise;
+          };
+        }
         this._marked.add(material);
       }
     });

@@ -130,7 +130,7 @@ KernelIO make_input(int id, Inputs& g) {
     break;
   case MSM_WK_THREE_GENERATE:
     x.a[0] = g.chance(0.05) ? float(g.integer(0, 4)) * 0.25f : g.uni(0.0f, 1.0f);
-    x.u[0] = uint32_t(g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64));
+    x.u[0] = uint32_t(g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL32));
     break;
   case MSM_WK_THREE_STORE: { // blurred channels in each technique's basis
     int t = g.integer(MSM_THREE_HAMBURGER_64, MSM_THREE_NL64);
@@ -157,6 +157,7 @@ KernelIO make_input(int id, Inputs& g) {
 // The renderer's technique (techniques.h) that each of the package's techniques is.
 int renderer_technique(uint32_t t) {
   if (t == uint32_t(MSM_THREE_HAMBURGER_64)) return MSM_TECH_HAMBURGER_64;
+  if (t == uint32_t(MSM_THREE_NL32)) return MSM_TECH_NL32;
   return t == uint32_t(MSM_THREE_NL64) ? MSM_TECH_NL64 : MSM_TECH_HAMBURGER_128;
 }
 
@@ -166,6 +167,10 @@ bool same_as_renderer(int id, const KernelIO& x, const KernelIO& r) {
   int t = renderer_technique(x.u[0]);
   if (id == MSM_WK_THREE_GENERATE) {
     vec4 want = msm_technique_generate(t, x.a[0], msm_technique_default_params(t)).a;
+    // The 32-bit map's RGBA8 texel holds the renderer's word (THREE_STORE has no 32-bit inputs: its
+    // bytes differ by whole steps where Ψ4 rounds differently on WebGL, which nl_pack32 bounds).
+    if (t == MSM_TECH_NL32 && msm_three_word_from_rgba8(msm_three_store(MSM_THREE_NL32, r.a)) != msm_nl32_encode(r.a))
+      return false;
     vec4 stored = msm_three_store(int(x.u[0]), r.a);
     // The renderer's 64-bit map rounds to UNORM16 on the write; msm_three_store does that in the shader.
     return r.a == want && (t != MSM_TECH_HAMBURGER_64 || stored == msm_quantize_unorm16(want));

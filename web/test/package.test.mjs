@@ -7,7 +7,7 @@ import { dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
-const REQUIRED = ['package.json', 'README.md', 'src/index.js', 'src/index.d.ts', 'src/generated/msm-glsl.js'];
+const REQUIRED = ['package.json', 'README.md', 'src/index.js', 'src/index.d.ts', 'src/generated/msm-glsl.js', 'src/generated/blue-noise.js'];
 let failed = false;
 const fail = (what) => {
   console.error(`web-package: FAILED: ${what}`);
@@ -31,7 +31,7 @@ try {
 const module = await import(resolve(webDir, 'src/index.js'));
 for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR'])
   if (!(name in module)) fail(`src/index.js does not export ${name}`);
-if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64']))
+if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32']))
   fail(`TECHNIQUES is ${JSON.stringify(module.TECHNIQUES)}, not what index.d.ts declares`);
 if (failed) process.exit(1);
 console.log('web-package: ok');

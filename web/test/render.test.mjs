@@ -3,16 +3,26 @@
 // VSM and the package's techniques, as the shadow attenuation 1 - image / unshadowed image of
 // every pixel. Asserts, with bounds from measurement ([web-render] lines):
 //  - the moment shadows are where PCF's are: mean |attenuation - PCF's| (the blur widens them:
-//    measured 0.0048 at 64 bits, 0.0052 at 128 bits, 0.0050 non-linear; bound 0.0075) and well away from none
+//    measured 0.0048 at 64 bits, 0.0052 at 128 bits, 0.0050 non-linear, 0.0055 at 32 bits non-linear
+//    (dithered); bound 0.0075; the 32-bit texel's bytes read in the wrong order give 0.11) and well away from none
 //    (an unshadowed image differs from PCF by 0.017; bound >= 0.012);
 //  - no shadow where PCF has none (mean attenuation on PCF-lit pixels, measured 0.0011 / 0.0018 /
-//    0.0014;
+//    0.0014 / 0.0019;
 //    bound 0.004: a leak of the other sign, acne or a wrong depth convention, shows here);
 //  - the same for the spot light alone (sun off): MAE 0.0014 at 64 bits, 0.0010 at 128 bits and
-//    non-linear
+//    non-linear 64 bits, 0.0012 at 32 bits
 //    (bound 0.003), an unshadowed image 0.009 from PCF (bound >= 0.006);
+//  - the point light alone (sun off, the lamp moved to LAMP), where three.js's VSM casts no shadow
+//    at all (the light on pixels that PCF has in shadow: measured 1.0, the whole of it; bound
+//    >= 0.95): the package's cube maps against PCF's, MAE 0.0014 at 64 bits and 0.0046 at 128 bits
+//    (bound 0.006; an unshadowed image 0.032, bound >= 0.018; the column cut by the near plane
+//    casting from its front faces only, as three.js's VSM renders them: 0.022), shadow on PCF-lit
+//    pixels 0.0016 and 0.0053 (bound 0.0075: the 128-bit map's smaller moment bias shows as faint
+//    self-shadowing where the cube's texels are long on the ground), light on PCF's shadows 0.373
+//    and 0.372 against PCF's own 0.364 (the blur's penumbrae; bound PCF's + 0.03);
 //  - what the package cannot do is said: without EXT_color_buffer_float it warns and stays off
-//    (three.js's shadow type unchanged); a point light's missing moment map is a warning naming it.
+//    (three.js's shadow type unchanged); a point light under msm-nl-64 (no cube map of
+//    non-linear moments) is a warning naming it, and three.js's own VSM warning never shows.
 // Also prints the frame time of each technique (same resolution and map size) against PCF's and
 // VSM's, as ratios: SwiftShader's, a CPU, not a GPU's.
 //   node test/render.test.mjs [OUT_DIR]   (writes the images there)
@@ -34,9 +44,16 @@ const RUNS = [
   ['msm-hamburger-64', { shadow: 'msm-hamburger-64' }],
   ['msm-hamburger-128', { shadow: 'msm-hamburger-128' }],
   ['msm-nl-64', { shadow: 'msm-nl-64' }],
+  ['msm-nl-32', { shadow: 'msm-nl-32' }],
 ];
 const MAE_MAX = 0.0075, MAE_NONE_MIN = 0.012, LIT_MAX = 0.004;
-const SPOT_RUNS = ['none', 'pcf', 'msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64'];
+const SPOT_RUNS = ['none', 'pcf', 'msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32'];
+// The point light alone: three.js's VSM has no point shadow (the light reaches every pixel).
+const POINT_RUNS = ['none', 'pcf', 'vsm', 'msm-hamburger-64', 'msm-hamburger-128'];
+// The lamp 0.36 m from a column's surface, inside the near plane (0.5): the column is cut open and
+// casts only by its far side.
+const LAMP = [7, 1.5, 2.5];
+const POINT_MAE_MAX = 0.006, POINT_MAE_NONE_MIN = 0.018, POINT_LIT_MAX = 0.0075, POINT_LEAK_OVER_PCF_MAX = 0.03, POINT_VSM_LEAK_MIN = 0.95;
 const SPOT_MAE_MAX = 0.003, SPOT_MAE_NONE_MIN = 0.006;
 
 async function main() {
@@ -52,6 +69,8 @@ async function main() {
       r[name] = await page.evaluate((o) => window.msmRender(o), { ...options, frames: 5, png: out !== undefined });
     for (const name of SPOT_RUNS)
       r[`spot-${name}`] = await page.evaluate((o) => window.msmRender(o), { shadow: name, sun: false, spot: true, png: out !== undefined });
+    for (const name of POINT_RUNS)
+      r[`point-${name}`] = await page.evaluate((o) => window.msmRender(o), { shadow: name, sun: false, point: true, lampPosition: LAMP, png: out !== undefined });
     unsupported = await page.evaluate(() => window.msmUnsupported());
   } finally {
     await browser.close();
@@ -96,12 +115,36 @@ async function main() {
     if (name === 'none') check(mae >= SPOT_MAE_NONE_MIN, `spot light: an unshadowed image differs from PCF by ${mae} only`);
     if (name.startsWith('msm')) check(mae <= SPOT_MAE_MAX, `spot light, ${name}: attenuation MAE vs PCF ${mae} > ${SPOT_MAE_MAX}`);
   }
+  const pointNone = r['point-none'].luminance;
+  const pointAttenuation = (img) => img.luminance.map((v, i) => 1 - v / Math.max(pointNone[i], 1e-3));
+  const pointPcf = pointAttenuation(r['point-pcf']);
+  const pointLit = pointPcf.map((a, i) => (a <= 0.02 && pointNone[i] > 0.05 ? i : -1)).filter((i) => i >= 0);
+  const pointShadowed = pointPcf.map((a, i) => (a >= 0.5 && pointNone[i] > 0.05 ? i : -1)).filter((i) => i >= 0);
+  let pointLeakPcf = 0;
+  for (const name of POINT_RUNS) {
+    const a = pointAttenuation(r[`point-${name}`]);
+    const mae = a.reduce((s, x, i) => s + Math.abs(x - pointPcf[i]), 0) / a.length;
+    const onLit = pointLit.reduce((s, i) => s + Math.max(0, a[i]), 0) / pointLit.length;
+    // Light leaking: the light that reaches pixels PCF has in shadow, as a share of the unshadowed light.
+    const leak = pointShadowed.reduce((s, i) => s + Math.min(1, Math.max(0, 1 - a[i])), 0) / pointShadowed.length;
+    console.log(`[web-render] point light, ${name}: attenuation MAE vs PCF ${mae.toFixed(4)}, on PCF-lit pixels ${onLit.toFixed(4)}, ` +
+      `light on PCF-shadowed pixels ${leak.toFixed(4)} (${pointShadowed.length} pixels)`);
+    if (name === 'none') check(mae >= POINT_MAE_NONE_MIN, `point light: an unshadowed image differs from PCF by ${mae} only`);
+    if (name === 'vsm') check(leak >= POINT_VSM_LEAK_MIN, `point light: three.js's VSM lets only ${leak} of the light onto PCF's shadows: it has a point shadow now?`);
+    if (name === 'pcf') pointLeakPcf = leak;
+    if (name.startsWith('msm')) {
+      check(mae <= POINT_MAE_MAX, `point light, ${name}: attenuation MAE vs PCF ${mae} > ${POINT_MAE_MAX}`);
+      check(onLit <= POINT_LIT_MAX, `point light, ${name}: shadow on PCF-lit pixels ${onLit} > ${POINT_LIT_MAX}`);
+      check(leak <= pointLeakPcf + POINT_LEAK_OVER_PCF_MAX, `point light, ${name}: light on PCF's shadows ${leak}, PCF's own ${pointLeakPcf}`);
+    }
+  }
   const w = unsupported.warnings;
   console.log(`[web-render] warnings: ${w.join(' | ')}`);
   check(!unsupported.noFloat.supported && unsupported.noFloat.type === unsupported.pcfType,
     'without EXT_color_buffer_float the package switched itself on or changed the shadow type');
   check(w.some((x) => x.includes('EXT_color_buffer_float')), 'no warning names the missing EXT_color_buffer_float');
-  check(w.some((x) => x.includes("PointLight 'lamp'")), "no warning names the point light 'lamp'");
+  check(w.some((x) => x.includes("PointLight 'lamp'") && x.includes('msm-nl-64')), "no warning says that the point light 'lamp' has no msm-nl-64 map");
+  check(!w.some((x) => x.includes('not supported for PointLights')), "three.js warned that VSM has no point shadows: the package's cube map was not used");
   if (failed) process.exit(1);
   console.log('web-render: ok');
 }

@@ -96,7 +96,7 @@ bool spot_lookup(int l, vec3 n, float n_dot_l, MsmFootprint pixel, out ShadowLoo
   s.dt_dx = spot_texels_along(l, clip, pixel.dp_dx);
   s.dt_dy = spot_texels_along(l, clip, pixel.dp_dy);
   float r = distance(p, light_position);
-  s.z = (r - frame.shadow_map.w * width_per_distance * r) / range;
+  s.z = msm_local_light_receiver_depth(r, range, frame.shadow_map.w, width_per_distance);
   // The receiver plane's radial depth per texel: d(r)/d(tangent) times d(tangent)/d(t).
   vec3 tangent_x = normalize(abs(n.x) > 0.5f ? cross(n, vec3(0.0f, 1.0f, 0.0f)) : cross(n, vec3(1.0f, 0.0f, 0.0f)));
   vec3 tangent_y = cross(n, tangent_x);

@@ -8,6 +8,7 @@
 #define MSM_LIGHT_BINDING MSM_BINDING_SHADOW_DEPTH_MASKED_LIGHTS
 #include "frame.glsl"
 #include "alpha_test.glsl"
+#include "msm/local_light.h"
 
 layout(binding = MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY) uniform sampler2D opacity_texture;
 // Per sample: gl_FragDepth is one depth for every sample the fragment covers, and the lookups take
@@ -19,5 +20,6 @@ layout(push_constant) uniform Push { ObjectPush object; };
 void main() {
   if (!alpha_test_passes(object, true, opacity_texture, texcoord)) discard;
   LightUniforms light = lights[object.light.x];
-  gl_FragDepth = clamp(distance(world_position, light.spot_position.xyz) / light.spot_position.w, 0.0f, 1.0f);
+  gl_FragDepth = clamp(msm_local_light_depth(distance(world_position, light.spot_position.xyz), light.spot_position.w),
+                       0.0f, 1.0f);
 }

@@ -11,6 +11,7 @@
 #include "msm/bias.h"
 #include "msm/filter.h"
 #include "msm/hamburger4.h"
+#include "msm/local_light.h"
 #include "msm/moments.h"
 #include "msm/nonlinear.h"
 #include "msm/quantize.h"
@@ -22,8 +23,20 @@ MSM_BEGIN
 const int MSM_THREE_HAMBURGER_64 = 0;  // 4 x 16 bits after Θ4*, [-1,1] depth (JCGT): msm-hamburger-64
 const int MSM_THREE_HAMBURGER_128 = 1; // 4 x float, [-1,1] depth (JCGT): msm-hamburger-128
 const int MSM_THREE_NL64 = 2;          // Φ of the float moments in 4 x 16 bits (HPG 2017): msm-nl-64
+const int MSM_THREE_NL32 = 3;          // Φ of the float moments in 32 bits (HPG 2017 §3.5): msm-nl-32
 
-MSM_FN bool msm_three_is_nonlinear(int t) { return t == MSM_THREE_NL64; }
+MSM_FN bool msm_three_is_nonlinear(int t) { return t == MSM_THREE_NL64 || t == MSM_THREE_NL32; }
+
+// A 32-bit word as the four bytes of an RGBA8 texel (byte k holds bits 8k..8k+7, stored as the
+// UNORM8 value byte / 255, which the texture holds exactly), and back: WebGL 2 binds no integer
+// texture where three.js's lookup expects a float one.
+MSM_FN vec4 msm_three_rgba8_from_word(uint p) {
+  return vec4(float(p & 255u), float((p >> 8u) & 255u), float((p >> 16u) & 255u), float(p >> 24u)) / 255.0f;
+}
+MSM_FN uint msm_three_word_from_rgba8(vec4 texel) {
+  uvec4 b = uvec4(round(texel * 255.0f));
+  return b.x | (b.y << 8u) | (b.z << 16u) | (b.w << 24u);
+}
 
 // The filterable channels of one depth, already in the storage basis (Θ4* commutes with the blur).
 MSM_FN vec4 msm_three_generate(int t, float unit_depth) {
@@ -35,8 +48,9 @@ MSM_FN vec4 msm_three_generate(int t, float unit_depth) {
 // What the shadow map stores of the blurred channels: 16-bit rounding (UNORM16 storage; the
 // package keeps the rounded values in a float texture, which filters them as UNORM16 would).
 // The non-linear map stores Φ's four UNORM16 values as floats k / 65535 (techniques.h's
-// msm_nl64_encode).
+// msm_nl64_encode); the 32-bit map its word as an RGBA8 texel (msm_nl32_encode).
 MSM_FN vec4 msm_three_store(int t, vec4 filtered) {
+  if (t == MSM_THREE_NL32) return msm_three_rgba8_from_word(msm_nl_pack32(msm_nl_from_filtered(filtered)));
   if (t == MSM_THREE_HAMBURGER_64) return msm_quantize_unorm16(filtered);
   if (t == MSM_THREE_NL64) {
     uvec2 p = msm_nl_pack64(msm_nl_from_filtered(filtered));
@@ -64,6 +78,8 @@ MSM_FN float msm_three_nl_shadow(vec4 moments, float unit_zf) {
 // biased moments (the representation's α and b*).
 MSM_FN float msm_three_shadow(int t, vec4 stored, float unit_zf) {
   if (t == MSM_THREE_NL64) return msm_three_nl_shadow(msm_three_nl64_moments(stored), unit_zf); // one texel
+  if (t == MSM_THREE_NL32)
+    return msm_nl_shadow(msm_nl_unpack32(msm_three_word_from_rgba8(stored)), msm_signed_depth(unit_zf));
   float zf = msm_signed_depth(unit_zf);
   if (t == MSM_THREE_HAMBURGER_64)
     return msm_hamburger4_lower(msm_apply_bias(msm_theta4_star_inverse(stored), msm_moment_bias(MSM_REP_SIGNED_THETA4)),
