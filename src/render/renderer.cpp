@@ -347,12 +347,22 @@ struct Renderer::Impl {
   }
 
   // What the renderer draws with spot lights: the hard, filtered and soft techniques of one depth
-  // per texel, opaque occluders, a finite range (the stored depth is distance / range).
+  // per texel, single scattering by ray marching, opaque occluders, a finite range (the stored
+  // depth is distance / range).
   void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots) const {
     const Technique& technique = find_rendered_technique(s.technique);
-    const char* unsupported = technique.scatters()                                  ? "scattering"
-                              : s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders"
-                                                                                    : nullptr;
+    // The prefiltered scattering's rectification (rectification.h) resamples a directional light's
+    // map along the epipolar planes of parallel light rays, and one visible fraction per ray stands
+    // for the ray's in-scattering because f E is the same all along it; a spot light's f E falls off
+    // with the inverse square of the distance to it along the ray, which one lookup of prefix sums
+    // over depth cannot weigh.
+    if (technique.prefiltered_scattering())
+      throw RenderError(fmt::format("{} with spot lights: the prefiltered scattering's rectification is derived for "
+                                    "directional lights (parallel rays, the same in-scattering all along a view ray); "
+                                    "a spot light's falls off with the inverse square of its distance along the ray. "
+                                    "Ray marching (scatter-march-32) draws spot lights' scattering",
+                                    technique.name));
+    const char* unsupported = s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders" : nullptr;
     if (unsupported)
       throw RenderError(fmt::format("{} with spot lights: the renderer draws spot lights' hard, filtered and soft "
                                     "shadows of opaque occluders only; the ray tracer (msm reference) traces them",
