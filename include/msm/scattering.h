@@ -16,6 +16,7 @@
 #include "msm/bias.h"
 #include "msm/hamburger4.h"
 #include "msm/hamburger6.h"
+#include "msm/local_light.h"
 #include "msm/quantize.h"
 #include "msm/shading.h"
 #include "msm/shared.h"
@@ -64,6 +65,20 @@ MSM_FN float msm_phase_henyey_greenstein_between(vec3 towards_light, vec3 view_d
 // vectors (view_dir from the camera outwards).
 MSM_FN float msm_scattering_phase_term(float extinction, float albedo, float g, vec3 towards_light, vec3 view_dir) {
   return albedo * extinction * msm_phase_henyey_greenstein_between(towards_light, view_dir, g);
+}
+
+// A spot or point light's in-scattering at a point p of a view ray (view_dir from the camera
+// outwards): f(ω_l, ω_p) E_l(p), the phase term towards the light's position times the irradiance
+// its intensity gives there (msm_local_light_irradiance: inverse square, the spot's cone, nothing
+// beyond range). Unlike a directional light's, it varies along the ray, so it is integrated with the
+// ray's samples: ∫₀ˢ exp(−σt t) f E V dt, what the ray tracer and the ray marching both estimate.
+MSM_FN vec3 msm_local_light_inscattering(vec3 p, vec3 view_dir, vec3 position, vec3 axis, vec3 intensity, float range,
+                                         float cos_outer, float cos_inner, float extinction, float albedo, float g) {
+  vec3 to_light = position - p;
+  float d = length(to_light);
+  vec3 towards = d > 0.0f ? to_light / d : -view_dir;
+  vec3 e = msm_local_light_irradiance(intensity, d, range, dot(-towards, axis), cos_outer, cos_inner);
+  return msm_scattering_phase_term(extinction, albedo, g, towards, view_dir) * e;
 }
 
 // (1 − exp(−x)) / x for x >= 0 without the cancellation of 1 − exp(−x) at small x (GLSL has no

@@ -28,6 +28,24 @@
 // The tables give box filters: exact for a rectangular light (JCGT §4.6.3); for a disc light a
 // box of the disc's radius covers the disc (pass tan(θ/2)·√π/2 instead for a box of equal area).
 //
+// ---- Geometry: spot lights (a sphere of radius R, a perspective map of radial depth) ----
+// The map looks from the sphere's centre o; its depth is u = r / range (r the distance from o),
+// z = 2u - 1 in [-1,1]; its texel coordinates are uniform in the tangent plane at unit distance,
+// (x, y) = (tan of the angles off the axis), a texel T = 2 tan(outer half-angle) / N wide. From a
+// receiver p at distance r_f, the rays to the sphere's points fill a cone about p → o that is R
+// wide at o and 0 at p; it crosses the sphere of radius r_b about o (a blocker's distance) R (r_f -
+// r_b) / r_f away from the line p → o, which o sees under the angle R (r_f - r_b) / (r_f r_b)
+// = R (1/r_b - 1/r_f) (similar triangles; PCSS's w_light (d_r - d_b) / d_b on the receiver, seen
+// from the light). Per unit angle the tangent-plane coordinates move by sqrt((1 + x²)(1 + x² + y²))
+// along x and sqrt((1 + y²)(1 + x² + y²)) along y at (x, y) (the gnomonic projection: the extent of
+// a small cone's image along each axis; 1 on the axis). So in texels, per axis,
+//     half-width = spread · reach,   spread = R / (2 T range) · stretch(x, y),
+//     reach = 2 (1/u_b - 1/u_f) = (z_f - z_b) / (u_f u_b),
+// the orthographic reach z_f - z_b divided by u_f u_b: the same depth difference reaches farther
+// near the light. The blocker search takes the nearest blocker there can be, at the sphere's
+// surface (u = R / range: nothing nearer casts a shadow that the sphere's points do not all see
+// around), the penumbra the average blocker depth, as above; the kernel limits below apply alike.
+//
 // ---- Kernel size limits ----
 // sat.h's queries are exact for rectangles of at most n_t texels. A region of width L texels
 // starting anywhere touches at most floor(L) + 2 texels, and at most L + 1 if L is an integer;
@@ -82,6 +100,30 @@ MSM_FN vec2 msm_soft_spread(vec2 tan_half_extent, float world_per_depth, vec2 wo
   return tan_half_extent * world_per_depth / world_per_texel;
 }
 
+// A spot light's spread (see "Geometry: spot lights" above) at the map coordinate t (texels, texel
+// i covers [i, i + 1)) of an N × N map over the tangents [-tan_outer, tan_outer]²: texels of
+// reach per unit of msm_soft_reach, per axis.
+MSM_FN vec2 msm_spot_soft_spread(float radius, float range, float tan_outer, float size, vec2 t) {
+  float texel = 2.0f * tan_outer / size;
+  vec2 xy = (t * (2.0f / size) - 1.0f) * tan_outer;
+  vec2 sq = xy * xy;
+  float radial = 1.0f + sq.x + sq.y;
+  vec2 stretch = vec2(sqrt((1.0f + sq.x) * radial), sqrt((1.0f + sq.y) * radial));
+  return stretch * (radius / (2.0f * texel * range));
+}
+// The [-1,1] depth of the nearest blocker a spot light's search has to reach: its sphere's surface
+// (at least the map's near plane, 1e-3 range, so that a point light's is finite).
+MSM_FN float msm_spot_soft_near_depth(float radius, float range) { return 2.0f * max(radius / range, 1e-3f) - 1.0f; }
+// The depth difference that the spread multiplies, from a receiver at [-1,1] depth zf to a blocker
+// at zb: zf - zb in an orthographic map; in a spot light's perspective map of radial depth
+// (perspective), 2 (1/u_b - 1/u_f) with u = (z + 1) / 2, u_b at least the spot's near depth.
+MSM_FN float msm_soft_reach(float zf, float zb, float near_depth, bool perspective) {
+  if (!perspective) return zf - zb;
+  float uf = max(0.5f * (zf + 1.0f), 1e-6f);
+  float ub = max(0.5f * (max(zb, near_depth) + 1.0f), 1e-6f);
+  return 2.0f * (1.0f / ub - 1.0f / uf);
+}
+
 // spread · depth_distance, clamped to [0.5, (W - 1) / 2] texels with W = max_kernel_width >= 2
 // (the queries then touch at most W texels per axis: n_t = W²). Negative distances (a blocker
 // depth behind the receiver: not a blocker) give the minimum.
@@ -103,22 +145,26 @@ MSM_FN bool msm_soft_kernel_clamped(vec2 spread, float depth_distance, int max_k
   return max(h.x, h.y) > msm_soft_largest_half_width(max_kernel_width);
 }
 
-// Blocker search half-width: blockers between the near plane (near_depth; -1 for [-1,1] depth)
-// and the fragment depth zf.
-MSM_FN vec2 msm_soft_search_half_width(vec2 spread, float zf, float near_depth, int max_kernel_width) {
-  return msm_soft_kernel_half_width(spread, zf - near_depth, max_kernel_width);
+// Blocker search half-width: blockers between the near plane (near_depth; -1 for [-1,1] depth of
+// an orthographic map, msm_spot_soft_near_depth for a spot light's) and the fragment depth zf.
+MSM_FN vec2 msm_soft_search_half_width(vec2 spread, float zf, float near_depth, bool perspective,
+                                       int max_kernel_width) {
+  return msm_soft_kernel_half_width(spread, msm_soft_reach(zf, near_depth, near_depth, perspective), max_kernel_width);
 }
 
 // Penumbra (filter) half-width for blockers at the average blocker depth.
-MSM_FN vec2 msm_soft_penumbra_half_width(vec2 spread, float zf, float blocker_depth, int max_kernel_width) {
-  return msm_soft_kernel_half_width(spread, zf - blocker_depth, max_kernel_width);
+MSM_FN vec2 msm_soft_penumbra_half_width(vec2 spread, float zf, float blocker_depth, float near_depth, bool perspective,
+                                         int max_kernel_width) {
+  return msm_soft_kernel_half_width(spread, msm_soft_reach(zf, blocker_depth, near_depth, perspective),
+                                    max_kernel_width);
 }
 
 // Whether the penumbra region was clamped to the kernel (the renderer counts these lookups and warns
 // above a share: RenderResult::soft_kernel_clamps). The blocker search is not counted: it is clamped
 // by design (JCGT's fixed 27² search region) for most receivers of any scene.
-MSM_FN bool msm_soft_penumbra_clamped(vec2 spread, float zf, float blocker_depth, int max_kernel_width) {
-  return msm_soft_kernel_clamped(spread, zf - blocker_depth, max_kernel_width);
+MSM_FN bool msm_soft_penumbra_clamped(vec2 spread, float zf, float blocker_depth, float near_depth, bool perspective,
+                                      int max_kernel_width) {
+  return msm_soft_kernel_clamped(spread, msm_soft_reach(zf, blocker_depth, near_depth, perspective), max_kernel_width);
 }
 
 // A region [center - h, center + h] in texel units (texel i covers [i, i + 1); a shadow-map
@@ -371,7 +417,9 @@ struct SoftSetup {
   ivec2 size;          // the shadow map's size in texels (one tile of a CSSM table)
   int kernel_width;    // W: the tables were built for kernels of at most W × W texels
   uint scale;          // msm_sat_scale(W * W)
-  vec2 spread;         // msm_soft_spread of the light
+  vec2 spread;         // msm_soft_spread of the light (a spot light's: msm_spot_soft_spread)
+  float near_depth;    // the nearest blocker's [-1,1] depth: -1, a spot's msm_spot_soft_near_depth
+  bool perspective;    // a spot light's perspective map of radial depth (msm_soft_reach)
   float constant_bias; // [-1,1] depth, beside the receiver plane's bias
   float umbra_epsilon; // ε_u (MSM_SOFT_UMBRA_EPSILON by default)
   vec4 params;         // the technique's parameters (techniques.h)
@@ -409,7 +457,7 @@ MSM_SOFT_FLOW_FN vec4 msm_soft_filter_average(MSM_SOFT_FETCH_PARAM SatFilter box
 // estimator, umbra early-out, penumbra, nine-region filter, the receiver plane's bias, the bound.
 MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup k, SoftFragment f, int moments) {
   float zf = msm_signed_depth(f.depth);
-  vec2 hs = msm_soft_search_half_width(k.spread, zf, -1.0f, k.kernel_width);
+  vec2 hs = msm_soft_search_half_width(k.spread, zf, k.near_depth, k.perspective, k.kernel_width);
   SatRect r = msm_soft_search_rect(f.position, hs, k.size);
   int texels = msm_sat_rect_texels(r);
   vec4 q = msm_sat_rect_average(msm_soft_rect_sum(MSM_SOFT_FETCH_ARG r, 0), texels, k.scale);
@@ -425,7 +473,7 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup 
   if (msm_soft_in_umbra(blocker, k.umbra_epsilon))
     return SoftShadow(1.0f, blocker.depth, blocker.shadow, vec2(0.0f), false);
 
-  vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker.depth, k.kernel_width);
+  vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker.depth, k.near_depth, k.perspective, k.kernel_width);
   SoftRegion region = msm_soft_region(f.position, hp, k.size);
   SatFilter box = msm_sat_filter(region.lo, region.hi);
   float zb = zf - k.constant_bias - msm_soft_plane_bias(hp, f.depth_per_texel, moments);
@@ -439,8 +487,9 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup 
   } else {
     shadow = msm_soft_shadow4(t, zb, k.umbra_epsilon, k.scale);
   }
-  return SoftShadow(shadow, blocker.depth, blocker.shadow, hp,
-                    msm_soft_penumbra_clamped(k.spread, zf, blocker.depth, k.kernel_width));
+  return SoftShadow(
+      shadow, blocker.depth, blocker.shadow, hp,
+      msm_soft_penumbra_clamped(k.spread, zf, blocker.depth, k.near_depth, k.perspective, k.kernel_width));
 }
 
 // Convolution soft shadows (cssm.h): the blocker search sums every tile over the search region (4
@@ -451,7 +500,7 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_moment_flow(MSM_SOFT_FETCH_PARAM SoftSetup 
 MSM_SOFT_FLOW_FN SoftShadow msm_soft_cssm_flow(MSM_SOFT_FETCH_PARAM SoftSetup k, SoftFragment f, CsmParams p) {
   int tiles = msm_cssm_tiles(p.terms), basis = msm_cssm_basis_tiles(p.terms);
   float zf = msm_signed_depth(f.depth);
-  vec2 hs = msm_soft_search_half_width(k.spread, zf, -1.0f, k.kernel_width);
+  vec2 hs = msm_soft_search_half_width(k.spread, zf, k.near_depth, k.perspective, k.kernel_width);
   SatRect r = msm_soft_search_rect(f.position, hs, k.size);
   int texels = msm_sat_rect_texels(r);
   float zs = zf - msm_soft_depth_bias(hs, f.depth_per_texel, k.constant_bias);
@@ -464,7 +513,7 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_cssm_flow(MSM_SOFT_FETCH_PARAM SoftSetup k,
   float blocker_depth = msm_signed_depth(blocker.depth);
   if (!(blocker.shadow > 0.0f)) return SoftShadow(0.0f, blocker_depth, blocker.shadow, vec2(0.0f), false);
 
-  vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker_depth, k.kernel_width);
+  vec2 hp = msm_soft_penumbra_half_width(k.spread, zf, blocker_depth, k.near_depth, k.perspective, k.kernel_width);
   SoftRegion region = msm_soft_region(f.position, hp, k.size);
   SatFilter box = msm_sat_filter(region.lo, region.hi);
   float zb = zf - msm_soft_depth_bias(hp, f.depth_per_texel, k.constant_bias);
@@ -473,8 +522,9 @@ MSM_SOFT_FLOW_FN SoftShadow msm_soft_cssm_flow(MSM_SOFT_FETCH_PARAM SoftSetup k,
   for (int tile = 0; tile < basis; ++tile)
     series += msm_csm_texel_terms(msm_csm_from_unorm(msm_soft_filter_average(MSM_SOFT_FETCH_ARG box, k.scale, tile)),
                                   xf, tile, p);
-  return SoftShadow(msm_csm_resolve(series, p), blocker_depth, blocker.shadow, hp,
-                    msm_soft_penumbra_clamped(k.spread, zf, blocker_depth, k.kernel_width));
+  return SoftShadow(
+      msm_csm_resolve(series, p), blocker_depth, blocker.shadow, hp,
+      msm_soft_penumbra_clamped(k.spread, zf, blocker_depth, k.near_depth, k.perspective, k.kernel_width));
 }
 
 MSM_END

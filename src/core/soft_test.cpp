@@ -131,16 +131,17 @@ TEST(SoftShadows, KernelSizesByHand) {
   vec2 spread = msm_soft_spread(vec2(0.05f), 50.0f, vec2(0.0625f));
   EXPECT_FLOAT_EQ(spread.x, 40.0f);
   EXPECT_FLOAT_EQ(spread.y, 40.0f);
-  vec2 search = msm_soft_search_half_width(spread, -0.8f, -1.0f, W);
+  vec2 search = msm_soft_search_half_width(spread, -0.8f, -1.0f, false, W);
   EXPECT_NEAR(search.x, 8.0f, 1e-5f);
   EXPECT_NEAR(search.y, 8.0f, 1e-5f);
-  vec2 penumbra = msm_soft_penumbra_half_width(spread, -0.8f, -0.9f, W);
+  vec2 penumbra = msm_soft_penumbra_half_width(spread, -0.8f, -0.9f, -1.0f, false, W);
   EXPECT_NEAR(penumbra.x, 4.0f, 1e-5f);
-  EXPECT_EQ(msm_soft_search_half_width(spread, 0.5f, -1.0f, W), vec2(13.0f));       // 60 -> 13
-  EXPECT_EQ(msm_soft_penumbra_half_width(spread, -0.8f, -0.7f, W), vec2(0.5f));     // not a blocker
-  EXPECT_EQ(msm_soft_penumbra_half_width(spread, -0.8f, -0.8f, W), vec2(0.5f));     // contact
-  EXPECT_EQ(msm_soft_penumbra_half_width(vec2(1e-3f), 0.5f, -0.5f, W), vec2(0.5f)); // tiny light
-  vec2 rect = msm_soft_search_half_width(msm_soft_spread(vec2(0.05f, 0.025f), 50.0f, vec2(0.0625f)), -0.8f, -1.0f, W);
+  EXPECT_EQ(msm_soft_search_half_width(spread, 0.5f, -1.0f, false, W), vec2(13.0f));              // 60 -> 13
+  EXPECT_EQ(msm_soft_penumbra_half_width(spread, -0.8f, -0.7f, -1.0f, false, W), vec2(0.5f));     // not a blocker
+  EXPECT_EQ(msm_soft_penumbra_half_width(spread, -0.8f, -0.8f, -1.0f, false, W), vec2(0.5f));     // contact
+  EXPECT_EQ(msm_soft_penumbra_half_width(vec2(1e-3f), 0.5f, -0.5f, -1.0f, false, W), vec2(0.5f)); // tiny light
+  vec2 rect =
+      msm_soft_search_half_width(msm_soft_spread(vec2(0.05f, 0.025f), 50.0f, vec2(0.0625f)), -0.8f, -1.0f, false, W);
   EXPECT_NEAR(rect.x, 8.0f, 1e-5f);
   EXPECT_NEAR(rect.y, 4.0f, 1e-5f);
   // Non-square texels: 0.0625 × 0.125 world units.
@@ -152,7 +153,7 @@ TEST(SoftShadows, KernelSizesByHand) {
   for (float zf : {-0.95f, -0.5f, -0.9f}) {
     float along = (zf + 1.0f) * depth_scale;
     float reach_texels = along * tan_half / texel;
-    EXPECT_NEAR(msm_soft_search_half_width(vec2(tan_half * depth_scale / texel), zf, -1.0f, 1000).x,
+    EXPECT_NEAR(msm_soft_search_half_width(vec2(tan_half * depth_scale / texel), zf, -1.0f, false, 1000).x,
                 std::max(reach_texels, 0.5f), 1e-4f);
   }
 
@@ -171,15 +172,60 @@ TEST(SoftShadows, KernelSizesByHand) {
   EXPECT_NEAR(msm_soft_depth_bias(vec2(4.0f, 2.0f), vec2(0.001f, -0.002f), 1e-4f), 0.0096f, 1e-7f);
 }
 
+// Hand-computed spot light: a sphere of radius R = 0.1 m, range 10 m, outer half-angle 45° (tan 1)
+// over a 256² map: a texel is T = 2 / 256 = 1/128 of a tangent. A receiver at r_f = 2 m (u = 0.2,
+// z = -0.6) behind a blocker at r_b = 1 m (u = 0.1, z = -0.8): the rays to the sphere cross the
+// blocker's distance within R (r_f - r_b) / r_f = 0.05 m of the line to the centre, which the
+// light sees under 0.05 rad, 0.05 · 128 = 6.4 texels on the axis. The search reaches from the
+// sphere's surface (r = 0.1 m): 0.1 · 1.9 / 2 = 0.095 m at 0.1 m, 0.95 rad: 121.6 texels. At
+// the map's edge x = tan 45° = 1, y = 0 the tangents move by sec² 45° = 2 per radian along x and
+// by sec 45° = √2 along y.
+TEST(SoftShadows, SpotLightKernelSizesByHand) {
+  const float radius = 0.1f, range = 10.0f, tan_outer = 1.0f, size = 256.0f;
+  const float near = msm_spot_soft_near_depth(radius, range);
+  EXPECT_NEAR(near, -0.98f, 1e-6f);
+  const vec2 axis = msm_spot_soft_spread(radius, range, tan_outer, size, vec2(128.0f));
+  EXPECT_NEAR(axis.x, 0.64f, 1e-6f);
+  EXPECT_NEAR(axis.y, 0.64f, 1e-6f);
+  EXPECT_NEAR(msm_soft_reach(-0.6f, -0.8f, near, true), 10.0f, 1e-4f);
+  vec2 penumbra = msm_soft_penumbra_half_width(axis, -0.6f, -0.8f, near, true, 1000);
+  EXPECT_NEAR(penumbra.x, 6.4f, 1e-4f);
+  EXPECT_NEAR(penumbra.y, 6.4f, 1e-4f);
+  EXPECT_NEAR(msm_soft_search_half_width(axis, -0.6f, near, true, 1000).x, 121.6f, 1e-3f);
+  EXPECT_EQ(msm_soft_search_half_width(axis, -0.6f, near, true, W), vec2(13.0f)); // the kernel's
+  // A blocker estimate nearer than the sphere reaches as far as the sphere's surface; one behind the
+  // receiver is none (the least half-width).
+  EXPECT_EQ(msm_soft_penumbra_half_width(axis, -0.6f, -1.0f, near, true, 1000),
+            msm_soft_search_half_width(axis, -0.6f, near, true, 1000));
+  EXPECT_EQ(msm_soft_penumbra_half_width(axis, -0.6f, -0.5f, near, true, 1000), vec2(0.5f));
+  const vec2 edge = msm_spot_soft_spread(radius, range, tan_outer, size, vec2(256.0f, 128.0f));
+  EXPECT_NEAR(edge.x, 2.0f * 0.64f, 1e-5f);
+  EXPECT_NEAR(edge.y, std::sqrt(2.0f) * 0.64f, 1e-5f);
+  // A point light (radius 0): hard shadows, whatever the depths.
+  EXPECT_EQ(msm_soft_search_half_width(msm_spot_soft_spread(0.0f, range, tan_outer, size, vec2(128.0f)), 0.9f,
+                                       msm_spot_soft_near_depth(0.0f, range), true, W),
+            vec2(0.5f));
+  // The geometry itself, for other distances: the angle under which the light sees the crossing
+  // over the texel's angle, against the reach of the [-1,1] depths r / range · 2 - 1.
+  for (float rf : {0.5f, 3.0f, 9.0f})
+    for (float rb : {0.2f, 0.4f, 0.45f}) {
+      const float angle = radius * (rf - rb) / (rf * rb);
+      EXPECT_NEAR(
+          msm_soft_penumbra_half_width(axis, 2.0f * rf / range - 1.0f, 2.0f * rb / range - 1.0f, near, true, 100000).x,
+          std::max(angle * 128.0f, 0.5f), 1e-3f * angle * 128.0f)
+          << rf << " " << rb;
+    }
+}
+
 // The clamp report says exactly when the half-width was cut to (W - 1) / 2 = 13 (W = 27): the
 // unclamped reach of KernelSizesByHand's light is 40 texels per unit of depth.
 TEST(SoftShadows, ClampReportMatchesTheClamp) {
   vec2 spread = msm_soft_spread(vec2(0.05f), 50.0f, vec2(0.0625f));
-  EXPECT_TRUE(msm_soft_penumbra_clamped(spread, 0.5f, -1.0f, W));            // 60 -> 13
-  EXPECT_FALSE(msm_soft_penumbra_clamped(spread, -0.8f, -0.7f, W));          // not a blocker: the minimum
-  EXPECT_FALSE(msm_soft_penumbra_clamped(spread, -0.8f, -0.9f, W));          // 4 texels
-  EXPECT_TRUE(msm_soft_penumbra_clamped(vec2(40.0f, 1.0f), 0.0f, -0.5f, W)); // x alone: 20 -> 13
-  EXPECT_TRUE(msm_soft_penumbra_clamped(vec2(1.0f, 40.0f), 0.0f, -0.5f, W)); // y alone
+  EXPECT_TRUE(msm_soft_penumbra_clamped(spread, 0.5f, -1.0f, -1.0f, false, W));            // 60 -> 13
+  EXPECT_FALSE(msm_soft_penumbra_clamped(spread, -0.8f, -0.7f, -1.0f, false, W));          // not a blocker: the minimum
+  EXPECT_FALSE(msm_soft_penumbra_clamped(spread, -0.8f, -0.9f, -1.0f, false, W));          // 4 texels
+  EXPECT_TRUE(msm_soft_penumbra_clamped(vec2(40.0f, 1.0f), 0.0f, -0.5f, -1.0f, false, W)); // x alone: 20 -> 13
+  EXPECT_TRUE(msm_soft_penumbra_clamped(vec2(1.0f, 40.0f), 0.0f, -0.5f, -1.0f, false, W)); // y alone
   // Against the clamp itself, over reaches about the limit.
   for (float reach = 0.0f; reach < 30.0f; reach += 0.25f) {
     vec2 h = msm_soft_kernel_half_width(vec2(reach, 0.0f), 1.0f, W);
@@ -198,7 +244,7 @@ TEST(SoftShadows, KernelsStayWithinTheTableLimit) {
     float zf = 2.0f * unit(rng) - 1.0f, zb = 2.0f * unit(rng) - 1.0f;
     vec2 center(unit(rng) * 1.2f * float(size.x) - 0.1f * float(size.x), unit(rng) * float(size.y));
     if (i % 5 == 0) center = floor(center) + vec2(0.5f);
-    vec2 hs = msm_soft_search_half_width(spread, zf, -1.0f, W);
+    vec2 hs = msm_soft_search_half_width(spread, zf, -1.0f, false, W);
     SatRect s = msm_soft_search_rect(center, hs, size);
     ASSERT_GE(s.lo.x, 0);
     ASSERT_GE(s.lo.y, 0);
@@ -208,7 +254,7 @@ TEST(SoftShadows, KernelsStayWithinTheTableLimit) {
     ASSERT_LE(s.lo.y, s.hi.y);
     ASSERT_LE(s.hi.x - s.lo.x + 1, W) << i;
     ASSERT_LE(s.hi.y - s.lo.y + 1, W) << i;
-    vec2 hp = msm_soft_penumbra_half_width(spread, zf, zb, W);
+    vec2 hp = msm_soft_penumbra_half_width(spread, zf, zb, -1.0f, false, W);
     SoftRegion r = msm_soft_region(center, hp, size);
     ASSERT_LT(r.lo.x, r.hi.x);
     ASSERT_LT(r.lo.y, r.hi.y);

@@ -268,13 +268,19 @@ EffectResult effect_translucent(const EffectContext& ctx, const SurfaceHit& hit,
 // shadow ray per light each; `visible` combines the lights with the weights w_l
 // (msm_scattering_light_weight; all 0: 1), and its std_error is that of the combined samples
 // Σ w_l V_l(t) / Σ w_l. With one light, visible is that light's.
+// A spot or point light (local): its in-scattering f E (msm_local_light_inscattering) varies along
+// the ray; its shadow rays end at the light. Its weight at t is the luminance of f E there, its
+// visible fraction Σ lum(f E) V / Σ lum(f E) over the samples, and light_unshadowed the samples'
+// mean of f E (rgb): the light's in-scattering is then visible × light_unshadowed × ∫₀ˢ exp(−σt t) dt.
 struct ScatteringLight {
-  glm::dvec3 towards_light{0.0, 1.0, 0.0}; // unit
-  double weight = 1.0;                     // w_l
+  glm::dvec3 towards_light{0.0, 1.0, 0.0}; // unit (directional)
+  double weight = 1.0;                     // w_l (directional)
+  const scene::LocalLight* local = nullptr;
 };
 struct ScatteringSample {
   double visible = 1.0, std_error = 0.0;
-  std::vector<double> light_visible; // per light
+  std::vector<double> light_visible;        // per light
+  std::vector<glm::dvec3> light_unshadowed; // per light: a local light's mean f E (directional: 0)
   int samples = 0;
   std::uint64_t rays = 0;
 };

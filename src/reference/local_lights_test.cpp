@@ -3,6 +3,7 @@
 // whole half-metres from the point below the light (x = (i − 10) / 2 for pixel i of 21), where
 // E cos θ = I cone(θ) cos θ / d² is worked out by hand; an occluder's exact shadow; never NaN.
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -182,15 +183,56 @@ TEST(LocalLightsReference, TranslucentPanesBetweenTheLightAndTheGroundColourItsL
   EXPECT_NEAR(r.visibility.at(x, y, 0), 2.0 / 3.0, 1e-6);
 }
 
-TEST(LocalLightsReference, EffectsBeyondHardSoftAndTranslucentAreRefusedForLocalLights) {
+TEST(LocalLightsReference, EffectsBeyondHardSoftTranslucentAndScatteringAreRefusedForLocalLights) {
   const Scene scene = scene_with(kSpot);
-  for (Effect effect : {Effect::filtered, Effect::scattering}) {
+  for (Effect effect : {Effect::filtered}) {
     Settings s;
     s.effect = effect;
     s.width = s.height = 8;
     s.samples = 4;
     EXPECT_THROW(render(scene, s), std::invalid_argument) << to_string(effect);
   }
+}
+
+// An unshadowed beam: a spot 1 m above the camera's central ray, its axis straight down, a hard cone
+// of 30° (inner = outer), intensity 4 W/sr; the ray runs 6 m from the camera to the axis and on
+// to a wall 6 m behind it, through an isotropic medium (p = 1 / 4π) of extinction σ = 1e-4 and
+// albedo 1. The beam lights the ray over |x| <= tan 30° about the axis, where E = I / (1 + x²):
+//   L = ∫ σ p I / (1 + x²) exp(−σ (6 + x)) dx = σ I / (4π) · 2 atan(tan 30°) · exp(−6σ) (1 + O(σ²))
+//     = σ I exp(−6σ) / 12,
+// the odd term of exp(−σ x) cancelling over the symmetric interval. With a plate 0.5 m wide across
+// the beam 0.5 m below the light, whose edges at ±0.25 m cast to ±0.5 m on the ray, the light
+// reaches |x| in [0.5, tan 30°] only: 2 (atan(tan 30°) − atan(0.5)) in place of 2 atan(tan 30°).
+TEST(LocalLightsReference, SpotLightScatteringOfAnUnshadowedBeamByHand) {
+  const auto beam = [](const std::string& extra) {
+    return msm::scene::load_scene_json(
+        R"({"msm_scene": 1, "camera": {"position": [-6, 0, 0], "target": [6, 0, 0], "fov_y_deg": 10, "near": 0.1,
+            "far": 100},
+          "lights": [{"type": "spot", "position": [0, 1, 0], "direction": [0, -1, 0], "inner_cone_deg": 30,
+                      "outer_cone_deg": 30, "range": 100, "intensity": [4, 4, 4]}],
+          "medium": {"extinction": 1e-4, "scattering_albedo": 1},
+          "objects": [{"primitive": {"type": "box", "size": [1, 40, 40]}, "transform": {"translate": [6.5, 0, 0]}})" +
+            extra + "]}",
+        std::filesystem::current_path(), "beam.json");
+  };
+  const double sigma = 1e-4, intensity = 4.0;
+  const auto centre = [](const Scene& scene) {
+    Settings s;
+    s.effect = Effect::scattering;
+    s.width = s.height = 5; // the centre pixel's ray: NDC (0, 0), the camera's axis
+    s.samples = 16384;
+    return render(scene, s).scattering.at(2, 2, 0);
+  };
+  const double open = centre(beam(""));
+  const double expected = sigma * intensity * std::exp(-6.0 * sigma) / 12.0;
+  EXPECT_NEAR(open, expected, 0.01 * expected);
+  const double blocked = centre(
+      beam(R"(, {"primitive": {"type": "box", "size": [0.5, 0.001, 40]}, "transform": {"translate": [0, 0.5, 0]}})"));
+  const double lit = 2.0 * (std::atan(std::tan(kPi / 6.0)) - std::atan(0.5));
+  const double expected_blocked = sigma * intensity / (4.0 * kPi) * lit * std::exp(-6.0 * sigma);
+  EXPECT_NEAR(blocked, expected_blocked, 0.01 * expected);
+  std::printf("beam: open %.6g (by hand %.6g), half blocked %.6g (by hand %.6g)\n", open, expected, blocked,
+              expected_blocked);
 }
 
 // scenes/street.json: a street at night (two point lights among columns, a spot light through a

@@ -169,13 +169,15 @@ scene::DirectionalLight first_light(const scene::Scene& scene) {
   return scene.lights.empty() ? scene::DirectionalLight{} : scene.light();
 }
 
-// Spot and point lights are traced by the hard, soft and translucent effects (trace_lights), as
+// Spot and point lights are traced by the hard, soft and translucent effects (trace_lights) and
+// the scattering effect (their in-scattering along the view rays, the surfaces' hard shadows), as
 // the scene declares them; std::invalid_argument for what else a scene with them asks.
 void check_local_lights(const scene::Scene& scene, const Settings& settings) {
   if (scene.local_lights.empty()) return;
-  if (settings.effect != Effect::hard && settings.effect != Effect::soft && settings.effect != Effect::translucent)
+  if (settings.effect != Effect::hard && settings.effect != Effect::soft && settings.effect != Effect::translucent &&
+      settings.effect != Effect::scattering)
     throw std::invalid_argument(fmt::format("the {} effect traces directional lights only; a scene with spot or point "
-                                            "lights is traced by the hard, soft and translucent effects",
+                                            "lights is traced by the hard, soft, translucent and scattering effects",
                                             to_string(settings.effect)));
   if (settings.light_extent_deg || settings.light_shape || settings.light_width_deg || settings.light_height_deg)
     throw std::invalid_argument("the light overrides (extent, shape, width, height) change a scene's one directional "
@@ -329,7 +331,7 @@ class PixelTracer {
     glm::dvec3 n = tracer_.shading_normal(hit);
     if (glm::dot(hit.normal, dir) > 0.0) n = -n;
     if (!scene_.local_lights.empty())
-      shade_lights(x, y, hit, n, rng, rays);
+      shade_lights(x, y, hit, n, dir, rng, rays);
     else if (lighting_)
       shade_environment(x, y, hit, n, dir, rng, rays);
     else
@@ -337,7 +339,8 @@ class PixelTracer {
   }
 
   // Spot and point lights (with the directional ones): every light of the scene (trace_lights).
-  void shade_lights(int x, int y, const SurfaceHit& hit, const glm::dvec3& n, Rng& rng, std::uint64_t& rays) {
+  void shade_lights(int x, int y, const SurfaceHit& hit, const glm::dvec3& n, const glm::dvec3& dir, Rng& rng,
+                    std::uint64_t& rays) {
     const LightsSample e = trace_lights(ctx_, hit, n, rng);
     rays += e.rays;
     float* v = result_.visibility.pixels().data() + pixel(x, y) * result_.visibility.channels();
@@ -346,13 +349,15 @@ class PixelTracer {
       v[2] = float(e.samples);
       v[3] = float(e.std_error);
     }
-    row_sum[y] += e.visible;
+    if (!scattering_) row_sum[y] += e.visible;
     if (!result_.visibility_rgb.empty()) {
       float* t = result_.visibility_rgb.pixels().data() + pixel(x, y) * 3;
       t[0] = float(e.visible_rgb.r), t[1] = float(e.visible_rgb.g), t[2] = float(e.visible_rgb.b);
     }
     write_surface(x, y, float(e.n_dot_l), hit);
-    write_radiance(x, y, msm_surface_radiance(tracer_.albedo(hit), glm::vec3(e.direct), MSM_AMBIENT));
+    const glm::vec3 colour = msm_surface_radiance(tracer_.albedo(hit), glm::vec3(e.direct), MSM_AMBIENT);
+    write_radiance(x, y, colour);
+    if (scattering_) add_scattering(x, y, dir, hit.p, colour, rays);
   }
 
   void write_radiance(int x, int y, const glm::vec3& colour) {
@@ -439,6 +444,8 @@ class PixelTracer {
                                            glm::vec3(dir));
       lights[l] = {light_towards_[l], double(msm_scattering_light_weight(glm::vec3(light_irradiance_[l]), phase[l]))};
     }
+    // Spot and point lights after the directional ones: f E varies along the ray (its samples' mean).
+    for (const scene::LocalLight& local : scene_.local_lights) lights.push_back({.local = &local});
     const ScatteringSample e = scattering_along_ray(ctx_, m, camera_, dir, s, lights, rng);
     rays += e.rays;
     row_sum[y] += e.visible;
@@ -448,8 +455,10 @@ class PixelTracer {
     v[3] = float(e.std_error);
     ScatteringSum sum = msm_scattering_sum_none();
     for (std::size_t l = 0; l < lights.size(); ++l)
-      sum = msm_scattering_add_light(sum, glm::vec3(light_irradiance_[l]), m.extinction, phase[l], float(s),
-                                     float(e.light_visible[l]));
+      sum = l < phase.size() ? msm_scattering_add_light(sum, glm::vec3(light_irradiance_[l]), m.extinction, phase[l],
+                                                        float(s), float(e.light_visible[l]))
+                             : msm_scattering_add_light(sum, glm::vec3(e.light_unshadowed[l]), m.extinction, 1.0f,
+                                                        float(s), float(e.light_visible[l]));
     const glm::vec3 in = sum.inscattered;
     float* q = result_.scattering.pixels().data() + pixel(x, y) * 4;
     q[0] = in.r, q[1] = in.g, q[2] = in.b, q[3] = float(s);

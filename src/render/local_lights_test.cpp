@@ -17,10 +17,12 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace msm::render {
 namespace {
@@ -167,10 +169,10 @@ TEST_F(LocalLightsRenderTest, SpotLightIrradianceBelowTheSpotIsIntensityOverHeig
 }
 
 // What the renderer does not draw with spot lights is refused by name, never drawn without them.
-TEST_F(LocalLightsRenderTest, SpotLightsWithSoftShadowsOrWithoutRangeAreRefused) {
+TEST_F(LocalLightsRenderTest, SpotLightsWithPrefilteredScatteringOrWithoutRangeAreRefused) {
   {
     Renderer renderer(ctx(), spot_scene());
-    for (const char* technique : {"pcss", "scatter-march-32"}) {
+    for (const char* technique : {"scatter-msm4-64", "scatter-csm-32"}) {
       try {
         renderer.render(spot_settings(technique));
         ADD_FAILURE() << "no RenderError for " << technique << " with a spot light";
@@ -184,6 +186,189 @@ TEST_F(LocalLightsRenderTest, SpotLightsWithSoftShadowsOrWithoutRangeAreRefused)
     renderer.render(spot_settings("pcf"));
     ADD_FAILURE() << "no RenderError for a spot light without range";
   } catch (const RenderError& e) { EXPECT_NE(std::string(e.what()).find("range"), std::string::npos) << e.what(); }
+}
+
+// ---- Soft shadows of a spot light of some radius ----
+// A spot (a sphere of radius 0.1 m) 2 m over the ground, its axis straight down; a thin plate
+// 0.4 m wide 0.5 m below it and a 0.8 m high box beside, whose top the plate's shadow edge crosses.
+// The lines from the plate's edge (±0.2, 1.5) that touch the sphere leave it at 21.80° ± 10.70°
+// from the vertical (atan(0.2 / 0.5) ± asin(0.1 / 0.5385)), so the penumbra spans x in [-1.156,
+// -0.494] on the ground (0.662 m) and [0.337, 0.646] on the box's top, 0.7 m lower than the plate
+// (0.309 m): 2 R (r_f - r_b) / r_b of the similar triangles, 0.6 m and 0.28 m, widened off the axis.
+// Their 10%-90% widths are 0.687 of those (a disc's straight edge, soft_shadow_test's
+// PenumbraeWidenWithReceiverDistance): 0.455 m and 0.212 m. The camera looks down from behind the
+// plate's shadow, so that the plate hides none of the two lines. The range, 3.5 m, just holds the
+// lit ground: the map's depths (distance / range) use the most of [0, 1] (CSSM's series needs it).
+scene::Scene soft_spot_scene() {
+  return scene::load_scene_json(R"({"msm_scene": 1,
+    "camera": {"position": [0, 4.2, 2.0], "target": [0, 0, 0.2], "fov_y_deg": 50},
+    "lights": [{"type": "spot", "position": [0, 2, 0], "direction": [0, -1, 0], "inner_cone_deg": 40,
+                "outer_cone_deg": 50, "range": 3.5, "intensity": [2, 2, 2], "radius": 0.1}],
+    "objects": [{"primitive": {"type": "plane", "size": [4, 4]}},
+                {"primitive": {"type": "box", "size": [0.4, 0.02, 0.4]}, "transform": {"translate": [0, 1.5, 0]}},
+                {"primitive": {"type": "box", "size": [0.7, 0.8, 1.0]}, "transform": {"translate": [0.55, 0.4, 0]}}]})",
+                                std::filesystem::current_path(), "soft-spot.json");
+}
+
+constexpr int kSoftSize = 160, kSoftShadowSize = 128;
+
+// The 10%-90% width (metres) of the visibility's ramp along the world segment from a (lit) to b
+// (in umbra), sampled at the pixels the segment projects to.
+double ramp_width(const scene::Scene& scene, const image::Image& visibility, glm::vec3 a, glm::vec3 b) {
+  const glm::mat4 view_projection = scene.camera_view_projection(1.0f);
+  const int steps = 400;
+  std::vector<float> v(steps + 1);
+  for (int i = 0; i <= steps; ++i) {
+    const glm::vec4 clip = view_projection * glm::vec4(glm::mix(a, b, float(i) / float(steps)), 1.0f);
+    const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+    const int x =
+        std::clamp(int(std::floor((ndc.x * 0.5f + 0.5f) * float(visibility.width()))), 0, visibility.width() - 1);
+    const int y =
+        std::clamp(int(std::floor((ndc.y * 0.5f + 0.5f) * float(visibility.height()))), 0, visibility.height() - 1);
+    v[size_t(i)] = visibility.at(x, y, 0);
+  }
+  const auto crossing = [&](float level) {
+    for (int i = 0; i < steps; ++i)
+      if (v[size_t(i)] >= level && v[size_t(i + 1)] < level)
+        return (double(i) + double(v[size_t(i)] - level) / double(v[size_t(i)] - v[size_t(i + 1)])) / steps;
+    return 1.0;
+  };
+  return std::abs(crossing(0.1f) - crossing(0.9f)) * double(glm::length(b - a));
+}
+
+struct PenumbraWidths {
+  double ground, box_top;
+};
+PenumbraWidths spot_penumbra_widths(const scene::Scene& scene, const image::Image& visibility) {
+  return {ramp_width(scene, visibility, {-1.4f, 0.0f, 0.0f}, {-0.25f, 0.0f, 0.0f}),
+          ramp_width(scene, visibility, {0.85f, 0.8f, 0.0f}, {0.25f, 0.8f, 0.0f})};
+}
+
+RenderSettings soft_spot_settings(std::string technique) {
+  RenderSettings s = test::render_settings(std::move(technique), kSoftSize, kSoftSize, kSoftShadowSize);
+  s.soft_kernel = 23; // the ground's penumbra is 19 texels wide
+  return s;
+}
+
+// MAE of each soft technique's visibility against the ray tracer's soft shadow of soft_spot_scene,
+// measured on lavapipe; the bound is 1.25x that, at least 0.002 more. CSSM's series leaves the
+// plate's umbra on the ground grey (0.04-0.05 leaking, twice PCF's error: the technique's
+// reconstruction, not the spot's sizes, which it shares with the others), so its penumbrae are not
+// measured; VSSM leaks as with directional lights (Chebyshev's bound), about as far from the truth as
+// the hard PCF.
+struct SoftSpotExpectation {
+  double mae;
+  bool beats_hard_shadows; // closer to the ray tracer than PCF's hard shadow, penumbrae checked
+};
+const std::map<std::string, SoftSpotExpectation> kSoftSpotMeasured = {
+    {"pcss", {0.0139, true}},  {"mssm4", {0.0141, true}},  {"mssm6", {0.0157, true}},
+    {"vssm", {0.0293, false}}, {"cssm8", {0.0452, false}}, {"cssm16", {0.0508, false}}};
+
+// The soft techniques against the ray traced sphere: the error per technique; for those that beat
+// the hard shadow the penumbra widths on both receivers (within 30% and 3 cm of the ray tracer's,
+// more than 1.5 times as wide on the ground as on the box: 2.0 ray traced); four moments leak less
+// than two (VSSM).
+TEST_F(LocalLightsRenderTest, SpotLightSoftShadowsAgreeWithTheRayTracer) {
+  const scene::Scene scene = soft_spot_scene();
+  reference::Settings r;
+  r.effect = reference::Effect::soft;
+  r.width = kSoftSize;
+  r.height = kSoftSize;
+  r.samples = 64;
+  const reference::Result truth = reference::render(scene, r);
+  const image::Image mask = truth.visibility.channel("background");
+  const image::Image truth_visibility = truth.visibility.channel("visibility");
+  const PenumbraWidths expected = spot_penumbra_widths(scene, truth_visibility);
+  fmt::print("spot penumbra 10%-90% (m): ray traced ground {:.3f}, box top {:.3f}\n", expected.ground,
+             expected.box_top);
+  EXPECT_NEAR(expected.ground, 0.687 * 0.662, 0.1 * 0.687 * 0.662);
+  EXPECT_NEAR(expected.box_top, 0.687 * 0.309, 0.1 * 0.687 * 0.309);
+  Renderer renderer(ctx(), scene);
+  const image::Metrics hard = image::compute_metrics(
+      renderer.render(soft_spot_settings("pcf")).shadow.channel("visibility"), truth_visibility, {.mask = &mask});
+  std::map<std::string, double> leaking;
+  for (const auto& [technique, measured] : kSoftSpotMeasured) {
+    const RenderResult result = renderer.render(soft_spot_settings(technique));
+    const image::Image visibility = result.shadow.channel("visibility");
+    image::Tolerances tolerances;
+    tolerances.max_mae = std::max(1.25 * measured.mae, measured.mae + 0.002);
+    tolerances.max_share_above_3pct = 1.0;
+    tolerances.max_share_above_10pct = 1.0;
+    const image::CompareResult c = image::compare(
+        visibility, truth_visibility, tolerances,
+        {.metrics = {.mask = &mask}, .failure_dir = "test-failures/local-lights/soft-spot-" + technique});
+    const PenumbraWidths got = spot_penumbra_widths(scene, visibility);
+    fmt::print("soft spot, {:<7} vs ray traced: MAE {:.4f} (pcf {:.4f}), leaking {:.4f}, penumbra ground {:.3f}, box "
+               "top {:.3f}\n",
+               technique, c.metrics.mae, hard.mae, c.metrics.light_leaking, got.ground, got.box_top);
+    leaking[technique] = c.metrics.light_leaking;
+    EXPECT_TRUE(c.passed) << technique << ": " << c.report;
+    EXPECT_EQ(c.metrics.non_finite_in_test, 0u) << technique;
+    EXPECT_EQ(image::compute_metrics(result.color, truth.radiance).non_finite_in_test, 0u) << technique;
+    if (!measured.beats_hard_shadows) continue;
+    EXPECT_LT(c.metrics.mae, hard.mae) << technique;
+    EXPECT_NEAR(got.ground, expected.ground, 0.3 * expected.ground + 0.03) << technique;
+    EXPECT_NEAR(got.box_top, expected.box_top, 0.3 * expected.box_top + 0.03) << technique;
+    EXPECT_GT(got.ground, 1.5 * got.box_top) << technique;
+  }
+  EXPECT_LT(leaking["mssm4"], 0.5 * leaking["vssm"]); // measured 0.0076 against 0.0212
+}
+// ---- Single scattering from a spot light (ray marching) ----
+// A spot 2 m over the ground, cones 25°/30°, range 6 m, in a medium of extinction 0.2 (isotropic,
+// albedo 1); a plate 0.3 m wide 0.8 m below the light cuts a shadow shaft out of its beam. The
+// camera looks at the beam from the side, so that the rays cross the lit cone, the shaft and the
+// dark medium outside the cone; a wall behind ends every ray within 8 m (ray marching spaces its
+// samples evenly over the ray: over a ray to the far plane they would step over the beam).
+scene::Scene spot_beam_scene() {
+  return scene::load_scene_json(R"({"msm_scene": 1,
+    "camera": {"position": [0, 1, 4.5], "target": [0, 0.9, 0], "fov_y_deg": 50},
+    "lights": [{"type": "spot", "position": [0, 2, 0], "direction": [0, -1, 0], "inner_cone_deg": 25,
+                "outer_cone_deg": 30, "range": 6, "intensity": [4, 4, 4]}],
+    "medium": {"extinction": 0.2, "scattering_albedo": 1},
+    "objects": [{"primitive": {"type": "plane", "size": [6, 6]}},
+                {"primitive": {"type": "box", "size": [0.3, 0.02, 0.3]}, "transform": {"translate": [0, 1.2, 0]}},
+                {"primitive": {"type": "box", "size": [10, 6, 0.2]}, "transform": {"translate": [0, 3, -3.1]}}]})",
+                                std::filesystem::current_path(), "spot-beam.json");
+}
+
+// Each ray-marching technique's in-scattered luminance against the ray tracer's (256 samples per
+// ray): the mean absolute difference over the mean (measured on lavapipe; bound 1.5x, at least
+// 0.02 more); the ray's visible fraction's MAE likewise (bound 1.5x, at least 0.01 more). 32
+// samples over rays of 5-8 m step over the plate's 0.3 m shaft unevenly (the per-pixel jitter's
+// noise), 128 much less.
+TEST_F(LocalLightsRenderTest, SpotLightScatteringByRayMarchingAgreesWithTheRayTracer) {
+  const scene::Scene scene = spot_beam_scene();
+  constexpr int width = 128, height = 96;
+  reference::Settings r;
+  r.effect = reference::Effect::scattering;
+  r.width = width;
+  r.height = height;
+  r.samples = 256;
+  const reference::Result truth = reference::render(scene, r);
+  const std::map<std::string, std::pair<double, double>> measured = {{"scatter-march-32", {0.1730, 0.0025}},
+                                                                     {"scatter-march-128", {0.0456, 0.0016}}};
+  Renderer renderer(ctx(), scene);
+  for (const auto& [technique, expected] : measured) {
+    const RenderResult result = renderer.render(test::render_settings(technique, width, height, 256));
+    double difference = 0.0, mean = 0.0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const glm::vec3 got(result.scattering.at(x, y, 0), result.scattering.at(x, y, 1),
+                            result.scattering.at(x, y, 2));
+        const glm::vec3 want(truth.scattering.at(x, y, 0), truth.scattering.at(x, y, 1), truth.scattering.at(x, y, 2));
+        difference += std::abs(double(msm_luminance(got)) - double(msm_luminance(want)));
+        mean += msm_luminance(want);
+      }
+    const image::Metrics m =
+        image::compute_metrics(result.scattering.channel("visible_fraction"), truth.visibility.channel("visibility"));
+    fmt::print("spot scattering, {:<17} vs ray traced: in-scattered luminance mean absolute error / mean {:.4f}, "
+               "visible fraction MAE {:.4f}, non-finite {}\n",
+               technique, difference / mean, m.mae, m.non_finite);
+    EXPECT_EQ(m.non_finite, 0u) << technique;
+    EXPECT_EQ(image::compute_metrics(result.color, truth.radiance).non_finite_in_test, 0u) << technique;
+    EXPECT_LT(difference / mean, std::max(1.5 * expected.first, expected.first + 0.02)) << technique;
+    EXPECT_LT(m.mae, std::max(1.5 * expected.second, expected.second + 0.01)) << technique;
+  }
 }
 
 } // namespace

@@ -273,7 +273,10 @@ struct Renderer::Impl {
   // A spot light as the shadow pass and the shading read it (docs/techniques.md, "Light kinds"): a
   // perspective map over the outer cone, radial distance / range its depth; the normal offset of
   // RenderSettings::normal_offset texels of the map's width where the receiver is.
-  static LightUniforms spot_light_uniforms(const RenderSettings& s, const scene::LocalLight& spot) {
+  // Soft shadows: soft.w the sphere's radius (soft.h's spot geometry; the shading's cone of the
+  // sphere); 0 for the techniques of hard shadows, which shade a point.
+  static LightUniforms spot_light_uniforms(const RenderSettings& s, const Technique& technique,
+                                           const scene::LocalLight& spot) {
     const glm::vec3 up = std::abs(spot.direction.y) > 0.99f ? glm::vec3(0.0f, 0.0f, 1.0f) : glm::vec3(0.0f, 1.0f, 0.0f);
     const float outer = glm::radians(spot.outer_cone_deg);
     // The near plane clips nothing (depth clamp, gl_FragDepth): it only has to be positive.
@@ -286,6 +289,7 @@ struct Renderer::Impl {
     u.spot_axis = glm::vec4(spot.direction, std::tan(outer));
     const float texel_angle = 2.0f * std::tan(outer) / float(s.shadow_size);
     u.spot_cone = glm::vec4(spot.cos_outer(), spot.cos_inner(), s.normal_offset * texel_angle, 0.0f);
+    if (msm_technique_is_area_light(technique.id)) u.soft = glm::vec4(0.0f, 0.0f, 0.0f, spot.radius);
     return u;
   }
 
@@ -342,17 +346,26 @@ struct Renderer::Impl {
                                     ctx.properties().limits.maxImageArrayLayers));
   }
 
-  // What the renderer draws with spot lights: the hard and filtered techniques of one depth per
-  // texel, opaque occluders, a finite range (the stored depth is distance / range).
+  // What the renderer draws with spot lights: the hard, filtered and soft techniques of one depth
+  // per texel, single scattering by ray marching, opaque occluders, a finite range (the stored
+  // depth is distance / range).
   void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots) const {
     const Technique& technique = find_rendered_technique(s.technique);
-    const char* unsupported = technique.soft() || msm_technique_is_area_light(technique.id) ? "soft shadows"
-                              : technique.scatters()                                        ? "scattering"
-                              : s.translucent_occluders && !gpu.translucent.empty()         ? "translucent occluders"
-                                                                                            : nullptr;
+    // The prefiltered scattering's rectification (rectification.h) resamples a directional light's
+    // map along the epipolar planes of parallel light rays, and one visible fraction per ray stands
+    // for the ray's in-scattering because f E is the same all along it; a spot light's f E falls off
+    // with the inverse square of the distance to it along the ray, which one lookup of prefix sums
+    // over depth cannot weigh.
+    if (technique.prefiltered_scattering())
+      throw RenderError(fmt::format("{} with spot lights: the prefiltered scattering's rectification is derived for "
+                                    "directional lights (parallel rays, the same in-scattering all along a view ray); "
+                                    "a spot light's falls off with the inverse square of its distance along the ray. "
+                                    "Ray marching (scatter-march-32) draws spot lights' scattering",
+                                    technique.name));
+    const char* unsupported = s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders" : nullptr;
     if (unsupported)
-      throw RenderError(fmt::format("{} with spot lights: the renderer draws spot lights' hard and filtered shadows "
-                                    "of opaque occluders only; the ray tracer (msm reference) traces them",
+      throw RenderError(fmt::format("{} with spot lights: the renderer draws spot lights' hard, filtered and soft "
+                                    "shadows of opaque occluders only; the ray tracer (msm reference) traces them",
                                     unsupported));
     for (const scene::LocalLight& spot : spots)
       if (!(spot.range < scene::LocalLight::kInfiniteRange))
@@ -432,7 +445,7 @@ struct Renderer::Impl {
     std::ranges::fill(soft_clamps.mapped<std::uint32_t>(), 0u);
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
-    for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, spot));
+    for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, technique, spot));
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {

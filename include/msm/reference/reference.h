@@ -118,6 +118,11 @@
 //               its std_error that of the samples sum_l w_l V_l(t) / sum_l w_l. A camera inside an
 //               occluder: the points inside are shadowed (their shadow rays hit its inside), its
 //               back faces are looked through as above; nothing special, never NaN.
+//               Spot and point lights scatter f E = msm_local_light_inscattering, which varies
+//               along the ray (inverse square, the cone, the range): at the same distances t,
+//               one shadow ray each to the light; V_l = sum lum(f E) V / sum lum(f E) and the
+//               light's term V_l mean(f E) integral_0^s exp(-st t) dt; its weight w_l the
+//               luminance of mean(f E). The surfaces are lit as by the hard effect.
 //
 //   environment Image-based lighting (Kneiphof 2017) with exact visibility: the irradiance
 //                 E(p) = ∫ L(ω) V(ω) max(n_s·ω, 0) dω

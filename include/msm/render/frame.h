@@ -51,7 +51,8 @@ struct LightUniforms {
                         // intensity, W/sr, msm_local_light_irradiance), a: unused
   vec4 soft;            // soft shadows: xy: texels of reach per unit of [-1,1] depth
                         // (msm_soft_spread), z: the light's cone half-angle in radians for the
-                        // shading's msm_cone_cosine (0: a point light, max(n·l, 0)), w: unused
+                        // shading's msm_cone_cosine (0: a point light, max(n·l, 0)), w: a spot
+                        // light's radius (soft.h's msm_spot_soft_spread; 0: hard shadows)
   vec4 rect_x_axis;     // xyz: a rectangular light's x axis (its frame's, Scene::light_frame), w: unused
   vec4 rect_extent;     // xy: a rectangular light's half extents as tangents (0: a disc or a point,
                         // shaded by soft.z); the shading's msm_light_cosine takes both. zw: its

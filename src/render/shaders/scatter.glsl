@@ -23,9 +23,13 @@
 // eight image layers each, light l's layer k from 8 (K l + k)).
 layout(constant_id = MSM_SPEC_SCATTER_LAYERS) const int kLayers = 1;
 layout(constant_id = MSM_SPEC_PREFIX_SUM_MIPS) const bool kPrefixSumMips = false; // FrameConfig::prefix_sum_mips > 1
-layout(constant_id = MSM_SPEC_SCATTER_BETA_MODE) const int kBetaMode = 0; // FrameConfig::scattering_beta: MSM_SCATTERING_BETA_*
-layout(binding = MSM_BINDING_SCATTER_SHADOW_MAP) uniform sampler2DArray prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
-layout(std430, binding = MSM_BINDING_SCATTER_RECTS) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
+layout(constant_id = MSM_SPEC_SCATTER_BETA_MODE) const
+    int kBetaMode = 0; // FrameConfig::scattering_beta: MSM_SCATTERING_BETA_*
+layout(binding = MSM_BINDING_SCATTER_SHADOW_MAP) uniform sampler2DArray
+    prefix_sums; // Θ4* (16-bit), Θ6* image 0 or CSM's RGBA8, bilinear
+layout(std430, binding = MSM_BINDING_SCATTER_RECTS) readonly buffer RectificationBlock {
+  RectificationUniforms rects[];
+};
 #ifdef MSM_SIX_MOMENTS
 layout(binding = MSM_BINDING_SCATTER_PREFIX_SUMS1) uniform sampler2DArray prefix_sums1; // Θ6* image 1
 #endif
@@ -44,24 +48,70 @@ layout(location = 0) out vec4 out_color;      // tone mapped; the attachment is 
 layout(location = 1) out vec4 out_scattering; // rgb: in-scattered radiance, a: visible fraction
 
 #ifndef MSM_SCATTER_PREFILTERED
+// Whether some light of the frame is a spot light (FrameConfig::spot_lights; shading.glsl's).
+layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
+bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
+
+// 1 where spot light shadow_layer reaches p, 0 where its map (radial distance / range) has an
+// occluder nearer to the light; its depth bias grows with the distance as the shading's
+// (spot_lookup). Outside the map's frustum: lit (the cone brings nothing there).
+float spot_light_reaches(vec3 p) {
+  vec4 clip = lights[shadow_layer].view_projection * vec4(p, 1.0f);
+  vec2 ndc = vec2(clip) / clip.w;
+  if (!(clip.w > 0.0f) || any(greaterThan(abs(ndc), vec2(1.0f)))) return 1.0f;
+  int size = int(frame.shadow_map.x);
+  ivec2 texel = clamp(ivec2(floor((ndc * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0), ivec2(size - 1));
+  float r = distance(p, lights[shadow_layer].spot_position.xyz);
+  float bias = frame.shadow_map.w * 2.0f * lights[shadow_layer].spot_axis.w * r;
+  return depth_sample(texel, 0) < min((r - bias) / lights[shadow_layer].spot_position.w, 1.0f) ? 0.0f : 1.0f;
+}
+
 // 1 where light shadow_layer reaches p, 0 where its depth map has an occluder in front of p.
 float light_reaches(vec3 p) {
   vec4 clip = lights[shadow_layer].view_projection * vec4(p, 1.0f);
   if (any(lessThan(vec2(clip.x, clip.y), vec2(-1.0f))) || any(greaterThan(vec2(clip.x, clip.y), vec2(1.0f))))
     return 1.0f;
   int size = int(frame.shadow_map.x);
-  ivec2 texel = clamp(ivec2(floor((vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0),
-                      ivec2(size - 1));
+  ivec2 texel =
+      clamp(ivec2(floor((vec2(clip.x, clip.y) * 0.5f + 0.5f) * frame.shadow_map.x)), ivec2(0), ivec2(size - 1));
   return depth_sample(texel, 0) < min(clip.z, 1.0f) - frame.shadow_map.w ? 0.0f : 1.0f;
+}
+
+// One blue-noise jitter per pixel (the frame's layer and offset), strictly below 1.
+float march_jitter(ivec2 pixel) {
+  ivec2 n = (pixel + ivec2(frame.lookup.z, frame.lookup.w)) & 63;
+  return (texelFetch(blue_noise, ivec3(n, frame.lookup.y), 0).x * 255.0f + 0.5f) / 256.0f;
+}
+
+// Spot light l's in-scattering along the ray, added to sum: its f E (msm_local_light_inscattering)
+// varies along the ray, so each sample weighs it with its shadow; the light's visible fraction is
+// Σ w f E V / Σ w f E (luminance) and its unshadowed f E the samples' mean, as the ray tracer's.
+ScatteringSum add_spot_light(ScatteringSum sum, int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  current_layer = l;
+  float extinction = scatter.medium.x;
+  int count = scatter.march.x;
+  float jitter = march_jitter(pixel);
+  vec3 unshadowed = vec3(0.0f), lit = vec3(0.0f);
+  for (int i = 0; i < count; ++i) {
+    vec3 p = camera + msm_ray_march_distance(s, count, i, jitter) * direction;
+    vec3 fe = msm_ray_march_weight(extinction, s, count, i) *
+              msm_local_light_inscattering(p, direction, lights[l].spot_position.xyz, lights[l].spot_axis.xyz,
+                                           lights[l].irradiance.rgb, lights[l].spot_position.w, lights[l].spot_cone.x,
+                                           lights[l].spot_cone.y, extinction, scatter.medium.y, scatter.medium.z);
+    unshadowed += fe;
+    if (msm_luminance(fe) > 0.0f) lit += fe * spot_light_reaches(p);
+  }
+  float total = msm_transmittance_integral(extinction, 0.0f, s);
+  float weight = msm_luminance(unshadowed);
+  float visible = weight > 0.0f ? msm_saturate(msm_luminance(lit) / weight) : 1.0f;
+  return msm_scattering_add_light(sum, total > 0.0f ? unshadowed / total : vec3(0.0f), extinction, 1.0f, s, visible);
 }
 
 float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
   current_layer = l;
   float extinction = scatter.medium.x;
   int count = scatter.march.x;
-  // One blue-noise jitter per pixel (the frame's layer and offset), strictly below 1.
-  ivec2 n = (pixel + ivec2(frame.lookup.z, frame.lookup.w)) & 63;
-  float jitter = (texelFetch(blue_noise, ivec3(n, frame.lookup.y), 0).x * 255.0f + 0.5f) / 256.0f;
+  float jitter = march_jitter(pixel);
   float weighted = 0.0f;
   for (int i = 0; i < count; ++i) {
     vec3 p = camera + msm_ray_march_distance(s, count, i, jitter) * direction;
@@ -97,24 +147,24 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   float layer0 = float(shadow_layer * kLayers), mix_t = 0.0f;
   if (kLayers > 1) {
     vec2 range = msm_transmittance_layer_range(b, scatter.medium.x, rect.map.x);
-    vec2 k = msm_transmittance_layer_lookup(range, msm_rectified_view_ray_step(f, b, direction, rect.map.x),
-                                            float(kLayers));
+    vec2 k =
+        msm_transmittance_layer_lookup(range, msm_rectified_view_ray_step(f, b, direction, rect.map.x), float(kLayers));
     layer0 += k.x;
     mix_t = k.y;
   }
-#define MSM_LAYERED_LOOKUP(image, layer)                                                                           \
-  (kLayers > 1 ? mix(textureLod(image, vec3(uv, (layer)), lod), textureLod(image, vec3(uv, (layer) + 1.0f), lod), \
-                     mix_t)                                                                                        \
-               : textureLod(image, vec3(uv, (layer)), lod))
+#define MSM_LAYERED_LOOKUP(image, layer)                                                                               \
+  (kLayers > 1                                                                                                         \
+       ? mix(textureLod(image, vec3(uv, (layer)), lod), textureLod(image, vec3(uv, (layer) + 1.0f), lod), mix_t)       \
+       : textureLod(image, vec3(uv, (layer)), lod))
 #ifdef MSM_CSM
   CsmMoments m = CsmMoments(mat4(0.0f), mat4(0.0f));
   for (int t = 0; t < MSM_CSM_MAX_TEXELS; ++t) {
     // Layer k + 1's term t is 8 image layers after layer k's.
     vec4 texel = msm_csm_from_unorm(
-        kLayers > 1 ? mix(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * layer0 + float(t)), lod),
-                          textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * (layer0 + 1.0f) + float(t)), lod),
-                          mix_t)
-                    : textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), lod));
+        kLayers > 1
+            ? mix(textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * layer0 + float(t)), lod),
+                  textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS) * (layer0 + 1.0f) + float(t)), lod), mix_t)
+            : textureLod(prefix_sums, vec3(uv, float(MSM_CSM_MAX_TEXELS * shadow_layer + t)), lod));
     if (t < 4)
       m.lo[t] = texel;
     else
@@ -145,6 +195,9 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
 
 // Light l's in-scattering along the view ray, added to sum.
 ScatteringSum add_light(ScatteringSum sum, int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
+#ifndef MSM_SCATTER_PREFILTERED
+  if (is_spot(l)) return add_spot_light(sum, l, pixel, camera, direction, s);
+#endif
   float extinction = scatter.medium.x;
   float phase =
       msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z, lights[l].towards_light.xyz, direction);
@@ -170,9 +223,7 @@ void main() {
     ScatteringSum sum = msm_scattering_sum_none();
     // One light: one pass through the body, no loop (light_loop.glsl).
     int l = 0;
-    do {
-      sum = add_light(sum, l, pixel, camera, direction, s);
-    } while (!kOneLight && ++l < kLightCount);
+    do { sum = add_light(sum, l, pixel, camera, direction, s); } while (!kOneLight && ++l < kLightCount);
     radiance = msm_scattering_sum_radiance(surface, extinction, s, sum);
     inscattered = sum.inscattered;
     visible = msm_scattering_sum_visible(sum);

@@ -26,16 +26,18 @@ layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
 bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
 
 layout(binding = MSM_BINDING_SHADING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
-layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
+layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D
+    opacity_texture; // R8: used where object.flags.z != 0
 layout(push_constant) uniform Push { ObjectPush object; };
 
 #ifdef MSM_DEFERRED_SHADOWS
 // Deferred shading (a full-screen pass): the visible surface of each pixel from the surfaces pass
 // (MSM_SURFACES below), bit for bit what the forward pass interpolates, so one shadow evaluation per
 // pixel gives the forward pass's result.
-layout(binding = MSM_BINDING_SHADING_SURFACE_POSITION) uniform sampler2D surface_position; // xyz; w: 1 where a surface, 0 background
-layout(binding = MSM_BINDING_SHADING_SURFACE_NORMAL) uniform sampler2D surface_normal;   // xyz: towards the viewer
-layout(binding = MSM_BINDING_SHADING_SURFACE_ALBEDO) uniform sampler2D surface_albedo;   // rgb, a: opacity
+layout(binding = MSM_BINDING_SHADING_SURFACE_POSITION) uniform sampler2D
+    surface_position; // xyz; w: 1 where a surface, 0 background
+layout(binding = MSM_BINDING_SHADING_SURFACE_NORMAL) uniform sampler2D surface_normal; // xyz: towards the viewer
+layout(binding = MSM_BINDING_SHADING_SURFACE_ALBEDO) uniform sampler2D surface_albedo; // rgb, a: opacity
 vec3 world_position;
 #else
 layout(location = 0) in vec3 world_position;
@@ -178,10 +180,12 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
   // tracer's formula); a directional light's are the same everywhere.
   vec3 towards_light = lights[l].towards_light.xyz;
   vec3 irradiance = lights[l].irradiance.rgb;
+  float spot_sin_alpha = 0.0f; // a spot's sphere (soft.w: its radius) fills the cone of sin α = r / d
   if (is_spot(l)) {
     vec3 to_light = lights[l].spot_position.xyz - world_position;
     float d = length(to_light);
     towards_light = to_light / max(d, 1e-20f);
+    spot_sin_alpha = min(lights[l].soft.w / max(d, 1e-20f), 1.0f);
     irradiance = msm_local_light_irradiance(irradiance, d, lights[l].spot_position.w,
                                             dot(-towards_light, lights[l].spot_axis.xyz), lights[l].spot_cone.x,
                                             lights[l].spot_cone.y);
@@ -203,6 +207,10 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
   if (sub_count > 0) {
     unshadowed = sub_lights_irradiance(l, n, sub_count);
     lit = max(unshadowed.r, max(unshadowed.g, unshadowed.b));
+  } else if (is_spot(l)) {
+    // The cosine over the sphere's cone, as the ray tracer integrates it; a point (soft.w = 0, the
+    // techniques of hard shadows): max(n·l, 0).
+    lit = msm_cone_cosine(n_dot_l, asin(spot_sin_alpha));
   } else {
     lit = msm_technique_is_area_light(kTechnique)
               ? msm_light_cosine(n, lights[l].towards_light.xyz, lights[l].rect_x_axis.xyz, lights[l].rect_extent.xy,

@@ -2,9 +2,9 @@
 // kernel the moment techniques get from their pipeline (Gaussian blur, then a bilinear lookup):
 // the weight of depth texel i along an axis is (1 - f) g[i - i0 + R] + f g[i - i0 - 1 + R] for
 // t = i0 + f, over taps + 1 texels, and every MSAA sample counts 1 / samples.
-#include "msm/soft.h"
 #include "shading.glsl"
 #include "soft_clamps.glsl"
+#include "soft_light.glsl"
 #define MSM_DEPTH_BINDING MSM_BINDING_SHADING_SHADOW_MAP
 #define MSM_DEPTH_LAYERED 1
 #include "depth_map.glsl"
@@ -48,20 +48,23 @@ float pcss_shadow(ShadowLookup s) {
   ivec2 map = ivec2(int(frame.shadow_map.x));
   int width = frame.soft_kernel.x;
   const int samples = kSamples;
-  vec2 spread = vec2(lights[shadow_layer].soft.x, lights[shadow_layer].soft.y);
+  SoftLight light = soft_light(shadow_layer, s);
   float zf = msm_signed_depth(s.z);
   vec2 position = s.t + 0.5f; // texel i covers [i, i + 1) in soft.h
-  SatRect r = msm_soft_search_rect(position, msm_soft_search_half_width(spread, zf, -1.0f, width), map);
+  SatRect r = msm_soft_search_rect(
+      position, msm_soft_search_half_width(light.spread, zf, light.near_depth, light.perspective, width), map);
   vec2 blockers = vec2(0.0f);
   for (int y = r.lo.y; y <= r.hi.y; ++y)
     for (int x = r.lo.x; x <= r.hi.x; ++x) blockers += texel_blockers(ivec2(x, y), s);
   BlockerResult blocker = msm_soft_pcss_blocker(blockers.y, blockers.x, float(msm_sat_rect_texels(r) * samples), s.z);
   bool filtered = blocker.shadow > 0.0f && blocker.shadow < 1.0f;
-  count_soft_lookup(filtered && msm_soft_penumbra_clamped(spread, zf, msm_signed_depth(blocker.depth), width));
+  float zb = msm_signed_depth(blocker.depth);
+  count_soft_lookup(filtered &&
+                    msm_soft_penumbra_clamped(light.spread, zf, zb, light.near_depth, light.perspective, width));
   if (blocker.shadow <= 0.0f) return 0.0f;
   // Every sample of the search region blocks: so does every one of the smaller filter region.
   if (blocker.shadow >= 1.0f) return 1.0f;
-  vec2 hp = msm_soft_penumbra_half_width(spread, zf, msm_signed_depth(blocker.depth), width);
+  vec2 hp = msm_soft_penumbra_half_width(light.spread, zf, zb, light.near_depth, light.perspective, width);
   SoftRegion region = msm_soft_region(position, hp, map);
   ivec2 lo = ivec2(floor(region.lo)), hi = min(ivec2(ceil(region.hi)), map) - 1;
   float shadow = 0.0f;

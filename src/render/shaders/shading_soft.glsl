@@ -6,9 +6,11 @@
 // cssm16 (cssm.h: CSM tiles stacked in one table).
 #include "msm/render/bindings.h"
 layout(binding = MSM_BINDING_SHADING_SHADOW_MAP) uniform usampler2DArray sat_table;
-layout(binding = MSM_BINDING_SHADING_SHADOW_MAP1) uniform usampler2DArray sat_table1; // six moments: b4, b6; else the first again
+layout(binding = MSM_BINDING_SHADING_SHADOW_MAP1) uniform usampler2DArray
+    sat_table1; // six moments: b4, b6; else the first again
 #include "shading.glsl"
 #include "soft_clamps.glsl"
+#include "soft_light.glsl"
 
 // soft.h's fetch: S(x, y) of the light's table `table`. Six moments: table 1 is the second table.
 // CSSM: tile `table` lies `table` shadow-map heights further along y; its row -1 is the previous
@@ -24,8 +26,9 @@ uvec4 sat_fetch(int x, int y, int table) {
 #include "msm/soft.h"
 
 float shadow_intensity(ShadowLookup s) {
-  SoftSetup k = SoftSetup(ivec2(int(frame.shadow_map.x)), frame.soft_kernel.x, uint(frame.soft_kernel.y),
-                          vec2(lights[shadow_layer].soft.x, lights[shadow_layer].soft.y), frame.soft.z, frame.soft.w,
+  SoftLight light = soft_light(shadow_layer, s);
+  SoftSetup k = SoftSetup(ivec2(int(frame.shadow_map.x)), frame.soft_kernel.x, uint(frame.soft_kernel.y), light.spread,
+                          light.near_depth, light.perspective, soft_constant_bias(shadow_layer, s), frame.soft.w,
                           frame.technique_params);
   // The receiver plane's slope: ShadowLookup's is in [0,1] depth per texel, soft.h's in [-1,1].
   SoftFragment f = SoftFragment(s.t + 0.5f, s.z, 2.0f * s.depth_per_texel);

@@ -44,7 +44,7 @@ MSM_SOFT_FLOW_FN SatQueryResult msm_test_sat_query(MSM_SOFT_FETCH_PARAM SatQuery
   vec2 lo = vec2(q.region[0], q.region[1]), hi = vec2(q.region[2], q.region[3]);
   uvec4 rect_sum = msm_soft_rect_sum(MSM_SOFT_FETCH_ARG msm_sat_grid_rect(lo, hi, pc.size), 0);
   vec4 filtered = msm_soft_filter_average(MSM_SOFT_FETCH_ARG msm_sat_filter(lo, hi), pc.scale, 0);
-  SoftSetup k = SoftSetup(pc.size, pc.kernel_width, pc.scale, pc.spread, MSM_TEST_SOFT_CONSTANT_BIAS,
+  SoftSetup k = SoftSetup(pc.size, pc.kernel_width, pc.scale, pc.spread, -1.0f, false, MSM_TEST_SOFT_CONSTANT_BIAS,
                           MSM_SOFT_UMBRA_EPSILON, pc.params);
   SoftFragment f = SoftFragment(vec2(q.fragment[0], q.fragment[1]), q.fragment[2], vec2(q.fragment[3], 0.0f));
   SoftShadow s;
