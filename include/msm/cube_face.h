@@ -56,6 +56,16 @@ MSM_FN float msm_cube_face_seam_texels(vec2 uv, float g, float size) {
   return (1.0f - max(abs(uv.x), abs(uv.y))) * size / (2.0f * g);
 }
 
+// The coarsest mip level a bilinear lookup at t (texel-centre coordinates of a face's map of `size`
+// texels per side) may read and stay on real data: the texels within `blur_radius` of the map's
+// edge were blurred with clamped neighbours, and a bilinear fetch at level k reaches up to 2^(k+1)
+// texels of level 0 from t. Near a seam this holds the lookup to the levels its guard band covers;
+// far from the map's edges it allows every level.
+MSM_FN float msm_cube_face_max_lod(vec2 t, float size, float blur_radius) {
+  float to_edge = min(min(t.x, t.y), min(size - 1.0f - t.x, size - 1.0f - t.y)) + 0.5f;
+  return log2(max(to_edge - blur_radius, 1.0f)) - 1.0f;
+}
+
 MSM_END
 
 #endif

@@ -80,3 +80,18 @@ TEST(CubeFace, TheFaceMatrixMapsADirectionToItsCoordinatesOverTheHalfWidth) {
 }
 
 } // namespace
+
+namespace {
+
+// A face of 256 texels, a blur of radius 4: at the map's centre every level of a 256² chain
+// (to_edge 128 - 4 = 124: log2 124 - 1 = 5.95); 12 texels from the edge (a seam with a guard band
+// of 12), level log2(8) - 1 = 2, whose bilinear fetch reaches 2^3 = 8 texels, to the blur's
+// clamped texels and no further; at the map's edge level 0.
+TEST(CubeFace, TheLookupsMipStaysWithinTheGuardBand) {
+  EXPECT_NEAR(msm::msm_cube_face_max_lod({127.5f, 127.5f}, 256.0f, 4.0f), std::log2(124.0f) - 1.0f, 1e-5f);
+  EXPECT_FLOAT_EQ(msm::msm_cube_face_max_lod({11.5f, 100.0f}, 256.0f, 4.0f), 2.0f);
+  EXPECT_FLOAT_EQ(msm::msm_cube_face_max_lod({100.0f, 243.5f}, 256.0f, 4.0f), 2.0f);
+  EXPECT_FLOAT_EQ(msm::msm_cube_face_max_lod({0.0f, 100.0f}, 256.0f, 4.0f), -1.0f);
+}
+
+} // namespace
