@@ -1,7 +1,8 @@
 // Spot and point lights in the renderer: spot lights' shadows (perspective maps of radial depth)
-// against the ray tracer's hard shadows per technique, their unshadowed irradiance against a value
-// worked out by hand; the light kinds and techniques it does not draw with them are refused with a
-// message that names them, never rendered as if they were absent.
+// and point lights' (six cube faces of it) against the ray tracer's hard shadows per technique, the
+// point lights' error along the cube's seams against elsewhere, the spot's unshadowed irradiance
+// against a value worked out by hand; the light kinds and techniques it does not draw with them are
+// refused with a message that names them, never rendered as if they were absent.
 #include "msm/cube_face.h"
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
