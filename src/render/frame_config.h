@@ -70,7 +70,13 @@ struct FrameConfig {
   // Spot lights in the frame (after its directional lights): the shadow pass writes their radial
   // depth and the shading's kSpotLights (shading.glsl) projects, biases and lights by each light's kind.
   int spot_lights = 0;
+  // Point lights in the frame (after its spot lights), six layers each, one per cube face
+  // (msm/cube_face.h): the same radial depth and shading as the spot lights' layers.
+  int point_lights = 0;
   bool operator==(const FrameConfig&) const = default;
+
+  // The layers of spot and point lights, the last of the shadow-map arrays.
+  int local_light_layers() const { return spot_lights + 6 * point_lights; }
 
   bool split_rg() const;                   // translucent and four channels in one image
   std::array<VkFormat, 2> formats() const; // of the moment images as allocated

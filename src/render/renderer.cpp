@@ -10,6 +10,7 @@
 #include "program_cache.h"
 #include "recipes.h"
 
+#include "msm/cube_face.h"
 #include "msm/filter.h"
 #include "msm/gpu/sat_builder.h"
 #include "msm/noise/blue_noise.h"
@@ -200,6 +201,21 @@ struct Renderer::Impl {
     return spots;
   }
 
+  // The scene's point lights, six layers each (one per cube face), after the spot lights'.
+  std::vector<scene::LocalLight> point_lights() const {
+    std::vector<scene::LocalLight> points;
+    std::ranges::copy_if(scene.local_lights, std::back_inserter(points),
+                         [](const scene::LocalLight& l) { return l.kind == scene::LightKind::point; });
+    return points;
+  }
+
+  // The shadow-map layers (and shading entries) of the frame's lights: one per directional or spot
+  // light, six per point light.
+  std::size_t light_layers(const RenderSettings& s) const {
+    return lights_of(s).size() + spot_lights().size() + kCubeFaces * point_lights().size();
+  }
+  static constexpr std::size_t kCubeFaces = 6;
+
   FrameUniforms frame_uniforms(const RenderSettings& s, const Technique& technique) const {
     FrameUniforms u{};
     u.camera_view_projection = scene.camera_view_projection(float(s.width) / float(s.height));
@@ -239,7 +255,7 @@ struct Renderer::Impl {
     double kernel_variance = msm_gaussian_variance(s.filter_size, s.filter_sigma);
     for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
     u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
-    u.lights = glm::ivec4(int(lights_of(s).size() + spot_lights().size()), 0, 0, 0);
+    u.lights = glm::ivec4(int(light_layers(s)), 0, 0, 0);
     u.camera_viewport = glm::vec4(float(s.width), float(s.height), 0.0f, 0.0f);
     return u;
   }
@@ -293,6 +309,36 @@ struct Renderer::Impl {
     return u;
   }
 
+  // Face `face` of a point light as the shadow pass and the shading read it: a spot light's entry
+  // (radial distance / range, the same biases) whose perspective view looks along the face's axis
+  // (msm/cube_face.h) over a square a guard band wider than the face's 90 degrees, so that the
+  // blur and the lookup's filter near a seam read the neighbouring face's texels rendered, not a
+  // clamped edge (docs/techniques.md, "Light kinds"). spot_cone.w: the face's number + 1, which
+  // the shading reads to evaluate the light once, at its first face's entry, from the face that
+  // holds the receiver's direction.
+  static LightUniforms point_face_uniforms(const RenderSettings& s, const scene::LocalLight& point, int face) {
+    const float g = msm_cube_face_half_width(float(point_light_guard_texels(s)), float(s.shadow_size));
+    const glm::mat4 projection = glm::perspective(2.0f * std::atan(g), 1.0f, 1e-3f * point.range, point.range);
+    LightUniforms u{};
+    u.view_projection =
+        projection * glm::lookAt(point.position, point.position + msm_cube_face_forward(face), msm_cube_face_up(face));
+    u.normal_matrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(u.view_projection))));
+    u.irradiance = glm::vec4(point.intensity, 0.0f);
+    u.spot_position = glm::vec4(point.position, point.range);
+    u.spot_axis = glm::vec4(msm_cube_face_forward(face), g);
+    const float texel_angle = 2.0f * g / float(s.shadow_size);
+    u.spot_cone = glm::vec4(point.cos_outer(), point.cos_inner(), s.normal_offset * texel_angle, float(face + 1));
+    return u;
+  }
+
+  // The guard band of a point light's faces, in texels beyond the 90-degree part on each side: the
+  // blur's radius, the lookup's reach past it (PCF's taps + 1, a bilinear fetch, the MSAA samples),
+  // the normal offset, which can move the looked-up point past the seam of the face picked for the
+  // surface, and two texels for the coarser mips and the receiver-plane slope.
+  static int point_light_guard_texels(const RenderSettings& s) {
+    return s.filter_size / 2 + 2 + int(std::ceil(s.normal_offset)) + 2;
+  }
+
   // A sub-light as the shading reads it: its direction, irradiance (on a surface facing it) and the
   // rectangle of msm_light_cosine; no shadow map of its own.
   static LightUniforms sub_light_uniforms(const scene::DirectionalLight& sub) {
@@ -338,18 +384,24 @@ struct Renderer::Impl {
     if (slots > kLightSlots)
       throw RenderError(
           fmt::format("{} lights, sub-lights and their summaries: the renderer holds {}", slots, kLightSlots));
-    const std::vector<scene::LocalLight> spots = spot_lights();
-    slots += spots.size();
-    if (!spots.empty()) check_spot_lights(s, spots);
-    if (frame_lights.size() + spots.size() > ctx.properties().limits.maxImageArrayLayers)
-      throw RenderError(fmt::format("{} lights: {} supports {} layers per image", frame_lights.size(), ctx.info().name,
-                                    ctx.properties().limits.maxImageArrayLayers));
+    const std::vector<scene::LocalLight> spots = spot_lights(), points = point_lights();
+    slots += spots.size() + kCubeFaces * points.size();
+    if (slots > kLightSlots)
+      throw RenderError(fmt::format("{} lights, sub-lights, their summaries and point lights' faces (6 each): the "
+                                    "renderer holds {}",
+                                    slots, kLightSlots));
+    if (!spots.empty()) check_spot_lights(s, spots, "spot");
+    if (!points.empty()) check_spot_lights(s, points, "point");
+    if (light_layers(s) > ctx.properties().limits.maxImageArrayLayers)
+      throw RenderError(fmt::format("{} shadow-map layers (point lights take 6): {} supports {} layers per image",
+                                    light_layers(s), ctx.info().name, ctx.properties().limits.maxImageArrayLayers));
   }
 
-  // What the renderer draws with spot lights: the hard, filtered and soft techniques of one depth
-  // per texel, single scattering by ray marching, opaque occluders, a finite range (the stored
-  // depth is distance / range).
-  void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots) const {
+  // What the renderer draws with spot and point lights (`kind`): the hard and filtered techniques
+  // of one depth per texel, opaque occluders, a finite range (the stored depth is distance / range);
+  // with spot lights also the soft techniques and single scattering by ray marching.
+  void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots,
+                         std::string_view kind) const {
     const Technique& technique = find_rendered_technique(s.technique);
     // The prefiltered scattering's rectification (rectification.h) resamples a directional light's
     // map along the epipolar planes of parallel light rays, and one visible fraction per ray stands
@@ -357,20 +409,26 @@ struct Renderer::Impl {
     // with the inverse square of the distance to it along the ray, which one lookup of prefix sums
     // over depth cannot weigh.
     if (technique.prefiltered_scattering())
-      throw RenderError(fmt::format("{} with spot lights: the prefiltered scattering's rectification is derived for "
-                                    "directional lights (parallel rays, the same in-scattering all along a view ray); "
-                                    "a spot light's falls off with the inverse square of its distance along the ray. "
-                                    "Ray marching (scatter-march-32) draws spot lights' scattering",
-                                    technique.name));
-    const char* unsupported = s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders" : nullptr;
+      throw RenderError(
+          fmt::format("{} with {} lights: the prefiltered scattering's rectification is derived for "
+                      "directional lights (parallel rays, the same in-scattering all along a view ray); "
+                      "a {} light's falls off with the inverse square of its distance along the ray.{}",
+                      technique.name, kind, kind,
+                      kind == "spot" ? " Ray marching (scatter-march-32) draws spot lights' scattering" : ""));
+    const bool spot = kind == "spot";
+    const char* unsupported = !spot && (technique.soft() || msm_technique_is_area_light(technique.id)) ? "soft shadows"
+                              : !spot && technique.scatters()                                          ? "scattering"
+                              : s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders"
+                                                                                    : nullptr;
     if (unsupported)
-      throw RenderError(fmt::format("{} with spot lights: the renderer draws spot lights' hard, filtered and soft "
-                                    "shadows of opaque occluders only; the ray tracer (msm reference) traces them",
-                                    unsupported));
+      throw RenderError(fmt::format("{} with {} lights: the renderer draws {} lights' {} shadows of opaque occluders "
+                                    "only; the ray tracer (msm reference) traces them",
+                                    unsupported, kind, kind, spot ? "hard, filtered and soft" : "hard and filtered"));
     for (const scene::LocalLight& spot : spots)
       if (!(spot.range < scene::LocalLight::kInfiniteRange))
-        throw RenderError("a spot light without \"range\": the renderer's spot shadow maps store distance / range, "
-                          "so a spot light it draws needs a finite range");
+        throw RenderError(fmt::format("a {} light without \"range\": the renderer's {} shadow maps store distance / "
+                                      "range, so a {} light it draws needs a finite range",
+                                      kind, kind, kind));
   }
 
   // Validates, (re)builds the frame graph where the configuration changed, writes the uniforms.
@@ -388,7 +446,7 @@ struct Renderer::Impl {
                   .msaa = s.msaa,
                   .taps = s.filter_size,
                   .sigma = s.filter_sigma,
-                  .lights = int(frame_lights.size() + spot_lights().size()),
+                  .lights = int(light_layers(s)),
                   .one_pass = one_pass,
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
@@ -401,7 +459,8 @@ struct Renderer::Impl {
                   .sub_lights = std::ranges::any_of(
                       lights_of(s), [](const scene::DirectionalLight& l) { return !l.sub_lights.empty(); }),
                   .front_back = s.front_back_depth,
-                  .spot_lights = int(spot_lights().size())};
+                  .spot_lights = int(spot_lights().size()),
+                  .point_lights = int(point_lights().size())};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     c.mip_levels =
@@ -446,6 +505,8 @@ struct Renderer::Impl {
     light_data.clear();
     for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
     for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, technique, spot));
+    for (const scene::LocalLight& point : point_lights())
+      for (int face = 0; face < int(kCubeFaces); ++face) light_data.push_back(point_face_uniforms(s, point, face));
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {

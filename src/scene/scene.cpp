@@ -41,8 +41,9 @@ constexpr LightKindInfo kLightKinds[] = {
      "parallel rays towards towards_light, unbounded; a disc or rectangle of directions when soft", true},
     {LightKind::spot, "spot", kSpotKeys, "perspective, the outer cone's field of view", 1, "radial distance / range",
      "a shadow ray to the light's position (bounded by the distance)", true},
-    {LightKind::point, "point", kPointKeys, "six perspective faces of a cube, 90 degrees each", 6,
-     "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", false},
+    {LightKind::point, "point", kPointKeys,
+     "six perspective faces of a cube, 90 degrees each and a guard band of the filter's reach", 6,
+     "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", true},
 };
 
 // What is wrong with a spot or point light (the key and the problem), or nothing: the one set of

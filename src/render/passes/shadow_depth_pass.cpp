@@ -39,7 +39,7 @@ void ShadowDepthPass::prepare(const PassResources& r) {
                           .samples = VkSampleCountFlagBits(config.msaa),
                           .depth_clamp = true};
   masked_program_ = &r.programs.graphics(masked);
-  if (config.spot_lights > 0) {
+  if (config.local_light_layers() > 0) {
     vk::GraphicsDesc spot = masked;
     spot.name = "shadow_depth (spot)";
     spot.vertex_shader = "shadow_depth_spot.vert";
@@ -74,8 +74,9 @@ void ShadowDepthPass::execute(const PassContext& c) const {
     bind_scene(c.cmd, c.frame.scene);
     const GpuScene& scene = c.frame.scene;
     const vk::Program* bound = nullptr;
-    // The spot lights' layers follow the directional lights' (FrameConfig::spot_lights).
-    const bool spot = l >= config_.lights - config_.spot_lights;
+    // The spot and point lights' layers follow the directional lights' (FrameConfig::spot_lights,
+    // point_lights): each a perspective view of radial depth, a point light's one per cube face.
+    const bool spot = l >= config_.lights - config_.local_light_layers();
     for (const Draw& d : scene.draws) {
       if (back_) {
         VkCullModeFlags want = d.double_sided ? VK_CULL_MODE_NONE : VK_CULL_MODE_FRONT_BIT;

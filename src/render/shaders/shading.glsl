@@ -3,6 +3,7 @@
 // visible surface) for error measurement. The including shader defines shadow_intensity() for its
 // family of techniques; it reads layer `shadow_layer` of the shadow-map arrays (the light being
 // evaluated).
+#include "msm/cube_face.h"
 #include "msm/footprint.h"
 #include "msm/local_light.h"
 #include "msm/shading.h"
@@ -24,6 +25,10 @@ layout(constant_id = MSM_SPEC_SUB_LIGHTS) const bool kSubLights = false;
 // frames of directional lights compile none of the spot lights' projection and irradiance.
 layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
 bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
+// A point light's six entries (spot_cone.w: the face's number + 1): the light is evaluated once,
+// at its first face's entry, from the face that holds the receiver; the other five only hold maps.
+bool is_point(int l) { return is_spot(l) && lights[l].spot_cone.w > 0.5f; }
+bool is_other_point_face(int l) { return is_spot(l) && lights[l].spot_cone.w > 1.5f; }
 
 layout(binding = MSM_BINDING_SHADING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
 layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D
@@ -122,7 +127,23 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
   bool inside;
   if (is_spot(l)) {
     if (lit <= 0.0f) return vec3(0.0f);
+    // A point light: the layer of the cube face the receiver's direction falls on, which its
+    // guard band lets the lookup filter across the face's edges (msm/cube_face.h), at the mip
+    // levels the guard band holds: coarser ones would read the blur's clamped edge.
+    bool point = is_point(l);
+    if (point) {
+      l += msm_cube_face(world_position - lights[l].spot_position.xyz);
+      current_layer = l;
+    }
     inside = spot_lookup(l, n, n_dot_l, pixel, s);
+    if (point) {
+      float lod = log2(max(length(s.dt_dx), length(s.dt_dy)));
+      float excess = lod - msm_cube_face_max_lod(s.t, frame.shadow_map.x, float(frame.kernel.z));
+      if (excess > 0.0f) {
+        s.dt_dx *= exp2(-excess);
+        s.dt_dy *= exp2(-excess);
+      }
+    }
   } else {
     // Normal offset: more at grazing light, where depth varies fastest across a texel.
     vec3 p = world_position + n * (lights[l].towards_light.w * (1.0f - n_dot_l));
@@ -176,8 +197,9 @@ vec3 sub_lights_irradiance(int l, vec3 n, int count) {
 // E max(n·l, 0), for area lights msm_light_cosine: the same factor as the shading) as its weight.
 vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inout vec3 weighted,
                       inout float weight_sum) {
-  // A spot light: its direction and irradiance at the surface (msm_local_light_irradiance, the ray
+  // A spot or point light: its direction and irradiance at the surface (msm_local_light_irradiance, the ray
   // tracer's formula); a directional light's are the same everywhere.
+  if (is_other_point_face(l)) return vec3(0.0f); // lit from the point light's first face's entry
   vec3 towards_light = lights[l].towards_light.xyz;
   vec3 irradiance = lights[l].irradiance.rgb;
   float spot_sin_alpha = 0.0f; // a spot's sphere (soft.w: its radius) fills the cone of sin α = r / d
