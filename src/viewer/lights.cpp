@@ -106,7 +106,7 @@ scene::DeclaredLight new_light(scene::LightKind kind, const scene::Camera& camer
   j["range"] = 4.0f * height;
   j["intensity"] = to_json(glm::vec3(3.0f * height * height)); // irradiance 3 at the target
   if (kind == scene::LightKind::spot) {
-    j["direction"] = to_json(-up);
+    j["direction"] = to_json(glm::vec3(0.0f) - up); // not -0 in the files
     j["inner_cone_deg"] = 25.0f;
     j["outer_cone_deg"] = 35.0f;
   }
