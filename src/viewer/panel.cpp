@@ -490,7 +490,8 @@ void Viewer::lights_section() {
       ImGui::Text("light %d", selected_light);
       if (std::optional<scene::DeclaredLight> edited = light_key_widgets(lights[size_t(selected_light)].light))
         (next = lights)->at(size_t(selected_light)).light = *edited;
-      ImGui::TextDisabled("arrows move it across the view, PgUp/PgDn along it");
+      ImGui::TextDisabled("arrows or Ctrl+drag move it across the view,");
+      ImGui::TextDisabled("PgUp/PgDn along it");
     }
   } catch (const ViewError& e) { report_error(fmt::format("light {}: {}", selected_light, e.what())); }
   if (next) set_lights(std::move(*next));
@@ -595,10 +596,11 @@ void Viewer::panel() {
 }
 
 // The selected spot or point light moves in the camera's plane (arrows) and along its view (PgUp,
-// PgDn) at the fly speed, four times with shift.
+// PgDn) at the fly speed, four times with shift; or follows the mouse across the view while the
+// left button drags it with Ctrl held.
 void Viewer::move_selected_light(float dt) {
   ImGuiIO& io = ImGui::GetIO();
-  if (io.WantCaptureKeyboard || selected_light < 0) return;
+  if (selected_light < 0) return;
   std::vector<ViewLight> next = light_list();
   if (selected_light >= int(next.size()) || next[size_t(selected_light)].kind() == scene::LightKind::directional)
     return;
@@ -606,15 +608,23 @@ void Viewer::move_selected_light(float dt) {
   const scene::Camera& c = *view.camera;
   const glm::vec3 forward = glm::normalize(c.target - c.position);
   const glm::vec3 right = glm::normalize(glm::cross(forward, c.up)), up = glm::cross(right, forward);
-  glm::vec3 move(0.0f);
-  if (ImGui::IsKeyDown(GLFW_KEY_RIGHT)) move += right;
-  if (ImGui::IsKeyDown(GLFW_KEY_LEFT)) move -= right;
-  if (ImGui::IsKeyDown(GLFW_KEY_UP)) move += up;
-  if (ImGui::IsKeyDown(GLFW_KEY_DOWN)) move -= up;
-  if (ImGui::IsKeyDown(GLFW_KEY_PAGE_UP)) move += forward;
-  if (ImGui::IsKeyDown(GLFW_KEY_PAGE_DOWN)) move -= forward;
-  if (!(glm::length(move) > 0)) return;
-  const glm::vec3 step = glm::normalize(move) * fly_speed * (io.KeyShift ? 4.0f : 1.0f) * dt;
+  glm::vec3 move(0.0f), step(0.0f);
+  if (!io.WantCaptureKeyboard) {
+    if (ImGui::IsKeyDown(GLFW_KEY_RIGHT)) move += right;
+    if (ImGui::IsKeyDown(GLFW_KEY_LEFT)) move -= right;
+    if (ImGui::IsKeyDown(GLFW_KEY_UP)) move += up;
+    if (ImGui::IsKeyDown(GLFW_KEY_DOWN)) move -= up;
+    if (ImGui::IsKeyDown(GLFW_KEY_PAGE_UP)) move += forward;
+    if (ImGui::IsKeyDown(GLFW_KEY_PAGE_DOWN)) move -= forward;
+  }
+  if (glm::length(move) > 0) step = glm::normalize(move) * fly_speed * (io.KeyShift ? 4.0f : 1.0f) * dt;
+  if (!io.WantCaptureMouse && io.KeyCtrl && ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f)) {
+    // A pixel's size at the light's distance along the view: the light stays under the cursor.
+    const float depth = std::max(glm::dot(light.light.local.position - c.position, forward), c.near);
+    const float pixel = 2.0f * depth * std::tan(glm::radians(c.fov_y_deg) / 2.0f) / io.DisplaySize.y;
+    step += pixel * (io.MouseDelta.x * right - io.MouseDelta.y * up);
+  }
+  if (!(glm::length(step) > 0)) return;
   try {
     next[size_t(selected_light)].light = moved_light(light.light, light.light.local.position + step);
   } catch (const ViewError& e) {
