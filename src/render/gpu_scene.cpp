@@ -99,13 +99,16 @@ vk::Image upload_probe(const vk::Context& ctx, const scene::ProbeLighting& p) {
 
 } // namespace
 
-GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
-  // The kinds of light whose shadows the renderer does not draw are refused, not left dark.
+void refuse_unrendered_lights(const scene::Scene& scene) {
   for (const scene::LightKindInfo& kind : scene::light_kinds())
     if (!kind.rendered && scene.light_count(kind.kind) > 0)
       throw RenderError(fmt::format("the scene has {} {} light(s): the renderer draws {}; the ray tracer (msm "
                                     "reference) traces them",
                                     scene.light_count(kind.kind), kind.name, rendered_light_kinds()));
+}
+
+GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
+  refuse_unrendered_lights(scene);
   const Geometry g = geometry(scene);
   std::map<std::filesystem::path, int> texture_index;
   for (std::size_t o = 0; o < scene.objects.size(); ++o) {

@@ -30,6 +30,10 @@ struct Draw {
   glm::vec3 center{0.0f}; // of the object's bounds (sorting for the camera)
 };
 
+// RenderError naming the kinds of light of `scene` whose shadows the renderer does not draw (the
+// light-kind declaration's `rendered`): refused, not left dark.
+void refuse_unrendered_lights(const scene::Scene& scene);
+
 struct GpuScene {
   vk::Buffer vertices, indices;
   std::vector<Draw> draws; // opaque objects, alpha-tested ones included

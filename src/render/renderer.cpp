@@ -771,6 +771,17 @@ void Renderer::move_objects(const scene::Scene& scene) {
   m.frames.clear();                   // the fitted light frusta depend on the vertices
 }
 
+void Renderer::set_lights(std::vector<scene::DirectionalLight> directional, std::vector<scene::LocalLight> local) {
+  if (directional.empty() && local.empty()) throw RenderError("no light: the renderer draws at least one");
+  scene::Scene lit; // the kinds alone, checked before anything changes
+  lit.lights = directional;
+  lit.local_lights = local;
+  refuse_unrendered_lights(lit);
+  Impl& m = *impl_;
+  m.scene.lights = std::move(directional);
+  m.scene.local_lights = std::move(local);
+}
+
 std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {
   if (frames < 1) throw RenderError("time_frames: at least one frame");
   Impl& m = *impl_;

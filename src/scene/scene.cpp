@@ -133,6 +133,21 @@ class Parser {
  public:
   Parser(std::string file, fs::path base) : file_(file.empty() ? "<json>" : std::move(file)), base_(std::move(base)) {}
 
+  // One "lights" entry (parse_light).
+  DeclaredLight parse_light(std::string_view text, const std::string& ptr) const {
+    json j;
+    try {
+      j = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/true, /*ignore_comments=*/true);
+    } catch (const json::exception& e) { fail(ptr, fmt::format("malformed JSON: {}", e.what())); }
+    DeclaredLight d;
+    d.kind = light_type(j, ptr);
+    if (d.kind == LightKind::directional)
+      d.directional = light(j, ptr);
+    else
+      d.local = local_light(j, ptr, d.kind);
+    return d;
+  }
+
   Scene parse(std::string_view text) {
     if (const std::string encoding = wide_encoding(text); !encoding.empty())
       fail("", fmt::format("the scene is {}, not UTF-8: save it as UTF-8", encoding));
@@ -999,6 +1014,10 @@ LightFrame Scene::light_frame(const DirectionalLight& light) const {
 Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir,
                       const std::string& source_name) {
   return Parser(source_name, base_dir).parse(json_text);
+}
+
+DeclaredLight parse_light(std::string_view json_text, const std::string& source, const std::string& where) {
+  return Parser(source, {}).parse_light(json_text, where);
 }
 
 Scene load_scene_file(const std::filesystem::path& file) {

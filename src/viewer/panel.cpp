@@ -95,12 +95,62 @@ void technique_parameters(render::RenderSettings& s, const Technique& t) {
 } // namespace
 
 glm::vec3 Viewer::light_direction() const {
-  return (view.settings.lights.empty() ? scene.lights : view.settings.lights).front().towards_light;
+  for (const ViewLight& l : light_list())
+    if (l.on && l.kind() == scene::LightKind::directional) return l.light.directional.towards_light;
+  return {0.0f, 1.0f, 0.0f};
 }
 
 void Viewer::set_light_direction(glm::vec3 towards) {
-  if (view.settings.lights.empty()) view.settings.lights = scene.lights;
-  view.settings.lights.front().towards_light = glm::normalize(towards);
+  if (!view.lights) { // the scene's lights: its directional ones through the settings
+    if (view.settings.lights.empty()) view.settings.lights = scene.lights;
+    if (!view.settings.lights.empty()) view.settings.lights.front().towards_light = glm::normalize(towards);
+    return;
+  }
+  std::vector<ViewLight> next = *view.lights;
+  for (ViewLight& l : next)
+    if (l.on && l.kind() == scene::LightKind::directional) {
+      l.light.directional.towards_light = glm::normalize(towards);
+      set_lights(std::move(next));
+      return;
+    }
+}
+
+std::vector<ViewLight> Viewer::light_list() const {
+  return view.lights ? *view.lights : scene_view_lights(scene, view.settings.lights);
+}
+
+bool Viewer::set_lights(std::vector<ViewLight> next) {
+  const DrawnLights drawn = drawn_lights(next), before = drawn_lights(light_list());
+  try {
+    left->set_lights(drawn.directional, drawn.local);
+    render::RenderSettings s = view.settings;
+    s.lights = drawn.directional;
+    left->check(s);
+    if (right) right->set_lights(drawn.directional, drawn.local); // a refusal there ends the split
+  } catch (const render::RenderError& e) {
+    left->set_lights(before.directional, before.local); // drawn until now
+    if (right) right->set_lights(before.directional, before.local);
+    report_error(e.what());
+    return false;
+  }
+  view.lights = std::move(next);
+  view.settings.lights = good_settings.lights = drawn.directional;
+  error.clear();
+  return true;
+}
+
+void Viewer::reset_lights() {
+  view.lights.reset();
+  view.settings.lights.clear();
+  good_settings.lights.clear();
+  selected_light = -1;
+  left->set_lights(scene.lights, scene.local_lights);
+  if (right) right->set_lights(scene.lights, scene.local_lights);
+}
+
+void Viewer::report_error(const std::string& message) {
+  error = message;
+  note(script ? fmt::format("{}: error: {}", script_where, message) : "error: " + message);
 }
 
 void Viewer::show_object_frame(int frame) {
@@ -127,17 +177,30 @@ void Viewer::set_split(const std::string& name) {
   if (!split_technique.empty()) render::find_rendered_technique(split_technique);
 }
 
-void Viewer::set_scene(const std::string& name, bool keep_view) {
+bool Viewer::set_scene(const std::string& name, bool keep_view) {
   scene::Scene loaded = scene::load_scene(name);
+  // The new scene's renderer first: one the renderer refuses (its lights, or the view's settings
+  // with them) leaves the viewer with the scene and renderers it had.
+  render::RenderSettings settings = view.settings;
+  if (!keep_view || view.lights) settings.lights.clear(); // the scene's own lights
+  std::unique_ptr<render::Renderer> renderer;
+  try {
+    renderer = std::make_unique<render::Renderer>(*ctx, loaded);
+    renderer->check(settings);
+  } catch (const render::RenderError& e) {
+    report_error(fmt::format("{}: {} (the viewer keeps {})", name, e.what(), view.scene));
+    return false;
+  }
   MSM_VK_CHECK(vkDeviceWaitIdle(ctx->device()));
   right.reset();
-  left.reset();
+  left = std::move(renderer);
   scene = std::move(loaded);
-  left = std::make_unique<render::Renderer>(*ctx, scene);
   view.scene = name;
+  view.settings.lights = good_settings.lights = settings.lights;
+  view.lights.reset();
+  selected_light = -1;
   if (!keep_view) {
     view.camera = scene.camera;
-    view.settings.lights.clear();
     view.object_frame = 0;
     animate_objects = false;
   }
@@ -146,6 +209,7 @@ void Viewer::set_scene(const std::string& name, bool keep_view) {
   scene_time.reset();
   if (std::filesystem::is_regular_file(name, ec)) scene_time = std::filesystem::last_write_time(name, ec);
   note(fmt::format("scene: {} ({} triangles)", name, scene.triangle_count()));
+  return true;
 }
 
 void Viewer::reload_if_changed() {
@@ -156,12 +220,9 @@ void Viewer::reload_if_changed() {
   auto time = std::filesystem::last_write_time(view.scene, ec);
   if (ec || time == *scene_time) return;
   try {
-    set_scene(view.scene, true);
-    error.clear();
-  } catch (const scene::SceneError& e) {
-    scene_time = time; // reported once; the next save is tried again
-    error = e.what();
-  }
+    if (set_scene(view.scene, true)) error.clear();
+  } catch (const scene::SceneError& e) { error = e.what(); }
+  scene_time = time; // a refusal is reported once; the next save is tried again
 }
 
 void Viewer::save_view_file(const std::string& path) {
@@ -218,6 +279,7 @@ void Viewer::fly(float dt) {
     set_light_direction(
         {std::cos(elevation) * std::cos(azimuth), std::sin(elevation), std::cos(elevation) * std::sin(azimuth)});
   }
+  move_selected_light(dt);
   if (animate_objects && scene.animated()) {
     object_clock += double(object_rate) * double(dt);
     if (int(object_clock) != view.object_frame) show_object_frame(int(object_clock));
@@ -363,8 +425,76 @@ void Viewer::light_and_camera_section() {
   ImGui::TextDisabled("middle drag turns the light");
   if (ImGui::Button("reset camera and light")) {
     view.camera = scene.camera;
-    view.settings.lights.clear();
+    reset_lights();
   }
+}
+
+// One widget per key of the light's kind (scene::light_kinds(): its declaration's keys, the scene's
+// ranges through with_light_key): numbers and [x, y, z] dragged, an unset key typed as JSON. The
+// edited light, or nothing; ViewError for a value the scene refuses.
+static std::optional<scene::DeclaredLight> light_key_widgets(const scene::DeclaredLight& light) {
+  const nlohmann::json j = light_json(light);
+  std::optional<scene::DeclaredLight> edited;
+  for (std::string_view name : scene::light_kind(light.kind).keys) {
+    const std::string key(name);
+    const nlohmann::json value = j.contains(key) ? j[key] : nlohmann::json();
+    if (value.is_array() && value.size() == 3) {
+      float v[3] = {value[0].get<float>(), value[1].get<float>(), value[2].get<float>()};
+      if (ImGui::DragFloat3(key.c_str(), v, 0.01f)) edited = with_light_key(light, key, {v[0], v[1], v[2]});
+    } else if (value.is_number()) {
+      float v = value.get<float>();
+      if (ImGui::DragFloat(key.c_str(), &v, 0.05f)) edited = with_light_key(light, key, v);
+    } else {
+      char text[64] = "";
+      if (ImGui::InputTextWithHint(key.c_str(), "unset (a JSON value)", text, sizeof text,
+                                   ImGuiInputTextFlags_EnterReturnsTrue))
+        edited = with_light_key(light, key, setting_value(text));
+    }
+  }
+  return edited;
+}
+
+// The view's lights by number and kind, each switched on or off, removed, selected (its keys
+// below, moved by the arrow keys); a light of each kind added where the camera looks.
+void Viewer::lights_section() {
+  const std::vector<ViewLight> lights = light_list();
+  std::optional<std::vector<ViewLight>> next;
+  if (selected_light >= int(lights.size())) selected_light = -1;
+  try {
+    for (size_t i = 0; i < lights.size(); ++i) {
+      ImGui::PushID(int(i));
+      bool on = lights[i].on;
+      if (ImGui::Checkbox("##on", &on)) (next = lights)->at(i).on = on;
+      ImGui::SameLine();
+      const std::string label = fmt::format("{} {}", i, scene::light_kind(lights[i].kind()).name);
+      if (ImGui::Selectable(label.c_str(), selected_light == int(i), 0, ImVec2(ImGui::CalcItemWidth() * 0.6f, 0)))
+        selected_light = selected_light == int(i) ? -1 : int(i);
+      ImGui::SameLine();
+      if (ImGui::SmallButton("remove")) {
+        next = lights;
+        next->erase(next->begin() + std::ptrdiff_t(i));
+        selected_light = -1;
+      }
+      ImGui::PopID();
+    }
+    for (const scene::LightKindInfo& kind : scene::light_kinds()) {
+      if (kind.kind != scene::light_kinds().front().kind) ImGui::SameLine();
+      if (ImGui::Button(fmt::format("add {}", kind.name).c_str())) {
+        next = lights;
+        next->push_back({new_light(kind.kind, *view.camera), true});
+        selected_light = int(next->size()) - 1;
+      }
+    }
+    if (!next && selected_light >= 0) {
+      ImGui::Separator();
+      ImGui::Text("light %d", selected_light);
+      if (std::optional<scene::DeclaredLight> edited = light_key_widgets(lights[size_t(selected_light)].light))
+        (next = lights)->at(size_t(selected_light)).light = *edited;
+      ImGui::TextDisabled("arrows or Ctrl+drag move it across the view,");
+      ImGui::TextDisabled("PgUp/PgDn along it");
+    }
+  } catch (const ViewError& e) { report_error(fmt::format("light {}: {}", selected_light, e.what())); }
+  if (next) set_lights(std::move(*next));
 }
 
 // The time of each pass of the last frame and the history of the total.
@@ -414,7 +544,9 @@ void Viewer::files_section() {
   if (ImGui::Button("load view")) try {
       View loaded = load_view(view_path);
       if (loaded.camera) view.camera = loaded.camera;
+      reset_lights();
       view.settings = loaded.settings;
+      if (loaded.lights) set_lights(*loaded.lights);
       show_object_frame(loaded.object_frame);
     } catch (const ViewError& e) { error = e.what(); }
   ImGui::SameLine();
@@ -453,6 +585,7 @@ void Viewer::panel() {
   choices_section();
   if (ImGui::CollapsingHeader("Technique settings", ImGuiTreeNodeFlags_DefaultOpen)) technique_settings_section();
   if (ImGui::CollapsingHeader("Light and camera")) light_and_camera_section();
+  if (ImGui::CollapsingHeader("Lights")) lights_section();
   ImGui::Checkbox("moment map in the corner", &show_map);
   if (ImGui::CollapsingHeader("GPU time", ImGuiTreeNodeFlags_DefaultOpen)) gpu_time_section();
   if (ImGui::CollapsingHeader("Ground truth", ImGuiTreeNodeFlags_DefaultOpen)) ground_truth_section();
@@ -460,6 +593,82 @@ void Viewer::panel() {
   if (!status.empty()) ImGui::TextWrapped("%s", status.c_str());
   ImGui::PopItemWidth();
   ImGui::End();
+}
+
+// The selected spot or point light moves in the camera's plane (arrows) and along its view (PgUp,
+// PgDn) at the fly speed, four times with shift; or follows the mouse across the view while the
+// left button drags it with Ctrl held.
+void Viewer::move_selected_light(float dt) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (selected_light < 0) return;
+  std::vector<ViewLight> next = light_list();
+  if (selected_light >= int(next.size()) || next[size_t(selected_light)].kind() == scene::LightKind::directional)
+    return;
+  const ViewLight light = next[size_t(selected_light)];
+  const scene::Camera& c = *view.camera;
+  const glm::vec3 forward = glm::normalize(c.target - c.position);
+  const glm::vec3 right = glm::normalize(glm::cross(forward, c.up)), up = glm::cross(right, forward);
+  glm::vec3 move(0.0f), step(0.0f);
+  if (!io.WantCaptureKeyboard) {
+    if (ImGui::IsKeyDown(GLFW_KEY_RIGHT)) move += right;
+    if (ImGui::IsKeyDown(GLFW_KEY_LEFT)) move -= right;
+    if (ImGui::IsKeyDown(GLFW_KEY_UP)) move += up;
+    if (ImGui::IsKeyDown(GLFW_KEY_DOWN)) move -= up;
+    if (ImGui::IsKeyDown(GLFW_KEY_PAGE_UP)) move += forward;
+    if (ImGui::IsKeyDown(GLFW_KEY_PAGE_DOWN)) move -= forward;
+  }
+  if (glm::length(move) > 0) step = glm::normalize(move) * fly_speed * (io.KeyShift ? 4.0f : 1.0f) * dt;
+  if (!io.WantCaptureMouse && io.KeyCtrl && ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f)) {
+    // A pixel's size at the light's distance along the view: the light stays under the cursor.
+    const float depth = std::max(glm::dot(light.light.local.position - c.position, forward), c.near);
+    const float pixel = 2.0f * depth * std::tan(glm::radians(c.fov_y_deg) / 2.0f) / io.DisplaySize.y;
+    step += pixel * (io.MouseDelta.x * right - io.MouseDelta.y * up);
+  }
+  if (!(glm::length(step) > 0)) return;
+  try {
+    next[size_t(selected_light)].light = moved_light(light.light, light.light.local.position + step);
+  } catch (const ViewError& e) {
+    report_error(fmt::format("light {}: {}", selected_light, e.what()));
+    return;
+  }
+  set_lights(std::move(next));
+}
+
+// A light-* action of the script (script.h): what the panel's Lights section does. A light the
+// scene or the renderer refuses is reported, the lights kept.
+void Viewer::light_action(const Action& a) {
+  const std::vector<std::string>& x = a.args;
+  std::vector<ViewLight> next = light_list();
+  if (a.verb == "light-add") {
+    if (next.size() >= size_t(scene::kMaxLights))
+      return report_error(fmt::format("light-add: the view has {} lights, the most a scene holds", next.size()));
+    const scene::LightKind kind = *scene::parse_light_kind(x[0]);
+    next.push_back({new_light(kind, *view.camera), true});
+    if (set_lights(next)) {
+      selected_light = int(next.size()) - 1;
+      note(fmt::format("light {}: {} added: {}", next.size() - 1, x[0], light_json(next.back().light).dump()));
+    }
+    return;
+  }
+  const size_t n = size_t(number(x[0]));
+  if (n >= next.size())
+    return report_error(fmt::format("{} {}: the view has {} lights (numbered from 0)", a.verb, n, next.size()));
+  try {
+    if (a.verb == "light-remove") {
+      next.erase(next.begin() + std::ptrdiff_t(n));
+    } else if (a.verb == "light-on" || a.verb == "light-off") {
+      next[n].on = a.verb == "light-on";
+    } else if (a.verb == "light-move") {
+      next[n].light = moved_light(next[n].light, glm::vec3(number(x[1]), number(x[2]), number(x[3])));
+    } else if (a.verb == "light-set") {
+      next[n].light = with_light_key(next[n].light, x[1], setting_value(x[2]));
+    }
+  } catch (const ViewError& e) { return report_error(fmt::format("light {}: {}", n, e.what())); }
+  if (!set_lights(next)) return;
+  if (a.verb == "light-remove")
+    note(fmt::format("light {}: removed", n));
+  else
+    note(fmt::format("light {}: {}{}", n, view_light_json(next[n]).dump(), next[n].on ? "" : " (off)"));
 }
 
 void Viewer::step_script() {
@@ -510,7 +719,9 @@ void Viewer::step_script() {
         throw ViewerError(
             fmt::format("{}: {} shows scene '{}', the viewer '{}'", a.where, x[0], loaded.scene, view.scene));
       if (loaded.camera) view.camera = loaded.camera;
+      reset_lights();
       view.settings = loaded.settings;
+      if (loaded.lights) set_lights(*loaded.lights);
       show_object_frame(loaded.object_frame);
       if (loaded.settings.width != int(swapchain->extent().width) ||
           loaded.settings.height != int(swapchain->extent().height)) {
@@ -559,6 +770,8 @@ void Viewer::step_script() {
       show_map = x[0] == "on";
     } else if (a.verb == "quit") {
       quit = true;
+    } else if (a.verb.starts_with("light-")) {
+      light_action(a);
     }
   } catch (const scene::SceneError& e) {
     throw ViewerError(fmt::format("{}: {}", a.where, e.what()));

@@ -3,10 +3,12 @@
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
 #include "msm/util/spelling.h"
+#include "msm/viewer/lights.h"
 #include "msm/viewer/view_file.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -27,7 +29,9 @@ constexpr Verb kVerbs[] = {{"technique", 1, 1},      {"set", 2, -1},         {"c
                            {"object-frame", 1, 1},   {"close", 0, 0},        {"quit", 0, 0},
                            {"each-technique", 0, 0}, {"ground-truth", 1, 1}, {"wait-ground-truth", 0, 0},
                            {"show-truth", 1, 1},     {"scene", 1, 1},        {"reload", 0, 0},
-                           {"show-map", 1, 1},       {"panel", 1, 1}};
+                           {"show-map", 1, 1},       {"panel", 1, 1},        {"light-add", 1, 1},
+                           {"light-remove", 1, 1},   {"light-on", 1, 1},     {"light-off", 1, 1},
+                           {"light-move", 4, 4},     {"light-set", 3, -1}};
 
 double parse_number(const std::string& where, const std::string& text) {
   double v = 0;
@@ -35,6 +39,35 @@ double parse_number(const std::string& where, const std::string& text) {
   if (err != std::errc() || end != text.data() + text.size() || !std::isfinite(v))
     throw ScriptError(fmt::format("{}: '{}' is not a number", where, text));
   return v;
+}
+
+// A light's number in the view's list (the panel's numbers), 0..kMaxLights - 1.
+void check_light_number(const Action& a) {
+  double v = parse_number(a.where, a.args[0]);
+  if (v != std::floor(v) || v < 0 || v >= scene::kMaxLights)
+    throw ScriptError(fmt::format("{}: {} {}: a light's number, an integer in [0, {}]", a.where, a.verb, a.args[0],
+                                  scene::kMaxLights - 1));
+}
+
+// light-add KIND, light-remove|on|off N, light-move N X Y Z, light-set N KEY VALUE.
+void check_light_action(const Action& a) {
+  const std::string& w = a.where;
+  if (a.verb == "light-add") {
+    if (scene::parse_light_kind(a.args[0])) return;
+    std::vector<std::string> names;
+    for (const scene::LightKindInfo& k : scene::light_kinds()) names.emplace_back(k.name);
+    throw ScriptError(
+        fmt::format("{}: light-add {}: unknown kind of light{}", w, a.args[0], util::did_you_mean(a.args[0], names)));
+  }
+  check_light_number(a);
+  if (a.verb == "light-move") {
+    for (size_t i = 1; i < a.args.size(); ++i) parse_number(w, a.args[i]);
+  } else if (a.verb == "light-set") {
+    const std::vector<std::string> keys = light_keys();
+    if (std::find(keys.begin(), keys.end(), a.args[1]) == keys.end())
+      throw ScriptError(fmt::format("{}: light-set {}: no kind of light has this key{}", w, a.args[1],
+                                    util::did_you_mean(a.args[1], keys)));
+  }
 }
 
 // The checks that need no window: names, keys, values and ranges.
@@ -70,6 +103,8 @@ void check(const Action& a) {
   } else if (a.verb == "show-truth" || a.verb == "show-map") {
     if (a.args[0] != "on" && a.args[0] != "off")
       throw ScriptError(fmt::format("{}: {} {}: on or off", w, a.verb, a.args[0]));
+  } else if (a.verb.starts_with("light-")) {
+    check_light_action(a);
   } else if (a.verb == "frames") {
     double v = parse_number(w, a.args[0]);
     if (v != std::floor(v) || v < 0 || v > 100000)
@@ -112,8 +147,8 @@ std::vector<Action> parse_script(std::string_view text, const std::string& name)
       throw ScriptError(fmt::format("{}: unknown action '{}'{}", a.where, a.verb, util::did_you_mean(a.verb, names)));
     }
     std::string word;
-    if (verb->max_args < 0) {
-      if (words >> word) a.args.push_back(word);
+    if (verb->max_args < 0) { // the first min_args - 1 words, then the rest of the line as one
+      for (int k = 0; k + 1 < verb->min_args && words >> word; ++k) a.args.push_back(word);
       std::string rest;
       std::getline(words, rest);
       size_t first = rest.find_first_not_of(" \t\r");

@@ -81,14 +81,16 @@ View default_view(const std::string& scene_name, const scene::Scene& scene) {
 json view_json(const View& v) {
   const json settings = render::settings_json(v.settings);
   json lights = json::array();
-  for (const scene::DirectionalLight& l : v.settings.lights) {
-    json light = {{"towards_light", to_json(l.towards_light)},
-                  {"irradiance", to_json(l.irradiance)},
-                  {"angular_extent_deg", l.angular_extent_deg}};
-    // A rectangular light (a probe's): its height and width direction (scene.h).
-    if (l.angular_height_deg) light["angular_height_deg"] = *l.angular_height_deg;
-    if (l.x_axis) light["x_axis"] = to_json(*l.x_axis);
-    lights.push_back(light);
+  if (v.lights) {
+    for (const ViewLight& l : *v.lights) lights.push_back(view_light_json(l));
+  } else {
+    for (const scene::DirectionalLight& l : v.settings.lights) {
+      scene::DeclaredLight declared;
+      declared.directional = l;
+      json light = light_json(declared);
+      light.erase("type"); // the default
+      lights.push_back(light);
+    }
   }
   json out = {{"msm_view", 1}, {"scene", v.scene}};
   if (v.camera)
@@ -145,33 +147,14 @@ View parse_view(std::string_view text, const std::filesystem::path& file) {
       const json& lights = j["lights"];
       if (!lights.is_array() || lights.empty() || lights.size() > size_t(scene::kMaxLights))
         fail("/lights", fmt::format("expected an array of 1 to {} lights", scene::kMaxLights));
-      std::vector<scene::DirectionalLight> lights_read;
-      for (size_t i = 0; i < lights.size(); ++i) {
-        std::string where = fmt::format("/lights/{}", i);
-        check_keys(lights[i], where,
-                   {"towards_light", "irradiance", "angular_extent_deg", "angular_height_deg", "x_axis"});
-        scene::DirectionalLight l;
-        if (!lights[i].contains("towards_light")) fail(where + "/towards_light", "required");
-        glm::vec3 t = vec3(where + "/towards_light", lights[i]["towards_light"]);
-        if (!(glm::length(t) > 0)) fail(where + "/towards_light", "is zero");
-        l.towards_light = glm::normalize(t);
-        if (lights[i].contains("irradiance")) l.irradiance = vec3(where + "/irradiance", lights[i]["irradiance"]);
-        if (lights[i].contains("angular_extent_deg"))
-          l.angular_extent_deg = number(where + "/angular_extent_deg", lights[i]["angular_extent_deg"]);
-        if (lights[i].contains("angular_height_deg")) {
-          l.angular_height_deg = number(where + "/angular_height_deg", lights[i]["angular_height_deg"]);
-          if (!(*l.angular_height_deg >= 0.0f && *l.angular_height_deg < 90.0f))
-            fail(where + "/angular_height_deg", "must be in [0, 90)");
-        }
-        if (lights[i].contains("x_axis")) {
-          const glm::vec3 x = vec3(where + "/x_axis", lights[i]["x_axis"]);
-          if (!(glm::length(glm::cross(x, l.towards_light)) > 1e-3f * glm::length(x)))
-            fail(where + "/x_axis", "must be non-zero and not parallel to towards_light");
-          l.x_axis = glm::normalize(x);
-        }
-        lights_read.push_back(l);
-      }
-      v.settings.lights = lights_read;
+      std::vector<ViewLight> lights_read;
+      for (size_t i = 0; i < lights.size(); ++i)
+        lights_read.push_back(parse_view_light(lights[i], fmt::format("/lights/{}", i)));
+      // Entries with their "type" (the viewer's) are every light of the view; without, directional
+      // lights in place of the scene's directional ones (the older files and msm render's --light).
+      if (std::any_of(lights.begin(), lights.end(), [](const json& l) { return l.contains("type"); }))
+        v.lights = lights_read;
+      v.settings.lights = drawn_lights(lights_read).directional;
     }
     if (j.contains("object_frame")) {
       v.object_frame = integer("/object_frame", j["object_frame"]);
@@ -233,8 +216,15 @@ void save_view(const std::filesystem::path& file, const View& view) {
   }
 }
 
+void apply_view_lights(const std::vector<ViewLight>& lights, scene::Scene& scene) {
+  DrawnLights drawn = drawn_lights(lights);
+  scene.lights = std::move(drawn.directional);
+  scene.local_lights = std::move(drawn.local);
+}
+
 scene::Scene load_view_scene(const View& view) {
   scene::Scene s = scene::load_scene(view.scene);
+  if (view.lights) apply_view_lights(*view.lights, s);
   if (view.object_frame > 0) s = scene::at_frame(s, view.object_frame);
   if (view.camera) s.camera = *view.camera;
   return s;

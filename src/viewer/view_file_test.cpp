@@ -225,5 +225,21 @@ TEST(Script, BadLinesAreNamed) {
             std::string::npos);
 }
 
+TEST(Script, LightActions) {
+  std::vector<Action> a = parse_script("light-add spot\nlight-move 1 0 2.5 0\nlight-set 1 intensity [5, 5, 5]\n"
+                                       "light-off 0\nlight-on 0\nlight-remove 1\n",
+                                       "s.txt");
+  ASSERT_EQ(a.size(), 6u);
+  EXPECT_EQ(a[2].args, (std::vector<std::string>{"1", "intensity", "[5, 5, 5]"})); // the value: the rest
+  EXPECT_EQ(setting_value(a[2].args[2]), nlohmann::json::array({5, 5, 5}));
+  auto bad = [](const std::string& text) { return error_of<ScriptError>([&] { parse_script(text, "s.txt"); }); };
+  EXPECT_EQ(bad("light-add spto\n"), "s.txt:1: light-add spto: unknown kind of light (did you mean spot?)");
+  EXPECT_EQ(bad("light-set 0 outer_cone\n"), "s.txt:1: light-set takes 3 arguments, got 2");
+  EXPECT_EQ(bad("light-set 0 outer_cone 40\n"),
+            "s.txt:1: light-set outer_cone: no kind of light has this key (did you mean outer_cone_deg?)");
+  EXPECT_EQ(bad("light-off -1\n"), "s.txt:1: light-off -1: a light's number, an integer in [0, 255]");
+  EXPECT_EQ(bad("light-move 0 1 2 z\n"), "s.txt:1: 'z' is not a number");
+}
+
 } // namespace
 } // namespace msm::viewer

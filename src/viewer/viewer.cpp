@@ -201,20 +201,20 @@ void Viewer::scale_panel(int width, int height) {
   ImGui::GetIO().FontGlobalScale = layout.scale;
 }
 
-// A frame of one renderer; an invalid setting (the panel allows combinations the renderer refuses)
-// goes back to the last settings that rendered, and the message is shown.
+// A frame of one renderer; an invalid setting (the panel and the script allow combinations the
+// renderer refuses) goes back to the last settings that rendered, and the message is shown and
+// printed.
 render::Renderer::DeviceFrame Viewer::render_side(render::Renderer& r, render::RenderSettings s, bool is_left) {
   r.set_camera(*view.camera);
   try {
     return r.render_on_device(s);
   } catch (const render::RenderError& e) {
-    error = e.what();
-    if (script) throw ViewerError(fmt::format("{}: {}", script_where, e.what()));
     if (!is_left) { // settings the left technique takes but the right one refuses: no split
-      error = fmt::format("{} (split screen off)", e.what());
+      report_error(fmt::format("{} (split screen off)", e.what()));
       split_technique.clear();
       return {};
     }
+    report_error(fmt::format("{} (the settings that rendered kept)", e.what()));
     view.settings = good_settings;
     return r.render_on_device(view.settings);
   }
@@ -265,6 +265,10 @@ void Viewer::frame() {
   } else if (!split_technique.empty()) {
     if (!right) {
       right = std::make_unique<render::Renderer>(*ctx, scene);
+      if (view.lights) { // drawn by the left one
+        const DrawnLights drawn = drawn_lights(*view.lights);
+        right->set_lights(drawn.directional, drawn.local);
+      }
       if (view.object_frame > 0 && scene.animated()) right->move_objects(scene::at_frame(scene, view.object_frame));
     }
     b = render_side(*right, split_settings(), false);
@@ -455,6 +459,7 @@ void Viewer::start_truth(int samples) {
   if (truth.running()) return;
   scene::Scene s = scene::at_frame(scene, view.object_frame);
   s.camera = *view.camera;
+  if (view.lights) apply_view_lights(*view.lights, s);
   truth_camera = *view.camera;
   size_t n = std::min<size_t>(frame_ms.size(), 10);
   frame_ms_before_truth = 0;

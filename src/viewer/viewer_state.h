@@ -68,8 +68,11 @@ struct Viewer {
   void gpu_time_section();
   void ground_truth_section();
   void files_section();
+  void lights_section();
   void fly(float dt);
+  void move_selected_light(float dt); // the arrow keys, PgUp and PgDn
   void step_script();
+  void light_action(const Action& a); // the script's light-* actions
   // The actions of the panel and the script.
   void set_technique(const std::string& name);
   void set_split(const std::string& name); // empty: off
@@ -77,12 +80,22 @@ struct Viewer {
   // The animated objects at this frame (scene::at_frame) in both renderers; view.object_frame.
   void show_object_frame(int frame);
   void save_view_file(const std::string& path);
-  // Another scene (its camera and lights), or the same file again (the view kept); SceneError
-  // leaves everything as it was.
-  void set_scene(const std::string& name, bool keep_view);
+  // Another scene (its camera and lights), or the same file again (the view kept, the scene's
+  // lights taken again); SceneError leaves everything as it was, and so does a scene or view that
+  // the renderer refuses (reported; false then).
+  bool set_scene(const std::string& name, bool keep_view);
   void reload_if_changed(); // a scene file whose modification time changed
   void copy_command();
-  glm::vec3 light_direction() const;
+  glm::vec3 light_direction() const; // of the first directional light (straight up where none)
+  // The view's lights (View::lights), or the scene's as the renderer draws them.
+  std::vector<ViewLight> light_list() const;
+  // Draws `next` from the next frame on. False where the renderer refuses them (a kind it does not
+  // draw, settings it does not take with them): the message shown and printed, the lights kept.
+  bool set_lights(std::vector<ViewLight> next);
+  // The scene's own lights again, the view's dropped.
+  void reset_lights();
+  // A refusal that leaves the viewer as it was: in the panel and printed (script: with its line).
+  void report_error(const std::string& message);
 
   View view;
   render::RenderSettings good_settings; // the last settings that rendered
@@ -117,7 +130,8 @@ struct Viewer {
   std::chrono::steady_clock::time_point last_frame;
 
   // Camera fly and light animation.
-  float fly_speed = 2.0f; // scene units per second
+  float fly_speed = 2.0f;  // scene units per second; also the selected light's (arrow keys)
+  int selected_light = -1; // in light_list(), -1: none
   bool animate_light = false;
   float light_speed_deg = 20.0f;
   // Object animation: the scene's "motion" frames advance at object_rate per second.

@@ -32,6 +32,7 @@ struct RenderOptions {
 struct ViewGiven {
   std::optional<scene::Camera> camera;
   int object_frame = 0;
+  std::optional<std::vector<viewer::ViewLight>> lights; // every light of the view (the viewer's)
 };
 ViewGiven apply_view(RenderOptions& o, const CLI::App& cmd) {
   ViewGiven given;
@@ -48,6 +49,7 @@ ViewGiven apply_view(RenderOptions& o, const CLI::App& cmd) {
     o.frame.scene = view.scene;
     given.camera = view.camera;
     given.object_frame = view.object_frame;
+    given.lights = view.lights;
     if (cmd.count("--techniques") + cmd.count("--technique") == 0) o.techniques = view.settings.technique;
   } catch (const viewer::ViewError& e) { throw UsageError(e.what()); }
   return given;
@@ -94,6 +96,7 @@ void add_render(CLI::App& app) {
     validate_techniques(opt->frame, names);
     scene::Scene scene = load_scene_or_fail(opt->frame.scene);
     if (view.camera) scene.camera = *view.camera;
+    if (view.lights) viewer::apply_view_lights(*view.lights, scene);
     if (view.object_frame > 0) scene = scene::at_frame(scene, view.object_frame); // the view's animated objects
     if (frames && opt->frame.animation_frame > 0)
       throw UsageError(fmt::format("--frame {} renders one frame of the scene, --frames a sequence from frame 0: give "

@@ -252,13 +252,17 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                                 : t.nonlinear()                                       ? "dither"
                                                                                       : "bilinear"},
                      {"filter_mode", one_pass ? "one-pass" : "three-pass"},
-                     {"light_extent_deg", s.light_extent_deg.value_or(scene.light().angular_extent_deg)}};
+                     {"light_extent_deg", s.light_extent_deg     ? nlohmann::json(*s.light_extent_deg)
+                                          : scene.lights.empty() ? nlohmann::json() // spot or point lights only
+                                                                 : nlohmann::json(scene.light().angular_extent_deg)}};
   // The view file of this render: msm render --view takes this JSON and renders the same again.
   viewer::View view;
   view.scene = scene.source.string().starts_with("builtin:") ? scene.name : scene.source.string();
   view.camera = scene.camera;
   view.settings = s;
   view.object_frame = frame;
+  // Spot and point lights (a scene's, or a view's in place of the scene's): every light, with its type.
+  if (!scene.local_lights.empty() || scene.lights.empty()) view.lights = viewer::scene_view_lights(scene, s.lights);
   out["view"] = viewer::view_json(view);
   out["frame"] = frame;                             // the animated objects' frame (the view's object_frame)
   std::vector<std::string> all_warnings = warnings; // the scene's, then the render's own

@@ -25,8 +25,9 @@ void add_view(CLI::App& app) {
   cmd->add_option("--view", opt->view_file, "Start from this view file (scene, camera, lights, settings)")
       ->excludes(scene);
   cmd->add_option("--script", opt->script_file,
-                  "Run these actions, one per frame (technique, set, camera, light, split, screenshot, resize, "
-                  "quit, ...: docs/viewer.md)");
+                  "Run these actions, one per frame (technique, set, camera, light, light-add, light-move, "
+                  "light-set, light-on, light-off, light-remove, split, screenshot, resize, quit, ...: "
+                  "docs/viewer.md)");
   add_term(cmd, "--width", opt->width, ": the window's")->capture_default_str()->check(CLI::Range(64, 8192));
   add_term(cmd, "--height", opt->height, ": the window's")->capture_default_str()->check(CLI::Range(64, 8192));
   add_term(cmd, "--device", opt->device);

@@ -278,6 +278,13 @@ class Renderer {
   // vertex or index count from the renderer's scene.
   void move_objects(const scene::Scene& scene);
 
+  // Draws later frames with these lights instead of the renderer's scene's (a viewer adds, moves and
+  // switches lights): the directional ones as scene::Scene::lights (RenderSettings::lights, where
+  // given, still replaces them), the spot and point ones as its local_lights. RenderError, the
+  // renderer unchanged, for no light at all (a scene holds one) or a kind it does not draw, as the
+  // constructor refuses it. Translucent objects stay sorted along the first light it was made with.
+  void set_lights(std::vector<scene::DirectionalLight> directional, std::vector<scene::LocalLight> local);
+
   // `frames` frames with the same settings, nothing read back: the per-pass times of each (for
   // msm bench). Precondition: frames >= 1.
   std::vector<std::vector<PassTime>> time_frames(const RenderSettings& settings, int frames);

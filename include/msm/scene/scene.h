@@ -410,6 +410,16 @@ struct LocalLight {
   glm::vec3 irradiance_at(const glm::vec3& p) const;
 };
 
+// One entry of a scene's "lights" (its JSON text, "type" and the kind's keys), checked by the
+// scene loader's own rules, ranges and messages: the light it declares. SceneError "<source>:
+// <where>/<key>: problem". What a tool that edits lights (msm view) checks an edit with.
+struct DeclaredLight {
+  LightKind kind = LightKind::directional;
+  DirectionalLight directional; // kind directional
+  LocalLight local;             // spot, point
+};
+DeclaredLight parse_light(std::string_view json_text, const std::string& source, const std::string& where);
+
 // The light that the renderer, the ray tracer and the viewer draw for `light` under a command
 // line's (or a viewer's) overrides, the one rule for all three: an extent alone replaces the light
 // by a disc of that angular diameter; a height makes it a rectangle of that height, its width the

@@ -8,7 +8,16 @@
 //   scene NAME|FILE           another scene (its camera and lights)
 //   reload                    the scene file again (the view kept)
 //   camera PX PY PZ TX TY TZ  camera position and target
-//   light X Y Z               direction towards the (first) light
+//   light X Y Z               direction towards the first directional light
+//   light-add KIND            a light of a kind of scene::light_kinds() (directional, spot, point) where
+//                             the camera looks (lights.h: new_light); it becomes light number N, the last
+//   light-remove N            remove light N (the panel's numbers: the view's lights from 0)
+//   light-on N | light-off N  switch light N on or off (kept in the list and the view file)
+//   light-move N X Y Z        move spot or point light N to (X, Y, Z) (a spot keeps its direction)
+//   light-set N KEY VALUE     set a key of light N's kind (scene.h: "lights"), VALUE as JSON (null:
+//                             unset); a value the scene refuses is refused with its message
+//   (A light the renderer does not draw, or that it refuses with the settings, is refused with the
+//   renderer's message, printed; the viewer goes on with the lights it had.)
 //   split NAME | off          split screen: this technique right of the divider
 //   divider F                 the divider at this fraction of the width, (0, 1)
 //   load-view FILE            the camera, lights and settings of a view file (its scene must be the viewer's)

@@ -7,7 +7,12 @@
 //   "scene": "fence",                               built-in name or scene file (relative: to the view file)
 //   "camera": {"position": [x,y,z], "target": [x,y,z], "up": [0,1,0], "fov_y_deg": 45, "near": 0.1, "far": 1000},
 //   "lights": [{"towards_light": [x,y,z], "irradiance": [r,g,b], "angular_extent_deg": 0}],  absent: the scene's
-//             (a rectangular light also "angular_height_deg": h, "x_axis": [x,y,z], as in a scene file)
+//             every light of the view, in place of all the scene's: entries of a scene file's "lights"
+//             (scene.h: "type" directional (the default), spot or point, and that kind's keys; a
+//             rectangular light also "angular_height_deg": h, "x_axis": [x,y,z]), each with
+//             "on": false where switched off (msm/viewer/lights.h). Where no entry has a "type",
+//             directional lights in place of the scene's directional ones only (its spot and point
+//             lights kept)
 //   "settings": {"technique": "msm-hamburger-64", "width": 1280, ...}   the keys of setting_keys()
 //   "object_frame": 0                               the frame of the scene's animated objects
 //                                                   (scene::at_frame), 0..100000; written when > 0
@@ -17,6 +22,7 @@
 
 #include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
+#include "msm/viewer/lights.h"
 
 #include <nlohmann/json.hpp>
 
@@ -37,8 +43,11 @@ class ViewError : public std::runtime_error {
 struct View {
   std::string scene = "fence";         // as given (built-in name or path)
   std::optional<scene::Camera> camera; // empty: the scene's
-  render::RenderSettings settings;     // its lights: "lights" (empty: the scene's)
-  int object_frame = 0;                // the animated objects at this frame (scene::at_frame)
+  render::RenderSettings settings;     // its lights: the directional ones of `lights` that are on
+  // Every light of the view, on and off, in place of the scene's: "lights" (none: the scene's, and
+  // settings.lights replaces its directional ones where given).
+  std::optional<std::vector<ViewLight>> lights;
+  int object_frame = 0; // the animated objects at this frame (scene::at_frame)
 };
 inline constexpr int kMaxObjectFrame = 100000;
 
@@ -59,6 +68,9 @@ View parse_view(std::string_view text, const std::filesystem::path& file);
 View load_view(const std::filesystem::path& file);
 // Written atomically (a temporary, then renamed); ViewError when it cannot be written.
 void save_view(const std::filesystem::path& file, const View& view);
+
+// A view's lights that are on (View::lights) in place of all of `scene`'s.
+void apply_view_lights(const std::vector<ViewLight>& lights, scene::Scene& scene);
 
 // Loads the view's scene (SceneError passes through) with the view's camera and its objects at the
 // view's object_frame: with view.settings, what `msm render --view` and the viewer render.
