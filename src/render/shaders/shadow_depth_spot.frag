@@ -12,12 +12,18 @@
 layout(binding = MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY) uniform sampler2D opacity_texture;
 // Per sample: gl_FragDepth is one depth for every sample the fragment covers, and the lookups take
 // the MSAA samples' depths at their own positions (the receiver plane's, shading_depth.glsl).
-layout(location = 0) sample in vec3 world_position;
+// Homogeneous, its w written as 1: the position is xyz / w, exact wherever the interpolator divides
+// by 1 / w_clip. lavapipe (Mesa 22.3) interpolates a sample-rate varying's a / w_clip at the sample
+// but divides by the pixel centre's 1 / w_clip: every component, w included, comes out scaled by the
+// same factor, which the division cancels (without it the depths moved by up to a third of their
+// slope across the texel along the map's depth gradient, and PCF's receiver plane shadowed lit ground).
+layout(location = 0) sample in vec4 world_position_h;
 layout(location = 1) in vec2 texcoord;
 layout(push_constant) uniform Push { ObjectPush object; };
 
 void main() {
   if (!alpha_test_passes(object, true, opacity_texture, texcoord)) discard;
   LightUniforms light = lights[object.light.x];
+  vec3 world_position = world_position_h.xyz / world_position_h.w;
   gl_FragDepth = clamp(distance(world_position, light.spot_position.xyz) / light.spot_position.w, 0.0f, 1.0f);
 }
