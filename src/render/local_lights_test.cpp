@@ -256,10 +256,18 @@ TEST_F(LocalLightsRenderTest, SpotMapSampleDepthsAreRadialDistancesAtTheStandard
              sum / counted, worst, counted);
 }
 
-// PCF with MSAA 4 under the oblique spot against the ray tracer's hard shadow: lit ground reads
-// lit (the receiver plane compares each sample's depth at its own position) and the box's shadow
-// is where the tracer puts it.
-TEST_F(LocalLightsRenderTest, PcfUnderAnObliqueSpotAgreesWithTheRayTracer) {
+// The depth-map techniques with MSAA 4 under the oblique spot against the ray tracer's hard
+// shadow: lit ground reads lit (each sample's depth is compared with the receiver plane at the
+// sample's own position) and the box's shadow is where the tracer puts it. Measured on lavapipe,
+// the bounds that much and a margin above; with the samples' depths off their positions, lit ground
+// read as partly shadowed: MAE 0.35 (plain) and 0.18 (PCF), over-darkening of lit ground 0.22 (PCF).
+struct ObliqueSpotMeasured {
+  const char* technique;
+  double mae, lit_over_darkening, share_above_3pct;
+};
+const ObliqueSpotMeasured kObliqueSpotMeasured[] = {{"plain", 0.0012, 0.0013, 0.0034}, {"pcf", 0.0049, 0.0039, 0.022}};
+
+TEST_F(LocalLightsRenderTest, DepthMapsUnderAnObliqueSpotAgreeWithTheRayTracer) {
   const scene::Scene scene = oblique_spot_scene(true);
   constexpr int width = 160, height = 120;
   reference::Settings r;
@@ -274,27 +282,28 @@ TEST_F(LocalLightsRenderTest, PcfUnderAnObliqueSpotAgreesWithTheRayTracer) {
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
       if (truth_visibility.at(x, y, 0) < 1.0f) shadowed_or_background.at(x, y, 0) = 1.0f;
-  RenderSettings s = test::render_settings("pcf", width, height, 256);
-  s.msaa = 4;
   Renderer renderer(ctx(), scene);
-  const RenderResult result = renderer.render(s);
-  const image::Image visibility = result.shadow.channel("visibility");
-  // Measured on lavapipe: MAE 0.0049 (the filtered edge against the tracer's hard one), the lit
-  // ground's over-darkening 0.0039 (the outer half of that edge); with the samples' depths off their
-  // positions, lit ground read as partly shadowed: MAE 0.18, over-darkening of lit ground 0.22.
-  image::Tolerances tolerances;
-  tolerances.max_mae = 0.0065;
-  tolerances.max_share_above_3pct = 0.03; // measured 0.022
-  const image::CompareResult all =
-      image::compare(visibility, truth_visibility, tolerances,
-                     {.metrics = {.mask = &background}, .failure_dir = "test-failures/local-lights/oblique-spot-pcf"});
-  EXPECT_TRUE(all.passed) << all.report;
-  const image::Metrics lit = image::compute_metrics(visibility, truth_visibility, {.mask = &shadowed_or_background});
-  EXPECT_GT(lit.pixels, size_t(width * height / 4)) << "too little lit ground in view";
-  EXPECT_LT(lit.over_darkening, 0.0055) << "lit ground read as shadowed";
-  fmt::print("oblique spot, pcf vs ray traced: MAE {:.4f}, over-darkening {:.4f}, > 3%: {:.4f}; lit ground's "
-             "over-darkening {:.4f} ({} pixels)\n",
-             all.metrics.mae, all.metrics.over_darkening, all.metrics.share_above_3pct, lit.over_darkening, lit.pixels);
+  for (const ObliqueSpotMeasured& measured : kObliqueSpotMeasured) {
+    RenderSettings s = test::render_settings(measured.technique, width, height, 256);
+    s.msaa = 4;
+    const image::Image visibility = renderer.render(s).shadow.channel("visibility");
+    image::Tolerances tolerances;
+    tolerances.max_mae = measured.mae + 0.0015;
+    tolerances.max_share_above_3pct = measured.share_above_3pct + 0.01;
+    const image::CompareResult all =
+        image::compare(visibility, truth_visibility, tolerances,
+                       {.metrics = {.mask = &background},
+                        .failure_dir = "test-failures/local-lights/oblique-spot-" + std::string(measured.technique)});
+    EXPECT_TRUE(all.passed) << measured.technique << ": " << all.report;
+    const image::Metrics lit = image::compute_metrics(visibility, truth_visibility, {.mask = &shadowed_or_background});
+    EXPECT_GT(lit.pixels, size_t(width * height / 4)) << "too little lit ground in view";
+    EXPECT_LT(lit.over_darkening, measured.lit_over_darkening + 0.0015)
+        << measured.technique << " reads lit ground as shadowed";
+    fmt::print("oblique spot, {:<5} vs ray traced: MAE {:.4f}, over-darkening {:.4f}, > 3%: {:.4f}; lit ground's "
+               "over-darkening {:.4f} ({} pixels)\n",
+               measured.technique, all.metrics.mae, all.metrics.over_darkening, all.metrics.share_above_3pct,
+               lit.over_darkening, lit.pixels);
+  }
 }
 
 } // namespace
