@@ -624,8 +624,19 @@ struct Renderer::Impl {
       size_t count = texels * size_t(s.msaa);
       vk::Buffer buffer =
           vk::create_buffer(ctx, count * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
-      VkImageLayout layout = graph->layout_after_record(kShadowDepth);
+      // The frame cut after the depth pass (the depth-based techniques) leaves the map a depth
+      // attachment, which a sampled image may not be: it is made read-only first (the next frame
+      // creates it anew).
+      const VkImageLayout recorded = graph->layout_after_record(kShadowDepth);
+      const VkImageLayout layout =
+          recorded == VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL ? VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL : recorded;
       vk::submit_and_wait(ctx, [&](VkCommandBuffer cmd) {
+        if (layout != recorded)
+          vk::pipeline_barrier(cmd, vk::image_barrier(depth.image.handle(), depth.image.aspect(),
+                                                      VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+                                                      VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, recorded,
+                                                      VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
+                                                      VK_ACCESS_2_SHADER_SAMPLED_READ_BIT, layout));
         uint32_t groups = vk::group_count(uint32_t(size), 8);
         vk::dispatch(cmd, *depth_copy, groups, groups, 1,
                      {{MSM_BINDING_DEPTH_SAMPLES_MAP, vk::Descriptor(depth.layer_views[0], layout, point_sampler)},
