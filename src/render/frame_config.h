@@ -70,6 +70,10 @@ struct FrameConfig {
   // Spot lights in the frame (after its directional lights): the shadow pass writes their radial
   // depth and the shading's kSpotLights (shading.glsl) projects, biases and lights by each light's kind.
   int spot_lights = 0;
+  // Cascades per directional light (RenderSettings::cascades resolved; scene::fit_cascades): each
+  // cascade is a layer of its own, a light's in a row; above 1 the shading's kCascades weighs each
+  // layer by the view depth (msm/cascade.h).
+  int cascades = 1;
   bool operator==(const FrameConfig&) const = default;
 
   bool split_rg() const;                   // translucent and four channels in one image

@@ -88,6 +88,8 @@ void RenderSettings::validate() const {
   };
   finite("filter sigma", filter_sigma, MSM_FILTER_MIN_SIGMA, MSM_FILTER_MAX_SIGMA);
   finite("over-darkening factor", overdarken, 0.5f, 1.0f);
+  if (cascades) range("cascades", *cascades, 1, scene::kMaxCascades);
+  finite("cascade lambda", cascade_lambda, 0.0f, 1.0f);
   finite("normal offset", normal_offset, 0.0f, 100.0f);
   finite("exposure", exposure, 1e-6f, 1e6f);
   if (depth_bias) finite("depth bias", *depth_bias, -1.0f, 1.0f);

@@ -3,6 +3,7 @@
 // visible surface) for error measurement. The including shader defines shadow_intensity() for its
 // family of techniques; it reads layer `shadow_layer` of the shadow-map arrays (the light being
 // evaluated).
+#include "msm/cascade.h"
 #include "msm/footprint.h"
 #include "msm/local_light.h"
 #include "msm/shading.h"
@@ -24,18 +25,23 @@ layout(constant_id = MSM_SPEC_SUB_LIGHTS) const bool kSubLights = false;
 // frames of directional lights compile none of the spot lights' projection and irradiance.
 layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
 bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
+// Whether the directional lights have cascades (FrameConfig::cascades > 1): a constant, so that
+// frames without them compile none of the cascades' weights.
+layout(constant_id = MSM_SPEC_CASCADES) const bool kCascades = false;
 
 layout(binding = MSM_BINDING_SHADING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
-layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D opacity_texture; // R8: used where object.flags.z != 0
+layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D
+    opacity_texture; // R8: used where object.flags.z != 0
 layout(push_constant) uniform Push { ObjectPush object; };
 
 #ifdef MSM_DEFERRED_SHADOWS
 // Deferred shading (a full-screen pass): the visible surface of each pixel from the surfaces pass
 // (MSM_SURFACES below), bit for bit what the forward pass interpolates, so one shadow evaluation per
 // pixel gives the forward pass's result.
-layout(binding = MSM_BINDING_SHADING_SURFACE_POSITION) uniform sampler2D surface_position; // xyz; w: 1 where a surface, 0 background
-layout(binding = MSM_BINDING_SHADING_SURFACE_NORMAL) uniform sampler2D surface_normal;   // xyz: towards the viewer
-layout(binding = MSM_BINDING_SHADING_SURFACE_ALBEDO) uniform sampler2D surface_albedo;   // rgb, a: opacity
+layout(binding = MSM_BINDING_SHADING_SURFACE_POSITION) uniform sampler2D
+    surface_position; // xyz; w: 1 where a surface, 0 background
+layout(binding = MSM_BINDING_SHADING_SURFACE_NORMAL) uniform sampler2D surface_normal; // xyz: towards the viewer
+layout(binding = MSM_BINDING_SHADING_SURFACE_ALBEDO) uniform sampler2D surface_albedo; // rgb, a: opacity
 vec3 world_position;
 #else
 layout(location = 0) in vec3 world_position;
@@ -186,6 +192,13 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
                                             dot(-towards_light, lights[l].spot_axis.xyz), lights[l].spot_cone.x,
                                             lights[l].spot_cone.y);
   }
+  // A cascade of a directional light brings its share at the surface's view depth (msm/cascade.h):
+  // none outside its slice (no lookup there), part of it in the bands where it blends with the next.
+  float cascade_weight = 1.0f;
+  if (kCascades && !is_spot(l))
+    cascade_weight =
+        msm_cascade_weight(lights[l].cascade, (frame.camera_view_projection * vec4(world_position, 1.0f)).w);
+  irradiance *= cascade_weight;
   float n_dot_l = dot(n, towards_light);
   // Area lights: the cosine integrated over the part of the light above the surface's horizon
   // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
@@ -212,6 +225,7 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
   // Where a spot light brings nothing (outside its cone, beyond its range) its visibility is 0, as
   // where a surface faces away from a light.
   if (is_spot(l) && max(irradiance.r, max(irradiance.g, irradiance.b)) <= 0.0f) lit = 0.0f;
+  if (cascade_weight <= 0.0f) lit = 0.0f;
   vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
   float w;
   if (sub_count > 0) {
