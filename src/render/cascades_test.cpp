@@ -222,5 +222,35 @@ TEST_F(CascadesRenderTest, BlendBandsAreNoWorseThanInsideTheCascades) {
   }
 }
 
+// Cascades where the frame cannot have them: by default one map; asked for, a RenderError that names
+// why; a count out of range, the settings' own error.
+TEST(Cascades, RefusedByNameWhereTheFrameCannotHaveThem) {
+  const scene::Scene box = box_on_ground();
+  scene::Scene whole = box;
+  whole.shadow.mode = scene::ShadowFraming::Mode::fit_scene;
+  const std::vector<std::pair<RenderSettings, scene::Scene>> cases = {
+      {test::render_settings("pcss", kWidth, kHeight, kShadowSize), box},
+      {test::render_settings("scatter-march-32", kWidth, kHeight, kShadowSize), box},
+      {test::render_settings("pcf", kWidth, kHeight, kShadowSize), whole}};
+  const std::vector<std::string> reasons = {"soft shadows", "scattering", "fit_scene"};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    RenderSettings s = cases[i].first;
+    EXPECT_EQ(resolved_cascades(s, cases[i].second), 1) << reasons[i];
+    s.cascades = 4;
+    try {
+      resolved_cascades(s, cases[i].second);
+      ADD_FAILURE() << "no RenderError for cascades with " << reasons[i];
+    } catch (const RenderError& e) { EXPECT_NE(std::string(e.what()).find(reasons[i]), std::string::npos) << e.what(); }
+  }
+  RenderSettings s = test::render_settings("pcf", kWidth, kHeight, kShadowSize);
+  for (int count : {0, scene::kMaxCascades + 1}) {
+    s.cascades = count;
+    EXPECT_THROW(s.validate(), RenderError) << count;
+  }
+  s.cascades = std::nullopt;
+  s.cascade_lambda = 1.5f;
+  EXPECT_THROW(s.validate(), RenderError);
+}
+
 } // namespace
 } // namespace msm::render

@@ -366,7 +366,9 @@ struct Renderer::Impl {
   void check(const RenderSettings& s) const {
     s.validate();
     try {
-      check_limits(s, scene.triangle_count(), scene.lights.size());
+      RenderSettings counted = s; // its cascades' maps too
+      counted.cascades = cascades(s);
+      check_limits(counted, scene.triangle_count(), scene.lights.size());
     } catch (const limits::LimitError& e) { throw RenderError(e.what()); }
     if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, VkSampleCountFlagBits(s.msaa)))
       throw RenderError(
