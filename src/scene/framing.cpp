@@ -305,11 +305,11 @@ std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, 
             : "a larger --cascade-lambda (the nearest cascade smaller)";
     out.push_back(fmt::format(
         "warning: one shadow-map texel ({:.3g} scene units{}) spans {:.1f} screen pixels (more than {:g}) at the "
-        "nearest visible surface, {:.3g} units from the camera: shadows there are blocky or lost. Cures: {}, a "
-        "larger map (--shadow-size {} or more), an explicit framing of what matters (\"shadow_map\": {{\"framing\": "
-        "\"explicit\", ...}}), a camera that sees less of a large scene.",
+        "nearest visible surface, {:.3g} units from the camera: shadows there are blocky or lost. Cures: a larger map "
+        "(--shadow-size {} or more), {} in msm render, an explicit framing of what matters (\"shadow_map\": "
+        "{{\"framing\": \"explicit\", ...}}), a camera that sees less of a large scene.",
         c.texel_size, cascades.count > 1 && fit ? fmt::format(", {} cascades", cascades.count) : std::string(),
-        c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, more_cascades, needed));
+        c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, needed, more_cascades));
   }
   if (c.aspect_beyond_fit)
     out.push_back(fmt::format("warning: the image ({}x{}) is wider than the {:g}:1 the shadow map's fit covers: "
