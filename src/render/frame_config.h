@@ -73,6 +73,10 @@ struct FrameConfig {
   // Point lights in the frame (after its spot lights), six layers each, one per cube face
   // (msm/cube_face.h): the same radial depth and shading as the spot lights' layers.
   int point_lights = 0;
+  // Cascades per directional light (RenderSettings::cascades resolved; scene::fit_cascades): each
+  // cascade is a layer of its own, a light's in a row; above 1 the shading's kCascades weighs each
+  // layer by the view depth (msm/cascade.h).
+  int cascades = 1;
   bool operator==(const FrameConfig&) const = default;
 
   // The layers of spot and point lights, the last of the shadow-map arrays.

@@ -153,6 +153,18 @@ struct Renderer::Impl {
   // Fitting a light's frustum visits every vertex: one fit per light direction, kept.
   // The fitted frame of each light, by its direction and x axis (light_frame).
   std::vector<std::pair<std::pair<glm::vec3, std::optional<glm::vec3>>, scene::LightFrame>> frames;
+  // The cascades of each light (scene::fit_cascades) by its direction, x axis and the settings they
+  // follow; and one_map_too_coarse by image and map size. Both follow the camera and the vertices.
+  struct CascadeKey {
+    glm::vec3 towards_light;
+    std::optional<glm::vec3> x_axis;
+    int count, shadow_size;
+    float lambda;
+    bool stabilize;
+    bool operator==(const CascadeKey&) const = default;
+  };
+  std::vector<std::pair<CascadeKey, std::vector<scene::Cascade>>> cascade_fits;
+  mutable std::vector<std::pair<glm::ivec3, bool>> too_coarse;
 
   Impl(const vk::Context& c, const scene::Scene& s)
       : ctx(c), scene(s), gpu(c, s),
@@ -190,6 +202,36 @@ struct Renderer::Impl {
     return frames.back().second;
   }
 
+  const std::vector<scene::Cascade>& cascade_fit(const RenderSettings& s, const scene::DirectionalLight& light,
+                                                 int count) {
+    const CascadeKey key{light.towards_light, light.x_axis,     count,
+                         s.shadow_size,       s.cascade_lambda, s.cascade_stabilize};
+    for (const auto& [k, fit] : cascade_fits)
+      if (k == key) return fit;
+    if (cascade_fits.size() >= 64) cascade_fits.clear(); // a light dragged around in a viewer
+    const scene::CascadeOptions options{.count = count, .lambda = s.cascade_lambda, .stabilize = s.cascade_stabilize};
+    cascade_fits.emplace_back(key, scene::fit_cascades(scene, light, s.shadow_size, options));
+    return cascade_fits.back().second;
+  }
+
+  // The cascades per directional light of these settings (resolved_cascades, its measure cached).
+  int cascades(const RenderSettings& s) const {
+    if (s.cascades || cascades_unsupported(s, scene)) return resolved_cascades(s, scene, false);
+    const glm::ivec3 key(s.width, s.height, s.shadow_size);
+    auto it = std::ranges::find(too_coarse, key, &std::pair<glm::ivec3, bool>::first);
+    if (it == too_coarse.end()) {
+      too_coarse.emplace_back(key, one_map_too_coarse(s, scene));
+      it = too_coarse.end() - 1;
+    }
+    return resolved_cascades(s, scene, it->second);
+  }
+
+  // The layers (and shading entries) of the frame's shadow-map arrays: the directional lights'
+  // cascades, then one per spot light, then six per point light (its cube faces).
+  int layers(const RenderSettings& s) const {
+    return int(lights_of(s).size()) * cascades(s) + int(spot_lights().size()) + int(kCubeFaces * point_lights().size());
+  }
+
   const std::vector<scene::DirectionalLight>& lights_of(const RenderSettings& s) const {
     return s.lights.empty() ? scene.lights : s.lights;
   }
@@ -209,11 +251,6 @@ struct Renderer::Impl {
     return points;
   }
 
-  // The shadow-map layers (and shading entries) of the frame's lights: one per directional or spot
-  // light, six per point light.
-  std::size_t light_layers(const RenderSettings& s) const {
-    return lights_of(s).size() + spot_lights().size() + kCubeFaces * point_lights().size();
-  }
   static constexpr std::size_t kCubeFaces = 6;
 
   FrameUniforms frame_uniforms(const RenderSettings& s, const Technique& technique) const {
@@ -255,14 +292,13 @@ struct Renderer::Impl {
     double kernel_variance = msm_gaussian_variance(s.filter_size, s.filter_sigma);
     for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
     u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
-    u.lights = glm::ivec4(int(light_layers(s)), 0, 0, 0);
+    u.lights = glm::ivec4(layers(s), 0, 0, 0);
     u.camera_viewport = glm::vec4(float(s.width), float(s.height), 0.0f, 0.0f);
     return u;
   }
 
   LightUniforms light_uniforms(const RenderSettings& s, const Technique& technique,
-                               const scene::DirectionalLight& light) {
-    const scene::LightFrame& f = light_frame(light);
+                               const scene::DirectionalLight& light, const scene::LightFrame& f) {
     LightUniforms u{};
     u.view_projection = f.view_projection;
     u.normal_matrix = glm::mat4(glm::transpose(glm::inverse(glm::mat3(f.view_projection))));
@@ -284,6 +320,21 @@ struct Renderer::Impl {
       u.rect_extent = glm::vec4(drawn.rectangle_extents(), 0.0f, 0.0f);
     }
     return u;
+  }
+
+  // A directional light's entries of lights[]: one, or one per cascade with the view depths of its
+  // share (msm/cascade.h), each with its own map and normal offset (of its own texels).
+  void add_directional_light(const RenderSettings& s, const Technique& technique, const scene::DirectionalLight& light,
+                             int count) {
+    if (count == 1) {
+      light_data.push_back(light_uniforms(s, technique, light, light_frame(light)));
+      return;
+    }
+    for (const scene::Cascade& c : cascade_fit(s, light, count)) {
+      LightUniforms u = light_uniforms(s, technique, light, c.frame);
+      u.cascade = glm::vec4(float(c.fade_in.x), float(c.fade_in.y), float(c.fade_out.x), float(c.fade_out.y));
+      light_data.push_back(u);
+    }
   }
 
   // A spot light as the shadow pass and the shading read it (docs/techniques.md, "Light kinds"): a
@@ -361,7 +412,9 @@ struct Renderer::Impl {
   void check(const RenderSettings& s) const {
     s.validate();
     try {
-      check_limits(s, scene.triangle_count(), scene.lights.size());
+      RenderSettings counted = s; // its cascades' maps too
+      counted.cascades = cascades(s);
+      check_limits(counted, scene.triangle_count(), scene.lights.size());
     } catch (const limits::LimitError& e) { throw RenderError(e.what()); }
     if (!vk::supports_attachment(ctx, VK_FORMAT_D16_UNORM, VkSampleCountFlagBits(s.msaa)))
       throw RenderError(
@@ -385,16 +438,19 @@ struct Renderer::Impl {
       throw RenderError(
           fmt::format("{} lights, sub-lights and their summaries: the renderer holds {}", slots, kLightSlots));
     const std::vector<scene::LocalLight> spots = spot_lights(), points = point_lights();
-    slots += spots.size() + kCubeFaces * points.size();
+    const std::size_t cascade_layers = frame_lights.size() * std::size_t(cascades(s) - 1);
+    slots += spots.size() + kCubeFaces * points.size() + cascade_layers;
     if (slots > kLightSlots)
-      throw RenderError(fmt::format("{} lights, sub-lights, their summaries and point lights' faces (6 each): the "
-                                    "renderer holds {}",
+      throw RenderError(fmt::format("{} lights, sub-lights, their summaries, cascades and point lights' faces (6 "
+                                    "each): the renderer holds {}",
                                     slots, kLightSlots));
     if (!spots.empty()) check_spot_lights(s, spots, "spot");
     if (!points.empty()) check_spot_lights(s, points, "point");
-    if (light_layers(s) > ctx.properties().limits.maxImageArrayLayers)
-      throw RenderError(fmt::format("{} shadow-map layers (point lights take 6): {} supports {} layers per image",
-                                    light_layers(s), ctx.info().name, ctx.properties().limits.maxImageArrayLayers));
+    if (std::size_t(layers(s)) > ctx.properties().limits.maxImageArrayLayers)
+      throw RenderError(fmt::format("{} shadow-map layers ({} cascades per directional light, 6 per point light): {} "
+                                    "supports {} layers per image",
+                                    layers(s), cascades(s), ctx.info().name,
+                                    ctx.properties().limits.maxImageArrayLayers));
   }
 
   // What the renderer draws with spot and point lights (`kind`): the hard and filtered techniques
@@ -446,7 +502,7 @@ struct Renderer::Impl {
                   .msaa = s.msaa,
                   .taps = s.filter_size,
                   .sigma = s.filter_sigma,
-                  .lights = int(light_layers(s)),
+                  .lights = layers(s),
                   .one_pass = one_pass,
                   .translucent = translucent,
                   .coloured = translucent && s.coloured_translucency,
@@ -460,7 +516,8 @@ struct Renderer::Impl {
                       lights_of(s), [](const scene::DirectionalLight& l) { return !l.sub_lights.empty(); }),
                   .front_back = s.front_back_depth,
                   .spot_lights = int(spot_lights().size()),
-                  .point_lights = int(point_lights().size())};
+                  .point_lights = int(point_lights().size()),
+                  .cascades = cascades(s)};
     // The non-linear maps are decoded before any interpolation and the tables replace the mips: only
     // the linear maps get a mip chain, where the device can blit their formats.
     c.mip_levels =
@@ -503,7 +560,7 @@ struct Renderer::Impl {
     std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation)
     std::ranges::fill(soft_clamps.mapped<std::uint32_t>(), 0u);
     light_data.clear();
-    for (const scene::DirectionalLight& light : frame_lights) light_data.push_back(light_uniforms(s, technique, light));
+    for (const scene::DirectionalLight& light : frame_lights) add_directional_light(s, technique, light, c.cascades);
     for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, technique, spot));
     for (const scene::LocalLight& point : point_lights())
       for (int face = 0; face < int(kCubeFaces); ++face) light_data.push_back(point_face_uniforms(s, point, face));
@@ -511,7 +568,7 @@ struct Renderer::Impl {
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {
       const std::vector<scene::DirectionalLight>& subs = frame_lights[i].sub_lights;
-      if (subs.empty()) continue;
+      if (subs.empty()) continue; // and the light has one cascade (cascades_unsupported)
       light_data[i].rect_extent.z = float(light_data.size());
       light_data[i].rect_extent.w = float(subs.size());
       light_data.push_back(sub_lights_summary(frame_lights[i]));
@@ -759,6 +816,8 @@ void Renderer::set_camera(const scene::Camera& camera) {
     return;
   c = camera;
   impl_->frames.clear(); // the fitted light frusta depend on the camera
+  impl_->cascade_fits.clear();
+  impl_->too_coarse.clear();
 }
 
 void Renderer::move_objects(const scene::Scene& scene) {
@@ -780,6 +839,8 @@ void Renderer::move_objects(const scene::Scene& scene) {
   }
   m.gpu.move_objects(m.ctx, m.scene); // sorted along the renderer's light, with its materials
   m.frames.clear();                   // the fitted light frusta depend on the vertices
+  m.cascade_fits.clear();
+  m.too_coarse.clear();
 }
 
 void Renderer::set_lights(std::vector<scene::DirectionalLight> directional, std::vector<scene::LocalLight> local) {

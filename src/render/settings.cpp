@@ -88,6 +88,8 @@ void RenderSettings::validate() const {
   };
   finite("filter sigma", filter_sigma, MSM_FILTER_MIN_SIGMA, MSM_FILTER_MAX_SIGMA);
   finite("over-darkening factor", overdarken, 0.5f, 1.0f);
+  if (cascades) range("cascades", *cascades, 1, scene::kMaxCascades);
+  finite("cascade lambda", cascade_lambda, 0.0f, 1.0f);
   finite("normal offset", normal_offset, 0.0f, 100.0f);
   finite("exposure", exposure, 1e-6f, 1e6f);
   if (depth_bias) finite("depth bias", *depth_bias, -1.0f, 1.0f);
@@ -189,7 +191,10 @@ std::uint64_t estimated_bytes(const RenderSettings& s, std::uint64_t triangles, 
   const Technique& t = find_rendered_technique(s.technique);
   const std::uint64_t moment_bytes =
       (texel_bytes(t.formats[0]) + texel_bytes(t.formats[1])) * std::uint64_t(msm_technique_tiles(t.id));
-  const std::uint64_t lights = s.lights.empty() ? scene_lights : s.lights.size();
+  // Each cascade is a map of its own (the default, unset, counted as one: the renderer's check
+  // counts the cascades it resolves).
+  const std::uint64_t lights =
+      (s.lights.empty() ? scene_lights : s.lights.size()) * std::uint64_t(s.cascades.value_or(1));
   // Prefiltered scattering: every light's rectified map and prefix sums (K transmittance layers),
   // shadow size² each.
   glm::ivec2 scatter = t.prefiltered_scattering() ? msm_technique_scatter_map_bytes(t.id) : glm::ivec2(0);

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include <fmt/format.h>
+#include <glm/ext/matrix_clip_space.hpp>
 
 #include "msm/scene/scene.h"
 
@@ -184,7 +185,8 @@ void clip_to_box(std::vector<glm::dvec4>& poly, std::vector<glm::dvec4>& scratch
 
 } // namespace
 
-TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size) {
+TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size,
+                                    const CascadeOptions& cascades) {
   TexelCoverage c;
   // The orthographic map of the first directional light; spot and point lights alone have none.
   if (width <= 0 || height <= 0 || shadow_size <= 0 || scene.lights.empty()) return c;
@@ -224,6 +226,14 @@ TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, i
   // Pixels per world unit across the view direction at view depth w: height / (2 w tan(fov/2)).
   const double pixels_per_unit =
       double(height) / (2.0 * nearest * std::tan(double(scene.camera.fov_y_deg) * std::numbers::pi / 360.0));
+  if (cascades.count > 1 && scene.shadow.mode == ShadowFraming::Mode::fit) {
+    // The cascade that shades the nearest surface (the first whose slice reaches it).
+    for (const Cascade& k : fit_cascades(scene, scene.light(), shadow_size, cascades)) {
+      const glm::dvec2 texel = k.frame.texel(shadow_size);
+      c.texel_size = std::max(texel.x, texel.y);
+      if (nearest <= k.fade_out.y) break;
+    }
+  }
   c.pixels_per_texel = c.texel_size * pixels_per_unit;
   c.aspect_beyond_fit = scene.shadow.mode == ShadowFraming::Mode::fit && double(width) / height > kFitMaxAspect;
   return c;
@@ -280,18 +290,26 @@ std::vector<FramingMiss> shadow_framing_misses(const Scene& scene, int width, in
   return misses;
 }
 
-std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, int height, int shadow_size) {
+std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, int height, int shadow_size,
+                                                 const CascadeOptions& cascades) {
   std::vector<std::string> out;
-  const TexelCoverage c = shadow_texel_coverage(scene, width, height, shadow_size);
+  const TexelCoverage c = shadow_texel_coverage(scene, width, height, shadow_size, cascades);
   if (c.pixels_per_texel > kMaxPixelsPerTexel) {
     const int needed = int(std::min<double>(65536.0, std::ceil(shadow_size * c.pixels_per_texel / kMaxPixelsPerTexel)));
+    const bool fit = scene.shadow.mode == ShadowFraming::Mode::fit;
+    const std::string more_cascades =
+        !fit ? "cascaded shadow maps (\"framing\": \"fit\", the default, and --cascades 4)"
+        : cascades.count < kMaxCascades
+            ? fmt::format("more cascades (--cascades {}; a larger --cascade-lambda puts more of them near)",
+                          std::max(4, std::min(kMaxCascades, 2 * cascades.count)))
+            : "a larger --cascade-lambda (the nearest cascade smaller)";
     out.push_back(fmt::format(
-        "warning: one shadow-map texel ({:.3g} scene units) spans {:.1f} screen pixels (more than {:g}) at the nearest "
-        "visible surface, {:.3g} units from the camera: shadows there are blocky or lost. Cures: a larger map "
-        "(--shadow-size {} or more), an explicit framing of what matters (\"shadow_map\": {{\"framing\": "
-        "\"explicit\", ...}}), a camera that sees less of a large scene; cascaded shadow maps would fix it but are "
-        "not implemented.",
-        c.texel_size, c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, needed));
+        "warning: one shadow-map texel ({:.3g} scene units{}) spans {:.1f} screen pixels (more than {:g}) at the "
+        "nearest visible surface, {:.3g} units from the camera: shadows there are blocky or lost. Cures: a larger map "
+        "(--shadow-size {} or more), {} in msm render, an explicit framing of what matters (\"shadow_map\": "
+        "{{\"framing\": \"explicit\", ...}}), a camera that sees less of a large scene.",
+        c.texel_size, cascades.count > 1 && fit ? fmt::format(", {} cascades", cascades.count) : std::string(),
+        c.pixels_per_texel, kMaxPixelsPerTexel, c.distance, needed, more_cascades));
   }
   if (c.aspect_beyond_fit)
     out.push_back(fmt::format("warning: the image ({}x{}) is wider than the {:g}:1 the shadow map's fit covers: "
@@ -313,12 +331,142 @@ std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, 
   return out;
 }
 
-std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size) {
-  const std::vector<std::string> warnings = shadow_framing_warnings(scene, width, height, shadow_size);
+std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size,
+                                                  const CascadeOptions& cascades) {
+  const std::vector<std::string> warnings = shadow_framing_warnings(scene, width, height, shadow_size, cascades);
   if (warnings.empty()) return std::nullopt;
   std::string text = warnings.front();
   for (std::size_t i = 1; i < warnings.size(); ++i) text += "\n" + warnings[i];
   return text;
+}
+
+} // namespace msm::scene
+
+namespace msm::scene {
+
+LightFrame orthographic_light_frame(const glm::mat4& view_projection, const glm::vec3& towards_light) {
+  LightFrame f;
+  f.view_projection = view_projection;
+  const glm::dmat4 inv = glm::inverse(glm::dmat4(view_projection));
+  f.towards_light = glm::normalize(glm::dvec3(towards_light));
+  // Orthographic: a unit step of clip x (y, z) moves by inv[0] (inv[1], inv[2]) in world space.
+  const glm::dvec3 cx(inv[0]), cy(inv[1]), cz(inv[2]);
+  f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
+  f.x_axis = glm::normalize(cx);
+  f.y_axis = glm::normalize(cy);
+  f.depth_extent = glm::length(cz);
+  return f;
+}
+
+std::vector<double> cascade_splits(double near, double far, int count, double lambda) {
+  std::vector<double> splits(std::size_t(count) + 1);
+  for (int i = 0; i <= count; ++i) {
+    const double t = double(i) / double(count);
+    splits[std::size_t(i)] = lambda * near * std::pow(far / near, t) + (1.0 - lambda) * (near + (far - near) * t);
+  }
+  splits.front() = near;
+  splits.back() = far;
+  return splits;
+}
+
+glm::dvec2 visible_depth_range(const Scene& scene) {
+  const Camera& camera = scene.camera;
+  const glm::dvec2 planes(camera.near, camera.far);
+  const Bounds b = scene.bounds();
+  if (b.empty()) return planes;
+  const double size = glm::length(glm::dvec3(b.size()));
+  const float margin = float(1e-5 * size + 1e-6);
+  Bounds grown = b;
+  grown.extend(b.min - glm::vec3(margin));
+  grown.extend(b.max + glm::vec3(margin));
+  const std::vector<glm::dvec3> corners = intersection_corners(camera_frustum(camera), box_hull(grown), 1e-9 * size);
+  if (corners.empty()) return planes;
+  const glm::dmat4 view(camera.view());
+  glm::dvec2 range(std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity());
+  for (const glm::dvec3& p : corners) {
+    const double depth = -(view * glm::dvec4(p, 1.0)).z; // view space looks down -z
+    range = {std::min(range.x, depth), std::max(range.y, depth)};
+  }
+  range = glm::clamp(range, planes.x, planes.y);
+  if (!(range.y > range.x)) range.y = std::min(planes.y, range.x * (1.0 + 1e-3) + 1e-6);
+  return range;
+}
+
+namespace {
+
+// The radius rounded up to 1/16 of the power of two below it: the same for every camera pose (the
+// slice's shape does not move with the camera; rounding absorbs the float noise of its corners).
+double stable_radius(double radius) {
+  const double step = std::exp2(std::floor(std::log2(radius)) - 4.0);
+  return std::ceil(radius / step) * step;
+}
+
+// The orthographic map of one cascade: the light's view, its box around the bounding sphere of
+// the slice corners (light view space), the casters over it moving the near plane up.
+glm::mat4 cascade_view_projection(const Scene& scene, const glm::dmat4& light_view,
+                                  const std::array<glm::dvec3, 8>& slice, int shadow_size, bool stabilize) {
+  glm::dvec3 centre(0.0);
+  for (const glm::dvec3& p : slice) centre += 0.125 * p;
+  double radius = 0.0;
+  for (const glm::dvec3& p : slice) radius = std::max(radius, glm::length(p - centre));
+  radius = std::max(radius, 1e-6);
+  glm::dvec3 c(light_view * glm::dvec4(centre, 1.0));
+  if (stabilize) {
+    radius = stable_radius(radius);
+    const double texel = 2.0 * radius / double(shadow_size);
+    c.x = std::round(c.x / texel) * texel;
+    c.y = std::round(c.y / texel) * texel;
+  }
+  glm::dvec3 lo = c - radius, hi = c + radius;
+  // Casters over the box nearer the light than the sphere (view space looks down -z: nearer the
+  // light = larger z) move its near plane up to them; nearer ones still are clamped to depth 0.
+  for (const Object& o : scene.objects)
+    for (const glm::vec3& q : o.mesh.positions) {
+      const glm::dvec3 p(light_view * glm::dvec4(glm::dvec3(q), 1.0));
+      if (p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y) hi.z = std::max(hi.z, p.z);
+    }
+  const double margin = 1e-5 * radius;
+  lo.z -= margin;
+  hi.z += margin;
+  glm::mat4 flip(1.0f);
+  flip[1][1] = -1.0f; // Vulkan's clip y points down
+  return flip * glm::orthoRH_ZO(float(lo.x), float(hi.x), float(lo.y), float(hi.y), float(-hi.z), float(-lo.z)) *
+         glm::mat4(light_view);
+}
+
+} // namespace
+
+std::vector<Cascade> fit_cascades(const Scene& scene, const DirectionalLight& light, int shadow_size,
+                                  const CascadeOptions& options) {
+  const int count = std::clamp(options.count, 1, kMaxCascades);
+  const glm::dvec2 range = visible_depth_range(scene);
+  const std::vector<double> splits = cascade_splits(range.x, range.y, count, options.lambda);
+  // The camera frustum's corners (bit 2: the far plane); view depth is linear along its edges.
+  const Hull frustum = camera_frustum(scene.camera);
+  const double near = scene.camera.near, far = scene.camera.far;
+  const auto corners_at = [&](double depth, std::array<glm::dvec3, 8>& out, int far_bit) {
+    const double t = (depth - near) / (far - near);
+    for (int i = 0; i < 4; ++i)
+      out[std::size_t(i | far_bit)] =
+          frustum.corners[std::size_t(i)] + t * (frustum.corners[std::size_t(i | 4)] - frustum.corners[std::size_t(i)]);
+  };
+  const glm::dmat4 light_view(scene.light_view(light));
+  std::vector<Cascade> cascades(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    Cascade& cascade = cascades[std::size_t(i)];
+    const double start = splits[std::size_t(i)], end = splits[std::size_t(i) + 1];
+    if (i > 0) {
+      const double previous = options.blend * (start - splits[std::size_t(i) - 1]);
+      cascade.fade_in = {start - previous, start};
+    }
+    if (i + 1 < count) cascade.fade_out = {end - options.blend * (end - start), end};
+    std::array<glm::dvec3, 8> slice;
+    corners_at(i > 0 ? cascade.fade_in.x : start, slice, 0);
+    corners_at(end, slice, 4);
+    cascade.frame = orthographic_light_frame(
+        cascade_view_projection(scene, light_view, slice, shadow_size, options.stabilize), light.towards_light);
+  }
+  return cascades;
 }
 
 } // namespace msm::scene

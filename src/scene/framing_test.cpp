@@ -117,7 +117,7 @@ TEST(Framing, CoarseTexelWarning) {
     ASSERT_TRUE(w.has_value());
     EXPECT_NE(w->find("--shadow-size"), std::string::npos) << *w;
     EXPECT_NE(w->find("explicit"), std::string::npos) << *w;
-    EXPECT_NE(w->find("cascade"), std::string::npos) << *w;
+    EXPECT_NE(w->find("cascades"), std::string::npos) << *w;
     EXPECT_GT(shadow_texel_coverage(s, 1280, 720, 1024).pixels_per_texel, kMaxPixelsPerTexel);
   }
   // The measure itself: halving the map's texel count per side doubles it; so does doubling the

@@ -998,17 +998,7 @@ glm::mat4 Scene::light_projection(const DirectionalLight& light) const {
 }
 
 LightFrame Scene::light_frame(const DirectionalLight& light) const {
-  LightFrame f;
-  f.view_projection = light_projection(light) * light_view(light);
-  const glm::dmat4 inv = glm::inverse(glm::dmat4(f.view_projection));
-  f.towards_light = glm::normalize(glm::dvec3(light.towards_light));
-  // Orthographic: a unit step of clip x (y, z) moves by inv[0] (inv[1], inv[2]) in world space.
-  const glm::dvec3 cx(inv[0]), cy(inv[1]), cz(inv[2]);
-  f.extent = {2.0 * glm::length(cx), 2.0 * glm::length(cy)};
-  f.x_axis = glm::normalize(cx);
-  f.y_axis = glm::normalize(cy);
-  f.depth_extent = glm::length(cz);
-  return f;
+  return orthographic_light_frame(light_projection(light) * light_view(light), light.towards_light);
 }
 
 Scene load_scene_json(std::string_view json_text, const std::filesystem::path& base_dir,

@@ -91,8 +91,10 @@ void compare_techniques(render::Renderer& renderer, const vk::Context& ctx, cons
     results.back().total_ms = 0;
     for (const render::PassTime& p : results.back().passes) results.back().total_ms += p.ms;
     write_render(out, s.technique, results.back(),
-                 render_json(s, scene, 0, scene::shadow_framing_warnings(scene, s.width, s.height, s.shadow_size), ctx,
-                             results.back()));
+                 render_json(s, scene, 0,
+                             scene::shadow_framing_warnings(scene, s.width, s.height, s.shadow_size,
+                                                            render::cascade_options(s, scene)),
+                             ctx, results.back()));
     signals.push_back(scattering ? results.back().scattering.channel("visible_fraction")
                                  : results.back().shadow.channel("visibility"));
   }
@@ -210,7 +212,10 @@ void ibl_part(const vk::Context& ctx, const FrameOptions& frame, const scene::Sc
     render::RenderResult r = renderer.render(s);
     const std::string name = fmt::format("ibl-{}-{}", c.technique, c.lights);
     write_render(out, name, r,
-                 render_json(s, lit, 0, scene::shadow_framing_warnings(lit, s.width, s.height, s.shadow_size), ctx, r));
+                 render_json(s, lit, 0,
+                             scene::shadow_framing_warnings(lit, s.width, s.height, s.shadow_size,
+                                                            render::cascade_options(s, lit)),
+                             ctx, r));
     // Both images are R, G, B: the metrics compare their luminance (msm/image/metrics.h).
     image::Metrics m = image::compute_metrics(r.color, truth_rgb, {.mask = &mask});
     fmt::print("{:<20} {:>6} {:>8.5f} {:>6.2f}% {:>12.3f}\n", c.technique, c.lights, m.mae, 100 * m.share_above_3pct,

@@ -136,7 +136,8 @@ void render_frames(const vk::Context& ctx, render::Renderer& renderer, const sce
   const std::size_t moving =
       std::ranges::count_if(scene.objects, [](const scene::Object& object) { return object.motion.has_value(); });
   const render::RenderSettings& f = frame.settings;
-  const std::vector<std::string> warnings = scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size);
+  const std::vector<std::string> warnings =
+      scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size, render::cascade_options(f, scene));
   nlohmann::json list = nlohmann::json::array();
   for (int k = 0; k < o.frames; ++k) {
     nlohmann::json entry = {{"frame", k}};

@@ -112,7 +112,8 @@ void add_render(CLI::App& app) {
                                      opt->sub_lights);
       } catch (const scene::SceneError& e) { throw UsageError(e.what()); }
     const render::RenderSettings& f = opt->frame.settings;
-    const std::vector<std::string> warnings = scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size);
+    const std::vector<std::string> warnings =
+        scene::shadow_framing_warnings(scene, f.width, f.height, f.shadow_size, render::cascade_options(f, scene));
     for (const std::string& w : warnings) fmt::print(stderr, "msm render: {}\n", w);
     check_limits(opt->frame, scene, names);
     if (frames) check_frames(scene, opt->frames);

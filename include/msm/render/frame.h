@@ -39,8 +39,9 @@ struct FrameUniforms {
   vec4 camera_viewport;    // xy: the camera image's size in pixels (msm_surface_footprint), zw: unused
 };
 
-// One shadow-casting light of the frame, directional or spot: its shadow map is layer `index` of
-// every shadow-map array of the frame (a storage buffer of these, binding named by each pipeline).
+// One shadow-casting light of the frame, directional or spot, or one cascade of a directional light
+// (each cascade an entry of its own, the light's cascades in a row): its shadow map is layer `index`
+// of every shadow-map array of the frame (a storage buffer of these, binding named by each pipeline).
 struct LightUniforms {
   mat4 view_projection; // world -> its shadow-map clip space (directional: orthographic, depth in
                         // [0,1]; spot: perspective, its map storing radial distance / range)
@@ -62,6 +63,9 @@ struct LightUniforms {
   vec4 spot_axis;       // xyz: the unit direction the spot shines in, w: tan of its outer half-angle
   vec4 spot_cone;       // x: cos of the outer half-angle, y: of the inner, z: normal offset in world
                         // units per metre of distance from the light, w: unused
+  vec4 cascade;         // a directional light's cascade (msm/cascade.h's msm_cascade_weight): the view
+                        // depths where its weight rises from 0 (x) to 1 (y) and falls from 1 (z) to 0
+                        // (w); all 0: no cascades (weight 1)
 };
 
 // The entry before a light's sub-lights in the lights' array: their linear part and the rectangle
@@ -80,7 +84,7 @@ MSM_FN LightUniforms msm_sub_lights_summary_entry(SubLightsSummary s) {
   packed[3] = vec4(s.bounds, 0.0f, 1.0f);
   mat4 axes = mat4(vec4(s.x_axis, 0.0f), vec4(s.y_axis, 0.0f), vec4(0.0f), vec4(0.0f));
   vec4 zero = vec4(0.0f);
-  return LightUniforms(packed, axes, zero, zero, zero, zero, zero, zero, zero, zero);
+  return LightUniforms(packed, axes, zero, zero, zero, zero, zero, zero, zero, zero, zero);
 }
 MSM_FN SubLightsSummary msm_sub_lights_summary(mat4 view_projection, mat4 normal_matrix) {
   return SubLightsSummary(mat3(view_projection), vec2(view_projection[3][0], view_projection[3][1]),
@@ -125,6 +129,7 @@ struct ObjectPush {
 #define MSM_SPEC_SCATTER_LAYERS 14    // int: transmittance layers per light (scatter.glsl)
 #define MSM_SPEC_SCATTER_BETA_MODE 15 // int: MSM_SCATTERING_BETA_* (scatter.glsl)
 #define MSM_SPEC_SPOT_LIGHTS 16       // bool: some light of the frame is a spot light (shading.glsl)
+#define MSM_SPEC_CASCADES 17          // bool: the directional lights have cascades (shading.glsl)
 // The blur's specialization constants (blur.comp, passes/blur_pass.cpp): id MSM_BLUR_SPEC_ID holds
 // the fetches per side, + 1 the centre weight, + 2 + i the offset and + 2 + MSM_BLUR_MAX_PAIRS + i
 // the weight of fetch i + 1 (msm_filter_pairs of the largest kernel: 16); + 2 + 2 MSM_BLUR_MAX_PAIRS
@@ -166,9 +171,9 @@ static_assert(sizeof(msm::FrameUniforms) == 544 && offsetof(msm::FrameUniforms, 
               offsetof(msm::FrameUniforms, filter_weights) == 128 && offsetof(msm::FrameUniforms, lookup) == 384 &&
               offsetof(msm::FrameUniforms, sample_offsets) == 432 && offsetof(msm::FrameUniforms, lights) == 512 &&
               offsetof(msm::FrameUniforms, camera_viewport) == 528);
-static_assert(sizeof(msm::LightUniforms) == 256 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
+static_assert(sizeof(msm::LightUniforms) == 272 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
               offsetof(msm::LightUniforms, towards_light) == 128 && offsetof(msm::LightUniforms, rect_extent) == 192 &&
-              offsetof(msm::LightUniforms, spot_cone) == 240);
+              offsetof(msm::LightUniforms, spot_cone) == 240 && offsetof(msm::LightUniforms, cascade) == 256);
 static_assert(sizeof(msm::ObjectPush) == 64 && offsetof(msm::ObjectPush, light) == 48);
 static_assert(sizeof(msm::ImagePassPush) == 16);
 static_assert(sizeof(msm::ScatteringPush) == 128 && offsetof(msm::ScatteringPush, sky) == 112);

@@ -69,6 +69,7 @@ inline constexpr int kMaxOnePassTaps = 17;                  // radius 8 in one_p
 inline constexpr int kDefaultSatKernel = kSatKernelDefault; // msm/cpu/techniques.h
 inline constexpr int kDefaultPcssKernel = kPcssKernelDefault;
 inline constexpr int kMaxPcssKernel = kPcssKernelMax;
+inline constexpr int kDefaultCascades = 4; // RenderSettings::cascades where one map is too coarse
 
 struct RenderSettings {
   std::string technique = "msm-hamburger-64";
@@ -163,6 +164,14 @@ struct RenderSettings {
   // MSM_MAX_LIGHTS (render/frame.h). Each gets its own shadow map (a layer of the frame's arrays),
   // fitted to the scene like the scene's lights; the shading sums their contributions.
   std::vector<scene::DirectionalLight> lights;
+  // Cascaded shadow maps (scene::fit_cascades; docs/techniques.md, "Cascades"): the maps per
+  // directional light, 1..scene::kMaxCascades, each shadow_size² texels over a slice of the view
+  // depth. Unset: kDefaultCascades where one map's texels would span more than
+  // scene::kMaxPixelsPerTexel pixels (scene::shadow_texel_coverage) and the frame can have them
+  // (cascades_supported), else 1.
+  std::optional<int> cascades;
+  float cascade_lambda = float(scene::kDefaultCascadeLambda); // the split scheme: 0 uniform, 1 logarithmic
+  bool cascade_stabilize = true; // radius rounded and centre snapped to whole texels (no shimmer)
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;
 };
@@ -177,6 +186,21 @@ int transmittance_layers(const RenderSettings& s);
 // limits::LimitError (msm/util/limits.h) when the scene or the estimate exceeds its limit; the
 // message names the technique, the sizes and the limit.
 void check_limits(const RenderSettings& s, std::uint64_t triangles, std::size_t scene_lights);
+
+// Cascaded shadow maps (RenderSettings::cascades): why a frame of these settings cannot have them
+// (a phrase: soft shadows, scattering, sub-lights, a framing other than "fit"), or none.
+std::optional<std::string> cascades_unsupported(const RenderSettings& s, const scene::Scene& scene);
+// Whether one map of the scene's first directional light would have texels spanning more than
+// scene::kMaxPixelsPerTexel pixels at the nearest visible surface (scene::shadow_texel_coverage).
+bool one_map_too_coarse(const RenderSettings& s, const scene::Scene& scene);
+// The cascades per directional light of a frame: s.cascades where set (RenderError where above 1
+// and cascades_unsupported), else kDefaultCascades where one map is too coarse (too_coarse, where
+// the caller knows it, else one_map_too_coarse) and the frame supports cascades, else 1.
+int resolved_cascades(const RenderSettings& s, const scene::Scene& scene, std::optional<bool> too_coarse = {});
+// The frame's cascades as scene::fit_cascades and scene::shadow_framing_warnings take them
+// (resolved_cascades; one where the settings ask for cascades the frame cannot have: the render
+// refuses those).
+scene::CascadeOptions cascade_options(const RenderSettings& s, const scene::Scene& scene);
 
 // The normalized 1D weights of the blur and PCF (msm/filter.h), tap k at [k]: what the frame's
 // uniforms hold and what the ray tracer's filtered effect samples (reference::FilterKernel).

@@ -559,6 +559,49 @@ struct LightBox {
 // of 1e-5 of the scene's size keeps rounding from pushing points out.
 LightBox fit_light_frustum(const Scene& scene, const glm::mat4& light_view, bool visible_only);
 
+// ---- Cascaded shadow maps (docs/techniques.md, "Cascades") ----------------------------------
+
+// A directional light's map split along the camera's view depth into 1..kMaxCascades maps, each
+// covering a slice of the view frustum: nearer slices are smaller, so their texels are finer.
+inline constexpr int kMaxCascades = 8;
+// The practical split scheme's default blend, towards the logarithmic split: a view depth range of a
+// few hundred times the nearest visible surface's distance still gets a near cascade fine enough.
+inline constexpr double kDefaultCascadeLambda = 0.9;
+
+struct CascadeOptions {
+  int count = 1;                         // 1..kMaxCascades
+  double lambda = kDefaultCascadeLambda; // the practical split scheme's blend: 0 uniform, 1 logarithmic
+  // Stabilisation: the bounding sphere's radius rounded up to 1/16 unit and its centre snapped to
+  // whole texels of the light's map, so a camera that moves or turns moves no texel edge.
+  bool stabilize = true;
+  double blend = 0.1; // the band at each cascade's far end where it fades into the next, as a fraction of its slice
+};
+
+// One cascade: its orthographic map and the view depths where it is used, a weight rising from 0 at
+// fade_in.x to 1 at fade_in.y and falling back to 0 from fade_out.x to fade_out.y (the next
+// cascade's rise over the same band: the weights sum to 1). The first has no rise, the last no fall.
+struct Cascade {
+  LightFrame frame;
+  glm::dvec2 fade_in{-1e30, -1e30}, fade_out{1e30, 1e30};
+};
+
+// The split distances (count + 1 view depths, first `near`, last `far`) of the practical scheme:
+// lambda times the logarithmic split plus (1 - lambda) times the uniform one.
+std::vector<double> cascade_splits(double near, double far, int count, double lambda);
+
+// The view depths [near, far] of what the camera can see of the scene: its view frustum (at
+// kFitMaxAspect) clipped to the scene's bounds, within the camera's near and far planes.
+glm::dvec2 visible_depth_range(const Scene& scene);
+
+// The cascades of a directional light for a map of shadow_size² texels per cascade: each fitted to
+// the bounding sphere of its slice of the view frustum (its band with the previous one included),
+// depth from the casters over it (the light's nearest vertex there) to the sphere's far side.
+std::vector<Cascade> fit_cascades(const Scene& scene, const DirectionalLight& light, int shadow_size,
+                                  const CascadeOptions& options);
+
+// The frame of an orthographic light view-projection (Scene::light_frame's definition).
+LightFrame orthographic_light_frame(const glm::mat4& view_projection, const glm::vec3& towards_light);
+
 // How coarse the shadow map is on screen: one texel (the larger of its two sides, in scene units)
 // over the size of a pixel at the nearest surface inside the view frustum (view depth `distance`;
 // pixels per unit there: height / (2 distance tan(fov_y / 2))), for an image of width x height and
@@ -571,7 +614,10 @@ struct TexelCoverage {
   glm::vec3 where{0.0f};          // a point of it
   bool aspect_beyond_fit = false; // "fit" framing and width / height > kFitMaxAspect
 };
-TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size);
+// With cascades (cascades.count > 1; fit_cascades), the texel of the cascade whose slice holds the
+// nearest visible surface.
+TexelCoverage shadow_texel_coverage(const Scene& scene, int width, int height, int shadow_size,
+                                    const CascadeOptions& cascades = {});
 
 // Above this many screen pixels per shadow-map texel the tools warn.
 inline constexpr double kMaxPixelsPerTexel = 8.0;
@@ -589,12 +635,15 @@ struct FramingMiss {
 std::vector<FramingMiss> shadow_framing_misses(const Scene& scene, int width, int height);
 
 // The warnings the tools print and write into their JSON "warnings", one string each (none: empty):
-// when a texel spans more than kMaxPixelsPerTexel pixels (naming the cures: a larger map, explicit
-// framing; cascades do not exist yet), when the image is wider than the fit covers, and for each
-// light whose framing misses the visible receivers or the casters (shadow_framing_misses).
-std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, int height, int shadow_size);
+// when a texel (of the cascades where `cascades` has several) spans more than kMaxPixelsPerTexel
+// pixels (naming the cures: more cascades, a larger map, explicit framing), when the image is wider
+// than the fit covers, and for each light whose framing misses the visible receivers or the casters
+// (shadow_framing_misses).
+std::vector<std::string> shadow_framing_warnings(const Scene& scene, int width, int height, int shadow_size,
+                                                 const CascadeOptions& cascades = {});
 // The same joined by newlines, or none.
-std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size);
+std::optional<std::string> shadow_framing_warning(const Scene& scene, int width, int height, int shadow_size,
+                                                  const CascadeOptions& cascades = {});
 
 // Loading. Relative mesh/texture paths resolve against base_dir (the file's directory).
 Scene load_scene_file(const std::filesystem::path& file);

@@ -83,7 +83,8 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
                                    {MSM_SPEC_LOOKUP, uint32_t(config.lookup)},
                                    {MSM_SPEC_TEXTURED_DRAWS, config.textured_draws ? 1u : 0u},
                                    {MSM_SPEC_SUB_LIGHTS, config.sub_lights ? 1u : 0u},
-                                   {MSM_SPEC_SPOT_LIGHTS, config.local_light_layers() > 0 ? 1u : 0u}}};
+                                   {MSM_SPEC_SPOT_LIGHTS, config.local_light_layers() > 0 ? 1u : 0u},
+                                   {MSM_SPEC_CASCADES, config.cascades > 1 ? 1u : 0u}}};
   // Scattering techniques: linear radiance for the scattering pass to composite and tone map.
   if (technique.scatters()) {
     d.color_formats[0] = VK_FORMAT_R16G16B16A16_SFLOAT;

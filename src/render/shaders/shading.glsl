@@ -4,6 +4,7 @@
 // family of techniques; it reads layer `shadow_layer` of the shadow-map arrays (the light being
 // evaluated).
 #include "msm/cube_face.h"
+#include "msm/cascade.h"
 #include "msm/footprint.h"
 #include "msm/local_light.h"
 #include "msm/shading.h"
@@ -29,6 +30,9 @@ bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
 // at its first face's entry, from the face that holds the receiver; the other five only hold maps.
 bool is_point(int l) { return is_spot(l) && lights[l].spot_cone.w > 0.5f; }
 bool is_other_point_face(int l) { return is_spot(l) && lights[l].spot_cone.w > 1.5f; }
+// Whether the directional lights have cascades (FrameConfig::cascades > 1): a constant, so that
+// frames without them compile none of the cascades' weights.
+layout(constant_id = MSM_SPEC_CASCADES) const bool kCascades = false;
 
 layout(binding = MSM_BINDING_SHADING_ALBEDO_TEXTURE) uniform sampler2D albedo_texture;
 layout(binding = MSM_BINDING_SHADING_OPACITY_TEXTURE) uniform sampler2D
@@ -212,6 +216,13 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
                                             dot(-towards_light, lights[l].spot_axis.xyz), lights[l].spot_cone.x,
                                             lights[l].spot_cone.y);
   }
+  // A cascade of a directional light brings its share at the surface's view depth (msm/cascade.h):
+  // none outside its slice (no lookup there), part of it in the bands where it blends with the next.
+  float cascade_weight = 1.0f;
+  if (kCascades && !is_spot(l))
+    cascade_weight =
+        msm_cascade_weight(lights[l].cascade, (frame.camera_view_projection * vec4(world_position, 1.0f)).w);
+  irradiance *= cascade_weight;
   float n_dot_l = dot(n, towards_light);
   // Area lights: the cosine integrated over the part of the light above the surface's horizon
   // (msm/light_probe.h; Eq. 15's π sin² α cos would go negative where the light dips below it):
@@ -242,6 +253,7 @@ vec3 add_direct_light(int l, vec3 n, MsmFootprint pixel, inout vec3 direct, inou
   // Where a spot light brings nothing (outside its cone, beyond its range) its visibility is 0, as
   // where a surface faces away from a light.
   if (is_spot(l) && max(irradiance.r, max(irradiance.g, irradiance.b)) <= 0.0f) lit = 0.0f;
+  if (cascade_weight <= 0.0f) lit = 0.0f;
   vec3 v = light_visibility(l, n, n_dot_l, lit, pixel);
   float w;
   if (sub_count > 0) {
