@@ -31,7 +31,9 @@ void throw_unknown_setting(std::string_view key, const std::vector<std::string>&
 std::string setting_range_text(const SettingRule& s) {
   switch (s.type) {
   case SettingType::number: return fmt::format("[{}, {}]", float(s.min), float(s.max)); // as the float reads
-  case SettingType::integer: return s.choices.empty() ? fmt::format("[{}, {}]", s.min, s.max) : names_text(s.choices);
+  case SettingType::integer:
+    return s.choices.empty() ? fmt::format("[{}, {}]", std::int64_t(s.min), std::int64_t(s.max))
+                             : names_text(s.choices);
   case SettingType::flag: return "true or false";
   case SettingType::choice: return names_text(s.choices);
   case SettingType::technique: return "a technique (msm techniques)";

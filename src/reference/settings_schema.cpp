@@ -3,7 +3,6 @@
 #include "msm/filter.h"
 
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -89,7 +88,7 @@ const SettingDeclaration kSettings[] = {
      .type = SettingType::integer,
      .help = "Seed of the per-pixel generators",
      .min = 0,
-     .max = double(std::numeric_limits<std::int64_t>::max()),
+     .max = 0x1p53, // every seed exact in JSON
      .get = get_value<&Settings::seed>,
      .set = set_value<&Settings::seed>},
     {.key = "sampler",

@@ -67,7 +67,7 @@ nlohmann::ordered_json light_json(const msm::scene::DirectionalLight& declared, 
 void add_reference_options(CLI::App* cmd, ReferenceOptions& o) {
   add_term(cmd, "--scene", o.scene, " (default fence)");
   add_setting_options(cmd, msm::reference::setting_declarations(), Settings{}, o.given);
-  cmd->get_option("--effect")->required();
+  cmd->get_option("--effect")->required()->default_str("");
   // The spellings of older versions.
   add_deprecated_option(cmd, "--light-extent", "--light-extent-deg", o.given["light_extent_deg"]);
   add_deprecated_option(cmd, "--light-width", "--light-width-deg", o.given["light_width_deg"]);

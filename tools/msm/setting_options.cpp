@@ -15,7 +15,7 @@ namespace {
 // The help line of a setting's option: its meaning and range.
 std::string setting_help(const SettingRule& setting, bool negated) {
   if (negated) return fmt::format("Turn off (on by default): {}", setting.help);
-  if (setting.type == SettingType::number || setting.type == SettingType::integer)
+  if (setting.type == SettingType::number || (setting.type == SettingType::integer && setting.choices.empty()))
     return fmt::format("{}; in {}", setting.help, setting_range_text(setting));
   return std::string(setting.help);
 }

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,8 +35,7 @@ std::vector<json> other_values(const BasicSettingDeclaration<Settings>& setting)
     for (double v : {setting.min, setting.max, 0.5 * (setting.min + setting.max)}) values.push_back(float(v));
     break;
   case SettingType::integer:
-    for (double v : {setting.min, setting.max, 0.5 * (setting.min + setting.max)})
-      values.push_back(v >= 0x1p63 ? std::numeric_limits<std::int64_t>::max() : std::int64_t(v));
+    for (double v : {setting.min, setting.max, 0.5 * (setting.min + setting.max)}) values.push_back(std::int64_t(v));
     break;
   case SettingType::flag: values.push_back(!fallback.get<bool>()); break;
   case SettingType::choice:
