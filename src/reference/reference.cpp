@@ -1,5 +1,6 @@
 // msm::reference: settings, the camera, the per-pixel loop (TBB) and the output images.
 #include "msm/reference/reference.h"
+#include "msm/reference/settings_schema.h"
 
 #include <atomic>
 #include <chrono>
@@ -68,31 +69,16 @@ std::optional<Sampler> parse_sampler(std::string_view name) {
 
 // ---- Settings ----------------------------------------------------------------------------------
 
-namespace {
-
-void check_range(const char* what, long long value, long long lo, long long hi) {
-  if (value < lo || value > hi)
-    throw std::invalid_argument(fmt::format("{} {} is out of range [{}, {}]", what, value, lo, hi));
-}
-
-void check_angle(const char* what, const std::optional<double>& deg) {
-  if (deg && !(std::isfinite(*deg) && *deg >= 0.0 && *deg < 90.0))
-    throw std::invalid_argument(fmt::format("{} {} degrees is out of range [0, 90)", what, *deg));
-}
-
-} // namespace
-
 void validate(const Settings& s) {
-  check_range("width", s.width, 1, kMaxSide);
-  check_range("height", s.height, 1, kMaxSide);
-  check_range("samples", s.samples, 1, kMaxSamples);
-  check_range("shadow map size", s.shadow_size, 1, kMaxShadowSize);
-  check_range("max crossings", s.max_crossings, 1, kMaxCrossings);
-  check_range("threads", s.threads, 0, kMaxThreads);
-  [[maybe_unused]] const FilterKernel kernel(s.filter_size, s.filter_sigma); // throws for a bad size or sigma
-  check_angle("light extent", s.light_extent_deg);
-  check_angle("light width", s.light_width_deg);
-  check_angle("light height", s.light_height_deg);
+  // Each setting in its declared range or choices (msm/reference/settings_schema.h): the ranges
+  // are stated there only.
+  for (const SettingDeclaration& setting : setting_declarations()) try {
+      check_setting(setting, setting.get(s));
+    } catch (const SettingError& e) { throw std::invalid_argument(fmt::format("{}: {}", setting.key, e.what())); }
+  if (s.threads < 0 || s.threads > kMaxThreads)
+    throw std::invalid_argument(fmt::format("threads {} is out of range [0, {}]", s.threads, kMaxThreads));
+  // What a range cannot say: an odd filter size, a light width or height of a disc.
+  [[maybe_unused]] const FilterKernel kernel(s.filter_size, s.filter_sigma);
   if (s.light_shape == LightShape::disc && (s.light_width_deg || s.light_height_deg))
     throw std::invalid_argument("a light width or height applies to a rectangular light only, not a disc");
 }

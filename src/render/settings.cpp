@@ -3,6 +3,7 @@
 #include "frame_config.h"
 #include "msm/rectification.h"
 #include "msm/render/renderer.h"
+#include "msm/render/settings_schema.h"
 #include "msm/techniques.h"
 #include "msm/util/limits.h"
 
@@ -71,28 +72,18 @@ std::string RenderSettings::parameter_text(std::string_view name) const {
 
 void RenderSettings::validate() const {
   find_rendered_technique(technique);
-  auto range = [](std::string_view what, long long v, long long lo, long long hi) {
-    if (v < lo || v > hi) throw RenderError(fmt::format("{} = {} is outside [{}, {}]", what, v, lo, hi));
-  };
-  range("width", width, 1, kMaxImageSide);
-  range("height", height, 1, kMaxImageSide);
+  // Each setting in its declared range or choices: the ranges are stated in the declarations only
+  // (msm/render/settings_schema.h). The technique's parameters are checked against its own below.
+  for (const SettingDeclaration& setting : setting_declarations()) {
+    if (setting.type == SettingType::technique || setting.type == SettingType::parameters) continue;
+    try {
+      check_setting(setting, setting.get(*this));
+    } catch (const SettingError& e) { throw RenderError(fmt::format("{}: {}", setting.key, e.what())); }
+  }
+  // What a range cannot say: rules of one setting's values, and of settings together.
   if (static_cast<long long>(width) * height > kMaxImagePixels)
     throw RenderError(fmt::format("{} x {} pixels is more than the {} allowed", width, height, kMaxImagePixels));
-  range("shadow size", shadow_size, 16, kMaxShadowSize);
-  if (msaa != 1 && msaa != 4 && msaa != 8) throw RenderError(fmt::format("msaa = {}: use 1, 4 or 8", msaa));
-  range("filter size", filter_size, 1, MSM_FILTER_MAX_TAPS);
   if (filter_size % 2 == 0) throw RenderError(fmt::format("filter size = {} must be odd", filter_size));
-  auto finite = [](std::string_view what, float v, float lo, float hi) {
-    if (!std::isfinite(v) || v < lo || v > hi)
-      throw RenderError(fmt::format("{} = {} is outside [{}, {}]", what, v, lo, hi));
-  };
-  finite("filter sigma", filter_sigma, MSM_FILTER_MIN_SIGMA, MSM_FILTER_MAX_SIGMA);
-  finite("over-darkening factor", overdarken, 0.5f, 1.0f);
-  if (cascades) range("cascades", *cascades, 1, scene::kMaxCascades);
-  finite("cascade lambda", cascade_lambda, 0.0f, 1.0f);
-  finite("normal offset", normal_offset, 0.0f, 100.0f);
-  finite("exposure", exposure, 1e-6f, 1e6f);
-  if (depth_bias) finite("depth bias", *depth_bias, -1.0f, 1.0f);
   const Technique& t = find_rendered_technique(technique);
   bool nonlinear = t.nonlinear();
   if (one_pass && !*one_pass && nonlinear)
@@ -100,8 +91,6 @@ void RenderSettings::validate() const {
   bool uses_one_pass = one_pass.value_or(t.one_pass_default());
   if (uses_one_pass && t.soft())
     throw RenderError(fmt::format("{} builds a summed-area table: no one-pass filter", technique));
-  if (light_extent_deg) finite("light extent", *light_extent_deg, 0.0f, 89.0f);
-  if (light_height_deg) finite("light height", *light_height_deg, 0.0f, 89.0f);
   if (front_back_depth && !t.soft())
     throw RenderError(fmt::format("front-and-back-face depth applies to the moment soft shadows (mssm4, mssm6, "
                                   "vssm, cssm8, cssm16), not to {}",
@@ -116,14 +105,14 @@ void RenderSettings::validate() const {
         "not reconstructed above W = {})",
         soft_kernel, t.max_soft_kernel, technique,
         std::log2(4294967295.0 / (double(soft_kernel) * double(soft_kernel))), soft_kernel, t.max_soft_kernel));
-  if (soft_kernel != 0) range("soft kernel", soft_kernel, 3, t.area_light ? t.max_soft_kernel : kSatKernelMax);
+  if (soft_kernel != 0 && (soft_kernel < 3 || soft_kernel > (t.area_light ? t.max_soft_kernel : kSatKernelMax)))
+    throw RenderError(fmt::format("soft kernel = {} is outside [3, {}] for {}", soft_kernel,
+                                  t.area_light ? t.max_soft_kernel : kSatKernelMax, technique));
   if (uses_one_pass && (t.formats[0] == TexelFormat::none || t.formats[1] != TexelFormat::none))
     throw RenderError(fmt::format("the one-pass filter is for techniques with one moment image, not {}", technique));
   if (uses_one_pass && filter_size > kMaxOnePassTaps)
     throw RenderError(
         fmt::format("filter size = {}: the one-pass filter takes at most {} taps", filter_size, kMaxOnePassTaps));
-  if (frame < 0) throw RenderError(fmt::format("frame = {} is negative", frame));
-  finite("translucent alpha threshold", translucent_alpha_threshold, 0.0f, 1.0f);
   for (const auto& [name, value] : parameters) {
     try {
       t.parameter(name);

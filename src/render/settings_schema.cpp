@@ -68,6 +68,11 @@ void set_auto_bool(RenderSettings& s, const json& v) {
 }
 
 json get_technique(const RenderSettings& s) { return s.technique; }
+void check_technique(const json& v) {
+  try {
+    find_rendered_technique(canonical_technique_name(v.get<std::string>()));
+  } catch (const RenderError& e) { throw SettingError(e.what()); }
+}
 void set_technique(RenderSettings& s, const json& v) {
   s.technique = std::string(find_rendered_technique(canonical_technique_name(v.get<std::string>())).name);
 }
@@ -109,6 +114,7 @@ void set_parameters(RenderSettings& s, const json& v) {
 }
 
 using R = RenderSettings;
+constexpr std::string_view kMsaaCounts[] = {"1", "4", "8"};
 constexpr std::string_view kLookups[] = {"auto", "bilinear", "nearest", "dither"}; // R::Lookup's order
 constexpr std::string_view kFilterModes[] = {"auto", "one-pass", "three-pass"};
 constexpr std::string_view kShadings[] = {"auto", "forward", "deferred"};
@@ -118,6 +124,7 @@ const SettingDeclaration kSettings[] = {
     {.key = "technique",
      .type = SettingType::technique,
      .help = "Technique or alias (msm techniques lists them)",
+     .check = check_technique,
      .get = get_technique,
      .set = set_technique},
     {.key = "width",
@@ -139,6 +146,9 @@ const SettingDeclaration kSettings[] = {
      .help = "Shadow map texels per side",
      .min = 16,
      .max = kMaxShadowSize,
+     .control_min = 256,
+     .control_max = 4096,
+     .scale = SettingScale::logarithmic,
      .get = get_value<&R::shadow_size>,
      .set = set_value<&R::shadow_size>},
     {.key = "msaa",
@@ -146,6 +156,7 @@ const SettingDeclaration kSettings[] = {
      .help = "Shadow depth samples: 1, 4 or 8",
      .min = 1,
      .max = 8,
+     .choices = kMsaaCounts,
      .get = get_value<&R::msaa>,
      .set = set_value<&R::msaa>},
     {.key = "filter_size",
@@ -153,6 +164,7 @@ const SettingDeclaration kSettings[] = {
      .help = "Gaussian taps per axis (odd; 1 = no blur)",
      .min = 1,
      .max = MSM_FILTER_MAX_TAPS,
+     .control_step = 2, // odd
      .get = get_value<&R::filter_size>,
      .set = set_value<&R::filter_size>},
     {.key = "filter_sigma",
@@ -160,6 +172,8 @@ const SettingDeclaration kSettings[] = {
      .help = "Gaussian standard deviation in texels",
      .min = MSM_FILTER_MIN_SIGMA,
      .max = MSM_FILTER_MAX_SIGMA,
+     .control_min = 0.1,
+     .control_max = 16,
      .get = get_value<&R::filter_sigma>,
      .set = set_value<&R::filter_sigma>},
     {.key = "mipmaps",
@@ -184,6 +198,7 @@ const SettingDeclaration kSettings[] = {
      .help = "Normal offset in shadow-map texels",
      .min = 0,
      .max = 100,
+     .control_max = 4,
      .get = get_value<&R::normal_offset>,
      .set = set_value<&R::normal_offset>},
     {.key = "depth_bias",
@@ -192,6 +207,8 @@ const SettingDeclaration kSettings[] = {
      .min = -1,
      .max = 1,
      .nullable = true,
+     .control_max = 0.05,
+     .scale = SettingScale::logarithmic,
      .get = get_optional<&R::depth_bias>,
      .set = set_optional<&R::depth_bias>},
     {.key = "receiver_plane_bias",
@@ -207,6 +224,8 @@ const SettingDeclaration kSettings[] = {
      .help = "Exposure before tone mapping",
      .min = 1e-6,
      .max = 1e6,
+     .control_min = 0.1,
+     .control_max = 4,
      .get = get_value<&R::exposure>,
      .set = set_value<&R::exposure>},
     {.key = "lookup",
@@ -248,6 +267,7 @@ const SettingDeclaration kSettings[] = {
      .help = "Blue-noise layer and offset of the dithered lookups",
      .min = 0,
      .max = 1 << 30,
+     .control_max = 63,
      .get = get_value<&R::frame>,
      .set = set_value<&R::frame>},
     {.key = "translucent_occluders",
@@ -265,6 +285,7 @@ const SettingDeclaration kSettings[] = {
      .help = "Translucent fragments below this opacity are not blended (JCGT: 1%)",
      .min = 0,
      .max = 1,
+     .control_max = 0.5,
      .get = get_value<&R::translucent_alpha_threshold>,
      .set = set_value<&R::translucent_alpha_threshold>},
     {.key = "cascades",
@@ -294,6 +315,7 @@ const SettingDeclaration kSettings[] = {
      .min = 0,
      .max = 89,
      .nullable = true,
+     .control_max = 20,
      .get = get_optional<&R::light_extent_deg>,
      .set = set_optional<&R::light_extent_deg>},
     {.key = "light_height_deg",
@@ -303,6 +325,7 @@ const SettingDeclaration kSettings[] = {
      .min = 0,
      .max = 89,
      .nullable = true,
+     .control_max = 20,
      .get = get_optional<&R::light_height_deg>,
      .set = set_optional<&R::light_height_deg>},
     {.key = "soft_kernel",
@@ -321,128 +344,14 @@ const SettingDeclaration kSettings[] = {
      .set = set_value<&R::front_back_depth>},
 };
 
-std::string names_text(std::span<const std::string_view> names) {
-  std::string text;
-  for (size_t i = 0; i < names.size(); ++i)
-    text += fmt::format("{}{}", i == 0 ? "" : i + 1 == names.size() ? " or " : ", ", names[i]);
-  return text;
-}
-
 } // namespace
 
 std::span<const SettingDeclaration> setting_declarations() { return kSettings; }
 
-std::vector<std::string> setting_keys() {
-  std::vector<std::string> keys;
-  for (const SettingDeclaration& s : kSettings) keys.emplace_back(s.key);
-  return keys;
-}
+std::vector<std::string> setting_keys() { return msm::setting_keys(setting_declarations()); }
 
-const SettingDeclaration& find_setting(std::string_view key) {
-  for (const SettingDeclaration& s : kSettings)
-    if (s.key == key) return s;
-  throw SettingError(fmt::format("unknown setting{}", util::did_you_mean(key, setting_keys())));
-}
+const SettingDeclaration& find_setting(std::string_view key) { return msm::find_setting(setting_declarations(), key); }
 
-std::string setting_range_text(const SettingDeclaration& s) {
-  switch (s.type) {
-  case SettingType::number: return fmt::format("[{}, {}]", float(s.min), float(s.max)); // as the float reads
-  case SettingType::integer: return fmt::format("[{}, {}]", s.min, s.max);
-  case SettingType::flag: return "true or false";
-  case SettingType::choice: return names_text(s.choices);
-  case SettingType::technique: return "a technique (msm techniques)";
-  case SettingType::parameters: return "{\"NAME\": value, ...}";
-  }
-  return "";
-}
-
-void check_setting(const SettingDeclaration& s, const json& v) {
-  if (s.nullable && v.is_null()) return;
-  auto expected = [&](std::string_view what) {
-    throw SettingError(fmt::format("expected {}, got {}", what, v.dump()));
-  };
-  switch (s.type) {
-  case SettingType::number:
-    if (!v.is_number() || !std::isfinite(v.get<double>())) expected("a number");
-    break;
-  case SettingType::integer:
-    if (!v.is_number_integer() || v.get<long long>() < INT_MIN || v.get<long long>() > INT_MAX) expected("an integer");
-    break;
-  case SettingType::flag:
-    if (!v.is_boolean()) expected("true or false");
-    break;
-  case SettingType::choice:
-  case SettingType::technique:
-    if (!v.is_string()) expected("a string");
-    break;
-  case SettingType::parameters:
-    if (!v.is_null() && !v.is_object()) expected("{\"NAME\": value, ...} or null");
-    if (v.is_object())
-      for (const auto& [name, value] : v.items())
-        if (!value.is_string() && !value.is_boolean() && !value.is_number())
-          throw SettingError(fmt::format("expected a number, true/false or a name, got {}", value.dump()), "/" + name);
-    break;
-  }
-  if ((s.type == SettingType::number || s.type == SettingType::integer) &&
-      !(v.get<double>() >= s.min && v.get<double>() <= s.max))
-    throw SettingError(fmt::format("{} is outside {}", v.dump(), setting_range_text(s)));
-  if (s.type == SettingType::choice) {
-    const std::string name = v.get<std::string>();
-    if (std::find(s.choices.begin(), s.choices.end(), name) == s.choices.end()) {
-      const std::vector<std::string> choices(s.choices.begin(), s.choices.end());
-      throw SettingError(
-          fmt::format("'{}': expected {}{}", name, names_text(s.choices), util::did_you_mean(name, choices)));
-    }
-  }
-  if (s.type == SettingType::technique) try {
-      find_rendered_technique(canonical_technique_name(v.get<std::string>()));
-    } catch (const RenderError& e) { throw SettingError(e.what()); }
-}
-
-void apply_setting(RenderSettings& settings, const SettingDeclaration& setting, const json& value) {
-  check_setting(setting, value);
-  setting.set(settings, value);
-}
-
-json settings_json(const RenderSettings& settings) {
-  json out = json::object();
-  for (const SettingDeclaration& s : kSettings) out[std::string(s.key)] = s.get(settings);
-  return out;
-}
-
-std::string setting_option_name(const SettingDeclaration& s, const RenderSettings& defaults) {
-  std::string name(s.key);
-  std::replace(name.begin(), name.end(), '_', '-');
-  if (s.type == SettingType::flag && s.get(defaults).get<bool>()) return "--no-" + name;
-  return "--" + name;
-}
-
-json setting_from_text(const SettingDeclaration& s, std::string_view text) {
-  const std::string t(text);
-  char* end = nullptr;
-  errno = 0;
-  switch (s.type) {
-  case SettingType::number: {
-    const double v = std::strtod(t.c_str(), &end);
-    if (t.empty() || *end != '\0' || !std::isfinite(v))
-      throw SettingError(fmt::format("expected a number, got '{}'", t));
-    return float(v);
-  }
-  case SettingType::integer: {
-    const long long v = std::strtoll(t.c_str(), &end, 10);
-    if (t.empty() || *end != '\0' || errno == ERANGE || v < INT_MIN || v > INT_MAX)
-      throw SettingError(fmt::format("expected an integer, got '{}'", t));
-    return int(v);
-  }
-  case SettingType::flag:
-    if (t == "true" || t == "on" || t == "1") return true;
-    if (t == "false" || t == "off" || t == "0") return false;
-    throw SettingError(fmt::format("expected true or false, got '{}'", t));
-  case SettingType::choice:
-  case SettingType::technique: return t;
-  case SettingType::parameters: break;
-  }
-  throw SettingError("set each parameter by name: NAME=VALUE");
-}
+json settings_json(const RenderSettings& settings) { return msm::settings_json(setting_declarations(), settings); }
 
 } // namespace msm::render

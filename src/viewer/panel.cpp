@@ -1,5 +1,6 @@
 // The viewer's panel, camera fly and script actions: each control and each action calls the same
 // setter, so a script exercises what the panel does.
+#include "setting_controls.h"
 #include "viewer_state.h"
 
 #include "msm/render/settings_schema.h"
@@ -52,12 +53,63 @@ std::vector<std::string> technique_names() {
 // A setting through the view file's setter (the one `set KEY VALUE` uses).
 void set(render::RenderSettings& s, const char* key, const nlohmann::json& value) { apply_setting(s, key, value); }
 
-// A choice setting's combo over its declared choices (msm/render/settings_schema.h).
-void choose_setting(render::RenderSettings& s, const char* label, const char* key) {
-  const render::SettingDeclaration& setting = render::find_setting(key);
-  std::string value = setting.get(s).get<std::string>();
-  if (choose(label, value, std::vector<std::string>(setting.choices.begin(), setting.choices.end())))
-    set(s, key, value);
+// A number or integer setting's slider over its control's range (an integer kept on its steps).
+bool setting_slider(const SettingControl& c, const char* label, nlohmann::json& value) {
+  const ImGuiSliderFlags flags = c.logarithmic ? ImGuiSliderFlags_Logarithmic : ImGuiSliderFlags_None;
+  if (c.setting->type == SettingType::integer) {
+    int v = value.get<int>();
+    if (!ImGui::SliderInt(label, &v, int(c.min), int(c.max), "%d", flags)) return false;
+    value = int(c.min) + (v - int(c.min)) / c.step * c.step;
+    return true;
+  }
+  float v = value.get<float>();
+  if (!ImGui::SliderFloat(label, &v, float(c.min), float(c.max), "%.3g", flags)) return false;
+  value = v;
+  return true;
+}
+
+// A plain setting's control (setting_controls.h): a checkbox, a combo over its declared choices, a
+// slider, or for a nullable number a checkbox for its own value (from the resolved default) and
+// its slider; the declaration's meaning and range as the tooltip. The value goes through the view
+// file's setter, checked against the declaration.
+void setting_control(render::RenderSettings& s, const SettingControl& c) {
+  const render::SettingDeclaration& setting = *c.setting;
+  nlohmann::json value = setting.get(s);
+  bool changed = false;
+  ImGui::BeginDisabled(!c.enabled);
+  switch (c.kind) {
+  case ControlKind::checkbox: {
+    bool on = value.get<bool>();
+    changed = ImGui::Checkbox(c.label.c_str(), &on);
+    value = on;
+    break;
+  }
+  case ControlKind::combo: {
+    std::string text = value.is_string() ? value.get<std::string>() : value.dump();
+    if ((changed =
+             choose(c.label.c_str(), text, std::vector<std::string>(setting.choices.begin(), setting.choices.end()))))
+      value = setting.type == SettingType::integer ? nlohmann::json(std::stoi(text)) : nlohmann::json(text);
+    break;
+  }
+  case ControlKind::slider: changed = setting_slider(c, c.label.c_str(), value); break;
+  case ControlKind::optional: {
+    bool own = !value.is_null();
+    if (ImGui::Checkbox(own ? fmt::format("##own {}", c.label).c_str() : c.label.c_str(), &own)) {
+      value = own ? nlohmann::json(optional_start(s, c)) : nlohmann::json();
+      changed = true;
+    }
+    if (own && !value.is_null()) {
+      ImGui::SameLine();
+      changed |= setting_slider(c, c.label.c_str(), value);
+    }
+    break;
+  }
+  default: break;
+  }
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("%s (%s)", std::string(setting.help).c_str(), render::setting_range_text(setting).c_str());
+  if (changed) set(s, std::string(setting.key).c_str(), value);
 }
 
 // One widget per declared parameter of the technique (msm/cpu/techniques.h), its meaning as the
@@ -332,69 +384,53 @@ void Viewer::choices_section() {
   }
 }
 
-// The technique's parameters, its shadow map, filter and bias, its light and the shading's settings.
+// Every declared render setting's control (setting_controls.h), in the table's order: the
+// technique's parameters, its shadow map, filter and bias, the shading's settings and its light.
 void Viewer::technique_settings_section() {
   render::RenderSettings& s = view.settings;
   const Technique& t = render::find_rendered_technique(s.technique);
-  technique_parameters(s, t);
-  bool own_bias = s.depth_bias.has_value();
-  if (ImGui::Checkbox("depth bias", &own_bias)) {
-    if (own_bias)
-      s.depth_bias = s.resolved_depth_bias();
-    else
-      s.depth_bias.reset();
-  }
-  if (s.depth_bias) {
-    ImGui::SameLine();
-    ImGui::DragFloat("##depth_bias", &*s.depth_bias, 1e-6f, 0.0f, 0.05f, "%.2e");
-  }
-  int taps = s.filter_size;
-  if (ImGui::SliderInt("kernel taps", &taps, 1, 63)) s.filter_size = taps | 1;
-  ImGui::SliderFloat("sigma", &s.filter_sigma, 0.1f, 16.0f);
-  std::string size = std::to_string(s.shadow_size);
-  if (choose("shadow map", size, {"256", "512", "1024", "2048", "4096"})) s.shadow_size = std::stoi(size);
-  std::string msaa = std::to_string(s.msaa);
-  if (choose("MSAA", msaa, {"1", "4", "8"})) s.msaa = std::stoi(msaa);
-  ImGui::Checkbox("mipmaps", &s.mipmaps);
-  choose_setting(s, "filter", "filter_mode");
-  choose_setting(s, "lookup", "lookup");
-  if (t.area_light) {
-    ImGui::SliderInt("soft kernel", &s.soft_kernel, 0, t.max_soft_kernel);
-    // A disc: one extent. A rectangle (the scene light's own, or made one here): its width along
-    // the light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider.
-    const scene::DirectionalLight drawn =
-        scene::overridden_light(scene.light(), s.light_extent_deg, s.light_height_deg);
-    float extent = drawn.angular_extent_deg;
-    bool rectangle = drawn.rectangular();
-    float height = drawn.angular_height_deg.value_or(extent);
-    if (ImGui::Checkbox("rectangular light", &rectangle)) {
-      s.light_extent_deg = extent;
-      if (rectangle)
-        s.light_height_deg = height;
-      else
-        s.light_height_deg.reset();
+  for (const SettingControl& c : setting_controls(t)) {
+    switch (c.kind) {
+    case ControlKind::technique: break; // choices_section
+    case ControlKind::parameters: technique_parameters(s, t); break;
+    case ControlKind::window_size:
+      if (c.setting->key == "width") ImGui::TextDisabled("image %dx%d: the window's size", s.width, s.height);
+      break;
+    case ControlKind::light:
+      if (c.enabled && c.setting->key == "light_extent_deg") light_shape_controls(s, c);
+      break;
+    default: setting_control(s, c);
     }
-    if (ImGui::SliderFloat(rectangle ? "light width (deg)" : "light extent (deg)", &extent, 0.0f, 20.0f)) {
-      s.light_extent_deg = extent;
-      if (rectangle) s.light_height_deg = height;
-    }
-    if (rectangle && ImGui::SliderFloat("light height (deg)", &height, 0.0f, 20.0f)) {
-      s.light_extent_deg = extent;
+  }
+}
+
+// A disc: one extent. A rectangle (the scene light's own, or made one here): its width along the
+// light frame's x axis and its height (RenderSettings::light_height_deg), each its own slider over
+// the declared control range.
+void Viewer::light_shape_controls(render::RenderSettings& s, const SettingControl& c) {
+  const scene::DirectionalLight drawn = scene::overridden_light(scene.light(), s.light_extent_deg, s.light_height_deg);
+  float extent = drawn.angular_extent_deg;
+  bool rectangle = drawn.rectangular();
+  float height = drawn.angular_height_deg.value_or(extent);
+  if (ImGui::Checkbox("rectangular light", &rectangle)) {
+    s.light_extent_deg = extent;
+    if (rectangle)
       s.light_height_deg = height;
-    }
+    else
+      s.light_height_deg.reset();
   }
-  // Kneiphof §4.2.3: the moments of the mean of the nearest front- and back-face depth (a second
-  // depth pass); the soft techniques only, greyed out for the others.
-  ImGui::BeginDisabled(!t.soft());
-  ImGui::Checkbox("front+back face depth", &s.front_back_depth);
-  ImGui::EndDisabled();
-  ImGui::Checkbox("translucent occluders", &s.translucent_occluders);
-  ImGui::Checkbox("coloured translucency", &s.coloured_translucency);
-  ImGui::SliderFloat("alpha threshold", &s.translucent_alpha_threshold, 0.0f, 0.5f);
-  ImGui::SliderFloat("over-darkening", &s.overdarken, 0.5f, 1.0f);
-  ImGui::SliderFloat("normal offset", &s.normal_offset, 0.0f, 4.0f);
-  ImGui::SliderFloat("receiver-plane bias", &s.receiver_plane_bias, 0.0f, 4.0f);
-  ImGui::SliderFloat("exposure", &s.exposure, 0.1f, 4.0f);
+  if (ImGui::SliderFloat(rectangle ? "light width deg" : "light extent deg", &extent, float(c.min), float(c.max))) {
+    s.light_extent_deg = extent;
+    if (rectangle) s.light_height_deg = height;
+  }
+  if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(c.setting->help).c_str());
+  const render::SettingDeclaration& h = render::find_setting("light_height_deg");
+  const auto [height_min, height_max] = render::setting_control_range(h);
+  if (rectangle && ImGui::SliderFloat("light height deg", &height, float(height_min), float(height_max))) {
+    s.light_extent_deg = extent;
+    s.light_height_deg = height;
+  }
+  if (rectangle && ImGui::IsItemHovered()) ImGui::SetTooltip("%s", std::string(h.help).c_str());
 }
 
 // The light's direction and animation, the objects' animation and the camera's fly speed.

@@ -4,6 +4,7 @@
 
 #include "ground_truth.h"
 #include "panel_layout.h"
+#include "setting_controls.h"
 
 #include "msm/image/metrics.h"
 #include "msm/render/renderer.h"
@@ -64,6 +65,7 @@ struct Viewer {
   // The panel's parts, each drawn by panel() under its header.
   void choices_section();
   void technique_settings_section();
+  void light_shape_controls(render::RenderSettings& settings, const SettingControl& control);
   void light_and_camera_section();
   void gpu_time_section();
   void ground_truth_section();

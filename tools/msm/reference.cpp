@@ -23,6 +23,7 @@
 #include "commands.h"
 #include "msm/image/io.h"
 #include "msm/reference/reference.h"
+#include "msm/reference/settings_schema.h"
 #include "msm/scene/scene.h"
 #include "msm/shading.h"
 #include "msm/util/clock.h"
@@ -30,6 +31,8 @@
 #include "msm/util/output_dir.h"
 #include "msm/util/progress.h"
 #include "reference_look.h"
+#include "reference_options.h"
+#include "setting_options.h"
 #include "usage.h"
 #include "vocabulary.h"
 
@@ -59,58 +62,25 @@ nlohmann::ordered_json light_json(const msm::scene::DirectionalLight& declared, 
           {"overrides", overrides}};
 }
 
-// The options of msm reference, as given.
-struct ReferenceOptions {
-  std::string scene{msm::scene::default_scene_name()};
-  std::string effect, out = "out/reference", light_shape, sampler = "stratified";
-  int width = 640, height = 360, samples = 256, shadow_size = 1024, filter_size = MSM_FILTER_DEFAULT_TAPS,
-      max_crossings = 64, threads = 0;
-  std::uint64_t seed = 1;
-  double filter_sigma = MSM_FILTER_DEFAULT_SIGMA;
-  std::optional<double> light_extent, light_width, light_height;
-  std::string probe;             // a probe instead of the scene's lighting (scene::set_probe)
-  std::optional<int> lights;     // the probe's area lights (scene::set_probe_light_count)
-  std::optional<int> sub_lights; // and their sub-lights
-  int frame = 0;                 // of a dynamic scene (msm render --frames)
-  float probe_rotation_speed = 0.0f;
-  bool json = false, progress = false, probe_lights = false;
-};
+} // namespace
 
 void add_reference_options(CLI::App* cmd, ReferenceOptions& o) {
   add_term(cmd, "--scene", o.scene, " (default fence)");
-  cmd->add_option("--effect", o.effect, "hard | filtered | soft | translucent | scattering | environment")->required();
-  add_term(cmd, "--width", o.width, " (default 640)");
-  add_term(cmd, "--height", o.height, " (default 360)");
-  cmd->add_option("--samples", o.samples, "Samples per pixel of filtered, soft and scattering (default 256)");
-  cmd->add_option("--seed", o.seed, "Seed of the per-pixel generators (default 1)");
-  cmd->add_option("--sampler", o.sampler, "stratified (default) | independent");
-  add_term(cmd, "--shadow-size", o.shadow_size, ", filtered (default 1024)");
-  add_term(cmd, "--filter-size", o.filter_size, ", filtered")->capture_default_str();
-  add_term(cmd, "--filter-sigma", o.filter_sigma, ", filtered")->capture_default_str();
-  add_term(cmd, "--light-extent-deg", o.light_extent,
-           ", soft: the light becomes a disc of this diameter, as msm render --light-extent-deg makes it (default: "
-           "the scene's light as it declares it)");
-  cmd->add_option("--light-shape", o.light_shape,
-                  "soft: override the light's shape: disc | rectangle (default: the scene light's own)");
-  add_term(cmd, "--light-width-deg", o.light_width, ", soft (default: the light's extent)");
-  add_term(cmd, "--light-height-deg", o.light_height,
-           ", soft, as msm render --light-height-deg (default: the light's own, else its extent)");
+  add_setting_options(cmd, msm::reference::setting_declarations(), Settings{}, o.given);
+  cmd->get_option("--effect")->required()->default_str("");
   // The spellings of older versions.
-  add_deprecated_option(cmd, "--light-extent", "--light-extent-deg", o.light_extent);
-  add_deprecated_option(cmd, "--light-width", "--light-width-deg", o.light_width);
-  add_deprecated_option(cmd, "--light-height", "--light-height-deg", o.light_height);
-  add_deprecated_flag(cmd, "--probe-lights", "--extracted-lights", o.probe_lights);
-  cmd->add_option("--max-crossings", o.max_crossings, "translucent: surfaces counted per light ray (default 64)");
+  add_deprecated_option(cmd, "--light-extent", "--light-extent-deg", o.given["light_extent_deg"]);
+  add_deprecated_option(cmd, "--light-width", "--light-width-deg", o.given["light_width_deg"]);
+  add_deprecated_option(cmd, "--light-height", "--light-height-deg", o.given["light_height_deg"]);
+  add_deprecated_flag(cmd, "--probe-lights", "--extracted-lights", o.deprecated_probe_lights);
   add_term(cmd, "--probe", o.probe,
            ": lights the scene instead of its own lights (image-based lighting; the scene's probe settings are "
            "kept, else 32 lights, 128² per face), as msm render --probe");
   add_term(cmd, "--lights", o.lights, " (default: the scene's)");
   add_term(cmd, "--sub-lights", o.sub_lights, " (default: the scene's); --extracted-lights traces them");
-  cmd->add_flag("--extracted-lights", o.probe_lights,
-                "environment: light with the probe's extracted area lights (uniform cones) instead of the full probe");
   add_term(cmd, "--frame", o.frame,
            ", traced as msm render --frames draws it, its probe turned K times --probe-rotation-speed")
-      ->check(CLI::Range(0, 9999));
+      ->check(integer_range("--frame", 0, 9999));
   add_term(cmd, "--probe-rotation-speed", o.probe_rotation_speed, " (with --frame)");
   add_term(cmd, "--threads", o.threads, " (default 0: all cores)");
   add_term(cmd, "--out", o.out, " (default out/reference)");
@@ -118,44 +88,23 @@ void add_reference_options(CLI::App* cmd, ReferenceOptions& o) {
   add_term_flag(cmd, "--progress", o.progress);
 }
 
-// The ray tracer's settings of the options; UsageError for a bad value.
-Settings reference_settings(const ReferenceOptions& o, const CLI::App& cmd) {
+Settings reference_settings(ReferenceOptions& o) {
+  if (o.deprecated_probe_lights) o.given["extracted_lights"] = "true";
   Settings settings;
-  const auto effect = msm::reference::parse_effect(o.effect);
-  if (!effect)
-    throw UsageError(
-        fmt::format("--effect {}: expected hard, filtered, soft, translucent, scattering or environment", o.effect));
-  if (o.probe_lights && *effect != msm::reference::Effect::environment)
-    throw UsageError("--extracted-lights applies to --effect environment only");
-  settings.probe_lights = o.probe_lights;
-  settings.effect = *effect;
-  if (cmd.count("--light-shape") > 0) {
-    const auto shape = msm::reference::parse_light_shape(o.light_shape);
-    if (!shape) throw UsageError(fmt::format("--light-shape {}: expected disc or rectangle", o.light_shape));
-    settings.light_shape = *shape;
-  }
-  const auto sampler = msm::reference::parse_sampler(o.sampler);
-  if (!sampler) throw UsageError(fmt::format("--sampler {}: expected stratified or independent", o.sampler));
-  settings.sampler = *sampler;
-  settings.width = o.width;
-  settings.height = o.height;
-  settings.samples = o.samples;
-  settings.seed = o.seed;
-  settings.shadow_size = o.shadow_size;
-  settings.filter_size = o.filter_size;
-  settings.filter_sigma = o.filter_sigma;
-  settings.light_extent_deg = o.light_extent;
-  settings.light_width_deg = o.light_width;
-  settings.light_height_deg = o.light_height;
-  settings.max_crossings = o.max_crossings;
+  apply_given_settings(msm::reference::setting_declarations(), o.given, settings);
   settings.threads = o.threads;
-  if (settings.light_shape == msm::reference::LightShape::disc && (o.light_width || o.light_height))
+  if (settings.probe_lights && settings.effect != msm::reference::Effect::environment)
+    throw UsageError("--extracted-lights applies to --effect environment only");
+  if (settings.light_shape == msm::reference::LightShape::disc &&
+      (settings.light_width_deg || settings.light_height_deg))
     throw UsageError("--light-width-deg / --light-height-deg make a rectangle: they cannot go with --light-shape disc");
   try {
     msm::reference::validate(settings);
   } catch (const std::invalid_argument& e) { throw UsageError(e.what()); }
   return settings;
 }
+
+namespace {
 
 // The scene as traced: its probe (--probe, turned to --frame), its animated objects at --frame, its
 // probe's light count; UsageError where the effect needs what the scene lacks.
@@ -244,21 +193,14 @@ nlohmann::ordered_json reference_json(const msm::scene::Scene& scene, const Sett
                                       const std::vector<std::string>& warnings, const msm::reference::Result& result) {
   nlohmann::ordered_json j;
   j["scene"] = {{"name", scene.name}, {"source", scene.source.string()}, {"triangles", scene.triangle_count()}};
-  j["effect"] = std::string(msm::reference::to_string(settings.effect));
+  // Every declared setting under its key (msm/reference/settings_schema.h), as render.json has
+  // its own; those msm render has too under the render settings' keys.
+  j.update(msm::reference::settings_json(settings));
   j["frame"] = frame;
-  j["width"] = settings.width;
-  j["height"] = settings.height;
-  j["samples"] = result.samples;
-  j["sampler"] = std::string(msm::reference::to_string(settings.sampler));
-  j["seed"] = settings.seed;
-  // Under the render settings' keys (msm/render/settings_schema.h), as render.json has them.
-  j["shadow_size"] = settings.shadow_size;
-  j["filter_size"] = settings.filter_size;
-  j["filter_sigma"] = settings.filter_sigma;
+  j["samples_per_pixel"] = result.samples; // as traced: 1 for hard and translucent
   if (!scene.lights.empty()) j["light"] = light_json(scene.light(), settings, result);
   for (const msm::scene::LightKindInfo& kind : msm::scene::light_kinds())
     j["light_counts"][std::string(kind.name)] = scene.light_count(kind.kind);
-  j["max_crossings"] = settings.max_crossings;
   j["warnings"] = warnings;
   j["threads"] = result.threads;
   j["rays"] = result.rays;
@@ -305,7 +247,7 @@ void add_reference(CLI::App& app) {
   add_reference_options(cmd, *opt);
   cmd->callback([opt, cmd] {
     const auto start = std::chrono::steady_clock::now();
-    Settings settings = reference_settings(*opt, *cmd);
+    Settings settings = reference_settings(*opt);
     msm::scene::Scene scene = reference_scene(*opt, *cmd, settings);
     // The filtered effect traces the renderer's shadow map: the warnings of its framing.
     std::vector<std::string> warnings;
@@ -349,8 +291,8 @@ void add_reference(CLI::App& app) {
       fmt::print("{}", text);
     else
       fmt::print("msm reference: {} {} {}x{}, {} spp: mean visibility {:.4f}, {:.2f} s ({} rays) -> {}\n", scene.name,
-                 opt->effect, settings.width, settings.height, result.samples, result.mean_visibility,
-                 result.render_seconds, result.rays, out.string());
+                 msm::reference::to_string(settings.effect), settings.width, settings.height, result.samples,
+                 result.mean_visibility, result.render_seconds, result.rays, out.string());
   });
 }
 

@@ -72,7 +72,7 @@ void add_render(CLI::App& app) {
                   "Frames to render of a dynamic scene, with their timings: each frame splits the scene's (turned) "
                   "light probe into its area lights again on the device, and moves its animated objects (an "
                   "object's \"motion\"; frames.h)")
-      ->check(CLI::Range(1, 10000));
+      ->check(integer_range("--frames", 1, 10000));
   add_term(cmd, "--probe-rotation-speed", opt->frames.rotation_speed_deg, " (with --frames)");
   add_term(cmd, "--probe", opt->probe,
            ": lights the scene instead of its own lights (image-based lighting; the scene's probe settings are "

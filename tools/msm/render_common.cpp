@@ -1,4 +1,5 @@
 #include "render_common.h"
+#include "setting_options.h"
 #include "vocabulary.h"
 
 #include "msm/image/io.h"
@@ -20,75 +21,9 @@
 
 namespace msm::tool {
 
-namespace {
-
-using render::SettingDeclaration;
-using render::SettingType;
-
-// The help line of a setting's option: its meaning and range.
-std::string setting_help(const SettingDeclaration& setting, bool negated) {
-  if (negated) return fmt::format("Turn off (on by default): {}", setting.help);
-  if (setting.type == SettingType::number || setting.type == SettingType::integer)
-    return fmt::format("{}; in {}", setting.help, render::setting_range_text(setting));
-  return std::string(setting.help);
-}
-
-std::string default_text(const nlohmann::json& value) {
-  if (value.is_null()) return "";
-  if (value.is_string()) return value.get<std::string>();
-  if (value.is_number_float()) return fmt::format("{}", value.get<float>());
-  return value.dump();
-}
-
-// One setting's option: its text is kept in options.given and applied by finish_frame_options;
-// a value that is not of the setting's type is a parse error naming the option.
-void add_setting_option(CLI::App* cmd, FrameOptions& o, const SettingDeclaration& setting) {
-  const std::string name = render::setting_option_name(setting, o.settings);
-  const std::string key(setting.key);
-  std::optional<std::string>& text = o.given[key];
-  if (setting.type == SettingType::flag) {
-    const bool value = !setting.get(o.settings).get<bool>();
-    cmd->add_flag_callback(
-        name, [&text, value] { text = value ? "true" : "false"; }, setting_help(setting, !value));
-    return;
-  }
-  CLI::Option* option = cmd->add_option(name, text, setting_help(setting, false));
-  option->type_name(setting.type == SettingType::number    ? "FLOAT"
-                    : setting.type == SettingType::integer ? "INT"
-                                                           : "TEXT");
-  option->default_str(setting.nullable ? "" : default_text(setting.get(o.settings)));
-  option->check([&setting](const std::string& value) -> std::string {
-    try {
-      render::setting_from_text(setting, value);
-    } catch (const render::SettingError& e) { return e.what(); }
-    return {};
-  });
-}
-
-// Why a setting's value from the command line is refused, in the words the renderer's own checks
-// use ("width = 0 is outside [1, 16384]").
-std::string setting_problem(const SettingDeclaration& setting, const std::string& option, const std::string& text,
-                            const render::SettingError& error) {
-  if (setting.type == SettingType::choice) {
-    const std::vector<std::string> choices(setting.choices.begin(), setting.choices.end());
-    return fmt::format("{} {}: use {}{}", option, text, render::setting_range_text(setting),
-                       util::did_you_mean(text, choices));
-  }
-  if (setting.type == SettingType::number || setting.type == SettingType::integer) {
-    std::string label(setting.key);
-    std::replace(label.begin(), label.end(), '_', ' ');
-    return fmt::format("{} = {} is outside {} ({})", label, text, render::setting_range_text(setting), option);
-  }
-  return fmt::format("{} {}: {}", option, text, error.what());
-}
-
-} // namespace
-
 void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   add_term(cmd, "--scene", o.scene)->capture_default_str();
-  for (const SettingDeclaration& setting : render::setting_declarations())
-    if (setting.type != SettingType::technique && setting.type != SettingType::parameters)
-      add_setting_option(cmd, o, setting);
+  add_setting_options(cmd, render::setting_declarations(), o.settings, o.given);
   cmd->get_option("--noise-frame")
       ->description(fmt::format("{} (default: the --frame)", render::find_setting("noise_frame").help))
       ->default_str("");
@@ -105,7 +40,7 @@ void add_frame_options(CLI::App* cmd, FrameOptions& o) {
   // The positional vector of older versions: still read for one version, with a warning.
   cmd->add_option("--param", o.params, "")->delimiter(',')->group("");
   add_term(cmd, "--frame", o.animation_frame, ", as msm reference --frame K traces it (default 0)")
-      ->check(CLI::Range(0, 9999));
+      ->check(integer_range("--frame", 0, 9999));
   add_term(cmd, "--device", o.device);
 }
 
@@ -115,14 +50,7 @@ void finish_frame_options(FrameOptions& o) {
     fmt::print(stderr, "msm: warning: --param is deprecated and goes in the next version: set each parameter by "
                        "name with --set NAME=VALUE (msm techniques NAME lists them)\n");
   }
-  for (const auto& [key, text] : o.given) {
-    if (!text) continue;
-    const SettingDeclaration& setting = render::find_setting(key);
-    const std::string option = render::setting_option_name(setting, render::RenderSettings{});
-    try {
-      render::apply_setting(o.settings, setting, render::setting_from_text(setting, *text));
-    } catch (const render::SettingError& e) { throw UsageError(setting_problem(setting, option, *text, e)); }
-  }
+  apply_given_settings(render::setting_declarations(), o.given, o.settings);
   if (o.given["noise_frame"])
     o.noise_frame = o.settings.frame;
   else

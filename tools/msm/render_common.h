@@ -6,6 +6,7 @@
 #include "msm/image/io.h"
 #include "msm/render/renderer.h"
 #include "msm/vk/context.h"
+#include "setting_options.h"
 #include "usage.h"
 
 #include <nlohmann/json.hpp>
@@ -32,7 +33,7 @@ struct FrameOptions {
   std::optional<int> noise_frame;
   // The text of each declared setting given on the command line (msm/render/settings_schema.h), by
   // key; finish_frame_options applies them to `settings`.
-  std::map<std::string, std::optional<std::string>, std::less<>> given;
+  GivenSettings given;
 };
 
 // --scene, an option for each declared setting of msm/render/settings_schema.h (--width, --msaa,

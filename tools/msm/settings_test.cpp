@@ -1,7 +1,9 @@
 // The declared render settings (msm/render/settings_schema.h) through the command line, the JSON
 // outputs and view files: every setting, a value other than its default, comes back the same.
+#include "reference_options.h"
 #include "render_common.h"
 
+#include "msm/reference/settings_schema.h"
 #include "msm/render/settings_schema.h"
 #include "msm/viewer/view_file.h"
 
@@ -10,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,15 +26,16 @@ using render::SettingType;
 
 // Values of a setting other than its default, from its declaration: the ends and the middle of a
 // range, the other choices, the other flag value, the other techniques.
-std::vector<json> other_values(const SettingDeclaration& setting) {
-  const json fallback = setting.get(render::RenderSettings{});
+template <class Settings>
+std::vector<json> other_values(const BasicSettingDeclaration<Settings>& setting) {
+  const json fallback = setting.get(Settings{});
   std::vector<json> values;
   switch (setting.type) {
   case SettingType::number:
     for (double v : {setting.min, setting.max, 0.5 * (setting.min + setting.max)}) values.push_back(float(v));
     break;
   case SettingType::integer:
-    for (double v : {setting.min, setting.max, 0.5 * (setting.min + setting.max)}) values.push_back(int(v));
+    for (double v : {setting.min, setting.max, 0.5 * (setting.min + setting.max)}) values.push_back(std::int64_t(v));
     break;
   case SettingType::flag: values.push_back(!fallback.get<bool>()); break;
   case SettingType::choice:
@@ -134,6 +138,42 @@ TEST(CliSettings, EverySettingGoesThroughCommandLineJsonAndViewFileUnchanged) {
   }
 }
 
+// What validate() says of a setting's value set straight into the settings (no check on the way):
+// empty where it accepts it.
+std::string validated(const SettingDeclaration& setting, const json& value) {
+  render::RenderSettings settings;
+  setting.set(settings, value);
+  try {
+    settings.validate();
+  } catch (const render::RenderError& e) { return e.what(); }
+  return {};
+}
+
+// The ranges are declared once: validate() accepts each number and integer setting at the ends of
+// its declared range and refuses it just outside them, naming the setting, so that a range changed
+// in the declaration alone changes what the renderer accepts.
+TEST(CliSettings, ValidateRefusesExactlyOutsideEveryDeclaredRange) {
+  for (const SettingDeclaration& setting : render::setting_declarations()) {
+    if (setting.type != SettingType::number && setting.type != SettingType::integer) continue;
+    SCOPED_TRACE(std::string(setting.key));
+    std::vector<json> inside, outside;
+    if (setting.type == SettingType::number) {
+      const float lo = float(setting.min), hi = float(setting.max);
+      inside = {lo, hi};
+      outside = {std::nextafter(lo, -INFINITY), std::nextafter(hi, INFINITY)};
+    } else {
+      inside = {int(setting.min), int(setting.max)};
+      outside = {int(setting.min) - 1, int(setting.max) + 1};
+    }
+    for (const json& value : inside) EXPECT_EQ(validated(setting, value), "") << value.dump();
+    for (const json& value : outside) {
+      const std::string error = validated(setting, value);
+      EXPECT_TRUE(error.starts_with(fmt::format("{}: ", setting.key))) << value.dump() << ": '" << error << "'";
+      EXPECT_NE(error.find(render::setting_range_text(setting)), std::string::npos) << error;
+    }
+  }
+}
+
 TEST(CliSettings, EveryDeclaredSettingHasItsOption) {
   FrameOptions options;
   CLI::App app;
@@ -167,6 +207,82 @@ TEST(CliSettings, UnknownKeyInAViewFileNamesItsPointerAndTheNearest) {
     FAIL() << "accepted a width of 0";
   } catch (const viewer::ViewError& e) {
     EXPECT_EQ(std::string(e.what()), "bad.json: /settings/width: 0 is outside [1, 16384]");
+  }
+}
+
+// msm reference's options on `args` (after the required --effect, unless they give it): the
+// settings, or the message of the error.
+struct ParsedReference {
+  reference::Settings settings;
+  std::string error;
+};
+ParsedReference parse_reference(std::vector<std::string> args) {
+  ReferenceOptions options;
+  CLI::App app;
+  add_reference_options(app.add_subcommand("reference"), options);
+  if (std::find(args.begin(), args.end(), "--effect") == args.end()) args.insert(args.begin(), {"--effect", "soft"});
+  args.insert(args.begin(), "reference");
+  std::reverse(args.begin(), args.end()); // CLI11 takes them last first
+  try {
+    app.parse(args);
+    return {reference_settings(options), ""};
+  } catch (const std::exception& e) { return {{}, e.what()}; }
+}
+
+// The command line of one reference setting's value, as a user types it.
+std::vector<std::string> reference_command_line(const reference::SettingDeclaration& setting, const json& value) {
+  std::vector<std::string> args = {setting_option_name(setting)};
+  if (setting.type != SettingType::flag)
+    args.push_back(value.is_string()         ? value.get<std::string>()
+                   : value.is_number_float() ? fmt::format("{}", value.get<double>())
+                                             : value.dump());
+  // What a value needs beside it: the effect it belongs to, a rectangle for its width and height.
+  if (setting.key == "extracted_lights") args.insert(args.end(), {"--effect", "environment"});
+  if (setting.key == "light_width_deg" || setting.key == "light_height_deg")
+    args.insert(args.end(), {"--light-shape", "rectangle"});
+  return args;
+}
+
+// Every reference setting, each value other than its default, from the command line through the
+// JSON that msm reference writes (reference.json's settings) back to the settings: the same values.
+TEST(CliSettings, EveryReferenceSettingGoesThroughCommandLineAndJsonUnchanged) {
+  for (const reference::SettingDeclaration& setting : reference::setting_declarations()) {
+    SCOPED_TRACE(std::string(setting.key));
+    int tried = 0;
+    for (const json& value : other_values(setting)) {
+      const std::vector<std::string> args = reference_command_line(setting, value);
+      const ParsedReference parsed = parse_reference(args);
+      if (!parsed.error.empty()) {
+        // Only a value that a rule across settings refuses (an even filter size) may be refused.
+        EXPECT_NE(parsed.error.find("must be odd"), std::string::npos) << value.dump() << ": " << parsed.error;
+        continue;
+      }
+      SCOPED_TRACE(value.dump());
+      ++tried;
+      const nlohmann::ordered_json written = reference::settings_json(parsed.settings);
+      EXPECT_EQ(json(written[std::string(setting.key)]), value);
+      // reference.json's text, read back into settings: every setting the same.
+      reference::Settings back;
+      reference::apply_settings_json(back, json::parse(written.dump(2)));
+      EXPECT_EQ(reference::settings_json(back), written);
+    }
+    EXPECT_GT(tried, 0);
+  }
+}
+
+TEST(CliSettings, ReferenceSettingsRefuseValuesAndKeysByTheirDeclarations) {
+  EXPECT_EQ(parse_reference({"--width", "0"}).error, "width = 0 is outside [1, 16384] (--width)");
+  EXPECT_EQ(parse_reference({"--effect", "sofft"}).error,
+            "--effect sofft: use hard, filtered, soft, translucent, scattering or environment (did you mean soft?)");
+  EXPECT_NE(parse_reference({"--samples", "many"}).error.find("--samples: expected an integer, got 'many'"),
+            std::string::npos);
+  reference::Settings settings;
+  try {
+    reference::apply_settings_json(settings, json::parse(R"({"width": 64, "filter_sise": 3})"));
+    FAIL() << "accepted an unknown key";
+  } catch (const SettingError& e) {
+    EXPECT_EQ(e.pointer, "/filter_sise");
+    EXPECT_TRUE(std::string(e.what()).starts_with("unknown setting (did you mean filter_size")) << e.what();
   }
 }
 

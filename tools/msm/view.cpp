@@ -28,8 +28,12 @@ void add_view(CLI::App& app) {
                   "Run these actions, one per frame (technique, set, camera, light, light-add, light-move, "
                   "light-set, light-on, light-off, light-remove, split, screenshot, resize, quit, ...: "
                   "docs/viewer.md)");
-  add_term(cmd, "--width", opt->width, ": the window's")->capture_default_str()->check(CLI::Range(64, 8192));
-  add_term(cmd, "--height", opt->height, ": the window's")->capture_default_str()->check(CLI::Range(64, 8192));
+  add_term(cmd, "--width", opt->width, ": the window's")
+      ->capture_default_str()
+      ->check(integer_range("--width", 64, 8192));
+  add_term(cmd, "--height", opt->height, ": the window's")
+      ->capture_default_str()
+      ->check(integer_range("--height", 64, 8192));
   add_term(cmd, "--device", opt->device);
   cmd->callback([opt, cmd] {
 #if !MSM_TOOL_VIEWER
