@@ -41,29 +41,6 @@ scene::Scene scene_with_lights(const std::string& lights) {
                                 std::filesystem::current_path(), "test.json");
 }
 
-TEST_F(LocalLightsRenderTest, KindsTheRendererDoesNotDrawAreRefusedByName) {
-  if (std::ranges::all_of(scene::light_kinds(), &scene::LightKindInfo::rendered))
-    GTEST_SKIP() << "the renderer draws every kind of light";
-  for (const scene::LightKindInfo& kind : scene::light_kinds()) {
-    if (kind.rendered) continue;
-    const std::string light = kind.kind == scene::LightKind::spot
-                                  ? R"({"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0]})"
-                                  : R"({"type": "point", "position": [0, 3, 0]})";
-    // Alone and beside a directional light (which alone would render).
-    for (const std::string& lights : {light, R"({"towards_light": [0, 1, 0]}, )" + light}) {
-      const scene::Scene s = scene_with_lights(lights);
-      try {
-        Renderer renderer(ctx(), s);
-        ADD_FAILURE() << "no RenderError for a scene with a " << kind.name << " light";
-      } catch (const RenderError& e) {
-        const std::string what = e.what();
-        EXPECT_NE(what.find(std::string(kind.name)), std::string::npos) << what;
-        EXPECT_NE(what.find("msm reference"), std::string::npos) << what;
-      }
-    }
-  }
-}
-
 // A spot 2 m over a 4 m plane, its axis straight down, 0.4 m beside a 0.3 m high box on the plane
 // and a small plate 0.3 m below the spot: the plate's shadow (about 1 m across) holds the box and
 // the edges of the box's own shadow, where two occluders far apart in depth and a receiver close
@@ -561,13 +538,14 @@ TEST_F(LocalLightsRenderTest, PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhe
       }
       for (std::size_t a = 0; a < 2; ++a) {
         const std::size_t b = 1 - a;
-        double near_seam = 0, same_pixels_turned = 0, elsewhere = 0;
+        double near_seam = 0, near_seam_squares = 0, same_pixels_turned = 0, elsewhere = 0;
         std::size_t n = 0, n_elsewhere = 0;
         for (std::size_t i = 0; i < error[a].size(); ++i) {
           const float here = turns[a].seam[i], there = turns[b].seam[i];
           if (!(here >= 0.0f) || !(there >= 0.0f)) continue; // not the ground in both
           if (here <= 2.0f && there > 4.0f) {
             near_seam += error[a][i];
+            near_seam_squares += double(error[a][i]) * error[a][i];
             same_pixels_turned += error[b][i];
             ++n;
           } else if (here > 4.0f) {
@@ -578,12 +556,17 @@ TEST_F(LocalLightsRenderTest, PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhe
         near_seam /= double(n);
         same_pixels_turned /= double(n);
         elsewhere /= double(n_elsewhere);
-        fmt::print("point, {:<16} {} taps, turned {:>2}: MAE within 2 texels of a seam {:.4f} ({} pixels), the same "
-                   "pixels turned {:.4f}, elsewhere {:.4f}\n",
-                   technique, taps, a == 0 ? 0 : 45, near_seam, n, same_pixels_turned, elsewhere);
+        // The pixels near a seam are other pixels than those elsewhere, a few hundred of them: their
+        // mean is compared with elsewhere's up to twice its standard error (the same pixels turned
+        // are compared exactly). Without the guard band the seams' error was 3 to 12 times elsewhere's.
+        const double standard_error =
+            std::sqrt(std::max(0.0, near_seam_squares / double(n) - near_seam * near_seam) / double(n));
+        fmt::print("point, {:<16} {} taps, turned {:>2}: MAE within 2 texels of a seam {:.4f} ({} pixels, standard "
+                   "error {:.4f}), the same pixels turned {:.4f}, elsewhere {:.4f}\n",
+                   technique, taps, a == 0 ? 0 : 45, near_seam, n, standard_error, same_pixels_turned, elsewhere);
         EXPECT_GT(n, 300u);
         EXPECT_LE(near_seam, same_pixels_turned) << technique << ", " << taps << " taps, turned " << a;
-        EXPECT_LE(near_seam, elsewhere) << technique << ", " << taps << " taps, turned " << a;
+        EXPECT_LE(near_seam, elsewhere + 2.0 * standard_error) << technique << ", " << taps << " taps, turned " << a;
       }
     }
 }

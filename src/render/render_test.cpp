@@ -714,18 +714,18 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
         technique, [&](RenderSettings& q) { q.parameters = parameters; }, needle);
   };
   rejects([](RenderSettings& q) { q.technique = "nope"; }, "unknown technique 'nope'");
-  rejects([](RenderSettings& q) { q.width = 0; }, "width = 0");
-  rejects([](RenderSettings& q) { q.height = 1000000; }, "height = 1000000");
+  rejects([](RenderSettings& q) { q.width = 0; }, "width: 0 is outside");
+  rejects([](RenderSettings& q) { q.height = 1000000; }, "height: 1000000 is outside");
   rejects(
       [](RenderSettings& q) {
         q.width = 16384;
         q.height = 16384;
       },
       "pixels");
-  rejects([](RenderSettings& q) { q.shadow_size = 1000000; }, "shadow size");
-  rejects([](RenderSettings& q) { q.msaa = 2; }, "msaa = 2");
+  rejects([](RenderSettings& q) { q.shadow_size = 1000000; }, "shadow_size: 1000000 is outside");
+  rejects([](RenderSettings& q) { q.msaa = 2; }, "msaa: 2: expected 1, 4 or 8");
   rejects([](RenderSettings& q) { q.filter_size = 8; }, "odd");
-  rejects([](RenderSettings& q) { q.filter_sigma = NAN; }, "filter sigma");
+  rejects([](RenderSettings& q) { q.filter_sigma = NAN; }, "filter_sigma: nan is not a finite number");
   rejects_parameters("msm-hamburger-64", {{"moment_bias", NAN}}, "parameter moment_bias = nan is outside [0, 1]");
   rejects_parameters("msm-hamburger-64", {{"moment_bais", 1e-4f}},
                      "unknown parameter 'moment_bais' of msm-hamburger-64 (did you mean moment_bias?)");
@@ -749,7 +749,7 @@ TEST_F(RenderTest, BadSettingsAreRejectedWithAClearMessage) {
   rejects_technique(
       "pcss", [](RenderSettings& q) { q.soft_kernel = 64; }, "soft kernel = 64");
   rejects_technique(
-      "mssm4", [](RenderSettings& q) { q.soft_kernel = 256; }, "soft kernel = 256");
+      "mssm4", [](RenderSettings& q) { q.soft_kernel = 256; }, "soft_kernel: 256 is outside");
   rejects_technique(
       "mssm4", [](RenderSettings& q) { q.one_pass = true; }, "summed-area table");
   if (!vk::supports_attachment(ctx(), VK_FORMAT_D16_UNORM, VK_SAMPLE_COUNT_8_BIT))

@@ -18,7 +18,11 @@ std::vector<SettingControl> setting_controls(const Technique& t) {
     case SettingType::parameters: c.kind = ControlKind::parameters; break;
     case SettingType::flag: c.kind = ControlKind::checkbox; break;
     case SettingType::choice: c.kind = ControlKind::combo; break;
-    case SettingType::integer: c.kind = setting.choices.empty() ? ControlKind::slider : ControlKind::combo; break;
+    case SettingType::integer:
+      c.kind = setting.nullable          ? ControlKind::optional
+               : setting.choices.empty() ? ControlKind::slider
+                                         : ControlKind::combo;
+      break;
     case SettingType::number: c.kind = setting.nullable ? ControlKind::optional : ControlKind::slider; break;
     }
     // What the viewer decides itself, and what applies to some techniques only.

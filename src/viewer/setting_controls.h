@@ -20,7 +20,7 @@ enum class ControlKind {
   slider,      // a number or an integer over [min, max]
   checkbox,    // a flag
   combo,       // a choice, or an integer with listed values
-  optional,    // a nullable number: a checkbox for "own value", then its slider
+  optional,    // a nullable number or integer: a checkbox for "own value", then its slider
 };
 
 struct SettingControl {

@@ -53,6 +53,18 @@ TEST(SettingControls, SlidersOfferOnlyDeclaredValues) {
   EXPECT_GT(sliders, 0);
 }
 
+// A setting whose default is null (it depends on the technique or the scene) gets the control that
+// can hold "none" (a checkbox for its own value), never a slider that reads a number from null.
+TEST(SettingControls, NullableSettingsGetTheOptionalControl) {
+  const render::RenderSettings defaults;
+  for (const SettingControl& c : setting_controls(render::find_rendered_technique("msm"))) {
+    SCOPED_TRACE(c.label);
+    if (c.kind == ControlKind::slider) EXPECT_FALSE(c.setting->get(defaults).is_null());
+    if (c.setting->nullable && (c.setting->type == SettingType::number || c.setting->type == SettingType::integer))
+      EXPECT_NE(c.kind, ControlKind::slider); // the optional control, or the light's own
+  }
+}
+
 TEST(SettingControls, ChoicesAreTheDeclaredOnes) {
   const Technique& t = render::find_rendered_technique("msm");
   for (const SettingControl& c : setting_controls(t)) {

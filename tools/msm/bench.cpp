@@ -703,6 +703,24 @@ void bench_light_kinds(const BenchOptions& o, const std::vector<std::string>& na
   write_results(o, doc, md);
 }
 
+// The per-technique bench's Markdown (printed) and JSON (--json-file) from its results.
+void write_technique_results(const BenchOptions& opt, vk::Context& ctx, const scene::Scene& scene,
+                             nlohmann::json& results, const std::vector<std::pair<int, int>>& resolutions,
+                             bool host_clock) {
+  const std::string md = bench_markdown(opt, ctx, scene, results, resolutions, host_clock);
+  fmt::print("{}", md);
+  const nlohmann::json doc = {{"device", ctx.info().describe()},
+                              {"scene", scene.name},
+                              {"frames", opt.frames},
+                              {"warmup", opt.warmup},
+                              {"repeats", opt.repeats},
+                              {"msaa", opt.frame.settings.msaa},
+                              {"filter_size", opt.frame.settings.filter_size},
+                              {"shadow_size", opt.frame.settings.shadow_size},
+                              {"results", results}};
+  write_results(opt, doc, md);
+}
+
 void add_bench(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
@@ -812,18 +830,7 @@ void add_bench(CLI::App& app) {
     }
     if (tty) fmt::print(stderr, "\r{:<70}\r", "");
     add_ratios(results, per_unit);
-    const std::string md = bench_markdown(*opt, *ctx, scene, results, resolutions, host_clock);
-    fmt::print("{}", md);
-    nlohmann::json doc = {{"device", ctx->info().describe()},
-                          {"scene", scene.name},
-                          {"frames", opt->frames},
-                          {"warmup", opt->warmup},
-                          {"repeats", opt->repeats},
-                          {"msaa", opt->frame.settings.msaa},
-                          {"filter_size", opt->frame.settings.filter_size},
-                          {"shadow_size", opt->frame.settings.shadow_size},
-                          {"results", results}};
-    write_results(*opt, doc, md);
+    write_technique_results(*opt, *ctx, scene, results, resolutions, host_clock);
   });
 }
 

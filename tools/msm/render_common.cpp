@@ -180,6 +180,7 @@ nlohmann::json render_json(const render::RenderSettings& s, const scene::Scene& 
                                 : t.nonlinear()                                       ? "dither"
                                                                                       : "bilinear"},
                      {"filter_mode", one_pass ? "one-pass" : "three-pass"},
+                     {"cascades", render::resolved_cascades(s, scene)},
                      {"light_extent_deg", s.light_extent_deg     ? nlohmann::json(*s.light_extent_deg)
                                           : scene.lights.empty() ? nlohmann::json() // spot or point lights only
                                                                  : nlohmann::json(scene.light().angular_extent_deg)}};
