@@ -8,6 +8,7 @@
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
+#include "msm/test/figures.h"
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
@@ -123,6 +124,11 @@ void expect_ordering(const vk::Context& ctx, scene::LightKind kind) {
   const Leaks l = leaks(ctx, kind);
   ASSERT_GT(l.vsm32, 0.0);
   const double bound = kMeasured.at(kind).bound();
+  msm::test::record_figure(std::string("ordering.") + std::string(info.name) + ".msm64_over_vsm32_leaking",
+                           l.msm64 / l.vsm32,
+                           {.below = bound,
+                            .meaning = "grate over a bench, " + std::string(info.name) +
+                                       " light: MSM 64's light leaking over VSM 32's (the 2015 ordering)"});
   EXPECT_LT(l.msm64, bound * l.vsm32) << info.name << ": MSM 64 leaks " << l.msm64 << ", VSM " << l.vsm32 << " (ratio "
                                       << l.msm64 / l.vsm32 << ", bound " << bound << ")";
 }

@@ -287,6 +287,10 @@ TEST_F(LocalLightsRenderTest, SpotLightSoftShadowsAgreeWithTheRayTracer) {
                technique, c.metrics.mae, hard.mae, c.metrics.light_leaking, got.ground, got.box_top);
     leaking[technique] = c.metrics.light_leaking;
     EXPECT_TRUE(c.passed) << technique << ": " << c.report;
+    msm::test::record_figure(
+        "light.spot_soft." + technique + ".mae", c.metrics.mae,
+        {.below = tolerances.max_mae,
+         .meaning = "spot light of radius 0.1 m, " + technique + ": MAE of visibility against the traced soft shadow"});
     EXPECT_EQ(c.metrics.non_finite_in_test, 0u) << technique;
     EXPECT_EQ(image::compute_metrics(result.color, truth.radiance).non_finite_in_test, 0u) << technique;
     if (!measured.beats_hard_shadows) continue;
@@ -457,6 +461,10 @@ TEST_F(LocalLightsRenderTest, PointLightShadowsAgreeWithTheRayTracer) {
         image::compare(result.shadow.channel("visibility"), truth.visibility.channel("visibility"), tolerances,
                        {.metrics = {.mask = &mask}, .failure_dir = "test-failures/local-lights/point-" + technique});
     EXPECT_TRUE(c.passed) << technique << ": " << c.report;
+    msm::test::record_figure(
+        "light.point." + technique + ".mae", c.metrics.mae,
+        {.below = tolerances.max_mae,
+         .meaning = "point light among columns, " + technique + ": MAE of visibility against the traced hard shadow"});
     EXPECT_EQ(c.metrics.non_finite_in_test, 0u) << technique;
     EXPECT_EQ(image::compute_metrics(result.color, truth.radiance).non_finite_in_test, 0u) << technique;
     leaking[technique] = c.metrics.light_leaking;
@@ -567,6 +575,12 @@ TEST_F(LocalLightsRenderTest, PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhe
         EXPECT_GT(n, 300u);
         EXPECT_LE(near_seam, same_pixels_turned) << technique << ", " << taps << " taps, turned " << a;
         EXPECT_LE(near_seam, elsewhere + 2.0 * standard_error) << technique << ", " << taps << " taps, turned " << a;
+        msm::test::record_figure(
+            fmt::format("light.point.seams.{}.taps{}.turned{}.near_seam_mae", technique, taps, a == 0 ? 0 : 45),
+            near_seam,
+            {.below = elsewhere + 2.0 * standard_error,
+             .meaning = "point light: MAE within 2 texels of a cube seam (bound: elsewhere's + twice its standard "
+                        "error)"});
       }
     }
 }

@@ -105,8 +105,14 @@ std::vector<Suite> declared_suites() {
        "GroundTruthTest.EveryTechniqueAgainstTheGroundTruth"},
       {"Soft shadows against the traced area light", "src/render/msm_render_soft_shadow_test",
        "SoftShadowTest.CloserToTheAreaLightThanHardShadows:SoftShadowTest.ModelsAndPillarBeforeBrickWall"},
-      {"Spot lights against the ray tracer", "src/render/msm_render_local_lights_test",
-       "LocalLightsRenderTest.SpotLightShadowsAgreeWithTheRayTracer"},
+      {"Spot and point lights against the ray tracer", "src/render/msm_render_local_lights_test",
+       "LocalLightsRenderTest.SpotLightShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
+       "SpotLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest.PointLightShadowsAgreeWithTheRayTracer:"
+       "LocalLightsRenderTest.PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere"},
+      {"The 2015 ordering per light kind", "src/render/msm_render_light_kind_ordering_test", "LightKindOrderingTest.*"},
+      {"Cascades: the box on a 500 m ground, a slow pan", "src/render/msm_render_cascades_test",
+       "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest."
+       "StabilisedCascadesShimmerLessInASlowPan"},
       {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"}};
   return {quick, full, gpu};
 }
