@@ -7,6 +7,7 @@
 #include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
 #include "msm/test/figures.h"
+#include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
 
 #include "msm/image/io.h"
@@ -48,10 +49,8 @@ scene::Scene fence_along_the_view() {
 }
 
 reference::Result hard_truth(const scene::Scene& scene, int width = kWidth, int height = kHeight) {
-  reference::Settings r;
-  r.effect = reference::Effect::hard;
-  r.width = width;
-  r.height = height;
+  const reference::Settings r =
+      test::reference_settings(reference::Effect::hard, width, height, reference::Settings{}.samples);
   return reference::render(scene, r);
 }
 

@@ -9,6 +9,7 @@
 #include "msm/render/renderer.h"
 #include "msm/scene/scene.h"
 #include "msm/test/figures.h"
+#include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
@@ -82,10 +83,8 @@ struct Leaks {
 // pixels) against the ray tracer's hard shadow.
 Leaks leaks(const vk::Context& ctx, scene::LightKind kind) {
   const scene::Scene scene = overlap_scene(kind);
-  reference::Settings r;
-  r.effect = reference::Effect::hard;
-  r.width = kWidth;
-  r.height = kHeight;
+  const reference::Settings r =
+      test::reference_settings(reference::Effect::hard, kWidth, kHeight, reference::Settings{}.samples);
   const reference::Result truth = reference::render(scene, r);
   const image::Image mask = truth.visibility.channel("background");
   Renderer renderer(ctx, scene);

@@ -11,6 +11,7 @@
 #include "msm/scene/scene.h"
 #include "msm/shading.h"
 #include "msm/techniques.h"
+#include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
@@ -97,10 +98,8 @@ const std::map<std::string, double> kSpotMeasuredMae = {{"plain", 0.0011},
 
 TEST_F(LocalLightsRenderTest, SpotLightShadowsAgreeWithTheRayTracer) {
   const scene::Scene scene = spot_scene();
-  reference::Settings r;
-  r.effect = reference::Effect::hard;
-  r.width = kWidth;
-  r.height = kHeight;
+  const reference::Settings r =
+      test::reference_settings(reference::Effect::hard, kWidth, kHeight, reference::Settings{}.samples);
   const reference::Result truth = reference::render(scene, r);
   const image::Image mask = truth.visibility.channel("background");
   Renderer renderer(ctx(), scene);
@@ -254,11 +253,7 @@ const std::map<std::string, SoftSpotExpectation> kSoftSpotMeasured = {
 // than two (VSSM).
 TEST_F(LocalLightsRenderTest, SpotLightSoftShadowsAgreeWithTheRayTracer) {
   const scene::Scene scene = soft_spot_scene();
-  reference::Settings r;
-  r.effect = reference::Effect::soft;
-  r.width = kSoftSize;
-  r.height = kSoftSize;
-  r.samples = 64;
+  const reference::Settings r = test::reference_settings(reference::Effect::soft, kSoftSize, kSoftSize, 64);
   const reference::Result truth = reference::render(scene, r);
   const image::Image mask = truth.visibility.channel("background");
   const image::Image truth_visibility = truth.visibility.channel("visibility");
@@ -327,11 +322,7 @@ scene::Scene spot_beam_scene() {
 TEST_F(LocalLightsRenderTest, SpotLightScatteringByRayMarchingAgreesWithTheRayTracer) {
   const scene::Scene scene = spot_beam_scene();
   constexpr int width = 128, height = 96;
-  reference::Settings r;
-  r.effect = reference::Effect::scattering;
-  r.width = width;
-  r.height = height;
-  r.samples = 256;
+  const reference::Settings r = test::reference_settings(reference::Effect::scattering, width, height, 256);
   const reference::Result truth = reference::render(scene, r);
   const std::map<std::string, std::pair<double, double>> measured = {{"scatter-march-32", {0.1730, 0.0025}},
                                                                      {"scatter-march-128", {0.0456, 0.0016}}};
@@ -404,10 +395,8 @@ RenderSettings point_settings(std::string technique) {
 }
 
 reference::Result point_truth(const scene::Scene& scene) {
-  reference::Settings r;
-  r.effect = reference::Effect::hard;
-  r.width = kPointImageWidth;
-  r.height = kPointImageHeight;
+  const reference::Settings r = test::reference_settings(reference::Effect::hard, kPointImageWidth, kPointImageHeight,
+                                                         reference::Settings{}.samples);
   return reference::render(scene, r);
 }
 
@@ -718,10 +707,8 @@ const ObliqueSpotMeasured kObliqueSpotMeasured[] = {{"plain", 0.0012, 0.0013, 0.
 TEST_F(LocalLightsRenderTest, DepthMapsUnderAnObliqueSpotAgreeWithTheRayTracer) {
   const scene::Scene scene = oblique_spot_scene(true);
   constexpr int width = 160, height = 120;
-  reference::Settings r;
-  r.effect = reference::Effect::hard;
-  r.width = width;
-  r.height = height;
+  const reference::Settings r =
+      test::reference_settings(reference::Effect::hard, width, height, reference::Settings{}.samples);
   const reference::Result truth = reference::render(scene, r);
   const image::Image background = truth.visibility.channel("background");
   // Over-darkening of what the tracer sees lit: everything but the lit ground masked.
