@@ -110,9 +110,9 @@ std::vector<Suite> declared_suites() {
        "SpotLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest.PointLightShadowsAgreeWithTheRayTracer:"
        "LocalLightsRenderTest.PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere"},
       {"The 2015 ordering per light kind", "src/render/msm_render_light_kind_ordering_test", "LightKindOrderingTest.*"},
-      {"Cascades: the box on a 500 m ground, a slow pan", "src/render/msm_render_cascades_test",
-       "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest."
-       "StabilisedCascadesShimmerLessInASlowPan"},
+      {"Cascades: the box on a 500 m ground, the town, a slow pan", "src/render/msm_render_cascades_test",
+       "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest.TownWithDefaultSettings:"
+       "CascadesRenderTest.StabilisedCascadesShimmerLessInASlowPan"},
       {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"}};
   return {quick, full, gpu};
 }
