@@ -259,10 +259,13 @@ TEST_F(TranslucencyTest, SmokeScene) {
 constexpr float kStairsLightHeight = 2.5f;
 const std::array<float, 3> kStairsGroundX = {-0.95f, -0.25f, 0.45f}; // behind 1, 2, 3 planes
 
-scene::Scene stairs(const std::string& kind) {
-  const std::string light = kind == "spot" ? R"({ "type": "spot", "position": [0, 2.5, 0], "direction": [0, -1, 0],
-                            "inner_cone_deg": 50, "outer_cone_deg": 60, "range": 4 })"
-                                           : R"({ "type": "point", "position": [0, 2.5, 0], "range": 4 })";
+const std::map<std::string, std::string> kStairsLights = {
+    {"spot", R"({ "type": "spot", "position": [0, 2.5, 0], "direction": [0, -1, 0], "inner_cone_deg": 50,
+                  "outer_cone_deg": 60, "range": 4 })"},
+    {"point", R"({ "type": "point", "position": [0, 2.5, 0], "range": 4 })"}};
+
+// The stairs under `lights` (the text of a scene's "lights" list).
+scene::Scene stairs(const std::string& lights) {
   std::string objects = R"({ "name": "ground", "primitive": { "type": "plane", "size": [4, 4] } })";
   const std::array<float, 3> height = {0.6f, 0.9f, 1.2f}, left = {-0.99f, -0.38f, 0.05f};
   for (int i = 0; i < 3; ++i)
@@ -273,8 +276,8 @@ scene::Scene stairs(const std::string& kind) {
   return scene::load_scene_json(fmt::format(R"({{ "msm_scene": 1, "name": "stairs",
       "camera": {{ "position": [0, 6, 3], "target": [0, 0, 0], "fov_y_deg": 40 }},
       "lights": [ {} ], "objects": [ {} ] }})",
-                                            light, objects),
-                                std::filesystem::current_path(), kind + "-stairs.json");
+                                            lights, objects),
+                                std::filesystem::current_path(), "stairs.json");
 }
 
 // Mean visibility over the 5 x 5 pixels about the one that sees the ground at (x, 0, 0).
@@ -301,7 +304,7 @@ RenderSettings local_light_settings(const std::string& technique, int width, int
 // ray tracer's shadow rays to the light's position say.
 TEST_F(TranslucencyTest, StackOfPlanesUnderSpotAndPointLightsTransmitsAsTheRayTracerSays) {
   for (const std::string kind : {"spot", "point"}) {
-    const scene::Scene scene = stairs(kind);
+    const scene::Scene scene = stairs(kStairsLights.at(kind));
     ASSERT_EQ(scene.local_lights.size(), 1u);
     reference::Settings rs;
     rs.effect = reference::Effect::translucent;
@@ -332,6 +335,39 @@ TEST_F(TranslucencyTest, StackOfPlanesUnderSpotAndPointLightsTransmitsAsTheRayTr
       }
     }
   }
+}
+
+// A directional light, a spot and a point light together: the translucent pass blends each layer
+// (the directional light's, the spot's, the point light's six faces) in its own light's depth
+// convention and order. The visibility (the lights' luminance-weighted mean) against the ray
+// tracer's over the whole image, MSM 64: measured MAE 0.0097 on lavapipe (128 x 96, 256² per
+// map, 9² filter: the filtered edges against the tracer's exact ones, widest for the directional
+// map fitted to the 4 m ground), bound 1.25x that.
+TEST_F(TranslucencyTest, StairsUnderDirectionalSpotAndPointLightsAgainstTheRayTracer) {
+  const scene::Scene scene =
+      stairs(R"({ "type": "directional", "towards_light": [0.3, 1, 0.2], "irradiance": [1, 1, 1] },
+                { "type": "spot", "position": [-0.3, 2.5, 0.2], "direction": [0, -1, 0], "inner_cone_deg": 50,
+                  "outer_cone_deg": 60, "range": 4, "intensity": [3, 3, 3] },
+                { "type": "point", "position": [0.5, 2.2, -0.2], "range": 4, "intensity": [3, 3, 3] })");
+  ASSERT_EQ(scene.local_lights.size(), 2u);
+  const reference::Result truth = transmittance(scene, 128, 96);
+  const image::Image mask = truth.visibility.channel("background");
+  Renderer renderer(ctx(), scene);
+  const RenderResult result = renderer.render(local_light_settings("msm-hamburger-64", 128, 96));
+  const double measured = 0.0097;
+  image::Tolerances tolerances;
+  tolerances.max_mae = std::max(1.25 * measured, measured + 0.002);
+  tolerances.max_share_above_3pct = 1.0; // the filtered edges: the MAE bounds the error
+  const image::CompareResult r =
+      image::compare(result.shadow.channel("visibility"), truth.visibility.channel("visibility"), tolerances,
+                     {.metrics = {.mask = &mask}, .failure_dir = "test-failures/translucency/stairs-three-lights"});
+  fmt::print("stairs under three lights, msm-hamburger-64: MAE {:.4f}, leaking {:.4f}, over-darkening {:.4f}\n",
+             r.metrics.mae, r.metrics.light_leaking, r.metrics.over_darkening);
+  EXPECT_TRUE(r.passed) << r.report;
+  msm::test::record_figure(
+      "translucent.three_lights.stairs.msm-hamburger-64.mae", r.metrics.mae,
+      {.below = tolerances.max_mae,
+       .meaning = "directional, spot and point light, three planes of opacity 0.5, MSM 64: MAE of visibility"});
 }
 
 // Coloured glass between a spot (a point) light and the ground: a red pane (opacity 0.6,
