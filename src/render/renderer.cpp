@@ -454,8 +454,8 @@ struct Renderer::Impl {
   }
 
   // What the renderer draws with spot and point lights (`kind`): the hard and filtered techniques
-  // of one depth per texel, opaque occluders, a finite range (the stored depth is distance / range);
-  // with spot lights also the soft techniques and single scattering by ray marching.
+  // of one depth per texel, opaque and translucent occluders, a finite range (the stored depth is
+  // distance / range); with spot lights also the soft techniques and single scattering by ray marching.
   void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots,
                          std::string_view kind) const {
     const Technique& technique = find_rendered_technique(s.technique);
@@ -474,11 +474,10 @@ struct Renderer::Impl {
     const bool spot = kind == "spot";
     const char* unsupported = !spot && (technique.soft() || msm_technique_is_area_light(technique.id)) ? "soft shadows"
                               : !spot && technique.scatters()                                          ? "scattering"
-                              : s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders"
-                                                                                    : nullptr;
+                                                                                                       : nullptr;
     if (unsupported)
-      throw RenderError(fmt::format("{} with {} lights: the renderer draws {} lights' {} shadows of opaque occluders "
-                                    "only; the ray tracer (msm reference) traces them",
+      throw RenderError(fmt::format("{} with {} lights: the renderer draws {} lights' {} shadows only; the ray "
+                                    "tracer (msm reference) traces them",
                                     unsupported, kind, kind, spot ? "hard, filtered and soft" : "hard and filtered"));
     for (const scene::LocalLight& spot : spots)
       if (!(spot.range < scene::LocalLight::kInfiniteRange))
