@@ -495,17 +495,6 @@ std::vector<float> seam_texels(const scene::Scene& scene, const reference::Resul
   return texels;
 }
 
-// Blurred and unblurred, the error against the ray tracer within 2 texels of a seam of the cube is
-// no higher than the error at the same pixels with the scene turned by 45 degrees about the light
-// (the same image, the seams elsewhere), nor than the error elsewhere on the ground: the guard band
-// lets the blur and the lookups filter across the seams as across any texel. Measured (MAE near the
-// seams, the same pixels turned, elsewhere; unturned, then turned): PCF unblurred 0.0106, 0.0304,
-// 0.0127; 0.0136, 0.0202, 0.0161; 9 taps 0.0088, 0.0298, 0.0247; 0.0215, 0.0257, 0.0268. VSM 32
-// unblurred 0.0048, 0.0094, 0.0139; 0.0130, 0.0207, 0.0136; 9 taps 0.0098, 0.0130, 0.0277; 0.0248,
-// 0.0318, 0.0275. MSM 64 unblurred 0.0092, 0.0115, 0.0171; 0.0132, 0.0209, 0.0166; 9 taps 0.0219,
-// 0.0307, 0.0393; 0.0258, 0.0336, 0.0400. The texels near a seam are finer (a face's texel
-// subtends half the angle at its edge that it does at its centre) and their lookups read finer mips
-// (msm_cube_face_max_lod), so the seams' error is lower, not only no higher.
 // point_scene turned by 0 and 45 degrees about the light, each with its ray-traced truth and the
 // texels from each ground pixel to the nearest seam (seam_texels).
 struct TurnedPointScene {
@@ -536,9 +525,10 @@ std::vector<float> visibility_error(const image::Image& visibility, const image:
 }
 
 // For each turn a of the two, the MAE within 2 texels of a seam (on pixels more than 4 texels from
-// every seam in the other turn) is asserted no higher than the same pixels' in the other turn, nor
-// than elsewhere's (pixels more than 4 texels from a seam) up to twice its standard error, and
-// recorded as `figure`.turned0 / .turned45.
+// every seam in the other turn) is asserted no higher than the same pixels' in the other turn (up
+// to paired_standard_errors times the standard error of the pixels' paired differences), nor than
+// elsewhere's (pixels more than 4 texels from a seam) up to twice its standard error, and recorded
+// as `figure`.turned0 / .turned45.
 void expect_seam_error_no_higher(const std::vector<TurnedPointScene>& turns,
                                  const std::vector<std::vector<float>>& error, const std::string& label,
                                  const std::string& figure, const std::string& light = "point light",
@@ -566,7 +556,7 @@ void expect_seam_error_no_higher(const std::vector<TurnedPointScene>& turns,
     elsewhere /= double(n_elsewhere);
     // The pixels near a seam are other pixels than those elsewhere, a few hundred of them: their
     // mean is compared with elsewhere's up to twice its standard error (the same pixels turned
-    // are compared exactly). Without the guard band the seams' error was 3 to 12 times elsewhere's.
+    // pair by pair). Without the guard band the seams' error was 3 to 12 times elsewhere's.
     const double standard_error =
         std::sqrt(std::max(0.0, near_seam_squares / double(n) - near_seam * near_seam) / double(n));
     const double paired_mean = near_seam - same_pixels_turned;
@@ -586,6 +576,17 @@ void expect_seam_error_no_higher(const std::vector<TurnedPointScene>& turns,
   }
 }
 
+// Blurred and unblurred, the error against the ray tracer within 2 texels of a seam of the cube is
+// no higher than the error at the same pixels with the scene turned by 45 degrees about the light
+// (the same image, the seams elsewhere), nor than the error elsewhere on the ground: the guard band
+// lets the blur and the lookups filter across the seams as across any texel. Measured (MAE near the
+// seams, the same pixels turned, elsewhere; unturned, then turned): PCF unblurred 0.0106, 0.0304,
+// 0.0127; 0.0136, 0.0202, 0.0161; 9 taps 0.0088, 0.0298, 0.0247; 0.0215, 0.0257, 0.0268. VSM 32
+// unblurred 0.0048, 0.0094, 0.0139; 0.0130, 0.0207, 0.0136; 9 taps 0.0098, 0.0130, 0.0277; 0.0248,
+// 0.0318, 0.0275. MSM 64 unblurred 0.0092, 0.0115, 0.0171; 0.0132, 0.0209, 0.0166; 9 taps 0.0219,
+// 0.0307, 0.0393; 0.0258, 0.0336, 0.0400. The texels near a seam are finer (a face's texel
+// subtends half the angle at its edge that it does at its centre) and their lookups read finer mips
+// (msm_cube_face_max_lod), so the seams' error is lower, not only no higher.
 TEST_F(LocalLightsRenderTest, PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere) {
   const std::vector<TurnedPointScene> turns =
       turned_point_scenes(0.0f, 10.0f,
@@ -628,8 +629,7 @@ reference::Settings soft_point_traced() {
 // MAE of each soft technique's visibility against the ray tracer's soft shadow of the point light
 // of radius 5 cm, measured on lavapipe; the bound is 1.25x that, at least 0.002 more. As with the
 // spot: CSSM's series leaves the umbrae grey (its leaking, 0.05-0.06, is nearly all its error) and
-// VSSM leaks (Chebyshev's bound); PCSS over-darkens the penumbrae' lit ends (its blocker average
-// over a search region that the kernel clamps).
+// VSSM leaks (Chebyshev's bound); PCSS's error is mostly over-darkening (0.0226 of its 0.0300).
 struct SoftPointExpectation {
   double mae;
   bool beats_hard_shadows; // closer to the ray tracer than PCF's hard shadow
@@ -677,8 +677,9 @@ TEST_F(LocalLightsRenderTest, PointLightSoftShadowsAgreeWithTheRayTracer) {
   EXPECT_LT(leaking.at("mssm4"), 0.5 * leaking.at("vssm")); // measured 0.0080 against 0.0298
 }
 
-// MSSM4's soft shadow of a point light of radius 15 cm with a 47-texel kernel (penumbrae up to 23
-// texels on each side, three times the hard filter's guard band): its error within 2 texels of a
+// MSSM4's soft shadow of a point light of radius 15 cm with a 47-texel kernel (search and filter
+// regions up to 23 texels on each side of the lookup, three times the hard filters' guard band of
+// 8 texels, so that a region cut at a face's edge would show): its error within 2 texels of a
 // seam no higher than elsewhere (up to twice the near pixels' standard error, as the hard test)
 // nor than at the same pixels turned 45 degrees, up to twice the standard error of the pixels'
 // paired differences: turned, a shadow is also seen by another face at another angle to its axes,
