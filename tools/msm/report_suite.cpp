@@ -111,7 +111,9 @@ std::vector<Suite> declared_suites() {
       {"Spot and point lights against the ray tracer", "src/render/msm_render_local_lights_test",
        "LocalLightsRenderTest.SpotLightShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
        "SpotLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest.PointLightShadowsAgreeWithTheRayTracer:"
-       "LocalLightsRenderTest.PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere"},
+       "LocalLightsRenderTest.PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere:LocalLightsRenderTest."
+       "PointLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
+       "PointLightSoftErrorAlongCubeSeamsIsNoHigherThanElsewhere"},
       {"The 2015 ordering per light kind", "src/render/msm_render_light_kind_ordering_test", "LightKindOrderingTest.*"},
       {"Cascades: the box on a 500 m ground, the town, a slow pan", "src/render/msm_render_cascades_test",
        "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest.TownWithDefaultSettings:"
