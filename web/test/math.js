@@ -19,6 +19,12 @@ uniform highp usampler2D u_a;
 uniform highp usampler2D u_b;
 uniform highp usampler2D u_u;
 uniform int u_function;
+// The soft lookup's summed-area table (msm_web_kernels' soft_table), fetched as soft.h's flow asks.
+uniform highp usampler2D u_table;
+uvec4 msm_three_sat_fetch(int x, int y, int table) {
+  if (x < 0 || y < 0) return uvec4(0u);
+  return texelFetch(u_table, ivec2(x, y), 0);
+}
 layout(location = 0) out highp uvec4 o_a;
 layout(location = 1) out highp uvec4 o_b;
 layout(location = 2) out highp uvec4 o_u;
@@ -60,7 +66,7 @@ function texture(gl, width, height, data) {
 }
 
 // words: count KernelIOs (12 words each) -> the kernel's results, in the same layout.
-export function evaluate(gl, program, functionId, words, count) {
+export function evaluate(gl, program, functionId, words, count, table) {
   const height = Math.ceil(count / WIDTH);
   const planes = [0, 1, 2].map(() => new Uint32Array(WIDTH * height * 4));
   for (let i = 0; i < count; ++i)
@@ -78,6 +84,9 @@ export function evaluate(gl, program, functionId, words, count) {
     gl.bindTexture(gl.TEXTURE_2D, inputs[p]);
     gl.uniform1i(gl.getUniformLocation(program, name), p);
   });
+  gl.activeTexture(gl.TEXTURE3);
+  gl.bindTexture(gl.TEXTURE_2D, table);
+  gl.uniform1i(gl.getUniformLocation(program, 'u_table'), 3);
   gl.uniform1i(gl.getUniformLocation(program, 'u_function'), functionId);
   gl.viewport(0, 0, WIDTH, height);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
@@ -115,11 +124,13 @@ window.msmRunKernels = async () => {
   const t0 = performance.now();
   const program = createKernelProgram(gl);
   const compileMs = performance.now() - t0;
+  const { width, height, offset: at } = meta.table;
+  const table = texture(gl, width, height, words.subarray(at, at + 4 * width * height));
   let offset = 0;
   const results = {};
   for (const f of meta.functions) {
     const n = 12 * f.count;
-    results[f.name] = base64(evaluate(gl, program, f.id, words.subarray(offset, offset + n), f.count));
+    results[f.name] = base64(evaluate(gl, program, f.id, words.subarray(offset, offset + n), f.count, table));
     offset += 2 * n;
   }
   return { renderer, compileMs, results };

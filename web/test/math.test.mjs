@@ -25,7 +25,7 @@ const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
 
 // metric: 'ulp' (units in the last place), 'abs' (|web - cpu| / max(1, |cpu|)), 'unorm16' (the
 // four 16-bit fields of u.xy, in steps; an exact tie k + 1/2 of the input may round either way),
-// 'nl32' (the fields of the 32-bit non-linear word, in steps). outputs: the compared floats, a[0..3]
+// 'nl32' (the fields of the 32-bit non-linear word, in steps), 'words' (u's four words, in steps). outputs: the compared floats, a[0..3]
 // then b[0..3]. max and p999 bound the largest per-input error and its 99.9th percentile.
 const SPECS = {
   fma: { metric: 'ulp', outputs: [0], max: 0, p999: 0 },
@@ -51,6 +51,14 @@ const SPECS = {
   three_generate: { metric: 'abs', outputs: [0, 1, 2, 3], max: 1e-6, p999: 5e-7 },
   three_shadow: { metric: 'abs', outputs: [0], max: 0.01, p999: 2e-4 },
   three_store: { metric: 'abs', outputs: [0, 1, 2, 3], max: 1.6e-5, p999: 1.6e-5 },
+  // Moment soft shadows (src/glsl/msm_three_soft.h): the table's texel (msm_web_kernels checks it
+  // is the renderer's mssm4 texel) and its four words exactly; the receiver plane's slope; soft.h's
+  // blocker search and filtered bound on quantized averages; the whole lookup over a 64² table.
+  three_sat_texel: { metric: 'words', max: 0, p999: 0 },
+  three_depth_per_texel: { metric: 'abs', outputs: [0, 1], max: 1e-6, p999: 1e-7 },
+  soft_blocker4: { metric: 'abs', outputs: [0, 1], max: 0.01, p999: 2e-4 },
+  soft_shadow4: { metric: 'abs', outputs: [0], max: 0.01, p999: 2e-4 },
+  three_soft_shadow: { metric: 'abs', outputs: [0, 1, 2, 3, 4], max: 0.01, p999: 2e-4 },
 };
 
 const f32 = new Float32Array(1);
@@ -82,6 +90,7 @@ function inputError(spec, input, web, cpu) {
     }
     return e;
   }
+  if (spec.metric === 'words') return Math.max(...[8, 9, 10, 11].map((k) => Math.abs(web[k] - cpu[k])));
   if (spec.metric === 'nl32') {
     const w = nl32Fields(web[8]), c = nl32Fields(cpu[8]);
     return Math.max(...w.map((x, i) => Math.abs(x - c[i])));
