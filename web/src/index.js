@@ -381,7 +381,7 @@ export class MomentShadowMaps {
   // Back to three.js's own shadows (the type the renderer had before).
   dispose() {
     if (!this.supported) return;
-    this._restore([...this._lights.keys()]);
+    this._restore([...this._lights.keys(), ...this._softStates.keys()]);
     for (const { moments, scratch, packed } of this._lights.values()) {
       moments.dispose();
       scratch.dispose();
