@@ -195,11 +195,11 @@ KernelIO make_input(int id, Inputs& g) {
   return x;
 }
 
-// The soft lookup's table: a 64 x 64 map of a sloped ground, a box of blockers over it, a second
-// box at another depth and a few single texels, summed as sat.h's tables (wrapping uint).
+// The soft lookup's depth map: 64 x 64 texels of a sloped ground, a box of blockers over it, a
+// second box at another depth and a few single texels.
 constexpr int kTableSize = 64;
-std::vector<uvec4> soft_table(int kernel_width) {
-  std::vector<uvec4> t(size_t(kTableSize * kTableSize));
+std::vector<float> soft_depths() {
+  std::vector<float> d(size_t(kTableSize * kTableSize));
   std::mt19937_64 rng(0x5a7);
   for (int y = 0; y < kTableSize; ++y)
     for (int x = 0; x < kTableSize; ++x) {
@@ -207,7 +207,17 @@ std::vector<uvec4> soft_table(int kernel_width) {
       if (x >= 20 && x < 36 && y >= 24 && y < 40) depth = 0.3f;
       if (x >= 40 && x < 48 && y >= 10 && y < 30) depth = 0.45f;
       if (rng() % 61 == 0) depth = std::uniform_real_distribution<float>(0.1f, 0.7f)(rng);
-      uvec4 v = msm_three_sat_texel(depth, kernel_width);
+      d[size_t(y * kTableSize + x)] = depth;
+    }
+  return d;
+}
+// Its summed-area table as sat.h defines it (wrapping uint running sums): what the renderer's
+// SatBuilder makes, and what the package's passes (src/soft.js) must make in WebGL.
+std::vector<uvec4> soft_table(const std::vector<float>& depths, int kernel_width) {
+  std::vector<uvec4> t(size_t(kTableSize * kTableSize));
+  for (int y = 0; y < kTableSize; ++y)
+    for (int x = 0; x < kTableSize; ++x) {
+      uvec4 v = msm_three_sat_texel(depths[size_t(y * kTableSize + x)], kernel_width);
       if (x > 0) v += t[size_t(y * kTableSize + x - 1)];
       t[size_t(y * kTableSize + x)] = v;
     }
@@ -287,7 +297,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "msm_web_kernels: the package's mssm4 parameters are not the renderer's\n");
     return 1;
   }
-  const std::vector<uvec4> table = soft_table(MSM_THREE_SOFT_KERNEL);
+  const std::vector<float> depths = soft_depths();
+  const std::vector<uvec4> table = soft_table(depths, MSM_THREE_SOFT_KERNEL);
   auto fetch = [&](int x, int y, int) {
     return x < 0 || y < 0 ? uvec4(0u)
                           : table[size_t(std::min(y, kTableSize - 1) * kTableSize + std::min(x, kTableSize - 1))];
@@ -313,11 +324,13 @@ int main(int argc, char** argv) {
     json += std::string(id ? ", " : "") + "{\"id\": " + std::to_string(id) + ", \"name\": \"" + kNames[id] +
             "\", \"count\": " + std::to_string(kInputs) + "}";
   }
-  // The table after the functions' words.
+  // The table after the functions' words, then its depth map (float bits).
   json += "], \"table\": {\"width\": " + std::to_string(kTableSize) + ", \"height\": " + std::to_string(kTableSize) +
-          ", \"offset\": " + std::to_string(words.size()) + "}}\n";
+          ", \"offset\": " + std::to_string(words.size()) +
+          ", \"depths\": " + std::to_string(words.size() + 4 * table.size()) + "}}\n";
   for (const uvec4& v : table)
     for (int i = 0; i < 4; ++i) words.push_back(v[i]);
+  for (float d : depths) words.push_back(std::bit_cast<uint32_t>(d));
   std::FILE* j = std::fopen(argv[1], "wb");
   std::FILE* b = std::fopen(argv[2], "wb");
   bool ok = j && b && std::fwrite(json.data(), 1, json.size(), j) == json.size() &&

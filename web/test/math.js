@@ -4,6 +4,8 @@
 // and render targets (integer formats are color-renderable in WebGL 2 without extensions, and
 // keep every bit: no float conversion stands between the shader and the comparison).
 import { MSM_KERNELS_GLSL } from './generated/kernels-glsl.js';
+import * as THREE from 'three';
+import { SoftShadowTables } from '../src/soft.js';
 
 const WIDTH = 64;
 
@@ -112,8 +114,43 @@ function base64(words) {
   return btoa(s);
 }
 
+// The package's summed-area table (src/soft.js's passes, in three.js) of the depth map `depths`
+// (width x height floats): its words, as readPixels gives them (rows from y = 0).
+function packageTable(depths, width, height) {
+  const renderer = new THREE.WebGLRenderer({ canvas: document.createElement('canvas') });
+  const triangle = new THREE.Mesh(new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3)));
+  const camera = new THREE.OrthographicCamera();
+  const tables = new SoftShadowTables((material, target) => {
+    renderer.setRenderTarget(target);
+    renderer.renderBufferDirect(camera, null, triangle.geometry, material, triangle, null);
+  });
+  const depth = new THREE.DataTexture(depths, width, height, THREE.RedFormat, THREE.FloatType);
+  depth.needsUpdate = true;
+  const state = tables.state(width, height);
+  const gl = renderer.getContext();
+  const words = new Uint32Array(4 * width * height);
+  // The passes draw inside a render, as the package's do inside three.js's shadow render.
+  const scene = new THREE.Scene();
+  scene.onAfterRender = () => {
+    tables.texels(state, depth);
+    tables.build(state, { shadow: { camera } }, { angularDiameter: 1 });
+    renderer.setRenderTarget(state.tables[state.result]);
+    gl.readPixels(0, 0, width, height, gl.RGBA_INTEGER, gl.UNSIGNED_INT, words);
+    renderer.setRenderTarget(null);
+  };
+  renderer.render(scene, camera);
+  const error = gl.getError();
+  tables.release(state);
+  tables.dispose();
+  depth.dispose();
+  renderer.dispose();
+  if (error !== gl.NO_ERROR) throw new Error(`WebGL error 0x${error.toString(16)} building the package's table`);
+  return words;
+}
+
 // Fetches /data/kernels.json and /data/kernels.bin (msm_web_kernels' output) and returns, per
-// function, the results as base64 of their words.
+// function, the results as base64 of their words, and the package's table of the soft lookup's
+// depth map.
 window.msmRunKernels = async () => {
   const gl = document.createElement('canvas').getContext('webgl2');
   if (!gl) throw new Error('no WebGL 2');
@@ -133,5 +170,6 @@ window.msmRunKernels = async () => {
     results[f.name] = base64(evaluate(gl, program, f.id, words.subarray(offset, offset + n), f.count, table));
     offset += 2 * n;
   }
-  return { renderer, compileMs, results };
+  const depths = new Float32Array(words.buffer, words.byteOffset + 4 * meta.table.depths, width * height).slice();
+  return { renderer, compileMs, results, packageTable: base64(packageTable(depths, width, height)) };
 };

@@ -168,6 +168,18 @@ async function main() {
       console.log(`  input ${i} error ${e}\n    in:  ${show(at(input))}\n    web: ${show(at(web))}\n    cpu: ${show(at(cpu))}`);
     }
   }
+  // The package's summed-area table (src/soft.js: texels, then prefix sums by recursive doubling in
+  // RGBA32UI fragment passes) is sat.h's, word for word: WebGL 2's uint sums wrap modulo 2^32.
+  const { width, height, offset: at } = meta.table;
+  const want = words.subarray(at, at + 4 * width * height);
+  const t = Buffer.from(run.packageTable, 'base64');
+  const have = new Uint32Array(t.buffer, t.byteOffset, t.byteLength / 4);
+  let differ = 0, wrapped = 0;
+  for (let i = 0; i < want.length; ++i) differ += have[i] !== want[i] ? 1 : 0;
+  for (let i = 4; i < want.length; i += 4) wrapped += want[i] < want[i - 4] ? 1 : 0; // a running sum along x went past 2^32
+  console.log(`[web-math] the package's summed-area table (${width}x${height}, RGBA32UI passes): ${differ} of ${want.length} words ` +
+    `differ from sat.h's (${wrapped} running sums wrapped around 2^32) ${differ === 0 && have.length === want.length ? 'ok' : 'FAILED'}`);
+  if (differ > 0 || have.length !== want.length) failed = true;
   if (failed) {
     console.error('web-math: FAILED');
     process.exit(1);
