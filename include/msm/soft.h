@@ -239,14 +239,14 @@ MSM_FN BlockerResult msm_soft_blocker4_upper(vec4 q, float zf, float delta1, flo
 }
 
 // The estimator chosen by the technique's parameters (techniques.h: x = δ1, y = δ2, z = 1 for
-// Kneiphof Eq. (19), 0 for JCGT Eq. (4) with ε = δ1).
+// Kneiphof Eq. (19), 0 for JCGT Eq. (4) with ε = δ1). An if, not ?: (WebGL allows no ?: on structs).
 MSM_FN BlockerResult msm_soft_blocker4_select(vec4 q, float zf, vec4 params, uint scale) {
-  return params.z > 0.5f ? msm_soft_blocker4_upper(q, zf, params.x, params.y, scale)
-                         : msm_blocker4(msm_soft_moments4(q, scale), zf, params.x);
+  if (params.z > 0.5f) return msm_soft_blocker4_upper(q, zf, params.x, params.y, scale);
+  return msm_blocker4(msm_soft_moments4(q, scale), zf, params.x);
 }
 MSM_FN BlockerResult msm_soft_blocker6_select(Moments6 q, float zf, vec4 params, uint scale) {
-  return params.z > 0.5f ? msm_soft_blocker6_upper(q, zf, params.x, params.y, scale)
-                         : msm_blocker6(msm_soft_moments6(q, scale), zf, params.x);
+  if (params.z > 0.5f) return msm_soft_blocker6_upper(q, zf, params.x, params.y, scale);
+  return msm_blocker6(msm_soft_moments6(q, scale), zf, params.x);
 }
 
 // ---- Naive variance soft shadow mapping (Yang et al. 2010, the baseline of JCGT §4) ----

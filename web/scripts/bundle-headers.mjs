@@ -22,6 +22,10 @@ export const BUNDLES = {
     // Everything the package's shaders call: the techniques' per-texel steps (src/glsl/msm_three.h:
     // moments, Θ4*, 16-bit storage, biases, Hamburger 4MSM) and the Gaussian blur's weights.
     MSM_THREE_GLSL: 'msm_three.h',
+    // Moment soft shadows (src/glsl/msm_three_soft.h: the summed-area table's texels and soft.h's
+    // flow), compiled only into the programs of msm-mssm4; its include guards skip what
+    // MSM_THREE_GLSL already holds.
+    MSM_THREE_SOFT_GLSL: 'msm_three_soft.h',
   },
   'test/generated/kernels-glsl.js': {
     // The browser test's dispatcher over the same functions (test/kernels.h).

@@ -1,7 +1,16 @@
 // Moment shadow maps for three.js's WebGLRenderer (see README.md).
 
-/** The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM, 64- and 32-bit non-linear moments. */
-export declare const TECHNIQUES: Readonly<{ 'msm-hamburger-64': 0; 'msm-hamburger-128': 1; 'msm-nl-64': 2; 'msm-nl-32': 3 }>;
+/**
+ * The techniques, by name: 64-bit (Θ4*, 16-bit) and 128-bit (float) Hamburger 4MSM, 64- and 32-bit non-linear moments,
+ * moment soft shadows (a 32-bit integer summed-area table of Θ4*; one directional light, the others get msm-hamburger-64).
+ */
+export declare const TECHNIQUES: Readonly<{
+  'msm-hamburger-64': 0;
+  'msm-hamburger-128': 1;
+  'msm-nl-64': 2;
+  'msm-nl-32': 3;
+  'msm-mssm4': 4;
+}>;
 export type Technique = keyof typeof TECHNIQUES;
 
 /** The Gaussian blur of the moment maps: taps x taps texels (odd, 1..63), σ in texels. */
@@ -11,9 +20,16 @@ export interface Blur {
 }
 export declare const DEFAULT_BLUR: Readonly<Blur>;
 
+/** msm-mssm4's area light: the directional light's angular diameter in degrees (a disc). */
+export interface Soft {
+  angularDiameter: number;
+}
+export declare const DEFAULT_SOFT: Readonly<Soft>;
+
 export interface MomentShadowMapsOptions {
   technique?: Technique;
   blur?: Blur;
+  soft?: Soft;
 }
 
 /** The part of three's WebGLRenderer this package uses (three's own types need not be installed). */
@@ -29,6 +45,7 @@ export declare class MomentShadowMaps {
   readonly supported: boolean;
   technique: Technique;
   blur: Blur;
+  soft: Soft;
   /** WebGL 2 with EXT_color_buffer_float and OES_texture_float_linear; report: warn on the console if not. */
   static isSupported(renderer: RendererLike, report?: boolean): boolean;
   /** Back to three's own shadows, of the type the renderer had before. */

@@ -15,10 +15,13 @@
 // for its own point shadows); the moments are made from it face by face, blurred over directions
 // across the faces' seams (a cube texture samples seamlessly in WebGL 2) and bound where three.js
 // binds a point light's cube map; the chunks gain a VSM getPointShadow.
+// Moment soft shadows (msm-mssm4, ./soft.js): a directional light's depth becomes a 32-bit integer
+// summed-area table, and its lookup is the renderer's soft.h flow.
 import { ShaderChunk, VSMShadowMap, RawShaderMaterial, GLSL3, WebGLRenderTarget, WebGLCubeRenderTarget, BufferGeometry,
   BufferAttribute, Mesh, OrthographicCamera, FloatType, UnsignedByteType, RGBAFormat, RGFormat, LinearFilter, NearestFilter,
   ClampToEdgeWrapping, Vector2, DataTexture, DoubleSide } from 'three';
-import { MSM_THREE_GLSL } from './generated/msm-glsl.js';
+import { MSM_THREE_GLSL, MSM_THREE_SOFT_GLSL } from './generated/msm-glsl.js';
+import { SoftShadowTables, DEFAULT_SOFT } from './soft.js';
 import { MSM_BLUE_NOISE } from './generated/blue-noise.js';
 
 // The techniques: name -> the id of src/glsl/msm_three.h (MSM_THREE_*).
@@ -27,8 +30,11 @@ export const TECHNIQUES = Object.freeze({
   'msm-hamburger-128': 1, // 4 x float (JCGT), Hamburger 4MSM
   'msm-nl-64': 2, // Φ of the float moments in 4 x 16 bits (HPG 2017), Algorithm 3
   'msm-nl-32': 3, // Φ in 32 bits (HPG 2017 §3.5) in an RGBA8 texture, a blue-noise dithered texel, Algorithm 3
+  'msm-mssm4': 4, // moment soft shadows (JCGT §4): Θ4* in a 32-bit integer summed-area table, one directional light
 });
 const NL32 = TECHNIQUES['msm-nl-32'];
+const MSSM4 = TECHNIQUES['msm-mssm4'];
+export { DEFAULT_SOFT };
 
 // The Gaussian blur: taps x taps texels, σ in texels (filter.h's defaults: the 2015 paper's kernel).
 export const DEFAULT_BLUR = Object.freeze({ taps: 9, sigma: 2.4 });
@@ -130,10 +136,36 @@ const GET_SHADOW = `
 		#if MSM_THREE_TECHNIQUE == 3
 		uniform highp sampler2D msmThreeBlueNoise;
 		#endif
+		#if MSM_THREE_TECHNIQUE == 4
+		${MSM_THREE_SOFT_GLSL}
+		// The soft light's table (the package binds it) and soft.h's fetch of it.
+		uniform highp usampler2D msmThreeSatTable;
+		uvec4 msm_three_sat_fetch( int x, int y, int table ) {
+			if ( x < 0 || y < 0 ) return uvec4( 0u );
+			return texelFetch( msmThreeSatTable, ivec2( x, y ), 0 );
+		}
+		// The other lights under msm-mssm4 have msm-hamburger-64's maps.
+		#define MSM_THREE_HARD_TECHNIQUE 0
+		#else
+		#define MSM_THREE_HARD_TECHNIQUE MSM_THREE_TECHNIQUE
+		#endif
 		float getShadow( sampler2D shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord ) {
 			float shadow = 1.0;
+			#if MSM_THREE_TECHNIQUE == 4
+				// The soft light's map is its 1 x 1 texel of light values (soft.js); the others' are moments.
+				if ( textureSize( shadowMap, 0 ) == ivec2( 1 ) ) {
+					ivec2 size = textureSize( msmThreeSatTable, 0 );
+					vec3 coord = shadowCoord.xyz / shadowCoord.w;
+					coord.z += shadowBias;
+					vec3 texels = vec3( coord.xy * vec2( size ), coord.z );
+					vec2 slope = msm_three_depth_per_texel( dFdx( texels ), dFdy( texels ) );
+					if ( coord.x >= 0.0 && coord.x <= 1.0 && coord.y >= 0.0 && coord.y <= 1.0 && coord.z <= 1.0 )
+						shadow = 1.0 - msm_three_soft_shadow( size, texelFetch( shadowMap, ivec2( 0 ), 0 ), MSM_THREE_SOFT_KERNEL, coord, slope ).shadow;
+					return mix( 1.0, shadow, shadowIntensity );
+				}
+			#endif
 			shadowCoord.xyz /= shadowCoord.w;
-			shadowCoord.z += shadowBias - msm_three_depth_bias( MSM_THREE_TECHNIQUE );
+			shadowCoord.z += shadowBias - msm_three_depth_bias( MSM_THREE_HARD_TECHNIQUE );
 			bool inFrustum = shadowCoord.x >= 0.0 && shadowCoord.x <= 1.0 && shadowCoord.y >= 0.0 && shadowCoord.y <= 1.0;
 			if ( inFrustum && shadowCoord.z <= 1.0 ) {
 				#if MSM_THREE_TECHNIQUE == 2
@@ -158,7 +190,7 @@ const GET_SHADOW = `
 					ivec2 i = clamp( ivec2( floor( t + noise ) ), ivec2( 0 ), last );
 					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texelFetch( shadowMap, i, 0 ), shadowCoord.z );
 				#else
-					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
+					shadow = 1.0 - msm_three_shadow( MSM_THREE_HARD_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
 				#endif
 			}
 			return mix( 1.0, shadow, shadowIntensity );
@@ -245,14 +277,18 @@ let activeInstances = 0;
 
 export class MomentShadowMaps {
   // Switches renderer's shadows to moment shadow maps of `technique` (a key of TECHNIQUES).
-  constructor(renderer, { technique = 'msm-hamburger-64', blur = DEFAULT_BLUR } = {}) {
+  // soft: msm-mssm4's light (DEFAULT_SOFT: its angular diameter in degrees).
+  constructor(renderer, { technique = 'msm-hamburger-64', blur = DEFAULT_BLUR, soft = DEFAULT_SOFT } = {}) {
     this.renderer = renderer;
     this.blur = { ...blur };
+    this.soft = { ...soft };
     this.supported = MomentShadowMaps.isSupported(renderer, true);
     this._technique = TECHNIQUES['msm-hamburger-64'];
     this.technique = technique;
     this._lights = new Map(); // light -> { threeMap, moments, scratch }
     this._points = new Map(); // point light -> { distance, moments, scratch } (cube render targets)
+    this._softStates = new Map(); // msm-mssm4's light -> its tables and light texture (soft.js)
+    this._softLight = null;
     this._warned = new Set();
     if (!this.supported) return;
     const chunks = Object.fromEntries(Object.entries(CHUNKS).map(([name, make]) => [name, make(originalChunks[name])]));
@@ -283,6 +319,7 @@ export class MomentShadowMaps {
       technique: { value: 0 }, store: { value: false },
     });
     this._weightsKey = '';
+    this._soft = new SoftShadowTables((material, target) => this._draw(material, target));
     // The dithered lookup's blue noise, bound in every marked material (_markMaterials).
     const noise = Uint8Array.from(atob(MSM_BLUE_NOISE.base64), (c) => c.charCodeAt(0));
     this._blueNoise = { value: new DataTexture(noise, MSM_BLUE_NOISE.size, MSM_BLUE_NOISE.size, RGFormat, UnsignedByteType) };
@@ -292,6 +329,8 @@ export class MomentShadowMaps {
     const self = this;
     shadowMap.render = function (lights, scene, camera) {
       self._restore(lights);
+      // msm-mssm4: the first shadow-casting directional light has soft shadows.
+      self._softLight = self._technique === MSSM4 ? lights.find((l) => l.isDirectionalLight && l.castShadow) ?? null : null;
       // The moments are made from each light's depth texture when three.js's VSM blur first reads
       // it (its vertical pass): the blur then clears the light's map, depth included.
       const draw = renderer.renderBufferDirect;
@@ -342,13 +381,16 @@ export class MomentShadowMaps {
   // Back to three.js's own shadows (the type the renderer had before).
   dispose() {
     if (!this.supported) return;
-    this._restore([...this._lights.keys()]);
+    this._restore([...this._lights.keys(), ...this._softStates.keys()]);
     for (const { moments, scratch, packed } of this._lights.values()) {
       moments.dispose();
       scratch.dispose();
       packed?.dispose();
     }
     this._lights.clear();
+    for (const state of this._softStates.values()) this._soft.release(state);
+    this._softStates.clear();
+    this._soft.dispose();
     for (const [light, { distance, moments, scratch }] of this._points) {
       if (light.shadow.map === distance || light.shadow.map === moments) light.shadow.map = null; // three.js makes its own
       for (const target of [distance, moments, scratch]) target.dispose();
@@ -374,6 +416,8 @@ export class MomentShadowMaps {
     for (const light of lights) {
       const state = this._lights.get(light);
       if (state && (light.shadow.map === state.moments || light.shadow.map === state.packed)) light.shadow.map = state.threeMap;
+      const soft = this._softStates.get(light);
+      if (soft && light.shadow.map === soft.light) light.shadow.map = soft.threeMap;
     }
   }
 
@@ -421,6 +465,19 @@ export class MomentShadowMaps {
       return;
     }
     const threeMap = light.shadow.map;
+    if (this._technique === MSSM4 && light === this._softLight) {
+      const soft = this._soft.state(threeMap.width, threeMap.height, this._softStates.get(light));
+      this._softStates.set(light, soft);
+      Object.assign(soft, { threeMap, generated: true });
+      const previousTarget = renderer.getRenderTarget();
+      this._soft.texels(soft, depth);
+      renderer.setRenderTarget(previousTarget);
+      return;
+    }
+    if (this._technique === MSSM4)
+      this._warnOnce(light, light.isDirectionalLight
+        ? 'msm-mssm4 gives soft shadows to one directional light per renderer: this one has msm-hamburger-64\'s'
+        : 'msm-mssm4 is for directional lights: this one has msm-hamburger-64\'s shadows');
     let state = this._lights.get(light);
     if (!state || state.moments.width !== threeMap.width || state.moments.height !== threeMap.height) {
       state?.moments.dispose();
@@ -434,10 +491,11 @@ export class MomentShadowMaps {
     }
     state.threeMap = threeMap;
     state.generated = true;
+    state.technique = this._technique === MSSM4 ? TECHNIQUES['msm-hamburger-64'] : this._technique;
     if (this._technique === NL32 && !state.packed) state.packed = mapTarget(threeMap.width, threeMap.height, NearestFilter, UnsignedByteType);
     const previousTarget = renderer.getRenderTarget();
     this._generatePass.uniforms.depthMap.value = depth;
-    this._generatePass.uniforms.technique.value = this._technique;
+    this._generatePass.uniforms.technique.value = state.technique;
     this._draw(this._generatePass, state.moments);
     renderer.setRenderTarget(previousTarget);
   }
@@ -460,6 +518,13 @@ export class MomentShadowMaps {
       this._weightsKey = key;
     }
     for (const light of lights) {
+      const soft = this._softStates.get(light);
+      if (soft && light === this._softLight && soft.threeMap === light.shadow.map) {
+        if (soft.generated) this._soft.build(soft, light, this.soft);
+        soft.generated = false;
+        light.shadow.map = soft.light;
+        continue;
+      }
       const state = this._lights.get(light);
       if (!state || state.threeMap !== light.shadow.map) continue;
       // A light that three.js did not update this frame (shadow.autoUpdate off) keeps its moments.
@@ -479,7 +544,7 @@ export class MomentShadowMaps {
   _pointMoments(light, state, taps) {
     state.rendered = false;
     let technique = this._technique;
-    if (technique === TECHNIQUES['msm-nl-64'] || technique === NL32) {
+    if (technique === TECHNIQUES['msm-nl-64'] || technique === NL32 || technique === MSSM4) {
       this._warnOnce(light, `${this.technique} has no cube maps: this point light's moments are msm-hamburger-128's`);
       technique = TECHNIQUES['msm-hamburger-128'];
     }
@@ -513,7 +578,7 @@ export class MomentShadowMaps {
     state.generated = false;
     const blur = this._blurPass.uniforms;
     blur.taps.value = taps;
-    blur.technique.value = this._technique;
+    blur.technique.value = state.technique;
     blur.source.value = state.moments.texture;
     blur.direction.value.set(1, 0);
     blur.store.value = false;
@@ -530,6 +595,7 @@ export class MomentShadowMaps {
     this._onBeforeCompile ??= new Map(); // a material's own hook, put back by dispose()
     const technique = this._technique;
     const blueNoise = this._blueNoise;
+    const satTable = this._soft.table;
     scene.traverse((object) => {
       if (!object.material) return;
       for (const material of Array.isArray(object.material) ? object.material : [object.material]) {
@@ -543,6 +609,7 @@ export class MomentShadowMaps {
           material.onBeforeCompile = function (shader, renderer) {
             own.call(this, shader, renderer);
             shader.uniforms.msmThreeBlueNoise = blueNoise;
+            shader.uniforms.msmThreeSatTable = satTable;
           };
         }
         this._marked.add(material);

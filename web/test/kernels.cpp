@@ -25,11 +25,31 @@ using namespace msm;
 
 constexpr int kInputs = 4096; // per function
 
-const char* const kNames[] = {
-    "fma",          "moments4",          "theta4_star",     "theta4_star_inverse", "pack_unorm16x4", "unpack_unorm16x4",
-    "apply_bias",   "hamburger4_bounds", "nl_from_moments", "nl_moments_from",     "nl_psi4",        "nl_psi4_inverse",
-    "nl_pack64",    "nl_unpack64",       "nl_pack32",       "nl_unpack32",         "nl_shadow",      "three_generate",
-    "three_shadow", "three_store"};
+const char* const kNames[] = {"fma",
+                              "moments4",
+                              "theta4_star",
+                              "theta4_star_inverse",
+                              "pack_unorm16x4",
+                              "unpack_unorm16x4",
+                              "apply_bias",
+                              "hamburger4_bounds",
+                              "nl_from_moments",
+                              "nl_moments_from",
+                              "nl_psi4",
+                              "nl_psi4_inverse",
+                              "nl_pack64",
+                              "nl_unpack64",
+                              "nl_pack32",
+                              "nl_unpack32",
+                              "nl_shadow",
+                              "three_generate",
+                              "three_shadow",
+                              "three_store",
+                              "three_sat_texel",
+                              "three_depth_per_texel",
+                              "soft_blocker4",
+                              "soft_shadow4",
+                              "three_soft_shadow"};
 static_assert(sizeof(kNames) / sizeof(kNames[0]) == MSM_WK_COUNT);
 
 class Inputs {
@@ -149,8 +169,72 @@ KernelIO make_input(int id, Inputs& g) {
     x.u[0] = uint32_t(t);
     break;
   }
+  case MSM_WK_THREE_SAT_TEXEL:
+    x.a[0] = g.chance(0.05) ? float(g.integer(0, 4)) * 0.25f : g.uni(0.0f, 1.0f);
+    x.u[0] = uint32_t(g.chance(0.5) ? MSM_THREE_SOFT_KERNEL : g.integer(2, MSM_SOFT_MAX_KERNEL_WIDTH4));
+    break;
+  case MSM_WK_THREE_DEPTH_PER_TEXEL: { // a plane's derivatives: dt/dx, dt/dy and g · dt, with noise
+    vec2 slope(g.uni(-0.03f, 0.03f), g.uni(-0.03f, 0.03f));
+    vec2 tx(g.uni(-2.0f, 2.0f), g.uni(-2.0f, 2.0f)), ty(g.uni(-2.0f, 2.0f), g.uni(-2.0f, 2.0f));
+    x.a = vec4(tx, dot(slope, tx) + (g.chance(0.2) ? g.uni(-1e-3f, 1e-3f) : 0.0f), 0.0f);
+    x.b = vec4(ty, dot(slope, ty), 0.0f);
+    if (g.chance(0.05)) x.b = vec4(tx * 2.0f, x.a[2] * 2.0f, 0.0f); // degenerate
+    break;
+  }
+  case MSM_WK_SOFT_BLOCKER4:
+  case MSM_WK_SOFT_SHADOW4: { // a region's average of quantized texels, a receiver near its depths
+    uint32_t scale = msm_sat_scale(MSM_THREE_SOFT_KERNEL * MSM_THREE_SOFT_KERNEL);
+    vec4 q = msm_theta4_star(test::moments4f(d));
+    x.a = msm_sat_dequantize(msm_sat_quantize(q, scale), scale);
+    x.b[0] = g.receiver(d);
+    x.u[0] = scale;
+    break;
+  }
   default: break;
   }
+  return x;
+}
+
+// The soft lookup's depth map: 64 x 64 texels of a sloped ground, a box of blockers over it, a
+// second box at another depth and a few single texels.
+constexpr int kTableSize = 64;
+std::vector<float> soft_depths() {
+  std::vector<float> d(size_t(kTableSize * kTableSize));
+  std::mt19937_64 rng(0x5a7);
+  for (int y = 0; y < kTableSize; ++y)
+    for (int x = 0; x < kTableSize; ++x) {
+      float depth = 0.6f + 0.002f * float(x) - 0.001f * float(y);
+      if (x >= 20 && x < 36 && y >= 24 && y < 40) depth = 0.3f;
+      if (x >= 40 && x < 48 && y >= 10 && y < 30) depth = 0.45f;
+      if (rng() % 61 == 0) depth = std::uniform_real_distribution<float>(0.1f, 0.7f)(rng);
+      d[size_t(y * kTableSize + x)] = depth;
+    }
+  return d;
+}
+// Its summed-area table as sat.h defines it (wrapping uint running sums): what the renderer's
+// SatBuilder makes, and what the package's passes (src/soft.js) must make in WebGL.
+std::vector<uvec4> soft_table(const std::vector<float>& depths, int kernel_width) {
+  std::vector<uvec4> t(size_t(kTableSize * kTableSize));
+  for (int y = 0; y < kTableSize; ++y)
+    for (int x = 0; x < kTableSize; ++x) {
+      uvec4 v = msm_three_sat_texel(depths[size_t(y * kTableSize + x)], kernel_width);
+      if (x > 0) v += t[size_t(y * kTableSize + x - 1)];
+      t[size_t(y * kTableSize + x)] = v;
+    }
+  for (int y = 1; y < kTableSize; ++y)
+    for (int x = 0; x < kTableSize; ++x) t[size_t(y * kTableSize + x)] += t[size_t((y - 1) * kTableSize + x)];
+  return t;
+}
+
+KernelIO soft_input(Inputs& g) {
+  KernelIO x{vec4(0.0f), vec4(0.0f), uvec4(uint32_t(MSM_THREE_SOFT_KERNEL), kTableSize, kTableSize, 0u)};
+  vec2 t(g.uni(-0.05f, 1.05f), g.uni(-0.05f, 1.05f));
+  vec2 texel = t * float(kTableSize);
+  float ground = 0.6f + 0.002f * (texel.x - 0.5f) - 0.001f * (texel.y - 0.5f);
+  float depth = g.chance(0.8) ? ground : g.uni(0.2f, 0.8f);
+  x.a = vec4(t, depth, g.log_uniform(0.002f, 0.05f));
+  x.b =
+      vec4(5.0f, 0.02f, g.chance(0.5) ? 0.002f : g.uni(-0.02f, 0.02f), g.chance(0.5) ? -0.001f : g.uni(-0.02f, 0.02f));
   return x;
 }
 
@@ -183,6 +267,11 @@ bool same_as_renderer(int id, const KernelIO& x, const KernelIO& r) {
   }
   // The non-linear shading is the renderer's bilinear lookup in shading_nonlinear.glsl (decode,
   // moments, Φ, Algorithm 3), which has no C++ twin: compared with the C++ build alone.
+  if (id == MSM_WK_THREE_SAT_TEXEL) { // the renderer's mssm4 texel, quantized as its tables (sat_common.glsl)
+    int w = int(x.u[0]);
+    vec4 moments = msm_technique_generate(MSM_TECH_MSSM4, x.a[0], msm_technique_default_params(MSM_TECH_MSSM4)).a;
+    return r.u == msm_sat_quantize(moments, msm_sat_scale(w * w));
+  }
   if (id == MSM_WK_THREE_SHADOW && t != MSM_TECH_NL64) {
     float want = msm_technique_shadow(t, MsmTexel(x.a, vec4(0.0f)), x.b[0], msm_technique_default_params(t));
     return std::bit_cast<uint32_t>(r.a[0]) == std::bit_cast<uint32_t>(want);
@@ -203,15 +292,26 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: msm_web_kernels OUT.json OUT.bin\n");
     return 2;
   }
+  // The lookup's settings are the renderer's mssm4 defaults.
+  if (msm_three_soft_params() != msm_technique_default_params(MSM_TECH_MSSM4)) {
+    std::fprintf(stderr, "msm_web_kernels: the package's mssm4 parameters are not the renderer's\n");
+    return 1;
+  }
+  const std::vector<float> depths = soft_depths();
+  const std::vector<uvec4> table = soft_table(depths, MSM_THREE_SOFT_KERNEL);
+  auto fetch = [&](int x, int y, int) {
+    return x < 0 || y < 0 ? uvec4(0u)
+                          : table[size_t(std::min(y, kTableSize - 1) * kTableSize + std::min(x, kTableSize - 1))];
+  };
   std::vector<uint32_t> words;
   std::string json = "{\"words_per_io\": 12, \"functions\": [";
   for (int id = 0; id < MSM_WK_COUNT; ++id) {
     Inputs g(0x5eed0000u + uint64_t(id));
     std::vector<KernelIO> in;
-    for (int n = 0; n < kInputs; ++n) in.push_back(make_input(id, g));
+    for (int n = 0; n < kInputs; ++n) in.push_back(id == MSM_WK_THREE_SOFT_SHADOW ? soft_input(g) : make_input(id, g));
     for (const KernelIO& x : in) put(words, x);
     for (const KernelIO& x : in) {
-      KernelIO r = msm_web_kernel(id, x);
+      KernelIO r = id == MSM_WK_THREE_SOFT_SHADOW ? msm_web_soft_kernel(fetch, x) : msm_web_kernel(id, x);
       if (!same_as_renderer(id, x, r)) {
         std::fprintf(stderr,
                      "msm_web_kernels: %s differs from the renderer's technique at a = (%.9g, %.9g, %.9g, %.9g), "
@@ -224,7 +324,13 @@ int main(int argc, char** argv) {
     json += std::string(id ? ", " : "") + "{\"id\": " + std::to_string(id) + ", \"name\": \"" + kNames[id] +
             "\", \"count\": " + std::to_string(kInputs) + "}";
   }
-  json += "]}\n";
+  // The table after the functions' words, then its depth map (float bits).
+  json += "], \"table\": {\"width\": " + std::to_string(kTableSize) + ", \"height\": " + std::to_string(kTableSize) +
+          ", \"offset\": " + std::to_string(words.size()) +
+          ", \"depths\": " + std::to_string(words.size() + 4 * table.size()) + "}}\n";
+  for (const uvec4& v : table)
+    for (int i = 0; i < 4; ++i) words.push_back(v[i]);
+  for (float d : depths) words.push_back(std::bit_cast<uint32_t>(d));
   std::FILE* j = std::fopen(argv[1], "wb");
   std::FILE* b = std::fopen(argv[2], "wb");
   bool ok = j && b && std::fwrite(json.data(), 1, json.size(), j) == json.size() &&

@@ -4,6 +4,8 @@
 // and render targets (integer formats are color-renderable in WebGL 2 without extensions, and
 // keep every bit: no float conversion stands between the shader and the comparison).
 import { MSM_KERNELS_GLSL } from './generated/kernels-glsl.js';
+import * as THREE from 'three';
+import { SoftShadowTables } from '../src/soft.js';
 
 const WIDTH = 64;
 
@@ -19,6 +21,12 @@ uniform highp usampler2D u_a;
 uniform highp usampler2D u_b;
 uniform highp usampler2D u_u;
 uniform int u_function;
+// The soft lookup's summed-area table (msm_web_kernels' soft_table), fetched as soft.h's flow asks.
+uniform highp usampler2D u_table;
+uvec4 msm_three_sat_fetch(int x, int y, int table) {
+  if (x < 0 || y < 0) return uvec4(0u);
+  return texelFetch(u_table, ivec2(x, y), 0);
+}
 layout(location = 0) out highp uvec4 o_a;
 layout(location = 1) out highp uvec4 o_b;
 layout(location = 2) out highp uvec4 o_u;
@@ -60,7 +68,7 @@ function texture(gl, width, height, data) {
 }
 
 // words: count KernelIOs (12 words each) -> the kernel's results, in the same layout.
-export function evaluate(gl, program, functionId, words, count) {
+export function evaluate(gl, program, functionId, words, count, table) {
   const height = Math.ceil(count / WIDTH);
   const planes = [0, 1, 2].map(() => new Uint32Array(WIDTH * height * 4));
   for (let i = 0; i < count; ++i)
@@ -78,6 +86,9 @@ export function evaluate(gl, program, functionId, words, count) {
     gl.bindTexture(gl.TEXTURE_2D, inputs[p]);
     gl.uniform1i(gl.getUniformLocation(program, name), p);
   });
+  gl.activeTexture(gl.TEXTURE3);
+  gl.bindTexture(gl.TEXTURE_2D, table);
+  gl.uniform1i(gl.getUniformLocation(program, 'u_table'), 3);
   gl.uniform1i(gl.getUniformLocation(program, 'u_function'), functionId);
   gl.viewport(0, 0, WIDTH, height);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
@@ -103,8 +114,43 @@ function base64(words) {
   return btoa(s);
 }
 
+// The package's summed-area table (src/soft.js's passes, in three.js) of the depth map `depths`
+// (width x height floats): its words, as readPixels gives them (rows from y = 0).
+function packageTable(depths, width, height) {
+  const renderer = new THREE.WebGLRenderer({ canvas: document.createElement('canvas') });
+  const triangle = new THREE.Mesh(new THREE.BufferGeometry().setAttribute('position', new THREE.BufferAttribute(new Float32Array(9), 3)));
+  const camera = new THREE.OrthographicCamera();
+  const tables = new SoftShadowTables((material, target) => {
+    renderer.setRenderTarget(target);
+    renderer.renderBufferDirect(camera, null, triangle.geometry, material, triangle, null);
+  });
+  const depth = new THREE.DataTexture(depths, width, height, THREE.RedFormat, THREE.FloatType);
+  depth.needsUpdate = true;
+  const state = tables.state(width, height);
+  const gl = renderer.getContext();
+  const words = new Uint32Array(4 * width * height);
+  // The passes draw inside a render, as the package's do inside three.js's shadow render.
+  const scene = new THREE.Scene();
+  scene.onAfterRender = () => {
+    tables.texels(state, depth);
+    tables.build(state, { shadow: { camera } }, { angularDiameter: 1 });
+    renderer.setRenderTarget(state.tables[state.result]);
+    gl.readPixels(0, 0, width, height, gl.RGBA_INTEGER, gl.UNSIGNED_INT, words);
+    renderer.setRenderTarget(null);
+  };
+  renderer.render(scene, camera);
+  const error = gl.getError();
+  tables.release(state);
+  tables.dispose();
+  depth.dispose();
+  renderer.dispose();
+  if (error !== gl.NO_ERROR) throw new Error(`WebGL error 0x${error.toString(16)} building the package's table`);
+  return words;
+}
+
 // Fetches /data/kernels.json and /data/kernels.bin (msm_web_kernels' output) and returns, per
-// function, the results as base64 of their words.
+// function, the results as base64 of their words, and the package's table of the soft lookup's
+// depth map.
 window.msmRunKernels = async () => {
   const gl = document.createElement('canvas').getContext('webgl2');
   if (!gl) throw new Error('no WebGL 2');
@@ -115,12 +161,15 @@ window.msmRunKernels = async () => {
   const t0 = performance.now();
   const program = createKernelProgram(gl);
   const compileMs = performance.now() - t0;
+  const { width, height, offset: at } = meta.table;
+  const table = texture(gl, width, height, words.subarray(at, at + 4 * width * height));
   let offset = 0;
   const results = {};
   for (const f of meta.functions) {
     const n = 12 * f.count;
-    results[f.name] = base64(evaluate(gl, program, f.id, words.subarray(offset, offset + n), f.count));
+    results[f.name] = base64(evaluate(gl, program, f.id, words.subarray(offset, offset + n), f.count, table));
     offset += 2 * n;
   }
-  return { renderer, compileMs, results };
+  const depths = new Float32Array(words.buffer, words.byteOffset + 4 * meta.table.depths, width * height).slice();
+  return { renderer, compileMs, results, packageTable: base64(packageTable(depths, width, height)) };
 };

@@ -25,7 +25,7 @@ const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
 
 // metric: 'ulp' (units in the last place), 'abs' (|web - cpu| / max(1, |cpu|)), 'unorm16' (the
 // four 16-bit fields of u.xy, in steps; an exact tie k + 1/2 of the input may round either way),
-// 'nl32' (the fields of the 32-bit non-linear word, in steps). outputs: the compared floats, a[0..3]
+// 'nl32' (the fields of the 32-bit non-linear word, in steps), 'words' (u's four words, in steps). outputs: the compared floats, a[0..3]
 // then b[0..3]. max and p999 bound the largest per-input error and its 99.9th percentile.
 const SPECS = {
   fma: { metric: 'ulp', outputs: [0], max: 0, p999: 0 },
@@ -51,6 +51,14 @@ const SPECS = {
   three_generate: { metric: 'abs', outputs: [0, 1, 2, 3], max: 1e-6, p999: 5e-7 },
   three_shadow: { metric: 'abs', outputs: [0], max: 0.01, p999: 2e-4 },
   three_store: { metric: 'abs', outputs: [0, 1, 2, 3], max: 1.6e-5, p999: 1.6e-5 },
+  // Moment soft shadows (src/glsl/msm_three_soft.h): the table's texel (msm_web_kernels checks it
+  // is the renderer's mssm4 texel) and its four words exactly; the receiver plane's slope; soft.h's
+  // blocker search and filtered bound on quantized averages; the whole lookup over a 64² table.
+  three_sat_texel: { metric: 'words', max: 0, p999: 0 },
+  three_depth_per_texel: { metric: 'abs', outputs: [0, 1], max: 1e-6, p999: 1e-7 },
+  soft_blocker4: { metric: 'abs', outputs: [0, 1], max: 0.01, p999: 2e-4 },
+  soft_shadow4: { metric: 'abs', outputs: [0], max: 0.01, p999: 2e-4 },
+  three_soft_shadow: { metric: 'abs', outputs: [0, 1, 2, 3, 4], max: 0.01, p999: 2e-4 },
 };
 
 const f32 = new Float32Array(1);
@@ -82,6 +90,7 @@ function inputError(spec, input, web, cpu) {
     }
     return e;
   }
+  if (spec.metric === 'words') return Math.max(...[8, 9, 10, 11].map((k) => Math.abs(web[k] - cpu[k])));
   if (spec.metric === 'nl32') {
     const w = nl32Fields(web[8]), c = nl32Fields(cpu[8]);
     return Math.max(...w.map((x, i) => Math.abs(x - c[i])));
@@ -159,6 +168,18 @@ async function main() {
       console.log(`  input ${i} error ${e}\n    in:  ${show(at(input))}\n    web: ${show(at(web))}\n    cpu: ${show(at(cpu))}`);
     }
   }
+  // The package's summed-area table (src/soft.js: texels, then prefix sums by recursive doubling in
+  // RGBA32UI fragment passes) is sat.h's, word for word: WebGL 2's uint sums wrap modulo 2^32.
+  const { width, height, offset: at } = meta.table;
+  const want = words.subarray(at, at + 4 * width * height);
+  const t = Buffer.from(run.packageTable, 'base64');
+  const have = new Uint32Array(t.buffer, t.byteOffset, t.byteLength / 4);
+  let differ = 0, wrapped = 0;
+  for (let i = 0; i < want.length; ++i) differ += have[i] !== want[i] ? 1 : 0;
+  for (let i = 4; i < want.length; i += 4) wrapped += want[i] < want[i - 4] ? 1 : 0; // a running sum along x went past 2^32
+  console.log(`[web-math] the package's summed-area table (${width}x${height}, RGBA32UI passes): ${differ} of ${want.length} words ` +
+    `differ from sat.h's (${wrapped} running sums wrapped around 2^32) ${differ === 0 && have.length === want.length ? 'ok' : 'FAILED'}`);
+  if (differ > 0 || have.length !== want.length) failed = true;
   if (failed) {
     console.error('web-math: FAILED');
     process.exit(1);

@@ -7,7 +7,7 @@ import { dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
-const REQUIRED = ['package.json', 'README.md', 'src/index.js', 'src/index.d.ts', 'src/generated/msm-glsl.js', 'src/generated/blue-noise.js'];
+const REQUIRED = ['package.json', 'README.md', 'src/index.js', 'src/index.d.ts', 'src/soft.js', 'src/generated/msm-glsl.js', 'src/generated/blue-noise.js'];
 let failed = false;
 const fail = (what) => {
   console.error(`web-package: FAILED: ${what}`);
@@ -29,9 +29,9 @@ try {
 
 // The module's exports (it imports three, which node resolves from node_modules).
 const module = await import(resolve(webDir, 'src/index.js'));
-for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR'])
+for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR', 'DEFAULT_SOFT'])
   if (!(name in module)) fail(`src/index.js does not export ${name}`);
-if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32']))
+if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32', 'msm-mssm4']))
   fail(`TECHNIQUES is ${JSON.stringify(module.TECHNIQUES)}, not what index.d.ts declares`);
 if (failed) process.exit(1);
 console.log('web-package: ok');

@@ -22,7 +22,8 @@
 //    and 0.372 against PCF's own 0.364 (the blur's penumbrae; bound PCF's + 0.03);
 //  - what the package cannot do is said: without EXT_color_buffer_float it warns and stays off
 //    (three.js's shadow type unchanged); a point light under msm-nl-64 (no cube map of
-//    non-linear moments) is a warning naming it, and three.js's own VSM warning never shows.
+//    non-linear moments) is a warning naming it, and three.js's own VSM warning never shows; so is
+//    a spot light under msm-mssm4 (soft shadows for directional lights), and the sun is not.
 // Also prints the frame time of each technique (same resolution and map size) against PCF's and
 // VSM's, as ratios: SwiftShader's, a CPU, not a GPU's.
 //   node test/render.test.mjs [OUT_DIR]   (writes the images there)
@@ -144,6 +145,9 @@ async function main() {
     'without EXT_color_buffer_float the package switched itself on or changed the shadow type');
   check(w.some((x) => x.includes('EXT_color_buffer_float')), 'no warning names the missing EXT_color_buffer_float');
   check(w.some((x) => x.includes("PointLight 'lamp'") && x.includes('msm-nl-64')), "no warning says that the point light 'lamp' has no msm-nl-64 map");
+  check(w.some((x) => x.includes("SpotLight 'spot'") && x.includes('msm-mssm4 is for directional lights')),
+    "no warning says that the spot light 'spot' has no msm-mssm4 shadows");
+  check(!w.some((x) => x.includes("DirectionalLight 'sun'")), "the sun under msm-mssm4 was warned about: it has no soft shadows");
   check(!w.some((x) => x.includes('not supported for PointLights')), "three.js warned that VSM has no point shadows: the package's cube map was not used");
   if (failed) process.exit(1);
   console.log('web-render: ok');

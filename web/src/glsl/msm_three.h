@@ -24,6 +24,7 @@ const int MSM_THREE_HAMBURGER_64 = 0;  // 4 x 16 bits after Θ4*, [-1,1] depth (
 const int MSM_THREE_HAMBURGER_128 = 1; // 4 x float, [-1,1] depth (JCGT): msm-hamburger-128
 const int MSM_THREE_NL64 = 2;          // Φ of the float moments in 4 x 16 bits (HPG 2017): msm-nl-64
 const int MSM_THREE_NL32 = 3;          // Φ of the float moments in 32 bits (HPG 2017 §3.5): msm-nl-32
+const int MSM_THREE_MSSM4 = 4; // Θ4* in a 32-bit integer summed-area table (JCGT §4): msm-mssm4 (msm_three_soft.h)
 
 MSM_FN bool msm_three_is_nonlinear(int t) { return t == MSM_THREE_NL64 || t == MSM_THREE_NL32; }
 
@@ -41,7 +42,7 @@ MSM_FN uint msm_three_word_from_rgba8(vec4 texel) {
 // The filterable channels of one depth, already in the storage basis (Θ4* commutes with the blur).
 MSM_FN vec4 msm_three_generate(int t, float unit_depth) {
   vec4 b = msm_moments4(msm_signed_depth(unit_depth));
-  if (t == MSM_THREE_HAMBURGER_64) return msm_theta4_star(b);
+  if (t == MSM_THREE_HAMBURGER_64 || t == MSM_THREE_MSSM4) return msm_theta4_star(b);
   return b;
 }
 
