@@ -1,9 +1,9 @@
 // The package in three.js, rendered in headless chromium (ANGLE on SwiftShader), one page load:
 // the example scene's sun shadow with three.js's PCF (the reference: hard, 1-texel filtered),
 // VSM and the package's techniques, as the shadow attenuation 1 - image / unshadowed image of
-// every pixel. Asserts, with bounds from measurement ([web-render] lines):
+// every pixel, 320x180. Asserts, with bounds from measurement ([web-render] lines):
 //  - the moment shadows are where PCF's are: mean |attenuation - PCF's| (the blur widens them:
-//    measured 0.0048 at 64 bits, 0.0052 at 128 bits, 0.0050 non-linear, 0.0055 at 32 bits non-linear
+//    measured 0.0048 at 64 bits, 0.0052 at 128 bits, 0.0049 non-linear, 0.0055 at 32 bits non-linear
 //    (dithered); bound 0.0075; the 32-bit texel's bytes read in the wrong order give 0.11) and well away from none
 //    (an unshadowed image differs from PCF by 0.017; bound >= 0.012);
 //  - no shadow where PCF has none (mean attenuation on PCF-lit pixels, measured 0.0011 / 0.0018 /
@@ -14,7 +14,7 @@
 //    (bound 0.003), an unshadowed image 0.009 from PCF (bound >= 0.006);
 //  - the point light alone (sun off, the lamp moved to LAMP), where three.js's VSM casts no shadow
 //    at all (the light on pixels that PCF has in shadow: measured 1.0, the whole of it; bound
-//    >= 0.95): the package's cube maps against PCF's, MAE 0.0014 at 64 bits and 0.0046 at 128 bits
+//    >= 0.95): the package's cube maps against PCF's, MAE 0.0013 at 64 bits and 0.0046 at 128 bits
 //    (bound 0.006; an unshadowed image 0.032, bound >= 0.018; the column cut by the near plane
 //    casting from its front faces only, as three.js's VSM renders them: 0.022), shadow on PCF-lit
 //    pixels 0.0016 and 0.0053 (bound 0.0075: the 128-bit map's smaller moment bias shows as faint
@@ -24,7 +24,8 @@
 //    (three.js's shadow type unchanged); a point light under msm-nl-64 (no cube map of
 //    non-linear moments) is a warning naming it, and three.js's own VSM warning never shows.
 // Also prints the frame time of each technique (same resolution and map size) against PCF's and
-// VSM's, as ratios: SwiftShader's, a CPU, not a GPU's.
+// VSM's, as ratios: SwiftShader's, a CPU, not a GPU's; and where the test's time goes (each
+// render's, and its first frame's, which compiles the programs).
 //   node test/render.test.mjs [OUT_DIR]   (writes the images there)
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
@@ -46,6 +47,11 @@ const RUNS = [
   ['msm-nl-64', { shadow: 'msm-nl-64' }],
   ['msm-nl-32', { shadow: 'msm-nl-32' }],
 ];
+// Every render's canvas (the lights' maps are the example scene's: 1024² for the sun and the
+// spot light, 512² per cube face for the point light; the moment passes over them are most of a
+// frame's time on SwiftShader), and the frames timed per technique after two untimed ones.
+const SIZE = { width: 320, height: 180 };
+const TIMED_FRAMES = 2;
 const MAE_MAX = 0.0075, MAE_NONE_MIN = 0.012, LIT_MAX = 0.004;
 const SPOT_RUNS = ['none', 'pcf', 'msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32'];
 // The point light alone: three.js's VSM has no point shadow (the light reaches every pixel).
@@ -56,26 +62,37 @@ const LAMP = [7, 1.5, 2.5];
 const POINT_MAE_MAX = 0.006, POINT_MAE_NONE_MIN = 0.018, POINT_LIT_MAX = 0.0075, POINT_LEAK_OVER_PCF_MAX = 0.03, POINT_VSM_LEAK_MIN = 0.95;
 const SPOT_MAE_MAX = 0.003, SPOT_MAE_NONE_MIN = 0.006;
 
+// A render's luminance per pixel from its RGBA8 bytes.
+function withLuminance(result) {
+  const rgba = Buffer.from(result.rgba, 'base64');
+  const luminance = new Array(rgba.length / 4);
+  for (let i = 0; i < luminance.length; ++i)
+    luminance[i] = (0.2126 * rgba[4 * i] + 0.7152 * rgba[4 * i + 1] + 0.0722 * rgba[4 * i + 2]) / 255;
+  return { ...result, luminance };
+}
+
+const T0 = Date.now(); // the browser's start and the page's load
 async function main() {
   const server = await serve(webDir);
   const browser = await launch();
   const errors = [];
   const r = {};
-  let unsupported;
+  let unsupported, pageMs;
   try {
     const page = await openPage(browser, `${server.url}/test/render.html`, errors);
     await page.waitForFunction(() => window.msmReady === true);
-    for (const [name, options] of RUNS)
-      r[name] = await page.evaluate((o) => window.msmRender(o), { ...options, frames: 5, png: out !== undefined });
-    for (const name of SPOT_RUNS)
-      r[`spot-${name}`] = await page.evaluate((o) => window.msmRender(o), { shadow: name, sun: false, spot: true, png: out !== undefined });
-    for (const name of POINT_RUNS)
-      r[`point-${name}`] = await page.evaluate((o) => window.msmRender(o), { shadow: name, sun: false, point: true, lampPosition: LAMP, png: out !== undefined });
+    pageMs = Date.now() - T0;
+    const render = async (options) => withLuminance(await page.evaluate((o) => window.msmRender(o), { ...SIZE, ...options, png: out !== undefined }));
+    for (const [name, options] of RUNS) r[name] = await render({ ...options, frames: TIMED_FRAMES });
+    for (const name of SPOT_RUNS) r[`spot-${name}`] = await render({ shadow: name, sun: false, spot: true });
+    for (const name of POINT_RUNS) r[`point-${name}`] = await render({ shadow: name, sun: false, point: true, lampPosition: LAMP });
     unsupported = await page.evaluate(() => window.msmUnsupported());
   } finally {
     await browser.close();
     await server.close();
   }
+  console.log(`[web-render] time: browser start and page load ${pageMs} ms; each render in all (its first frame, with the programs' compilation): ` +
+    Object.entries(r).map(([name, x]) => `${name} ${(x.totalMs / 1000).toFixed(1)} s (${(x.firstMs / 1000).toFixed(1)})`).join(', '));
   if (out) {
     mkdirSync(out, { recursive: true });
     for (const [name, { png }] of Object.entries(r)) writeFileSync(join(out, `${name}.png`), Buffer.from(png.split(',')[1], 'base64'));
