@@ -67,8 +67,8 @@ const SPOT_MAE_MAX = 0.003, SPOT_MAE_NONE_MIN = 0.006;
 // camera (the same image, the cube's seams elsewhere on it), 128² faces. Measured |A - B| within 2
 // texels of A's seam against more than 4 texels from either's: 0.0352 vs 0.0380 at 64 bits (0.93x),
 // 0.0332 vs 0.0317 at 128 bits (1.05x); bound 1.15x. Taps clamped to their own face (no blur across
-// the seams) give 0.99x and 1.23x. Turned by exactly 45°, the package loses the wall's shadow on
-// the side faces (not the seams: see web/README.md), so the turn is 40°.
+// the seams) give 0.99x and 1.23x. Not 45°: the ground's corners would lie exactly in a face's eye
+// plane, which SwiftShader rasterizes wrongly into the distance cube (web/README.md).
 const SEAM_RUNS = ['none', 'msm-hamburger-64', 'msm-hamburger-128'], SEAM_TURN = (40 * Math.PI) / 180, SEAM_MAP = 128;
 const SEAM_OVER_ELSEWHERE_MAX = 1.15;
 
