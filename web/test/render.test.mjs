@@ -1,9 +1,9 @@
 // The package in three.js, rendered in headless chromium (ANGLE on SwiftShader), one page load:
 // the example scene's sun shadow with three.js's PCF (the reference: hard, 1-texel filtered),
 // VSM and the package's techniques, as the shadow attenuation 1 - image / unshadowed image of
-// every pixel. Asserts, with bounds from measurement ([web-render] lines):
+// every pixel, 320x180. Asserts, with bounds from measurement ([web-render] lines):
 //  - the moment shadows are where PCF's are: mean |attenuation - PCF's| (the blur widens them:
-//    measured 0.0048 at 64 bits, 0.0052 at 128 bits, 0.0050 non-linear, 0.0055 at 32 bits non-linear
+//    measured 0.0048 at 64 bits, 0.0052 at 128 bits, 0.0049 non-linear, 0.0055 at 32 bits non-linear
 //    (dithered); bound 0.0075; the 32-bit texel's bytes read in the wrong order give 0.11) and well away from none
 //    (an unshadowed image differs from PCF by 0.017; bound >= 0.012);
 //  - no shadow where PCF has none (mean attenuation on PCF-lit pixels, measured 0.0011 / 0.0018 /
@@ -14,18 +14,21 @@
 //    (bound 0.003), an unshadowed image 0.009 from PCF (bound >= 0.006);
 //  - the point light alone (sun off, the lamp moved to LAMP), where three.js's VSM casts no shadow
 //    at all (the light on pixels that PCF has in shadow: measured 1.0, the whole of it; bound
-//    >= 0.95): the package's cube maps against PCF's, MAE 0.0014 at 64 bits and 0.0046 at 128 bits
+//    >= 0.95): the package's cube maps against PCF's, MAE 0.0013 at 64 bits and 0.0046 at 128 bits
 //    (bound 0.006; an unshadowed image 0.032, bound >= 0.018; the column cut by the near plane
 //    casting from its front faces only, as three.js's VSM renders them: 0.022), shadow on PCF-lit
 //    pixels 0.0016 and 0.0053 (bound 0.0075: the 128-bit map's smaller moment bias shows as faint
 //    self-shadowing where the cube's texels are long on the ground), light on PCF's shadows 0.373
 //    and 0.372 against PCF's own 0.364 (the blur's penumbrae; bound PCF's + 0.03);
+//  - the point light's cube seams (SEAM_*): a shadow edge crossing a seam is no worse there than
+//    elsewhere, the scene as built against the same turned so that its seams move;
 //  - what the package cannot do is said: without EXT_color_buffer_float it warns and stays off
 //    (three.js's shadow type unchanged); a point light under msm-nl-64 (no cube map of
 //    non-linear moments) is a warning naming it, and three.js's own VSM warning never shows; so is
 //    a spot light under msm-mssm4 (soft shadows for directional lights), and the sun is not.
 // Also prints the frame time of each technique (same resolution and map size) against PCF's and
-// VSM's, as ratios: SwiftShader's, a CPU, not a GPU's.
+// VSM's, as ratios: SwiftShader's, a CPU, not a GPU's; and where the test's time goes (each
+// render's, and its first frame's, which compiles the programs).
 //   node test/render.test.mjs [OUT_DIR]   (writes the images there)
 import { mkdirSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
@@ -47,6 +50,11 @@ const RUNS = [
   ['msm-nl-64', { shadow: 'msm-nl-64' }],
   ['msm-nl-32', { shadow: 'msm-nl-32' }],
 ];
+// Every render's canvas (the lights' maps are the example scene's: 1024² for the sun and the
+// spot light, 512² per cube face for the point light; the moment passes over them are most of a
+// frame's time on SwiftShader), and the frames timed per technique after two untimed ones.
+const SIZE = { width: 320, height: 180 };
+const TIMED_FRAMES = 2;
 const MAE_MAX = 0.0075, MAE_NONE_MIN = 0.012, LIT_MAX = 0.004;
 const SPOT_RUNS = ['none', 'pcf', 'msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32'];
 // The point light alone: three.js's VSM has no point shadow (the light reaches every pixel).
@@ -56,27 +64,74 @@ const POINT_RUNS = ['none', 'pcf', 'vsm', 'msm-hamburger-64', 'msm-hamburger-128
 const LAMP = [7, 1.5, 2.5];
 const POINT_MAE_MAX = 0.006, POINT_MAE_NONE_MIN = 0.018, POINT_LIT_MAX = 0.0075, POINT_LEAK_OVER_PCF_MAX = 0.03, POINT_VSM_LEAK_MIN = 0.95;
 const SPOT_MAE_MAX = 0.003, SPOT_MAE_NONE_MIN = 0.006;
+// The point light's seams: the seam scene (msmSeam) as built and turned by SEAM_TURN with its
+// camera (the same image, the cube's seams elsewhere on it), 128² faces. Measured |A - B| within 2
+// texels of A's seam against more than 4 texels from either's: 0.0352 vs 0.0380 at 64 bits (0.93x),
+// 0.0332 vs 0.0317 at 128 bits (1.05x); bound 1.15x. Taps clamped to their own face (no blur across
+// the seams) give 0.99x and 1.23x. Not 45°: the ground's corners would lie exactly in a face's eye
+// plane, which SwiftShader rasterizes wrongly into the distance cube (web/README.md).
+const SEAM_RUNS = ['none', 'msm-hamburger-64', 'msm-hamburger-128'], SEAM_TURN = (40 * Math.PI) / 180, SEAM_MAP = 128;
+const SEAM_OVER_ELSEWHERE_MAX = 1.15;
 
+// A render's luminance per pixel from its RGBA8 bytes.
+function withLuminance(result) {
+  const rgba = Buffer.from(result.rgba, 'base64');
+  const luminance = new Array(rgba.length / 4);
+  for (let i = 0; i < luminance.length; ++i)
+    luminance[i] = (0.2126 * rgba[4 * i] + 0.7152 * rgba[4 * i + 1] + 0.0722 * rgba[4 * i + 2]) / 255;
+  return { ...result, luminance };
+}
+
+// |attenuation as built - turned| near the seams of the built scene's cube against elsewhere, on the
+// pixels of the shadow's edges (either attenuation in (0.05, 0.95)) that the light reaches well.
+function checkSeams(seam, check) {
+  const turns = [0, SEAM_TURN];
+  const none = turns.map((turn) => seam[`none/${turn}`].luminance);
+  const distance = turns.map((turn) => new Float32Array(new Uint8Array(Buffer.from(seam[`none/${turn}`].distance, 'base64')).buffer));
+  for (const shadow of SEAM_RUNS.filter((name) => name !== 'none')) {
+    const [a, b] = turns.map((turn, k) => seam[`${shadow}/${turn}`].luminance.map((v, i) => 1 - v / Math.max(none[k][i], 1e-3)));
+    const near = [], elsewhere = [];
+    for (let i = 0; i < a.length; ++i) {
+      const edge = Math.min(a[i], b[i]) < 0.95 && Math.max(a[i], b[i]) > 0.05;
+      if (none[0][i] <= 0.3 || !edge || distance[1][i] <= 4) continue;
+      if (distance[0][i] <= 2) near.push(Math.abs(a[i] - b[i]));
+      else if (distance[0][i] > 4) elsewhere.push(Math.abs(a[i] - b[i]));
+    }
+    const mean = (values) => values.reduce((sum, x) => sum + x, 0) / Math.max(values.length, 1);
+    const ratio = mean(near) / mean(elsewhere);
+    console.log(`[web-render] point light's seams, ${shadow} (${SEAM_MAP}² faces): |as built - turned| within 2 texels of a seam ` +
+      `${mean(near).toFixed(4)} (${near.length} pixels), elsewhere ${mean(elsewhere).toFixed(4)} (${elsewhere.length} pixels): ${ratio.toFixed(2)}x`);
+    check(near.length >= 50 && elsewhere.length >= 1000, `point light's seams, ${shadow}: too few pixels to compare (${near.length}, ${elsewhere.length})`);
+    check(ratio <= SEAM_OVER_ELSEWHERE_MAX, `point light's seams, ${shadow}: the error near the seams is ${ratio}x elsewhere's (bound ${SEAM_OVER_ELSEWHERE_MAX})`);
+  }
+}
+
+const T0 = Date.now(); // the browser's start and the page's load
 async function main() {
   const server = await serve(webDir);
   const browser = await launch();
   const errors = [];
   const r = {};
-  let unsupported;
+  let unsupported, pageMs;
+  const seam = {};
   try {
     const page = await openPage(browser, `${server.url}/test/render.html`, errors);
     await page.waitForFunction(() => window.msmReady === true);
-    for (const [name, options] of RUNS)
-      r[name] = await page.evaluate((o) => window.msmRender(o), { ...options, frames: 5, png: out !== undefined });
-    for (const name of SPOT_RUNS)
-      r[`spot-${name}`] = await page.evaluate((o) => window.msmRender(o), { shadow: name, sun: false, spot: true, png: out !== undefined });
-    for (const name of POINT_RUNS)
-      r[`point-${name}`] = await page.evaluate((o) => window.msmRender(o), { shadow: name, sun: false, point: true, lampPosition: LAMP, png: out !== undefined });
+    pageMs = Date.now() - T0;
+    const render = async (options) => withLuminance(await page.evaluate((o) => window.msmRender(o), { ...SIZE, ...options, png: out !== undefined }));
+    for (const [name, options] of RUNS) r[name] = await render({ ...options, frames: TIMED_FRAMES });
+    for (const name of SPOT_RUNS) r[`spot-${name}`] = await render({ shadow: name, sun: false, spot: true });
+    for (const name of POINT_RUNS) r[`point-${name}`] = await render({ shadow: name, sun: false, point: true, lampPosition: LAMP });
+    for (const turn of [0, SEAM_TURN])
+      for (const shadow of SEAM_RUNS)
+        seam[`${shadow}/${turn}`] = withLuminance(await page.evaluate((o) => window.msmSeam(o), { shadow, turn, mapSize: SEAM_MAP }));
     unsupported = await page.evaluate(() => window.msmUnsupported());
   } finally {
     await browser.close();
     await server.close();
   }
+  console.log(`[web-render] time: browser start and page load ${pageMs} ms; each render in all (its first frame, with the programs' compilation): ` +
+    Object.entries(r).map(([name, x]) => `${name} ${(x.totalMs / 1000).toFixed(1)} s (${(x.firstMs / 1000).toFixed(1)})`).join(', '));
   if (out) {
     mkdirSync(out, { recursive: true });
     for (const [name, { png }] of Object.entries(r)) writeFileSync(join(out, `${name}.png`), Buffer.from(png.split(',')[1], 'base64'));
@@ -139,6 +194,7 @@ async function main() {
       check(leak <= pointLeakPcf + POINT_LEAK_OVER_PCF_MAX, `point light, ${name}: light on PCF's shadows ${leak}, PCF's own ${pointLeakPcf}`);
     }
   }
+  checkSeams(seam, check);
   const w = unsupported.warnings;
   console.log(`[web-render] warnings: ${w.join(' | ')}`);
   check(!unsupported.noFloat.supported && unsupported.noFloat.type === unsupported.pcfType,
