@@ -3,6 +3,7 @@
 // pipelines stay in the program cache.
 #include "msm/render/renderer.h"
 
+#include "depth_bounds.h"
 #include "frame_config.h"
 #include "frame_graph.h"
 #include "gpu_scene.h"
@@ -161,9 +162,16 @@ struct Renderer::Impl {
     int count, shadow_size;
     float lambda;
     bool stabilize;
+    std::optional<glm::dvec2> depth_range;
     bool operator==(const CascadeKey&) const = default;
   };
   std::vector<std::pair<CascadeKey, std::vector<scene::Cascade>>> cascade_fits;
+  // The camera's depth bounds (RenderSettings::cascade_depth_bounds reduce), made on first use; the
+  // range the frame's cascades split (unset: the scene's estimate) and the GPU time of measuring
+  // it, which the next read_times reports as the pass "depth_bounds".
+  std::unique_ptr<DepthBoundsReducer> depth_bounds;
+  std::optional<glm::dvec2> split_range;
+  std::optional<double> depth_bounds_ms;
   mutable std::vector<std::pair<glm::ivec3, bool>> too_coarse;
 
   Impl(const vk::Context& c, const scene::Scene& s)
@@ -204,14 +212,28 @@ struct Renderer::Impl {
 
   const std::vector<scene::Cascade>& cascade_fit(const RenderSettings& s, const scene::DirectionalLight& light,
                                                  int count) {
-    const CascadeKey key{light.towards_light, light.x_axis,     count,
-                         s.shadow_size,       s.cascade_lambda, s.cascade_stabilize};
+    const CascadeKey key{light.towards_light, light.x_axis,        count,      s.shadow_size,
+                         s.cascade_lambda,    s.cascade_stabilize, split_range};
     for (const auto& [k, fit] : cascade_fits)
       if (k == key) return fit;
     if (cascade_fits.size() >= 64) cascade_fits.clear(); // a light dragged around in a viewer
-    const scene::CascadeOptions options{.count = count, .lambda = s.cascade_lambda, .stabilize = s.cascade_stabilize};
+    const scene::CascadeOptions options{
+        .count = count, .lambda = s.cascade_lambda, .stabilize = s.cascade_stabilize, .depth_range = split_range};
     cascade_fits.emplace_back(key, scene::fit_cascades(scene, light, s.shadow_size, options));
     return cascade_fits.back().second;
+  }
+
+  // The view depths the frame's cascades split: with cascade_depth_bounds reduce, the camera's depth
+  // buffer's range, measured anew each frame (the readback stalls: an engine would split with the
+  // previous frame's); unset (fit_cascades' scene estimate) with scene, one map, or no surface seen.
+  void measure_split_range(const RenderSettings& s, int count) {
+    split_range.reset();
+    depth_bounds_ms.reset();
+    if (count <= 1 || s.cascade_depth_bounds != RenderSettings::CascadeDepthBounds::reduce) return;
+    if (!depth_bounds) depth_bounds = std::make_unique<DepthBoundsReducer>(ctx, programs);
+    const DepthBounds b = depth_bounds->measure(gpu, scene.camera, s.width, s.height);
+    depth_bounds_ms = b.ms;
+    if (b.any) split_range = b.view_depth;
   }
 
   // The cascades per directional light of these settings (resolved_cascades, its measure cached).
@@ -581,6 +603,7 @@ struct Renderer::Impl {
     std::memcpy(uniforms.data(), &u, sizeof(u)); // NOLINT(bugprone-undefined-memory-manipulation)
     std::ranges::fill(soft_clamps.mapped<std::uint32_t>(), 0u);
     light_data.clear();
+    measure_split_range(s, c.cascades);
     for (const scene::DirectionalLight& light : frame_lights) add_directional_light(s, technique, light, c.cascades);
     for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, technique, spot));
     for (const scene::LocalLight& point : point_lights())
@@ -659,6 +682,8 @@ struct Renderer::Impl {
 
   // Pass totals (outermost scopes) and, with several lights, each light's share.
   void read_times(std::vector<PassTime>& passes, std::vector<LightPassTime>* per_light) {
+    if (depth_bounds_ms) passes.push_back({"depth_bounds", *depth_bounds_ms}); // before the frame
+    depth_bounds_ms.reset();
     vk::TimerResults r = timer.read();
     for (const vk::TimerScope& scope : r.scopes) {
       if (scope.depth == 0) {
@@ -766,6 +791,7 @@ RenderResult Renderer::render(const RenderSettings& s, Intermediates* intermedia
   for (const PassTime& p : r.passes) r.total_ms += p.ms;
   std::span<const std::uint32_t> clamps = m.soft_clamps.mapped<const std::uint32_t>();
   r.soft_kernel_clamps = {.lookups = std::uint64_t(clamps[0]) + clamps[1], .clamped = clamps[1]};
+  if (m.config.cascades > 1) r.cascade_depth_range = m.split_range.value_or(scene::visible_depth_range(m.scene));
   if (std::optional<std::string> w = soft_kernel_clamp_warning(r.soft_kernel_clamps, s.resolved_soft_kernel()))
     r.warnings.push_back(*w);
   const FrameGraph& g = *m.graph;
@@ -879,9 +905,9 @@ void Renderer::set_lights(std::vector<scene::DirectionalLight> directional, std:
 std::vector<std::vector<PassTime>> Renderer::time_frames(const RenderSettings& s, int frames) {
   if (frames < 1) throw RenderError("time_frames: at least one frame");
   Impl& m = *impl_;
-  m.prepare(s);
   std::vector<std::vector<PassTime>> out;
   for (int i = 0; i < frames; ++i) {
+    m.prepare(s); // each frame measures its cascades' depth bounds anew, as a moving camera's would
     vk::submit_and_wait(m.ctx, [&](VkCommandBuffer cmd) { m.record(cmd); });
     out.emplace_back();
     m.read_times(out.back(), nullptr);

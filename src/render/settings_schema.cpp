@@ -118,7 +118,8 @@ constexpr std::string_view kMsaaCounts[] = {"1", "4", "8"};
 constexpr std::string_view kLookups[] = {"auto", "bilinear", "nearest", "dither"}; // R::Lookup's order
 constexpr std::string_view kFilterModes[] = {"auto", "one-pass", "three-pass"};
 constexpr std::string_view kShadings[] = {"auto", "forward", "deferred"};
-constexpr std::string_view kPrefixSums[] = {"rows", "appendix-c"}; // R::PrefixSums's order
+constexpr std::string_view kPrefixSums[] = {"rows", "appendix-c"};      // R::PrefixSums's order
+constexpr std::string_view kCascadeDepthBounds[] = {"reduce", "scene"}; // R::CascadeDepthBounds's order
 
 const SettingDeclaration kSettings[] = {
     {.key = "technique",
@@ -309,6 +310,14 @@ const SettingDeclaration kSettings[] = {
      .help = "The cascades' maps snapped to whole texels, their size fixed: no shimmer as the camera moves",
      .get = get_value<&R::cascade_stabilize>,
      .set = set_value<&R::cascade_stabilize>},
+    {.key = "cascade_depth_bounds",
+     .type = SettingType::choice,
+     .help = "The view depths the cascades split: reduce (the nearest and farthest surface in the camera's depth "
+             "buffer, by a depth pre-pass and a compute reduction) or scene (the camera's frustum clipped to the "
+             "scene's bounds)",
+     .choices = kCascadeDepthBounds,
+     .get = get_enum<&R::cascade_depth_bounds, kCascadeDepthBounds>,
+     .set = set_enum<&R::cascade_depth_bounds, kCascadeDepthBounds>},
     {.key = "light_extent_deg",
      .type = SettingType::number,
      .help = "Angular diameter of the light in degrees, for soft shadows (default: the scene's)",

@@ -148,3 +148,34 @@ TEST(Cascades, StabilisedGridsMoveByWholeTexels) {
     }
   }
 }
+
+// A given depth range (the renderer's depth-buffer bounds) is what the splits divide, in place of
+// the scene's estimate: the first cascade's far end and the last's near band at the practical
+// scheme's splits of it; a range beyond the camera's planes is clamped to them and an empty one
+// still gives increasing slices; a tighter range gives the near cascade finer texels.
+TEST(Cascades, SplitTheGivenDepthRange) {
+  const Scene s = box_on_ground();
+  const int size = 1024;
+  const CascadeOptions scene_estimate{.count = 4};
+  CascadeOptions given = scene_estimate;
+  given.depth_range = glm::dvec2(3.0, 40.0);
+  const std::vector<double> splits = cascade_splits(3.0, 40.0, 4, given.lambda);
+  const std::vector<Cascade> fitted = fit_cascades(s, s.light(), size, given);
+  ASSERT_EQ(fitted.size(), 4u);
+  for (std::size_t i = 0; i + 1 < fitted.size(); ++i) EXPECT_EQ(fitted[i].fade_out.y, splits[i + 1]) << i;
+  EXPECT_EQ(fitted[3].fade_in.y, splits[3]);
+  const std::vector<Cascade> estimated = fit_cascades(s, s.light(), size, scene_estimate);
+  EXPECT_NE(estimated[0].fade_out.y, fitted[0].fade_out.y);
+  EXPECT_LT(fitted[0].frame.texel(size).x, estimated[0].frame.texel(size).x);
+
+  given.depth_range = glm::dvec2(0.001, 1e6); // beyond near 0.1 and far 1000
+  const std::vector<double> clamped = cascade_splits(s.camera.near, s.camera.far, 4, given.lambda);
+  const std::vector<Cascade> wide = fit_cascades(s, s.light(), size, given);
+  EXPECT_NEAR(wide[0].fade_out.y, clamped[1], 1e-9 * clamped[1]);
+  EXPECT_NEAR(wide[3].fade_in.y, clamped[3], 1e-9 * clamped[3]);
+
+  given.depth_range = glm::dvec2(7.0, 7.0); // one depth: a flat wall facing the camera
+  const std::vector<Cascade> flat = fit_cascades(s, s.light(), size, given);
+  for (std::size_t i = 1; i + 1 < flat.size(); ++i) EXPECT_GT(flat[i].fade_out.y, flat[i - 1].fade_out.y);
+  for (const Cascade& k : flat) EXPECT_TRUE(std::isfinite(k.frame.texel(size).x));
+}

@@ -434,12 +434,22 @@ glm::mat4 cascade_view_projection(const Scene& scene, const glm::dmat4& light_vi
          glm::mat4(light_view);
 }
 
+// The view depths the cascades split: the given range (a depth buffer's) or the scene's estimate,
+// within the camera's planes and never empty (a flat view of one depth still gets slices).
+glm::dvec2 split_range(const Scene& scene, const CascadeOptions& options) {
+  if (!options.depth_range) return visible_depth_range(scene);
+  const glm::dvec2 planes(scene.camera.near, scene.camera.far);
+  glm::dvec2 range = glm::clamp(*options.depth_range, planes.x, planes.y);
+  if (!(range.y > range.x)) range.y = std::min(planes.y, range.x * (1.0 + 1e-3) + 1e-6);
+  return range;
+}
+
 } // namespace
 
 std::vector<Cascade> fit_cascades(const Scene& scene, const DirectionalLight& light, int shadow_size,
                                   const CascadeOptions& options) {
   const int count = std::clamp(options.count, 1, kMaxCascades);
-  const glm::dvec2 range = visible_depth_range(scene);
+  const glm::dvec2 range = split_range(scene, options);
   const std::vector<double> splits = cascade_splits(range.x, range.y, count, options.lambda);
   // The camera frustum's corners (bit 2: the far plane); view depth is linear along its edges.
   const Hull frustum = camera_frustum(scene.camera);

@@ -546,6 +546,22 @@ std::string bench_markdown(const BenchOptions& o, const vk::Context& ctx, const 
   return md;
 }
 
+// The cascades' depth bounds (pre-pass + reduction, the pass "depth_bounds") against the frame,
+// where a configuration measured them; empty where none did.
+std::string depth_bounds_markdown(const nlohmann::json& results) {
+  std::string md;
+  for (const nlohmann::json& entry : results)
+    if (entry.contains("depth_bounds"))
+      for (const auto& [resolution, v] : entry["depth_bounds"].items())
+        md += fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.1f}% |\n", entry["technique"].get<std::string>(),
+                          resolution, v["median_ms"].get<double>(), v["frame_ms"].get<double>(),
+                          100.0 * v["share_of_frame"].get<double>());
+  if (md.empty()) return md;
+  return "\nCascades' depth bounds (camera depth pre-pass + min/max reduction, read back before the frame):\n\n"
+         "| technique | resolution | depth bounds ms | frame ms | share of the frame |\n|---|---|---:|---:|---:|\n" +
+         md;
+}
+
 // A progress line: rewritten in place on a terminal, one line per step in a log.
 void print_progress(bool tty, const std::string& line) {
   if (tty)
@@ -707,7 +723,8 @@ void bench_light_kinds(const BenchOptions& o, const std::vector<std::string>& na
 void write_technique_results(const BenchOptions& opt, vk::Context& ctx, const scene::Scene& scene,
                              nlohmann::json& results, const std::vector<std::pair<int, int>>& resolutions,
                              bool host_clock) {
-  const std::string md = bench_markdown(opt, ctx, scene, results, resolutions, host_clock);
+  const std::string md =
+      bench_markdown(opt, ctx, scene, results, resolutions, host_clock) + depth_bounds_markdown(results);
   fmt::print("{}", md);
   const nlohmann::json doc = {{"device", ctx.info().describe()},
                               {"scene", scene.name},
@@ -795,6 +812,16 @@ void add_bench(CLI::App& app) {
         per_unit[name]["shading " + key] = ns;
         entry["shading"][key] = {
             {"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_pixel", ns}};
+        if (std::ranges::any_of(frames[0], [](const render::PassTime& p) { return p.name == "depth_bounds"; })) {
+          std::vector<std::string> all; // every pass of the frame, the depth bounds included
+          for (const render::PassTime& p : frames[0]) all.push_back(p.name);
+          const Stats bounds = pass_sum(frames, {"depth_bounds"}), frame = pass_sum(frames, all);
+          entry["depth_bounds"][key] = {{"median_ms", bounds.median},
+                                        {"p10_ms", bounds.p10},
+                                        {"p90_ms", bounds.p90},
+                                        {"frame_ms", frame.median},
+                                        {"share_of_frame", bounds.median / frame.median}};
+        }
         if (scatters) { // the deferred pass alone (the prefiltered maps: per texel below)
           Stats sc = pass_sum(frames, {"scattering"});
           entry["scattering"][key] = {{"median_ms", sc.median},

@@ -59,6 +59,12 @@
 #define MSM_BINDING_DEPTH_SAMPLES_MAP 0
 #define MSM_BINDING_DEPTH_SAMPLES_BUFFER 1
 
+// The camera's depth pre-pass of alpha-tested objects (camera_depth_masked.frag) and the reduction
+// of its depth to the visible range (depth_bounds.comp).
+#define MSM_BINDING_CAMERA_DEPTH_OPACITY 0
+#define MSM_BINDING_DEPTH_BOUNDS_MAP 0
+#define MSM_BINDING_DEPTH_BOUNDS_RESULT 1
+
 // Rectification of the light's map for prefiltered scattering (rectify.glsl).
 #define MSM_BINDING_RECTIFY_RECTS 1
 #define MSM_BINDING_RECTIFY_LIGHTS 2

@@ -172,6 +172,12 @@ struct RenderSettings {
   std::optional<int> cascades;
   float cascade_lambda = float(scene::kDefaultCascadeLambda); // the split scheme: 0 uniform, 1 logarithmic
   bool cascade_stabilize = true; // radius rounded and centre snapped to whole texels (no shimmer)
+  // The view depths the cascades split (scene::CascadeOptions::depth_range): reduce = the smallest
+  // and largest view depth in the camera's depth buffer (a depth pre-pass and a compute reduction,
+  // read back before the frame's shadow maps: sample-distribution shadow maps; its GPU time the
+  // frame's pass "depth_bounds"); scene = scene::visible_depth_range's estimate from the scene's
+  // bounds (the camera's frustum clipped to them), which counts hidden and empty space too.
+  enum class CascadeDepthBounds { reduce, scene } cascade_depth_bounds = CascadeDepthBounds::reduce;
   // Throws RenderError naming the setting and the allowed range.
   void validate() const;
 };
@@ -244,6 +250,7 @@ struct RenderResult {
   std::vector<LightPassTime> light_passes; // several lights: each light's share of the passes
   SoftKernelClamps soft_kernel_clamps;     // soft techniques (mssm4/6, vssm, pcss, cssm8/16); else zeros
   std::vector<std::string> warnings;       // where the result is known degraded (soft_kernel_clamp_warning)
+  std::optional<glm::dvec2> cascade_depth_range; // with cascades: the view depths they split (cascade_depth_bounds)
 };
 
 struct Intermediates;     // the internal header's (msm/render/renderer_internals.h, not installed)

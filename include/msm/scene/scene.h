@@ -575,6 +575,10 @@ struct CascadeOptions {
   // whole texels of the light's map, so a camera that moves or turns moves no texel edge.
   bool stabilize = true;
   double blend = 0.1; // the band at each cascade's far end where it fades into the next, as a fraction of its slice
+  // The view depths [near, far] the splits divide: where set, what the camera's depth buffer holds
+  // (the renderer's reduction, sample-distribution shadow maps); unset, visible_depth_range's
+  // estimate from the scene's bounds. Clamped to the camera's near and far planes either way.
+  std::optional<glm::dvec2> depth_range = std::nullopt;
 };
 
 // One cascade: its orthographic map and the view depths where it is used, a weight rising from 0 at
@@ -595,7 +599,8 @@ glm::dvec2 visible_depth_range(const Scene& scene);
 
 // The cascades of a directional light for a map of shadow_size² texels per cascade: each fitted to
 // the bounding sphere of its slice of the view frustum (its band with the previous one included),
-// depth from the casters over it (the light's nearest vertex there) to the sphere's far side.
+// depth from the casters over it (the light's nearest vertex there) to the sphere's far side. The
+// slices split options.depth_range, else visible_depth_range(scene).
 std::vector<Cascade> fit_cascades(const Scene& scene, const DirectionalLight& light, int shadow_size,
                                   const CascadeOptions& options);
 
