@@ -134,9 +134,7 @@ struct ObjectPush {
 #define MSM_SPEC_SCATTER_LAYERS 14    // int: transmittance layers per light (scatter.glsl)
 #define MSM_SPEC_SCATTER_BETA_MODE 15 // int: MSM_SCATTERING_BETA_* (scatter.glsl)
 #define MSM_SPEC_SPOT_LIGHTS 16       // bool: some light of the frame is a spot light (shading.glsl)
-#define MSM_SPEC_CASCADES                                                                                              \
-  17  // bool: the directional lights have cascades (shading.glsl,                                                     \
-      // one_pass_filter.glsl)
+#define MSM_SPEC_CASCADES 17          // bool: the directional lights have cascades (shading, one-pass filter)
 // The blur's specialization constants (blur.comp, passes/blur_pass.cpp): id MSM_BLUR_SPEC_ID holds
 // the fetches per side of the frame's widest kernel (msm_filter_pairs of the largest kernel: 16;
 // each layer's offsets and weights are its BlurKernel's); + 2 + 2 MSM_BLUR_MAX_PAIRS is true for
