@@ -40,15 +40,28 @@ std::string rendered_light_kinds() {
   return fmt::format("{} lights only", fmt::join(names, " and "));
 }
 
-// The direction translucent surfaces are sorted along: the first directional light's travel (a
-// scene of spot lights only has no translucent pass, RenderError in the renderer's check).
-glm::vec3 translucent_travel(const scene::Scene& scene) {
-  return scene.lights.empty() ? glm::vec3(0.0f, -1.0f, 0.0f) : scene.light().travel();
+// How far from the light a point lies, along which translucent surfaces are sorted far to near
+// (JCGT §3) for the renderer's first shadow-map layer: along the first directional light's
+// travel, or in a scene of spot and point lights only by the distance from the first spot light
+// (else the first point light), whose layer comes first. The translucent pass re-sorts the objects
+// for its other layers; each object's triangles keep this order.
+struct LightFarness {
+  bool local = false;
+  glm::vec3 travel{0.0f, -1.0f, 0.0f}, position{0.0f};
+  float operator()(glm::vec3 p) const { return local ? glm::distance(p, position) : glm::dot(p, travel); }
+};
+
+LightFarness translucent_farness(const scene::Scene& scene) {
+  if (!scene.lights.empty()) return {.travel = scene.light().travel()};
+  auto spot = std::ranges::find_if(scene.local_lights, &scene::LocalLight::spot);
+  if (spot != scene.local_lights.end()) return {.local = true, .position = spot->position};
+  if (!scene.local_lights.empty()) return {.local = true, .position = scene.local_lights.front().position};
+  return {};
 }
 
 Geometry geometry(const scene::Scene& scene) {
   Geometry g;
-  const glm::vec3 travel = translucent_travel(scene);
+  const LightFarness farness = translucent_farness(scene);
   for (const scene::Object& object : scene.objects) {
     const scene::Mesh& mesh = object.mesh;
     const uint32_t base = uint32_t(g.vertices.size());
@@ -60,7 +73,7 @@ Geometry geometry(const scene::Scene& scene) {
     if (scene.materials.at(object.material).translucent()) {
       auto depth = [&](uint32_t t) {
         const uint32_t* i = &mesh.indices[3 * t];
-        return glm::dot(mesh.positions[i[0]] + mesh.positions[i[1]] + mesh.positions[i[2]], travel);
+        return farness((mesh.positions[i[0]] + mesh.positions[i[1]] + mesh.positions[i[2]]) / 3.0f);
       };
       std::stable_sort(triangles.begin(), triangles.end(), [&](uint32_t a, uint32_t b) { return depth(a) > depth(b); });
     }
@@ -70,11 +83,10 @@ Geometry geometry(const scene::Scene& scene) {
   return g;
 }
 
-// The translucent draws far to near along the light (their centres'), as blended (JCGT §3).
-void sort_translucent(std::vector<Draw>& translucent, glm::vec3 travel) {
-  std::stable_sort(translucent.begin(), translucent.end(), [&](const Draw& a, const Draw& b) {
-    return glm::dot(a.center, travel) > glm::dot(b.center, travel);
-  });
+// The translucent draws far to near from the light (their centres'), as blended (JCGT §3).
+void sort_translucent(std::vector<Draw>& translucent, const LightFarness& farness) {
+  std::stable_sort(translucent.begin(), translucent.end(),
+                   [&](const Draw& a, const Draw& b) { return farness(a.center) > farness(b.center); });
 }
 
 // The probe's cube map as a six-layer image (layer = face), the background of a probe-lit scene.
@@ -144,7 +156,7 @@ GpuScene::GpuScene(const vk::Context& ctx, const scene::Scene& scene) {
     if (!draw.index_count) continue;
     (material.translucent() ? translucent : draws).push_back(draw);
   }
-  sort_translucent(translucent, translucent_travel(scene));
+  sort_translucent(translucent, translucent_farness(scene));
   vertices = vk::create_buffer(ctx, g.vertices.size() * sizeof(Vertex), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
   vk::upload_buffer(ctx, vertices, std::as_bytes(std::span(g.vertices)));
   indices = vk::create_buffer(ctx, g.indices.size() * sizeof(uint32_t), VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
@@ -165,7 +177,7 @@ void GpuScene::move_objects(const vk::Context& ctx, const scene::Scene& scene) {
   vk::upload_buffer(ctx, indices, std::as_bytes(std::span(g.indices)));
   for (std::vector<Draw>* list : {&draws, &translucent})
     for (Draw& d : *list) d.center = scene.objects.at(d.object).bounds.center();
-  sort_translucent(translucent, translucent_travel(scene));
+  sort_translucent(translucent, translucent_farness(scene));
 }
 
 } // namespace msm::render

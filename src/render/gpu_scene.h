@@ -37,9 +37,10 @@ void refuse_unrendered_lights(const scene::Scene& scene);
 struct GpuScene {
   vk::Buffer vertices, indices;
   std::vector<Draw> draws; // opaque objects, alpha-tested ones included
-  // Objects with opacity < 1 or an opacity texture, sorted far to near along the light's
-  // direction of travel, each one's triangles too (JCGT §3: blended back to front into the
-  // moment shadow map; the light is fixed, so the order is computed once here).
+  // Objects with opacity < 1 or an opacity texture, sorted far to near from the first
+  // shadow-map layer's light (along a directional light's travel, by the distance from a spot or
+  // point light), each one's triangles too (JCGT §3: blended back to front into the moment shadow
+  // map; the lights are fixed, so the order is computed once here).
   std::vector<Draw> translucent;
   std::vector<vk::Image> textures;         // RGBA8 sRGB
   std::vector<vk::Image> opacity_textures; // R8 UNORM: scene::opacity_image of the material

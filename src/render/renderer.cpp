@@ -385,8 +385,11 @@ struct Renderer::Impl {
   // clamped edge (docs/techniques.md, "Light kinds"). spot_cone.w: the face's number + 1, which
   // the shading reads to evaluate the light once, at its first face's entry, from the face that
   // holds the receiver's direction.
-  static LightUniforms point_face_uniforms(const RenderSettings& s, const scene::LocalLight& point, int face) {
-    const float g = msm_cube_face_half_width(float(point_light_guard_texels(s)), float(s.shadow_size));
+  // Soft shadows: soft.w the sphere's radius, as a spot's (soft.h's spot geometry in the face's
+  // perspective).
+  static LightUniforms point_face_uniforms(const RenderSettings& s, const Technique& technique,
+                                           const scene::LocalLight& point, int face) {
+    const float g = msm_cube_face_half_width(float(point_light_guard_texels(s, technique)), float(s.shadow_size));
     const glm::mat4 projection = glm::perspective(2.0f * std::atan(g), 1.0f, 1e-3f * point.range, point.range);
     LightUniforms u{};
     u.view_projection =
@@ -397,15 +400,21 @@ struct Renderer::Impl {
     u.spot_axis = glm::vec4(msm_cube_face_forward(face), g);
     const float texel_angle = 2.0f * g / float(s.shadow_size);
     u.spot_cone = glm::vec4(point.cos_outer(), point.cos_inner(), s.normal_offset * texel_angle, float(face + 1));
+    if (msm_technique_is_area_light(technique.id)) u.soft = glm::vec4(0.0f, 0.0f, 0.0f, point.radius);
     return u;
   }
 
   // The guard band of a point light's faces, in texels beyond the 90-degree part on each side: the
-  // blur's radius, the lookup's reach past it (PCF's taps + 1, a bilinear fetch, the MSAA samples),
-  // the normal offset, which can move the looked-up point past the seam of the face picked for the
-  // surface, and two texels for the coarser mips and the receiver-plane slope.
-  static int point_light_guard_texels(const RenderSettings& s) {
-    return s.filter_size / 2 + 2 + int(std::ceil(s.normal_offset)) + 2;
+  // lookup's reach — the blur's radius and past it PCF's taps + 1, a bilinear fetch, the MSAA
+  // samples; for the soft techniques (no blur) the widest search or filter region, half the kernel
+  // width W (soft.h clamps every region to it), plus the grid-aligned search rectangle's rounding
+  // out to whole texels — the normal offset, which can move the looked-up point past the seam of
+  // the face picked for the surface, and two texels for the coarser mips and the receiver-plane
+  // slope.
+  static int point_light_guard_texels(const RenderSettings& s, const Technique& technique) {
+    const int reach =
+        msm_technique_is_area_light(technique.id) ? (s.resolved_soft_kernel() + 1) / 2 + 1 : s.filter_size / 2 + 2;
+    return reach + int(std::ceil(s.normal_offset)) + 2;
   }
 
   // A sub-light as the shading reads it: its direction, irradiance (on a surface facing it) and the
@@ -472,8 +481,8 @@ struct Renderer::Impl {
   }
 
   // What the renderer draws with spot and point lights (`kind`): the hard and filtered techniques
-  // of one depth per texel, opaque occluders, a finite range (the stored depth is distance / range);
-  // with spot lights also the soft techniques and single scattering by ray marching.
+  // of one depth per texel and the soft techniques, opaque and translucent occluders, a finite range
+  // (the stored depth is distance / range); with spot lights also single scattering by ray marching.
   void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots,
                          std::string_view kind) const {
     const Technique& technique = find_rendered_technique(s.technique);
@@ -490,19 +499,31 @@ struct Renderer::Impl {
                       technique.name, kind, kind,
                       kind == "spot" ? " Ray marching (scatter-march-32) draws spot lights' scattering" : ""));
     const bool spot = kind == "spot";
-    const char* unsupported = !spot && (technique.soft() || msm_technique_is_area_light(technique.id)) ? "soft shadows"
-                              : !spot && technique.scatters()                                          ? "scattering"
-                              : s.translucent_occluders && !gpu.translucent.empty() ? "translucent occluders"
-                                                                                    : nullptr;
+    const char* unsupported = !spot && technique.scatters() ? "scattering" : nullptr;
     if (unsupported)
-      throw RenderError(fmt::format("{} with {} lights: the renderer draws {} lights' {} shadows of opaque occluders "
+      throw RenderError(fmt::format("{} with {} lights: the renderer draws {} lights' hard, filtered and soft shadows "
                                     "only; the ray tracer (msm reference) traces them",
-                                    unsupported, kind, kind, spot ? "hard, filtered and soft" : "hard and filtered"));
+                                    unsupported, kind, kind));
+    if (!spot) check_point_light_guard_band(s, technique);
     for (const scene::LocalLight& spot : spots)
       if (!(spot.range < scene::LocalLight::kInfiniteRange))
         throw RenderError(fmt::format("a {} light without \"range\": the renderer's {} shadow maps store distance / "
                                       "range, so a {} light it draws needs a finite range",
                                       kind, kind, kind));
+  }
+
+  // A point light's faces keep at least half their texels per side for their 90-degree part: a
+  // guard band (point_light_guard_texels) of more than a quarter of the map on each side would
+  // leave the cube too few texels (and at half the map none).
+  static void check_point_light_guard_band(const RenderSettings& s, const Technique& technique) {
+    const int guard = point_light_guard_texels(s, technique);
+    if (4 * guard <= s.shadow_size) return;
+    const bool soft = msm_technique_is_area_light(technique.id);
+    throw RenderError(fmt::format(
+        "{} with point lights at --shadow-size {}: each cube face's guard band ({} texels on each side, the {} and the "
+        "normal offset) would take more than a quarter of the face's map; use --shadow-size {} or more{}",
+        technique.name, s.shadow_size, guard, soft ? "soft kernel's half width" : "filter's reach", 4 * guard,
+        soft ? " or a smaller soft kernel" : " or a smaller filter"));
   }
 
   // Validates, (re)builds the frame graph where the configuration changed, writes the uniforms.
@@ -582,7 +603,8 @@ struct Renderer::Impl {
     const std::size_t first_local_light = light_data.size();
     for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, technique, spot));
     for (const scene::LocalLight& point : point_lights())
-      for (int face = 0; face < int(kCubeFaces); ++face) light_data.push_back(point_face_uniforms(s, point, face));
+      for (int face = 0; face < int(kCubeFaces); ++face)
+        light_data.push_back(point_face_uniforms(s, technique, point, face));
     for (std::size_t i = first_local_light; i < light_data.size(); ++i) light_data[i].kernel = layer_kernel(s, 1.0f);
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).

@@ -42,7 +42,7 @@ constexpr LightKindInfo kLightKinds[] = {
     {LightKind::spot, "spot", kSpotKeys, "perspective, the outer cone's field of view", 1, "radial distance / range",
      "a shadow ray to the light's position (bounded by the distance)", true},
     {LightKind::point, "point", kPointKeys,
-     "six perspective faces of a cube, 90 degrees each and a guard band of the filter's reach", 6,
+     "six perspective faces of a cube, 90 degrees each and a guard band of the filter's or soft kernel's reach", 6,
      "radial distance / range", "a shadow ray to the light's position (bounded by the distance)", true},
 };
 

@@ -198,9 +198,12 @@ reference::Settings truth_settings(const SuiteRow& row, const render::RenderSett
   return rs;
 }
 
-// The row's scene, under the row's light kind where it names one.
+// The row's scene, under the row's light kind where it names one: a built-in, else a scene file of
+// the source tree msm was built from (as the suite's test executables are the build's).
 scene::Scene row_scene(const SuiteRow& row) {
-  scene::Scene scene = load_scene_or_fail(row.scene);
+  const std::vector<std::string> builtins = scene::builtin_scene_names();
+  const bool builtin = std::find(builtins.begin(), builtins.end(), row.scene) != builtins.end();
+  scene::Scene scene = load_scene_or_fail(builtin ? row.scene : (fs::path(MSM_SOURCE_DIR) / row.scene).string());
   if (!row.light_kind) return scene;
   scene::Scene lit = scene_under_light_kind(scene, *row.light_kind);
   lit.name = fmt::format("{} ({} light)", scene.name, scene::light_kind(*row.light_kind).name);

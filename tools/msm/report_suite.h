@@ -22,7 +22,7 @@ struct SuiteTechnique {
 // One row: a scene rendered by every technique and traced by the ray tracer at one size.
 struct SuiteRow {
   std::string id;    // names the row's images and its section of the page
-  std::string scene; // a built-in scene or a scene file
+  std::string scene; // a built-in scene, or a scene file relative to the source tree (scenes/NAME.json)
   // The ray-traced truth the techniques are measured against: filtered (the renderer's shadow map
   // and filter traced), soft (the scene's area light), scattering (the visible fraction of each
   // view ray, every pixel compared), environment (the whole light probe of the scene; compared is

@@ -30,6 +30,23 @@ vk::GraphicsDesc translucent_desc(const FrameConfig& config) {
   return d;
 }
 
+// The translucent draws far to near from layer l's light: along a directional light's travel, by
+// the distance from a spot or point light (per object, by the centre of its bounds). The scene
+// sorted them, and each one's triangles, for its first layer's light (gpu_scene.h); the objects are
+// sorted here for every layer (a few draws).
+std::vector<const Draw*> back_to_front(const GpuScene& scene, const LightUniforms& light) {
+  std::vector<const Draw*> order;
+  order.reserve(scene.translucent.size());
+  for (const Draw& d : scene.translucent) order.push_back(&d);
+  const bool local = light.spot_position.w > 0.0f;
+  const glm::vec3 travel = -glm::vec3(light.towards_light), position(light.spot_position);
+  auto farness = [&](const Draw* d) {
+    return local ? glm::distance(d->center, position) : glm::dot(d->center, travel);
+  };
+  std::stable_sort(order.begin(), order.end(), [&](const Draw* a, const Draw* b) { return farness(a) > farness(b); });
+  return order;
+}
+
 } // namespace
 
 void TranslucentPass::prepare(const PassResources& r) { program_ = &r.programs.graphics(translucent_desc(config_)); }
@@ -58,18 +75,7 @@ void TranslucentPass::execute(const PassContext& c) const {
     bind_scene(c.cmd, scene);
     vk::Descriptor depth_samples(depth.layer_views[size_t(l)], VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                  c.frame.point_sampler);
-    // Back to front along this light's travel (the scene sorted them, and each one's triangles, for
-    // its first light; the objects are re-sorted here for the others).
-    std::vector<const Draw*> order;
-    order.reserve(scene.translucent.size());
-    for (const Draw& d : scene.translucent) order.push_back(&d);
-    if (l > 0) {
-      glm::vec3 travel = -glm::vec3(c.frame.light_data[size_t(l)].towards_light);
-      std::stable_sort(order.begin(), order.end(), [&](const Draw* a, const Draw* b) {
-        return glm::dot(a->center, travel) > glm::dot(b->center, travel);
-      });
-    }
-    for (const Draw* d : order) {
+    for (const Draw* d : back_to_front(scene, c.frame.light_data[size_t(l)])) {
       ObjectPush push = d->push;
       push.flags.w = config_.coloured ? channel_ : -1; // the channel whose opacity to blend
       push.light.x = l;

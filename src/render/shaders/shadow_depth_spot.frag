@@ -9,6 +9,7 @@
 #include "frame.glsl"
 #include "alpha_test.glsl"
 #include "msm/local_light.h"
+#include "local_light_depth.glsl"
 
 layout(binding = MSM_BINDING_SHADOW_DEPTH_MASKED_OPACITY) uniform sampler2D opacity_texture;
 // Per sample: gl_FragDepth is one depth for every sample the fragment covers, and the lookups take
@@ -26,6 +27,5 @@ void main() {
   if (!alpha_test_passes(object, true, opacity_texture, texcoord)) discard;
   LightUniforms light = lights[object.light.x];
   vec3 world_position = world_position_h.xyz / world_position_h.w;
-  gl_FragDepth =
-      clamp(msm_local_light_depth(distance(world_position, light.spot_position.xyz), light.spot_position.w), 0.0f, 1.0f);
+  gl_FragDepth = local_light_map_depth(light, world_position);
 }

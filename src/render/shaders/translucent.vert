@@ -1,5 +1,6 @@
-// Translucent occluders into the moment shadow map: light clip space, and the texture coordinate
-// of the opacity texture. One draw per light and object, into the light's layer.
+// Translucent occluders into the moment shadow map: light clip space, the texture coordinate of the
+// opacity texture and the world position (a spot light or a point light's face stores the radial
+// distance from it). One draw per light and object, into the light's layer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "msm/render/bindings.h"
@@ -9,9 +10,11 @@
 layout(location = 0) in vec3 position;
 layout(location = 2) in vec2 uv;
 layout(location = 0) out vec2 texcoord;
+layout(location = 1) out vec3 world_position;
 layout(push_constant) uniform Push { ObjectPush object; };
 
 void main() {
   texcoord = uv;
+  world_position = position;
   gl_Position = lights[object.light.x].view_projection * vec4(position, 1.0f);
 }

@@ -4,8 +4,16 @@
 // behind the fragment (a translucent surface behind an opaque one casts nothing there); below the
 // threshold (1% by default, frame.shading.z) the fragment is discarded: many nearly transparent
 // fragments would otherwise accumulate the rounding of every blend.
+// The fragment's depth is in the convention of the opaque depth pass for its layer: the
+// orthographic depth of a directional light, the radial distance / range of a spot light or a
+// point light's face (shadow_depth_spot.frag), taken at the texel's centre like the
+// orthographic one and compared, like it, with each opaque sample's depth.
+#include "msm/render/bindings.h"
+#define MSM_LIGHT_BINDING MSM_BINDING_TRANSLUCENT_LIGHTS
 #include "msm/techniques.h"
+#include "msm/local_light.h"
 #include "frame.glsl"
+#include "local_light_depth.glsl"
 
 layout(binding = MSM_BINDING_TRANSLUCENT_OPACITY) uniform sampler2D opacity_texture;
 #define MSM_DEPTH_BINDING MSM_BINDING_TRANSLUCENT_DEPTH
@@ -13,6 +21,7 @@ layout(binding = MSM_BINDING_TRANSLUCENT_OPACITY) uniform sampler2D opacity_text
 layout(push_constant) uniform Push { ObjectPush object; };
 
 layout(location = 0) in vec2 texcoord;
+layout(location = 1) in vec3 world_position;
 layout(location = 0) out vec4 out0;
 #ifdef MSM_TWO_TARGETS
 layout(location = 1) out vec4 out1;
@@ -24,7 +33,9 @@ void main() {
   // Coloured translucency: this pass blends one colour channel's map, with that channel's opacity.
   if (object.flags.w >= 0) alpha *= 1.0f - object.transmission[object.flags.w];
   ivec2 p = ivec2(gl_FragCoord.xy);
-  float z = gl_FragCoord.z;
+  LightUniforms light = lights[object.light.x];
+  bool local_light = light.spot_position.w > 0.0f;
+  float z = local_light ? local_light_map_depth(light, world_position) : gl_FragCoord.z;
   int samples = frame.kernel.y, behind = 0;
   for (int s = 0; s < samples; ++s) behind += depth_sample(p, s) > z ? 1 : 0;
   alpha *= float(behind) / float(samples);
