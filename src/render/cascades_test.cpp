@@ -384,7 +384,10 @@ TEST_F(CascadesRenderTest, PenumbraKeepsItsWorldWidthAcrossCascades) {
       EXPECT_NEAR(sum[k] / rows[k] / (sum[0] / rows[0]), 1.0, 0.15) << technique << ", cascade " << k;
       failed |= std::abs(sum[k] / rows[k] / (sum[0] / rows[0]) - 1.0) > 0.15;
     }
-    if (failed) image::write_png(fmt::format("cascades_penumbra_{}.png", technique), r.shadow.channel("visibility"));
+    if (failed) {
+      std::filesystem::create_directories("test-failures/cascades");
+      image::write_png("test-failures/cascades/penumbra-" + technique + ".png", r.shadow.channel("visibility"));
+    }
   }
 }
 
