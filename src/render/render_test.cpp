@@ -291,8 +291,9 @@ TEST_F(RenderTest, ColourBytesAreTheFloatColourEncoded) {
             image::encode_png("c.png", r.color));
 }
 
-// The blur (bilinear pairs of taps, msm/filter.h, compiled in) is the separable Gaussian of the
-// clamped texels, for kernels with an even and an odd radius and one of a single pair.
+// The blur (bilinear pairs of taps, msm/filter.h, the layer's kernel from a buffer) is the
+// separable Gaussian of the clamped texels, for kernels with an even and an odd radius, one of a
+// single pair, and a narrower kernel than the blur was compiled for (a farther cascade's).
 TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
   const int n = 32;
   std::vector<float> texels(size_t(n * n * 4));
@@ -311,21 +312,31 @@ TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
   auto at = [&](const std::vector<float>& v, int x, int y, int c) {
     return v[size_t((std::clamp(y, 0, n - 1) * n + std::clamp(x, 0, n - 1)) * 4 + c)];
   };
-  for (auto [taps, sigma] : {std::pair{9, MSM_FILTER_DEFAULT_SIGMA}, std::pair{15, 1.5f}, std::pair{3, 0.8f},
-                             std::pair{MSM_FILTER_MAX_TAPS, 20.0f}})
+  struct Case {
+    int compiled_taps, taps;
+    float sigma;
+  };
+  for (auto [compiled_taps, taps, sigma] : {Case{9, 9, MSM_FILTER_DEFAULT_SIGMA}, Case{15, 15, 1.5f}, Case{3, 3, 0.8f},
+                                            Case{MSM_FILTER_MAX_TAPS, MSM_FILTER_MAX_TAPS, 20.0f}, Case{15, 5, 1.2f}})
     for (bool bilinear : {true, false})
       for (bool mip1 : {false, true}) {
-        SCOPED_TRACE(fmt::format("{} taps, sigma {}, {}{}", taps, sigma, bilinear ? "bilinear" : "point pairs",
-                                 mip1 ? ", mip 1" : ""));
+        SCOPED_TRACE(fmt::format("{} taps (compiled for {}), sigma {}, {}{}", taps, compiled_taps, sigma,
+                                 bilinear ? "bilinear" : "point pairs", mip1 ? ", mip 1" : ""));
         const std::vector<vk::Binding> bindings =
             vk::bindings_at({{MSM_BINDING_BLUR_SOURCE, vk::Binding::sampled_image},
                              {MSM_BINDING_BLUR_TARGET, vk::Binding::storage_image},
-                             {MSM_BINDING_BLUR_TARGET_MIP1, vk::Binding::storage_image}});
+                             {MSM_BINDING_BLUR_TARGET_MIP1, vk::Binding::storage_image},
+                             {MSM_BINDING_BLUR_KERNELS, vk::Binding::storage_buffer}});
         vk::Program horizontal =
             vk::create_program(ctx(), vk::embedded_shader("blur.comp"), "blur.comp", bindings, sizeof(ImagePassPush),
-                               blur_constants(taps, sigma, bilinear, false));
+                               blur_constants(compiled_taps, bilinear, false));
         vk::Program vertical = vk::create_program(ctx(), vk::embedded_shader("blur.comp"), "blur.comp", bindings,
-                                                  sizeof(ImagePassPush), blur_constants(taps, sigma, bilinear, mip1));
+                                                  sizeof(ImagePassPush), blur_constants(compiled_taps, bilinear, mip1));
+        // The kernel as layer 1 of the buffer (layer 0 another: the push constant picks it).
+        vk::Buffer kernels =
+            vk::create_buffer(ctx(), 2 * sizeof(BlurKernel), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
+        kernels.mapped<BlurKernel>()[0] = blur_kernel(compiled_taps, 0.5f * sigma);
+        kernels.mapped<BlurKernel>()[1] = blur_kernel(taps, sigma);
         vk::submit_and_wait(ctx(), [&](VkCommandBuffer cmd) {
           VkImageMemoryBarrier2 init[3];
           int i = 0;
@@ -338,8 +349,9 @@ TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
           vk::dispatch(cmd, horizontal, groups, groups, 1,
                        {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(input, VK_IMAGE_LAYOUT_GENERAL, sampler)},
                         {MSM_BINDING_BLUR_TARGET, vk::Descriptor(temp)},
-                        {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(temp)}},
-                       ImagePassPush{glm::ivec4(n, n, 0, 0)});
+                        {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(temp)},
+                        {MSM_BINDING_BLUR_KERNELS, vk::Descriptor(kernels)}},
+                       ImagePassPush{glm::ivec4(n, n, 0, 1)});
           vk::pipeline_barrier(
               cmd, vk::memory_barrier(VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT,
                                       VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT));
@@ -347,8 +359,9 @@ TEST_F(RenderTest, BlurIsTheSeparableGaussianOfClampedTexels) {
           vk::dispatch(cmd, vertical, vertical_groups, vertical_groups, 1,
                        {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(temp, VK_IMAGE_LAYOUT_GENERAL, sampler)},
                         {MSM_BINDING_BLUR_TARGET, vk::Descriptor(output)},
-                        {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(half)}},
-                       ImagePassPush{glm::ivec4(n, n, 1, 0)});
+                        {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(half)},
+                        {MSM_BINDING_BLUR_KERNELS, vk::Descriptor(kernels)}},
+                       ImagePassPush{glm::ivec4(n, n, 1, 1)});
         });
         std::vector<std::byte> bytes = vk::readback_image(ctx(), output, VK_IMAGE_LAYOUT_GENERAL);
         std::vector<float> out(texels.size());

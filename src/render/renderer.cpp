@@ -11,6 +11,7 @@
 #include "program_cache.h"
 #include "recipes.h"
 
+#include "msm/cascade.h"
 #include "msm/cube_face.h"
 #include "msm/filter.h"
 #include "msm/gpu/sat_builder.h"
@@ -308,15 +309,27 @@ struct Renderer::Impl {
       u.sample_offsets[i / 2][int(2 * (i % 2))] = offsets[i].x;
       u.sample_offsets[i / 2][int(2 * (i % 2) + 1)] = offsets[i].y;
     }
-    // Receiver-plane bias of the filtered techniques (lookup.glsl, msm/bias.h): the kernel's
-    // variance per axis in texels², of the normalized Gaussian taps plus the MSAA sample positions
-    // (the resolve averages depths taken there; mean of x and y); the lookup adds its own.
-    double kernel_variance = msm_gaussian_variance(s.filter_size, s.filter_sigma);
-    for (const glm::vec2& o : offsets) kernel_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
-    u.receiver_bias = glm::vec4(float(kernel_variance), s.receiver_plane_bias, 0.0f, 0.0f);
+    u.receiver_bias = glm::vec4(layer_kernel(s, 1.0f).z, s.receiver_plane_bias, 0.0f, 0.0f);
     u.lights = glm::ivec4(layers(s), 0, 0, 0);
     u.camera_viewport = glm::vec4(float(s.width), float(s.height), 0.0f, 0.0f);
     return u;
+  }
+
+  // LightUniforms::kernel of a layer whose texels are 1 / scale times the size of the first
+  // cascade's (1: every layer but the farther cascades): the Gaussian whose filter has the same
+  // width in world units (msm/cascade.h), with what the chain adds in the layer's own texels (the
+  // bilinear lookup's tent, 1/6 texel², and the MSAA sample positions': the resolve averages depths
+  // taken there; mean of x and y); and, for the receiver-plane bias (lookup.glsl, msm/bias.h), its
+  // variance per axis in texels² with the MSAA positions' (the lookup adds its own).
+  glm::vec4 layer_kernel(const RenderSettings& s, float scale) const {
+    std::vector<glm::vec2> offsets =
+        ctx.properties().limits.standardSampleLocations ? standard_sample_offsets(s.msaa) : std::vector<glm::vec2>(8);
+    double msaa_variance = 0.0;
+    for (const glm::vec2& o : offsets) msaa_variance += 0.5 * double(o.x * o.x + o.y * o.y) / double(offsets.size());
+    const int taps = msm_cascade_filter_taps(s.filter_size, scale);
+    const float sigma =
+        msm_cascade_filter_sigma(s.filter_size, s.filter_sigma, scale, float(msaa_variance + 1.0 / 6.0));
+    return glm::vec4(sigma, float(taps), float(msm_gaussian_variance(taps, sigma) + msaa_variance), 0.0f);
   }
 
   LightUniforms light_uniforms(const RenderSettings& s, const Technique& technique,
@@ -327,6 +340,7 @@ struct Renderer::Impl {
     glm::dvec2 texel = f.texel(s.shadow_size);
     u.towards_light = glm::vec4(light.towards_light, s.normal_offset * float(texel.x));
     u.irradiance = glm::vec4(light.irradiance, 0.0f);
+    u.kernel = layer_kernel(s, 1.0f);
     if (msm_technique_is_area_light(technique.id)) {
       // The light's two half extents along the frame's axes (a disc: its radius both), the search
       // region and filter per axis from them.
@@ -345,16 +359,20 @@ struct Renderer::Impl {
   }
 
   // A directional light's entries of lights[]: one, or one per cascade with the view depths of its
-  // share (msm/cascade.h), each with its own map and normal offset (of its own texels).
+  // share (msm/cascade.h), each with its own map and normal offset (of its own texels) and the
+  // filter of the first cascade's width in world units.
   void add_directional_light(const RenderSettings& s, const Technique& technique, const scene::DirectionalLight& light,
                              int count) {
     if (count == 1) {
       light_data.push_back(light_uniforms(s, technique, light, light_frame(light)));
       return;
     }
-    for (const scene::Cascade& c : cascade_fit(s, light, count)) {
+    const std::vector<scene::Cascade>& cascades = cascade_fit(s, light, count);
+    const double first_texel = cascades.front().frame.texel(s.shadow_size).x;
+    for (const scene::Cascade& c : cascades) {
       LightUniforms u = light_uniforms(s, technique, light, c.frame);
       u.cascade = glm::vec4(float(c.fade_in.x), float(c.fade_in.y), float(c.fade_out.x), float(c.fade_out.y));
+      u.kernel = layer_kernel(s, float(first_texel / c.frame.texel(s.shadow_size).x));
       light_data.push_back(u);
     }
   }
@@ -605,10 +623,12 @@ struct Renderer::Impl {
     light_data.clear();
     measure_split_range(s, c.cascades);
     for (const scene::DirectionalLight& light : frame_lights) add_directional_light(s, technique, light, c.cascades);
+    const std::size_t first_local_light = light_data.size();
     for (const scene::LocalLight& spot : spot_lights()) light_data.push_back(spot_light_uniforms(s, technique, spot));
     for (const scene::LocalLight& point : point_lights())
       for (int face = 0; face < int(kCubeFaces); ++face)
         light_data.push_back(point_face_uniforms(s, technique, point, face));
+    for (std::size_t i = first_local_light; i < light_data.size(); ++i) light_data[i].kernel = layer_kernel(s, 1.0f);
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {

@@ -6,12 +6,15 @@
 // host clock on a CPU device, whose compute timestamps are not the passes' time (results.md).
 // `--light-kinds`: the scene under one light of each kind (light_kinds.h), each kind's shadow map
 // and shading against the directional light's at the same texel count.
+// `--against-one-map`: cascades of each shadow size against one map of the same total texels,
+// their time and their error against the ray tracer's hard shadows.
 #include "light_kinds.h"
 #include "probe_bench.h"
 #include "render_common.h"
 #include "vocabulary.h"
 
 #include "msm/image/io.h"
+#include "msm/reference/reference.h"
 #include "msm/render/renderer_internals.h"
 #include "msm/techniques.h"
 #include "msm/util/clock.h"
@@ -23,6 +26,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -345,6 +349,7 @@ struct BenchOptions {
   int frames = 20, warmup = 2, repeats = 5;
   std::string json, markdown;
   bool callgrind = false, scattering = false, quick = false, light_kinds = false;
+  bool against_one_map = false; // cascades against one map of the same total texels
   ProbeBench probe;
 };
 
@@ -373,6 +378,11 @@ void add_bench_options(CLI::App* cmd, BenchOptions& o) {
                 "message), each kind's shadow map and shading against the directional light's at the same texel "
                 "count (a point light's six faces against six maps); unless given: techniques "
                 "pcf,vsm-32,msm-hamburger-64");
+  cmd->add_flag("--against-one-map", o.against_one_map,
+                "Cascaded shadow maps against one map of the same total texels: --cascades (default 4) cascades of "
+                "each shadow size against one map of size x sqrt(count), the shadow-map passes' and the frame's time "
+                "at the first resolution and the error against the ray tracer's hard shadows there (e.g. --scene "
+                "scenes/box_on_ground.json or scenes/town.json); unless given: techniques pcf,msm-hamburger-64");
   cmd->add_flag("--quick", o.quick,
                 "A short run, to check that it works (not for recorded numbers): unless given, resolution 320x180, "
                 "shadow size and sizes 256, 1 frame after 1 warm-up, 2 repeats");
@@ -407,6 +417,13 @@ void apply_bench_defaults(BenchOptions& o, const CLI::App& cmd) {
     if (o.scattering || !o.probe.probe.empty())
       throw UsageError("--light-kinds, --scattering and --probe: one at a time");
     if (o.techniques.empty()) o.techniques = {"pcf", "vsm-32", "msm-hamburger-64"};
+  }
+  if (o.against_one_map) {
+    if (o.light_kinds || o.scattering || !o.probe.probe.empty())
+      throw UsageError("--against-one-map, --light-kinds, --scattering and --probe: one at a time");
+    if (o.frame.settings.cascades.value_or(render::kDefaultCascades) < 2)
+      throw UsageError("--against-one-map: --cascades must be at least 2");
+    if (o.techniques.empty()) o.techniques = {"pcf", "msm-hamburger-64"};
   }
   if (o.scattering) {
     if (!o.probe.probe.empty()) throw UsageError("--scattering and --probe: one at a time");
@@ -719,6 +736,81 @@ void bench_light_kinds(const BenchOptions& o, const std::vector<std::string>& na
   write_results(o, doc, md);
 }
 
+// The mean absolute error of the shadow buffer against the ray tracer's visibility over the pixels
+// that show a surface, and the error summed per pixel the tracer shadows (visibility below 1/2:
+// comparable between a scene of large shadows and one of a small shadow on a large lit ground).
+std::pair<double, double> error_against(const render::RenderResult& r, const reference::Result& truth) {
+  double sum = 0.0;
+  std::size_t surface = 0, shadowed = 0;
+  for (int y = 0; y < truth.visibility.height(); ++y)
+    for (int x = 0; x < truth.visibility.width(); ++x) {
+      if (truth.visibility.at(x, y, 1) > 0.5f) continue; // background
+      const float v = truth.visibility.at(x, y, 0);
+      sum += std::abs(double(r.shadow.at(x, y, 0)) - double(v));
+      ++surface;
+      shadowed += v < 0.5f;
+    }
+  return {sum / double(std::max<std::size_t>(surface, 1)), sum / double(std::max<std::size_t>(shadowed, 1))};
+}
+
+// --against-one-map: per technique and shadow size S, N cascades (--cascades, default 4) of S²
+// against one map of (S sqrt(N))²
+// (the same texels): the shadow-map passes' and the whole frame's time at the first resolution,
+// and the error against the ray tracer's hard shadows there.
+void bench_cascades(const BenchOptions& o, const std::vector<std::string>& names,
+                    const std::vector<std::pair<int, int>>& resolutions) {
+  const scene::Scene scene = scene_at_frame(o.frame, load_scene_or_fail(o.frame.scene));
+  std::unique_ptr<vk::Context> ctx = open_device(o.frame.device);
+  render::Renderer renderer(*ctx, scene);
+  const auto [width, height] = resolutions.front();
+  const int cascades = o.frame.settings.cascades.value_or(render::kDefaultCascades);
+  reference::Settings traced;
+  traced.width = width;
+  traced.height = height;
+  const reference::Result truth = reference::render(scene, traced);
+  nlohmann::json results = nlohmann::json::array();
+  std::string md = fmt::format("Device: {}. Scene '{}', {}x{}, {} frames per configuration (median), {}x MSAA; "
+                               "error against the ray tracer's hard shadows (MAE over the surface; summed per "
+                               "pixel the tracer shadows).\n\n| technique | maps | shadow-map passes ms | frame ms | "
+                               "MAE | error per shadowed pixel |\n|---|---|---:|---:|---:|---:|\n",
+                               ctx->info().describe(), scene.name, width, height, o.frames, o.frame.settings.msaa);
+  for (const std::string& name : names)
+    for (int size : o.shadow_sizes)
+      for (int count : {cascades, 1}) {
+        render::RenderSettings s = settings_for(o.frame, name);
+        s.width = width;
+        s.height = height;
+        s.cascades = count;
+        s.shadow_size = count == 1 ? int(std::lround(size * std::sqrt(double(cascades)))) : size;
+        if (o.warmup) renderer.time_frames(s, o.warmup);
+        const auto frames = renderer.time_frames(s, o.frames);
+        std::vector<std::string> all;
+        for (const render::PassTime& p : frames.front())
+          if (p.name.find('#') == std::string::npos) all.push_back(p.name);
+        const Stats shadow = pass_sum(frames, kShadowMapPasses), frame = pass_sum(frames, all);
+        const auto [mae, per_shadowed] = error_against(renderer.render(s), truth);
+        const std::string maps = fmt::format("{} x {}²", count, s.shadow_size);
+        md += fmt::format("| {} | {} | {:.3f} | {:.3f} | {:.4f} | {:.3f} |\n", name, maps, shadow.median, frame.median,
+                          mae, per_shadowed);
+        results.push_back({{"technique", name},
+                           {"cascades", count},
+                           {"shadow_size", s.shadow_size},
+                           {"shadow_map_ms", {{"median", shadow.median}, {"p10", shadow.p10}, {"p90", shadow.p90}}},
+                           {"frame_ms", {{"median", frame.median}, {"p10", frame.p10}, {"p90", frame.p90}}},
+                           {"mae", mae},
+                           {"error_per_shadowed_pixel", per_shadowed}});
+      }
+  fmt::print("{}", md);
+  const nlohmann::json doc = {{"device", ctx->info().describe()},
+                              {"scene", scene.name},
+                              {"resolution", fmt::format("{}x{}", width, height)},
+                              {"frames", o.frames},
+                              {"warmup", o.warmup},
+                              {"msaa", o.frame.settings.msaa},
+                              {"cascades", results}};
+  write_results(o, doc, md);
+}
+
 // The per-technique bench's Markdown (printed) and JSON (--json-file) from its results.
 void write_technique_results(const BenchOptions& opt, vk::Context& ctx, const scene::Scene& scene,
                              nlohmann::json& results, const std::vector<std::pair<int, int>>& resolutions,
@@ -759,6 +851,11 @@ void add_bench(CLI::App& app) {
     if (opt->light_kinds) {
       if (opt->callgrind) throw UsageError("--light-kinds and --callgrind: one at a time");
       bench_light_kinds(*opt, names, resolutions);
+      return;
+    }
+    if (opt->against_one_map) {
+      if (opt->callgrind) throw UsageError("--against-one-map and --callgrind: one at a time");
+      bench_cascades(*opt, names, resolutions);
       return;
     }
     scene::Scene scene = scene_at_frame(opt->frame, load_scene_or_fail(opt->frame.scene));

@@ -49,11 +49,13 @@
 // The one-pass filter (one_pass_filter.glsl).
 #define MSM_BINDING_ONE_PASS_DEPTH 1
 #define MSM_BINDING_ONE_PASS_TARGET 2
+#define MSM_BINDING_ONE_PASS_LIGHTS 3 // LightUniforms[] (each layer's kernel)
 
 // The separable blur (blur.comp).
 #define MSM_BINDING_BLUR_SOURCE 0
 #define MSM_BINDING_BLUR_TARGET 1
 #define MSM_BINDING_BLUR_TARGET_MIP1 2
+#define MSM_BINDING_BLUR_KERNELS 3 // BlurKernel per layer (frame.h)
 
 // The depth map's samples into a buffer (depth_samples.comp).
 #define MSM_BINDING_DEPTH_SAMPLES_MAP 0

@@ -66,6 +66,11 @@ struct LightUniforms {
   vec4 cascade;         // a directional light's cascade (msm/cascade.h's msm_cascade_weight): the view
                         // depths where its weight rises from 0 (x) to 1 (y) and falls from 1 (z) to 0
                         // (w); all 0: no cascades (weight 1)
+  vec4 kernel;          // the Gaussian filter of this layer (msm/filter.h), in its own texels: x: σ, y: taps
+                        // (odd), z: its variance per axis in texels² with the MSAA sample positions'
+                        // (the receiver-plane bias, lookup.glsl), w: unused. A cascade's is the frame's
+                        // scaled to the same width in world units (msm_cascade_filter_*), every other
+                        // layer's the frame's (FrameUniforms::filter_weights, ::receiver_bias.x).
 };
 
 // The entry before a light's sub-lights in the lights' array: their linear part and the rectangle
@@ -84,7 +89,7 @@ MSM_FN LightUniforms msm_sub_lights_summary_entry(SubLightsSummary s) {
   packed[3] = vec4(s.bounds, 0.0f, 1.0f);
   mat4 axes = mat4(vec4(s.x_axis, 0.0f), vec4(s.y_axis, 0.0f), vec4(0.0f), vec4(0.0f));
   vec4 zero = vec4(0.0f);
-  return LightUniforms(packed, axes, zero, zero, zero, zero, zero, zero, zero, zero, zero);
+  return LightUniforms(packed, axes, zero, zero, zero, zero, zero, zero, zero, zero, zero, zero);
 }
 MSM_FN SubLightsSummary msm_sub_lights_summary(mat4 view_projection, mat4 normal_matrix) {
   return SubLightsSummary(mat3(view_projection), vec2(view_projection[3][0], view_projection[3][1]),
@@ -129,11 +134,12 @@ struct ObjectPush {
 #define MSM_SPEC_SCATTER_LAYERS 14    // int: transmittance layers per light (scatter.glsl)
 #define MSM_SPEC_SCATTER_BETA_MODE 15 // int: MSM_SCATTERING_BETA_* (scatter.glsl)
 #define MSM_SPEC_SPOT_LIGHTS 16       // bool: some light of the frame is a spot light (shading.glsl)
-#define MSM_SPEC_CASCADES 17          // bool: the directional lights have cascades (shading.glsl)
+#define MSM_SPEC_CASCADES 17          // bool: the directional lights have cascades (shading, one-pass filter)
 // The blur's specialization constants (blur.comp, passes/blur_pass.cpp): id MSM_BLUR_SPEC_ID holds
-// the fetches per side, + 1 the centre weight, + 2 + i the offset and + 2 + MSM_BLUR_MAX_PAIRS + i
-// the weight of fetch i + 1 (msm_filter_pairs of the largest kernel: 16); + 2 + 2 MSM_BLUR_MAX_PAIRS
-// is true for bilinear fetches, false for each pair's two texels (exact: the 32-bit float maps).
+// the fetches per side of the frame's widest kernel (msm_filter_pairs of the largest kernel: 16;
+// each layer's offsets and weights are its BlurKernel's); + 2 + 2 MSM_BLUR_MAX_PAIRS is true for
+// bilinear fetches, false for each pair's two texels (exact: the 32-bit float maps), + 3 + 2
+// MSM_BLUR_MAX_PAIRS true where the vertical direction also writes mip 1.
 #define MSM_BLUR_SPEC_ID 100
 #define MSM_BLUR_MAX_PAIRS 16
 // The prefix sums' scheme (prefix_sums.glsl, RenderSettings::prefix_sums): true for the row sweep
@@ -143,10 +149,21 @@ struct ObjectPush {
 // true for the on-the-fly filter of the depth map's moments, false for its nearest texel.
 #define MSM_RECTIFY_ON_THE_FLY_SPEC_ID 201
 
+// The blur's kernel of one layer of the shadow-map arrays (blur.comp, passes/blur_pass.cpp), in
+// msm/filter.h's bilinear pairs of taps: value 0 the centre weight, 2 j - 1 and 2 j the offset and
+// the weight of pair j in [1, MSM_BLUR_MAX_PAIRS] (value i at values[i / 4][i % 4]; the pairs beyond
+// the layer's kernel weigh 0). Computed by the host, so every layer's weights are msm/filter.h's to
+// the bit.
+const int MSM_BLUR_KERNEL_VEC4S = (2 * MSM_BLUR_MAX_PAIRS + 4) / 4;
+struct BlurKernel {
+  vec4 values[MSM_BLUR_KERNEL_VEC4S];
+};
+
 // The compute passes on shadow-map images (push constants).
 struct ImagePassPush {
   ivec4 size; // xy: image size in texels, z: pass-specific (rectify, prefix_sums: the light),
-              // w: pass-specific (prefix_sums: the transmittance layers K), else unused
+              // w: pass-specific (prefix_sums: the transmittance layers K; blur: the layer, whose
+              // BlurKernel it reads; one-pass filter: the layer), else unused
 };
 
 // The scattering pass (push constants): single scattering of every light of the frame in the
@@ -171,9 +188,11 @@ static_assert(sizeof(msm::FrameUniforms) == 544 && offsetof(msm::FrameUniforms, 
               offsetof(msm::FrameUniforms, filter_weights) == 128 && offsetof(msm::FrameUniforms, lookup) == 384 &&
               offsetof(msm::FrameUniforms, sample_offsets) == 432 && offsetof(msm::FrameUniforms, lights) == 512 &&
               offsetof(msm::FrameUniforms, camera_viewport) == 528);
-static_assert(sizeof(msm::LightUniforms) == 272 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
+static_assert(sizeof(msm::LightUniforms) == 288 && offsetof(msm::LightUniforms, normal_matrix) == 64 &&
               offsetof(msm::LightUniforms, towards_light) == 128 && offsetof(msm::LightUniforms, rect_extent) == 192 &&
-              offsetof(msm::LightUniforms, spot_cone) == 240 && offsetof(msm::LightUniforms, cascade) == 256);
+              offsetof(msm::LightUniforms, spot_cone) == 240 && offsetof(msm::LightUniforms, cascade) == 256 &&
+              offsetof(msm::LightUniforms, kernel) == 272);
+static_assert(sizeof(msm::BlurKernel) == 144);
 static_assert(sizeof(msm::ObjectPush) == 64 && offsetof(msm::ObjectPush, light) == 48);
 static_assert(sizeof(msm::ImagePassPush) == 16);
 static_assert(sizeof(msm::ScatteringPush) == 128 && offsetof(msm::ScatteringPush, sky) == 112);

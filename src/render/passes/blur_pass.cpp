@@ -2,7 +2,8 @@
 
 #include <fmt/format.h>
 
-#include <bit>
+#include <algorithm>
+#include <span>
 
 namespace msm::render {
 
@@ -15,20 +16,22 @@ constexpr VkFormat kTempFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
 
 } // namespace
 
-std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear, bool mip1) {
+std::vector<vk::SpecConstant> blur_constants(int taps, bool bilinear, bool mip1) {
   static_assert(MSM_BLUR_MAX_PAIRS == (MSM_FILTER_MAX_TAPS / 2 + 1) / 2);
-  auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
-  int pairs = msm_filter_pairs(taps);
-  std::vector<vk::SpecConstant> c = {{MSM_BLUR_SPEC_ID, uint32_t(pairs)},
-                                     {MSM_BLUR_SPEC_ID + 1, bits(msm_filter_weight_at(0, taps, sigma))}};
-  for (int j = 1; j <= pairs; ++j) {
-    c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 1 + j), bits(msm_filter_pair_offset(j, taps, sigma))});
-    c.push_back(
-        {uint32_t(MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + j), bits(msm_filter_pair_weight(j, taps, sigma))});
+  return {{MSM_BLUR_SPEC_ID, uint32_t(msm_filter_pairs(taps))},
+          {uint32_t(MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS), bilinear ? 1u : 0u},
+          {uint32_t(MSM_BLUR_SPEC_ID + 3 + 2 * MSM_BLUR_MAX_PAIRS), mip1 ? 1u : 0u}};
+}
+
+BlurKernel blur_kernel(int taps, float sigma) {
+  BlurKernel k{};
+  auto set = [&](int i, float value) { k.values[i / 4][i % 4] = value; };
+  set(0, msm_filter_weight_at(0, taps, sigma));
+  for (int j = 1; j <= MSM_BLUR_MAX_PAIRS; ++j) {
+    set(2 * j - 1, msm_filter_pair_offset(j, taps, sigma));
+    set(2 * j, msm_filter_pair_weight(j, taps, sigma)); // 0 beyond the kernel
   }
-  c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 2 + 2 * MSM_BLUR_MAX_PAIRS), bilinear ? 1u : 0u});
-  c.push_back({uint32_t(MSM_BLUR_SPEC_ID + 3 + 2 * MSM_BLUR_MAX_PAIRS), mip1 ? 1u : 0u});
-  return c;
+  return k;
 }
 
 namespace {
@@ -49,17 +52,18 @@ void BlurPass::prepare(const PassResources& r) {
     throw RenderError(fmt::format("the blur needs linear filtering of RGBA32F images; {} has none (use "
                                   "--filter-mode one-pass or --filter 1)",
                                   ctx.info().name));
-  const std::vector<vk::Binding> bindings =
-      vk::bindings_at({{MSM_BINDING_BLUR_SOURCE, vk::Binding::sampled_image},
-                       {MSM_BINDING_BLUR_TARGET, vk::Binding::storage_image},
-                       {MSM_BINDING_BLUR_TARGET_MIP1, vk::Binding::storage_image}});
+  const std::vector<vk::Binding> bindings = vk::bindings_at({{MSM_BINDING_BLUR_SOURCE, vk::Binding::sampled_image},
+                                                             {MSM_BINDING_BLUR_TARGET, vk::Binding::storage_image},
+                                                             {MSM_BINDING_BLUR_TARGET_MIP1, vk::Binding::storage_image},
+                                                             {MSM_BINDING_BLUR_KERNELS, vk::Binding::storage_buffer}});
   bool bilinear = bilinear_blur(config_);
-  program_ = &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush),
-                                 blur_constants(config_.taps, config_.sigma, bilinear, false));
-  vertical_program_ = config_.blur_writes_mip1()
-                          ? &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush),
-                                                blur_constants(config_.taps, config_.sigma, bilinear, true))
-                          : program_;
+  program_ =
+      &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush), blur_constants(config_.taps, bilinear, false));
+  vertical_program_ = config_.blur_writes_mip1() ? &r.programs.compute("blur.comp", bindings, sizeof(ImagePassPush),
+                                                                       blur_constants(config_.taps, bilinear, true))
+                                                 : program_;
+  kernels_ = vk::create_buffer(ctx, sizeof(BlurKernel) * std::size_t(std::max(config_.lights, 1)),
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Memory::host);
 }
 
 void BlurPass::reflect(PassBuilder& b) const {
@@ -79,6 +83,13 @@ void BlurPass::execute(const PassContext& c) const {
   constexpr VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
   VkSampler sampler = bilinear_blur(config_) ? c.frame.linear_sampler : c.frame.point_sampler;
   constexpr VkPipelineStageFlags2 compute = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+  // Each layer's kernel (LightUniforms::kernel: a cascade's scaled to the world width of the
+  // first's); the frame is submitted and waited for before the next is recorded.
+  std::span<BlurKernel> kernels = kernels_.mapped<BlurKernel>();
+  for (int l = 0; l < config_.lights; ++l) {
+    const glm::vec4& k = c.frame.light_data[size_t(l)].kernel;
+    kernels[size_t(l)] = blur_kernel(int(k.y), k.x);
+  }
   for (int l = 0; l < config_.lights; ++l) {
     c.begin_light(name(), l);
     for (int i = 0; i < config_.moment_images(); ++i) {
@@ -92,8 +103,9 @@ void BlurPass::execute(const PassContext& c) const {
       vk::dispatch(c.cmd, *program_, groups, groups, 1,
                    {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(moments, general, sampler)},
                     {MSM_BINDING_BLUR_TARGET, temp_storage},
-                    {MSM_BINDING_BLUR_TARGET_MIP1, temp_storage}},
-                   ImagePassPush{glm::ivec4(size, size, 0, 0)});
+                    {MSM_BINDING_BLUR_TARGET_MIP1, temp_storage},
+                    {MSM_BINDING_BLUR_KERNELS, vk::Descriptor(kernels_)}},
+                   ImagePassPush{glm::ivec4(size, size, 0, l)});
       vk::pipeline_barrier(
           c.cmd,
           vk::memory_barrier(compute, VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_SHADER_SAMPLED_READ_BIT,
@@ -102,12 +114,13 @@ void BlurPass::execute(const PassContext& c) const {
       bool mip1 = config_.blur_writes_mip1();
       const GraphImage& target = c.image(moment_image(channel_, i));
       uint32_t vertical_groups = mip1 ? vk::group_count(uint32_t(size / 2), 8) : groups;
-      vk::dispatch(c.cmd, *vertical_program_, vertical_groups, vertical_groups, 1,
-                   {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(temp.layer_views[0], general, sampler)},
-                    {MSM_BINDING_BLUR_TARGET, vk::Descriptor(moments, general)},
-                    {MSM_BINDING_BLUR_TARGET_MIP1,
-                     vk::Descriptor(mip1 ? target.layer_mip1_views[size_t(l)] : moments, general)}},
-                   ImagePassPush{glm::ivec4(size, size, 1, 0)});
+      vk::dispatch(
+          c.cmd, *vertical_program_, vertical_groups, vertical_groups, 1,
+          {{MSM_BINDING_BLUR_SOURCE, vk::Descriptor(temp.layer_views[0], general, sampler)},
+           {MSM_BINDING_BLUR_TARGET, vk::Descriptor(moments, general)},
+           {MSM_BINDING_BLUR_TARGET_MIP1, vk::Descriptor(mip1 ? target.layer_mip1_views[size_t(l)] : moments, general)},
+           {MSM_BINDING_BLUR_KERNELS, vk::Descriptor(kernels_)}},
+          ImagePassPush{glm::ivec4(size, size, 1, l)});
     }
     c.end_light();
   }

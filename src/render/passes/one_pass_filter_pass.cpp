@@ -28,12 +28,14 @@ const vk::Program& one_pass_program(ProgramCache& programs, const FrameConfig& c
   return programs.compute(shader,
                           vk::bindings_at({{MSM_BINDING_FRAME, vk::Binding::uniform_buffer},
                                            {MSM_BINDING_ONE_PASS_DEPTH, vk::Binding::sampled_image},
-                                           {MSM_BINDING_ONE_PASS_TARGET, vk::Binding::storage_image}}),
+                                           {MSM_BINDING_ONE_PASS_TARGET, vk::Binding::storage_image},
+                                           {MSM_BINDING_ONE_PASS_LIGHTS, vk::Binding::storage_buffer}}),
                           sizeof(ImagePassPush),
                           {{MSM_SPEC_TECHNIQUE, uint32_t(config.technique->id)},
                            {MSM_SPEC_FILTER_RADIUS, uint32_t(radius)},
                            {MSM_SPEC_FILTER_COLUMNS, uint32_t(kOnePassColumns)},
-                           {MSM_SPEC_FILTER_SAMPLES, uint32_t(config.msaa)}});
+                           {MSM_SPEC_FILTER_SAMPLES, uint32_t(config.msaa)},
+                           {MSM_SPEC_CASCADES, config.cascades > 1 ? 1u : 0u}});
 }
 
 } // namespace
@@ -56,8 +58,9 @@ void OnePassFilterPass::execute(const PassContext& c) const {
         {{MSM_BINDING_FRAME, vk::Descriptor(c.frame.uniforms)},
          {MSM_BINDING_ONE_PASS_DEPTH, vk::Descriptor(depth.layer_views[size_t(l)],
                                                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, c.frame.point_sampler)},
-         {MSM_BINDING_ONE_PASS_TARGET, vk::Descriptor(moments.layer_mip0_views[size_t(l)], VK_IMAGE_LAYOUT_GENERAL)}},
-        ImagePassPush{glm::ivec4(int(size), int(size), 0, 0)});
+         {MSM_BINDING_ONE_PASS_TARGET, vk::Descriptor(moments.layer_mip0_views[size_t(l)], VK_IMAGE_LAYOUT_GENERAL)},
+         {MSM_BINDING_ONE_PASS_LIGHTS, vk::Descriptor(c.frame.lights)}},
+        ImagePassPush{glm::ivec4(int(size), int(size), 0, l)});
     c.end_light();
   }
 }

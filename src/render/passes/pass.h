@@ -95,12 +95,15 @@ class TranslucentPass : public Pass {
   int channel_;
 };
 
-// blur.comp's specialization constants for a kernel (msm/filter.h's pairs of taps), fetched
-// bilinearly or as point pairs; the shader's bindings are the source (sampled through a linear,
-// clamp-to-edge sampler when bilinear) and the target.
+// blur.comp's specialization constants: the fetches per side of the widest kernel it blurs with
+// (msm/filter.h's pairs of `taps`), bilinear or as point pairs; the shader's bindings are the
+// source (sampled through a linear, clamp-to-edge sampler when bilinear), the target and the
+// layers' kernels (a storage buffer of BlurKernel, the push constant's size.w the layer's).
 // With mip1 the shader blurs 2 x 2 texels per invocation and writes their average to binding 2
 // (dispatch over half the size in each direction; the size even).
-std::vector<vk::SpecConstant> blur_constants(int taps, float sigma, bool bilinear, bool mip1);
+std::vector<vk::SpecConstant> blur_constants(int taps, bool bilinear, bool mip1);
+// A layer's kernel for blur.comp: `taps` (at most the compiled taps) and σ in its texels.
+BlurKernel blur_kernel(int taps, float sigma);
 
 // Moment images (mip 0) of one channel -> separable Gaussian (msm/filter.h) in place, through a
 // float scratch image; the vertical direction also writes mip 1 where FrameConfig::blur_writes_mip1().
@@ -114,6 +117,7 @@ class BlurPass : public Pass {
 
  private:
   const vk::Program *program_ = nullptr, *vertical_program_ = nullptr;
+  vk::Buffer kernels_; // BlurKernel per layer, written as each frame is recorded
   FrameConfig config_;
   int channel_;
 };

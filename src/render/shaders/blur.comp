@@ -1,13 +1,12 @@
 // One direction of the separable Gaussian blur of a moment image: horizontal when pc.size.z == 0,
-// vertical otherwise. The kernel is compiled in (specialization constants, MSM_BLUR_SPEC_ID in
-// msm/render/frame.h): the centre fetch, then kPairs fetches on each side at fixed offsets and
-// weights, unrolled. With a linear sampler each side fetch is one bilinear pair of taps
-// (msm_filter_pair_offset in msm/filter.h); with a point sampler the host passes the single taps
-// at integer offsets. Clamp-to-edge comes from the sampler. No test for non-finite texels: the
+// vertical otherwise. The centre fetch, then kPairs fetches on each side (a specialization
+// constant, MSM_BLUR_SPEC_ID in msm/render/frame.h: the widest kernel of the frame), unrolled, at
+// the offsets and with the weights of the layer's kernel (kernels[pc.size.w], BlurKernel: a
+// cascade's is narrower in its texels than the first cascade's, the same in world units; its
+// pairs beyond its own radius weigh 0). With a linear sampler each side fetch is one bilinear pair
+// of taps (msm_filter_pair_offset in msm/filter.h); with a point sampler the pair's two texels at
+// integer offsets. Clamp-to-edge comes from the sampler. No test for non-finite texels: the
 // resolve writes finite moments only (RenderTest.ResolveWritesFiniteMoments).
-// With kMip1 (the vertical direction where the map has mips) each invocation blurs a 2 x 2 block of
-// texels and also writes their average to `target_mip1`, the next mip: the mipmap pass then starts
-// at mip 2 and no pass reads mip 0 again for it.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "msm/render/frame.h"
@@ -20,27 +19,12 @@ layout(binding = MSM_BINDING_BLUR_TARGET_MIP1) writeonly uniform image2D target_
 
 layout(push_constant) uniform Push { ImagePassPush pc; };
 
+layout(std430, binding = MSM_BINDING_BLUR_KERNELS) readonly buffer Kernels { BlurKernel kernels[]; };
+
 layout(constant_id = MSM_BLUR_SPEC_ID) const int kPairs = 2;
-layout(constant_id = MSM_BLUR_SPEC_ID + 1) const float kCentre = 1.0f;
-#define MSM_BLUR_PAIR(I)                                                                                           \
-  layout(constant_id = MSM_BLUR_SPEC_ID + 1 + I) const float kOffset##I = 0.0f;                                   \
-  layout(constant_id = MSM_BLUR_SPEC_ID + 1 + MSM_BLUR_MAX_PAIRS + I) const float kWeight##I = 0.0f;
-MSM_BLUR_PAIR(1)
-MSM_BLUR_PAIR(2)
-MSM_BLUR_PAIR(3)
-MSM_BLUR_PAIR(4)
-MSM_BLUR_PAIR(5)
-MSM_BLUR_PAIR(6)
-MSM_BLUR_PAIR(7)
-MSM_BLUR_PAIR(8)
-MSM_BLUR_PAIR(9)
-MSM_BLUR_PAIR(10)
-MSM_BLUR_PAIR(11)
-MSM_BLUR_PAIR(12)
-MSM_BLUR_PAIR(13)
-MSM_BLUR_PAIR(14)
-MSM_BLUR_PAIR(15)
-MSM_BLUR_PAIR(16)
+
+// Value i of the layer's kernel: 0 the centre weight, 2 j - 1 pair j's offset, 2 j its weight.
+float kernel_value(int i) { return kernels[pc.size.w].values[i / 4][i % 4]; }
 
 // false: each pair as its two texels, point fetches with the weights W (1 - f) and W f, f the
 // fraction of the pair's offset: exact, for the 32-bit float maps (a bilinear fetch's fraction is
@@ -59,6 +43,13 @@ vec4 point_pair(int inner, float offset, float weight) {
               texelFetch(source, clamp(g_p + (inner + 1) * g_step, ivec2(0), g_last), 0));
 }
 
+// Pair j's two fetches, weighted, at its offset from the centre (uv) along step (one texel in uv).
+vec4 pair_fetch(int j, vec2 centre, vec2 step) {
+  float offset = kernel_value(2 * j - 1), weight = kernel_value(2 * j);
+  if (!kBilinear) return point_pair(2 * j - 1, offset, weight);
+  return weight * (textureLod(source, centre - offset * step, 0.0f) + textureLod(source, centre + offset * step, 0.0f));
+}
+
 vec4 blur_at(ivec2 p) {
   vec2 texel = 1.0f / vec2(pc.size.xy);
   vec2 centre = (vec2(p) + 0.5f) * texel;
@@ -66,13 +57,10 @@ vec4 blur_at(ivec2 p) {
   g_p = p;
   g_step = pc.size.z == 0 ? ivec2(1, 0) : ivec2(0, 1);
   g_last = pc.size.xy - 1;
-  vec4 sum = kCentre * texelFetch(source, p, 0); // on the texel: no filtering to pay for
+  vec4 sum = kernel_value(0) * texelFetch(source, p, 0); // on the texel: no filtering to pay for
   // Dead after specialization beyond kPairs: the driver keeps kPairs straight-line fetch pairs.
 #define MSM_BLUR_FETCH(I)                                                                                          \
-  if (kPairs >= I && kBilinear)                                                                                    \
-    sum += kWeight##I * (textureLod(source, centre - kOffset##I * step, 0.0f) +                                    \
-                         textureLod(source, centre + kOffset##I * step, 0.0f));                                    \
-  if (kPairs >= I && !kBilinear) sum += point_pair(2 * I - 1, kOffset##I, kWeight##I);
+  if (kPairs >= I) sum += pair_fetch(I, centre, step);
   MSM_BLUR_FETCH(1)
   MSM_BLUR_FETCH(2)
   MSM_BLUR_FETCH(3)

@@ -38,7 +38,7 @@ Bilinear bilinear_texels(vec2 t) {
 // the fragment depth: the filter kernel spans several texels of a sloped receiver, and the half
 // of them in front of the fragment would shadow it (self-shadowing, worst at grazing light).
 // frame.receiver_bias.x: the kernel's variance per axis in texels² from the blur and the MSAA
-// sample positions (host), .y: a multiplier (RenderSettings::receiver_plane_bias; 0 = off), applied
+// sample positions (host; with cascades the layer's, LightUniforms::kernel.z), .y: a multiplier (RenderSettings::receiver_plane_bias; 0 = off), applied
 // to σ (so the negative warp's σ² bias scales by its square). The lookup adds its own
 // footprint: bilinear at mip λ reads texels that average 2^λ x 2^λ mip-0 texels (variance
 // (4^λ − 1)/12 per axis) with tent weights over 2^λ texels (4^λ f(1 − f), 4^λ/6 on average over
@@ -46,7 +46,8 @@ Bilinear bilinear_texels(vec2 t) {
 // which λ's fraction approximates. A nearest or dithered lookup compares at the receiver plane's
 // depth at the texel it reads (receiver_depth_at): its kernel is the blur's.
 float receiver_plane_bias(ShadowLookup s, float lod) {
-  float variance = frame.receiver_bias.x;
+  // A cascade's kernel is its own (narrower in its texels: LightUniforms::kernel).
+  float variance = kCascades ? lights[shadow_layer].kernel.z : frame.receiver_bias.x;
   // Off (or NaN): a multiplier of 0 (finite σ), selected rather than branched on, because lavapipe
   // recompiles a shader per frame for some branches on a uniform (kLightCount, shading.glsl).
   float multiplier = frame.receiver_bias.y > 0.0f ? frame.receiver_bias.y : 0.0f;

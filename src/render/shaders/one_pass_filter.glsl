@@ -19,11 +19,16 @@
 // specialization constants, so every loop below except the walk unrolls.
 #extension GL_GOOGLE_include_directive : require
 #include "msm/techniques.h"
+#define MSM_LIGHT_BINDING MSM_BINDING_ONE_PASS_LIGHTS
 #include "frame.glsl"
 
 layout(constant_id = MSM_SPEC_FILTER_RADIUS) const int kRadius = 4;  // taps = 2 kRadius + 1; frame.filter_weights
 layout(constant_id = MSM_SPEC_FILTER_COLUMNS) const int kColumns = 4; // adjacent columns per thread
 layout(constant_id = MSM_SPEC_FILTER_SAMPLES) const int kSamples = 1; // MSAA samples per texel, = frame.kernel.y
+// With cascades each layer filters with its own kernel (LightUniforms::kernel of layer pc.size.w:
+// the first cascade's width in world units, msm/cascade.h; 0 beyond its radius), from
+// msm/filter.h as the host computes the frame's; without, the frame's (kernel_weight).
+layout(constant_id = MSM_SPEC_CASCADES) const bool kCascades = false;
 #define MSM_RESOLVE_SAMPLES kSamples
 layout(local_size_x = 32) in;
 
@@ -57,6 +62,10 @@ void main() {
   int rows = min(kStripH, size.y - origin.y);
   int first = kRadius + thread * kColumns; // tile column of the thread's first own column
   vec4 window[kColumns][kTaps];            // [c][k]: horizontal row t - 2R + k of own column c
+  float weights[kTaps];
+  vec4 kernel = kCascades ? lights[pc.size.w].kernel : vec4(0.0f);
+  for (int k = 0; k < kTaps; ++k)
+    weights[k] = kCascades ? msm_filter_weight_at(k - kRadius, int(kernel.y), kernel.x) : kernel_weight(k);
   for (int c = 0; c < kColumns; ++c)
     for (int k = 0; k < kTaps; ++k) window[c][k] = vec4(0.0f);
   for (int t0 = 0; t0 < rows + 2 * kRadius; t0 += kStep) {
@@ -91,11 +100,11 @@ void main() {
       int o = t0 + s - 2 * kRadius;
       for (int c = 0; c < kColumns; ++c) {
         vec4 sum = vec4(0.0f);
-        for (int k = 0; k < kTaps; ++k) sum += kernel_weight(k) * row[c + k];
+        for (int k = 0; k < kTaps; ++k) sum += weights[k] * row[c + k];
         for (int k = 0; k + 1 < kTaps; ++k) window[c][k] = window[c][k + 1];
         window[c][kTaps - 1] = sum;
         sum = vec4(0.0f);
-        for (int k = 0; k < kTaps; ++k) sum += kernel_weight(k) * window[c][k];
+        for (int k = 0; k < kTaps; ++k) sum += weights[k] * window[c][k];
         ivec2 p = origin + ivec2(first - kRadius + c, o);
         if (o >= 0 && o < rows && p.x < size.x) {
 #ifdef MSM_NL32

@@ -77,17 +77,28 @@ float pcss_shadow(ShadowLookup s) {
   return shadow / (extent.x * extent.y);
 }
 
+// Tap k of the PCF kernel of the light's layer: the frame's (kTaps of them), or with cascades the
+// layer's own (LightUniforms::kernel: the first cascade's width in world units, msm/cascade.h; 0
+// beyond its radius), from msm/filter.h as the host computes the frame's.
+float pcf_weight(int k) {
+  if (!kCascades) return kernel_weight(k);
+  vec4 kernel = lights[shadow_layer].kernel;
+  return msm_filter_weight_at(k - kTaps / 2, int(kernel.y), kernel.x);
+}
+
 float shadow_intensity(ShadowLookup s) {
   if (kTechnique == MSM_TECH_PCSS) return pcss_shadow(s);
   if (kTechnique == MSM_TECH_PLAIN) return texel_occlusion(ivec2(floor(s.t + 0.5f)), s);
   const int taps = kTaps, radius = kTaps / 2;
+  float weights[kTaps];
+  for (int k = 0; k < taps; ++k) weights[k] = pcf_weight(k);
   ivec2 i0 = ivec2(floor(s.t));
   vec2 f = s.t - vec2(i0);
   float shadow = 0.0f;
   for (int y = 0; y <= taps; ++y) {
-    float wy = (y < taps ? (1.0f - f.y) * kernel_weight(y) : 0.0f) + (y > 0 ? f.y * kernel_weight(y - 1) : 0.0f);
+    float wy = (y < taps ? (1.0f - f.y) * weights[y] : 0.0f) + (y > 0 ? f.y * weights[y - 1] : 0.0f);
     for (int x = 0; x <= taps; ++x) {
-      float wx = (x < taps ? (1.0f - f.x) * kernel_weight(x) : 0.0f) + (x > 0 ? f.x * kernel_weight(x - 1) : 0.0f);
+      float wx = (x < taps ? (1.0f - f.x) * weights[x] : 0.0f) + (x > 0 ? f.x * weights[x - 1] : 0.0f);
       shadow += wx * wy * texel_occlusion(i0 + ivec2(x, y) - ivec2(radius), s);
     }
   }
