@@ -9,6 +9,7 @@
 #include "msm/render/renderer.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/figures.h"
 #include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
@@ -195,6 +196,10 @@ std::map<std::string, image::Metrics> check_scene(Renderer& renderer, const std:
     }
     const Measured& expected = scene_measured->second.at(technique);
     EXPECT_LT(m.mae, mae_bound(expected.mae));
+    test::record_figure(
+        fmt::format("scattering.{}.{}.mae", name, technique), m.mae,
+        {.below = mae_bound(expected.mae),
+         .meaning = fmt::format("{}, {}: MAE of the visible fraction against the traced scattering", name, technique)});
     EXPECT_LT(m.share_above_3pct, share_bound(expected.share3));
   }
   return metrics;

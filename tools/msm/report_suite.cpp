@@ -113,7 +113,13 @@ std::vector<Suite> declared_suites() {
       {"Cascades: the box on a 500 m ground, a slow pan", "src/render/msm_render_cascades_test",
        "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest."
        "StabilisedCascadesShimmerLessInASlowPan"},
-      {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"}};
+      {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"},
+      {"Probe lights: the plane's irradiance at every light count", "src/reference/msm_reference_environment_test",
+       "Environment.AreaLightsKeepThePlanesIrradiance*"},
+      {"Translucent occluders against the ray tracer", "src/render/msm_render_translucency_test",
+       "TranslucencyTest.StackOfPlanesTransmitsAsTheRayTracerSays"},
+      {"Single scattering against the ray tracer", "src/render/msm_render_scattering_ground_truth_test",
+       "ScatteringGroundTruthTest.*"}};
   return {quick, full, gpu};
 }
 
