@@ -104,7 +104,8 @@ std::vector<Suite> declared_suites() {
       {"Every technique against the filtered ground truth", "src/render/msm_render_ground_truth_test",
        "GroundTruthTest.EveryTechniqueAgainstTheGroundTruth"},
       {"Soft shadows against the traced area light", "src/render/msm_render_soft_shadow_test",
-       "SoftShadowTest.CloserToTheAreaLightThanHardShadows:SoftShadowTest.ModelsAndPillarBeforeBrickWall"},
+       "SoftShadowTest.CloserToTheAreaLightThanHardShadows:SoftShadowTest.ModelsAndPillarBeforeBrickWall:"
+       "SoftShadowTest.ConvolutionSoftShadowMaps:SoftShadowTest.RectangularLightsPenumbraeFollowTheirTwoExtents"},
       {"Spot and point lights against the ray tracer", "src/render/msm_render_local_lights_test",
        "LocalLightsRenderTest.SpotLightShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
        "SpotLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest.PointLightShadowsAgreeWithTheRayTracer:"
@@ -119,7 +120,9 @@ std::vector<Suite> declared_suites() {
       {"Translucent occluders against the ray tracer", "src/render/msm_render_translucency_test",
        "TranslucencyTest.StackOfPlanesTransmitsAsTheRayTracerSays"},
       {"Single scattering against the ray tracer", "src/render/msm_render_scattering_ground_truth_test",
-       "ScatteringGroundTruthTest.*"}};
+       "ScatteringGroundTruthTest.*"},
+      {"Single scattering against the ray tracer", "src/render/msm_render_scattering_lights_test",
+       "ScatteringLightsTest.TwoLightsAgreeWithTheGroundTruth"}};
   return {quick, full, gpu};
 }
 
