@@ -130,12 +130,27 @@ def grid_place(key):
     return (".".join(parts[:-3]), parts[-1]), parts[-3], parts[-2]
 
 
+def measure_place(key):
+    """(table, column, row) of a figure keyed PREFIX.ROW.MEASURE whose PREFIX has two parts or more: the
+    measures as columns (an ordering's ratios per scene, say)."""
+    parts = key.split(".")
+    if len(parts) < 4:
+        return None
+    return (".".join(parts[:-2]), ""), parts[-1], parts[-2]
+
+
 def grid_tables(figures):
-    """The figures that share a key's prefix and measure, as tables of column x row when there are at least
-    two of each and every cell is one figure; the remaining figures as they come."""
+    """The figures as tables of column x row where at least two of each share a table (by grid_place, then
+    by measure_place) and every cell is one figure; the remaining figures as they come."""
+    grids, rest = grid_tables_by(figures, grid_place)
+    more, rest = grid_tables_by(rest, measure_place)
+    return grids + more, rest
+
+
+def grid_tables_by(figures, place_of):
     tables = {}
     for f in figures:
-        place = grid_place(f["key"])
+        place = place_of(f["key"])
         if place:
             tables.setdefault(place[0], []).append((place[1], place[2], f))
     grids, gridded = [], set()
@@ -146,14 +161,36 @@ def grid_tables(figures):
             continue
         grids.append((prefix, measure, columns, rows, {(c, r): f for c, r, f in cells}))
         gridded.update(id(f) for _, _, f in cells)
-    return grids, [f for f in figures if id(f) not in gridded]
+    return merged_grids(grids), [f for f in figures if id(f) not in gridded]
+
+
+def merged_grids(grids):
+    """Tables whose prefixes differ in their last part alone, with the same columns, as one table whose rows
+    are named by that part and their own row (the seams' table per technique: one table)."""
+    merged, index = [], {}
+    for prefix, measure, columns, rows, cells in grids:
+        parent, _, last = prefix.rpartition(".")
+        key = (parent, measure, tuple(columns))
+        if not parent or key not in index:
+            index[key] = len(merged)
+            merged.append((prefix, measure, columns, rows, cells, [(last, rows, cells)]))
+            continue
+        first = merged[index[key]]
+        merged[index[key]] = (parent + ".*", measure, columns, None, None, first[5] + [(last, rows, cells)])
+    out = []
+    for prefix, measure, columns, rows, cells, parts in merged:
+        if len(parts) > 1:
+            rows = [f"{last} {row}" for last, part_rows, _ in parts for row in part_rows]
+            cells = {(c, f"{last} {r}"): f for last, _, part_cells in parts for (c, r), f in part_cells.items()}
+        out.append((prefix, measure, columns, rows, cells))
+    return out
 
 
 def grid_lines(prefix, measure, columns, rows, cells):
     figures = list(cells.values())
     meanings = list(dict.fromkeys(f["meaning"].split(": ", 1)[-1] for f in figures))
-    lines = [f"`{prefix}.COLUMN.ROW.{measure}`: {'; '.join(meanings)} (each cell: the value, and in brackets the "
-             "bound asserted):", "", "| | " + " | ".join(columns) + " |", "|---|" + "--:|" * len(columns)]
+    pattern = f"{prefix}.COLUMN.ROW.{measure}" if measure else f"{prefix}.ROW.COLUMN"
+    lines = [f"`{pattern}`: {'; '.join(meanings)} (each cell: the value, and in brackets the bound asserted):", "", "| | " + " | ".join(columns) + " |", "|---|" + "--:|" * len(columns)]
     for row in rows:
         texts = []
         for column in columns:
