@@ -97,6 +97,9 @@ std::vector<Suite> declared_suites() {
       {"The single-source math against the oracles", "src/core/msm_blocker_test", "Blocker.*EqualEquation4*"},
       {"The single-source math against the oracles", "src/core/msm_nonlinear_test",
        "NonLinear.Algorithm3EqualsHamburger4"},
+      {"The single-source math against the oracles", "src/core/msm_edges_test",
+       "Edges.Hamburger4AgainstAlgorithm1OnEveryStoragePath:Edges.Hamburger6AgainstAlgorithm1OnEveryStoragePath:"
+       "Edges.NonLinearAgainstAlgorithm1"},
       {"The single-source math against the oracles", "src/core/msm_baselines_test",
        "Vsm.EqualsTheMomentOracleWithTwoMoments:Esm.EqualsTheLinearProgramForTheExponentialBasis"},
       {"The papers' leaking orderings (against PCF)", "src/render/msm_render_test",
