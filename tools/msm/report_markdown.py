@@ -54,12 +54,23 @@ def row_section(run, row):
     return lines
 
 
+def variant_heading(first, variant):
+    """What sets a variant row apart from the first of its group: its scene's name, output or map size."""
+    parts = [variant["scene"]] if variant["scene"] != first["scene"] else []
+    if (variant["width"], variant["height"]) != (first["width"], first["height"]):
+        parts.append(f"{variant['width']}×{variant['height']}")
+    if variant["shadow_size"] != first["shadow_size"]:
+        parts.append(f"map {variant['shadow_size']}²")
+    return ", ".join(parts) or variant["id"]
+
+
 def variants_lines(first, variants):
-    """Rows of the first one's scene, effect and techniques at other sizes: MAE and time per row."""
-    lines = [f"**{first['scene']}**, {first['truth']['effect']} at other output and shadow-map sizes (rows "
-             + ", ".join(f"`{v['id']}`" for v in variants) + "): MAE / GPU ms per frame:", "",
-             "| technique | " + " | ".join(f"{v['width']}×{v['height']}, map {v['shadow_size']}²" for v in variants)
-             + " |", "|---|" + "--:|" * len(variants)]
+    """Rows of the first one's scene, effect and techniques with another light, output or map size: MAE and
+    time per row."""
+    lines = [f"**{first['scene']}**, {first['truth']['effect']}, the same techniques in rows "
+             + ", ".join(f"`{v['id']}`" for v in variants) + ": MAE / GPU ms per frame:", "",
+             "| technique | " + " | ".join(variant_heading(first, v) for v in variants) + " |",
+             "|---|" + "--:|" * len(variants)]
     for i, t in enumerate(first["techniques"]):
         cells = [f"{v['techniques'][i]['metrics']['mae']:.4f} / {v['techniques'][i]['gpu_ms_total']:.1f}"
                  for v in variants]
@@ -68,9 +79,9 @@ def variants_lines(first, variants):
 
 
 def row_groups(rows):
-    """The rows in order, each with the later rows of its scene, effect and techniques (its variants)."""
+    """The rows in order, each with the later rows of its scene file, effect and techniques (its variants)."""
     def shape(row):
-        return row["scene"], row["truth"]["effect"], tuple(t["name"] for t in row["techniques"])
+        return row["scene_source"], row["truth"]["effect"], tuple(t["name"] for t in row["techniques"])
     groups, seen = [], {}
     for row in rows:
         if shape(row) in seen:
