@@ -9,6 +9,7 @@
 #include "msm/render/renderer.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/figures.h"
 #include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
@@ -195,9 +196,21 @@ std::map<std::string, image::Metrics> check_scene(Renderer& renderer, const std:
     }
     const Measured& expected = scene_measured->second.at(technique);
     EXPECT_LT(m.mae, mae_bound(expected.mae));
+    test::record_figure(
+        fmt::format("scattering.{}.{}.mae", name, technique), m.mae,
+        {.below = mae_bound(expected.mae),
+         .meaning = fmt::format("{}, {}: MAE of the visible fraction against the traced scattering", name, technique)});
     EXPECT_LT(m.share_above_3pct, share_bound(expected.share3));
   }
   return metrics;
+}
+
+// The gate's frame-to-frame change of one resampling over another's, with the bound asserted.
+void record_flicker(const std::string& technique, const std::string& ratio, double value, double bound) {
+  test::record_figure("scattering.flicker." + technique + "." + ratio + ".ratio", value,
+                      {.below = bound,
+                       .meaning = "gate, a slow drift: mean frame-to-frame change of the visible fraction, one "
+                                  "resampling over another"});
 }
 
 struct SceneRun {
@@ -322,16 +335,20 @@ TEST_F(ScatteringGroundTruthTest, Gate) {
     // The bilinear moments: measured 0.00303 vs 0.00634 (four moments), 0.00325 vs 0.00670 (six)
     // and 0.00375 vs 0.00706 (CSM-32): ratio 0.48-0.53.
     EXPECT_LT(change[2], 0.6 * change[0]) << technique;
+    record_flicker(technique, "bilinear_over_unfiltered", change[2] / change[0], 0.6);
     // The blurred, mipmapped map flickers less still: measured 0.00142 (four moments), 0.00176
     // (six), 0.00294 (CSM-32): 0.22-0.42x unfiltered, 0.47 and 0.54x the bilinear moments for the
     // moment techniques, 0.78x for CSM-32 (whose 16 terms ring at the shafts' edges either way).
     EXPECT_LT(change[1], 0.5 * change[0]) << technique;
+    record_flicker(technique, "blurred_map_over_unfiltered", change[1] / change[0], 0.5);
     const bool moments = technique != std::string("scatter-csm-32");
     EXPECT_LT(change[1], (moments ? 0.7 : 0.9) * change[2]) << technique;
+    record_flicker(technique, "blurred_map_over_bilinear", change[1] / change[2], moments ? 0.7 : 0.9);
     // App. D.5's mips of the prefix sums flicker a little less than none (measured 0.00612 / 0.00634,
     // 0.00646 / 0.00670, 0.00688 / 0.00706: 0.96-0.97x): at 160 x 90 and 512 rows few pixels span more
     // than a texel both along and across the rows, the footprint that picks the level.
     EXPECT_LT(change[3], change[0]) << technique;
+    record_flicker(technique, "prefix_sum_mips_over_unfiltered", change[3] / change[0], 1.0);
   }
 }
 

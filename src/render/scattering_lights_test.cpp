@@ -11,6 +11,7 @@
 
 #include "msm/image/metrics.h"
 #include "msm/scattering.h"
+#include "msm/test/figures.h"
 #include "msm/test/reference_settings.h"
 #include "msm/test/render_settings.h"
 #include "msm/test/vulkan_test.h"
@@ -171,8 +172,15 @@ TEST_F(ScatteringLightsTest, TwoLightsAgreeWithTheGroundTruth) {
     EXPECT_EQ(m.non_finite, 0u);
     const Measured& expected = kMeasured.at(technique);
     EXPECT_LT(m.mae, mae_bound(expected.mae));
+    test::record_figure(
+        "scattering.gate_two_lights." + technique + ".mae", m.mae,
+        {.below = mae_bound(expected.mae), .meaning = "MAE of the visible fraction against the traced scattering"});
     EXPECT_LT(m.share_above_3pct, share_bound(expected.share3));
     EXPECT_LT(difference / mean, inscattered_bound(expected.inscattered));
+    test::record_figure("scattering.gate_two_lights." + technique + ".inscattered_relative_error", difference / mean,
+                        {.below = inscattered_bound(expected.inscattered),
+                         .meaning = "gate under two lights: mean absolute error of the in-scattered luminance over "
+                                    "the truth's mean"});
   }
 }
 

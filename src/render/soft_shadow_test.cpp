@@ -193,6 +193,8 @@ TEST_F(SoftShadowTest, ConvolutionSoftShadowMaps) {
     for (const char* t : {"cssm8", "cssm16"}) {
       const double bound = std::max(1.5 * measured.at(t), measured.at(t) + 0.002);
       EXPECT_LE(m[t].mae, bound) << name << ", " << t << " (measured " << measured.at(t) << ")";
+      msm::test::record_figure("ground_truth.soft." + name + "." + t + ".mae", m[t].mae,
+                               {.below = bound, .meaning = "MAE of visibility against the traced area light"});
     }
     EXPECT_LE(m["cssm16"].mae, m["cssm8"].mae) << name;
     EXPECT_LT(m["mssm4"].mae, m["cssm16"].mae) << name;
@@ -585,6 +587,17 @@ RampWidths rectangle_ramps(const scene::Scene& scene, const image::Image& v) {
 const std::map<std::string, double> kRectangleRampFraction = {{"mssm4", 0.987}, {"mssm6", 0.808}, {"vssm", 0.989},
                                                               {"pcss", 0.999},  {"cssm8", 0.674}, {"cssm16", 0.680}};
 
+// A penumbra's width (or the ratio of the two) against the one expected, with the relative tolerance
+// asserted.
+void record_ramp(const std::string& across, const std::string& who, double got, double expected, double tolerance) {
+  msm::test::record_figure(
+      "penumbra.rectangle." + across + "." + who + ".relative_error", std::abs(got / expected - 1.0),
+      {.below = tolerance,
+       .meaning = "a 20° x 8° rectangular light: the penumbra's width (or the ratio of the "
+                  "two widths) against the hand-computed one (a renderer's times its technique's measured "
+                  "fraction), relative distance"});
+}
+
 TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
   const scene::Scene scene = rectangle_edge_scene();
   const double wide = 3.0 * std::tan(glm::radians(10.0)), narrow = 3.0 * std::tan(glm::radians(4.0));
@@ -601,7 +614,9 @@ TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
   fmt::print("rectangle 20° x 8°: ray traced ramps {:.4f} m (expected {:.4f}), {:.4f} m ({:.4f})\n", t.across_width,
              wide, t.across_height, narrow);
   EXPECT_NEAR(t.across_width, wide, 0.03 * wide);
+  record_ramp("width", "ray_tracer", t.across_width, wide, 0.03);
   EXPECT_NEAR(t.across_height, narrow, 0.03 * narrow);
+  record_ramp("height", "ray_tracer", t.across_height, narrow, 0.03);
   // The environment effect's rectangles (--extracted-lights: how the probe's lights are ray traced):
   // "visibility" is the irradiance over the unoccluded one, so a direction (a, b) of the light
   // weighs (n·d) dω / dA = (1 + a² + b²)^−2 on a surface facing it: the ramp is that weight's
@@ -617,7 +632,9 @@ TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
     fmt::print("rectangle 20° x 8°: environment (probe lights) ramps {:.4f} m (expected {:.4f}), {:.4f} m ({:.4f})\n",
                e.across_width, wide_cos, e.across_height, narrow_cos);
     EXPECT_NEAR(e.across_width, wide_cos, 0.03 * wide_cos);
+    record_ramp("width", "ray_tracer_probe_lights", e.across_width, wide_cos, 0.03);
     EXPECT_NEAR(e.across_height, narrow_cos, 0.03 * narrow_cos);
+    record_ramp("height", "ray_tracer_probe_lights", e.across_height, narrow_cos, 0.03);
   }
   Renderer renderer(ctx(), scene);
   for (const std::string t : {"mssm4", "mssm6", "vssm", "pcss", "cssm8", "cssm16"}) {
@@ -633,8 +650,11 @@ TEST_F(SoftShadowTest, RectangularLightsPenumbraeFollowTheirTwoExtents) {
         100.0 * (r.across_height / narrow - 1.0), r.across_width / r.across_height, wide / narrow);
     const double fraction = kRectangleRampFraction.at(t);
     EXPECT_NEAR(r.across_width, fraction * wide, 0.05 * fraction * wide) << t;
+    record_ramp("width", t, r.across_width, fraction * wide, 0.05);
     EXPECT_NEAR(r.across_height, fraction * narrow, 0.05 * fraction * narrow) << t;
+    record_ramp("height", t, r.across_height, fraction * narrow, 0.05);
     EXPECT_NEAR(r.across_width / r.across_height, wide / narrow, 0.03 * wide / narrow) << t;
+    record_ramp("ratio", t, r.across_width / r.across_height, wide / narrow, 0.03);
   }
 }
 

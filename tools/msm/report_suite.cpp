@@ -100,6 +100,9 @@ std::vector<Suite> declared_suites() {
       {"The single-source math against the oracles", "src/core/msm_blocker_test", "Blocker.*EqualEquation4*"},
       {"The single-source math against the oracles", "src/core/msm_nonlinear_test",
        "NonLinear.Algorithm3EqualsHamburger4"},
+      {"The single-source math against the oracles", "src/core/msm_edges_test",
+       "Edges.Hamburger4AgainstAlgorithm1OnEveryStoragePath:Edges.Hamburger6AgainstAlgorithm1OnEveryStoragePath:"
+       "Edges.NonLinearAgainstAlgorithm1"},
       {"The single-source math against the oracles", "src/core/msm_baselines_test",
        "Vsm.EqualsTheMomentOracleWithTwoMoments:Esm.EqualsTheLinearProgramForTheExponentialBasis"},
       {"The papers' leaking orderings (against PCF)", "src/render/msm_render_test",
@@ -107,7 +110,8 @@ std::vector<Suite> declared_suites() {
       {"Every technique against the filtered ground truth", "src/render/msm_render_ground_truth_test",
        "GroundTruthTest.EveryTechniqueAgainstTheGroundTruth"},
       {"Soft shadows against the traced area light", "src/render/msm_render_soft_shadow_test",
-       "SoftShadowTest.CloserToTheAreaLightThanHardShadows:SoftShadowTest.ModelsAndPillarBeforeBrickWall"},
+       "SoftShadowTest.CloserToTheAreaLightThanHardShadows:SoftShadowTest.ModelsAndPillarBeforeBrickWall:"
+       "SoftShadowTest.ConvolutionSoftShadowMaps:SoftShadowTest.RectangularLightsPenumbraeFollowTheirTwoExtents"},
       {"Spot and point lights against the ray tracer", "src/render/msm_render_local_lights_test",
        "LocalLightsRenderTest.SpotLightShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
        "SpotLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest.PointLightShadowsAgreeWithTheRayTracer:"
@@ -117,8 +121,19 @@ std::vector<Suite> declared_suites() {
       {"The 2015 ordering per light kind", "src/render/msm_render_light_kind_ordering_test", "LightKindOrderingTest.*"},
       {"Cascades: the box on a 500 m ground, the town, a slow pan", "src/render/msm_render_cascades_test",
        "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest.TownWithDefaultSettings:"
-       "CascadesRenderTest.StabilisedCascadesShimmerLessInASlowPan"},
-      {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"}};
+       "CascadesRenderTest.StabilisedCascadesShimmerLessInASlowPan:CascadesRenderTest."
+       "DepthBoundsGiveTheNearCascadeFinerTexels:"
+       "CascadesRenderTest.PenumbraKeepsItsWorldWidthAcrossCascades"},
+      {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"},
+      {"Probe lights: the plane's irradiance at every light count", "src/reference/msm_reference_environment_test",
+       "Environment.AreaLightsKeepThePlanesIrradiance*"},
+      {"Translucent occluders against the ray tracer", "src/render/msm_render_translucency_test",
+       "TranslucencyTest.StackOfPlanesTransmitsAsTheRayTracerSays:TranslucencyTest.*UnderSpotAndPointLights*:"
+       "TranslucencyTest.StairsUnderDirectionalSpotAndPointLightsAgainstTheRayTracer"},
+      {"Single scattering against the ray tracer", "src/render/msm_render_scattering_ground_truth_test",
+       "ScatteringGroundTruthTest.*"},
+      {"Single scattering against the ray tracer", "src/render/msm_render_scattering_lights_test",
+       "ScatteringLightsTest.TwoLightsAgreeWithTheGroundTruth"}};
   return {quick, full, gpu};
 }
 
