@@ -53,7 +53,7 @@ const float MSM_NL_TOLERANCE = 1.0e-6f;
 const float MSM_BLOCKER_EPSILON = 1.0e-3f;
 // Kneiphof Eq. (19): upper clamp δ2 of the mass at the fragment depth counted into the average
 // blocker depth (δ1 = MSM_BLOCKER_EPSILON). The paper gives no value; this one is measured on the
-// built-in scenes (docs/results.md): larger values harden penumbrae where the moments are unsure.
+// built-in scenes (ground_truth.soft.*): larger values harden penumbrae where the moments are unsure.
 const float MSM_SOFT6_DELTA2 = 0.1f;
 // Naive VSSM: minimum variance of (z, z²) of [0,1] depth read from a 32-bit integer table
 // (~22.5 bits for a 27² kernel: quantization errors of a few 1e-7 in the variance).

@@ -315,7 +315,7 @@ MSM_FN float msm_transmittance_layer_step(vec2 range, float layer, float layers)
 // linear in log Δ between the bracketing steps Δ_k0 <= delta <= Δ_k0+1 (geometrically spaced, so
 // x = (K − 1) log(delta / Δ_lo) / log(Δ_hi / Δ_lo) and k0 = floor(x)); steps outside the range
 // read its end layer. K = 1 or an empty range: (0, 0). (Measured against a mix that keeps the ray's
-// mean distance: that one is worse with few layers, docs/results.md.)
+// mean distance: that one is worse with few layers.)
 MSM_FN vec2 msm_transmittance_layer_lookup(vec2 range, float delta, float layers) {
   float span = log(range.y / range.x);
   float x = span > 0.0f && layers > 1.0f ? msm_saturate(log(delta / range.x) / span) * (layers - 1.0f) : 0.0f;

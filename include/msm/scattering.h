@@ -187,8 +187,8 @@ MSM_FN int msm_scattering_beta_mode(float z) {
 // decided (a decided mass below 1e-6 blends towards it), without a branch. Then, as §5.3.1 wants,
 // towards the epipole it falls to 0 (msm_scattering_epipole_ramp: no occluder can lie in front of
 // the ray there, so the bounds leak): β = min(ratio, ramp).
-// Measured against the ground truth on the four scenes and the bunny (docs/results.md): 6–61%
-// less error than §5.3.1's β, the epipole's leaking within 2% of it.
+// Measured against the ground truth on the four scenes (rows +adaptive of scattering.*) and the
+// bunny: 6–61% less error than §5.3.1's β, the epipole's leaking within 2% of it.
 MSM_FN float msm_scattering_beta_mass_ratio(vec2 shadow_bounds) {
   float lit = 1.0f - msm_saturate(shadow_bounds.y), shadowed = msm_saturate(shadow_bounds.x);
   float decided = lit + shadowed;

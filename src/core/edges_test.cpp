@@ -12,7 +12,7 @@
 // such move have no sharp bound; for them the tests check the side the technique errs on
 // (docs/techniques.md, "Outside the moment space"): never darker than the distribution the texel
 // came from, plus the bias.
-// Measured values are printed as "[edges]" lines (docs/results.md quotes them).
+// Measured values are printed as "[edges]" lines and recorded as math.edges.*.
 #include "msm/blocker.h"
 #include "msm/msm.h"
 #include "msm/sat.h"

@@ -26,7 +26,7 @@
 // |device - cpu| / max(1, |cpu|): absolute for values in [-1,1] (shadow intensities, weights,
 // depths), relative for large ones (roots, exponential warps). Each function bounds the max and
 // the 99.9th percentile (some also the fraction of inputs that differ at all). The measured values
-// are printed as "[gpu-math]" lines (docs/results.md quotes them); "measured" below is lavapipe
+// are printed as "[gpu-math]" lines; "measured" below is lavapipe
 // (Mesa 22.3.6, LLVM 15), where msm_fma is the emulation (see GpuMath).
 #include "gpu/kernels.h"
 #include "test_distributions.h"

@@ -1,7 +1,7 @@
 // Non-linearly quantized moment shadow maps (include/msm/nonlinear.h, HPG 2017 §3) against the
 // double-precision moment oracle (JCGT Algorithm 1), against Hamburger 4MSM in float, and against
 // the figures the paper states. Every tolerance says where it comes from; measured values are
-// printed (grep "[nonlinear") for docs/results.md.
+// printed (grep "[nonlinear").
 #include "msm/msm.h"
 #include "msm/nonlinear.h"
 #include "msm/oracle/moment_oracle.h"
@@ -633,7 +633,7 @@ TEST(NonLinear, LargerXi4NeverRaisesTheShadow) {
 // Shadows of quantized NL moments on random distributions (biased float moments, then Φ) and
 // random fragment depths (half uniform on [-1,1], half within 0.02 of y1 or y2):
 //  - error against unquantized float MSM (msm_hamburger4_lower of the biased float moments),
-//    mean and max, recorded for docs/results.md; also against JCGT Alg. 1 on the same float
+//    mean and max, printed; also against JCGT Alg. 1 on the same float
 //    moments (float MSM has its own rounding error, up to ~0.25 on these inputs, see above) and
 //    against the true CDF (mostly the leaking every 4MSM has). Expected (HPG §5): NL64
 //    indistinguishable from float MSM (mean <= 1e-4), NL32 adds banding only (mean <= 1e-2).

@@ -1,8 +1,7 @@
 // Storage robustness: millions of random filtered moment vectors, degenerate ones included, go
 // through each representation's store -> load -> bias -> reconstruction. Every result must be
 // finite and inside [0,1] (a NaN or out-of-range shadow is a visible pixel error), and the
-// error of each representation against unquantized float moments is measured and printed: that
-// table is what docs/results.md quotes.
+// error of each representation against unquantized float moments is measured and printed.
 #include "msm/hamburger6.h"
 #include "msm/msm.h"
 

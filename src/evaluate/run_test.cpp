@@ -135,8 +135,8 @@ TEST(Run, WritesTheReports) {
 
 // 2015 §3.2: the power and the trigonometric moments rank among the best of the four-function sets.
 // 100 sets drawn from our 37 functions, three built-in scenes at 96 x 96 (measured: trig4 first,
-// power4 13th of 102). The full-size result (1000 sets, six scenes, 128 x 128) is in
-// docs/results.md: trig4 3rd, power4 46th of 1002.
+// power4 13th of 102). The full-size run (`msm evaluate`: 1000 sets, six scenes, 128 x 128) ranks
+// trig4 3rd, power4 46th of 1002.
 TEST(Run, PowerAndTrigonometricMomentsRankHigh) {
   const auto comm = single_process();
   RunSettings s;
@@ -156,8 +156,8 @@ TEST(Run, PowerAndTrigonometricMomentsRankHigh) {
   EXPECT_LE(rank(1), 5) << "trig4";   // the best 5%
   EXPECT_LE(rank(0), 20) << "power4"; // the best 20%
   // LPs that neither GridLp nor GLPK solve count as leaking (run.h); they must stay rare: 5 of
-  // 2.5e5 LPs here with the view-fitted stacks (0 before), 126 of 1.1e7 in the large run of
-  // docs/results.md. Allowed: 1 in 10^4 of the LPs, and at most one per candidate.
+  // 2.5e5 LPs here with the view-fitted stacks, 126 of 1.1e7 in the full-size run. Allowed: 1 in
+  // 10^4 of the LPs, and at most one per candidate.
   std::int64_t lps = 0, failures = 0;
   for (const CandidateResult& r : run.results) {
     lps += r.lps(), failures += r.failures();

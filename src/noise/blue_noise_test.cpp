@@ -23,7 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bounds every blue-noise channel must meet and the controls must break (blue_noise_measures.h has the
-// definitions; the measured values are in docs/results.md, "Blue noise").
+// definitions; the measured values are printed; docs/results.md, "Blue noise").
 constexpr double kMaxLowToHigh = 0.01;            // white noise: ~1; ours: ~2e-4
 constexpr double kMaxLowToHighTiled = 5e-4;       // what our tileable textures reach (max 3e-4 at 64²)
 constexpr double kMaxAnisotropy64 = 0.2;          // any isotropic noise at 64²: ~0.08 (periodogram scatter)

@@ -465,13 +465,13 @@ void expect_sky_plane_energy(int first, bool horizon_split, Bound bound) {
 }
 
 // Measured on the sky (32² faces), worst relative error over the three normals, with the lights'
-// direction the region's mean direction (msm_region_mean_direction; before, with Eq. (9)'s
-// centroid on the face plane, in brackets; docs/results.md, "The sphere's centroid"): 76.0% at 1
+// direction the region's mean direction (msm_region_mean_direction; with Eq. (9)'s centroid on the
+// face plane in brackets; docs/results.md, "The sphere's centroid"): 76.0% at 1
 // light [77.9%], 44.7% at 2 [44.7%], 18.9% at 3 [19.0%], 5.2% at 4 [4.7%], 11.8% at 5 [11.9%],
 // 11.6% at 6 [11.7%] (groups of faces, one light standing for the sun and a sixth of the sky: the
 // +Z plane sees that sky, not the sun), 2.6% at 7–10, 1.26% at 11–12, and within 1% from 13 on:
-// 0.68% at 16 [0.53%], 0.02% at 32 [1.11%], 0.03% at 64 [0.35%] (before: 35 of the 256 counts
-// over 1%, up to 2.0% at 21). Asserted: the 1% from 13 lights on, 1.5x the measured error
+// 0.68% at 16 [0.53%], 0.02% at 32 [1.11%], 0.03% at 64 [0.35%] (Eq. (9)'s centroid: 35 of the 256
+// counts over 1%, up to 2.0% at 21). Asserted: 1% from 13 lights on, 1.5x the measured error
 // below.
 TEST(Environment, AreaLightsKeepThePlanesIrradianceForEveryCount) {
   const std::map<int, double> measured = {{1, 0.760},  {2, 0.447},   {3, 0.190},   {4, 0.0516},
@@ -548,8 +548,8 @@ void expect_studio_plane_energy(int first, int last, const char* what, LightsOf 
 // lights. Measured: within 1% at every count from 62 on for all eight (the last over 1%: studio 61
 // lights, 1.45%); at 16–61 lights up to 6% (studio), regions that straddle a plane's horizon being
 // uniform rectangles where the probe is not: 300 of the 8 x 256 (probe, count) cases over 1%
-// (before, with Eq. (9)'s centroid: 414, the last at 83 lights, city; docs/results.md). Asserted:
-// the 1% from 64 lights on.
+// (with Eq. (9)'s centroid: 414, the last at 83 lights, city). Asserted: 1% from 64 lights
+// on.
 TEST(Environment, AreaLightsKeepTheStudioProbesIrradianceFromSixtyFourLights) {
   expect_studio_plane_energy(64, 256, "no sub-lights", [](const msm::probe::ProbeTables& tables, int count) {
     std::vector<msm::scene::DirectionalLight> lights;

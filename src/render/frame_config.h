@@ -38,7 +38,7 @@ struct FrameConfig {
   // Whether any draw of the scene reads an albedo or opacity texture (ObjectPush::flags x, z): a
   // specialization constant of the shading (shading.glsl, kTexturedDraws), as lavapipe fetches the
   // textures under a branch on the draw's flags for untextured draws too (MSM-64's forward shading
-  // on the fence: 14% of its instructions, docs/results.md).
+  // on the fence: 14% of its instructions, scripts/callgrind-passes.sh).
   bool textured_draws = true;
   // Whether any light of the frame has sub-lights (scene::DirectionalLight::sub_lights): the
   // shading's kSubLights (shading.glsl), which sums them for the light's unshadowed irradiance.
@@ -48,10 +48,10 @@ struct FrameConfig {
   // with resampling_moments()), and rectify samples it trilinearly (rectify.glsl).
   bool filtered_resampling = false;
   uint32_t resampling_mips = 1; // of that map (1: no mips, where the device cannot blit RGBA32F)
-  // Prefiltered scattering, parameter resampling = bilinear-moments: the earlier on-the-fly filter of rectify (a bilinear
+  // Prefiltered scattering, parameter resampling = bilinear-moments: an on-the-fly filter of rectify (a bilinear
   // sample of the depth map's texels' moments). A specialization constant of rectify, as lavapipe
   // runs both sides of a branch on a uniform: the unfiltered resampling paid for this path (16-20%
-  // of the pass, docs/results.md).
+  // of the pass, scripts/callgrind-passes.sh).
   bool on_the_fly_resampling = false;
   // Prefiltered scattering: K transmittance layers (rectification.h; parameter layers): K prefix
   // sums per light with the steps Δ_k, mixed per pixel at its own Δ; 1 = the paper's Δ(v) per row.
@@ -106,9 +106,9 @@ inline uint32_t full_mip_chain(int size) { return uint32_t(std::bit_width(uint32
 
 // Names of the frame's images (the frame graph's resources).
 // Prefiltered scattering's transmittance layers when the technique's parameter layers is 0: the paper's
-// single Δ(v). 4 layers have 0.4-0.6x its error on the tower and the gate, but on lavapipe they make
-// the scattering pass 1.4-2x as costly, below the 10x margin to ray marching (docs/results.md,
-// "Single scattering: transmittance layers").
+// single Δ(v). 4 layers have 0.4-0.7x its error on the tower and the gate (rows +layers of
+// scattering.*), but on lavapipe they make the scattering pass 1.4-2x as costly, below the 10x
+// margin to ray marching (docs/results.md, "Single scattering: transmittance layers").
 inline constexpr int kDefaultTransmittanceLayers = 1;
 inline constexpr const char* kShadowDepth = "shadow_depth";
 inline constexpr const char* kShadowDepthBack = "shadow_depth_back"; // FrameConfig::front_back

@@ -1,6 +1,7 @@
 // The renderer against the ray-traced ground truth (msm::reference) on the built-in scenes:
 // the two agree on geometry (what is visible where) and on where shadow edges are, and every
-// technique's error against the ground truth is bounded. Prints the table of docs/results.md.
+// technique's error against the ground truth is bounded. Records each MAE as
+// ground_truth.filtered.SCENE.TECHNIQUE.mae.
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 #include "msm/techniques.h"
@@ -144,8 +145,8 @@ TEST_F(GroundTruthTest, PcfAgreesWithTheRayTracedFilteredShadow) {
   }
 }
 
-// Every technique against the ground truth: MAE and light leaking per scene (the table of
-// docs/results.md), each MAE within mae_bound of its measured value.
+// Every technique against the ground truth: MAE and light leaking per scene (printed; the MAE
+// recorded as ground_truth.filtered.*), each MAE within mae_bound of its measured value.
 TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
   std::map<std::string, std::map<std::string, image::Metrics>> table;
   for (std::size_t i = 0; i < kHardShadowScenes.size(); ++i) {

@@ -72,34 +72,22 @@ scene::Scene with_lights(const std::string& name, int count, const std::string& 
 
 const std::string kStudioLights = "/usr/share/blender/datafiles/studiolights/world/";
 
-// Measured margins (docs/results.md): MAE(256 hard point lights) − MAE(32 lights, mssm6) and
+// Measured margins (recorded as ordering.ibl.*): MAE(256 hard point lights) − MAE(32 lights, mssm6) and
 // MAE(mssm4) − MAE(mssm6) at 16 lights; asserted at half their measured size. The truth's noise at
 // these sample counts moves them far less: over seeds 1-3 the first spread by 6e-5, the second by
-// 1e-6 (msm reference and msm compare, 160x90). The new probes' values are this test's own
-// measurements (256-sample truth): under interior.exr the first was 0.0008 here and 0.0004-0.0005
-// against 1024-sample truths of two seeds (scripts/ibl-compare.sh), a narrow ordering (now 0.0010
-// here, below).
+// 1e-6 (msm reference and msm compare, 160x90). The studio probes' values are this test's own
+// measurements (256-sample truth): under interior.exr the first is 0.0004-0.0005 against
+// 1024-sample truths of two seeds (scripts/ibl-compare.sh), a narrow ordering.
 // area_over_points 0: not asserted (on city_probe's plain cut, under city.exr and courtyard.exr,
-// the 256 point lights are closer, docs/results.md; with the rectangles shaded as rectangles at the
-// horizon they still are). Re-measured here after that change (before -> after, the
-// bounds kept): sky_probe 0.0042 -> 0.0042 and 0.0006 -> 0.0007, city_probe - and 0.0013 ->
-// 0.0012, interior.exr 0.0010 -> 0.0006 and 0.0006 -> 0.0008, courtyard.exr - and 0.0042 -> 0.0043.
-// And after the lights' direction became the region's mean direction (msm_region_mean_direction;
-// before -> after, the bounds kept): sky_probe 0.0042 -> 0.0043 and 0.0007 -> 0.0007, city_probe -
-// and 0.0012 -> 0.0013, interior.exr 0.0006 -> 0.0005 and 0.0008 -> 0.0007, courtyard.exr - and
-// 0.0043 -> 0.0041.
-// And after the soft techniques took the least bias for the receiver's plane (msm_soft_plane_bias,
-// soft.h; before -> after, re-measured here, the values below): sky_probe 0.0043 -> 0.0048 and
-// 0.0007 -> 0.0003, city_probe - and 0.0013 -> 0.0010, interior.exr 0.0005 -> 0.0010 and 0.0006 ->
-// 0.0003, courtyard.exr - and 0.0042 -> 0.0011; city_probe with the horizon split (new) 0.0006
-// (0.0005 with the mean's shift) and 0.0009. Every MAE fell; MSSM4's the most (its bound needs a
-// bias of σ, MSSM6's sqrt(m4/m2)), so the six-over-four margins narrowed: the ordering holds
-// everywhere, by less.
+// the 256 point lights are closer, with the rectangles shaded as rectangles at the horizon too).
+// The least bias for the receiver's plane (msm_soft_plane_bias, soft.h) lowers MSSM4's MAE more
+// than MSSM6's (its bound needs a bias of σ, MSSM6's sqrt(m4/m2)), so the six-over-four margins are
+// narrow: the ordering holds everywhere, by little.
 // pcss_over_points: the same with the 32 area lights rendered by PCSS, as the paper's Figure 2
 // renders them (Kneiphof §6: "the extracted area lights are rendered using PCSS"); measured here
 // (256-sample truth): sky_probe 0.01143 − 0.00643, city_probe split 0.00736 − 0.00599, under
-// interior.exr 0.00987 − 0.00779; with city.exr's plain cut and under courtyard.exr PCSS loses too
-// (docs/results.md), not asserted there.
+// interior.exr 0.00987 − 0.00779; with city.exr's plain cut and under courtyard.exr PCSS loses too,
+// not asserted there.
 struct Expected {
   double area_over_points, six_over_four, pcss_over_points = 0.0;
 };
@@ -145,8 +133,8 @@ TEST_F(IblTest, SkyProbeOrderings) { check_orderings(ctx(), "sky_probe", {0.0048
 TEST_F(IblTest, CityProbeOrderings) { check_orderings(ctx(), "city_probe", {0.0, 0.0010}); }
 // city_probe with the horizon split (docs/techniques.md): its 32 area lights beat the 256 point
 // lights since the soft techniques take the least bias for the receiver's plane (docs/results.md,
-// "The least bias for the receiver's plane"; before, they lost by 0.0007 against ibl-compare's
-// 1024-sample truths).
+// "The least bias for the receiver's plane"; with JCGT's bias they lose by 0.0007 against
+// ibl-compare's 1024-sample truths).
 TEST_F(IblTest, CityProbeWithTheHorizonSplitOrderings) {
   check_orderings(ctx(), "city_probe", {0.0006, 0.0009, 0.0013}, "", true);
 }
@@ -178,10 +166,10 @@ TEST_F(IblTest, ModelsUnderCityOrderings) {
   check_orderings(ctx(), "models", {0.0, 0.0005, 0.0017}, kStudioLights + "city.exr");
 }
 
-// A wide PCSS kernel under many lights keeps the image's brightness. While the light count was a
-// uniform loop bound, lavapipe recompiled the shading at every bind with the frame's values
+// A wide PCSS kernel under many lights keeps the image's brightness. With the light count a
+// uniform loop bound, lavapipe recompiles the shading at every bind with the frame's values
 // inlined (docs/results.md, "CPU-side costs"), and with 64 lights and a 31-texel kernel the image
-// came out 0.128 darker on average than with 7 (city_probe, 160x90, 256²; under courtyard.exr:
+// comes out 0.128 darker on average than with 7 (city_probe, 160x90, 256²; under courtyard.exr:
 // 0.21). With the count a specialization constant: 0.0002. The cause in
 // the driver was not isolated; this holds the result.
 TEST_F(IblTest, WidePcssKernelUnderManyLightsKeepsTheBrightness) {

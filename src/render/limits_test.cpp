@@ -32,7 +32,7 @@ std::string limit_message(auto&& f) {
 
 TEST(Limits, TheHeaviestRenderTriedStaysWithinTheDefaults) {
   // `msm render --scene fence -t msm6-192 --shadow-size 8192` peaks at 4.9 GB on lavapipe (device
-  // memory is host memory there; docs/results.md): the estimate must be of that order (within 25%)
+  // memory is host memory there): the estimate must be of that order (within 25%)
   // and within the limit, or the limit refuses what works.
   const std::uint64_t bytes = render::estimated_bytes(heaviest_working_render(), 410, 1);
   EXPECT_GT(double(bytes), 0.75 * 4.9e9);

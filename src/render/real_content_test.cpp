@@ -2,7 +2,7 @@
 // Stanford bunny, the Khronos 2CylinderEngine of assimp-testmodels, found through CMake-configured
 // paths; missing models fail the test) and a 1 m box on a 500 m ground. PCF's error there must stay
 // within twice its error on the built-in scenes, measured here with the same settings; the tables
-// of docs/results.md are printed.
+// are printed.
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 

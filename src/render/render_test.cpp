@@ -48,8 +48,8 @@ image::Image visibility(const RenderResult& r) { return r.shadow.channel("visibi
 image::Image background(const RenderResult& r) { return r.shadow.channel("background"); }
 
 // The error of each technique against PCF on each built-in scene at the settings of small(), as
-// measured on lavapipe after issues 12, 13 and 19 (docs/results.md, "Renderer: every technique
-// against PCF and the ray-traced ground truth", the table "Against PCF"): MAE and the share of
+// measured on lavapipe (docs/results.md, "Renderer: every technique against PCF and the
+// ray-traced ground truth"; the leaking orderings are recorded as ordering.leaking.*): MAE and the share of
 // pixels more than 3% off, per scene in the order of kHardShadowScenes.
 struct Measured {
   double mae, share_above_3pct;

@@ -3,8 +3,8 @@
 // the margin measured on lavapipe. The signal is the visible fraction of each view ray (the
 // renderer's `visible_fraction`, the reference's `visibility`): the in-scattered radiance over the
 // ray's maximal scattering f E ∫₀ˢ exp(−σt t) dt, so that "off by > 3% of the maximal scattering"
-// is a difference above 0.03. Prints the table of docs/results.md, "Single scattering against the
-// ground truth".
+// is a difference above 0.03. Records the table scattering.* of docs/results.md ("Single scattering
+// against the ground truth").
 #include "msm/reference/reference.h"
 #include "msm/render/renderer.h"
 

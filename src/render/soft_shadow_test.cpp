@@ -821,7 +821,7 @@ namespace {
 // and back-face depth (a second depth pass culling the faces towards the light). Against the
 // ray-traced area light (240x135, 512²), per scene and light: plain, averaged, and averaged without
 // the constant depth bias (--depth-bias 0: the paper drops the bias; the receiver plane's slope term
-// of soft.h stays). Measured on lavapipe (docs/results.md); each bound as expect_near_measured (1.5x
+// of soft.h stays). Measured on lavapipe; each bound as expect_near_measured (1.5x
 // the measured MAE, at least +0.002). Asserted besides: the averaged map changes the image (the
 // back-face pass is in effect: had it culled the wrong side, it would draw the front faces again and
 // every pixel would be equal), and a technique that reads no moment map refuses the setting.

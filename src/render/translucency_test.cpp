@@ -213,7 +213,7 @@ TEST_F(TranslucencyTest, AlphaThresholdAgainstManyFaintLayers) {
     // With the threshold every layer is discarded: the map is that of the ground alone (lit up
     // to the moment bias). Without it the blends are kept and land near the truth: the failure
     // the paper guards against (drift of 16-bit moments under many faint blends) did not show
-    // here, at 40 layers, nor in a wider search (docs/results.md): 100-300 layers of opacity
+    // here, at 40 layers, nor in a wider search: 100-300 layers of opacity
     // 0.2-0.9% 0.5 mm to 2 cm apart, where 16-bit MSM stays within 5e-4 of float MSM without the
     // threshold, and the smoke scene, whose MAE it changes by 1e-4.
     EXPECT_NEAR(v_with, 1.0, 0.01);
@@ -224,7 +224,7 @@ TEST_F(TranslucencyTest, AlphaThresholdAgainstManyFaintLayers) {
 // JCGT Fig. 5: the smoke scene against the ray-traced transmittance (opacity noise sampled the
 // same way by both), on the opaque surfaces: every technique's error and leaking, with the
 // receiver-plane bias (RenderSettings::receiver_plane_bias = 1) and without it (the default), are
-// printed (docs/results.md). The side wall is lit at 77° incidence and seen at a grazing angle
+// printed. The side wall is lit at 77° incidence and seen at a grazing angle
 // from the camera, so its lookups read coarse mips: the kernel spans a wide range of the wall's own
 // depths, and without the bias the moment techniques shadow the wall with itself (MSM 64:
 // over-darkening 0.025, MAE 0.043 against VSM's 0.032). Asserted with the bias, as JCGT Fig. 5

@@ -59,7 +59,7 @@ class SatBuilder {
     subgroup_rows_then_columns,
     // subgroup_rows_then_columns whose column pass is the same subgroup scan down each column (its
     // lanes a row pitch apart: no coalescing on a GPU; measured against the thread-per-column pass
-    // on lavapipe, docs/results.md). Same fallback and timer scopes.
+    // on lavapipe, msm_sat_timing). Same fallback and timer scopes.
     subgroup_rows_and_columns,
   };
 

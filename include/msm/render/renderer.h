@@ -99,7 +99,8 @@ struct RenderSettings {
   // 6MSM: √3, EVSM4: c⁻σ²/2, VSM/ESM: 0), times this factor, on top of depth_bias. 1 removes the
   // self-shadowing of sloped receivers (grazing light, coarse mips); it also loses short-range
   // shadows of occluders closer than the bias (the railing: leaking x1.6-2), hence off (0) by
-  // default: at mip 0 the 16-bit maps' moment bias already absorbs most of it (docs/results.md).
+  // default: at mip 0 the 16-bit maps' moment bias already absorbs most of it (docs/results.md,
+  // "Translucent occluders").
   float receiver_plane_bias = 0.0f;
   float exposure = 1.0f;
   // How the shading reads a filtered map: automatic = dither for the non-linear techniques (HPG),
@@ -147,7 +148,7 @@ struct RenderSettings {
   bool front_back_depth = false;
   // Prefiltered scattering's transmittance-weighted prefix sums along the rectified rows (JCGT
   // §5.1.1): rows = one thread per row walks it once, each texel read and written once (on lavapipe
-  // 3.6-6.8x faster than the other, docs/results.md); appendix_c = the paper's Appendix C, 8 x 8 threads,
+  // 3.6-6.8x faster than the other, msm bench --scattering); appendix_c = the paper's Appendix C, 8 x 8 threads,
   // eight threads per row each summing the whole row so that a block's writes coalesce. The same
   // sums in the same order: the images agree (ScatteringTest.PrefixSumSchemesAgree).
   enum class PrefixSums { rows, appendix_c } prefix_sums = PrefixSums::rows;
@@ -155,7 +156,7 @@ struct RenderSettings {
   // pass at the level of the pixel's smaller footprint along or across the rows (msm_prefix_sum_lod),
   // against the aliasing of thin shafts where neighbouring pixels skip rows; where the device can
   // blit and filter the storage formats (else none). Off by default: little gain measured
-  // (docs/results.md).
+  // (docs/results.md, "Prefix sums: a thread per row; App. D.5's mips").
   bool prefix_sum_mips = false;
   int soft_kernel = 0;
   int resolved_soft_kernel() const; // soft_kernel or the technique's default

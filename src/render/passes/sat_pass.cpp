@@ -21,7 +21,8 @@ void SatPass::reflect(PassBuilder& b) const {
 }
 
 void SatPass::execute(const PassContext& c) const {
-  // Rows then columns: on lavapipe 3-7x faster than the block scheme (docs/results.md). Every layer
+  // Rows then columns: on lavapipe several times faster than the block scheme (docs/results.md,
+  // "Integer summed-area tables"). Every layer
   // (light) of every image in one record(), so the row passes run side by side.
   std::vector<gpu::SatImage> moments, tables;
   for (int l = 0; l < config_.lights; ++l)

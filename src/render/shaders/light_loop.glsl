@@ -3,7 +3,7 @@
 // The frame's lights (FrameConfig::lights): a specialization constant, not frame.lights.x, because
 // lavapipe (Mesa 22.3) re-optimizes and recompiles a shader at every bind whose loop bound is a
 // uniform (it inlines the value to unroll the loop): about 0.8 s per frame of MSM-64 shading with
-// Mesa's shader cache off, and a cache lookup per frame with it on (docs/results.md).
+// Mesa's shader cache off, and a cache lookup per frame with it on (docs/results.md, "CPU-side costs").
 layout(constant_id = MSM_SPEC_LIGHT_COUNT) const int kLightCount = 1;
 const bool kOneLight = kLightCount == 1;
 

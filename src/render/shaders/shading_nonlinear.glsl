@@ -15,7 +15,7 @@ layout(binding = MSM_BINDING_SHADING_SHADOW_MAP1) uniform sampler2DArray unused_
 // The lookup compiled in (kLookup, frame.glsl): llvmpipe executes both sides of a branch on a
 // uniform under a mask, so with the branch the nearest and dithered lookups paid for the four
 // decodes and Φ of the bilinear one (1416 instructions per pixel of NL64 shading instead of 645,
-// docs/results.md).
+// scripts/callgrind-passes.sh).
 const bool kBilinearLookup = kLookup == MSM_LOOKUP_BILINEAR;
 
 NonLinearMoments decode(ivec2 i) {
