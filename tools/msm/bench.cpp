@@ -830,6 +830,21 @@ void write_technique_results(const BenchOptions& opt, vk::Context& ctx, const sc
   write_results(opt, doc, md);
 }
 
+// The cascades' depth bounds (the camera's depth pre-pass and its reduction) against the whole
+// frame, where the frame has them.
+std::optional<nlohmann::json> depth_bounds_json(const std::vector<std::vector<render::PassTime>>& frames) {
+  if (!std::ranges::any_of(frames[0], [](const render::PassTime& p) { return p.name == "depth_bounds"; }))
+    return std::nullopt;
+  std::vector<std::string> all; // every pass of the frame, the depth bounds included
+  for (const render::PassTime& p : frames[0]) all.push_back(p.name);
+  const Stats bounds = pass_sum(frames, {"depth_bounds"}), frame = pass_sum(frames, all);
+  return nlohmann::json{{"median_ms", bounds.median},
+                        {"p10_ms", bounds.p10},
+                        {"p90_ms", bounds.p90},
+                        {"frame_ms", frame.median},
+                        {"share_of_frame", bounds.median / frame.median}};
+}
+
 void add_bench(CLI::App& app) {
   auto opt = std::make_shared<BenchOptions>();
   auto* cmd = app.add_subcommand("bench", "GPU time per pass, and each technique's cost relative to PCF (shading per "
@@ -909,16 +924,7 @@ void add_bench(CLI::App& app) {
         per_unit[name]["shading " + key] = ns;
         entry["shading"][key] = {
             {"median_ms", st.median}, {"p10_ms", st.p10}, {"p90_ms", st.p90}, {"ns_per_pixel", ns}};
-        if (std::ranges::any_of(frames[0], [](const render::PassTime& p) { return p.name == "depth_bounds"; })) {
-          std::vector<std::string> all; // every pass of the frame, the depth bounds included
-          for (const render::PassTime& p : frames[0]) all.push_back(p.name);
-          const Stats bounds = pass_sum(frames, {"depth_bounds"}), frame = pass_sum(frames, all);
-          entry["depth_bounds"][key] = {{"median_ms", bounds.median},
-                                        {"p10_ms", bounds.p10},
-                                        {"p90_ms", bounds.p90},
-                                        {"frame_ms", frame.median},
-                                        {"share_of_frame", bounds.median / frame.median}};
-        }
+        if (std::optional<nlohmann::json> bounds = depth_bounds_json(frames)) entry["depth_bounds"][key] = *bounds;
         if (scatters) { // the deferred pass alone (the prefiltered maps: per texel below)
           Stats sc = pass_sum(frames, {"scattering"});
           entry["scattering"][key] = {{"median_ms", sc.median},

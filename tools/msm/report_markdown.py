@@ -65,15 +65,15 @@ def variant_heading(first, variant):
 
 
 def variants_lines(first, variants):
-    """Rows of the first one's scene, effect and techniques with another light, output or map size: MAE and
-    time per row."""
+    """Rows of the first one's scene, effect and techniques with another light, output or map size: MAE, light
+    leaking and time per row."""
     lines = [f"**{first['scene']}**, {first['truth']['effect']}, the same techniques in rows "
-             + ", ".join(f"`{v['id']}`" for v in variants) + ": MAE / GPU ms per frame:", "",
+             + ", ".join(f"`{v['id']}`" for v in variants) + ": MAE / light leaking / GPU ms per frame:", "",
              "| technique | " + " | ".join(variant_heading(first, v) for v in variants) + " |",
              "|---|" + "--:|" * len(variants)]
     for i, t in enumerate(first["techniques"]):
-        cells = [f"{v['techniques'][i]['metrics']['mae']:.4f} / {v['techniques'][i]['gpu_ms_total']:.1f}"
-                 for v in variants]
+        cells = [f"{v['techniques'][i]['metrics']['mae']:.4f} / {v['techniques'][i]['metrics']['light_leaking']:.4f}"
+                 f" / {v['techniques'][i]['gpu_ms_total']:.1f}" for v in variants]
         lines.append(f"| {t['name']} | " + " | ".join(cells) + " |")
     return lines
 
