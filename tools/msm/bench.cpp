@@ -3,7 +3,7 @@
 // map (depth, resolve, blur, mips) per texel at the given sizes. JSON and a markdown table.
 // `--scattering`: the scattering techniques alone (JCGT §5): the scattering pass per pixel against
 // ray marching, the rectified map's passes per texel against a copy of the same bytes, timed by the
-// host clock on a CPU device, whose compute timestamps are not the passes' time (results.md).
+// host clock on a CPU device, whose compute timestamps are not the passes' time (docs/techniques.md).
 // `--light-kinds`: the scene under one light of each kind (light_kinds.h), each kind's shadow map
 // and shading against the directional light's at the same texel count.
 // `--against-one-map`: cascades of each shadow size against one map of the same total texels,
@@ -75,7 +75,7 @@ const std::vector<std::string> kShadowMapPasses = {"shadow_depth", "moment_resol
 //    and the wait cancel);
 //  - timestamps: a timer scope around the copy, as the frame's passes are timed;
 //  - timestamps_flushed: the same with a pipeline barrier right after the scope's begin.
-// On lavapipe only the first two agree with each other when the third does (results.md: llvmpipe
+// On lavapipe only the first two agree with each other when the third does (docs/techniques.md: llvmpipe
 // writes a timestamp when the binned scene it was put in is rasterized, at the next flush; a
 // compute dispatch or a copy runs on the spot, before it, unless a barrier flushes it first).
 struct CopyTimes {
@@ -886,7 +886,7 @@ void add_bench(CLI::App& app) {
     }
     const std::vector<std::string>& shadow_passes = kShadowMapPasses;
     // The rectified map's compute passes and the copy: on a CPU device (lavapipe) their timestamps
-    // are not the time they take (results.md), so there the host clock times them.
+    // are not the time they take (docs/techniques.md), so there the host clock times them.
     const bool host_clock = ctx->info().type == VK_PHYSICAL_DEVICE_TYPE_CPU;
 
     const bool tty = isatty(fileno(stderr));
