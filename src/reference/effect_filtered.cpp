@@ -108,6 +108,7 @@ EffectResult filtered_local_visibility(const EffectContext& ctx, const SurfaceHi
   const double r0 = glm::length(from_light);
   const LocalMap map = local_map(light, from_light, ctx.settings.shadow_size);
   const double along = glm::dot(from_light, map.forward);
+  if (!(along > 0.0)) return EffectResult{}; // the light on the surface: lit, as the hard effect has it
   const glm::dvec2 uv0(glm::dot(from_light, map.right) / along, glm::dot(from_light, map.up) / along);
   const double plane = glm::dot(from_light, n); // the tangent plane: dot(x − position, n) = plane
   const double slope_limit = double(MSM_MAX_RECEIVER_DEPTH_SLOPE) * double(light.range);

@@ -120,7 +120,13 @@ TEST(LocalLightsReference, ALightOnTheSurfaceOrInsideAMeshGivesNoNaN) {
   const Result inside = trace(scene_with(R"({"type": "point", "position": [0, 1, 0], "intensity": [8, 8, 8]})",
                                          R"(, {"primitive": {"type": "box", "size": [0.5, 0.5, 0.5]},
                                                "transform": {"translate": [0, 1, 0]}})"));
-  for (const Result* r : {&on, &inside})
+  Settings filtered;
+  filtered.effect = Effect::filtered;
+  filtered.width = filtered.height = kSide;
+  filtered.samples = 16;
+  const Result on_filtered =
+      render(scene_with(R"({"type": "point", "position": [0, 0, 0], "intensity": [8, 8, 8]})"), filtered);
+  for (const Result* r : {&on, &inside, &on_filtered})
     for (int y = 0; y < kSide; ++y)
       for (int x = 0; x < kSide; ++x)
         for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(r->radiance.at(x, y, c))) << x << ", " << y;
