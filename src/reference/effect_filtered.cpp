@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "internal.h"
+#include "msm/cube_face.h"
 #include "msm/render/frame.h"
 
 namespace msm::reference::detail {
@@ -54,6 +55,80 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
     for (int k = 0; k < n; ++k) dirs[k] = ctx.towards_light;
     ctx.tracer.occluded(origins, dirs, n, blocked);
     for (int k = 0; k < n; ++k) stats.add(blocked[k] ? 0.0 : 1.0);
+  }
+  return monte_carlo_result(stats);
+}
+
+namespace {
+
+// A local light's map about the receiver's direction: its axes (the map's plane at unit distance
+// along `forward`, coordinates the tangents along `right` and `up`) and one texel in tangents.
+struct LocalMap {
+  glm::dvec3 forward{0.0}, right{0.0}, up{0.0};
+  double texel = 0.0;
+};
+
+// A spot's perspective map over its outer cone (the renderer's spot_light_uniforms: a look-at
+// along its direction, 2 tan(outer) / size per texel). A point light's cube face that holds the
+// receiver's direction over its 90-degree part, 2 / size per texel, and the kernel continues on
+// that face's plane past the seam: what the renderer's guard band approximates (its faces are a
+// few texels wider, so its texel is g = msm_cube_face_half_width times this one; the ideal map is
+// the one without a seam, whose texel does not depend on the technique's guard band).
+LocalMap local_map(const scene::LocalLight& light, const glm::dvec3& from_light, int shadow_size) {
+  LocalMap m;
+  if (light.spot()) {
+    m.forward = glm::normalize(glm::dvec3(light.direction));
+    const glm::dvec3 up = std::abs(m.forward.y) > 0.99 ? glm::dvec3(0.0, 0.0, 1.0) : glm::dvec3(0.0, 1.0, 0.0);
+    m.right = glm::normalize(glm::cross(m.forward, up));
+    m.up = glm::cross(m.right, m.forward);
+    m.texel = 2.0 * std::tan(glm::radians(double(light.outer_cone_deg))) / shadow_size;
+    return m;
+  }
+  const int face = msm_cube_face(glm::vec3(from_light));
+  m.forward = glm::dvec3(msm_cube_face_forward(face));
+  m.up = glm::dvec3(msm_cube_face_up(face));
+  m.right = glm::dvec3(msm_cube_face_right(face));
+  m.texel = 2.0 / shadow_size;
+  return m;
+}
+
+} // namespace
+
+// The filtered effect's definition in a spot's or point light's own map. The kernel's offset o
+// (texels) moves the light ray's point on the map's plane by o texels; the receiver's depth along
+// that ray is where it meets the receiver's tangent plane (n_s), the exact plane rather than the
+// renderer's first-order extrapolation of the radial depth, which agrees with it to first order in
+// o; like the renderer's, the plane's radial distance changes by at most
+// MSM_MAX_RECEIVER_DEPTH_SLOPE × range per texel along each axis, which also bounds a plane the
+// ray meets at grazing incidence or not at all. V_o: nothing between that point and the light
+// (a segment, not a ray to infinity), beyond the receiver plane's tolerance as for directional.
+EffectResult filtered_local_visibility(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n,
+                                       const scene::LocalLight& light, Rng& rng) {
+  const glm::dvec3 position(light.position), from_light = hit.p - position;
+  const double r0 = glm::length(from_light);
+  const LocalMap map = local_map(light, from_light, ctx.settings.shadow_size);
+  const double along = glm::dot(from_light, map.forward);
+  if (!(along > 0.0)) return EffectResult{}; // the light on the surface: lit, as the hard effect has it
+  const glm::dvec2 uv0(glm::dot(from_light, map.right) / along, glm::dot(from_light, map.up) / along);
+  const double plane = glm::dot(from_light, n); // the tangent plane: dot(x − position, n) = plane
+  const double slope_limit = double(MSM_MAX_RECEIVER_DEPTH_SLOPE) * double(light.range);
+  const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
+  RunningStats stats;
+  for (int i = 0; i < set.count(); ++i) {
+    const glm::dvec2 u = set.point(i, rng);
+    const glm::dvec2 o(ctx.kernel.sample(u.x), ctx.kernel.sample(u.y));
+    const glm::dvec2 uv = uv0 + o * map.texel;
+    const glm::dvec3 d = glm::normalize(map.forward + uv.x * map.right + uv.y * map.up);
+    const double reach = slope_limit * (std::abs(o.x) + std::abs(o.y));
+    const double towards_plane = glm::dot(d, n);
+    double r = towards_plane != 0.0 ? plane / towards_plane : std::numeric_limits<double>::infinity();
+    if (!(r > 0.0)) r = r0 + reach; // the plane lies behind the light along this ray
+    r = std::clamp(r, r0 - reach, r0 + reach);
+    const glm::dvec3 q = position + r * d;
+    const double tolerance =
+        kOffsetScale * std::max(hit.scale, point_scale(q)) + kReceiverPlaneTolerance * glm::length(q - hit.p);
+    const double length = r - tolerance; // from q, beyond the receiver's own surface, to the light
+    stats.add(length > 0.0 && ctx.tracer.occluded(q - tolerance * d, -d, length) ? 0.0 : 1.0);
   }
   return monte_carlo_result(stats);
 }

@@ -1,4 +1,4 @@
-// hard and soft over every light of a scene with spot or point lights: the visibility of each light
+// hard, soft, translucent and filtered over every light of a scene with spot or point lights: the visibility of each light
 // at the visible point (one shadow ray per light that lights it, or `samples` rays over its extent)
 // and the direct light they bring.
 #include <cmath>
@@ -57,6 +57,7 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
   const scene::Scene& scene = ctx.tracer.scene();
   const bool soft = ctx.settings.effect == Effect::soft;
   const bool translucent = ctx.settings.effect == Effect::translucent;
+  const bool filtered = ctx.settings.effect == Effect::filtered;
   const int samples = soft ? ctx.settings.samples : 1;
   const SampleSet set(ctx.settings.sampler, samples);
   // The geometric normal on the viewer's side: light from below it is blocked by the surface.
@@ -67,7 +68,8 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
   glm::dvec3 lit_sum{0.0};                                   // Σ_l lum(E_l) lit_l (per channel)
   double unoccluded_sum = 0.0;                               // Σ_l lum(E_l) lit0_l
   bool first = true;
-  const auto add = [&](const LightAtPoint& l) {
+  double filtered_variance = 0.0; // of Σ_l lum(E_l) lit_l, the lights' estimates independent
+  const auto add = [&](const LightAtPoint& l, const scene::LocalLight* local) {
     const double n_dot_l = glm::dot(n, l.towards);
     if (first) out.n_dot_l = n_dot_l;
     first = false;
@@ -107,6 +109,14 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
         lit += weight * c * t.channels;
         continue;
       }
+      if (filtered) { // the light's own filtered map (ctx.frame: the first directional light's)
+        const EffectResult f =
+            local ? filtered_local_visibility(ctx, hit, n, *local, rng) : effect_filtered(ctx, hit, rng);
+        out.rays += f.rays;
+        lit += weight * c * f.value;
+        filtered_variance += std::pow(luminance * weight * c * f.std_error, 2);
+        continue;
+      }
       ++out.rays;
       if (tfar > 0.0 && ctx.tracer.occluded(origin, d, tfar)) continue;
       lit += weight * c;
@@ -118,12 +128,16 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
     lit_sum += luminance * lit;
     unoccluded_sum += luminance * unoccluded;
   };
-  for (const scene::DirectionalLight& l : scene.lights) add(at_point(l, soft));
-  for (const scene::LocalLight& l : scene.local_lights) add(at_point(l, hit.p, soft));
+  for (const scene::DirectionalLight& l : scene.lights) add(at_point(l, soft), nullptr);
+  for (const scene::LocalLight& l : scene.local_lights) add(at_point(l, hit.p, soft), &l);
   out.visible_rgb = unoccluded_sum > 0.0 ? lit_sum / unoccluded_sum : glm::dvec3(0.0);
   // The mean, written so that three equal channels give exactly that value.
   const glm::dvec3& v = out.visible_rgb;
   out.visible = v.r + ((v.g - v.r) + (v.b - v.r)) / 3.0;
+  if (filtered) {
+    out.samples = ctx.settings.samples;
+    if (unoccluded_sum > 0.0) out.std_error = std::sqrt(filtered_variance) / unoccluded_sum;
+  }
   if (unoccluded_sum > 0.0 && samples > 1) {
     RunningStats stats;
     for (double v : per_sample) stats.add(v / unoccluded_sum);

@@ -10,12 +10,16 @@
 
 #include <gtest/gtest.h>
 
+#include "msm/filter.h"
+#include "msm/reference/kernel.h"
 #include "msm/reference/reference.h"
 #include "msm/scene/scene.h"
 
 namespace {
 
 using namespace msm::reference;
+using msm::MSM_FILTER_DEFAULT_SIGMA;
+using msm::MSM_FILTER_DEFAULT_TAPS;
 using msm::scene::Scene;
 
 constexpr double kPi = std::numbers::pi;
@@ -116,7 +120,13 @@ TEST(LocalLightsReference, ALightOnTheSurfaceOrInsideAMeshGivesNoNaN) {
   const Result inside = trace(scene_with(R"({"type": "point", "position": [0, 1, 0], "intensity": [8, 8, 8]})",
                                          R"(, {"primitive": {"type": "box", "size": [0.5, 0.5, 0.5]},
                                                "transform": {"translate": [0, 1, 0]}})"));
-  for (const Result* r : {&on, &inside})
+  Settings filtered;
+  filtered.effect = Effect::filtered;
+  filtered.width = filtered.height = kSide;
+  filtered.samples = 16;
+  const Result on_filtered =
+      render(scene_with(R"({"type": "point", "position": [0, 0, 0], "intensity": [8, 8, 8]})"), filtered);
+  for (const Result* r : {&on, &inside, &on_filtered})
     for (int y = 0; y < kSide; ++y)
       for (int x = 0; x < kSide; ++x)
         for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(r->radiance.at(x, y, c))) << x << ", " << y;
@@ -204,15 +214,105 @@ TEST(LocalLightsReference, TranslucentPanesBetweenTheLightAndTheGroundColourItsL
   EXPECT_NEAR(r.visibility.at(x, y, 0), 2.0 / 3.0, 1e-6);
 }
 
-TEST(LocalLightsReference, EffectsBeyondHardSoftTranslucentAndScatteringAreRefusedForLocalLights) {
-  const Scene scene = scene_with(kSpot);
-  for (Effect effect : {Effect::filtered}) {
-    Settings s;
-    s.effect = effect;
-    s.width = s.height = 8;
-    s.samples = 4;
-    EXPECT_THROW(render(scene, s), std::invalid_argument) << to_string(effect);
+// filtered: a thin occluder 1 m up covering z < 0, its edge along x through the light's axis; the
+// light 2 m above the plane. A receiver (x, 0, z) sees the edge at z / 2 in tangents of the map
+// facing down (its plane at unit distance, the edge's direction there at tangent 0), so its light
+// rays are blocked where z / 2 + o t < 0 (o the kernel's offset across the edge in texels, t the
+// texel in tangents) and the filtered visibility is the kernel's CDF K1(z / (2 t)) — for every x,
+// the edge being a line in the map.
+const std::string kEdgeOccluder = R"(, {"primitive": {"type": "box", "size": [40, 0.0002, 10]},
+    "transform": {"translate": [0, 1, -5]}})";
+
+Result trace_filtered(const Scene& scene, int shadow_size, int filter_size = MSM_FILTER_DEFAULT_TAPS) {
+  Settings s;
+  s.effect = Effect::filtered;
+  s.width = s.height = kSide;
+  s.samples = 1024;
+  s.shadow_size = shadow_size;
+  s.filter_size = filter_size;
+  return render(scene, s);
+}
+
+// The middle row sees z = 0; rows r > 10 see z = (r − 10) / 2.
+int row_at(double z) { return 10 + int(std::lround(2.0 * z)); }
+
+TEST(LocalLightsReference, FilteredSpotAcrossAStraightEdgeIsTheKernelsCdf) {
+  const Scene scene = scene_with(kSpot, kEdgeOccluder);
+  constexpr int kShadowSize = 8;
+  const double texel = 2.0 * std::tan(kPi / 4.0) / kShadowSize; // the spot's outer cone: 45°
+  const Result r = trace_filtered(scene, kShadowSize);
+  const FilterKernel kernel(MSM_FILTER_DEFAULT_TAPS, MSM_FILTER_DEFAULT_SIGMA);
+  for (double x : {-1.0, -0.5, 0.0, 0.5, 1.0}) // within the inner cone: one light, V its visibility
+    for (double z : {0.0, 0.5, 1.0}) {
+      const double expected = kernel.cdf(z / 2.0 / texel);
+      const float v = r.visibility.at(pixel(x), row_at(z), 0);
+      EXPECT_NEAR(v, expected, 0.01) << "x = " << x << ", z = " << z;
+      EXPECT_EQ(r.visibility.at(pixel(x), row_at(z), 2), 1024.0f);
+      std::printf("spot x %4.1f z %.1f: filtered %.4f, K1 %.4f\n", x, z, v, expected);
+    }
+}
+
+// A point light's faces meet at 45°: 2 m from the point below it (x = 2 relative to the light). The cube's -y face sees the edge
+// at z / 2 in its tangents, the +x face at z / x; the kernel continues on each face's plane across
+// the seam, so on both sides of it (x = 1.5, 2, 2.5, the seam within the kernel's reach) the
+// profile is that face's CDF, the two meeting at the seam. The range of 100 m lets the receiver
+// plane's radial distance change by 2 m per texel (the renderer's clamp, MSM_MAX_RECEIVER_DEPTH_SLOPE
+// of the range), more than the ground's does across these coarse texels near the seam.
+TEST(LocalLightsReference, FilteredPointLightEdgeAcrossACubeSeamHasOneProfile) {
+  const Scene scene =
+      scene_with(R"({"type": "point", "position": [-2, 2, 0], "range": 100, "intensity": [8, 8, 8]})", kEdgeOccluder);
+  constexpr int kShadowSize = 16;         // the kernel (±5 texels) stays below the ground's horizon
+  const double texel = 2.0 / kShadowSize; // the face's 90° part
+  const Result r = trace_filtered(scene, kShadowSize);
+  const FilterKernel kernel(MSM_FILTER_DEFAULT_TAPS, MSM_FILTER_DEFAULT_SIGMA);
+  for (double x : {1.5, 2.0, 2.5})
+    for (double z : {0.0, 0.5, 1.0}) {
+      const double along_axis = std::max(x, 2.0); // the face that holds (x, −2, z): −y up to x = 2, then +x
+      const double expected = kernel.cdf(z / along_axis / texel);
+      const float v = r.visibility.at(pixel(x - 2.0), row_at(z), 0); // the light 2 m to the left of x = 0
+      EXPECT_NEAR(v, expected, 0.01) << "x = " << x << ", z = " << z;
+      std::printf("point x %.1f z %.1f: filtered %.4f, K1 %.4f\n", x, z, v, expected);
+    }
+}
+
+// A kernel of one tap spreads over one bilinear tent (±1 texel); with a map of 4096 texels that is
+// 1 mm at the receivers, none of which lies that close to a shadow's edge: the filtered effect's
+// images are the hard effect's, exactly.
+TEST(LocalLightsReference, FilteredWithOneTapOfAFineMapIsTheHardShadow) {
+  const std::string box = R"(, {"primitive": {"type": "box", "size": [0.5, 0.5, 0.5]},
+      "transform": {"translate": [0, 1, 0]}})";
+  for (const std::string& light :
+       {std::string(R"({"type": "point", "position": [0, 2, 0], "intensity": [8, 8, 8]})"), kSpot}) {
+    SCOPED_TRACE(light);
+    const Scene scene = scene_with(light, box);
+    const Result filtered = trace_filtered(scene, 4096, 1), hard = trace(scene);
+    std::size_t shadowed = 0;
+    for (int y = 0; y < kSide; ++y)
+      for (int x = 0; x < kSide; ++x) {
+        ASSERT_EQ(filtered.visibility.at(x, y, 0), hard.visibility.at(x, y, 0)) << x << ", " << y;
+        for (int c = 0; c < 3; ++c)
+          ASSERT_EQ(filtered.radiance.at(x, y, c), hard.radiance.at(x, y, c)) << x << ", " << y;
+        shadowed += hard.visibility.at(x, y, 0) < 1.0f;
+      }
+    EXPECT_GT(shadowed, 0u);
   }
+  // A directional light beside the spot, nothing in the way: each light's filtered visibility is 1.
+  const Scene both = scene_with(R"({"towards_light": [0.3, 1, 0], "irradiance": [3, 3, 3]}, )" + kSpot);
+  const Result filtered = trace_filtered(both, 4096, 1), hard = trace(both);
+  for (int y = 0; y < kSide; ++y)
+    for (int x = 0; x < kSide; ++x)
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(filtered.radiance.at(x, y, c), hard.radiance.at(x, y, c)) << x << ", " << y;
+}
+
+TEST(LocalLightsReference, FilteredRefusesLocalLightsWithSeveralDirectionalLights) {
+  const Scene scene = scene_with(R"({"towards_light": [0, 1, 0], "irradiance": [3, 3, 3]},
+                                    {"towards_light": [0.3, 1, 0], "irradiance": [3, 3, 3]}, )" +
+                                 kSpot);
+  Settings s;
+  s.effect = Effect::filtered;
+  s.width = s.height = 8;
+  s.samples = 4;
+  EXPECT_THROW(render(scene, s), std::invalid_argument);
 }
 
 // An unshadowed beam: a spot 1 m above the camera's central ray, its axis straight down, a hard cone

@@ -155,16 +155,21 @@ scene::DirectionalLight first_light(const scene::Scene& scene) {
   return scene.lights.empty() ? scene::DirectionalLight{} : scene.light();
 }
 
-// Spot and point lights are traced by the hard, soft and translucent effects (trace_lights) and
+// Spot and point lights are traced by the hard, filtered, soft and translucent effects (trace_lights) and
 // the scattering effect (their in-scattering along the view rays, the surfaces' hard shadows), as
 // the scene declares them; std::invalid_argument for what else a scene with them asks.
 void check_local_lights(const scene::Scene& scene, const Settings& settings) {
   if (scene.local_lights.empty()) return;
   if (settings.effect != Effect::hard && settings.effect != Effect::soft && settings.effect != Effect::translucent &&
-      settings.effect != Effect::scattering)
+      settings.effect != Effect::scattering && settings.effect != Effect::filtered)
     throw std::invalid_argument(fmt::format("the {} effect traces directional lights only; a scene with spot or point "
-                                            "lights is traced by the hard, soft, translucent and scattering effects",
+                                            "lights is traced by the hard, filtered, soft, translucent and scattering "
+                                            "effects",
                                             to_string(settings.effect)));
+  // The filtered effect's directional map is the first directional light's frame (Scene::light_frame).
+  if (settings.effect == Effect::filtered && scene.lights.size() > 1)
+    throw std::invalid_argument("the filtered effect traces a scene with spot or point lights with at most one "
+                                "directional light");
   if (settings.light_extent_deg || settings.light_shape || settings.light_width_deg || settings.light_height_deg)
     throw std::invalid_argument("the light overrides (extent, shape, width, height) change a scene's one directional "
                                 "light; a scene with spot or point lights is traced as it declares its lights");

@@ -42,9 +42,16 @@
 //               = Σ lum(E_l) lit_l / Σ lum(E_l) lit0_l (lit0 unoccluded, the same samples). The
 //               translucent effect: one ray per light, V_l the transmittance per channel of the
 //               surfaces between p and the light (none beyond it), "visibility_rgb" the weighted
-//               mean per channel and "visibility" their mean. The filtered, scattering and
-//               environment effects, the light overrides and rectangular or probe lights with
-//               soft refuse such scenes (std::invalid_argument).
+//               mean per channel and "visibility" their mean. The filtered effect: V_l the
+//               light's filtered visibility (below), a spot's in its perspective map over the
+//               outer cone, a point light's in the cube face that holds p's direction, the kernel
+//               continuing on that face's plane across its seams (offsets o move the light ray's
+//               tangents by o times the texel: 2 tan(outer) / shadow_size, 2 / shadow_size), the
+//               ray meeting the receiver's tangent plane within MSM_MAX_RECEIVER_DEPTH_SLOPE x
+//               range of radial distance per texel, its visibility a segment to the light; a
+//               directional light's as for one light (at most one: the scene's light frame). The
+//               environment effect, the light overrides and rectangular or probe lights with soft
+//               refuse such scenes (std::invalid_argument).
 //
 //   filtered    What a filtered shadow map means, on any geometry (the renderer's PCF with
 //               perfect depth): with n_s the interpolated normal turned towards the viewer (the
