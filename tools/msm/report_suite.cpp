@@ -117,7 +117,8 @@ std::vector<Suite> declared_suites() {
        "SpotLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest.PointLightShadowsAgreeWithTheRayTracer:"
        "LocalLightsRenderTest.PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere:LocalLightsRenderTest."
        "PointLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
-       "PointLightSoftErrorAlongCubeSeamsIsNoHigherThanElsewhere"},
+       "PointLightSoftErrorAlongCubeSeamsIsNoHigherThanElsewhere:LocalLightsRenderTest."
+       "PcfUnderSpotAndPointLightsIsCloserToTheFilteredTruthThanToTheHard"},
       {"The 2015 ordering per light kind", "src/render/msm_render_light_kind_ordering_test", "LightKindOrderingTest.*"},
       {"Cascades: the box on a 500 m ground, the town, a slow pan", "src/render/msm_render_cascades_test",
        "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest.TownWithDefaultSettings:"
