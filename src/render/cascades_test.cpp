@@ -423,17 +423,19 @@ TEST_F(CascadesRenderTest, DepthBoundsGiveTheNearCascadeFinerTexels) {
   }
 }
 
-// A 1 m high, 120 m long wall along the view direction, lit from its side at 26.6 degrees: the
-// shadow of its top edge is a straight line on the ground at x = 1.1 from the camera's feet to the
-// far plane, through every cascade, 2 m from the wall's foot. A narrow view straight along the
-// line, so that the ground's pixels are small enough far away to resolve the penumbra there.
+// A 3 m high, 120 m long wall along the view direction, lit from its side at 26.6 degrees: the
+// shadow of its top edge is a straight line on the ground at x = 5.1 from the camera's feet to the
+// far plane, through every cascade, 6 m from the wall's foot (2.7 m across in the light's view:
+// wider than the last cascade's kernel, which over a narrower shadow would reach the lit ground
+// before the wall). A narrow view straight along the line, so that the ground's pixels are small
+// enough far away to resolve the penumbra there.
 scene::Scene wall_along_the_view() {
   return scene::load_scene_json(R"({"msm_scene": 1,
-    "camera": {"position": [1.1, 3, 6], "target": [1.1, 0, -14], "fov_y_deg": 20, "near": 0.1, "far": 60},
+    "camera": {"position": [5.1, 3, 6], "target": [5.1, 0, -14], "fov_y_deg": 20, "near": 0.1, "far": 60},
     "light": {"towards_light": [-2, 1, 0]},
     "objects": [{"name": "ground", "primitive": {"type": "plane", "size": [200, 200]}},
-                {"name": "wall", "primitive": {"type": "box", "size": [0.2, 1, 120]},
-                 "transform": {"translate": [-1, 0.5, -55]}}]})",
+                {"name": "wall", "primitive": {"type": "box", "size": [0.2, 3, 120]},
+                 "transform": {"translate": [-1, 1.5, -55]}}]})",
                                 ".", "wall_along_the_view.json");
 }
 
@@ -448,43 +450,54 @@ std::optional<glm::dvec3> ground_point(const scene::Camera& camera, int width, i
   return p0 + (p0.y / (p0.y - p1.y)) * (p1 - p0);
 }
 
-// The penumbra's width in world units across the wall's shadow edge on image row y: the ground's
-// x where the visibility crosses 1/4 and where it crosses 3/4 (linear between pixels), their
-// distance (for a Gaussian edge of σ, 1.35 σ); nullopt where the row does not hold both.
+// The penumbra's width in world units across the wall's shadow edge on image row y: the standard
+// deviation of the edge's profile, the visibility's rise along the ground's x taken as a
+// distribution (the differences between neighbouring pixels, at their midpoints), over 2.5 m on
+// either side of the edge at x = 5.1 (inside the 6 m shadow, clear of the wall's foot); nullopt
+// where the row does not span that window or the visibility rises by less than 0.9 across it (MSM
+// leaks: its umbra is not quite 0).
+// The variance is what the filter keeps across cascades (msm/cascade.h); the distance between the
+// 1/4 and 3/4 crossings is not: it depends on the kernel's shape, and a narrow kernel's central
+// tap (3 taps of σ 0.5: 79% of the weight) makes it a third narrower at the same variance.
 std::optional<double> penumbra_width(const RenderResult& r, const scene::Camera& camera, int y) {
+  constexpr double lo = 2.6, hi = 7.6;
   const int width = r.shadow.width(), height = r.shadow.height();
-  std::optional<double> quarter, three_quarters;
-  bool has_previous = false;
+  double rise = 0.0, first = 0.0, second = 0.0; // the profile's mass and its first and second moments
+  bool below = false, above = false, has_previous = false;
   double previous_x = 0.0, previous_v = 0.0; // the previous pixel's ground x and visibility
   for (int x = 0; x < width; ++x) {
     const std::optional<glm::dvec3> p = ground_point(camera, width, height, x, y);
-    if (!p || p->x < 0.1 || p->x > 2.1) { // a metre on either side of the edge, clear of the wall
+    below |= p && p->x < lo;
+    above |= p && p->x > hi;
+    if (!p || p->x < lo || p->x > hi) {
       has_previous = false;
       continue;
     }
     const double v = r.shadow.at(x, y, 0);
-    if (has_previous)
-      for (auto [level, crossing] : {std::pair{0.25, &quarter}, std::pair{0.75, &three_quarters}})
-        if (!*crossing && previous_v < level && v >= level)
-          *crossing = previous_x + (level - previous_v) / (v - previous_v) * (p->x - previous_x);
+    if (has_previous) {
+      const double dv = v - previous_v, middle = 0.5 * (previous_x + p->x);
+      rise += dv;
+      first += dv * middle;
+      second += dv * middle * middle;
+    }
     has_previous = true;
     previous_x = p->x;
     previous_v = v;
   }
-  if (!quarter || !three_quarters) return std::nullopt;
-  return *three_quarters - *quarter;
+  if (!below || !above || rise < 0.9) return std::nullopt;
+  const double mean = first / rise;
+  return std::sqrt(std::max(0.0, second / rise - mean * mean));
 }
 
 // The filter in world units: the wall's straight shadow edge on the ground crosses the four
-// cascades, whose texels grow from one to the next (5x from the first to the last here); the
-// penumbra's width in world units, measured on the shadow buffer row by row and averaged over the
-// rows where one cascade alone shades the ground, is within 15% of the first cascade's in each of
-// the others. Measured on lavapipe, PCF: 0.683, 0.659, 0.632, 0.688 m; with the first cascade's
-// kernel in every cascade's own texels (as before) 0.683, 1.240 m and wider than the 2 m shadow
-// beyond. MSM 64 (the blur's per-layer kernel) is asserted in the first two cascades (0.695, 0.725
-// m; before: 1.393 m in the second): farther out its own leaking, not the filter, sets the width
-// (the far cascades' maps span tens of metres of depth for the 1 m wall: 0.918 m in the third and
-// no 1/4 crossing in the fourth). 128² maps, 256 x 192.
+// cascades of the default (depth-buffer) splits, whose texels grow from one to the next (3.75x from
+// the first to the last here); the penumbra's width in world units (the edge profile's standard
+// deviation, penumbra_width), measured on the shadow buffer row by row and averaged over the rows
+// where one cascade alone shades the ground, is within 15% of the first cascade's in each of the
+// others. Measured on lavapipe, PCF: 0.594, 0.593, 0.517, 0.571 m. MSM 64 (the blur's per-layer
+// kernel) is asserted in the first two cascades (0.513, 0.529 m): farther out its own leaking, not
+// the filter, sets the width (the far cascades' maps span tens of metres of depth for the wall:
+// 0.767 and 0.901 m). 128² maps, 256 x 192.
 TEST_F(CascadesRenderTest, PenumbraKeepsItsWorldWidthAcrossCascades) {
   constexpr int width = 256, height = 192, shadow_size = 128;
   const scene::Scene scene = wall_along_the_view();
@@ -492,9 +505,6 @@ TEST_F(CascadesRenderTest, PenumbraKeepsItsWorldWidthAcrossCascades) {
   for (auto [technique, asserted] : {std::pair<std::string, std::size_t>{"pcf", 4}, {"msm-hamburger-64", 2}}) {
     RenderSettings s = test::render_settings(technique, width, height, shadow_size);
     s.cascades = kDefaultCascades;
-    // The scene's depth estimate places the splits: the filter's scaling is measured apart from the
-    // depth buffer's split placement (with it, PCF's last cascade measured 0.81 of the first's).
-    s.cascade_depth_bounds = RenderSettings::CascadeDepthBounds::scene;
     const RenderResult r = renderer.render(s);
     ASSERT_TRUE(r.cascade_depth_range);
     const std::vector<scene::Cascade> cascades = scene::fit_cascades(
@@ -517,7 +527,7 @@ TEST_F(CascadesRenderTest, PenumbraKeepsItsWorldWidthAcrossCascades) {
     for (std::size_t k = 0; k < cascades.size(); ++k)
       widths += fmt::format(" {:.3f} m ({} rows, texel {:.3f} m)", rows[k] ? sum[k] / rows[k] : 0.0, rows[k],
                             cascades[k].frame.texel(shadow_size).x);
-    fmt::print("{:<18} penumbra width (1/4 to 3/4) per cascade:{}\n", technique, widths);
+    fmt::print("{:<18} penumbra width (standard deviation) per cascade:{}\n", technique, widths);
     bool failed = false;
     for (std::size_t k = 0; k < asserted && k < cascades.size(); ++k) {
       ASSERT_GE(rows[k], 10) << technique << ", cascade " << k << ": too few rows to measure";
