@@ -537,8 +537,9 @@ TEST_F(CascadesRenderTest, PenumbraKeepsItsWorldWidthAcrossCascades) {
             fmt::format("cascades.penumbra_width.{}.cascade{}_change", technique, k),
             std::abs(sum[k] / rows[k] / (sum[0] / rows[0]) - 1.0),
             {.below = 0.15,
-             .meaning = "a straight shadow edge's penumbra (1/4 to 3/4 visibility) in world units: this cascade's "
-                        "relative difference from the first's"});
+             .meaning =
+                 "a straight shadow edge's penumbra (its profile's standard deviation) in world units: this cascade's "
+                 "relative difference from the first's"});
       failed |= std::abs(sum[k] / rows[k] / (sum[0] / rows[0]) - 1.0) > 0.15;
     }
     if (failed) {
