@@ -471,6 +471,38 @@ TEST_F(LocalLightsRenderTest, PointLightShadowsAgreeWithTheRayTracer) {
   EXPECT_LT(leaking.at("msm-hamburger-64"), 0.99 * leaking.at("vsm-32"));
 }
 
+// A bare 4 m ground 0.5 m below a point light of 25 m range (the street's lamps'), nothing to cast
+// a shadow: every lit pixel the tracer sees is fully visible. The map rounds distance / range to
+// 16-bit steps of 0.38 mm; a depth bias that only grew with the texel's world size (2e-5 of the
+// face's width, 0.04 mm at 1 m) stayed below half a step this near the light, and the depth-based
+// techniques shadowed the ground in rings of equal distance (over-darkening 0.1734 plain, 0.0313 PCF,
+// measured); with the bias in [0,1] depth as well, 0 (measured). The bound: 0.002.
+TEST_F(LocalLightsRenderTest, DepthTechniquesDoNotShadowABareGroundNearAPointLightOfLongRange) {
+  const scene::Scene scene = scene::load_scene_json(R"({"msm_scene": 1,
+    "camera": {"position": [0.3, 2.5, 2.5], "target": [0, 0, 0], "fov_y_deg": 55},
+    "lights": [{"type": "point", "position": [0, 0.5, 0], "range": 25, "intensity": [1, 1, 1]}],
+    "objects": [{"primitive": {"type": "plane", "size": [4, 4]}}]})",
+                                                    std::filesystem::current_path(), "ground.json");
+  constexpr int width = 128, height = 96;
+  const reference::Result truth =
+      reference::render(scene, test::reference_settings(reference::Effect::hard, width, height, 1));
+  const image::Image mask = truth.visibility.channel("background");
+  Renderer renderer(ctx(), scene);
+  for (const std::string technique : {"plain", "pcf"}) {
+    RenderSettings s = test::render_settings(technique, width, height, 256);
+    s.msaa = 4;
+    const RenderResult result = renderer.render(s);
+    image::Tolerances tolerances;
+    tolerances.max_over_darkening = 0.002;
+    image::CompareResult c = image::compare(
+        result.shadow.channel("visibility"), truth.visibility.channel("visibility"), tolerances,
+        {.metrics = {.mask = &mask}, .failure_dir = "test-failures/local-lights/ground-near-point-" + technique});
+    EXPECT_TRUE(c.passed) << technique << ": " << c.report;
+    fmt::print("bare ground near a point light, {:<5}: over-darkening {:.4f}, MAE {:.4f}\n", technique,
+               c.metrics.over_darkening, c.metrics.mae);
+  }
+}
+
 // Per pixel of the ground (object 0 of point_scene), the texels of a 90-degree face of
 // kPointShadowSize between the point it sees and the nearest seam of the light's cube; NaN
 // elsewhere.
