@@ -34,11 +34,16 @@ MSM_FN vec3 msm_local_light_irradiance(vec3 intensity, float distance, float ran
 // kinds"), not a perspective z / w, whose precision crowds at the near plane.
 MSM_FN float msm_local_light_depth(float distance, float range) { return distance / range; }
 
-// A receiver's depth in that convention less the depth bias, which grows with the texel's world
-// size: `bias` is relative to the map's width where the receiver is, width_per_distance × distance
-// (2 tan of the map's half-angle: 2 for a cube map's face).
+// A receiver's depth in that convention less the depth bias, twice: once in [0,1] depth as the
+// directional light's, since the map rounds distance / range to the same steps (1.5e-5 of the range
+// in 16 bits: the techniques' biases in config.h were derived to exceed them), and once relative to
+// the map's width where the receiver is, width_per_distance × distance (2 tan of the map's
+// half-angle: 2 for a cube map's face), which grows with the texel's world size. The second alone
+// is below half a 16-bit step (7.6e-6) nearer the light than 7.6e-6 × range / (width_per_distance ×
+// bias): 4.7 m for PCF's 2e-5, a cube face and a 25 m range, where the rounded depths shadowed the
+// receiver in rings of equal distance.
 MSM_FN float msm_local_light_receiver_depth(float distance, float range, float bias, float width_per_distance) {
-  return msm_local_light_depth(distance - bias * width_per_distance * distance, range);
+  return msm_local_light_depth(distance - bias * width_per_distance * distance, range) - bias;
 }
 
 MSM_END
