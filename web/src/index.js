@@ -78,19 +78,11 @@ void main() {
   result = store ? msm_three_store(technique, sum) : sum;
 }`;
 
-// A cube face's texel (its gl_FragCoord, face coordinates st in [-1, 1]) as the direction WebGL's
-// cube sampling maps to it (the major-axis table of the OpenGL ES 3.0 specification, 3.8.10).
+// A cube face's texel (its gl_FragCoord) as the direction WebGL's cube sampling maps to it
+// (msm_three_cube_direction: the major-axis table of the OpenGL ES 3.0 specification, 3.8.10).
 const CUBE_DIRECTION = `
 uniform int face;
-vec3 cubeDirection(vec2 st) {
-  if (face == 0) return vec3(1.0, -st.y, -st.x);
-  if (face == 1) return vec3(-1.0, -st.y, st.x);
-  if (face == 2) return vec3(st.x, 1.0, st.y);
-  if (face == 3) return vec3(st.x, -1.0, -st.y);
-  if (face == 4) return vec3(st.x, -st.y, 1.0);
-  return vec3(-st.x, -st.y, -1.0);
-}
-vec2 faceCoordinates(vec2 texel, float size) { return 2.0 * texel / size - 1.0; }`;
+vec3 cubeDirection(vec2 fragCoord, float size) { return msm_three_cube_direction(face, 2.0 * fragCoord / size - 1.0); }`;
 
 // The filterable channels of a point light's cube face, from three.js's distance map:
 // (distance - near) / (far - near), far the light's range; msm's depth is distance / range.
@@ -102,7 +94,7 @@ uniform int technique;
 layout(location = 0) out vec4 channels;
 void main() {
   float size = float(textureSize(distanceMap, 0).x);
-  float stored = texture(distanceMap, cubeDirection(faceCoordinates(gl_FragCoord.xy, size))).x;
+  float stored = texture(distanceMap, cubeDirection(gl_FragCoord.xy, size)).x;
   channels = msm_three_generate(technique, msm_local_light_depth(mix(near, range, stored), range));
 }`;
 
@@ -118,11 +110,10 @@ uniform bool store;
 layout(location = 0) out vec4 result;
 void main() {
   float size = float(textureSize(source, 0).x);
-  vec2 st = faceCoordinates(gl_FragCoord.xy, size);
   int r = taps / 2;
   vec4 sum = vec4(0.0);
   for (int k = 0; k < taps; ++k)
-    sum += texelFetch(weights, ivec2(k, 0), 0).x * texture(source, cubeDirection(st + float(2 * (k - r)) / size * direction));
+    sum += texelFetch(weights, ivec2(k, 0), 0).x * texture(source, cubeDirection(gl_FragCoord.xy + float(k - r) * direction, size));
   result = store ? msm_three_store(technique, sum) : sum;
 }`;
 
@@ -199,15 +190,35 @@ const GET_SHADOW = `
 
 // A point light's lookup under VSM (three.js has none): the receiver's radial depth in msm's
 // convention for local lights, the depth bias relative to the texel's size (a cube face spans
-// 2 x distance); the non-linear techniques' point lights keep float moments (technique 1).
+// 2 x distance); msm-mssm4's point lights have msm-hamburger-128's cubes (technique 1). The
+// non-linear cubes are nearest-filtered, their texels read as the 2D lookup reads them, found by
+// direction (msm_three_cube_texel_direction): the texels past a face's edge lie in the next face.
 const GET_POINT_SHADOW = `
 	#elif defined( SHADOWMAP_TYPE_VSM )
 	float getPointShadow( samplerCube shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord, float shadowCameraNear, float shadowCameraFar ) {
-		const int technique = MSM_THREE_TECHNIQUE >= 2 ? 1 : MSM_THREE_TECHNIQUE;
+		const int technique = MSM_THREE_TECHNIQUE == 4 ? 1 : MSM_THREE_TECHNIQUE;
 		float shadow = 1.0;
 		vec3 lightToPosition = shadowCoord.xyz;
 		float depth = msm_local_light_receiver_depth( length( lightToPosition ), shadowCameraFar, msm_three_depth_bias( technique ), 2.0 ) + shadowBias;
-		if ( depth <= 1.0 ) shadow = 1.0 - msm_three_shadow( technique, texture( shadowMap, lightToPosition ), depth );
+		if ( depth <= 1.0 ) {
+			#if MSM_THREE_TECHNIQUE == 2
+				// Four texels decoded to moments, those interpolated (the 2D lookup's bilinear weights).
+				float size = float( textureSize( shadowMap, 0 ).x );
+				vec2 f = fract( msm_three_cube_texel_coordinates( lightToPosition, size ) );
+				vec4 m00 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 0.0 ) ) ) );
+				vec4 m10 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 0.0 ) ) ) );
+				vec4 m01 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 1.0 ) ) ) );
+				vec4 m11 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 1.0 ) ) ) );
+				shadow = 1.0 - msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), depth );
+			#elif MSM_THREE_TECHNIQUE == 3
+				// One texel, the nearest moved by blue noise in [-0.5, 0.5) texels (as the 2D lookup).
+				float size = float( textureSize( shadowMap, 0 ).x );
+				vec2 noise = texelFetch( msmThreeBlueNoise, ivec2( gl_FragCoord.xy ) & ( textureSize( msmThreeBlueNoise, 0 ) - 1 ), 0 ).xy;
+				shadow = 1.0 - msm_three_shadow( technique, texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, noise ) ), depth );
+			#else
+				shadow = 1.0 - msm_three_shadow( technique, texture( shadowMap, lightToPosition ), depth );
+			#endif
+		}
 		return mix( 1.0, shadow, shadowIntensity );
 	}
 `;
@@ -248,6 +259,12 @@ function mapTarget(width, height, filter, type = FloatType) {
   return target;
 }
 
+function cubeTarget(size, filter, type, depthBuffer) {
+  return new WebGLCubeRenderTarget(size, {
+    type, format: RGBAFormat, minFilter: filter, magFilter: filter, generateMipmaps: false, depthBuffer,
+  });
+}
+
 function pass(fragmentShader, uniforms) {
   return new RawShaderMaterial({ glslVersion: GLSL3, vertexShader: VERTEX, fragmentShader, uniforms, depthTest: false, depthWrite: false });
 }
@@ -286,7 +303,7 @@ export class MomentShadowMaps {
     this._technique = TECHNIQUES['msm-hamburger-64'];
     this.technique = technique;
     this._lights = new Map(); // light -> { threeMap, moments, scratch }
-    this._points = new Map(); // point light -> { distance, moments, scratch } (cube render targets)
+    this._points = new Map(); // point light -> { distance, moments, scratch, packed, stored } (cube render targets)
     this._softStates = new Map(); // msm-mssm4's light -> its tables and light texture (soft.js)
     this._softLight = null;
     this._warned = new Set();
@@ -391,9 +408,9 @@ export class MomentShadowMaps {
     for (const state of this._softStates.values()) this._soft.release(state);
     this._softStates.clear();
     this._soft.dispose();
-    for (const [light, { distance, moments, scratch }] of this._points) {
-      if (light.shadow.map === distance || light.shadow.map === moments) light.shadow.map = null; // three.js makes its own
-      for (const target of [distance, moments, scratch]) target.dispose();
+    for (const [light, { distance, moments, scratch, packed }] of this._points) {
+      if ([distance, moments, packed].includes(light.shadow.map)) light.shadow.map = null; // three.js makes its own
+      for (const target of [distance, moments, scratch, packed]) target?.dispose();
     }
     this._points.clear();
     this.renderer.shadowMap.render = this._render;
@@ -428,12 +445,11 @@ export class MomentShadowMaps {
       const size = light.shadow.mapSize.x;
       let state = this._points.get(light);
       if (!state || state.distance.width !== size) {
-        if (state) for (const target of [state.distance, state.moments, state.scratch]) target.dispose();
+        if (state) for (const target of [state.distance, state.moments, state.scratch, state.packed]) target?.dispose();
         else if (light.shadow.map !== null) light.shadow.map.dispose(); // three.js's own, from another shadow type
-        const cube = (filter, depthBuffer) => new WebGLCubeRenderTarget(size, {
-          type: FloatType, format: RGBAFormat, minFilter: filter, magFilter: filter, generateMipmaps: false, depthBuffer,
-        });
+        const cube = (filter, depthBuffer) => cubeTarget(size, filter, FloatType, depthBuffer);
         state = { distance: cube(NearestFilter, true), moments: cube(LinearFilter, false), scratch: cube(LinearFilter, false) };
+        state.stored = state.moments; // the cube the lights bind: the moments, or the technique's non-linear texels
         state.moments.texture.name = 'msm-three';
         // three.js disposes it instead of rendering where the shadow type changed in this render.
         state.distance.addEventListener('dispose', () => (state.rendered = false));
@@ -535,18 +551,30 @@ export class MomentShadowMaps {
       const state = this._points.get(light);
       if (!state || light.shadow.map !== state.distance) continue;
       if (state.rendered) this._pointMoments(light, state, taps);
-      light.shadow.map = state.moments;
+      light.shadow.map = state.stored;
     }
     renderer.setRenderTarget(previousTarget);
   }
 
-  // A point light's moments, face by face from its distances, then blurred across the faces.
+  // A point light's moments, face by face from its distances, then blurred across the faces and
+  // stored: the non-linear texels in a nearest-filtered cube of their own (RGBA8 for 32 bits), the
+  // other techniques' in the linearly filtered moment cube.
   _pointMoments(light, state, taps) {
     state.rendered = false;
     let technique = this._technique;
-    if (technique === TECHNIQUES['msm-nl-64'] || technique === NL32 || technique === MSSM4) {
+    if (technique === MSSM4) {
       this._warnOnce(light, `${this.technique} has no cube maps: this point light's moments are msm-hamburger-128's`);
       technique = TECHNIQUES['msm-hamburger-128'];
+    }
+    state.stored = state.moments;
+    if (technique === NL32 || technique === TECHNIQUES['msm-nl-64']) {
+      const type = technique === NL32 ? UnsignedByteType : FloatType;
+      if (state.packed?.texture.type !== type) {
+        state.packed?.dispose();
+        state.packed = cubeTarget(state.moments.width, NearestFilter, type, false);
+        state.packed.texture.name = 'msm-three';
+      }
+      state.stored = state.packed;
     }
     const generate = this._generateCubePass.uniforms, blur = this._blurCubePass.uniforms;
     generate.distanceMap.value = state.distance.texture;
@@ -570,7 +598,7 @@ export class MomentShadowMaps {
     blur.source.value = state.scratch.texture;
     blur.direction.value.set(0, 1);
     blur.store.value = true;
-    faces(this._blurCubePass, state.moments);
+    faces(this._blurCubePass, state.stored);
   }
 
   // The separable Gaussian of the generated moments, then their storage.

@@ -9,6 +9,7 @@
 #ifndef MSM_THREE_H
 #define MSM_THREE_H
 #include "msm/bias.h"
+#include "msm/cube_face.h"
 #include "msm/filter.h"
 #include "msm/hamburger4.h"
 #include "msm/local_light.h"
@@ -73,6 +74,46 @@ MSM_FN vec4 msm_three_nl64_moments(vec4 texel) {
 }
 MSM_FN float msm_three_nl_shadow(vec4 moments, float unit_zf) {
   return msm_nl_shadow(msm_nl_from_moments(moments), msm_signed_depth(unit_zf));
+}
+
+// A point light's cube map as WebGL 2 samples it (the major-axis table of the OpenGL ES 3.0
+// specification, 3.8.10): faces +x, -x, +y, -y, +z, -z (msm_cube_face picks them, in that order),
+// each with face coordinates st in [-1, 1], st = 2 (s, t) - 1 of its texture coordinates (texel
+// (i, j)'s centre at s = (i + 1/2) / size). The direction a face's st stands for:
+MSM_FN vec3 msm_three_cube_direction(int face, vec2 st) {
+  if (face == 0) return vec3(1.0f, -st.y, -st.x);
+  if (face == 1) return vec3(-1.0f, -st.y, st.x);
+  if (face == 2) return vec3(st.x, 1.0f, st.y);
+  if (face == 3) return vec3(st.x, -1.0f, -st.y);
+  if (face == 4) return vec3(st.x, -st.y, 1.0f);
+  return vec3(-st.x, -st.y, -1.0f);
+}
+
+// Its inverse: direction d's face coordinates on `face` (in [-1, 1] on msm_cube_face(d)).
+MSM_FN vec2 msm_three_cube_face_coordinates(vec3 d, int face) {
+  vec3 a = abs(d);
+  if (face == 0) return vec2(-d.z, -d.y) / a.x;
+  if (face == 1) return vec2(d.z, -d.y) / a.x;
+  if (face == 2) return vec2(d.x, d.z) / a.y;
+  if (face == 3) return vec2(d.x, -d.z) / a.y;
+  if (face == 4) return vec2(d.x, -d.y) / a.z;
+  return vec2(-d.x, -d.y) / a.z;
+}
+
+// Direction d in texel-centre coordinates of its face (size texels per side): texel (i, j)'s centre
+// at (i, j); a bilinear lookup's texels are floor of it and one more, its weights the fraction.
+MSM_FN vec2 msm_three_cube_texel_coordinates(vec3 d, float size) {
+  return (msm_three_cube_face_coordinates(d, msm_cube_face(d)) + 1.0f) * (0.5f * size) - 0.5f;
+}
+
+// The direction of the centre of texel floor(t + offset) of d's face, t its texel-centre
+// coordinates: offset (0, 0), (1, 0), (0, 1), (1, 1) give a bilinear lookup's four texels, a blue
+// noise offset in [0, 1) the dithered lookup's one. A texel past the face's edge is a direction off
+// the face, which a nearest-filtered cube lookup finds in the neighbouring face: the lookup reads
+// across the seams as the blur does.
+MSM_FN vec3 msm_three_cube_texel_direction(vec3 d, float size, vec2 offset) {
+  vec2 texel = floor(msm_three_cube_texel_coordinates(d, size) + offset);
+  return msm_three_cube_direction(msm_cube_face(d), (texel + 0.5f) * (2.0f / size) - 1.0f);
 }
 
 // Shadow intensity in [0,1] (1 = fully shadowed) at receiver depth unit_zf: Hamburger 4MSM on the
