@@ -4,8 +4,10 @@
 // (world = translate * rotate * scale, Euler rotations applied X, then Y, then Z), the camera its
 // look-at and vertical field of view, the light its one directional light with the explicit
 // shadow framing (the same orthographic map: centre, extent, depth range, the map's up (0, 1, 0),
-// or (0, 0, 1) for a light within 8° of vertical, as Scene::light_view). Both sides of every
-// surface cast (msm's depth pass culls nothing). Anything else is refused with an Error naming it.
+// or (0, 0, 1) for a light within 8° of vertical, as Scene::light_view), or its one point light
+// ("lights": [{ "type": "point" }]: its range the shadow camera's far plane, the near one at 1e-3 of
+// the range as msm's, which clips nothing in front of a caster). Both sides of every surface cast
+// (msm's depth pass culls nothing). Anything else is refused with an Error naming it.
 import * as THREE from 'three';
 
 function grid(nu, nv, vertex) {
@@ -129,9 +131,10 @@ export function buildMsmScene(description, aspect, material) {
   const refuse = (what) => {
     throw new Error(`msm scene '${name}': ${what} is not built for three.js`);
   };
+  const point = description.lights?.length === 1 && description.lights[0].type === 'point' && !description.light;
   const framing = description.shadow_map ?? {};
-  if (framing.framing !== 'explicit') refuse(`shadow framing '${framing.framing ?? 'fit'}' (give an explicit one)`);
-  if (!description.light || description.lights) refuse('a scene without exactly one directional "light"');
+  if (!point && framing.framing !== 'explicit') refuse(`shadow framing '${framing.framing ?? 'fit'}' (give an explicit one)`);
+  if (!point && (!description.light || description.lights)) refuse('a scene without exactly one directional "light" or one point light');
   const scene = new THREE.Scene();
   for (const object of description.objects) {
     const type = object.primitive?.type;
@@ -150,6 +153,16 @@ export function buildMsmScene(description, aspect, material) {
   camera.lookAt(new THREE.Vector3().fromArray(c.target));
   camera.updateMatrixWorld();
 
+  if (point) {
+    const { position, range, radius = 0 } = description.lights[0];
+    if (radius !== 0 || !(range > 0)) refuse('a point light with a radius or without a range');
+    const light = new THREE.PointLight(0xffffff, 1, range, 2);
+    light.position.fromArray(position);
+    light.shadow.camera.near = 1e-3 * range;
+    light.castShadow = true;
+    scene.add(light);
+    return { scene, camera, light };
+  }
   const towards = new THREE.Vector3().fromArray(description.light.towards_light).normalize();
   if (description.light.x_axis) refuse('a light with an x_axis');
   const light = new THREE.DirectionalLight(0xffffff, 1);
