@@ -4,10 +4,12 @@
 // and render targets (integer formats are color-renderable in WebGL 2 without extensions, and
 // keep every bit: no float conversion stands between the shader and the comparison).
 import { MSM_KERNELS_GLSL } from './generated/kernels-glsl.js';
+import { MSM_THREE_GLSL } from '../src/generated/msm-glsl.js';
 import * as THREE from 'three';
 import { SoftShadowTables } from '../src/soft.js';
 
 const WIDTH = 64;
+const CUBE_SIZE = 16, CUBE_DIRECTIONS = 4096;
 
 const VERTEX = `#version 300 es
 void main() {
@@ -148,6 +150,125 @@ function packageTable(depths, width, height) {
   return words;
 }
 
+// The point lights' cube lookup (msm_three.h) against WebGL 2's own cube sampling: a nearest-
+// filtered RGBA32UI cube whose texels hold (face, i, j) is sampled by the package's functions.
+// Per direction d (rows of RGBA32F) and offset o, out0: the texel the sampler returns, out1: the
+// texel the functions mean, (msm_cube_face(d), floor(t + o)) with t msm_three_cube_texel_coordinates;
+// offset (0.5, 0.5) samples d itself (the texel holding d: checks msm_three_cube_face_coordinates),
+// the others msm_three_cube_texel_direction(d, size, o) (the lookups' texels); w of out1: 1 where
+// d lies within 1e-3 texel of a texel's or a face's edge (either texel is right). u_texels: the
+// directions are every texel's centre, msm_three_cube_direction(face, st) (the passes' texels).
+const CUBE_FRAGMENT = `#version 300 es
+${MSM_THREE_GLSL}
+uniform highp usamplerCube u_cube;
+uniform highp sampler2D u_directions;
+uniform vec2 u_offset;
+uniform bool u_texels;
+layout(location = 0) out highp uvec4 o_sampled;
+layout(location = 1) out highp ivec4 o_meant;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  float size = float(textureSize(u_cube, 0).x);
+  if (u_texels) {
+    int n = int(size), face = p.x / n;
+    ivec2 texel = ivec2(p.x % n, p.y);
+    o_sampled = texture(u_cube, msm_three_cube_direction(face, (vec2(texel) + 0.5) * (2.0 / size) - 1.0));
+    o_meant = ivec4(face, texel, 0);
+    return;
+  }
+  vec3 d = texelFetch(u_directions, p, 0).xyz;
+  int face = msm_cube_face(d);
+  vec2 t = msm_three_cube_texel_coordinates(d, size) + u_offset;
+  vec3 a = abs(d);
+  float second = a.x + a.y + a.z - max(a.x, max(a.y, a.z)) - min(a.x, min(a.y, a.z));
+  bool onEdge = abs(t.x - round(t.x)) < 1e-3 || abs(t.y - round(t.y)) < 1e-3 || second > (1.0 - 1e-5) * max(a.x, max(a.y, a.z));
+  bool self = u_offset == vec2(0.5);
+  o_sampled = texture(u_cube, self ? d : msm_three_cube_texel_direction(d, size, u_offset));
+  o_meant = ivec4(face, ivec2(floor(t)), self && onEdge ? 1 : 0);
+}`;
+
+// The cube check's results: per offset (and the texels' centres), the sampled and meant texels.
+function cubeCheck(gl, size, directions) {
+  const program = gl.createProgram();
+  gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, VERTEX));
+  gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, CUBE_FRAGMENT));
+  gl.linkProgram(program);
+  if (!gl.getProgramParameter(program, gl.LINK_STATUS)) throw new Error(`link: ${gl.getProgramInfoLog(program)}`);
+  const cube = gl.createTexture();
+  gl.bindTexture(gl.TEXTURE_CUBE_MAP, cube);
+  gl.texStorage2D(gl.TEXTURE_CUBE_MAP, 1, gl.RGBA32UI, size, size);
+  for (let face = 0; face < 6; ++face) {
+    const texels = new Uint32Array(4 * size * size);
+    for (let j = 0; j < size; ++j) for (let i = 0; i < size; ++i) texels.set([face, i, j, 0], 4 * (j * size + i));
+    gl.texSubImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + face, 0, 0, 0, size, size, gl.RGBA_INTEGER, gl.UNSIGNED_INT, texels);
+  }
+  gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+  gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+  const count = directions.length / 4, height = Math.ceil(count / WIDTH);
+  const rows = new Float32Array(4 * WIDTH * height);
+  rows.set(directions);
+  const input = gl.createTexture();
+  gl.bindTexture(gl.TEXTURE_2D, input);
+  gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, WIDTH, height);
+  gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, WIDTH, height, gl.RGBA, gl.FLOAT, rows);
+  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+  gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+  const runs = [[0.5, 0.5], [0, 0], [1, 0], [0, 1], [1, 1], 'texels'];
+  const results = {};
+  for (const run of runs) {
+    const [w, h] = run === 'texels' ? [6 * size, size] : [WIDTH, height];
+    const targets = [gl.RGBA32UI, gl.RGBA32I].map((format) => {
+      const t = gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, t);
+      gl.texStorage2D(gl.TEXTURE_2D, 1, format, w, h);
+      return t;
+    });
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    targets.forEach((t, k) => gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + k, gl.TEXTURE_2D, t, 0));
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
+    gl.useProgram(program);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_CUBE_MAP, cube);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_cube'), 0);
+    gl.activeTexture(gl.TEXTURE1);
+    gl.bindTexture(gl.TEXTURE_2D, input);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_directions'), 1);
+    gl.uniform2fv(gl.getUniformLocation(program, 'u_offset'), run === 'texels' ? [0, 0] : run);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_texels'), run === 'texels' ? 1 : 0);
+    gl.viewport(0, 0, w, h);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    const sampled = new Uint32Array(4 * w * h), meant = new Int32Array(4 * w * h);
+    gl.readBuffer(gl.COLOR_ATTACHMENT0);
+    gl.readPixels(0, 0, w, h, gl.RGBA_INTEGER, gl.UNSIGNED_INT, sampled);
+    gl.readBuffer(gl.COLOR_ATTACHMENT1);
+    gl.readPixels(0, 0, w, h, gl.RGBA_INTEGER, gl.INT, meant);
+    const n = run === 'texels' ? w * h : count;
+    results[run === 'texels' ? run : run.join(',')] = { sampled: [...sampled.subarray(0, 4 * n)], meant: [...meant.subarray(0, 4 * n)] };
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    targets.forEach((t) => gl.deleteTexture(t));
+    gl.deleteFramebuffer(fb);
+  }
+  [cube, input].forEach((t) => gl.deleteTexture(t));
+  gl.deleteProgram(program);
+  const error = gl.getError();
+  if (error !== gl.NO_ERROR) throw new Error(`WebGL error 0x${error.toString(16)} in the cube check`);
+  return results;
+}
+
+// Directions for the cube check: uniform over the sphere, and as many near a face's edge or corner.
+function cubeDirections(count) {
+  let seed = 12345;
+  const random = () => ((seed = (Math.imul(seed, 1664525) + 1013904223) >>> 0) / 2 ** 32) * 2 - 1;
+  const directions = new Float32Array(4 * count);
+  for (let k = 0; k < count; ++k) {
+    let d = [random(), random(), random()];
+    if (k % 2 === 1) d = d.map((x) => (Math.abs(x) > 0.6 ? Math.sign(x) * (0.97 + 0.03 * Math.abs(random())) : x));
+    directions.set([...d, 0], 4 * k);
+  }
+  return directions;
+}
+
 // Fetches /data/kernels.json and /data/kernels.bin (msm_web_kernels' output) and returns, per
 // function, the results as base64 of their words, and the package's table of the soft lookup's
 // depth map.
@@ -171,5 +292,6 @@ window.msmRunKernels = async () => {
     offset += 2 * n;
   }
   const depths = new Float32Array(words.buffer, words.byteOffset + 4 * meta.table.depths, width * height).slice();
-  return { renderer, compileMs, results, packageTable: base64(packageTable(depths, width, height)) };
+  const cube = cubeCheck(gl, CUBE_SIZE, cubeDirections(CUBE_DIRECTIONS));
+  return { renderer, compileMs, results, packageTable: base64(packageTable(depths, width, height)), cube: { size: CUBE_SIZE, runs: cube } };
 };

@@ -14,6 +14,8 @@
 // Hankel matrices amplify last-bit differences near steep steps, as on the Vulkan device
 // (src/core/gpu_math_test.cpp gives the same reasons; the bounds here are its bounds where the
 // function is the same, and the measured SwiftShader values are quoted beside them).
+// Also the point lights' cube lookup (msm_three.h's msm_three_cube_* functions) against WebGL 2's
+// own cube sampling, the oracle for the OpenGL ES 3.0 major-axis table (checkCube).
 import { execFileSync } from 'node:child_process';
 import { mkdirSync, readFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
@@ -108,6 +110,45 @@ const show = (words) =>
     .map((x) => x.toPrecision(9))
     .join(', ')}) u=(${[...words.slice(8, 12)].map((w) => '0x' + w.toString(16)).join(', ')})`;
 
+// The point lights' cube lookup against WebGL 2's cube sampling (test/math.js, cubeCheck): every
+// texel centre msm_three_cube_direction gives is sampled as that texel; a direction is sampled as
+// the texel msm_three_cube_face_coordinates puts it in (but within 1e-3 texel of an edge); the
+// bilinear lookup's texels (msm_three_cube_texel_direction) are those floor(t) + offset names on
+// the direction's face, and where that lies past the face's edge, a texel on the edge of another
+// face (the seam's other side). Returns whether all hold.
+function checkCube({ size, runs }) {
+  let ok = true;
+  const texel = (v, k) => [v[4 * k], v[4 * k + 1], v[4 * k + 2]];
+  for (const [name, { sampled, meant }] of Object.entries(runs)) {
+    const n = sampled.length / 4;
+    let wrong = 0, across = 0, ambiguous = 0;
+    const examples = [];
+    for (let k = 0; k < n; ++k) {
+      const [sf, si, sj] = texel(sampled, k), [mf, mi, mj] = texel(meant, k);
+      const inFace = mi >= 0 && mi < size && mj >= 0 && mj < size;
+      let right;
+      if (name !== 'texels' && meant[4 * k + 3] === 1) {
+        ambiguous += 1;
+        right = true;
+      } else if (inFace) right = sf === mf && si === mi && sj === mj;
+      else {
+        across += 1;
+        right = sf !== mf && sf < 6 && (si === 0 || si === size - 1 || sj === 0 || sj === size - 1);
+      }
+      if (!right) {
+        wrong += 1;
+        if (examples.length < 3) examples.push(`meant (${mf}, ${mi}, ${mj}), sampled (${sf}, ${si}, ${sj})`);
+      }
+    }
+    const fine = wrong === 0 && (name === 'texels' || name === '0.5,0.5' || across >= 100);
+    console.log(`[web-math] cube lookup (${size}² faces), ${name === 'texels' ? "every texel's centre" : name === '0.5,0.5' ? 'the texel holding a direction' : `offset (${name})`}: ` +
+      `${wrong} of ${n} sampled other than meant (${across} past the face's edge, ${ambiguous} on an edge) ${fine ? 'ok' : 'FAILED'}` +
+      (examples.length ? `\n  ${examples.join('\n  ')}` : ''));
+    ok &&= fine;
+  }
+  return ok;
+}
+
 async function main() {
   const [tool, work] = process.argv.slice(2);
   if (!tool || !work) throw new Error('usage: node test/math.test.mjs MSM_WEB_KERNELS WORK_DIR');
@@ -180,6 +221,7 @@ async function main() {
   console.log(`[web-math] the package's summed-area table (${width}x${height}, RGBA32UI passes): ${differ} of ${want.length} words ` +
     `differ from sat.h's (${wrapped} running sums wrapped around 2^32) ${differ === 0 && have.length === want.length ? 'ok' : 'FAILED'}`);
   if (differ > 0 || have.length !== want.length) failed = true;
+  if (!checkCube(run.cube)) failed = true;
   if (failed) {
     console.error('web-math: FAILED');
     process.exit(1);
