@@ -27,7 +27,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { launch, openPage } from './browser.mjs';
-import { encodeExr } from './exr.mjs';
+import { encodeExr, shadowBufferFromBase64, typedFromBase64 } from './exr.mjs';
 import { serve } from './serve.mjs';
 
 const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
@@ -148,11 +148,12 @@ async function renderInBrowser() {
     const page = await openPage(browser, `${server.url}/test/same-scene.html`, errors);
     await page.waitForFunction(() => window.msmReady === true);
     for (const light of LOCAL_LIGHTS)
-      local[light] = await page.evaluate((o) => window.msmOverdarkenedLight(o), { light, factors: [1, LOCAL_OVERDARKEN], ...LOCAL_SIZE });
+      local[light] = (await page.evaluate((o) => window.msmOverdarkenedLight(o), { light, factors: [1, LOCAL_OVERDARKEN], ...LOCAL_SIZE }))
+        .map((image) => typedFromBase64(Float32Array, image));
     for (const scene of SCENES) {
       const variants = variantsOf(scene);
-      const list = await page.evaluate(([d, o, v]) => window.msmShadowBuffers(d, o, v),
-        [scene.description, { width: WIDTH, height: HEIGHT, shadowSize: scene.shadowSize }, variants]);
+      const list = (await page.evaluate(([d, o, v]) => window.msmShadowBuffers(d, o, v),
+        [scene.description, { width: WIDTH, height: HEIGHT, shadowSize: scene.shadowSize }, variants])).map(shadowBufferFromBase64);
       variants[0].overdarken.forEach((factor, k) => (buffers[overdarkenKey(scene.name, factor)] = list[k]));
       buffers[`${scene.name}-${VSM.technique}`] = list[list.length - 1];
     }
