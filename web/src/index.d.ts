@@ -26,10 +26,18 @@ export interface Soft {
 }
 export declare const DEFAULT_SOFT: Readonly<Soft>;
 
+/**
+ * Over-darkening (JCGT §2.6, msm's `overdarken` setting): each lookup's shadow intensity divided by the factor and
+ * clamped, which cuts light leaking below 1 - factor and darkens penumbrae. In [0.5, 1]; 1 (the default) is off.
+ */
+export declare const DEFAULT_OVERDARKEN: 1;
+
 export interface MomentShadowMapsOptions {
   technique?: Technique;
   blur?: Blur;
   soft?: Soft;
+  /** The over-darkening factor in [0.5, 1] (DEFAULT_OVERDARKEN); another value throws. */
+  overdarken?: number;
 }
 
 /** The part of three's WebGLRenderer this package uses (three's own types need not be installed). */
@@ -46,6 +54,8 @@ export declare class MomentShadowMaps {
   technique: Technique;
   blur: Blur;
   soft: Soft;
+  /** The over-darkening factor in [0.5, 1] (1: off), applied from the next frame; another value throws. */
+  overdarken: number;
   /** WebGL 2 with EXT_color_buffer_float and OES_texture_float_linear; report: warn on the console if not. */
   static isSupported(renderer: RendererLike, report?: boolean): boolean;
   /** Back to three's own shadows, of the type the renderer had before. */

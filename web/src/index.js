@@ -39,6 +39,12 @@ export { DEFAULT_SOFT };
 // The Gaussian blur: taps x taps texels, σ in texels (filter.h's defaults: the 2015 paper's kernel).
 export const DEFAULT_BLUR = Object.freeze({ taps: 9, sigma: 2.4 });
 
+// Over-darkening (JCGT §2.6, baselines.h's msm_overdarken): each lookup's shadow intensity is
+// divided by the factor and clamped, so that leaking below 1 - factor is cut. The renderer's
+// `overdarken` setting: 1 (off) by default, in [0.5, 1]; the JCGT paper uses 0.98.
+export const DEFAULT_OVERDARKEN = 1;
+const OVERDARKEN_MIN = 0.5;
+
 const VERTEX = `
 void main() {
   vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
@@ -121,8 +127,12 @@ void main() {
 // same shadow coordinates, bias and frustum test.
 const GET_SHADOW = `
 		${MSM_THREE_GLSL}
-		#ifndef MSM_THREE_TECHNIQUE
+		#ifdef MSM_THREE_TECHNIQUE
+		// The over-darkening factor (the package's overdarken), bound in the materials it marks.
+		uniform float msmThreeOverdarken;
+		#else
 		#define MSM_THREE_TECHNIQUE 0
+		#define msmThreeOverdarken 1.0
 		#endif
 		#if MSM_THREE_TECHNIQUE == 3
 		uniform highp sampler2D msmThreeBlueNoise;
@@ -140,8 +150,12 @@ const GET_SHADOW = `
 		#else
 		#define MSM_THREE_HARD_TECHNIQUE MSM_THREE_TECHNIQUE
 		#endif
+		// The light's visibility from the technique's shadow intensity, over-darkened as msm's renderer does.
+		float msmThreeVisibility( float shadow, float shadowIntensity ) {
+			return mix( 1.0, 1.0 - msm_overdarken( shadow, msmThreeOverdarken ), shadowIntensity );
+		}
 		float getShadow( sampler2D shadowMap, vec2 shadowMapSize, float shadowIntensity, float shadowBias, float shadowRadius, vec4 shadowCoord ) {
-			float shadow = 1.0;
+			float shadow = 0.0; // the technique's shadow intensity (0: lit)
 			#if MSM_THREE_TECHNIQUE == 4
 				// The soft light's map is its 1 x 1 texel of light values (soft.js); the others' are moments.
 				if ( textureSize( shadowMap, 0 ) == ivec2( 1 ) ) {
@@ -151,8 +165,8 @@ const GET_SHADOW = `
 					vec3 texels = vec3( coord.xy * vec2( size ), coord.z );
 					vec2 slope = msm_three_depth_per_texel( dFdx( texels ), dFdy( texels ) );
 					if ( coord.x >= 0.0 && coord.x <= 1.0 && coord.y >= 0.0 && coord.y <= 1.0 && coord.z <= 1.0 )
-						shadow = 1.0 - msm_three_soft_shadow( size, texelFetch( shadowMap, ivec2( 0 ), 0 ), MSM_THREE_SOFT_KERNEL, coord, slope ).shadow;
-					return mix( 1.0, shadow, shadowIntensity );
+						shadow = msm_three_soft_shadow( size, texelFetch( shadowMap, ivec2( 0 ), 0 ), MSM_THREE_SOFT_KERNEL, coord, slope ).shadow;
+					return msmThreeVisibility( shadow, shadowIntensity );
 				}
 			#endif
 			shadowCoord.xyz /= shadowCoord.w;
@@ -171,7 +185,7 @@ const GET_SHADOW = `
 					vec4 m10 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i1.x, i0.y ), 0 ) );
 					vec4 m01 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i0.x, i1.y ), 0 ) );
 					vec4 m11 = msm_three_nl64_moments( texelFetch( shadowMap, i1, 0 ) );
-					shadow = 1.0 - msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), shadowCoord.z );
+					shadow = msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), shadowCoord.z );
 				#elif MSM_THREE_TECHNIQUE == 3
 					// The 32-bit texels decode alone: the texel nearest to the lookup moved by blue noise
 					// in [-0.5, 0.5) texels (the renderer's dithered lookup, lookup.glsl).
@@ -179,12 +193,12 @@ const GET_SHADOW = `
 					vec2 t = shadowCoord.xy * vec2( last + 1 ) - 0.5;
 					vec2 noise = texelFetch( msmThreeBlueNoise, ivec2( gl_FragCoord.xy ) & ( textureSize( msmThreeBlueNoise, 0 ) - 1 ), 0 ).xy;
 					ivec2 i = clamp( ivec2( floor( t + noise ) ), ivec2( 0 ), last );
-					shadow = 1.0 - msm_three_shadow( MSM_THREE_TECHNIQUE, texelFetch( shadowMap, i, 0 ), shadowCoord.z );
+					shadow = msm_three_shadow( MSM_THREE_TECHNIQUE, texelFetch( shadowMap, i, 0 ), shadowCoord.z );
 				#else
-					shadow = 1.0 - msm_three_shadow( MSM_THREE_HARD_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
+					shadow = msm_three_shadow( MSM_THREE_HARD_TECHNIQUE, texture( shadowMap, shadowCoord.xy ), shadowCoord.z );
 				#endif
 			}
-			return mix( 1.0, shadow, shadowIntensity );
+			return msmThreeVisibility( shadow, shadowIntensity );
 		}
 `;
 
@@ -209,14 +223,14 @@ const GET_POINT_SHADOW = `
 				vec4 m10 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 0.0 ) ) ) );
 				vec4 m01 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 1.0 ) ) ) );
 				vec4 m11 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 1.0 ) ) ) );
-				shadow = 1.0 - msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), depth );
+				shadow = 1.0 - msm_overdarken( msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), depth ), msmThreeOverdarken );
 			#elif MSM_THREE_TECHNIQUE == 3
 				// One texel, the nearest moved by blue noise in [-0.5, 0.5) texels (as the 2D lookup).
 				float size = float( textureSize( shadowMap, 0 ).x );
 				vec2 noise = texelFetch( msmThreeBlueNoise, ivec2( gl_FragCoord.xy ) & ( textureSize( msmThreeBlueNoise, 0 ) - 1 ), 0 ).xy;
-				shadow = 1.0 - msm_three_shadow( technique, texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, noise ) ), depth );
+				shadow = 1.0 - msm_overdarken( msm_three_shadow( technique, texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, noise ) ), depth ), msmThreeOverdarken );
 			#else
-				shadow = 1.0 - msm_three_shadow( technique, texture( shadowMap, lightToPosition ), depth );
+				shadow = 1.0 - msm_overdarken( msm_three_shadow( technique, texture( shadowMap, lightToPosition ), depth ), msmThreeOverdarken );
 			#endif
 		}
 		return mix( 1.0, shadow, shadowIntensity );
@@ -294,11 +308,14 @@ let activeInstances = 0;
 
 export class MomentShadowMaps {
   // Switches renderer's shadows to moment shadow maps of `technique` (a key of TECHNIQUES).
-  // soft: msm-mssm4's light (DEFAULT_SOFT: its angular diameter in degrees).
-  constructor(renderer, { technique = 'msm-hamburger-64', blur = DEFAULT_BLUR, soft = DEFAULT_SOFT } = {}) {
+  // soft: msm-mssm4's light (DEFAULT_SOFT: its angular diameter in degrees); overdarken: the
+  // lookups' over-darkening factor (DEFAULT_OVERDARKEN).
+  constructor(renderer, { technique = 'msm-hamburger-64', blur = DEFAULT_BLUR, soft = DEFAULT_SOFT, overdarken = DEFAULT_OVERDARKEN } = {}) {
     this.renderer = renderer;
     this.blur = { ...blur };
     this.soft = { ...soft };
+    this._overdarken = { value: DEFAULT_OVERDARKEN }; // the lookups' uniform (_markMaterials binds it)
+    this.overdarken = overdarken;
     this.supported = MomentShadowMaps.isSupported(renderer, true);
     this._technique = TECHNIQUES['msm-hamburger-64'];
     this.technique = technique;
@@ -393,6 +410,15 @@ export class MomentShadowMaps {
   set technique(name) {
     if (!(name in TECHNIQUES)) throw new Error(`msm-three: unknown technique '${name}' (one of ${Object.keys(TECHNIQUES).join(', ')})`);
     this._technique = TECHNIQUES[name];
+  }
+
+  get overdarken() {
+    return this._overdarken.value;
+  }
+  set overdarken(factor) {
+    if (!(typeof factor === 'number' && factor >= OVERDARKEN_MIN && factor <= 1))
+      throw new Error(`msm-three: overdarken needs a factor in [${OVERDARKEN_MIN}, 1] (1: off), not ${factor}`);
+    this._overdarken.value = factor;
   }
 
   // Back to three.js's own shadows (the type the renderer had before).
@@ -624,6 +650,7 @@ export class MomentShadowMaps {
     const technique = this._technique;
     const blueNoise = this._blueNoise;
     const satTable = this._soft.table;
+    const overdarken = this._overdarken;
     scene.traverse((object) => {
       if (!object.material) return;
       for (const material of Array.isArray(object.material) ? object.material : [object.material]) {
@@ -638,6 +665,7 @@ export class MomentShadowMaps {
             own.call(this, shader, renderer);
             shader.uniforms.msmThreeBlueNoise = blueNoise;
             shader.uniforms.msmThreeSatTable = satTable;
+            shader.uniforms.msmThreeOverdarken = overdarken;
           };
         }
         this._marked.add(material);

@@ -59,3 +59,15 @@ export function encodeExr(width, height, channels) {
   }
   return Buffer.concat([...header, offsets, ...lines]);
 }
+
+// A typed array of `Type` from base64 of its bytes (as the test pages send them).
+export function typedFromBase64(Type, text) {
+  const bytes = Buffer.from(text, 'base64');
+  return new Type(new Uint8Array(bytes).buffer); // a copy: Buffer's pool need not align
+}
+
+// A shadow buffer of test/same-scene.html (visibility and background as base64 of a Float32Array
+// and a Uint8Array), as the channels encodeExr writes.
+export function shadowBufferFromBase64({ visibility, background }) {
+  return { visibility: typedFromBase64(Float32Array, visibility), background: typedFromBase64(Uint8Array, background) };
+}

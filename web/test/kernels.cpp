@@ -49,7 +49,8 @@ const char* const kNames[] = {"fma",
                               "three_depth_per_texel",
                               "soft_blocker4",
                               "soft_shadow4",
-                              "three_soft_shadow"};
+                              "three_soft_shadow",
+                              "overdarken"};
 static_assert(sizeof(kNames) / sizeof(kNames[0]) == MSM_WK_COUNT);
 
 class Inputs {
@@ -188,6 +189,11 @@ KernelIO make_input(int id, Inputs& g) {
     x.a = msm_sat_dequantize(msm_sat_quantize(q, scale), scale);
     x.b[0] = g.receiver(d);
     x.u[0] = scale;
+    break;
+  }
+  case MSM_WK_OVERDARKEN: { // intensities from lit to full shadow, some exact; the option's factors
+    x.a[0] = g.chance(0.1) ? float(g.integer(0, 4)) * 0.25f : g.uni(0.0f, 1.0f);
+    x.a[1] = g.chance(0.2) ? (g.chance(0.5) ? 1.0f : MSM_OVERDARKEN_DEFAULT) : g.uni(0.5f, 1.0f);
     break;
   }
   default: break;

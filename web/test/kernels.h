@@ -53,7 +53,8 @@ const int MSM_WK_SOFT_SHADOW4 = 23;          // a = Θ4* average, b.x = biased z
 // depth, world per texel, depth per texel xy), u = (kernel width, table width, table height)
 // -> a = (shadow, blocker depth, search shadow, penumbra.x), b.x = penumbra.y.
 const int MSM_WK_THREE_SOFT_SHADOW = 24;
-const int MSM_WK_COUNT = 25;
+const int MSM_WK_OVERDARKEN = 25; // a.x = shadow intensity, a.y = factor -> a.x (the lookups' over-darkening)
+const int MSM_WK_COUNT = 26;
 
 MSM_FN KernelIO msm_web_kernel_nl(NonLinearMoments m) {
   return KernelIO(vec4(m.y1, m.y2, m.v2, m.xi4), vec4(0.0f), uvec4(0u));
@@ -108,6 +109,7 @@ MSM_FN KernelIO msm_web_kernel(int function, KernelIO x) {
     break;
   }
   case MSM_WK_SOFT_SHADOW4: r.a[0] = msm_soft_shadow4(x.a, x.b[0], MSM_SOFT_UMBRA_EPSILON, x.u[0]); break;
+  case MSM_WK_OVERDARKEN: r.a[0] = msm_overdarken(x.a[0], x.a[1]); break;
 #if !MSM_CPP
   case MSM_WK_THREE_SOFT_SHADOW: r = msm_web_soft_kernel(x); break; // C++: msm_web_soft_kernel(fetch, x)
 #endif

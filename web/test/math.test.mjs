@@ -61,6 +61,9 @@ const SPECS = {
   soft_blocker4: { metric: 'abs', outputs: [0, 1], max: 0.01, p999: 2e-4 },
   soft_shadow4: { metric: 'abs', outputs: [0], max: 0.01, p999: 2e-4 },
   three_soft_shadow: { metric: 'abs', outputs: [0, 1, 2, 3, 4], max: 0.01, p999: 2e-4 },
+  // The lookups' over-darkening (baselines.h, the package's overdarken): a division, clamped;
+  // bit-identical on SwiftShader (GLSL ES allows division 2.5 ulp: a GPU may need 3).
+  overdarken: { metric: 'ulp', outputs: [0], max: 0, p999: 0 },
 };
 
 const f32 = new Float32Array(1);

@@ -29,9 +29,37 @@ try {
 
 // The module's exports (it imports three, which node resolves from node_modules).
 const module = await import(resolve(webDir, 'src/index.js'));
-for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR', 'DEFAULT_SOFT'])
+for (const name of ['MomentShadowMaps', 'TECHNIQUES', 'DEFAULT_BLUR', 'DEFAULT_SOFT', 'DEFAULT_OVERDARKEN'])
   if (!(name in module)) fail(`src/index.js does not export ${name}`);
 if (JSON.stringify(Object.keys(module.TECHNIQUES)) !== JSON.stringify(['msm-hamburger-64', 'msm-hamburger-128', 'msm-nl-64', 'msm-nl-32', 'msm-mssm4']))
   fail(`TECHNIQUES is ${JSON.stringify(module.TECHNIQUES)}, not what index.d.ts declares`);
+// The over-darkening factor, validated as msm's `overdarken` setting ([0.5, 1]) when it is given, the
+// constructor's and the property's (a renderer without float targets: the package stays off, and says so).
+const offRenderer = { extensions: { has: () => false }, shadowMap: { enabled: true, type: 0, render() {} } };
+const warn = console.warn;
+console.warn = () => {};
+try {
+  if (new module.MomentShadowMaps(offRenderer).overdarken !== module.DEFAULT_OVERDARKEN || module.DEFAULT_OVERDARKEN !== 1)
+    fail('the over-darkening factor is not 1 (off, the renderer\'s default) by default');
+  for (const factor of [0.5, 0.7, 1])
+    if (new module.MomentShadowMaps(offRenderer, { overdarken: factor }).overdarken !== factor) fail(`overdarken ${factor} is not kept`);
+  const refused = (what, make) => {
+    try {
+      make();
+      fail(`${what} is accepted`);
+    } catch (e) {
+      if (!/overdarken needs a factor in \[0\.5, 1\]/.test(e.message)) fail(`${what}: ${e.message}`);
+    }
+  };
+  for (const factor of [0.49, 1.01, 0, -1, NaN, Infinity, '0.9', null]) {
+    refused(`overdarken ${String(factor)} in the options`, () => new module.MomentShadowMaps(offRenderer, { overdarken: factor }));
+    const moments = new module.MomentShadowMaps(offRenderer, { overdarken: 0.9 });
+    refused(`overdarken = ${String(factor)}`, () => (moments.overdarken = factor));
+    if (moments.overdarken !== 0.9) fail(`overdarken = ${String(factor)} changed the factor to ${moments.overdarken}`);
+  }
+} finally {
+  console.warn = warn;
+}
+if (!failed) console.log('[web-package] overdarken: 1 by default, factors outside [0.5, 1] refused');
 if (failed) process.exit(1);
 console.log('web-package: ok');

@@ -24,7 +24,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { launch, openPage } from './browser.mjs';
-import { encodeExr } from './exr.mjs';
+import { encodeExr, shadowBufferFromBase64 } from './exr.mjs';
 import { serve } from './serve.mjs';
 
 const webDir = resolve(dirname(fileURLToPath(import.meta.url)), '..');
@@ -92,8 +92,8 @@ async function runCase(description, c, browser, server, errors) {
 
   const page = await openPage(browser, `${server.url}/test/same-scene.html`, errors);
   await page.waitForFunction(() => window.msmReady === true);
-  const buffer = await page.evaluate(([d, o]) => window.msmShadowBuffer(d, o), [scene,
-    { width: WIDTH, height: HEIGHT, shadowSize, technique: c.technique, soft: { angularDiameter: c.extent ?? 0 } }]);
+  const buffer = shadowBufferFromBase64(await page.evaluate(([d, o]) => window.msmShadowBuffer(d, o), [scene,
+    { width: WIDTH, height: HEIGHT, shadowSize, technique: c.technique, soft: { angularDiameter: c.extent ?? 0 } }]));
   await page.close();
   const packageFile = join(dir, 'msm-three.exr');
   writeFileSync(packageFile, encodeExr(WIDTH, HEIGHT, buffer));

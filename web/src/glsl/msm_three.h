@@ -8,6 +8,7 @@
 // Depths: unit_depth and unit_zf are shadow-map depths in [0,1] (three.js's shadow coordinates).
 #ifndef MSM_THREE_H
 #define MSM_THREE_H
+#include "msm/baselines.h" // msm_overdarken: the lookups' over-darkening, as the renderer's shading
 #include "msm/bias.h"
 #include "msm/cube_face.h"
 #include "msm/filter.h"
