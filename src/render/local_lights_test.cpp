@@ -552,6 +552,18 @@ TEST_F(LocalLightsRenderTest, DepthTechniquesDoNotShadowTheLitFacetsOfACylinderU
                                          ": over-darkening of its side against the traced hard shadow"});
     fmt::print("cylinder of 16 facets under a point light, {:<5}: over-darkening {:.4f}, MAE {:.4f}\n", technique,
                c.metrics.over_darkening, c.metrics.mae);
+    // The deferred pass (PCF's default) reads the triangle's normal the surfaces pass stored, the
+    // forward pass (the plain map's) takes it from its own derivatives: the same visibility
+    // (measured: bit for bit).
+    s.deferred_shading = false;
+    const image::Image forward = renderer.render(s).shadow.channel("visibility");
+    s.deferred_shading = true;
+    const image::Image deferred = renderer.render(s).shadow.channel("visibility");
+    double worst = 0;
+    for (size_t i = 0; i < forward.pixels().size(); ++i)
+      worst = std::max(worst, double(std::abs(forward.pixels()[i] - deferred.pixels()[i])));
+    EXPECT_LE(worst, 1e-6) << technique << ": forward and deferred shading differ";
+    fmt::print("  forward against deferred shading: largest difference {}\n", worst);
   }
 }
 

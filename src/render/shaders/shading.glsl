@@ -59,11 +59,13 @@ layout(location = 2) in vec2 texcoord;
 // derivatives: both lie in the triangle's plane, where the interpolation puts every position it
 // extrapolates for the quad's other fragments. The interpolated normal of a faceted or coarse mesh
 // turns across each triangle; the shadow pass rasterized the triangle itself. The fallback where the
-// derivatives are parallel (a triangle seen edge-on).
+// derivatives are within 0.06 degrees of parallel (a triangle seen edge-on), where their rounding
+// would turn the cross product anywhere.
 vec3 triangle_normal(vec3 fallback) {
-  vec3 c = cross(dFdx(world_position), dFdy(world_position));
-  float length2 = dot(c, c);
-  return length2 > 0.0f && !isinf(length2) ? c * inversesqrt(length2) : fallback;
+  vec3 dx = dFdx(world_position), dy = dFdy(world_position);
+  vec3 c = cross(dx, dy);
+  float length2 = dot(c, c); // |dx|² |dy|² sin² of their angle
+  return length2 > 1e-6f * dot(dx, dx) * dot(dy, dy) && !isinf(length2) ? c * inversesqrt(length2) : fallback;
 }
 #endif
 // The receiver's geometric normal (triangle_normal; the deferred pass reads the surfaces pass's): a
