@@ -119,6 +119,7 @@ inline constexpr const char* kCameraDepth = "camera_depth";
 inline constexpr const char* kSurfacePosition = "surface_position";
 inline constexpr const char* kSurfaceNormal = "surface_normal";
 inline constexpr const char* kSurfaceAlbedo = "surface_albedo";
+inline constexpr const char* kSurfaceGeometricNormal = "surface_geometric_normal"; // the triangle's
 // Scattering techniques: the shading's linear radiance (RGBA16F, before exposure) and the
 // scattering pass's in-scattered radiance and visible fraction (RGBA32F, an output of the frame).
 inline constexpr const char* kSurfaceRadiance = "surface_radiance";

@@ -25,7 +25,8 @@
 #define MSM_BINDING_SHADING_SURFACE_POSITION 11 // the deferred pass's surfaces; white in the forward passes
 #define MSM_BINDING_SHADING_SURFACE_NORMAL 12
 #define MSM_BINDING_SHADING_SURFACE_ALBEDO 13
-#define MSM_BINDING_SHADING_SOFT_CLAMPS 14 // soft_clamps.glsl: lookups the kernel clamped
+#define MSM_BINDING_SHADING_SOFT_CLAMPS 14              // soft_clamps.glsl: lookups the kernel clamped
+#define MSM_BINDING_SHADING_SURFACE_GEOMETRIC_NORMAL 15 // the deferred pass's too (its triangle's normal)
 
 // The probe's background (background.frag).
 #define MSM_BINDING_BACKGROUND_PROBE 1

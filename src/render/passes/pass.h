@@ -157,7 +157,8 @@ class SatPass : public Pass {
 };
 
 // Deferred shading (FrameConfig::deferred): the opaque scene -> camera_depth and the visible
-// surface of each pixel (surface_position, surface_normal, surface_albedo), cut-outs discarded.
+// surface of each pixel (surface_position, surface_normal, surface_albedo, and its triangle's normal
+// surface_geometric_normal), cut-outs discarded.
 class SurfacesPass : public Pass {
  public:
   explicit SurfacesPass(const FrameConfig& config) : config_(config) {}

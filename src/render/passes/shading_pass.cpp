@@ -55,7 +55,8 @@ std::vector<vk::Binding> shading_bindings() {
                           {MSM_BINDING_SHADING_SURFACE_POSITION, B::sampled_image},
                           {MSM_BINDING_SHADING_SURFACE_NORMAL, B::sampled_image},
                           {MSM_BINDING_SHADING_SURFACE_ALBEDO, B::sampled_image},
-                          {MSM_BINDING_SHADING_SOFT_CLAMPS, B::storage_buffer}});
+                          {MSM_BINDING_SHADING_SOFT_CLAMPS, B::storage_buffer},
+                          {MSM_BINDING_SHADING_SURFACE_GEOMETRIC_NORMAL, B::sampled_image}});
 }
 
 vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
@@ -94,8 +95,8 @@ vk::GraphicsDesc shading_desc(const FrameConfig& config, Stage stage) {
     d.name += " (translucent)";
     d.alpha_blend = true;
     d.color_write_masks = {VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT, 0};
-  } else if (stage == Stage::surfaces) { // position, normal, albedo: exact, as the forward pass has them
-    d.color_formats.assign(3, VK_FORMAT_R32G32B32A32_SFLOAT);
+  } else if (stage == Stage::surfaces) { // position, normal, albedo, geometric normal: as the forward pass has them
+    d.color_formats.assign(4, VK_FORMAT_R32G32B32A32_SFLOAT);
   } else if (stage == Stage::deferred) { // the surfaces (the surface bindings), a full-screen triangle
     d.name += " (deferred)";
     d.vertex_shader = "fullscreen.vert";
@@ -176,7 +177,8 @@ std::vector<vk::Descriptor> frame_descriptors(const PassContext& c, const FrameC
                              {MSM_BINDING_SHADING_SURFACE_POSITION, white},
                              {MSM_BINDING_SHADING_SURFACE_NORMAL, white},
                              {MSM_BINDING_SHADING_SURFACE_ALBEDO, white},
-                             {MSM_BINDING_SHADING_SOFT_CLAMPS, vk::Descriptor(*c.frame.soft_clamps)}});
+                             {MSM_BINDING_SHADING_SOFT_CLAMPS, vk::Descriptor(*c.frame.soft_clamps)},
+                             {MSM_BINDING_SHADING_SURFACE_GEOMETRIC_NORMAL, white}});
 }
 
 // Draws the scene's `draws` (in that order) with `program`, each with its albedo and opacity textures.
@@ -209,7 +211,7 @@ void SurfacesPass::prepare(const PassResources& r) {
 
 void SurfacesPass::reflect(PassBuilder& b) const {
   uint32_t w = uint32_t(config_.width), h = uint32_t(config_.height);
-  for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo})
+  for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo, kSurfaceGeometricNormal})
     b.create(name, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
   b.create(kCameraDepth, {.format = VK_FORMAT_D32_SFLOAT, .width = w, .height = h}, use::depth_attachment());
 }
@@ -220,7 +222,8 @@ void SurfacesPass::execute(const PassContext& c) const {
   vk::begin_rendering(c.cmd, size,
                       {{c.image(kSurfacePosition).layer_views[0], none},
                        {c.image(kSurfaceNormal).layer_views[0], none},
-                       {c.image(kSurfaceAlbedo).layer_views[0], none}},
+                       {c.image(kSurfaceAlbedo).layer_views[0], none},
+                       {c.image(kSurfaceGeometricNormal).layer_views[0], none}},
                       vk::DepthAttachment{c.image(kCameraDepth).layer_views[0], 1.0f});
   vk::set_viewport_scissor(c.cmd, size);
   bind_scene(c.cmd, c.frame.scene);
@@ -253,7 +256,8 @@ void ShadingPass::reflect(PassBuilder& b) const {
     b.create(kColor, {.format = VK_FORMAT_R8G8B8A8_SRGB, .width = w, .height = h}, use::color_attachment());
   b.create(kShadowBuffer, {.format = VK_FORMAT_R32G32B32A32_SFLOAT, .width = w, .height = h}, use::color_attachment());
   if (config_.deferred) {
-    for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo}) b.read(name, use::sampled(fragment));
+    for (const char* name : {kSurfacePosition, kSurfaceNormal, kSurfaceAlbedo, kSurfaceGeometricNormal})
+      b.read(name, use::sampled(fragment));
     b.modify(kCameraDepth, use::depth_attachment()); // the translucent draws test against it
   } else {
     b.create(kCameraDepth, {.format = VK_FORMAT_D32_SFLOAT, .width = w, .height = h}, use::depth_attachment());
@@ -283,6 +287,7 @@ void ShadingPass::execute(const PassContext& c) const {
     deferred[MSM_BINDING_SHADING_SURFACE_POSITION] = surface(kSurfacePosition);
     deferred[MSM_BINDING_SHADING_SURFACE_NORMAL] = surface(kSurfaceNormal);
     deferred[MSM_BINDING_SHADING_SURFACE_ALBEDO] = surface(kSurfaceAlbedo);
+    deferred[MSM_BINDING_SHADING_SURFACE_GEOMETRIC_NORMAL] = surface(kSurfaceGeometricNormal);
     vkCmdSetCullMode(c.cmd, VK_CULL_MODE_NONE);
     ObjectPush none{};
     vk::bind_program(c.cmd, *program_, deferred, std::as_bytes(std::span(&none, 1)));

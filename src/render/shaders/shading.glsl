@@ -47,17 +47,36 @@ layout(binding = MSM_BINDING_SHADING_SURFACE_POSITION) uniform sampler2D
     surface_position; // xyz; w: 1 where a surface, 0 background
 layout(binding = MSM_BINDING_SHADING_SURFACE_NORMAL) uniform sampler2D surface_normal; // xyz: towards the viewer
 layout(binding = MSM_BINDING_SHADING_SURFACE_ALBEDO) uniform sampler2D surface_albedo; // rgb, a: opacity
+layout(binding = MSM_BINDING_SHADING_SURFACE_GEOMETRIC_NORMAL) uniform sampler2D
+    surface_geometric_normal; // xyz: the triangle's normal (triangle_normal)
 vec3 world_position;
 #else
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
 layout(location = 2) in vec2 texcoord;
+
+// The normal of the triangle the fragment lies on (either side), from the world position's screen
+// derivatives: both lie in the triangle's plane, where the interpolation puts every position it
+// extrapolates for the quad's other fragments. The interpolated normal of a faceted or coarse mesh
+// turns across each triangle; the shadow pass rasterized the triangle itself. The fallback where the
+// derivatives are within 0.06 degrees of parallel (a triangle seen edge-on), where their rounding
+// would turn the cross product anywhere.
+vec3 triangle_normal(vec3 fallback) {
+  vec3 dx = dFdx(world_position), dy = dFdy(world_position);
+  vec3 c = cross(dx, dy);
+  float length2 = dot(c, c); // |dx|² |dy|² sin² of their angle
+  return length2 > 1e-6f * dot(dx, dx) * dot(dy, dy) && !isinf(length2) ? c * inversesqrt(length2) : fallback;
+}
 #endif
+// The receiver's geometric normal (triangle_normal; the deferred pass reads the surfaces pass's): a
+// local light's receiver plane (spot_lookup) is the triangle's, as the depth pass drew it.
+vec3 geometric_normal;
 
 #ifdef MSM_SURFACES
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 layout(location = 2) out vec4 out_albedo;
+layout(location = 3) out vec4 out_geometric_normal;
 #else
 layout(location = 0) out vec4 out_color;  // tone mapped; the attachment is sRGB (kLinearRadiance: linear)
 layout(location = 1) out vec4 out_shadow; // rgb: light visibility per colour channel, a: 1 (a surface)
@@ -95,7 +114,11 @@ vec2 spot_texels_along(int l, vec4 clip, vec3 v) {
 // kinds"): projected as the shadow pass projects the casters, its depth in the map's convention
 // (radial distance / range) less the depth bias, which like the normal offset grows with the
 // texel's world size (distance × texel angle): frame.shadow_map.w is the bias relative to the map's
-// width where the receiver is. Returns whether the receiver is inside the map's frustum.
+// width where the receiver is. The receiver plane is the triangle's (geometric_normal): the
+// interpolated normal's plane differs from it by the mesh's faceting, and at grazing light its
+// slope by that angle over cos² of the incidence, which put the neighbouring texels of a lit facet
+// in front of the plane (acne in bands on faceted columns at grazing light). Returns whether the
+// receiver is inside the map's frustum.
 bool spot_lookup(int l, vec3 n, float n_dot_l, MsmFootprint pixel, out ShadowLookup s) {
   vec3 light_position = lights[l].spot_position.xyz;
   float range = lights[l].spot_position.w;
@@ -109,8 +132,9 @@ bool spot_lookup(int l, vec3 n, float n_dot_l, MsmFootprint pixel, out ShadowLoo
   float r = distance(p, light_position);
   s.z = msm_local_light_receiver_depth(r, range, frame.shadow_map.w, width_per_distance);
   // The receiver plane's radial depth per texel: d(r)/d(tangent) times d(tangent)/d(t).
-  vec3 tangent_x = normalize(abs(n.x) > 0.5f ? cross(n, vec3(0.0f, 1.0f, 0.0f)) : cross(n, vec3(1.0f, 0.0f, 0.0f)));
-  vec3 tangent_y = cross(n, tangent_x);
+  vec3 g = geometric_normal;
+  vec3 tangent_x = normalize(abs(g.x) > 0.5f ? cross(g, vec3(0.0f, 1.0f, 0.0f)) : cross(g, vec3(1.0f, 0.0f, 0.0f)));
+  vec3 tangent_y = cross(g, tangent_x);
   mat2 texels_per_tangent = mat2(spot_texels_along(l, clip, tangent_x), spot_texels_along(l, clip, tangent_y));
   vec3 away = (p - light_position) / max(r, 1e-20f);
   vec2 depth_per_tangent = vec2(dot(away, tangent_x), dot(away, tangent_y)) / range;
@@ -314,6 +338,7 @@ void main() {
   out_position = vec4(world_position, 1.0f);
   out_normal = vec4(facing_normal(), 0.0f);
   out_albedo = surface_albedo_opacity();
+  out_geometric_normal = vec4(triangle_normal(out_normal.xyz), 0.0f);
   if (cut_out) discard;
 }
 #elif defined(MSM_DEFERRED_SHADOWS)
@@ -322,6 +347,7 @@ void main() {
   vec4 position = texelFetch(surface_position, p, 0);
   if (position.w == 0.0f) discard; // the background keeps its clear values
   world_position = position.xyz;
+  geometric_normal = texelFetch(surface_geometric_normal, p, 0).xyz;
   vec3 direct, visibility;
   direct_light(texelFetch(surface_normal, p, 0).xyz, direct, visibility);
   write_shaded(texelFetch(surface_albedo, p, 0), direct, visibility);
@@ -331,7 +357,9 @@ void main() {
   // Cut-outs (alpha mask) are discarded at the end: the lookups' derivatives need the whole quad.
   bool cut_out = !alpha_test_passes(object, kTexturedDraws, opacity_texture, texcoord);
   vec3 direct, visibility;
-  direct_light(facing_normal(), direct, visibility);
+  vec3 n = facing_normal();
+  geometric_normal = triangle_normal(n);
+  direct_light(n, direct, visibility);
   write_shaded(surface_albedo_opacity(), direct, visibility);
   if (cut_out) discard;
 }
