@@ -309,7 +309,7 @@ struct Renderer::Impl {
       u.sample_offsets[i / 2][int(2 * (i % 2))] = offsets[i].x;
       u.sample_offsets[i / 2][int(2 * (i % 2) + 1)] = offsets[i].y;
     }
-    u.receiver_bias = glm::vec4(layer_kernel(s, 1.0f).z, s.receiver_plane_bias, 0.0f, 0.0f);
+    u.receiver_bias = glm::vec4(layer_kernel(s, 1.0f, false).z, 0.0f, 0.0f, 0.0f);
     u.lights = glm::ivec4(layers(s), 0, 0, 0);
     u.camera_viewport = glm::vec4(float(s.width), float(s.height), 0.0f, 0.0f);
     return u;
@@ -320,8 +320,9 @@ struct Renderer::Impl {
   // width in world units (msm/cascade.h), with what the chain adds in the layer's own texels (the
   // bilinear lookup's tent, 1/6 texel², and the MSAA sample positions': the resolve averages depths
   // taken there; mean of x and y); and, for the receiver-plane bias (lookup.glsl, msm/bias.h), its
-  // variance per axis in texels² with the MSAA positions' (the lookup adds its own).
-  glm::vec4 layer_kernel(const RenderSettings& s, float scale) const {
+  // variance per axis in texels² with the MSAA positions' (the lookup adds its own), and its
+  // multiplier (RenderSettings::resolved_receiver_plane_bias: a cascade's map or another).
+  glm::vec4 layer_kernel(const RenderSettings& s, float scale, bool cascade) const {
     std::vector<glm::vec2> offsets =
         ctx.properties().limits.standardSampleLocations ? standard_sample_offsets(s.msaa) : std::vector<glm::vec2>(8);
     double msaa_variance = 0.0;
@@ -329,7 +330,8 @@ struct Renderer::Impl {
     const int taps = msm_cascade_filter_taps(s.filter_size, scale);
     const float sigma =
         msm_cascade_filter_sigma(s.filter_size, s.filter_sigma, scale, float(msaa_variance + 1.0 / 6.0));
-    return glm::vec4(sigma, float(taps), float(msm_gaussian_variance(taps, sigma) + msaa_variance), 0.0f);
+    return glm::vec4(sigma, float(taps), float(msm_gaussian_variance(taps, sigma) + msaa_variance),
+                     s.resolved_receiver_plane_bias(cascade));
   }
 
   LightUniforms light_uniforms(const RenderSettings& s, const Technique& technique,
@@ -340,7 +342,7 @@ struct Renderer::Impl {
     glm::dvec2 texel = f.texel(s.shadow_size);
     u.towards_light = glm::vec4(light.towards_light, s.normal_offset * float(texel.x));
     u.irradiance = glm::vec4(light.irradiance, 0.0f);
-    u.kernel = layer_kernel(s, 1.0f);
+    u.kernel = layer_kernel(s, 1.0f, false);
     if (msm_technique_is_area_light(technique.id)) {
       // The light's two half extents along the frame's axes (a disc: its radius both), the search
       // region and filter per axis from them.
@@ -372,7 +374,7 @@ struct Renderer::Impl {
     for (const scene::Cascade& c : cascades) {
       LightUniforms u = light_uniforms(s, technique, light, c.frame);
       u.cascade = glm::vec4(float(c.fade_in.x), float(c.fade_in.y), float(c.fade_out.x), float(c.fade_out.y));
-      u.kernel = layer_kernel(s, float(first_texel / c.frame.texel(s.shadow_size).x));
+      u.kernel = layer_kernel(s, float(first_texel / c.frame.texel(s.shadow_size).x), true);
       light_data.push_back(u);
     }
   }
@@ -628,7 +630,8 @@ struct Renderer::Impl {
     for (const scene::LocalLight& point : point_lights())
       for (int face = 0; face < int(kCubeFaces); ++face)
         light_data.push_back(point_face_uniforms(s, technique, point, face));
-    for (std::size_t i = first_local_light; i < light_data.size(); ++i) light_data[i].kernel = layer_kernel(s, 1.0f);
+    for (std::size_t i = first_local_light; i < light_data.size(); ++i)
+      light_data[i].kernel = layer_kernel(s, 1.0f, false);
     // Sub-lights after the frame's lights, each light's after their summary, whose index and the
     // sub-lights' count are in the light's rect_extent.zw (shading.glsl).
     for (std::size_t i = 0; i < frame_lights.size(); ++i) {

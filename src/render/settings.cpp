@@ -52,6 +52,10 @@ float RenderSettings::resolved_depth_bias() const {
   return depth_bias ? *depth_bias : find_rendered_technique(technique).depth_bias;
 }
 
+float RenderSettings::resolved_receiver_plane_bias(bool cascade) const {
+  return receiver_plane_bias ? *receiver_plane_bias : cascade ? 1.0f : 0.0f;
+}
+
 glm::vec4 RenderSettings::parameter_vector() const {
   return msm::parameter_vector(find_rendered_technique(technique), parameters);
 }

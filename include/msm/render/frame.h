@@ -33,8 +33,8 @@ struct FrameUniforms {
   vec4 sample_offsets[4];  // MSAA sample positions relative to the texel centre, in
                            // texels: sample 2i in [i].xy, 2i + 1 in [i].zw
   vec4 receiver_bias;      // receiver-plane bias of the filtered techniques (lookup.glsl):
-                           // x: the kernel's variance per axis in texels² (blur + MSAA),
-                           // y: multiplier of the bias each bound needs (0 = off), zw: unused
+                           // x: the kernel's variance per axis in texels² (blur + MSAA), yzw:
+                           // unused (the multiplier is each layer's, LightUniforms::kernel.w)
   ivec4 lights;            // x: number of lights (layers of the shadow-map arrays), yzw: unused
   vec4 camera_viewport;    // xy: the camera image's size in pixels (msm_surface_footprint), zw: unused
 };
@@ -68,7 +68,8 @@ struct LightUniforms {
                         // (w); all 0: no cascades (weight 1)
   vec4 kernel;          // the Gaussian filter of this layer (msm/filter.h), in its own texels: x: σ, y: taps
                         // (odd), z: its variance per axis in texels² with the MSAA sample positions'
-                        // (the receiver-plane bias, lookup.glsl), w: unused. A cascade's is the frame's
+                        // (the receiver-plane bias, lookup.glsl), w: that bias's multiplier (0 = off;
+                        // RenderSettings::resolved_receiver_plane_bias). A cascade's is the frame's
                         // scaled to the same width in world units (msm_cascade_filter_*), every other
                         // layer's the frame's (FrameUniforms::filter_weights, ::receiver_bias.x).
 };

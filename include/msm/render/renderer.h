@@ -98,10 +98,16 @@ struct RenderSettings {
   // standard deviation, mips included) times what the technique's bound needs on a plane (4MSM: 1,
   // 6MSM: √3, EVSM4: c⁻σ²/2, VSM/ESM: 0), times this factor, on top of depth_bias. 1 removes the
   // self-shadowing of sloped receivers (grazing light, coarse mips); it also loses short-range
-  // shadows of occluders closer than the bias (the railing: leaking x1.6-2), hence off (0) by
-  // default: at mip 0 the 16-bit maps' moment bias already absorbs most of it (docs/results.md,
-  // "Translucent occluders").
-  float receiver_plane_bias = 0.0f;
+  // shadows of occluders closer than the bias (the railing: leaking x1.6-2).
+  // Unset: resolved_receiver_plane_bias's default per shadow map.
+  std::optional<float> receiver_plane_bias;
+  // receiver_plane_bias, or its default for a map: 1 for a cascade of a directional light, 0 for
+  // every other map. The moment bias and the depth bias are constants in [0,1] depth, so the depth
+  // spread they absorb in world units grows with the map's depth range: one map fitted to the view
+  // spans all of it and absorbs the receiver's spread at mip 0 (docs/results.md, "Translucent
+  // occluders"); a cascade's range is its slice's (22 m against 280 m on box_on_ground), and there
+  // its ground shadows itself unless the spread is biased (docs/techniques.md, "Cascades").
+  float resolved_receiver_plane_bias(bool cascade) const;
   float exposure = 1.0f;
   // How the shading reads a filtered map: automatic = dither for the non-linear techniques (HPG),
   // bilinear for the others; nearest = the texel under the fragment (mip 0); bilinear for the

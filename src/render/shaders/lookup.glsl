@@ -38,8 +38,10 @@ Bilinear bilinear_texels(vec2 t) {
 // the fragment depth: the filter kernel spans several texels of a sloped receiver, and the half
 // of them in front of the fragment would shadow it (self-shadowing, worst at grazing light).
 // frame.receiver_bias.x: the kernel's variance per axis in texels² from the blur and the MSAA
-// sample positions (host; with cascades the layer's, LightUniforms::kernel.z), .y: a multiplier (RenderSettings::receiver_plane_bias; 0 = off), applied
-// to σ (so the negative warp's σ² bias scales by its square). The lookup adds its own
+// sample positions (host; with cascades the layer's, LightUniforms::kernel.z); the layer's
+// LightUniforms::kernel.w: a multiplier (RenderSettings::resolved_receiver_plane_bias, by default
+// 1 for a cascade and 0 for one map; 0 = off), applied to σ (so the negative warp's σ² bias scales
+// by its square). The lookup adds its own
 // footprint: bilinear at mip λ reads texels that average 2^λ x 2^λ mip-0 texels (variance
 // (4^λ − 1)/12 per axis) with tent weights over 2^λ texels (4^λ f(1 − f), 4^λ/6 on average over
 // the fractional position f): 4^λ/4 − 1/12 in all, 1/6 at mip 0; trilinear blends two levels,
@@ -50,7 +52,7 @@ float receiver_plane_bias(ShadowLookup s, float lod) {
   float variance = kCascades ? lights[shadow_layer].kernel.z : frame.receiver_bias.x;
   // Off (or NaN): a multiplier of 0 (finite σ), selected rather than branched on, because lavapipe
   // recompiles a shader per frame for some branches on a uniform (kLightCount, shading.glsl).
-  float multiplier = frame.receiver_bias.y > 0.0f ? frame.receiver_bias.y : 0.0f;
+  float multiplier = lights[shadow_layer].kernel.w > 0.0f ? lights[shadow_layer].kernel.w : 0.0f;
   if (kLookup == MSM_LOOKUP_BILINEAR) variance += exp2(2.0f * lod) * 0.25f - 1.0f / 12.0f;
   float sigma = multiplier * msm_receiver_depth_sigma(s.depth_per_texel, variance); // [0,1] depth
   if (msm_technique_is_six_moments(kTechnique)) return MSM_RECEIVER_SIGMAS6 * sigma;
