@@ -46,6 +46,12 @@
 //   msm_rectified_moments4 / msm_rectified_moments6 / msm_rectified_csm(two_depths[, terms])
 // then the storage transform of the technique (msm_theta4_star, msm_theta6_star, msm_csm_to_unorm
 // per texel; quantize.h, baselines.h), which commutes with the prefix sums (both are affine).
+// Spot lights (the section at the end: columns are the angle ψ at the light, the depth the angle γ
+// at the camera):
+//   msm_spot_rectification_frame, msm_spot_psi, msm_spot_psi_max, msm_spot_light_ray_direction
+//   msm_spot_rectified_signed_depth / msm_spot_rectified_one_depth     resampling the spot's map
+//   msm_spot_row_gamma, msm_spot_prefix_sum_weight                      the prefix sums' weights
+//   msm_spot_view_lookup                                                a pixel's (u, v, depth)
 #ifndef MSM_RECTIFICATION_H
 #define MSM_RECTIFICATION_H
 #include "msm/baselines.h"

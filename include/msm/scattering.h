@@ -9,7 +9,8 @@
 // θ is the scattering angle between the light's direction of travel and the direction the
 // scattered light travels, towards the camera (−ω_p): cos θ = dot(towards_light, ω_p). Henyey–
 // Greenstein with g > 0 scatters forwards, so looking into the light is brightest; g = 0 is
-// isotropic, 1/(4π).
+// isotropic, 1/(4π). Spot lights' f E varies along the ray (msm_local_light_inscattering; its
+// integral over the light's angle ψ, msm_spot_unshadowed_inscattering).
 #ifndef MSM_SCATTERING_H
 #define MSM_SCATTERING_H
 #include "msm/baselines.h"
