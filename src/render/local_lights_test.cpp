@@ -151,7 +151,7 @@ TEST_F(LocalLightsRenderTest, SpotLightIrradianceBelowTheSpotIsIntensityOverHeig
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(result.color.at(x, y, c), expected[c], 0.02f * expected[c]) << c;
 }
 
-scene::Scene spot_beam_scene(); // below: a spot's beam in a medium
+scene::Scene spot_beam_scene(bool light_in_view = true); // below: a spot's beam in a medium
 
 // What the renderer does not draw with spot lights is refused by name, never drawn without them:
 // the prefiltered scattering with a filtered resampling or transmittance layers, a spot without range.
@@ -316,9 +316,13 @@ TEST_F(LocalLightsRenderTest, SpotLightSoftShadowsAgreeWithTheRayTracer) {
 // camera looks at the beam from the side, so that the rays cross the lit cone, the shaft and the
 // dark medium outside the cone; a wall behind ends every ray within 8 m (ray marching spaces its
 // samples evenly over the ray: over a ray to the far plane they would step over the beam).
-scene::Scene spot_beam_scene() {
+// light_in_view false: the camera looks down at the beam from the side, the light above the view.
+scene::Scene spot_beam_scene(bool light_in_view) {
+  const std::string camera =
+      light_in_view ? R"("camera": {"position": [0, 1, 4.5], "target": [0, 0.9, 0], "fov_y_deg": 50},)"
+                    : R"("camera": {"position": [2.5, 0.8, 3.0], "target": [0, 0.5, 0], "fov_y_deg": 40},)";
   return scene::load_scene_json(R"({"msm_scene": 1,
-    "camera": {"position": [0, 1, 4.5], "target": [0, 0.9, 0], "fov_y_deg": 50},
+    )" + camera + R"(
     "lights": [{"type": "spot", "position": [0, 2, 0], "direction": [0, -1, 0], "inner_cone_deg": 25,
                 "outer_cone_deg": 30, "range": 6, "intensity": [4, 4, 4]}],
     "medium": {"extinction": 0.2, "scattering_albedo": 1},
@@ -351,25 +355,32 @@ ScatteringError scattering_error(const RenderResult& result, const reference::Re
 
 constexpr int kBeamWidth = 128, kBeamHeight = 96;
 
-const reference::Result& spot_beam_truth() {
-  static const reference::Result truth = reference::render(
-      spot_beam_scene(), test::reference_settings(reference::Effect::scattering, kBeamWidth, kBeamHeight, 256));
-  return truth;
+const reference::Result& spot_beam_truth(bool light_in_view) {
+  static std::map<bool, reference::Result> truths;
+  auto it = truths.find(light_in_view);
+  if (it == truths.end())
+    it = truths
+             .emplace(light_in_view, reference::render(spot_beam_scene(light_in_view),
+                                                       test::reference_settings(reference::Effect::scattering,
+                                                                                kBeamWidth, kBeamHeight, 256)))
+             .first;
+  return it->second;
 }
 
 // Each technique's in-scattered luminance against the ray tracer's (256 samples per ray): the
 // mean absolute difference over the mean (measured on lavapipe; bound 1.5x, at least 0.02 more);
 // the ray's visible fraction's MAE likewise (bound 1.5x, at least 0.01 more).
 std::map<std::string, ScatteringError>
-expect_spot_beam_scattering(Renderer& renderer, const std::map<std::string, std::pair<double, double>>& measured) {
-  const reference::Result& truth = spot_beam_truth();
+expect_spot_beam_scattering(Renderer& renderer, const std::map<std::string, std::pair<double, double>>& measured,
+                            bool light_in_view = true) {
+  const reference::Result& truth = spot_beam_truth(light_in_view);
   std::map<std::string, ScatteringError> errors;
   for (const auto& [technique, expected] : measured) {
     const RenderResult result = renderer.render(test::render_settings(technique, kBeamWidth, kBeamHeight, 256));
     const ScatteringError e = scattering_error(result, truth);
-    fmt::print("spot scattering, {:<17} vs ray traced: in-scattered luminance mean absolute error / mean {:.4f}, "
+    fmt::print("spot scattering{}, {:<17} vs ray traced: in-scattered luminance mean absolute error / mean {:.4f}, "
                "visible fraction MAE {:.4f}, non-finite {}\n",
-               technique, e.inscattered, e.visible_fraction, e.non_finite);
+               light_in_view ? "" : " (light out of view)", technique, e.inscattered, e.visible_fraction, e.non_finite);
     EXPECT_EQ(e.non_finite, 0u) << technique;
     EXPECT_EQ(image::compute_metrics(result.color, truth.radiance).non_finite_in_test, 0u) << technique;
     EXPECT_LT(e.inscattered, std::max(1.5 * expected.first, expected.first + 0.02)) << technique;
@@ -402,6 +413,12 @@ TEST_F(LocalLightsRenderTest, SpotLightPrefilteredScatteringAgreesWithTheRayTrac
                                              {"scatter-march-32", {0.1730, 0.0025}}});
   for (const char* technique : {"scatter-msm4-64", "scatter-msm6-64", "scatter-csm-32"})
     EXPECT_LT(e[technique].inscattered, 0.5 * e["scatter-march-32"].inscattered) << technique;
+  // The light just above the view: the slices a wedge of φ (the epipole out of view), not the full
+  // circle. Measured 0.045 against ray marching's 0.156 with 32 samples.
+  Renderer side(ctx(), spot_beam_scene(false));
+  std::map<std::string, ScatteringError> s = expect_spot_beam_scattering(
+      side, {{"scatter-msm4-64", {0.0450, 0.0064}}, {"scatter-march-32", {0.1558, 0.0062}}}, false);
+  EXPECT_LT(s["scatter-msm4-64"].inscattered, s["scatter-march-32"].inscattered);
 }
 
 // A point light 1 m over a plane among columns 0.8 m high at 0.6 m from the light's foot: their
