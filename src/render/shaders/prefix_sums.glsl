@@ -42,6 +42,9 @@ layout(binding = MSM_BINDING_PREFIX_TARGET1, MSM_PREFIX_FORMAT1) uniform writeon
 #endif
 
 layout(constant_id = MSM_PREFIX_ROWS_SPEC_ID) const bool kRowSweep = true;
+// Whether some light of the frame is a spot light (FrameConfig::spot_lights): a constant, so that
+// frames of directional lights only compile no spot path.
+layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
 
 void store_prefix_sum(int x, int row, vec4 mine, vec4 mine1) {
   ivec3 texel = MSM_OUT(x, row);
@@ -69,7 +72,7 @@ float spot_row_v = 0.0f, spot_row_gamma = 0.0f;
 // weight of its light ray (floored, so that a row wholly outside the cone reads the mean of its
 // texels, never 0 / 0; what it scatters is 0 there anyway).
 float texel_weight(int x, float extinction, float delta) {
-  if (!spot_light) return msm_prefix_sum_weight(extinction, delta, float(x));
+  if (!(kSpotLights && spot_light)) return msm_prefix_sum_weight(extinction, delta, float(x));
   RectificationUniforms rect = rects[pass.size.z];
   vec2 uv = vec2((float(x) + 0.5f) / rect.map.x, spot_row_v);
   float cone = msm_spot_cone(dot(msm_spot_light_ray_direction(spot_frame, spot_bounds, uv), vec3(rect.spot_axis)),

@@ -31,6 +31,10 @@ layout(binding = MSM_BINDING_RECTIFY_SOURCE) uniform sampler2D resampling_moment
 layout(constant_id = MSM_RECTIFY_ON_THE_FLY_SPEC_ID) const bool kOnTheFlyFilter = false; // parameter x = 2
 #endif
 
+// Whether some light of the frame is a spot light (FrameConfig::spot_lights): a constant, so that
+// frames of directional lights only compile no spot path.
+layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
+
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(std430, binding = MSM_BINDING_RECTIFY_RECTS) readonly buffer RectificationBlock { RectificationUniforms rects[]; };
 layout(push_constant) uniform Push { ImagePassPush pass; }; // size.z: the light
@@ -136,7 +140,7 @@ void main() {
   TwoDepths d = TwoDepths(vec2(1.0f), vec2(1.0f, 0.0f));
 #ifndef MSM_FILTERED_MAP
   // Spot lights are resampled without filtering only (the renderer refuses the other resamplings).
-  if (msm_rectification_is_spot(rect)) {
+  if (kSpotLights && msm_rectification_is_spot(rect)) {
     d = spot_texel(light, rect, f, b, uv);
   } else
 #endif
