@@ -49,6 +49,7 @@
 // Spot lights (the section at the end: columns are the angle ψ at the light, the depth the angle γ
 // at the camera):
 //   msm_spot_rectification_frame, msm_spot_psi, msm_spot_psi_max, msm_spot_light_ray_direction
+//   msm_spot_cone_phi_range, msm_spot_rectified_bounds                  ψ_max and the slices of the cone
 //   msm_spot_rectified_signed_depth / msm_spot_rectified_one_depth     resampling the spot's map
 //   msm_spot_row_gamma, msm_spot_prefix_sum_weight                      the prefix sums' weights
 //   msm_spot_view_lookup                                                a pixel's (u, v, depth)
@@ -459,6 +460,32 @@ MSM_FN float msm_spot_psi(vec3 p, float d) { return msm_atan2_safe(length(vec2(p
 // beyond carry no light. The rectified map spans ψ in [0, ψ_max].
 MSM_FN float msm_spot_psi_max(vec3 axis, float outer) {
   return min(msm_inclination(axis) + outer, MSM_PI) * (1.0f + MSM_RECT_R_PAD);
+}
+
+// The slices that the outer cone (half-angle `outer`, unit axis `axis` in the frame) reaches:
+// (φ_min, φ_span) of its wedge about the z axis, the axis's azimuth ± asin(sin outer / sin β), with
+// MSM_RECT_PHI_PAD on each side; the full circle (0, 2π) where the cone holds +z or −z (β <= outer
+// or β >= π − outer). A pixel of another slice has no in-scattering from the spot.
+MSM_FN vec2 msm_spot_cone_phi_range(vec3 axis, float outer) {
+  float beta = msm_inclination(axis);
+  if (beta <= outer || beta >= MSM_PI - outer) return vec2(0.0f, MSM_TWO_PI);
+  float half_width = asin(min(sin(outer) / sin(beta), 1.0f)) + MSM_RECT_PHI_PAD;
+  float phi = msm_rectified_spherical(axis).y - half_width;
+  return vec2(phi < 0.0f ? phi + MSM_TWO_PI : phi, 2.0f * half_width);
+}
+
+// A spot light's bounds from the view's (msm_rectification_bounds of the spot's frame): ψ_max of the
+// cone, and of the two wedges of slices, the view's and the cone's, the narrower (the lit slices
+// in view lie in both; a lookup outside the cone's scatters nothing).
+MSM_FN RectifiedBounds msm_spot_rectified_bounds(RectifiedBounds view, vec3 axis, float outer) {
+  RectifiedBounds b = view;
+  b.r_max = msm_spot_psi_max(axis, outer);
+  vec2 cone = msm_spot_cone_phi_range(axis, outer);
+  if (cone.y < b.phi_span) {
+    b.phi_min = cone.x;
+    b.phi_span = cone.y;
+  }
+  return b;
 }
 
 // The world direction of the light ray of texel coordinates uv (ψ = u ψ_max, φ of v).

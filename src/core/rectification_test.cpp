@@ -539,7 +539,7 @@ TEST(SpotRectification, TexelsMapToLightRaysThroughTheLight) {
   msm::RectifiedBounds b = msm::msm_rectification_bounds(f, v.far_corners());
   const glm::vec3 axis_f =
       msm::msm_to_rectification_space(msm::RectificationFrame{glm::vec3(0.0f), f.x_axis, f.y_axis, f.z_axis}, axis);
-  b.r_max = msm::msm_spot_psi_max(axis_f, float(M_PI / 6));
+  b = msm::msm_spot_rectified_bounds(b, axis_f, float(M_PI / 6));
   const float d = glm::length(light - camera);
   // The cone's widest ray makes β + 30° with +z, β the axis's angle from the light → camera direction.
   const float beta = std::acos(glm::dot(axis, glm::normalize(camera - light)));
@@ -635,8 +635,8 @@ TEST(SpotRectification, RowWeightsAtTheSlicesMeanGammaApproachTheRaysOwn) {
   v.up = glm::cross(v.right, v.forward);
   const msm::RectificationFrame f = msm::msm_spot_rectification_frame(camera, light);
   msm::RectifiedBounds b = msm::msm_rectification_bounds(f, v.far_corners());
-  b.r_max = msm::msm_spot_psi_max(
-      glm::vec3(glm::dot(f.x_axis, axis), glm::dot(f.y_axis, axis), glm::dot(f.z_axis, axis)), outer);
+  b = msm::msm_spot_rectified_bounds(
+      b, glm::vec3(glm::dot(f.x_axis, axis), glm::dot(f.y_axis, axis), glm::dot(f.z_axis, axis)), outer);
   const float d = glm::length(light - camera), extinction = 0.2f, s = 8.0f;
   const float shaft = std::cos(float(M_PI / 18));
   for (float g : {0.0f, 0.5f}) {
@@ -681,4 +681,39 @@ TEST(SpotRectification, RowWeightsAtTheSlicesMeanGammaApproachTheRaysOwn) {
     EXPECT_LT(largest, 0.01);
     if (g > 0.0f) EXPECT_LT(sum, 0.25 * sum_cone_only);
   }
+}
+
+// The slices of the cone: by hand, an axis across the line light–camera (β = 90°) and a 30° cone
+// span asin(sin 30° / sin 90°) = 30° on each side of the axis's azimuth; a cone that holds the
+// line spans the full circle. For random cones, every direction inside maps into the wedge.
+TEST(SpotRectification, ConeSlicesHoldEveryDirectionOfTheCone) {
+  const float pad = msm::MSM_RECT_PHI_PAD;
+  const glm::vec2 across = msm::msm_spot_cone_phi_range(glm::vec3(0.0f, 1.0f, 0.0f), float(M_PI / 6));
+  EXPECT_NEAR(across.x, float(M_PI / 2 - M_PI / 6) - pad, 1e-6f);
+  EXPECT_NEAR(across.y, float(M_PI / 3) + 2.0f * pad, 1e-6f);
+  EXPECT_EQ(msm::msm_spot_cone_phi_range(glm::normalize(glm::vec3(0.1f, 0.0f, 1.0f)), 0.3f).y, float(2 * M_PI));
+  EXPECT_EQ(msm::msm_spot_cone_phi_range(glm::normalize(glm::vec3(0.1f, 0.0f, -1.0f)), 0.3f).y, float(2 * M_PI));
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int narrower = 0;
+  for (int cone = 0; cone < 200; ++cone) {
+    const glm::vec3 axis = glm::vec3(random_unit(rng));
+    const float outer = float(0.05 + 1.2 * u(rng));
+    msm::RectifiedBounds view{};
+    view.phi_min = 0.0f;
+    view.phi_span = float(2 * M_PI);
+    const msm::RectifiedBounds b = msm::msm_spot_rectified_bounds(view, axis, outer);
+    narrower += b.phi_span < float(2 * M_PI);
+    for (int i = 0; i < 200; ++i) {
+      // A direction within the cone: the axis turned by up to `outer` about a random perpendicular.
+      const glm::dvec3 p = glm::normalize(glm::cross(glm::dvec3(axis), random_unit(rng)));
+      const double a = outer * std::sqrt(u(rng));
+      const glm::vec3 d = glm::vec3(std::cos(a) * glm::dvec3(axis) + std::sin(a) * p);
+      const float v = msm::msm_rectified_coordinates(b, d).y;
+      EXPECT_GE(v, 0.0f);
+      EXPECT_LE(v, 1.0f) << "cone " << cone << " axis " << axis.x << " " << axis.y << " " << axis.z << " outer "
+                         << outer;
+    }
+  }
+  EXPECT_GT(narrower, 100);
 }

@@ -702,13 +702,15 @@ struct Renderer::Impl {
   }
 
   // A spot light's rectification (rectification.h's spot section): the camera's frame towards the
-  // light, the view's φ and γ bounds, ψ over the spot's outer cone.
+  // light, the view's γ bounds, ψ over the spot's outer cone, φ over the narrower of the view's and
+  // the cone's wedges.
   RectificationUniforms spot_rectification_uniforms(const RenderSettings& s, const scene::LocalLight& spot) const {
     RectificationFrame f = msm_spot_rectification_frame(scene.camera.position, spot.position);
-    RectifiedBounds b = msm_rectification_bounds(f, far_corners(s));
     const glm::vec3 axis = glm::normalize(spot.direction);
-    b.r_max = msm_spot_psi_max(glm::vec3(glm::dot(f.x_axis, axis), glm::dot(f.y_axis, axis), glm::dot(f.z_axis, axis)),
-                               glm::radians(spot.outer_cone_deg));
+    const RectifiedBounds b = msm_spot_rectified_bounds(
+        msm_rectification_bounds(f, far_corners(s)),
+        glm::vec3(glm::dot(f.x_axis, axis), glm::dot(f.y_axis, axis), glm::dot(f.z_axis, axis)),
+        glm::radians(spot.outer_cone_deg));
     const float extinction = scene.medium ? scene.medium->extinction : 0.0f;
     RectificationUniforms u =
         msm_rectification_uniforms(f, b, glm::vec4(float(s.shadow_size), float(s.shadow_size), 0.0f, extinction));
