@@ -46,6 +46,13 @@
 //   msm_rectified_moments4 / msm_rectified_moments6 / msm_rectified_csm(two_depths[, terms])
 // then the storage transform of the technique (msm_theta4_star, msm_theta6_star, msm_csm_to_unorm
 // per texel; quantize.h, baselines.h), which commutes with the prefix sums (both are affine).
+// Spot lights (the section at the end: columns are the angle ψ at the light, the depth the angle γ
+// at the camera):
+//   msm_spot_rectification_frame, msm_spot_psi, msm_spot_psi_max, msm_spot_light_ray_direction
+//   msm_spot_cone_phi_range, msm_spot_rectified_bounds                  ψ_max and the slices of the cone
+//   msm_spot_rectified_signed_depth / msm_spot_rectified_one_depth     resampling the spot's map
+//   msm_spot_row_gamma, msm_spot_prefix_sum_weight                      the prefix sums' weights
+//   msm_spot_view_lookup                                                a pixel's (u, v, depth)
 #ifndef MSM_RECTIFICATION_H
 #define MSM_RECTIFICATION_H
 #include "msm/baselines.h"
@@ -416,6 +423,114 @@ MSM_FN CsmMoments msm_rectified_csm(TwoDepths d, int terms) {
   CsmMoments m = msm_csm_moments_scale_add(CsmMoments(mat4(0.0f), mat4(0.0f)),
                                            msm_csm_moments(msm_unit_depth(d.z.x), terms), d.w.x);
   return msm_csm_moments_scale_add(m, msm_csm_moments(msm_unit_depth(d.z.y), terms), d.w.y);
+}
+
+// ---- Spot lights: the rectification of a point source (docs/techniques.md, "Prefiltered single
+// scattering from spot lights") ----
+// Light at L, camera at p, d = |L − p|. The epipolar slices are the half-planes through the line
+// L–p, at azimuth φ about it: the same φ as above in the camera's frame whose "towards the light"
+// points at L (msm_spot_rectification_frame: z = (p − L) / d, L at z = −d). In a slice a LIGHT ray
+// has its angle ψ at L from the direction L→p, a VIEW ray its angle γ at p from p→L, which is
+// π − θ with θ the inclination above: a view ray is still a row at one rectified depth
+// (θ_max − θ) / (θ_max − θ_min), and the bounds of θ, φ are msm_rectification_bounds' of the camera
+// in that frame. Along a light ray γ grows monotonically from 0 (at L) towards π − ψ, so γ is its
+// depth: texel (u, v) = (ψ / ψ_max, φ) stores the moments of the first occluder's γ. The view ray
+// (φ, γ) from p to a point q crosses the light rays ψ in [0, ψ(q)]: a prefix of the row. Law of
+// sines in the triangle (L, p, point): t = d sin ψ / sin(ψ + γ) from p, r = d sin γ / sin(ψ + γ)
+// from L, dt/dψ = d sin γ / sin²(ψ + γ), hence dt / r² = dψ / h with h = d sin γ the light's
+// distance from the view ray (scattering.h: msm_spot_ray_distances, msm_spot_dt_dpsi), and the in-scattering ∫ f I(ω) r⁻² exp(−σt t) V dt becomes
+//   (1/h) ∫₀^ψ(q) f(ψ + γ) I(ω(φ, ψ)) exp(−σt t(ψ, γ)) V dψ
+// (the scattering angle is ψ + γ): the inverse square is exact in ψ and the cone's factor I(ω)
+// belongs to the texel. The phase and the transmittance depend on γ: the prefix sums weigh row v
+// at one γ, the mean of the slice's view inclinations (msm_spot_row_gamma), as JCGT weighs a row
+// with the Δ(v) of its mean θ. The stored RectifiedBounds hold ψ_max in r_max.
+
+// The spot's frame: the camera's, its z axis from the light through the camera.
+// Precondition: the camera is not at the light.
+MSM_FN RectificationFrame msm_spot_rectification_frame(vec3 camera, vec3 light_position) {
+  return msm_rectification_frame(camera, light_position - camera);
+}
+
+// ψ of a point p in that frame (the light at z = −d): its angle at the light from the direction
+// light → camera, in [0, π].
+MSM_FN float msm_spot_psi(vec3 p, float d) { return msm_atan2_safe(length(vec2(p.x, p.y)), p.z + d); }
+
+// ψ_max: the light rays of the spot's outer cone (half-angle `outer`, unit axis `axis` in the
+// frame's coordinates) make angles up to β + outer with +z, β the axis's angle from +z; rays
+// beyond carry no light. The rectified map spans ψ in [0, ψ_max].
+MSM_FN float msm_spot_psi_max(vec3 axis, float outer) {
+  return min(msm_inclination(axis) + outer, MSM_PI) * (1.0f + MSM_RECT_R_PAD);
+}
+
+// The slices that the outer cone (half-angle `outer`, unit axis `axis` in the frame) reaches:
+// (φ_min, φ_span) of its wedge about the z axis, the axis's azimuth ± asin(sin outer / sin β), with
+// MSM_RECT_PHI_PAD on each side; the full circle (0, 2π) where the cone holds +z or −z (β <= outer
+// or β >= π − outer). A pixel of another slice has no in-scattering from the spot.
+MSM_FN vec2 msm_spot_cone_phi_range(vec3 axis, float outer) {
+  float beta = msm_inclination(axis);
+  if (beta <= outer || beta >= MSM_PI - outer) return vec2(0.0f, MSM_TWO_PI);
+  float half_width = asin(min(sin(outer) / sin(beta), 1.0f)) + MSM_RECT_PHI_PAD;
+  float phi = msm_rectified_spherical(axis).y - half_width;
+  return vec2(phi < 0.0f ? phi + MSM_TWO_PI : phi, 2.0f * half_width);
+}
+
+// A spot light's bounds from the view's (msm_rectification_bounds of the spot's frame): ψ_max of the
+// cone, and of the two wedges of slices, the view's and the cone's, the narrower (the lit slices
+// in view lie in both; a lookup outside the cone's scatters nothing).
+MSM_FN RectifiedBounds msm_spot_rectified_bounds(RectifiedBounds view, vec3 axis, float outer) {
+  RectifiedBounds b = view;
+  b.r_max = msm_spot_psi_max(axis, outer);
+  vec2 cone = msm_spot_cone_phi_range(axis, outer);
+  if (cone.y < b.phi_span) {
+    b.phi_min = cone.x;
+    b.phi_span = cone.y;
+  }
+  return b;
+}
+
+// The world direction of the light ray of texel coordinates uv (ψ = u ψ_max, φ of v).
+MSM_FN vec3 msm_spot_light_ray_direction(RectificationFrame f, RectifiedBounds b, vec2 uv) {
+  vec2 psi_phi = msm_rectified_r_phi(b, uv);
+  float s = sin(psi_phi.x);
+  return s * cos(psi_phi.y) * f.x_axis + s * sin(psi_phi.y) * f.y_axis + cos(psi_phi.x) * f.z_axis;
+}
+
+// Rectified signed depth [-1, 1] (clamped) of the point at `distance` from the light along the
+// light ray ψ: the inclination of (distance sin ψ, distance cos ψ − d) as seen from the camera.
+MSM_FN float msm_spot_rectified_signed_depth(RectifiedBounds b, float psi, float d, float distance) {
+  return msm_signed_depth(msm_rectified_depth_of_rz(b, distance * sin(psi), distance * cos(psi) - d));
+}
+// Without filtering: the first occluder at `distance` along the light ray, weight 1.
+MSM_FN TwoDepths msm_spot_rectified_one_depth(RectifiedBounds b, float psi, float d, float distance) {
+  float z = msm_spot_rectified_signed_depth(b, psi, d, distance);
+  return TwoDepths(vec2(z, z), vec2(1.0f, 0.0f));
+}
+
+// The γ at which row v (texture coordinate) is weighed: π − the mean of the slice's inclinations.
+MSM_FN float msm_spot_row_gamma(RectifiedBounds b, float v) {
+  vec2 range = msm_slice_inclination_range(b, b.phi_min + v * b.phi_span);
+  return MSM_PI - 0.5f * (range.x + range.y);
+}
+
+// The weight of the light ray ψ in the prefix sums of a row weighed at γ: f(ψ + γ) I(ω) exp(−σt t)
+// up to the factors common to the row (ρ σt, the intensity, dψ, 1/h), with f the Henyey–Greenstein
+// phase of the scattering angle ψ + γ and `cone` the spot's cone factor of the ray (msm_spot_cone);
+// 0 where the view ray never meets the light ray.
+MSM_FN float msm_spot_prefix_sum_weight(float d, float psi, float gamma, float extinction, float g, float cone) {
+  vec2 tr = msm_spot_ray_distances(d, psi, gamma);
+  float half_angle = 0.5f * (psi + gamma);
+  float s = sin(half_angle), c = cos(half_angle);
+  float phase = msm_phase_henyey_greenstein_versines(2.0f * s * s, 2.0f * c * c, g);
+  return tr.x >= 0.0f ? phase * cone * exp(-extinction * tr.x) : 0.0f;
+}
+
+// The lookup of a pixel whose view ray ends at end_world: (u, v, depth), u = ψ(end) / ψ_max −
+// 0.5 / width (the prefix texel j's centre holds the rays up to (j + 1) ψ_max / width, as
+// msm_prefix_sum_lookup_u), v the row and depth the ray's rectified depth (γ) in [0,1].
+MSM_FN vec3 msm_spot_view_lookup(RectificationFrame f, RectifiedBounds b, float d, vec3 end_world, float width) {
+  vec3 p = msm_to_rectification_space(f, end_world);
+  vec3 c = msm_rectified_coordinates(b, p);
+  return vec3(msm_spot_psi(p, d) / b.r_max - 0.5f / width, c.y, c.z);
 }
 
 MSM_END

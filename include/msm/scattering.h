@@ -9,7 +9,8 @@
 // θ is the scattering angle between the light's direction of travel and the direction the
 // scattered light travels, towards the camera (−ω_p): cos θ = dot(towards_light, ω_p). Henyey–
 // Greenstein with g > 0 scatters forwards, so looking into the light is brightest; g = 0 is
-// isotropic, 1/(4π).
+// isotropic, 1/(4π). Spot lights' f E varies along the ray (msm_local_light_inscattering; its
+// integral over the light's angle ψ, msm_spot_unshadowed_inscattering).
 #ifndef MSM_SCATTERING_H
 #define MSM_SCATTERING_H
 #include "msm/baselines.h"
@@ -79,6 +80,64 @@ MSM_FN vec3 msm_local_light_inscattering(vec3 p, vec3 view_dir, vec3 position, v
   vec3 towards = d > 0.0f ? to_light / d : -view_dir;
   vec3 e = msm_local_light_irradiance(intensity, d, range, dot(-towards, axis), cos_outer, cos_inner);
   return msm_scattering_phase_term(extinction, albedo, g, towards, view_dir) * e;
+}
+
+// ---- A spot light's in-scattering by its angle at the light (rectification.h's spot section) ----
+// In the triangle of the light L, the camera p (d = |L − p|) and a point of a view ray, ψ the angle
+// at L from the direction L→p and γ the angle at p from p→L, the law of sines gives (t, r): the
+// point at t from p along the view ray γ and at r from L along the light ray ψ; (−1, −1) where the
+// rays do not meet (ψ + γ >= π).
+MSM_FN vec2 msm_spot_ray_distances(float d, float psi, float gamma) {
+  float s = sin(psi + gamma);
+  return s > 0.0f && psi + gamma < MSM_PI ? (d / s) * vec2(sin(psi), sin(gamma)) : vec2(-1.0f);
+}
+// dt/dψ along the view ray γ: d sin γ / sin²(ψ + γ), which is r² / h with h = d sin γ (the light's
+// distance from the view ray): dt / r² = dψ / h. Precondition: 0 < ψ + γ < π.
+MSM_FN float msm_spot_dt_dpsi(float d, float psi, float gamma) {
+  float s = sin(psi + gamma);
+  return d * sin(gamma) / (s * s);
+}
+
+// The angle between two vectors, accurate at 0 and π alike; 0 where one is zero (GLSL's atan(0, 0)
+// is undefined).
+MSM_FN float msm_angle_between(vec3 a, vec3 b) {
+  float sine = length(cross(a, b)), cosine = dot(a, b);
+  return sine == 0.0f && cosine == 0.0f ? 0.0f : atan(sine, cosine);
+}
+
+// Samples of msm_spot_unshadowed_inscattering in the renderer's prefiltered scattering.
+const int MSM_SPOT_INSCATTERING_SAMPLES = 32;
+
+// A spot light's unshadowed in-scattering along the view ray of length s from `camera` along the
+// unit view_dir: ∫₀ˢ exp(−σt t) f E dt with f E = msm_local_light_inscattering, by the midpoint rule
+// in ψ with `samples` points over the part of [0, ψ(end)] that the spot's outer cone can reach
+// (|ψ − β| <= its half-angle, β the axis's angle from the direction light → camera), dt =
+// (dt/dψ) dψ: the inverse square of E cancels against dt/dψ = r² / h, so the integrand is smooth
+// where one in t peaks as 1/r² near the light (only the range's end and the cone's edges are not).
+// 0 for a ray of no length, through the light or outside the cone.
+MSM_FN vec3 msm_spot_unshadowed_inscattering(vec3 camera, vec3 view_dir, float s, vec3 position, vec3 axis,
+                                             vec3 intensity, float range, float cos_outer, float cos_inner,
+                                             float extinction, float albedo, float g, int samples) {
+  vec3 to_light = position - camera;
+  float d = length(to_light);
+  if (!(d > 0.0f) || !(s > 0.0f)) return vec3(0.0f);
+  float gamma = msm_angle_between(view_dir, to_light);
+  float psi_end = msm_angle_between(-to_light, camera + s * view_dir - position);
+  // Only the light rays of the outer cone carry light: ψ within its half-angle of the axis's angle.
+  float beta = msm_angle_between(-to_light, axis), outer = acos(clamp(cos_outer, -1.0f, 1.0f));
+  float psi_lo = max(beta - outer, 0.0f), psi_hi = min(beta + outer, psi_end);
+  if (!(sin(gamma) > 0.0f) || !(psi_hi > psi_lo)) return vec3(0.0f);
+  float step = (psi_hi - psi_lo) / float(samples);
+  vec3 sum = vec3(0.0f);
+  for (int k = 0; k < samples; ++k) {
+    float psi = psi_lo + (float(k) + 0.5f) * step;
+    float t = msm_spot_ray_distances(d, psi, gamma).x;
+    if (!(t >= 0.0f)) continue;
+    vec3 fe = msm_local_light_inscattering(camera + t * view_dir, view_dir, position, axis, intensity, range, cos_outer,
+                                           cos_inner, extinction, albedo, g);
+    sum += (exp(-extinction * t) * msm_spot_dt_dpsi(d, psi, gamma) * step) * fe;
+  }
+  return sum;
 }
 
 // (1 − exp(−x)) / x for x >= 0 without the cancellation of 1 − exp(−x) at small x (GLSL has no

@@ -506,23 +506,13 @@ struct Renderer::Impl {
 
   // What the renderer draws with spot and point lights (`kind`): the hard and filtered techniques
   // of one depth per texel and the soft techniques, opaque and translucent occluders, a finite range
-  // (the stored depth is distance / range); with spot lights also single scattering by ray marching.
+  // (the stored depth is distance / range); with spot lights also single scattering, by ray marching
+  // and prefiltered (rectification.h's spot section).
   void check_spot_lights(const RenderSettings& s, const std::vector<scene::LocalLight>& spots,
                          std::string_view kind) const {
     const Technique& technique = find_rendered_technique(s.technique);
-    // The prefiltered scattering's rectification (rectification.h) resamples a directional light's
-    // map along the epipolar planes of parallel light rays, and one visible fraction per ray stands
-    // for the ray's in-scattering because f E is the same all along it; a spot light's f E falls off
-    // with the inverse square of the distance to it along the ray, which one lookup of prefix sums
-    // over depth cannot weigh.
-    if (technique.prefiltered_scattering())
-      throw RenderError(
-          fmt::format("{} with {} lights: the prefiltered scattering's rectification is derived for "
-                      "directional lights (parallel rays, the same in-scattering all along a view ray); "
-                      "a {} light's falls off with the inverse square of its distance along the ray.{}",
-                      technique.name, kind, kind,
-                      kind == "spot" ? " Ray marching (scatter-march-32) draws spot lights' scattering" : ""));
     const bool spot = kind == "spot";
+    if (spot && technique.prefiltered_scattering()) check_spot_prefiltered_scattering(s, technique, spots);
     const char* unsupported = !spot && technique.scatters() ? "scattering" : nullptr;
     if (unsupported)
       throw RenderError(fmt::format("{} with {} lights: the renderer draws {} lights' hard, filtered and soft shadows "
@@ -534,6 +524,27 @@ struct Renderer::Impl {
         throw RenderError(fmt::format("a {} light without \"range\": the renderer's {} shadow maps store distance / "
                                       "range, so a {} light it draws needs a finite range",
                                       kind, kind, kind));
+  }
+
+  // The prefiltered scattering of spot lights (rectification.h's spot section): the spot's map
+  // resampled without filtering, one weight per row (no transmittance layers), and a camera off the
+  // light (the rectification's axis runs from the light through the camera).
+  void check_spot_prefiltered_scattering(const RenderSettings& s, const Technique& technique,
+                                         const std::vector<scene::LocalLight>& spots) const {
+    const std::string resampling = s.parameter_text("resampling");
+    if (resampling != "none")
+      throw RenderError(fmt::format("{} with spot lights and --set resampling={}: a spot light's rectified map is "
+                                    "resampled without filtering only (--set resampling=none)",
+                                    technique.name, resampling));
+    if (transmittance_layers(s) != 1)
+      throw RenderError(fmt::format("{} with spot lights and --set layers={}: a spot light's prefix sums weigh each "
+                                    "row at one angle, without transmittance layers (--set layers=1)",
+                                    technique.name, transmittance_layers(s)));
+    for (const scene::LocalLight& spot : spots)
+      if (!(glm::distance(scene.camera.position, spot.position) > 1e-4f * spot.range))
+        throw RenderError(fmt::format("{}: the camera is at a spot light's position; the prefiltered scattering "
+                                      "rectifies about the line from the light through the camera",
+                                      technique.name));
   }
 
   // A point light's faces keep at least half their texels per side for their 90-degree part: a
@@ -648,6 +659,7 @@ struct Renderer::Impl {
     if (technique.prefiltered_scattering()) {
       std::vector<RectificationUniforms> r;
       for (const scene::DirectionalLight& light : frame_lights) r.push_back(rectification_uniforms(s, light));
+      for (const scene::LocalLight& spot : spot_lights()) r.push_back(spot_rectification_uniforms(s, spot));
       // NOLINTNEXTLINE(bugprone-undefined-memory-manipulation): standard layout (vec4 members only)
       std::memcpy(rectification.data(), r.data(), r.size() * sizeof(RectificationUniforms));
     }
@@ -669,9 +681,8 @@ struct Renderer::Impl {
     return p;
   }
 
-  // The rectification of one light for this camera (rectification.h, JCGT Appendix A): the bounds
-  // cover the pyramid from the camera to its far plane. The passes read one per light (std430 array).
-  RectificationUniforms rectification_uniforms(const RenderSettings& s, const scene::DirectionalLight& light) {
+  // The camera's far-plane corners in order around the quad (world).
+  glm::mat4x3 far_corners(const RenderSettings& s) const {
     glm::dmat4 inverse = glm::inverse(glm::dmat4(scene.camera_view_projection(float(s.width) / float(s.height))));
     glm::mat4x3 corners;
     const glm::dvec2 ndc[4] = {{-1.0, -1.0}, {1.0, -1.0}, {1.0, 1.0}, {-1.0, 1.0}}; // around the quad
@@ -679,12 +690,37 @@ struct Renderer::Impl {
       glm::dvec4 p = inverse * glm::dvec4(ndc[j], 1.0, 1.0);
       corners[j] = glm::vec3(glm::dvec3(p) / p.w);
     }
+    return corners;
+  }
+
+  // The rectification of one light for this camera (rectification.h, JCGT Appendix A): the bounds
+  // cover the pyramid from the camera to its far plane. The passes read one per light (std430 array).
+  RectificationUniforms rectification_uniforms(const RenderSettings& s, const scene::DirectionalLight& light) {
     RectificationFrame f = msm_rectification_frame(scene.camera.position, light.towards_light);
-    RectifiedBounds b = msm_rectification_bounds(f, corners);
+    RectifiedBounds b = msm_rectification_bounds(f, far_corners(s));
     float extinction = scene.medium ? scene.medium->extinction : 0.0f;
     return msm_rectification_uniforms(
         f, b,
         glm::vec4(float(s.shadow_size), float(s.shadow_size), float(light_frame(light).depth_extent), extinction));
+  }
+
+  // A spot light's rectification (rectification.h's spot section): the camera's frame towards the
+  // light, the view's γ bounds, ψ over the spot's outer cone, φ over the narrower of the view's and
+  // the cone's wedges.
+  RectificationUniforms spot_rectification_uniforms(const RenderSettings& s, const scene::LocalLight& spot) const {
+    RectificationFrame f = msm_spot_rectification_frame(scene.camera.position, spot.position);
+    const glm::vec3 axis = glm::normalize(spot.direction);
+    const RectifiedBounds b = msm_spot_rectified_bounds(
+        msm_rectification_bounds(f, far_corners(s)),
+        glm::vec3(glm::dot(f.x_axis, axis), glm::dot(f.y_axis, axis), glm::dot(f.z_axis, axis)),
+        glm::radians(spot.outer_cone_deg));
+    const float extinction = scene.medium ? scene.medium->extinction : 0.0f;
+    RectificationUniforms u =
+        msm_rectification_uniforms(f, b, glm::vec4(float(s.shadow_size), float(s.shadow_size), 0.0f, extinction));
+    u.spot = glm::vec4(glm::distance(scene.camera.position, spot.position), scene.medium ? scene.medium->g : 0.0f,
+                       spot.cos_outer(), spot.cos_inner());
+    u.spot_axis = glm::vec4(axis, 0.0f);
+    return u;
   }
 
   void record(VkCommandBuffer cmd, std::optional<std::string_view> stop_after = std::nullopt) {

@@ -132,7 +132,12 @@ const int MSM_K_PREFIX_SUM_LOD = 65; // a = (du/dx, du/dy, dv/dx, dv/dy), b = (w
 const int MSM_K_SCATTERING_BETA = 66; // a = (lower, upper, view.xy), b = (view.z, towards_light) -> a.x
 // scattering.h: the Henyey–Greenstein phase function of a light and a view direction
 const int MSM_K_SCATTERING_PHASE = 67; // a = (towards_light, g), b.xyz = view direction -> a.x
-const int MSM_K_COUNT = 68;
+// scattering.h: a spot light's unshadowed in-scattering by its angle ψ (the light at (0, 2, 0)
+// shining down, cones 30° / 25°, 10 W/sr, range 6, σt 0.2, albedo 1)
+const int MSM_K_SPOT_INSCATTERING = 68; // a = (camera, s), b = (view direction, g) -> a.x
+// rectification.h: a spot light's prefix-sum weight of a light ray ψ in a row weighed at γ
+const int MSM_K_SPOT_PREFIX_WEIGHT = 69; // a = (d, ψ, γ, σt), b.xy = (g, cone) -> a.x
+const int MSM_K_COUNT = 70;
 
 // Structs as results: six moments (odd in a.xyz, even in b.xyz), non-linear moments, blockers.
 MSM_FN KernelIO msm_kernel_result6(Moments6 m) { return KernelIO(vec4(m.odd, 0.0f), vec4(m.even, 0.0f), uvec4(0u)); }
@@ -268,6 +273,15 @@ MSM_FN KernelIO msm_test_kernel(int function, KernelIO x) {
     r.a[1] = msm_transmittance_layer_step(vec2(x.a[0], x.a[1]), floor(0.5f * x.a[3]), x.a[3]) / x.a[0];
     break;
   }
+  case MSM_K_SPOT_INSCATTERING:
+    r.a[0] = msm_spot_unshadowed_inscattering(vec3(x.a), vec3(x.b), x.a[3], vec3(0.0f, 2.0f, 0.0f),
+                                              vec3(0.0f, -1.0f, 0.0f), vec3(10.0f), 6.0f, 0.8660254f, 0.9063078f, 0.2f,
+                                              1.0f, x.b[3], MSM_SPOT_INSCATTERING_SAMPLES)
+                 .x;
+    break;
+  case MSM_K_SPOT_PREFIX_WEIGHT:
+    r.a[0] = msm_spot_prefix_sum_weight(x.a[0], x.a[1], x.a[2], x.a[3], x.b[0], x.b[1]);
+    break;
   default: break;
   }
   return r;

@@ -49,7 +49,9 @@ void RectifyPass::prepare(const PassResources& r) {
                                          {MSM_BINDING_RECTIFY_TARGET, vk::Binding::storage_image}};
   if (six) bindings.push_back({MSM_BINDING_RECTIFY_TARGET1, vk::Binding::storage_image});
   program_ = &r.programs.compute(shader, vk::bindings_at(bindings), sizeof(ImagePassPush),
-                                 {{MSM_RECTIFY_ON_THE_FLY_SPEC_ID, config_.on_the_fly_resampling ? 1u : 0u}});
+                                 {{MSM_RECTIFY_ON_THE_FLY_SPEC_ID, config_.on_the_fly_resampling ? 1u : 0u},
+                                  // Spot lights' rectification (rectify.glsl): compiled only where the frame has them.
+                                  {MSM_SPEC_SPOT_LIGHTS, config_.spot_lights > 0 ? 1u : 0u}});
 }
 
 void RectifyPass::reflect(PassBuilder& b) const {
@@ -113,7 +115,8 @@ void PrefixSumPass::prepare(const PassResources& r) {
     bindings.push_back({MSM_BINDING_PREFIX_TARGET1, vk::Binding::storage_image});
   }
   program_ = &r.programs.compute(shader, vk::bindings_at(bindings), sizeof(ImagePassPush),
-                                 {{MSM_PREFIX_ROWS_SPEC_ID, config_.prefix_sums_appendix_c ? 0u : 1u}});
+                                 {{MSM_PREFIX_ROWS_SPEC_ID, config_.prefix_sums_appendix_c ? 0u : 1u},
+                                  {MSM_SPEC_SPOT_LIGHTS, config_.spot_lights > 0 ? 1u : 0u}});
 }
 
 void PrefixSumPass::reflect(PassBuilder& b) const {

@@ -35,7 +35,7 @@ void ScatteringPass::prepare(const PassResources& r) {
                                    {MSM_SPEC_PREFIX_SUM_MIPS, config_.prefix_sum_mips > 1 ? 1u : 0u},
                                    // β: proportional, fixed or §5.3.1's adaptive (scattering.h).
                                    {MSM_SPEC_SCATTER_BETA_MODE, uint32_t(config_.scattering_beta)},
-                                   // Spot lights' in-scattering along the ray (ray marching only).
+                                   // Spot lights' in-scattering along the ray (ray marching and prefiltered).
                                    {MSM_SPEC_SPOT_LIGHTS, config_.spot_lights > 0 ? 1u : 0u}}};
   program_ = &r.programs.graphics(d);
 }

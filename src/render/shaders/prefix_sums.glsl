@@ -16,6 +16,7 @@
 // Transmittance layers (rectification.h): size.w = K prefix sums of the light's map, with the steps
 // Δ_k (K = 1: the paper's Δ(v) per row); dispatch z = k (CSM: 8 k + t) writes output layer
 // K light + k (CSM: 8 (K light + k) + t).
+// A spot light's rows (rects[light].spot) weigh their light rays at the row's γ (texel_weight).
 #include "msm/render/frame.h"
 #include "msm/render/rectification_uniforms.h"
 
@@ -41,6 +42,9 @@ layout(binding = MSM_BINDING_PREFIX_TARGET1, MSM_PREFIX_FORMAT1) uniform writeon
 #endif
 
 layout(constant_id = MSM_PREFIX_ROWS_SPEC_ID) const bool kRowSweep = true;
+// Whether some light of the frame is a spot light (FrameConfig::spot_lights): a constant, so that
+// frames of directional lights only compile no spot path.
+layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
 
 void store_prefix_sum(int x, int row, vec4 mine, vec4 mine1) {
   ivec3 texel = MSM_OUT(x, row);
@@ -57,9 +61,30 @@ void store_prefix_sum(int x, int row, vec4 mine, vec4 mine1) {
 #endif
 }
 
+// A spot light's rows (rectification.h's spot section) weigh the light ray ψ of texel x by the
+// phase, the cone and the transmittance at the row's γ (msm_spot_prefix_sum_weight); main sets these.
+bool spot_light = false;
+RectificationFrame spot_frame;
+RectifiedBounds spot_bounds;
+float spot_row_v = 0.0f, spot_row_gamma = 0.0f;
+
+// w(x, v): a directional light's transmittance integral over the texel's segment, a spot light's
+// weight of its light ray (floored, so that a row wholly outside the cone reads the mean of its
+// texels, never 0 / 0; what it scatters is 0 there anyway).
+float texel_weight(int x, float extinction, float delta) {
+  if (!(kSpotLights && spot_light)) return msm_prefix_sum_weight(extinction, delta, float(x));
+  RectificationUniforms rect = rects[pass.size.z];
+  vec2 uv = vec2((float(x) + 0.5f) / rect.map.x, spot_row_v);
+  float cone = msm_spot_cone(dot(msm_spot_light_ray_direction(spot_frame, spot_bounds, uv), vec3(rect.spot_axis)),
+                             rect.spot.z, rect.spot.w);
+  float w = msm_spot_prefix_sum_weight(rect.spot.x, uv.x * spot_bounds.r_max, spot_row_gamma, extinction, rect.spot.y,
+                                       cone);
+  return max(w, 1e-30f);
+}
+
 // Adds texel x of the row with its weight w(x, v) to the running sums (both schemes, in order).
 void add_texel(int x, int row, float extinction, float delta, inout vec4 sum, inout vec4 sum1, inout float weight_sum) {
-  float w = msm_prefix_sum_weight(extinction, delta, float(x));
+  float w = texel_weight(x, extinction, delta);
   sum += w * texelFetch(rectified, MSM_TEXEL(x, row), 0);
 #ifdef MSM_SIX_MOMENTS
   sum1 += w * texelFetch(rectified1, ivec2(x, row), 0);
@@ -77,6 +102,11 @@ void main() {
   if (row >= size.y) return;
   RectifiedBounds b = msm_rectified_bounds_of(rect);
   float extinction = rect.map.w;
+  spot_light = msm_rectification_is_spot(rect);
+  spot_frame = msm_rectification_frame_of(rect);
+  spot_bounds = b;
+  spot_row_v = (float(row) + 0.5f) / float(size.y);
+  spot_row_gamma = msm_spot_row_gamma(b, spot_row_v);
   float delta = msm_prefix_sum_step(b, (float(row) + 0.5f) / float(size.y), float(size.x), extinction, float(kLayer),
                                     float(pass.size.w));
   vec4 sum = vec4(0.0f), sum1 = vec4(0.0f);

@@ -10,7 +10,9 @@
 //    prefix-summed rectified map (its layer; its rectification rects[l], rectification.h), four (or,
 //    MSM_SIX_MOMENTS, six) moments with adaptive β (or a fixed one: parameters y, z); with MSM_CSM
 //    (Klehm et al. 2014) the eight layers 8 l .. 8 l + 7 of a convolution shadow map with 32
-//    coefficients at 8 bits, reconstructed at the ray's [0,1] rectified depth.
+//    coefficients at 8 bits, reconstructed at the ray's [0,1] rectified depth. A spot light's lookup
+//    is at its angle ψ at the light (rectification.h's spot section), and its unshadowed
+//    in-scattering an integral over ψ (msm_spot_unshadowed_inscattering).
 // The scattering attachment's alpha is the visible fraction over all lights (msm_scattering_sum_visible).
 #include "msm/ray_march.h"
 #include "msm/render/rectification_uniforms.h"
@@ -47,10 +49,12 @@ layout(push_constant) uniform Push { ScatteringPush scatter; };
 layout(location = 0) out vec4 out_color;      // tone mapped; the attachment is sRGB
 layout(location = 1) out vec4 out_scattering; // rgb: in-scattered radiance, a: visible fraction
 
-#ifndef MSM_SCATTER_PREFILTERED
-// Whether some light of the frame is a spot light (FrameConfig::spot_lights; shading.glsl's).
+// Whether some light of the frame is a spot light (FrameConfig::spot_lights; shading.glsl's): a
+// constant, so that frames of directional lights only compile no spot path.
 layout(constant_id = MSM_SPEC_SPOT_LIGHTS) const bool kSpotLights = false;
 bool is_spot(int l) { return kSpotLights && lights[l].spot_position.w > 0.0f; }
+
+#ifndef MSM_SCATTER_PREFILTERED
 
 // 1 where spot light shadow_layer reaches p, 0 where its map (radial distance / range) has an
 // occluder nearer to the light; its depth bias grows with the distance as the shading's
@@ -127,7 +131,10 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   RectificationUniforms rect = rects[shadow_layer];
   RectificationFrame f = msm_rectification_frame_of(rect);
   RectifiedBounds b = msm_rectified_bounds_of(rect);
-  vec3 lookup = msm_rectified_view_lookup(f, b, camera + s * direction, rect.map.x);
+  bool spot = kSpotLights && msm_rectification_is_spot(rect);
+  vec3 end = camera + s * direction;
+  vec3 lookup = spot ? msm_spot_view_lookup(f, b, rect.spot.x, end, rect.map.x)
+                     : msm_rectified_view_lookup(f, b, end, rect.map.x);
   // The sampler repeats: u and, unless φ spans the full circle (rows 0 and height − 1 neighbours,
   // rectification.h), v are clamped to the texel centres at the edges here.
   bool full_circle = b.phi_span >= MSM_TWO_PI;
@@ -186,18 +193,33 @@ float visible_fraction(int l, ivec2 pixel, vec3 camera, vec3 direction, float s)
   vec2 bounds = msm_scattering_shadow_bounds4(stored, MSM_REP_SIGNED_THETA4, zf);
 #endif
   // kBetaMode (the technique's parameter z): a fixed β = y, §5.3.1's adaptive β or the proportional β.
-  float adaptive = msm_scattering_beta_adaptive(lights[shadow_layer].towards_light.xyz, direction);
+  // A spot light's epipole is the direction from the camera to the light.
+  vec3 towards_light = spot ? -vec3(f.z_axis) : lights[shadow_layer].towards_light.xyz;
+  float adaptive = msm_scattering_beta_adaptive(towards_light, direction);
   return msm_scattering_visibility_between(bounds,
                                            msm_scattering_beta(kBetaMode, bounds, frame.technique_params.y, adaptive));
 #endif // MSM_CSM
 }
 #endif
 
+#ifdef MSM_SCATTER_PREFILTERED
+// Spot light l's in-scattering along the ray, added to sum: the visible fraction of its prefix sums
+// times its unshadowed in-scattering, integrated over the light's angle ψ (scattering.h).
+ScatteringSum add_spot_light(ScatteringSum sum, int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
+  float extinction = scatter.medium.x;
+  vec3 unshadowed = msm_spot_unshadowed_inscattering(
+      camera, direction, s, lights[l].spot_position.xyz, lights[l].spot_axis.xyz, lights[l].irradiance.rgb,
+      lights[l].spot_position.w, lights[l].spot_cone.x, lights[l].spot_cone.y, extinction, scatter.medium.y,
+      scatter.medium.z, MSM_SPOT_INSCATTERING_SAMPLES);
+  float total = msm_transmittance_integral(extinction, 0.0f, s);
+  return msm_scattering_add_light(sum, total > 0.0f ? unshadowed / total : vec3(0.0f), extinction, 1.0f, s,
+                                  visible_fraction(l, pixel, camera, direction, s));
+}
+#endif
+
 // Light l's in-scattering along the view ray, added to sum.
 ScatteringSum add_light(ScatteringSum sum, int l, ivec2 pixel, vec3 camera, vec3 direction, float s) {
-#ifndef MSM_SCATTER_PREFILTERED
   if (is_spot(l)) return add_spot_light(sum, l, pixel, camera, direction, s);
-#endif
   float extinction = scatter.medium.x;
   float phase =
       msm_scattering_phase_term(extinction, scatter.medium.y, scatter.medium.z, lights[l].towards_light.xyz, direction);
