@@ -503,6 +503,44 @@ TEST_F(LocalLightsRenderTest, DepthTechniquesDoNotShadowABareGroundNearAPointLig
   }
 }
 
+// The 64-bit non-linear map's bilinear lookup (msm_nl_bilinear) on the ground near a point light:
+// the light 1 m over a plane, its range 20 m ([-1,1] depths near -0.9), a low wall beside it. Where
+// msm-hamburger-128's bilinear lookup has the ground lit (visibility at least 0.98), msm-nl64's is
+// no more than 0.05 darker on any of them (32173). Measured: at most 0.012; with the interpolated
+// moments taken about depth 0, 52 pixels were darker by more than 0.05, up to 0.67 (isolated dark
+// texels).
+TEST_F(LocalLightsRenderTest, NonLinear64BilinearLookupLeavesTheGroundNearAPointLightLit) {
+  const scene::Scene scene = scene::load_scene_json(R"({"msm_scene": 1,
+    "camera": {"position": [1, 3, 2], "target": [1, 0, 0.7], "fov_y_deg": 50},
+    "lights": [{"type": "point", "position": [0, 1, 0], "range": 20, "intensity": [10, 10, 10]}],
+    "objects": [{"primitive": {"type": "plane", "size": [8, 8]}},
+                {"primitive": {"type": "box", "size": [3, 0.5, 0.05]}, "transform": {"translate": [1.6, 0.25, 0.5]}}]})",
+                                                    std::filesystem::current_path(), "ground.json");
+  Renderer renderer(ctx(), scene);
+  auto shadow = [&](const char* technique) {
+    RenderSettings s = test::render_settings(technique, 320, 180, 128);
+    s.lookup = RenderSettings::Lookup::bilinear;
+    return renderer.render(s).shadow;
+  };
+  const image::Image reference = shadow("msm-hamburger-128"), nl64 = shadow("msm-nl64");
+  const int visibility = reference.find_channel("visibility"), background = reference.find_channel("background");
+  int lit = 0, dark = 0;
+  float worst = 0.0f;
+  for (int y = 0; y < reference.height(); ++y)
+    for (int x = 0; x < reference.width(); ++x) {
+      if (reference.at(x, y, background) > 0.5f || reference.at(x, y, visibility) < 0.98f) continue;
+      const float darker = reference.at(x, y, visibility) - nl64.at(x, y, visibility);
+      ++lit;
+      dark += darker > 0.05f ? 1 : 0;
+      worst = std::max(worst, darker);
+    }
+  fmt::print("ground near a point light, msm-nl64 (bilinear) on msm-hamburger-128's lit pixels ({}): {} darker by "
+             "more than 0.05, at most {:.3f}\n",
+             lit, dark, worst);
+  EXPECT_GE(lit, 10000);
+  EXPECT_EQ(dark, 0);
+}
+
 // Per pixel of the ground (object 0 of point_scene), the texels of a 90-degree face of
 // kPointShadowSize between the point it sees and the nearest seam of the light's cube; NaN
 // elsewhere.
