@@ -265,8 +265,9 @@ bool same_as_renderer(int id, const KernelIO& x, const KernelIO& r) {
                                            : x.a;
     return r.a == want;
   }
-  // The non-linear shading is the renderer's bilinear lookup in shading_nonlinear.glsl (decode,
-  // moments, Φ, Algorithm 3), which has no C++ twin: compared with the C++ build alone.
+  // The 64-bit non-linear shading of one texel (decode, Algorithm 3) has no twin in techniques.h
+  // (the renderer's shading_nonlinear.glsl calls nonlinear.h's functions): compared with the C++
+  // build alone.
   if (id == MSM_WK_THREE_SAT_TEXEL) { // the renderer's mssm4 texel, quantized as its tables (sat_common.glsl)
     int w = int(x.u[0]);
     vec4 moments = msm_technique_generate(MSM_TECH_MSSM4, x.a[0], msm_technique_default_params(MSM_TECH_MSSM4)).a;
