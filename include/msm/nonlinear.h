@@ -60,8 +60,14 @@ struct NonLinearMoments {
 const NonLinearMoments MSM_NL_FAR = NonLinearMoments(1.0f, 1.0f, 0.0f, 0.0f);
 MSM_FN bool msm_nl_is_finite(NonLinearMoments m) { return msm_is_finite4(vec4(m.y1, m.y2, m.v2, m.xi4)); }
 
-MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
-  if (!msm_is_finite4(b)) return MSM_NL_FAR;
+// Φ of moments about depth c, b = (E[y - c], E[(y - c)²], E[(y - c)³], E[(y - c)⁴]), its depths
+// given about 0 (c = 0: Φ of the moments themselves). Only the depths depend on c: moving every
+// depth by c multiplies the Hankel matrix by a unit triangular matrix on either side, which keeps
+// the pivots of its LDLᵀ, ξ4 among them, and the weights. In float, moments about a depth near the
+// distribution's mean keep what moments about 0 of a depth far from 0 cancel away (see
+// msm_nl_bilinear).
+MSM_FN NonLinearMoments msm_nl_from_moments_about(vec4 b, float c) {
+  if (!msm_is_finite4(b) || !msm_is_finite(c)) return MSM_NL_FAR;
   // Steps 1-5: the two depths and the weight of the larger one.
   TwoDepths two = msm_two_depths_from_three_moments(vec3(b[0], b[1], b[2]));
   // Steps 6-7: third diagonal entry of the LDLᵀ factorization of the Hankel matrix (Eq. (3)),
@@ -70,24 +76,50 @@ MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) {
   // multiplies and subtractions (max 4e-8 instead of 2.3e-7 against double on the same float
   // moments), which matters because ξ4 is ~1e-7 for the most common texel, a single surface.
   float xi4 = msm_hankel3_ldl(b).D2;
-  NonLinearMoments m =
-      NonLinearMoments(clamp(two.z.x, -1.0f, 1.0f), clamp(two.z.y, -1.0f, 1.0f), two.w.y, msm_at_least(xi4, 0.0f));
+  NonLinearMoments m = NonLinearMoments(clamp(two.z.x + c, -1.0f, 1.0f), clamp(two.z.y + c, -1.0f, 1.0f), two.w.y,
+                                        msm_at_least(xi4, 0.0f));
   if (!msm_nl_is_finite(m)) return MSM_NL_FAR; // finite but overflowing garbage
   return m;
 }
+MSM_FN NonLinearMoments msm_nl_from_moments(vec4 b) { return msm_nl_from_moments_about(b, 0.0f); }
 
 // Φ of filtered, unbiased float moments: applies the float bias of [-1,1] depth first.
 MSM_FN NonLinearMoments msm_nl_from_filtered(vec4 b) {
   return msm_nl_from_moments(msm_apply_bias(b, msm_moment_bias(MSM_REP_SIGNED_FLOAT)));
 }
 
-// HPG Eq. (4): b = (1 - v2) b(y1) + v2 b(y2) + (0, 0, 0, ξ4). Inverse of Φ (for tests, and for
-// true bilinear filtering: convert four texels back to moments, interpolate, apply Φ again).
-MSM_FN vec4 msm_nl_moments_from(NonLinearMoments m) {
+// HPG Eq. (4) about depth c: the moments of (1 - v2) δ(y1 - c) + v2 δ(y2 - c), plus ξ4 in the
+// fourth. Inverse of msm_nl_from_moments_about(·, c); c = 0 is Eq. (4) itself (msm_nl_moments_from).
+MSM_FN vec4 msm_nl_moments_about(NonLinearMoments m, float c) {
   float v1 = 1.0f - m.v2;
-  float y1s = m.y1 * m.y1, y2s = m.y2 * m.y2;
-  return vec4(v1 * m.y1 + m.v2 * m.y2, v1 * y1s + m.v2 * y2s, v1 * y1s * m.y1 + m.v2 * y2s * m.y2,
+  float y1 = m.y1 - c, y2 = m.y2 - c;
+  float y1s = y1 * y1, y2s = y2 * y2;
+  return vec4(v1 * y1 + m.v2 * y2, v1 * y1s + m.v2 * y2s, v1 * y1s * y1 + m.v2 * y2s * y2,
               v1 * y1s * y1s + m.v2 * y2s * y2s + m.xi4);
+}
+// HPG Eq. (4): b = (1 - v2) b(y1) + v2 b(y2) + (0, 0, 0, ξ4). Inverse of Φ (for tests, and for
+// true bilinear filtering: msm_nl_bilinear).
+MSM_FN vec4 msm_nl_moments_from(NonLinearMoments m) { return msm_nl_moments_about(m, 0.0f); }
+
+// The mean depth of m, (1 - v2) y1 + v2 y2.
+MSM_FN float msm_nl_mean(NonLinearMoments m) { return mix(m.y1, m.y2, m.v2); }
+
+// Φ of the bilinear interpolation of four texels' distributions, f the weights along x (m00 to m10,
+// m01 to m11) and y: each texel back to moments (Eq. (4)), those interpolated, Φ again, so that the
+// non-linear maps filter as the other moment maps do (HPG §4.2 interpolates the four texels'
+// shadow intensities instead). The moments are taken about the interpolated mean depth c: a texel
+// of a single surface has ξ4 ~ 1e-7 and a second depth of weight ~1e-3 (the blur over a sloped
+// surface), which its moments about 0 hold only as a cancellation of O(1) terms where the depth is
+// far from 0; interpolated and put through Φ in float, those lose them (ξ4 clamped to 0, two
+// depths a few 1e-3 apart at the receiver: isolated texels up to 0.64 dark on lit ground near a
+// local light, where [-1,1] depth is near -1; NonLinear.BilinearLookupOfLitPlanes). About c the
+// moments are O((y - c)²) and keep them.
+MSM_FN NonLinearMoments msm_nl_bilinear(NonLinearMoments m00, NonLinearMoments m10, NonLinearMoments m01,
+                                        NonLinearMoments m11, vec2 f) {
+  float c = mix(mix(msm_nl_mean(m00), msm_nl_mean(m10), f.x), mix(msm_nl_mean(m01), msm_nl_mean(m11), f.x), f.y);
+  vec4 b = mix(mix(msm_nl_moments_about(m00, c), msm_nl_moments_about(m10, c), f.x),
+               mix(msm_nl_moments_about(m01, c), msm_nl_moments_about(m11, c), f.x), f.y);
+  return msm_nl_from_moments_about(b, c);
 }
 
 // ---- Ψ4: the warp of ξ4 to [0,1] (HPG §3.3) ----

@@ -181,11 +181,8 @@ const GET_SHADOW = `
 					vec2 f = t - floor( t );
 					ivec2 i1 = min( i0 + 1, last );
 					i0 = max( i0, ivec2( 0 ) );
-					vec4 m00 = msm_three_nl64_moments( texelFetch( shadowMap, i0, 0 ) );
-					vec4 m10 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i1.x, i0.y ), 0 ) );
-					vec4 m01 = msm_three_nl64_moments( texelFetch( shadowMap, ivec2( i0.x, i1.y ), 0 ) );
-					vec4 m11 = msm_three_nl64_moments( texelFetch( shadowMap, i1, 0 ) );
-					shadow = msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), shadowCoord.z );
+					shadow = msm_three_nl64_bilinear_shadow( texelFetch( shadowMap, i0, 0 ), texelFetch( shadowMap, ivec2( i1.x, i0.y ), 0 ),
+						texelFetch( shadowMap, ivec2( i0.x, i1.y ), 0 ), texelFetch( shadowMap, i1, 0 ), f, shadowCoord.z );
 				#elif MSM_THREE_TECHNIQUE == 3
 					// The 32-bit texels decode alone: the texel nearest to the lookup moved by blue noise
 					// in [-0.5, 0.5) texels (the renderer's dithered lookup, lookup.glsl).
@@ -219,11 +216,11 @@ const GET_POINT_SHADOW = `
 				// Four texels decoded to moments, those interpolated (the 2D lookup's bilinear weights).
 				float size = float( textureSize( shadowMap, 0 ).x );
 				vec2 f = fract( msm_three_cube_texel_coordinates( lightToPosition, size ) );
-				vec4 m00 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 0.0 ) ) ) );
-				vec4 m10 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 0.0 ) ) ) );
-				vec4 m01 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 1.0 ) ) ) );
-				vec4 m11 = msm_three_nl64_moments( texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 1.0 ) ) ) );
-				shadow = 1.0 - msm_overdarken( msm_three_nl_shadow( mix( mix( m00, m10, f.x ), mix( m01, m11, f.x ), f.y ), depth ), msmThreeOverdarken );
+				shadow = 1.0 - msm_overdarken( msm_three_nl64_bilinear_shadow(
+					texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 0.0 ) ) ),
+					texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 0.0 ) ) ),
+					texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 0.0, 1.0 ) ) ),
+					texture( shadowMap, msm_three_cube_texel_direction( lightToPosition, size, vec2( 1.0, 1.0 ) ) ), f, depth ), msmThreeOverdarken );
 			#elif MSM_THREE_TECHNIQUE == 3
 				// One texel, the nearest moved by blue noise in [-0.5, 0.5) texels (as the 2D lookup).
 				float size = float( textureSize( shadowMap, 0 ).x );

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -50,7 +51,8 @@ const char* const kNames[] = {"fma",
                               "soft_blocker4",
                               "soft_shadow4",
                               "three_soft_shadow",
-                              "overdarken"};
+                              "overdarken",
+                              "three_nl64_bilinear"};
 static_assert(sizeof(kNames) / sizeof(kNames[0]) == MSM_WK_COUNT);
 
 class Inputs {
@@ -101,6 +103,36 @@ class Inputs {
  private:
   std::mt19937_64 rng_;
 };
+
+// Two neighbouring 64-bit texels and a receiver between them: texels (i, j) and (i + 1, j) of a
+// plane 0.3 to 3 m below a point light of range 20 m (a 128² cube face, the package's 9-tap blur,
+// σ = 2.4), the receiver on the plane with the non-linear depth bias. The plane is lit: moments
+// about depth 0 lose what these texels hold (ξ4 ~ 1e-7, a second depth of weight ~1e-3) and shadow
+// some receivers, which msm_nl_bilinear's moments about the mean keep (same_as_renderer checks it).
+void nl64_neighbours(KernelIO& x, Inputs& g) {
+  const int n = 128, taps = 9;
+  const float below = g.uni(0.3f, 3.0f), range = 20.0f, fx = g.uni(0.0f, 1.0f);
+  auto distance = [&](float i, float j) {
+    float s = (i + 0.5f) * 2.0f / n - 1.0f, t = (j + 0.5f) * 2.0f / n - 1.0f;
+    return below * std::sqrt(1.0f + s * s + t * t);
+  };
+  auto blurred = [&](int i, int j) {
+    vec4 sum(0.0f);
+    for (int l = 0; l < taps; ++l)
+      for (int k = 0; k < taps; ++k) {
+        float depth = msm_local_light_depth(distance(float(i + k - taps / 2), float(j + l - taps / 2)), range);
+        sum += msm_gaussian_weight(k, taps, 2.4f) * msm_gaussian_weight(l, taps, 2.4f) *
+               msm_moments4(msm_signed_depth(depth));
+      }
+    return sum;
+  };
+  int i = g.integer(taps, n - taps - 1), j = g.integer(taps, n - taps - 1);
+  x.u =
+      uvec4(msm_nl_pack64(msm_nl_from_filtered(blurred(i, j))), msm_nl_pack64(msm_nl_from_filtered(blurred(i + 1, j))));
+  x.a =
+      vec4(fx, msm_local_light_receiver_depth(distance(float(i) + fx, float(j)), range, MSM_DEPTH_BIAS_NONLINEAR, 2.0f),
+           0.0f, 0.0f);
+}
 
 KernelIO make_input(int id, Inputs& g) {
   KernelIO x{vec4(0.0f), vec4(0.0f), uvec4(0u)};
@@ -196,6 +228,7 @@ KernelIO make_input(int id, Inputs& g) {
     x.a[1] = g.chance(0.2) ? (g.chance(0.5) ? 1.0f : MSM_OVERDARKEN_DEFAULT) : g.uni(0.5f, 1.0f);
     break;
   }
+  case MSM_WK_THREE_NL64_BILINEAR: nl64_neighbours(x, g); break;
   default: break;
   }
   return x;
@@ -271,8 +304,10 @@ bool same_as_renderer(int id, const KernelIO& x, const KernelIO& r) {
                                            : x.a;
     return r.a == want;
   }
-  // The non-linear shading is the renderer's bilinear lookup in shading_nonlinear.glsl (decode,
-  // moments, Φ, Algorithm 3), which has no C++ twin: compared with the C++ build alone.
+  // The 64-bit non-linear shading of one texel (decode, Algorithm 3) has no twin in techniques.h
+  // (the renderer's shading_nonlinear.glsl calls nonlinear.h's functions): compared with the C++
+  // build alone.
+  if (id == MSM_WK_THREE_NL64_BILINEAR) return r.a[0] <= 1e-3f; // the lit plane's receivers
   if (id == MSM_WK_THREE_SAT_TEXEL) { // the renderer's mssm4 texel, quantized as its tables (sat_common.glsl)
     int w = int(x.u[0]);
     vec4 moments = msm_technique_generate(MSM_TECH_MSSM4, x.a[0], msm_technique_default_params(MSM_TECH_MSSM4)).a;
@@ -318,6 +353,13 @@ int main(int argc, char** argv) {
     for (const KernelIO& x : in) put(words, x);
     for (const KernelIO& x : in) {
       KernelIO r = id == MSM_WK_THREE_SOFT_SHADOW ? msm_web_soft_kernel(fetch, x) : msm_web_kernel(id, x);
+      if (id == MSM_WK_THREE_NL64_BILINEAR && !same_as_renderer(id, x, r)) {
+        std::fprintf(stderr,
+                     "msm_web_kernels: %s shadows the lit plane's receiver by %.9g at a = (%.9g, %.9g), texels "
+                     "0x%08x 0x%08x and 0x%08x 0x%08x\n",
+                     kNames[id], r.a[0], x.a[0], x.a[1], x.u[0], x.u[1], x.u[2], x.u[3]);
+        return 1;
+      }
       if (!same_as_renderer(id, x, r)) {
         std::fprintf(stderr,
                      "msm_web_kernels: %s differs from the renderer's technique at a = (%.9g, %.9g, %.9g, %.9g), "

@@ -54,7 +54,11 @@ const int MSM_WK_SOFT_SHADOW4 = 23;          // a = Θ4* average, b.x = biased z
 // -> a = (shadow, blocker depth, search shadow, penumbra.x), b.x = penumbra.y.
 const int MSM_WK_THREE_SOFT_SHADOW = 24;
 const int MSM_WK_OVERDARKEN = 25; // a.x = shadow intensity, a.y = factor -> a.x (the lookups' over-darkening)
-const int MSM_WK_COUNT = 26;
+// The 64-bit non-linear map's bilinear lookup between two neighbouring texels (msm_nl_pack64's words
+// u.xy and u.zw, each row of the lookup the same two): a.x = weight of the second, a.y = unit zf ->
+// a.x (msm_three_nl64_bilinear_shadow).
+const int MSM_WK_THREE_NL64_BILINEAR = 26;
+const int MSM_WK_COUNT = 27;
 
 MSM_FN KernelIO msm_web_kernel_nl(NonLinearMoments m) {
   return KernelIO(vec4(m.y1, m.y2, m.v2, m.xi4), vec4(0.0f), uvec4(0u));
@@ -110,6 +114,12 @@ MSM_FN KernelIO msm_web_kernel(int function, KernelIO x) {
   }
   case MSM_WK_SOFT_SHADOW4: r.a[0] = msm_soft_shadow4(x.a, x.b[0], MSM_SOFT_UMBRA_EPSILON, x.u[0]); break;
   case MSM_WK_OVERDARKEN: r.a[0] = msm_overdarken(x.a[0], x.a[1]); break;
+  case MSM_WK_THREE_NL64_BILINEAR: {
+    vec4 t0 = vec4(unpackUnorm2x16(x.u[0]), unpackUnorm2x16(x.u[1]));
+    vec4 t1 = vec4(unpackUnorm2x16(x.u[2]), unpackUnorm2x16(x.u[3]));
+    r.a[0] = msm_three_nl64_bilinear_shadow(t0, t1, t0, t1, vec2(x.a[0], 0.0f), x.a[1]);
+    break;
+  }
 #if !MSM_CPP
   case MSM_WK_THREE_SOFT_SHADOW: r = msm_web_soft_kernel(x); break; // C++: msm_web_soft_kernel(fetch, x)
 #endif

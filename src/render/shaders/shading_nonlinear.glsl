@@ -1,7 +1,7 @@
 // Shading with the non-linearly quantized maps (HPG 2017): decode, then Algorithm 3. Their
 // texels cannot be interpolated as stored: nearest and dithered lookups decode one texel; the
 // true bilinear lookup decodes four, converts each back to moments (Eq. 4), interpolates those
-// and applies Φ again.
+// and applies Φ again (msm_nl_bilinear, about the interpolated mean depth).
 #include "msm/render/bindings.h"
 #ifdef MSM_NL32
 layout(binding = MSM_BINDING_SHADING_SHADOW_MAP) uniform usampler2DArray moments0;
@@ -34,8 +34,7 @@ float shadow_intensity(ShadowLookup s) {
     return msm_nl_shadow(decode(i), msm_signed_depth(receiver_depth_at(s, i)));
   }
   Bilinear b = bilinear_texels(s.t);
-  vec4 m00 = msm_nl_moments_from(decode(b.i0)), m10 = msm_nl_moments_from(decode(ivec2(b.i1.x, b.i0.y)));
-  vec4 m01 = msm_nl_moments_from(decode(ivec2(b.i0.x, b.i1.y))), m11 = msm_nl_moments_from(decode(b.i1));
-  vec4 m = mix(mix(m00, m10, b.f.x), mix(m01, m11, b.f.x), b.f.y);
-  return msm_nl_shadow(msm_nl_from_moments(m), zf);
+  NonLinearMoments m = msm_nl_bilinear(decode(b.i0), decode(ivec2(b.i1.x, b.i0.y)), decode(ivec2(b.i0.x, b.i1.y)),
+                                       decode(b.i1), b.f);
+  return msm_nl_shadow(m, zf);
 }

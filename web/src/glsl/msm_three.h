@@ -67,14 +67,17 @@ MSM_FN float msm_three_depth_bias(int t) {
   return msm_three_is_nonlinear(t) ? MSM_DEPTH_BIAS_NONLINEAR : MSM_DEPTH_BIAS_FILTERED;
 }
 
-// A non-linear texel back to moments (HPG Eq. (4)): what the bilinear lookup interpolates, as the
-// renderer's shading_nonlinear.glsl does, before Φ and Algorithm 3 (msm_three_nl_shadow).
-MSM_FN vec4 msm_three_nl64_moments(vec4 texel) {
-  uvec2 p = uvec2(packUnorm2x16(vec2(texel.x, texel.y)), packUnorm2x16(vec2(texel.z, texel.w)));
-  return msm_nl_moments_from(msm_nl_unpack64(p));
+// A 64-bit non-linear texel as msm_three_store stores it, decoded (techniques.h's msm_nl64_decode).
+MSM_FN NonLinearMoments msm_three_nl64_decode(vec4 texel) {
+  return msm_nl_unpack64(uvec2(packUnorm2x16(vec2(texel.x, texel.y)), packUnorm2x16(vec2(texel.z, texel.w))));
 }
-MSM_FN float msm_three_nl_shadow(vec4 moments, float unit_zf) {
-  return msm_nl_shadow(msm_nl_from_moments(moments), msm_signed_depth(unit_zf));
+// The bilinear lookup of the 64-bit non-linear map, as the renderer's shading_nonlinear.glsl reads
+// it: four stored texels (t10 the next along x, t01 along y), f the weights, msm_nl_bilinear's Φ of
+// the interpolated distributions, Algorithm 3 at receiver depth unit_zf.
+MSM_FN float msm_three_nl64_bilinear_shadow(vec4 t00, vec4 t10, vec4 t01, vec4 t11, vec2 f, float unit_zf) {
+  NonLinearMoments m = msm_nl_bilinear(msm_three_nl64_decode(t00), msm_three_nl64_decode(t10),
+                                       msm_three_nl64_decode(t01), msm_three_nl64_decode(t11), f);
+  return msm_nl_shadow(m, msm_signed_depth(unit_zf));
 }
 
 // A point light's cube map as WebGL 2 samples it (the major-axis table of the OpenGL ES 3.0
@@ -120,7 +123,7 @@ MSM_FN vec3 msm_three_cube_texel_direction(vec3 d, float size, vec2 offset) {
 // Shadow intensity in [0,1] (1 = fully shadowed) at receiver depth unit_zf: Hamburger 4MSM on the
 // biased moments (the representation's α and b*).
 MSM_FN float msm_three_shadow(int t, vec4 stored, float unit_zf) {
-  if (t == MSM_THREE_NL64) return msm_three_nl_shadow(msm_three_nl64_moments(stored), unit_zf); // one texel
+  if (t == MSM_THREE_NL64) return msm_nl_shadow(msm_three_nl64_decode(stored), msm_signed_depth(unit_zf)); // one texel
   if (t == MSM_THREE_NL32)
     return msm_nl_shadow(msm_nl_unpack32(msm_three_word_from_rgba8(stored)), msm_signed_depth(unit_zf));
   float zf = msm_signed_depth(unit_zf);
