@@ -23,12 +23,17 @@ EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rn
     return turned_away;
   }
   // The plane's depth per texel along the map's x and y ([0,1] depth: world distance along the
-  // light's travel over the map's depth range), clamped as the renderer clamps it.
-  const double nx = glm::dot(n, ctx.frame.x_axis), ny = glm::dot(n, ctx.frame.y_axis);
+  // light's travel over the map's depth range), clamped as the renderer clamps it. The plane is
+  // the hit triangle's, as the renderer's (its triangle_normal): either side gives the same slope.
+  const glm::dvec3& g = hit.normal;
+  const double gx = glm::dot(g, ctx.frame.x_axis), gy = glm::dot(g, ctx.frame.y_axis);
+  const double g_dot_l = glm::dot(g, ctx.towards_light);
   const double limit = double(MSM_MAX_RECEIVER_DEPTH_SLOPE);
-  const glm::dvec2 slope = glm::clamp(glm::dvec2(nx * glm::length(ctx.texel_x), ny * glm::length(ctx.texel_y)) /
-                                          (n_dot_l * ctx.frame.depth_extent),
-                                      glm::dvec2(-limit), glm::dvec2(limit));
+  const glm::dvec2 slope = std::abs(g_dot_l) > 1e-6
+                               ? glm::clamp(glm::dvec2(gx * glm::length(ctx.texel_x), gy * glm::length(ctx.texel_y)) /
+                                                (g_dot_l * ctx.frame.depth_extent),
+                                            glm::dvec2(-limit), glm::dvec2(limit))
+                               : glm::dvec2(0.0);
   const glm::dvec3 travel = -ctx.towards_light;
   const SampleSet set(ctx.settings.sampler, ctx.settings.samples);
   RunningStats stats;
@@ -96,14 +101,15 @@ LocalMap local_map(const scene::LocalLight& light, const glm::dvec3& from_light,
 
 // The filtered effect's definition in a spot's or point light's own map. The kernel's offset o
 // (texels) moves the light ray's point on the map's plane by o texels; the receiver's depth along
-// that ray is where it meets the receiver's tangent plane (n_s), the exact plane rather than the
+// that ray is where it meets the receiver's triangle's plane, the exact plane rather than the
 // renderer's first-order extrapolation of the radial depth, which agrees with it to first order in
 // o; like the renderer's, the plane's radial distance changes by at most
 // MSM_MAX_RECEIVER_DEPTH_SLOPE × range per texel along each axis, which also bounds a plane the
 // ray meets at grazing incidence or not at all. V_o: nothing between that point and the light
 // (a segment, not a ray to infinity), beyond the receiver plane's tolerance as for directional.
-EffectResult filtered_local_visibility(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n,
-                                       const scene::LocalLight& light, Rng& rng) {
+EffectResult filtered_local_visibility(const EffectContext& ctx, const SurfaceHit& hit, const scene::LocalLight& light,
+                                       Rng& rng) {
+  const glm::dvec3& n = hit.normal; // the hit triangle's plane, as the renderer's (either side)
   const glm::dvec3 position(light.position), from_light = hit.p - position;
   const double r0 = glm::length(from_light);
   const LocalMap map = local_map(light, from_light, ctx.settings.shadow_size);

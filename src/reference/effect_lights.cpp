@@ -111,7 +111,7 @@ LightsSample trace_lights(const EffectContext& ctx, const SurfaceHit& hit, const
       }
       if (filtered) { // the light's own filtered map (ctx.frame: the first directional light's)
         const EffectResult f =
-            local ? filtered_local_visibility(ctx, hit, n, *local, rng) : effect_filtered(ctx, hit, rng);
+            local ? filtered_local_visibility(ctx, hit, *local, rng) : effect_filtered(ctx, hit, rng);
         out.rays += f.rays;
         lit += weight * c * f.value;
         filtered_variance += std::pow(luminance * weight * c * f.std_error, 2);

@@ -261,10 +261,10 @@ using EffectFunction = EffectResult (*)(const EffectContext&, const SurfaceHit&,
 EffectResult effect_hard(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 EffectResult effect_filtered(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 EffectResult effect_soft(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
-// filtered for a spot or point light (reference.h's definition in the light's own map); n: the
-// shading normal turned towards the viewer, facing the light.
-EffectResult filtered_local_visibility(const EffectContext& ctx, const SurfaceHit& hit, const glm::dvec3& n,
-                                       const scene::LocalLight& light, Rng& rng);
+// filtered for a spot or point light (reference.h's definition in the light's own map), at a
+// receiver whose shading normal faces the light.
+EffectResult filtered_local_visibility(const EffectContext& ctx, const SurfaceHit& hit, const scene::LocalLight& light,
+                                       Rng& rng);
 EffectResult effect_translucent(const EffectContext& ctx, const SurfaceHit& hit, Rng& rng);
 
 // scattering (effect_scattering.cpp): the transmittance-weighted visible fraction of each light

@@ -63,7 +63,8 @@
 //               moved by o, at the receiver's depth extrapolated along its plane: 1 unless a
 //               surface lies between the light and q(o) = p + o_world + (s . o) D travel, where
 //               o_world = ox * texel_x * x_axis + oy * texel_y * y_axis (LightFrame), D the map's
-//               depth_range and s the receiver plane's depth per texel (from n_s; each component
+//               depth_range and s the receiver plane's depth per texel (the hit triangle's plane,
+//               as the renderer's, whose interpolated normal n_s turns across a facet; each component
 //               clamped to +-MSM_MAX_RECEIVER_DEPTH_SLOPE of msm/render/frame.h, as the renderer
 //               clamps it), except surfaces within kOffsetScale * scale + kReceiverPlaneTolerance
 //               * |o_world| of q(o) along the ray: those are the receiver's own surface, which the

@@ -68,8 +68,9 @@ vec3 triangle_normal(vec3 fallback) {
   return length2 > 1e-6f * dot(dx, dx) * dot(dy, dy) && !isinf(length2) ? c * inversesqrt(length2) : fallback;
 }
 #endif
-// The receiver's geometric normal (triangle_normal; the deferred pass reads the surfaces pass's): a
-// local light's receiver plane (spot_lookup) is the triangle's, as the depth pass drew it.
+// The receiver's geometric normal (triangle_normal; the deferred pass reads the surfaces pass's): the
+// receiver plane of every light kind (light_visibility, spot_lookup) is the triangle's, as the depth
+// pass drew it.
 vec3 geometric_normal;
 
 #ifdef MSM_SURFACES
@@ -181,9 +182,10 @@ vec3 light_visibility(int l, vec3 n, float n_dot_l, float lit, MsmFootprint pixe
     s.dt_dx = vec2(lights[l].view_projection * vec4(pixel.dp_dx, 0.0f)) * texels_per_clip_unit;
     s.dt_dy = vec2(lights[l].view_projection * vec4(pixel.dp_dy, 0.0f)) * texels_per_clip_unit;
     if (lit <= 0.0f) return vec3(0.0f);
-    vec3 nc = mat3(lights[l].normal_matrix) * n;
+    vec3 nc = mat3(lights[l].normal_matrix) * geometric_normal;
     s.z = clip.z - frame.shadow_map.w;
-    // The plane n_c . (dx, dy, dz) = 0 in clip space; one texel is 2 / size clip units.
+    // The receiver plane n_c . (dx, dy, dz) = 0 in clip space, of the triangle's normal n_c (as
+    // spot_lookup's); one texel is 2 / size clip units.
     float slope_limit = MSM_MAX_RECEIVER_DEPTH_SLOPE; // per texel (frame.h)
     s.depth_per_texel = abs(nc.z) > 1e-6f
                             ? clamp(-vec2(nc.x, nc.y) / nc.z * (2.0f * frame.shadow_map.y), -slope_limit, slope_limit)
