@@ -10,6 +10,7 @@
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/faceted_cylinder.h"
 #include "msm/test/figures.h"
 #include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
@@ -207,21 +208,12 @@ TEST_F(GroundTruthTest, EveryTechniqueAgainstTheGroundTruth) {
 // with either plane): the facet at the terminator, which the tracer shadows where the triangle
 // faces away from the light and the renderer's interpolated normal still turns towards it.
 TEST_F(GroundTruthTest, DepthTechniquesDoNotShadowTheLitFacetsOfACylinderUnderADirectionalLight) {
-  const scene::Scene scene = scene::load_scene_json(R"({"msm_scene": 1,
-    "camera": {"position": [0.6, 1.5, 2.6], "target": [0, 0.5, 0], "fov_y_deg": 40},
-    "lights": [{"type": "directional", "towards_light": [1.6, 1.0, 0.8], "irradiance": [3, 3, 3]}],
-    "objects": [{"primitive": {"type": "plane", "size": [4, 4]}},
-                {"primitive": {"type": "cylinder", "radius": 0.3, "height": 1.0, "segments": 16},
-                 "transform": {"translate": [0, 0.5, 0]}}]})",
-                                                    std::filesystem::current_path(), "cylinder.json");
+  const scene::Scene scene = test::faceted_cylinder_scene(
+      R"({"type": "directional", "towards_light": [1.6, 1.0, 0.8], "irradiance": [3, 3, 3]})");
   constexpr int width = 160, height = 120;
   const reference::Result truth =
       reference::render(scene, test::reference_settings(reference::Effect::hard, width, height, 1));
-  // Every pixel but the cylinder's (object 1) masked.
-  const image::Image object = truth.surface.channel("object");
-  image::Image not_cylinder(width, height, 1);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) not_cylinder.at(x, y) = object.at(x, y) == 1.0f ? 0.0f : 1.0f;
+  const image::Image not_cylinder = test::all_but_object(truth.surface.channel("object"), test::kFacetedCylinderObject);
   Renderer renderer(ctx(), scene);
   struct Case {
     const char* technique;
@@ -254,13 +246,7 @@ TEST_F(GroundTruthTest, DepthTechniquesDoNotShadowTheLitFacetsOfACylinderUnderAD
                name, c.metrics.over_darkening, c.metrics.light_leaking, c.metrics.mae);
     // Forward shading takes the triangle's normal from its own derivatives, deferred shading reads
     // the one the surfaces pass stored: the same visibility.
-    s.deferred_shading = false;
-    const image::Image forward = renderer.render(s).shadow.channel("visibility");
-    s.deferred_shading = true;
-    const image::Image deferred = renderer.render(s).shadow.channel("visibility");
-    double worst = 0;
-    for (size_t i = 0; i < forward.pixels().size(); ++i)
-      worst = std::max(worst, double(std::abs(forward.pixels()[i] - deferred.pixels()[i])));
+    const double worst = test::forward_deferred_difference(renderer, s);
     EXPECT_LE(worst, 1e-6) << name << ": forward and deferred shading differ";
   }
 }

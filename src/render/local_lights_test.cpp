@@ -15,6 +15,7 @@
 #include "msm/test/render_settings.h"
 
 #include "msm/image/metrics.h"
+#include "msm/test/faceted_cylinder.h"
 #include "msm/test/figures.h"
 #include "msm/test/image_compare.h"
 #include "msm/test/vulkan_test.h"
@@ -591,21 +592,12 @@ TEST_F(LocalLightsRenderTest, DepthTechniquesDoNotShadowABareGroundNearAPointLig
 // kernel reaches the ground in front of the cylinder's foot) and 0.0029 (measured). The bound:
 // 1.25x that, at least 0.002 more.
 TEST_F(LocalLightsRenderTest, DepthTechniquesDoNotShadowTheLitFacetsOfACylinderUnderAPointLight) {
-  const scene::Scene scene = scene::load_scene_json(R"({"msm_scene": 1,
-    "camera": {"position": [0.6, 1.5, 2.6], "target": [0, 0.5, 0], "fov_y_deg": 40},
-    "lights": [{"type": "point", "position": [1.6, 1.5, 0.8], "range": 25, "intensity": [4, 4, 4]}],
-    "objects": [{"primitive": {"type": "plane", "size": [4, 4]}},
-                {"primitive": {"type": "cylinder", "radius": 0.3, "height": 1.0, "segments": 16},
-                 "transform": {"translate": [0, 0.5, 0]}}]})",
-                                                    std::filesystem::current_path(), "cylinder.json");
+  const scene::Scene scene = test::faceted_cylinder_scene(
+      R"({"type": "point", "position": [1.6, 1.5, 0.8], "range": 25, "intensity": [4, 4, 4]})");
   constexpr int width = 160, height = 120;
   const reference::Result truth =
       reference::render(scene, test::reference_settings(reference::Effect::hard, width, height, 1));
-  // Every pixel but the cylinder's (object 1) masked.
-  const image::Image object = truth.surface.channel("object");
-  image::Image not_cylinder(width, height, 1);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) not_cylinder.at(x, y) = object.at(x, y) == 1.0f ? 0.0f : 1.0f;
+  const image::Image not_cylinder = test::all_but_object(truth.surface.channel("object"), test::kFacetedCylinderObject);
   Renderer renderer(ctx(), scene);
   const std::pair<const char*, double> measured[] = {{"pcf", 0.0164}, {"plain", 0.0029}};
   for (const auto& [technique, over_darkening] : measured) {
@@ -633,13 +625,7 @@ TEST_F(LocalLightsRenderTest, DepthTechniquesDoNotShadowTheLitFacetsOfACylinderU
     // The deferred pass (PCF's default) reads the triangle's normal the surfaces pass stored, the
     // forward pass (the plain map's) takes it from its own derivatives: the same visibility
     // (measured: bit for bit).
-    s.deferred_shading = false;
-    const image::Image forward = renderer.render(s).shadow.channel("visibility");
-    s.deferred_shading = true;
-    const image::Image deferred = renderer.render(s).shadow.channel("visibility");
-    double worst = 0;
-    for (size_t i = 0; i < forward.pixels().size(); ++i)
-      worst = std::max(worst, double(std::abs(forward.pixels()[i] - deferred.pixels()[i])));
+    const double worst = test::forward_deferred_difference(renderer, s);
     EXPECT_LE(worst, 1e-6) << technique << ": forward and deferred shading differ";
     fmt::print("  forward against deferred shading: largest difference {}\n", worst);
   }
