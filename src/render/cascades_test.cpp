@@ -617,6 +617,10 @@ TEST_F(CascadesRenderTest, EveryHardAndFilteredTechniqueWorksPerCascade) {
       fmt::print("{:<32} error per shadowed pixel (MAE): {} cascades {:.4f} ({:.5f})\n", label, kDefaultCascades, error,
                  mae(cascaded, truth));
       EXPECT_LT(error, per_cascade_error_bound(name)) << label;
+      msm::test::record_figure("cascades.every_technique." + label + ".error_per_shadowed_pixel", error,
+                               {.below = per_cascade_error_bound(name),
+                                .meaning = "1 m box on a 500 m ground, 4 cascades of 256² maps, default settings, " +
+                                           label + ": error per shadowed pixel against the ray tracer"});
       EXPECT_EQ(image::compute_metrics(cascaded.shadow.channel("visibility"), truth.visibility.channel("visibility"))
                     .non_finite,
                 0u)

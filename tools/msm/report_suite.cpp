@@ -118,13 +118,19 @@ std::vector<Suite> declared_suites() {
        "LocalLightsRenderTest.PointLightErrorAlongCubeSeamsIsNoHigherThanElsewhere:LocalLightsRenderTest."
        "PointLightSoftShadowsAgreeWithTheRayTracer:LocalLightsRenderTest."
        "PointLightSoftErrorAlongCubeSeamsIsNoHigherThanElsewhere:LocalLightsRenderTest."
-       "PcfUnderSpotAndPointLightsIsCloserToTheFilteredTruthThanToTheHard"},
+       "PcfUnderSpotAndPointLightsIsCloserToTheFilteredTruthThanToTheHard:LocalLightsRenderTest."
+       "DepthTechniquesDoNotShadowTheLitFacetsOfACylinderUnderAPointLight:LocalLightsRenderTest."
+       "SpotLightPrefilteredScatteringAgreesWithTheRayTracer"},
+      {"The receiver plane on a faceted cylinder", "src/render/msm_render_ground_truth_test",
+       "GroundTruthTest.DepthTechniquesDoNotShadowTheLitFacetsOfACylinderUnderADirectionalLight"},
       {"The 2015 ordering per light kind", "src/render/msm_render_light_kind_ordering_test", "LightKindOrderingTest.*"},
-      {"Cascades: the box on a 500 m ground, the town, a slow pan", "src/render/msm_render_cascades_test",
+      {"Cascades: the box on a 500 m ground, the town, a slow pan, every technique",
+       "src/render/msm_render_cascades_test",
        "CascadesRenderTest.BoxOnLargeGroundWithDefaultSettings:CascadesRenderTest.TownWithDefaultSettings:"
        "CascadesRenderTest.StabilisedCascadesShimmerLessInASlowPan:CascadesRenderTest."
        "DepthBoundsGiveTheNearCascadeFinerTexels:"
-       "CascadesRenderTest.PenumbraKeepsItsWorldWidthAcrossCascades"},
+       "CascadesRenderTest.PenumbraKeepsItsWorldWidthAcrossCascades:"
+       "CascadesRenderTest.EveryHardAndFilteredTechniqueWorksPerCascade"},
       {"Image-based lighting: the paper's orderings", "src/render/msm_render_ibl_test", "IblTest.*Orderings"},
       {"Probe lights: the plane's irradiance at every light count", "src/reference/msm_reference_environment_test",
        "Environment.AreaLightsKeepThePlanesIrradiance*"},
