@@ -319,7 +319,6 @@ TEST(Rectification, ResamplingLevelIsTheTexelsFootprintInTheShadowMap) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int above_zero = 0;
   for (const View& view : configurations()) {
-    const msm::RectificationFrame f = view.frame();
     const msm::RectifiedBounds b = view.bounds();
     const int width = 1 << (8 + int(4.0 * u(rng))), height = width;
     // Shadow-map texels per world unit, the light's x axis at angle a to the frame's, either hand.
@@ -679,7 +678,7 @@ TEST(SpotRectification, RowWeightsAtTheSlicesMeanGammaApproachTheRaysOwn) {
     EXPECT_GT(rays, 100);
     EXPECT_LT(sum / rays, 0.001);
     EXPECT_LT(largest, 0.01);
-    if (g > 0.0f) EXPECT_LT(sum, 0.25 * sum_cone_only);
+    if (g > 0.0f) { EXPECT_LT(sum, 0.25 * sum_cone_only); }
   }
 }
 
